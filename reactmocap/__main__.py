@@ -1,0 +1,5 @@
+import sys
+
+from reactmocap.cli import main
+
+sys.exit(main())

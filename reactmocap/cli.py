@@ -1,0 +1,55 @@
+"""The ``reactmocap`` command: parse, call the Python API, print. Algorithms live elsewhere."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from reactmocap import __version__
+from reactmocap.errors import ReactMocapError
+
+__all__ = ["build_parser", "main"]
+
+# Modules under reactmocap.commands, each with register(subparsers). Order = help order.
+COMMAND_MODULES = ("library", "search", "sim")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="reactmocap",
+        description="Motion-capture characters that react physically to impacts.",
+    )
+    parser.add_argument("--version", action="version", version=f"reactmocap {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMAND_MODULES:
+        try:
+            module = importlib.import_module(f"reactmocap.commands.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"reactmocap.commands.{name}":
+                continue  # command group not built yet
+            raise
+        module.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    func = getattr(args, "func", None)
+    if func is None:
+        parser.print_help()
+        return 2
+    try:
+        return int(func(args) or 0)
+    except ReactMocapError as exc:
+        print(f"reactmocap: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("reactmocap: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
