@@ -136,7 +136,9 @@ def _load_overrides(rules: str | Path | Mapping[str, object] | None) -> dict[str
         raise ConfigError(f"{path}: cannot read body-part rules: {exc}") from None
     unknown = set(data) - {"parts", "aliases"}
     if unknown:
-        raise ConfigError(f"{path}: unknown sections {sorted(unknown)}; expected [parts], [aliases]")
+        raise ConfigError(
+            f"{path}: unknown sections {sorted(unknown)}; expected [parts], [aliases]"
+        )
     return data
 
 

@@ -1,0 +1,33 @@
+"""Shared fixtures. Real motion capture lives in ../shared/mocap beside the repository (present in
+CI); tests that need it skip with a clear reason on a user's fresh clone."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED_MOCAP = REPO.parent / "shared" / "mocap"
+SYNTHETIC = REPO / "data" / "synthetic_clips"
+
+
+@pytest.fixture(scope="session")
+def shared_mocap_dir() -> Path:
+    d = SHARED_MOCAP / "bandai-namco-1"
+    if not d.is_dir():
+        pytest.skip(f"real mocap not found at {d} (../shared/mocap is only beside the repo in CI)")
+    return d
+
+
+@pytest.fixture(scope="session")
+def synthetic_dir() -> Path:
+    return SYNTHETIC
+
+
+@pytest.fixture(autouse=True)
+def _isolated_cache(
+    tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Tests never touch the user's ~/.cache.
+    monkeypatch.setenv("REACTMOCAP_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "clip-cache"))
