@@ -1,0 +1,109 @@
+"""Transition-quality metrics, defined once and reused by the response report and by batch
+regression. Every function takes Motions (Z-up metres) and returns a float in the stated unit."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from reactmocap.library.bodyparts import BodyPartMap
+from reactmocap.library.motion import Motion
+from reactmocap.rotations import quat_conj, quat_log, quat_mul
+
+__all__ = [
+    "blend_joint_correction_max_rad",
+    "blend_root_offset_max_m",
+    "fell",
+    "foot_skate_m",
+    "intended_fall",
+    "match_distance",
+    "penetration_max_m",
+    "stitch_velocity_jump_rad_s",
+]
+
+#: a foot point counts as planted below this height above its lowest height in the motion (m)
+PLANT_HEIGHT_M = 0.03
+#: ... and below this horizontal speed (m/s)
+PLANT_SPEED_M_S = 0.5
+#: fallen when the pelvis is below this fraction of its first-frame height
+FALL_FRACTION = 0.5
+
+
+def match_distance(distance: float) -> float:
+    """The paper's window distance ``D`` of the chosen match (weighted metres + radians)."""
+    return float(distance)
+
+
+def blend_root_offset_max_m(simulated: Motion, blended: Motion) -> float:
+    """Largest root displacement the final blend applied (m): how far Simulation 2 ended from
+    the found clip on its own. 0 means the simulation landed exactly."""
+    d = blended.global_positions()[:, 0] - simulated.global_positions()[:, 0]
+    return float(np.max(np.linalg.norm(d, axis=-1)))
+
+
+def blend_joint_correction_max_rad(simulated: Motion, blended: Motion) -> float:
+    """Largest local joint rotation (rad) the final blend applied, over frames and joints."""
+    rel = quat_mul(quat_conj(simulated.rotations), blended.rotations)
+    return float(np.max(np.linalg.norm(quat_log(rel), axis=-1)))
+
+
+def stitch_velocity_jump_rad_s(motion: Motion, seams: Sequence[int]) -> float:
+    """Largest change (rad/s) of any joint's local angular velocity across the given seam
+    frames (the first frame of each new segment), from one-sided finite differences."""
+    if motion.num_frames < 3 or not seams:
+        return 0.0
+    q = motion.rotations
+    w = quat_log(quat_mul(q[1:], quat_conj(q[:-1]))) * motion.fps  # w[i]: frame i -> i+1
+    jumps = [
+        float(np.max(np.linalg.norm(w[s] - w[s - 1], axis=-1)))
+        for s in seams
+        if 1 <= s < motion.num_frames - 1
+    ]
+    return max(jumps, default=0.0)
+
+
+def _foot_points(motion: Motion, parts: BodyPartMap) -> np.ndarray:
+    idx = [parts.joint_of(p) for p in ("l_foot", "r_foot", "l_toe", "r_toe") if p in parts.joints]
+    return motion.global_positions()[:, idx]
+
+
+def foot_skate_m(motion: Motion, parts: BodyPartMap) -> float:
+    """Horizontal travel (m) of the foot and toe joints while planted, summed over the motion.
+
+    A point is planted on a frame pair when it is within ``PLANT_HEIGHT_M`` of its lowest height
+    in the motion on both frames and moving slower than ``PLANT_SPEED_M_S``.
+    """
+    p = _foot_points(motion, parts)
+    if p.shape[0] < 2:
+        return 0.0
+    low = p[..., 2] <= p[..., 2].min(axis=0) + PLANT_HEIGHT_M
+    step = np.linalg.norm(np.diff(p[..., :2], axis=0), axis=-1)
+    planted = low[1:] & low[:-1] & (step * motion.fps < PLANT_SPEED_M_S)
+    return float(np.sum(step[planted]))
+
+
+def penetration_max_m(motion: Motion) -> float:
+    """Deepest joint or end site below the ground plane z=0 (m, >= 0). Joints and end sites
+    stand in for the body surface since metrics do not know the collision geometry."""
+    pos = np.concatenate([motion.global_positions(), motion.end_site_positions()], axis=1)
+    return float(max(0.0, -pos[..., 2].min()))
+
+
+def _pelvis_height(motion: Motion, parts: BodyPartMap) -> np.ndarray:
+    return motion.global_positions()[:, parts.joint_of("pelvis"), 2]
+
+
+def fell(motion: Motion, parts: BodyPartMap, reference_height: float | None = None) -> bool:
+    """Whether the pelvis drops below ``FALL_FRACTION`` of ``reference_height`` (default: its
+    first-frame height) at any frame."""
+    h = _pelvis_height(motion, parts)
+    ref = h[0] if reference_height is None else reference_height
+    return bool(np.min(h) < FALL_FRACTION * ref)
+
+
+def intended_fall(found_clip: Motion, parts: BodyPartMap, from_frame: int = 0) -> bool:
+    """Whether the found clip itself falls from its matched frame on (pelvis below
+    ``FALL_FRACTION`` of its standing height, taken as the clip's highest pelvis height)."""
+    h = _pelvis_height(found_clip, parts)
+    return bool(np.min(h[from_frame:]) < FALL_FRACTION * np.max(h))

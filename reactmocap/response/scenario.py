@@ -1,0 +1,237 @@
+"""Scenario files (TOML): who plays what, where, and what hits them.
+
+Validated once at load time with errors that name the file and field. Relative paths (the
+library, clip files) resolve against the scenario file's folder first, then the working folder.
+Angles are degrees in the file and radians inside.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any, Literal
+
+from reactmocap.errors import ConfigError
+
+__all__ = [
+    "SIM1_MODES",
+    "AttackerSpec",
+    "CharacterSpec",
+    "ImpactSpec",
+    "ResponseConfig",
+    "Scenario",
+    "load_scenario",
+    "parse_scenario",
+]
+
+SIM1_MODES = ("passive", "holding")
+
+
+@dataclass(frozen=True)
+class CharacterSpec:
+    """A character playing ``clip`` from ``start`` seconds, turned to ``facing_deg`` (heading
+    from +X, counter-clockwise about +Z) with its root over ``position`` (x, y) at that time."""
+
+    clip: str
+    start: float = 0.0
+    facing_deg: float = 0.0
+    position: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class AttackerSpec(CharacterSpec):
+    facing_deg: float = 180.0
+    position: tuple[float, float] = (1.1, 0.0)
+
+
+@dataclass(frozen=True)
+class ImpactSpec:
+    """An explicit force on the recipient: ``force`` N (world frame) on ``body`` at ``point``
+    (body-local metres) from ``at`` seconds after the scenario start for ``duration``."""
+
+    body: str = "chest"
+    force: tuple[float, float, float] = (-350.0, 0.0, 0.0)
+    at: float = 0.5
+    duration: float = 0.1
+    point: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class ResponseConfig:
+    """The paper's defaults (Zordan et al. 2005), each overridable from ``[response]``."""
+
+    reaction_delay: float = 0.15  # s, human reaction time 0.1-0.2 s
+    kp: float = 600.0  # 1/s^2, inertia-scaled stiffness
+    kv: float = 50.0  # 1/s, inertia-scaled damping
+    friction_sim1: float = 1.0
+    friction_sim2: float = 0.5
+    sim1_mode: Literal["passive", "holding"] = "passive"
+    sim1_duration: float = 1.0  # s after the impact
+    search_start: float = 0.1  # s after the impact
+    search_end: float = 1.0
+    contact_shift_max: float = 0.25  # s the search start moves later while contact lasts
+    attacker_follow: float = 0.1  # s the attacker follows its own simulation
+    attacker_blend: float = 0.3  # s to blend the attacker back to its clip
+    tail: float = 1.0  # s of the found clip played after landing
+    top_k: int = 5
+    timestep: float = 0.0005
+    total_mass: float = 75.0
+
+
+@dataclass(frozen=True)
+class Scenario:
+    library: Path
+    recipient: CharacterSpec
+    attacker: AttackerSpec | None = None
+    impact: ImpactSpec | None = None
+    response: ResponseConfig = field(default_factory=ResponseConfig)
+    source: Path | None = None
+    name: str = "scenario"
+
+    def with_changes(self, **changes: Any) -> Scenario:
+        return replace(self, **changes)
+
+
+_TOP_KEYS = {"library", "recipient", "attacker", "impact", "response", "name"}
+
+
+class _Reader:
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, where: str, msg: str) -> ConfigError:
+        return ConfigError(f"{self.source}: {where}: {msg}")
+
+    def table(self, data: Mapping[str, Any], key: str) -> dict[str, Any]:
+        value = data[key]
+        if not isinstance(value, dict):
+            raise self.fail(f"[{key}]", f"expected a table, got {type(value).__name__}")
+        return value
+
+    def number(
+        self, where: str, value: Any, *, positive: bool = False, min_: float | None = None
+    ) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(where, f"expected a number, got {value!r}")
+        v = float(value)
+        if not math.isfinite(v):
+            raise self.fail(where, f"expected a finite number, got {value!r}")
+        if positive and v <= 0:
+            raise self.fail(where, f"expected a number > 0, got {value!r}")
+        if min_ is not None and v < min_:
+            raise self.fail(where, f"expected a number >= {min_}, got {value!r}")
+        return v
+
+    def vector(self, where: str, value: Any, n: int) -> tuple[float, ...]:
+        if not isinstance(value, list) or len(value) != n:
+            raise self.fail(where, f"expected a list of {n} numbers, got {value!r}")
+        return tuple(self.number(f"{where}[{i}]", v) for i, v in enumerate(value))
+
+    def string(self, where: str, value: Any) -> str:
+        if not isinstance(value, str) or not value:
+            raise self.fail(where, f"expected a non-empty string, got {value!r}")
+        return value
+
+    def build(self, cls: type, section: str, raw: Mapping[str, Any]) -> Any:
+        known = {f.name: f for f in fields(cls)}
+        unknown = sorted(set(raw) - set(known))
+        if unknown:
+            raise self.fail(
+                f"[{section}]", f"unknown key(s) {unknown}; valid keys are {sorted(known)}"
+            )
+        kwargs: dict[str, Any] = {}
+        defaults = cls.__dataclass_fields__  # type: ignore[attr-defined]
+        for name, value in raw.items():
+            where = f"[{section}].{name}"
+            ftype = str(defaults[name].type)
+            if name == "clip" or name == "body":
+                kwargs[name] = self.string(where, value)
+            elif name == "sim1_mode":
+                if value not in SIM1_MODES:
+                    raise self.fail(where, f"expected one of {list(SIM1_MODES)}, got {value!r}")
+                kwargs[name] = value
+            elif "tuple[float, float, float]" in ftype:
+                kwargs[name] = self.vector(where, value, 3)
+            elif "tuple[float, float]" in ftype:
+                kwargs[name] = self.vector(where, value, 2)
+            elif ftype == "int":
+                if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                    raise self.fail(where, f"expected a positive integer, got {value!r}")
+                kwargs[name] = value
+            else:
+                nonneg = name in {"start", "at", "reaction_delay", "search_start", "tail",
+                                  "contact_shift_max", "attacker_follow", "attacker_blend",
+                                  "friction_sim1", "friction_sim2", "kv"}  # fmt: skip
+                positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
+                                    "total_mass"}  # fmt: skip
+                kwargs[name] = self.number(
+                    where, value, positive=positive, min_=0.0 if nonneg else None
+                )
+        missing = [
+            n
+            for n, f in known.items()
+            if f.default is f.default_factory is __import__("dataclasses").MISSING
+            and n not in kwargs
+        ]
+        if missing:
+            raise self.fail(f"[{section}]", f"missing required key(s) {missing}")
+        return cls(**kwargs)
+
+
+def parse_scenario(
+    data: Mapping[str, Any], *, source: str = "<scenario>", base_dir: Path | None = None
+) -> Scenario:
+    """Validate a scenario mapping (as read from TOML)."""
+    r = _Reader(source)
+    unknown = sorted(set(data) - _TOP_KEYS)
+    if unknown:
+        raise r.fail("top level", f"unknown key(s) {unknown}; valid keys are {sorted(_TOP_KEYS)}")
+    if "library" not in data:
+        raise r.fail("library", "missing: a folder of BVH clips or a saved search index")
+    if "recipient" not in data:
+        raise r.fail("[recipient]", "missing: the character that is hit")
+    library = _resolve(r, "library", r.string("library", data["library"]), base_dir)
+    recipient = r.build(CharacterSpec, "recipient", r.table(data, "recipient"))
+    attacker = (
+        r.build(AttackerSpec, "attacker", r.table(data, "attacker")) if "attacker" in data else None
+    )
+    impact = r.build(ImpactSpec, "impact", r.table(data, "impact")) if "impact" in data else None
+    if attacker is None and impact is None:
+        raise r.fail("top level", "give either an [attacker] or an [impact]")
+    if attacker is not None and impact is not None:
+        raise r.fail("top level", "give either an [attacker] or an [impact], not both")
+    response = (
+        r.build(ResponseConfig, "response", r.table(data, "response"))
+        if "response" in data
+        else ResponseConfig()
+    )
+    if response.search_end <= response.search_start:
+        raise r.fail("[response].search_end", "must be greater than search_start")
+    name = r.string("name", data["name"]) if "name" in data else Path(source).stem
+    return Scenario(library, recipient, attacker, impact, response, Path(source), name)
+
+
+def _resolve(r: _Reader, where: str, value: str, base_dir: Path | None) -> Path:
+    p = Path(value)
+    candidates = [p] if p.is_absolute() else ([base_dir / p] if base_dir else []) + [Path.cwd() / p]
+    for c in candidates:
+        if c.exists():
+            return c.resolve()
+    raise r.fail(where, f"{value!r} not found (looked in {[str(c) for c in candidates]})")
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario TOML file."""
+    p = Path(path)
+    try:
+        text = p.read_text()
+    except OSError as exc:
+        raise ConfigError(f"{p}: cannot read scenario: {exc.strerror}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{p}: invalid TOML: {exc}") from None
+    return parse_scenario(data, source=str(p), base_dir=p.parent)
