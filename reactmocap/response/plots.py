@@ -1,0 +1,114 @@
+"""Figures of a response: the paper's Figure 1 pelvis-height plot and a stick-figure video.
+
+matplotlib and imageio are optional extras (``pip install reactmocap[plot,video]``); a missing
+one raises a ReactMocapError that says which extra to install.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import ReactMocapError
+from reactmocap.io import atomic_write
+from reactmocap.library.motion import Motion
+
+__all__ = ["pelvis_height_plot", "stick_figure_video"]
+
+
+def _pyplot():  # type: ignore[no-untyped-def]
+    try:
+        import matplotlib
+
+        matplotlib.use(os.environ.get("MPLBACKEND", "Agg"))
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise ReactMocapError("plots need matplotlib: pip install 'reactmocap[plot]'") from None
+    return plt
+
+
+def pelvis_height_plot(
+    curves: Mapping[str, tuple[NDArray[np.float64], NDArray[np.float64]]],
+    path: str | Path,
+    *,
+    impact_time: float,
+    transition: tuple[float, float],
+    title: str = "",
+) -> Path:
+    """Pelvis height over time for each labelled curve (like the paper's Figure 1), with the
+    impact and the transition interval marked."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4), dpi=100)
+    styles = {"mocap before": "b-", "found clip": "g-", "final blend": "r-",
+              "simulation 1": "k:", "simulation 2": "m--"}  # fmt: skip
+    for label, (t, h) in curves.items():
+        ax.plot(t, h, styles.get(label, "-"), label=label, lw=2 if label == "final blend" else 1.2)
+    ax.axvline(impact_time, color="orange", lw=1, label="impact")
+    ax.axvspan(transition[0], transition[1], color="0.9", label="transition")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("pelvis height (m)")
+    if title:
+        ax.set_title(title)
+    ax.legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    out = Path(path)
+    with atomic_write(out, "wb") as fh:
+        fig.savefig(fh, format="png")
+    plt.close(fig)
+    return out
+
+
+def stick_figure_video(
+    motions: Sequence[tuple[Motion, str]],
+    path: str | Path,
+    *,
+    fps: float = 30.0,
+    size: tuple[int, int] = (480, 360),
+) -> Path:
+    """Render motions as coloured stick figures from a fixed 3/4 view into a GIF or MP4
+    (by ``path``'s suffix). Used when no GL context is available for MuJoCo's renderer."""
+    plt = _pyplot()
+    try:
+        import imageio.v3 as iio
+    except ImportError:
+        raise ReactMocapError("videos need imageio: pip install 'reactmocap[video]'") from None
+    sampled = []
+    n = 0
+    for motion, color in motions:
+        m = motion.resample(fps)
+        n = max(n, m.num_frames)
+        sampled.append((m.global_positions(), m.skeleton.parents, color))
+    allp = np.concatenate([p.reshape(-1, 3) for p, _, _ in sampled])
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    centre = (lo + hi) / 2
+    half = max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 2.0) / 2
+    fig = plt.figure(figsize=(size[0] / 100, size[1] / 100), dpi=100)
+    ax = fig.add_subplot(projection="3d")
+    frames = []
+    for i in range(n):
+        ax.cla()
+        ax.set_xlim(centre[0] - half, centre[0] + half)
+        ax.set_ylim(centre[1] - half, centre[1] + half)
+        ax.set_zlim(0, 2 * half)
+        ax.set_axis_off()
+        ax.view_init(elev=15, azim=-60)
+        for pos, parents, color in sampled:
+            p = pos[min(i, len(pos) - 1)]
+            for j, par in enumerate(parents):
+                if par >= 0:
+                    ax.plot(*zip(p[par], p[j]), color=color, lw=2)
+        fig.canvas.draw()
+        frames.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
+    plt.close(fig)
+    out = Path(path)
+    ext = out.suffix.lower()
+    with atomic_write(out, "wb") as fh:
+        if ext == ".gif":
+            iio.imwrite(fh, np.stack(frames), extension=".gif", duration=1000 / fps, loop=0)
+        else:
+            iio.imwrite(fh, np.stack(frames), extension=ext, fps=fps)
+    return out
