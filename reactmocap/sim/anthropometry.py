@@ -45,6 +45,7 @@ __all__ = [
     "ThesisSegment",
     "part_mass_fractions",
     "table_total_mass",
+    "listing_body_part",
     "thesis_segments",
 ]
 
@@ -98,7 +99,7 @@ _MALE = (  # Table 3.1, section 3.1, p. 30
     _s("Upper Leg",   1.040, 10.46, (0.1535, 0.1637, 0.0443), (-0.008, 0.096, 0.763), "ULEGL", "ULEGR"),  # noqa: E501
     _s("Lower Leg",   1.079,  5.32, (0.0745, 0.0784, 0.0113), (-0.041, 0.096, 0.333), "LLEGL", "LLEGR"),  # noqa: E501
     _s("Foot",        1.066,  0.83, (0.0008, 0.0017, 0.0017), (-0.020, 0.097, 0.039), "FOOTL", "FOOTR"),  # noqa: E501
-    _s("Metatarsal",  1.066,  0.28, (0.0002, 0.0002, 0.0003), (0.085, 0.103, 0.018), "TOEL", "TOER"),
+    _s("Metatarsal",  1.066,  0.28, (0.0002, 0.0002, 0.0003), (0.085, 0.103, 0.018), "TOEL", "TOER"),  # noqa: E501
     _s("Shoulder",    1.009,  4.09, (0.0144, 0.0204, 0.0204), (-0.009, 0.104, 1.464), "CHESTL", "CHESTR"),  # noqa: E501
     _s("Upper Arm",   1.068,  3.82, (0.0257, 0.0092, 0.0272), (0.005, 0.296, 1.467), "UARML", "UARMR"),  # noqa: E501
     _s("Lower Arm",   1.102,  1.78, (0.0130, 0.0029, 0.0148), (0.057, 0.591, 1.478), "LARML", "LARMR"),  # noqa: E501
@@ -199,7 +200,8 @@ SEGMENT_TO_PART: MappingProxyType[str, str] = MappingProxyType(
 
 #: the canonical parts the thesis bodies resolve to (a subset of ``bodyparts.BODY_PARTS``: the
 #: neck is inside chest/head and the toes inside the feet)
-REFERENCE_PARTS: tuple[str, ...] = ("pelvis", "waist", "chest", "head") + tuple(
+_TRUNK_KINDS = ("pelvis", "waist", "chest", "head")
+REFERENCE_PARTS: tuple[str, ...] = _TRUNK_KINDS + tuple(
     f"{s}_{p}"
     for s in ("l", "r")
     for p in ("upper_arm", "forearm", "hand", "thigh", "shin", "foot")
@@ -219,14 +221,30 @@ def table_total_mass(sex: str) -> float:
     return sum(s.mass * (2 if s.bilateral else 1) for s in thesis_segments(sex))
 
 
+def listing_body_part(sex: str, body: str) -> str:
+    """Canonical part of an Appendix A body (``"ULEGL"`` -> ``"l_thigh"``, ``"CHESTR"`` ->
+    ``"chest"``)."""
+    for seg in thesis_segments(sex):
+        if body in seg.listing:
+            kind = SEGMENT_TO_PART[seg.name]
+            if kind in _TRUNK_KINDS:
+                return kind
+            return ("l_" if body.endswith("L") else "r_") + kind
+    raise UnknownKeyError(f"unknown listing body {body!r}; valid keys: {_listing_names(sex)}")
+
+
+def _listing_names(sex: str) -> list[str]:
+    return [b for seg in thesis_segments(sex) for b in seg.listing]
+
+
 def part_mass_fractions(sex: str) -> dict[str, float]:
-    """Fraction of total mass in each of :data:`REFERENCE_PARTS` (sums to 1)."""
+    """Fraction of total mass in each of :data:`REFERENCE_PARTS` (sums to 1). A bilateral row
+    counts once per side; its mass is the side the table prints."""
     total = table_total_mass(sex)
     out = dict.fromkeys(REFERENCE_PARTS, 0.0)
     for seg in thesis_segments(sex):
-        kind = SEGMENT_TO_PART[seg.name]
-        for part in (f"l_{kind}", f"r_{kind}") if seg.bilateral else (kind,):
-            out[part] += seg.mass / total
+        for body in seg.listing:
+            out[listing_body_part(sex, body)] += seg.mass / total
     return out
 
 

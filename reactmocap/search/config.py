@@ -1,0 +1,158 @@
+"""Search settings: one weights object (:class:`SearchWeights`) and one window/index object
+(:class:`WindowConfig`). Both are frozen, validated on construction and hashable into the index
+fingerprint, so a saved index knows which settings built it."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import ConfigError
+
+__all__ = ["SearchWeights", "WindowConfig", "settings_hash"]
+
+
+def _check_nonneg(obj: object, names: tuple[str, ...]) -> None:
+    for n in names:
+        v = getattr(obj, n)
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v) or v < 0:
+            raise ConfigError(f"{type(obj).__name__}.{n} must be a finite number >= 0, got {v!r}")
+
+
+@dataclass(frozen=True)
+class SearchWeights:
+    """Every weight of the window distance ``D`` (the paper's intent as defaults).
+
+    ``D(Wa, Wb) = sum_i w_i sum_b (w_pb |p_b(a_i) - p_b(b_i)| + w_thb d_theta(a_i, b_i))``
+
+    * ``w_i``: quadratic window weight ``floor + (1 - floor) ((L - i) / L)^2``, highest at the
+      first frame, normalised to sum to 1 (so ``D`` is a per-frame average and comparable across
+      window lengths).
+    * ``w_pb`` (per metre) and ``w_thb`` (per unit of ``d_theta``, ~radian): ``trunk_*`` for the
+      trunk parts, ``limb_*`` for the limbs. The ground-support body chosen for the *query* gets
+      ``max(base, support_*)`` for the whole window.
+    * ``support_height``: hands and pelvis count as ground support when they are within this many
+      metres of the lowest mapped body part at the query's first frame (a fallen character);
+      the feet always count.
+    * ``feature_set``: key into :data:`reactmocap.search.features.FEATURE_SETS`.
+    """
+
+    feature_set: str = "paper"
+    trunk_position: float = 1.0
+    trunk_orientation: float = 0.5
+    limb_position: float = 0.25
+    limb_orientation: float = 0.1
+    support_position: float = 2.0
+    support_orientation: float = 0.25
+    support_height: float = 0.25
+    window_floor: float = 0.0
+
+    def __post_init__(self) -> None:
+        from reactmocap.search.features import get_feature_set
+
+        if not isinstance(self.feature_set, str):
+            raise ConfigError(f"SearchWeights.feature_set must be a string, got {self.feature_set!r}")
+        get_feature_set(self.feature_set)  # UnknownKeyError listing the valid keys
+        _check_nonneg(
+            self,
+            (
+                "trunk_position", "trunk_orientation", "limb_position", "limb_orientation",
+                "support_position", "support_orientation", "support_height", "window_floor",
+            ),
+        )  # fmt: skip
+        if self.window_floor > 1:
+            raise ConfigError(f"SearchWeights.window_floor must be in [0, 1], got {self.window_floor}")
+        if self.trunk_position + self.trunk_orientation + self.limb_position + self.limb_orientation == 0:
+            raise ConfigError("SearchWeights: all body weights are zero")
+
+    def window_weights(self, length: int) -> NDArray[np.float64]:
+        """``(L,)`` quadratic window weights, highest at frame 0, summing to 1."""
+        i = np.arange(length, dtype=np.float64)
+        w = self.window_floor + (1.0 - self.window_floor) * ((length - i) / length) ** 2
+        return w / w.sum()
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SearchWeights:
+        known = {f.name for f in fields(cls)}
+        unknown = set(data) - known
+        if unknown:
+            raise ConfigError(f"SearchWeights: unknown fields {sorted(unknown)}; known {sorted(known)}")
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class WindowConfig:
+    """Window and index settings.
+
+    * ``fps``: the index rate. Library clips are resampled to it at build time, queries at query
+      time.
+    * ``duration``: seconds covered by a window; ``L = round(duration * fps) + 1`` frames.
+    * ``unique_tolerance``: a window start is dropped when its window is closer than this (in the
+      units of ``D``'s first-frame term, along the clip) to the previous kept start.
+    * ``max_gap``: seconds; a start is kept at least this often whatever the tolerance, which
+      bounds the refinement interval.
+    * ``embed_frames``: window frames that enter the KD embedding (exact ``D`` uses all ``L``).
+    * ``pca_dims``: PCA dimensions of the KD embedding (0: no PCA).
+    """
+
+    fps: float = 30.0
+    duration: float = 0.3
+    unique_tolerance: float = 0.02
+    max_gap: float = 0.2
+    embed_frames: int = 6
+    pca_dims: int = 32
+
+    def __post_init__(self) -> None:
+        _check_nonneg(self, ("fps", "duration", "unique_tolerance", "max_gap"))
+        if self.fps <= 0:
+            raise ConfigError(f"WindowConfig.fps must be > 0, got {self.fps}")
+        for n in ("embed_frames", "pca_dims"):
+            v = getattr(self, n)
+            if not isinstance(v, int) or isinstance(v, bool) or v < 0:
+                raise ConfigError(f"WindowConfig.{n} must be an integer >= 0, got {v!r}")
+        if self.embed_frames < 1:
+            raise ConfigError("WindowConfig.embed_frames must be >= 1")
+        if self.length > 10_000:
+            raise ConfigError(f"WindowConfig: window of {self.length} frames is unreasonably long")
+
+    @property
+    def length(self) -> int:
+        """Frames per window, ``L``."""
+        return int(round(self.duration * self.fps)) + 1
+
+    @property
+    def max_gap_frames(self) -> int:
+        return max(1, int(round(self.max_gap * self.fps)))
+
+    def embed_offsets(self) -> NDArray[np.int64]:
+        """Frame offsets inside the window that enter the KD embedding (always includes 0)."""
+        e = min(self.embed_frames, self.length)
+        return np.unique(np.round(np.linspace(0, self.length - 1, e)).astype(np.int64))
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> WindowConfig:
+        known = {f.name for f in fields(cls)}
+        unknown = set(data) - known
+        if unknown:
+            raise ConfigError(f"WindowConfig: unknown fields {sorted(unknown)}; known {sorted(known)}")
+        return cls(**data)
+
+
+def settings_hash(weights: SearchWeights, window: WindowConfig, mirror: bool) -> str:
+    blob = json.dumps(
+        {"weights": weights.to_dict(), "window": window.to_dict(), "mirror": bool(mirror)},
+        sort_keys=True,
+    )
+    return hashlib.sha256(blob.encode()).hexdigest()

@@ -1,0 +1,346 @@
+"""Per-frame body features of a Motion: positions and orientations of the mapped body parts,
+the root heading and ground origin, and an approximate centre of mass.
+
+Nothing here knows about simulation: a simulated trajectory read back as a Motion goes through
+the same code.
+
+Definitions (documented in ``docs``-style detail because the search must be explainable):
+
+* **Body frame and heading.** From the skeleton's rest pose (identity local rotations, skeleton
+  offsets) we build an anatomical pelvis frame: ``up`` = pelvis -> chest, ``left`` = right thigh
+  joint -> left thigh joint (orthogonalised), ``forward = left x up``. It is stored in the pelvis
+  joint's local frame, so it is body-fixed whatever the rest pose looks like (the Bandai Namco files'
+  rest pose lies along +X; the frame still comes out anatomical). Each frame, the body frame's world
+  orientation is ``q_pelvis(t) * B``; the **heading** is its twist about world +Z
+  (``yaw = 2 atan2(q_z, q_w)`` of the swing-twist decomposition ``q = twist_z * swing``). Unlike the
+  projected forward axis, this stays defined when the character lies face down or face up; it is
+  singular only when the pelvis is exactly upside down.
+* **Root origin.** The pelvis joint's horizontal position (not joint 0, which may be a dummy such as
+  the Bandai ``joint_Root``).
+* **Part orientations.** Part ``b``'s canonical frame is the rest body frame, swung so that the
+  canonical bone direction (trunk: up, arms: out to their side, legs: down, feet: forward) lands on
+  the part's rest bone direction. Its world orientation at ``t`` is ``q_b(t) * c_b`` with
+  ``c_b = q_b_rest^-1 * W_rest * S_b^-1``. Within one skeleton family (and its mirror) this is exact;
+  across families it is the swing-aligned approximation (twist about a bone can differ).
+* **Centre of mass.** Fixed mass fractions (Winter's tables, trunk split into pelvis/abdomen/
+  thorax) at segment midpoints (part joint to the next part's joint; hand, foot and head at their
+  joint). An approximation: good enough to pick which support body is nearest to it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import BodyPartMappingError, SearchError, UnknownKeyError
+from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
+from reactmocap.library.motion import Motion
+from reactmocap.library.skeleton import Skeleton
+from reactmocap.rotations import quat_conj, quat_from_matrix, quat_mul, quat_rotate
+
+__all__ = [
+    "FEATURE_SETS",
+    "MASS_FRACTIONS",
+    "FeatureSet",
+    "FrameFeatures",
+    "SkeletonCalibration",
+    "calibrate",
+    "calibrations_for",
+    "frame_features",
+    "get_feature_set",
+    "quat_to_matrix_fast",
+]
+
+F64 = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class FeatureSet:
+    """Which body parts enter ``D`` and how they are grouped."""
+
+    name: str
+    trunk: tuple[str, ...]
+    limbs: tuple[str, ...]
+    #: always ground-support candidates
+    support_always: tuple[str, ...] = ("l_foot", "r_foot")
+    #: support candidates only when near the ground (a fallen character)
+    support_low: tuple[str, ...] = ("l_hand", "r_hand", "pelvis")
+
+    @property
+    def parts(self) -> tuple[str, ...]:
+        return self.trunk + self.limbs
+
+    def is_trunk(self) -> NDArray[np.bool_]:
+        return np.array([p in self.trunk for p in self.parts])
+
+
+FEATURE_SETS: dict[str, FeatureSet] = {
+    # All required parts of the physics character: 4 trunk + 12 limb bodies.
+    "paper": FeatureSet(
+        "paper",
+        trunk=("pelvis", "waist", "chest", "head"),
+        limbs=tuple(
+            f"{s}_{p}"
+            for s in ("l", "r")
+            for p in ("upper_arm", "forearm", "hand", "thigh", "shin", "foot")
+        ),
+    ),
+    # Fewer bodies, for speed: end effectors and the middle joints of the limbs.
+    "compact": FeatureSet(
+        "compact",
+        trunk=("pelvis", "chest", "head"),
+        limbs=("l_forearm", "l_hand", "r_forearm", "r_hand", "l_shin", "l_foot", "r_shin", "r_foot"),
+    ),
+}
+
+
+def get_feature_set(name: str) -> FeatureSet:
+    try:
+        return FEATURE_SETS[name]
+    except (KeyError, TypeError):
+        raise UnknownKeyError(
+            f"unknown feature set {name!r}; valid feature sets are {sorted(FEATURE_SETS)}"
+        ) from None
+
+
+#: mass fraction of each part (Winter; trunk 0.497 split into pelvis/abdomen/thorax; the neck is
+#: folded into the head). Sums to 1 over the required parts.
+MASS_FRACTIONS: dict[str, float] = {
+    "pelvis": 0.142, "waist": 0.139, "chest": 0.216, "head": 0.081,
+    **{f"{s}_{p}": m for s in ("l", "r") for p, m in (
+        ("upper_arm", 0.028), ("forearm", 0.016), ("hand", 0.006),
+        ("thigh", 0.100), ("shin", 0.0465), ("foot", 0.0145))},
+}  # fmt: skip
+
+# Next part down each chain (bone direction and segment midpoint); the first present one is used.
+_NEXT_PART: dict[str, tuple[str, ...]] = {
+    "pelvis": ("waist", "chest"),
+    "waist": ("chest",),
+    "chest": ("neck", "head"),
+    "neck": ("head",),
+    "head": (),
+    **{f"{s}_upper_arm": (f"{s}_forearm",) for s in "lr"},
+    **{f"{s}_forearm": (f"{s}_hand",) for s in "lr"},
+    **{f"{s}_hand": () for s in "lr"},
+    **{f"{s}_thigh": (f"{s}_shin",) for s in "lr"},
+    **{f"{s}_shin": (f"{s}_foot",) for s in "lr"},
+    **{f"{s}_foot": (f"{s}_toe",) for s in "lr"},
+    **{f"{s}_toe": () for s in "lr"},
+}
+_PARENT_PART: dict[str, str] = {c[0]: p for p, c in _NEXT_PART.items() if c}
+_PARENT_PART.update({"head": "chest", "l_hand": "l_forearm", "r_hand": "r_forearm"})
+
+
+def _canonical_direction(part: str) -> F64:
+    """Bone direction of ``part`` in the body frame (x forward, y left, z up) in a T-pose."""
+    kind = part[2:] if part[:2] in ("l_", "r_") else part
+    if kind in ("upper_arm", "forearm", "hand"):
+        return np.array([0.0, 1.0 if part.startswith("l_") else -1.0, 0.0])
+    if kind in ("thigh", "shin"):
+        return np.array([0.0, 0.0, -1.0])
+    if kind in ("foot", "toe"):
+        return np.array([1.0, 0.0, 0.0])
+    return np.array([0.0, 0.0, 1.0])
+
+
+def _swing(a: F64, b: F64) -> F64:
+    """Minimal rotation (wxyz) taking unit vector ``a`` to unit vector ``b``; for opposite vectors
+    the half turn is about the body's left axis (a sagittal unfold), or forward if a is along it."""
+    c = float(np.dot(a, b))
+    if c < -1 + 1e-9:
+        axis = np.cross(a, [0.0, 1.0, 0.0])
+        if np.linalg.norm(axis) < 1e-6:
+            axis = np.cross(a, [1.0, 0.0, 0.0])
+        axis /= np.linalg.norm(axis)
+        return np.array([0.0, *axis])
+    v = np.cross(a, b)
+    q = np.array([1.0 + c, *v])
+    return q / np.linalg.norm(q)
+
+
+@dataclass(frozen=True)
+class SkeletonCalibration:
+    """Per-skeleton constants: part joints, body frame ``B`` in pelvis-local coordinates and each
+    part's canonical-frame offset ``c_b`` (see the module docstring)."""
+
+    feature_set: FeatureSet
+    joints: NDArray[np.int64]  # (P,) joint index of each feature part
+    pelvis: int
+    body_frame: F64  # (4,) B, pelvis-local
+    offsets: F64  # (P, 4) c_b
+    com_joints: NDArray[np.int64]  # (M,) joint of each massed part
+    com_next: NDArray[np.int64]  # (M,) joint of the next part (== com_joints when none)
+    com_mass: F64  # (M,) normalised mass fractions
+
+
+def _rest_pose(skeleton: Skeleton) -> tuple[F64, F64]:
+    j = skeleton.num_joints
+    rot = np.zeros((1, j, 4))
+    rot[..., 0] = 1.0
+    m = Motion(skeleton, 30.0, np.zeros((1, 3)), rot)
+    pos, grot = m.forward_kinematics()
+    return pos[0], grot[0]
+
+
+def calibrate(
+    skeleton: Skeleton, feature_set: FeatureSet, parts: BodyPartMap | None = None
+) -> SkeletonCalibration:
+    """Work out the body frame and canonical part frames of ``skeleton``.
+
+    Raises:
+        SearchError: when a feature part cannot be mapped or the rest pose is degenerate.
+    """
+    try:
+        bp = parts if parts is not None else map_body_parts(skeleton)
+        joints = bp.indices(list(feature_set.parts))
+    except BodyPartMappingError as exc:
+        raise SearchError(f"cannot compute search features: {exc}") from None
+    pos, grot = _rest_pose(skeleton)
+    jm = bp.joints
+    pelvis = jm["pelvis"]
+    up = pos[jm["chest"]] - pos[pelvis]
+    left = pos[jm["l_thigh"]] - pos[jm["r_thigh"]]
+    if np.linalg.norm(up) < 1e-6 or np.linalg.norm(left) < 1e-6:
+        raise SearchError("cannot compute search features: degenerate rest pose (pelvis frame)")
+    z = up / np.linalg.norm(up)
+    y = left - np.dot(left, z) * z
+    if np.linalg.norm(y) < 1e-6:
+        raise SearchError("cannot compute search features: thighs are collinear with the spine")
+    y /= np.linalg.norm(y)
+    x = np.cross(y, z)
+    w_rest = quat_from_matrix(np.stack([x, y, z], axis=1))
+    body = quat_mul(quat_conj(grot[pelvis]), w_rest)
+
+    def bone_dir(part: str) -> F64 | None:
+        for nxt in _NEXT_PART.get(part, ()):
+            if nxt in jm:
+                d = pos[jm[nxt]] - pos[jm[part]]
+                if np.linalg.norm(d) > 1e-6:
+                    return d / np.linalg.norm(d)
+        j = jm[part]
+        kids = skeleton.children(j)
+        cands = [pos[k] - pos[j] for k in kids]
+        site = skeleton.layout.end_sites.get(j)
+        if site is not None:
+            cands.append(quat_rotate(grot[j], np.asarray(site, float)))
+        for d in cands:
+            if np.linalg.norm(d) > 1e-6:
+                return d / np.linalg.norm(d)
+        par = _PARENT_PART.get(part)
+        return bone_dir(par) if par in jm else None
+
+    offs = np.empty((len(feature_set.parts), 4))
+    w_inv = quat_conj(w_rest)
+    for i, part in enumerate(feature_set.parts):
+        j = jm[part]
+        if part == "pelvis":
+            s = np.array([1.0, 0.0, 0.0, 0.0])
+        else:
+            d = bone_dir(part)
+            if d is None:
+                s = np.array([1.0, 0.0, 0.0, 0.0])
+            else:
+                r = quat_rotate(w_inv, d)  # rest bone direction in body-frame coordinates
+                s = _swing(r, _canonical_direction(part))  # S_b: r -> canonical
+        offs[i] = quat_mul(quat_mul(quat_conj(grot[j]), w_rest), quat_conj(s))
+
+    massed = [p for p in MASS_FRACTIONS if p in jm]
+    com_j, com_n, mass = [], [], []
+    for p in massed:
+        com_j.append(jm[p])
+        nxt = next((jm[n] for n in _NEXT_PART.get(p, ()) if n in jm), jm[p])
+        if p in ("l_hand", "r_hand", "l_foot", "r_foot", "head"):
+            nxt = jm[p]
+        com_n.append(nxt)
+        mass.append(MASS_FRACTIONS[p])
+    mass_arr = np.asarray(mass) / np.sum(mass)
+    return SkeletonCalibration(
+        feature_set=feature_set,
+        joints=joints,
+        pelvis=pelvis,
+        body_frame=body,
+        offsets=offs,
+        com_joints=np.asarray(com_j, dtype=np.int64),
+        com_next=np.asarray(com_n, dtype=np.int64),
+        com_mass=mass_arr,
+    )
+
+
+@dataclass(frozen=True)
+class FrameFeatures:
+    """World-frame features of every frame of a motion (P = parts of the feature set)."""
+
+    positions: F64  # (T, P, 3) part joint positions, metres
+    orientations: F64  # (T, P, 4) canonical part frames, wxyz, w >= 0
+    heading: F64  # (T,) radians
+    origin: F64  # (T, 2) pelvis ground position
+    com: F64  # (T, 3) approximate centre of mass
+
+    @property
+    def num_frames(self) -> int:
+        return int(self.positions.shape[0])
+
+
+def frame_features(motion: Motion, calib: SkeletonCalibration) -> FrameFeatures:
+    """Features of every frame of ``motion`` (at its own rate)."""
+    pos, grot = motion.forward_kinematics()
+    parts_pos = pos[:, calib.joints]
+    ori = quat_mul(grot[:, calib.joints], calib.offsets[None])
+    ori = np.where(ori[..., :1] < 0, -ori, ori)
+    body = quat_mul(grot[:, calib.pelvis], calib.body_frame[None])
+    heading = 2.0 * np.arctan2(body[:, 3], body[:, 0])
+    heading = (heading + np.pi) % (2 * np.pi) - np.pi
+    origin = pos[:, calib.pelvis, :2]
+    seg = 0.5 * (pos[:, calib.com_joints] + pos[:, calib.com_next])
+    com = np.einsum("tmk,m->tk", seg, calib.com_mass)
+    return FrameFeatures(parts_pos, ori, heading, origin.copy(), com)
+
+
+def quat_to_matrix_fast(q: NDArray[np.floating]) -> NDArray[np.floating]:
+    """``(..., 3, 3)`` rotation matrices of unit wxyz quaternions (no scipy round trip)."""
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    xx, yy, zz = x * x, y * y, z * z
+    xy, xz, yz = x * y, x * z, y * z
+    wx, wy, wz = w * x, w * y, w * z
+    m = np.empty(q.shape[:-1] + (3, 3), dtype=q.dtype)
+    m[..., 0, 0] = 1 - 2 * (yy + zz)
+    m[..., 0, 1] = 2 * (xy - wz)
+    m[..., 0, 2] = 2 * (xz + wy)
+    m[..., 1, 0] = 2 * (xy + wz)
+    m[..., 1, 1] = 1 - 2 * (xx + zz)
+    m[..., 1, 2] = 2 * (yz - wx)
+    m[..., 2, 0] = 2 * (xz - wy)
+    m[..., 2, 1] = 2 * (yz + wx)
+    m[..., 2, 2] = 1 - 2 * (xx + yy)
+    return m
+
+
+def skeleton_key(skeleton: Skeleton) -> tuple[object, ...]:
+    return (skeleton.names, skeleton.parents.tobytes(), np.asarray(skeleton.offsets).tobytes())
+
+
+def calibrations_for(
+    motions: Mapping[str, Motion],
+    feature_set: FeatureSet,
+    parts: Mapping[str, BodyPartMap] | None = None,
+) -> dict[str, SkeletonCalibration]:
+    """One calibration per distinct skeleton, shared by the clips that use it."""
+    cache: dict[tuple[object, ...], SkeletonCalibration] = {}
+    out: dict[str, SkeletonCalibration] = {}
+    for name, m in motions.items():
+        bp = parts.get(name) if parts else None
+        key = skeleton_key(m.skeleton)
+        if bp is None and key in cache:
+            out[name] = cache[key]
+            continue
+        try:
+            cal = calibrate(m.skeleton, feature_set, bp)
+        except SearchError as exc:
+            raise SearchError(f"clip {name!r}: {exc}") from None
+        if bp is None:
+            cache[key] = cal
+        out[name] = cal
+    return out
