@@ -20,6 +20,7 @@ whole body is lifted so no joint or end site is below the ground (falls rotate o
 from __future__ import annotations
 
 import sys
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -105,8 +106,9 @@ _Y = np.array([0.0, 1.0, 0.0])
 # Every channel is a 3-vector. rootrot, lfoot/rfoot: yaw, pitch (+ leans forward / toes down),
 # roll (+ tilts to the right) in degrees, R = Rz Ry Rx. Spine..Head, shoulders, wrists: local
 # rotation vectors in degrees (+y bends forward, +z turns left). lhand/rhand: wrist target
-# relative to the shoulder joint, in the heading (root-yaw) frame. lball/rball: world position
-# of the ball of the foot. Poles (elbow/knee): the direction the joint points, heading frame.
+# relative to the shoulder joint and elbow poles (where the elbow points), in the heading
+# (root-yaw) frame so the arms turn with the body. lball/rball: world position of the ball of
+# the foot; knee poles: world direction the knee points (planted feet and knees are world-fixed).
 GUARD: dict[str, tuple[float, float, float]] = {
     "root": (0.0, 0.0, 0.91),
     "rootrot": (0.0, 3.0, 0.0),
@@ -129,6 +131,9 @@ GUARD: dict[str, tuple[float, float, float]] = {
     "lknee": (1.0, 0.2, 0.0),
     "rknee": (0.8, -0.5, 0.0),
 }
+
+
+_EULER_CHANNELS = ("rootrot", "lfoot", "rfoot")
 
 
 class _Clip:
@@ -158,12 +163,12 @@ class _Clip:
         """Pin ``chans`` at their current value until ``t`` (motion starts after)."""
         return self.at(t, **{ch: self.now(ch) for ch in chans})
 
-    def guard(self, t: float, *chans: str) -> _Clip:
+    def guard(self, t: float, *chans: str, home: bool = False) -> _Clip:
         """Return ``chans`` (default: every non-foot channel) to the guard pose at ``t``; the
-        root keeps its ground position (x, y) and takes the guard height."""
+        root keeps its ground position (x, y) unless ``home`` and takes the guard height."""
         names = chans or tuple(k for k in GUARD if k[1:] not in ("ball", "foot"))
         vals = {ch: np.array(GUARD[ch]) for ch in names}
-        if "root" in vals:
+        if "root" in vals and not home:
             vals["root"][:2] = self.now("root")[:2]
         return self.at(t, **vals)
 
@@ -178,7 +183,8 @@ class _Clip:
     ) -> _Clip:
         """Swing foot ``side`` ('l'/'r') so its ball lands at ``to`` (x, y[, z]).
 
-        The foot rises before it moves and stops before it lands (no sliding near the ground).
+        The foot rises before it moves or turns and stops before it lands (no sliding near the
+        ground); ``foot`` is its new yaw/pitch/roll.
         """
         ball, fch = side + "ball", side + "foot"
         a = self.now(ball)
@@ -187,8 +193,8 @@ class _Clip:
         f1 = f0 if foot is None else np.asarray(foot, float)
         d, up = t1 - t0, np.array([0.0, 0.0, h])
         self.at(t0, **{ball: a, fch: f0})
-        self.at(t0 + 0.2 * d, **{ball: a + 0.5 * up})
-        self.at(t0 + 0.5 * d, **{ball: 0.5 * (a + b) + up, fch: 0.5 * (f0 + f1) * (1, 0.3, 1)})
+        self.at(t0 + 0.2 * d, **{ball: a + 0.5 * up, fch: f0})
+        self.at(t0 + 0.5 * d, **{ball: 0.5 * (a + b) + up})
         self.at(t1 - 0.2 * d, **{ball: b + 0.5 * up, fch: f1})
         return self.at(t1, **{ball: b, fch: f1})
 
@@ -198,7 +204,16 @@ class _Clip:
         kv = np.stack([v for _, v in keys])
         if len(keys) == 1:
             return np.broadcast_to(kv[0], (t.size, 3)).copy()
-        return PchipInterpolator(kt, kv, axis=0)(np.clip(t, kt[0], kt[-1]))
+        if ch not in _EULER_CHANNELS:
+            return PchipInterpolator(kt, kv, axis=0)(np.clip(t, kt[0], kt[-1]))
+        # Euler keys can wrap or pass near gimbal lock: interpolate sign-continuous quaternions
+        q = Rotation.from_euler("ZYX", kv, degrees=True).as_quat()
+        for i in range(1, len(q)):
+            q[i] *= np.sign(q[i] @ q[i - 1]) or 1.0
+        qt = PchipInterpolator(kt, q, axis=0)(np.clip(t, kt[0], kt[-1]))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # gimbal lock: still a valid triple
+            return Rotation.from_quat(qt).as_euler("ZYX", degrees=True)
 
 
 # ---------------------------------------------------------------------------------- solving
@@ -276,7 +291,7 @@ def _locals(c: dict[str, F64], root: F64) -> F64:
         fk(thigh)
         rf = _euler(c[s + "foot"])
         ankle = c[s + "ball"] - _mv(rf, _OFF[toe])
-        up, hinge = _two_bone(pos[:, thigh], ankle, _mv(heading, c[s + "knee"]), *_LEG, 1.0)
+        up, hinge = _two_bone(pos[:, thigh], ankle, c[s + "knee"], *_LEG, 1.0)
         loc[:, thigh] = np.swapaxes(loc[:, 0], -1, -2) @ up
         loc[:, shin] = hinge
         loc[:, foot] = np.swapaxes(up @ hinge, -1, -2) @ rf
@@ -351,10 +366,297 @@ def _step_back() -> _Clip:
     return c.at(1.4, root=(-0.35, 0.0, 0.91)).guard(1.6).hold(2.0, "root")
 
 
+def _heading(v: ArrayLike, yaw: float) -> F64:
+    """World vector ``v`` in the heading frame of a root turned ``yaw`` degrees."""
+    return _mv(_euler(np.array([-yaw, 0.0, 0.0])), np.asarray(v, float))
+
+
+def _leg(
+    root: ArrayLike, rootrot: ArrayLike, side: str, hip: ArrayLike, knee: float,
+    ankle: ArrayLike = (0.0, 0.0, 0.0),
+) -> dict[str, F64]:  # fmt: skip
+    """Foot keys (ball, foot, knee pole) that reproduce a leg given by joint angles (degrees):
+    lying and kneeling poses are easier to set that way than by foot placement."""
+    s, name = side[0].lower(), "Left" if side[0].lower() == "l" else "Right"
+    rr = _euler(np.asarray(rootrot, float))
+    ru = rr @ _rotvec(np.asarray(hip, float))
+    rs = ru @ _rotvec(np.array([0.0, knee, 0.0]))
+    rf = rs @ _rotvec(np.asarray(ankle, float))
+    ankle_p = np.asarray(root, float) + rr @ _OFF[_IDX[name + "UpLeg"]]
+    ankle_p = ankle_p + ru @ _OFF[_IDX[name + "Leg"]] + rs @ _OFF[_IDX[name + "Foot"]]
+    return {
+        s + "ball": ankle_p + rf @ _OFF[_IDX[name + "ToeBase"]],
+        s + "foot": Rotation.from_matrix(rf).as_euler("ZYX", degrees=True),
+        s + "knee": ru @ (1.0, 0.0, 0.0),
+    }
+
+
+def _punch() -> _Clip:
+    c = _Clip(2.0).hold(0.15, "root", "rootrot", "Spine", "Spine1", "rhand", "lhand")
+    c.at(0.3, root=(0.0, 0.0, 0.90), rootrot=(-5.0, 3.0, 0.0), rhand=(0.14, 0.10, -0.03))
+    c.at(
+        0.48,
+        root=(0.06, 0.0, 0.89), rootrot=(25.0, 6.0, 0.0), Spine=(0.0, 5.0, 8.0),
+        Spine1=(0.0, 5.0, 8.0), Neck=(0.0, -3.0, -20.0), Head=(0.0, -3.0, -16.0),
+        RightShoulder=(0.0, 0.0, 15.0), rhand=_heading((0.535, 0.09, 0.02), 25.0),
+        relbow=(0.0, -0.3, -1.0), lhand=(0.16, -0.05, 0.02), rfoot=(-30.0, 25.0, 0.0),
+    )  # fmt: skip
+    c.hold(0.56, "root", "rootrot", "Spine", "Spine1", "rhand", "RightShoulder", "Neck", "Head")
+    c.at(0.75, rhand=(0.22, 0.08, -0.05), RightShoulder=(0.0, 0.0, 0.0))
+    return c.guard(1.05, home=True).at(1.05, rfoot=GUARD["rfoot"]).hold(2.0, "root")
+
+
+def _push() -> _Clip:
+    c = _Clip(2.4).step("l", 0.1, 0.45, (0.62, 0.15))
+    c.at(0.25, lhand=(0.2, -0.02, -0.1), rhand=(0.2, 0.02, -0.1), lwrist=(0.0, -30.0, 0.0))
+    c.at(0.25, rwrist=(0.0, -30.0, 0.0))
+    peak = dict(
+        root=(0.30, 0.0, 0.87), rootrot=(0.0, 12.0, 0.0), Spine=(0.0, 6.0, 0.0),
+        Spine1=(0.0, 6.0, 0.0), Neck=(0.0, -8.0, 0.0), Head=(0.0, -8.0, 0.0),
+        lhand=(0.52, -0.10, -0.10), rhand=(0.52, 0.10, -0.10), lwrist=(0.0, -70.0, 0.0),
+        rwrist=(0.0, -70.0, 0.0), lelbow=(0.0, 0.3, -1.0), relbow=(0.0, -0.3, -1.0),
+        rfoot=(-30.0, 30.0, 0.0), LeftShoulder=(0.0, 0.0, -10.0), RightShoulder=(0.0, 0.0, 10.0),
+    )  # fmt: skip
+    c.at(0.6, **peak).hold(0.68, *peak)
+    c.at(0.95, root=(0.15, 0.0, 0.89), lhand=(0.25, -0.06, -0.04), rhand=(0.2, 0.08, -0.04))
+    c.at(0.95, rootrot=(0.0, 3.0, 0.0), lwrist=(0.0, 0.0, 0.0), rwrist=(0.0, 0.0, 0.0))
+    c.step("l", 1.0, 1.35, GUARD["lball"]).at(1.4, root=(0.0, 0.0, 0.90))
+    return c.guard(1.7, home=True).at(1.7, rfoot=GUARD["rfoot"]).hold(2.4, "root")
+
+
+def _front_kick() -> _Clip:
+    c = _Clip(2.4)
+    lean = dict(root=(0.10, 0.05, 0.90), rootrot=(0.0, -3.0, 0.0), Spine=(0.0, 0.0, -8.0))
+    c.at(0.3, **lean).at(0.3, lhand=(0.22, -0.06, 0.0), rhand=(0.16, 0.08, 0.0))
+    chamber = dict(rball=(0.45, -0.10, 0.42), rfoot=(0.0, 30.0, 0.0), rknee=(0.4, 0.0, 1.0))
+    c.at(0.35, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.04)), rfoot=(-30.0, 20.0, 0.0))
+    c.at(0.58, **chamber).at(0.58, rootrot=(0.0, -6.0, 0.0), root=(0.12, 0.05, 0.90))
+    c.at(
+        0.8,
+        rball=(0.93, -0.08, 0.93), rfoot=(0.0, -50.0, 0.0), root=(0.15, 0.05, 0.90),
+        rootrot=(0.0, -15.0, 0.0), Spine=(0.0, -4.0, -8.0), Spine1=(0.0, -2.0, -8.0),
+        Neck=(0.0, 8.0, 8.0), Head=(0.0, 5.0, 8.0), rhand=(0.0, 0.15, -0.25),
+    )  # fmt: skip
+    c.hold(0.86, "rball", "rfoot", "root", "rootrot", "Spine", "Spine1", "Neck", "Head")
+    c.at(1.05, **chamber).at(1.05, root=(0.12, 0.05, 0.90), rootrot=(0.0, -4.0, 0.0))
+    c.at(1.05, Spine=GUARD["Spine"], Spine1=GUARD["Spine1"], Neck=GUARD["Neck"])
+    c.at(1.05, Head=GUARD["Head"], rhand=(0.16, 0.08, 0.0))
+    c.at(1.3, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.05)), rfoot=GUARD["rfoot"])
+    c.at(1.3, rknee=GUARD["rknee"]).at(1.45, rball=GUARD["rball"])
+    return c.guard(1.75, home=True).hold(2.4, "root")
+
+
+def _side_kick() -> _Clip:
+    # The support foot turns out first (a small lifted pivot step) so the hips can turn side-on;
+    # the kicking foot is off the floor whenever the hips are turned far from it.
+    yaw, c = 80.0, _Clip(2.8)
+    c.step("l", 0.05, 0.3, GUARD["lball"], foot=(70.0, 0.0, 0.0), h=0.045)
+    half = dict(root=(0.0, 0.03, 0.90), rootrot=(25.0, 0.0, -3.0), Spine=(0.0, 2.0, -10.0))
+    c.at(0.3, **half, lknee=(0.35, 1.0, 0.0), rknee=(0.87, -0.5, 0.0))
+    c.hold(0.3, "rball", "rfoot").at(0.4, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.06)))
+    turn = dict(
+        root=(0.0, 0.04, 0.89), rootrot=(yaw, 0.0, -5.0), Spine=(0.0, 0.0, -10.0),
+        Spine1=(0.0, 0.0, -10.0), Neck=(0.0, 0.0, -30.0), Head=(0.0, 0.0, -25.0),
+        lhand=_heading((0.22, 0.05, 0.0), yaw), rhand=_heading((0.20, 0.15, 0.0), yaw),
+        lknee=(0.35, 1.0, 0.0),
+    )  # fmt: skip
+    lift = dict(rknee=(0.5, 0.8, 0.3), rfoot=(40.0, 30.0, 0.0))
+    c.at(0.55, **turn).at(0.58, **lift)
+    chamber = _leg(turn["root"], turn["rootrot"], "r", (-20.0, -60.0, 0.0), 120.0, (0.0, -10.0, 0.0))
+    c.at(0.72, **chamber)
+    ext_root, ext_rot = (0.0, 0.10, 0.88), (yaw, 0.0, -25.0)
+    ext = dict(
+        _leg(ext_root, ext_rot, "r", (-62.0, 0.0, 0.0), 4.0, (0.0, -15.0, 0.0)),
+        root=ext_root, rootrot=ext_rot, Spine=(-8.0, 0.0, -10.0), Spine1=(-6.0, 0.0, -10.0),
+        Neck=(10.0, 0.0, -30.0), Head=(8.0, 0.0, -25.0),
+    )  # fmt: skip
+    c.at(0.92, **ext).hold(0.98, *ext)
+    c.at(1.18, **chamber).at(1.18, **turn)
+    c.at(1.35, rootrot=(50.0, 0.0, -4.0), rknee=(0.6, 0.6, 0.4), rfoot=lift["rfoot"])
+    c.at(1.5, **half, rknee=(0.87, -0.5, 0.0))
+    c.at(1.5, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.06)), rfoot=GUARD["rfoot"])
+    c.at(1.65, rball=GUARD["rball"]).at(1.7, lknee=(0.35, 1.0, 0.0), rknee=GUARD["rknee"])
+    c.step("l", 1.7, 2.0, GUARD["lball"], foot=GUARD["lfoot"], h=0.045)
+    return c.guard(2.1, home=True)
+
+
+def _sway() -> _Clip:
+    c = _Clip(2.5)
+    c.at(
+        0.25,
+        root=(-0.05, 0.0, 0.90), rootrot=(0.0, -6.0, 0.0), Spine=(0.0, -5.0, -8.0),
+        Spine1=(0.0, -5.0, -8.0), Neck=(0.0, 6.0, 8.0), Head=(0.0, 4.0, 8.0),
+        lhand=(0.24, -0.02, 0.03), rhand=(0.15, 0.12, 0.03),
+    )  # fmt: skip
+    c.at(0.75, root=(0.01, 0.0, 0.91), rootrot=(0.0, 4.0, 0.0), Spine=(0.0, 5.0, -8.0))
+    c.at(0.75, Spine1=GUARD["Spine1"], Neck=GUARD["Neck"], Head=GUARD["Head"])
+    return c.guard(1.3, home=True).hold(2.5, "root")
+
+
+def _back_steps(n: int, dist: float = 0.35) -> _Clip:
+    """Knocked back ``n`` shuffle steps (rear foot first), then recover the guard."""
+    c = _Clip(2.5 + (n - 1) * 0.9)
+    c.at(
+        0.15,
+        root=(-0.06, 0.0, 0.90), rootrot=(0.0, -8.0, 0.0), Spine=(0.0, -5.0, -8.0),
+        Spine1=(0.0, -5.0, -8.0), Neck=(0.0, 6.0, 8.0), lhand=(0.26, 0.02, 0.02),
+        rhand=(0.16, 0.14, 0.02),
+    )  # fmt: skip
+    for i in range(n):
+        t, back = 0.12 + 0.8 * i, (i + 1) * dist
+        c.step("r", t, t + 0.35, np.add(GUARD["rball"], (-back, 0.0, 0.0)))
+        c.at(t + 0.45, root=(-back + 0.1, 0.0, 0.89))
+        c.step("l", t + 0.42, t + 0.77, np.add(GUARD["lball"], (-back, 0.0, 0.0)))
+    t = 0.12 + 0.8 * n
+    c.at(t, root=(-n * dist, 0.0, 0.90), rootrot=(0.0, 0.0, 0.0))
+    return c.guard(t + 0.4).hold(c.duration, "root")
+
+
+def _side_steps(side: str, dist: float = 0.3) -> _Clip:
+    """Pushed sideways: the near foot steps out ``dist`` toward ``side``, the other follows."""
+    sg, lead, trail = (1.0, "l", "r") if side == "l" else (-1.0, "r", "l")
+    c = _Clip(2.5)
+    c.at(
+        0.15,
+        root=(0.0, 0.05 * sg, 0.90), rootrot=(0.0, 3.0, -8.0 * sg), Spine=(-6.0 * sg, 4.0, -8.0),
+        Spine1=(-4.0 * sg, 4.0, -8.0), Neck=(8.0 * sg, -3.0, 8.0),
+    )  # fmt: skip
+    c.step(lead, 0.12, 0.47, np.add(GUARD[lead + "ball"], (0.0, dist * sg, 0.0)))
+    c.at(0.6, root=(0.0, 0.22 * sg, 0.89), rootrot=(0.0, 3.0, 0.0))
+    c.step(trail, 0.55, 0.9, np.add(GUARD[trail + "ball"], (0.0, dist * sg, 0.0)))
+    c.at(1.0, root=(0.0, dist * sg, 0.90))
+    return c.guard(1.4).hold(2.5, "root")
+
+
+def _stumble_forward() -> _Clip:
+    c = _Clip(2.5)
+    c.at(
+        0.15,
+        root=(0.08, 0.0, 0.89), rootrot=(0.0, 15.0, 0.0), Spine=(0.0, 8.0, -8.0),
+        Spine1=(0.0, 6.0, -8.0), Neck=(0.0, -12.0, 8.0), Head=(0.0, -8.0, 8.0),
+        lhand=(0.2, 0.15, -0.15), rhand=(0.15, -0.05, -0.15), rfoot=(-30.0, 30.0, 0.0),
+    )  # fmt: skip
+    c.step("l", 0.12, 0.42, np.add(GUARD["lball"], (0.40, 0.0, 0.0)), h=0.07)
+    c.at(0.55, root=(0.32, 0.0, 0.87), rootrot=(0.0, 10.0, 0.0))
+    c.step("r", 0.47, 0.85, np.add(GUARD["rball"], (0.40, 0.0, 0.0)), foot=GUARD["rfoot"])
+    c.at(1.0, root=(0.40, 0.0, 0.90), rootrot=(0.0, 3.0, 0.0))
+    return c.guard(1.45).hold(2.5, "root")
+
+
+def _fall_backward() -> _Clip:
+    # stagger back on the right foot, sit down behind it, roll onto the back (knees up)
+    c = _Clip(4.5)
+    c.at(
+        0.12,
+        root=(-0.06, 0.0, 0.90), rootrot=(0.0, -12.0, 0.0), Spine=(0.0, -8.0, -8.0),
+        Spine1=(0.0, -8.0, -8.0), Neck=(0.0, 12.0, 8.0), Head=(0.0, 8.0, 8.0),
+        lhand=(0.30, 0.05, -0.05), rhand=(0.30, -0.05, -0.05),
+    )  # fmt: skip
+    c.step("r", 0.1, 0.42, (-0.30, -0.22), h=0.06)
+    c.at(0.55, root=(-0.28, -0.02, 0.84), rootrot=(0.0, -15.0, 0.0))
+    c.step("l", 0.6, 1.1, (-0.06, 0.16), foot=(10.0, 0.0, 0.0), h=0.2)
+    c.at(1.05, root=(-0.62, 0.0, 0.42), rootrot=(0.0, -25.0, 0.0), Spine=(0.0, 5.0, 0.0))
+    c.at(1.05, Spine1=(0.0, 5.0, 0.0), Neck=(0.0, 15.0, 0.0), Head=(0.0, 10.0, 0.0))
+    c.at(1.05, lknee=(1.0, 0.2, 0.6), rknee=(0.8, -0.4, 0.6))
+    c.at(
+        1.3,
+        root=(-0.83, 0.0, 0.15), rootrot=(0.0, -45.0, 0.0), lhand=(-0.25, 0.15, -0.42),
+        rhand=(-0.25, -0.15, -0.42), lelbow=(-1.0, 0.3, 0.0), relbow=(-1.0, -0.3, 0.0),
+        lknee=(0.4, 0.2, 1.0), rknee=(0.4, -0.3, 1.0),
+    )  # fmt: skip
+    c.at(1.75, root=(-0.84, 0.0, 0.13), rootrot=(0.0, -70.0, 0.0), Neck=(0.0, 25.0, 0.0))
+    lying = dict(
+        root=(-0.85, 0.0, 0.12), rootrot=(0.0, -86.0, 0.0), Spine=(0.0, -2.0, 0.0),
+        Spine1=(0.0, -2.0, 0.0), Neck=(0.0, 12.0, 0.0), Head=(0.0, 5.0, 0.0),
+        lhand=(0.45, 0.15, 0.0), rhand=(0.45, -0.15, 0.0), lelbow=(0.0, 1.0, 0.3),
+        relbow=(0.0, -1.0, 0.3), lknee=(0.2, 0.3, 1.0), rknee=(0.2, -0.3, 1.0),
+    )  # fmt: skip
+    return c.at(2.3, **lying).hold(4.5, *lying)
+
+
+def _fall_forward() -> _Clip:
+    # stumble two steps, drop to the knees, catch with the hands, end prone
+    c = _Clip(4.5)
+    c.at(
+        0.12,
+        root=(0.08, 0.0, 0.88), rootrot=(0.0, 18.0, 0.0), Spine=(0.0, 10.0, -8.0),
+        Spine1=(0.0, 8.0, -8.0), Neck=(0.0, -15.0, 8.0), Head=(0.0, -10.0, 8.0),
+        lhand=(0.25, 0.10, -0.20), rhand=(0.25, -0.10, -0.20),
+    )  # fmt: skip
+    c.step("l", 0.1, 0.4, (0.70, 0.15), h=0.07)
+    c.at(0.5, root=(0.40, 0.0, 0.84), rootrot=(0.0, 25.0, 0.0))
+    c.at(0.5, lhand=(0.35, 0.05, -0.25), rhand=(0.35, -0.05, -0.25))
+    c.step("r", 0.45, 0.8, (0.70, -0.13), foot=(-5.0, 0.0, 0.0), h=0.07)
+    c.hold(0.85, "lfoot", "rfoot").at(1.08, lfoot=(10.0, 40.0, 0.0), rfoot=(-5.0, 40.0, 0.0))
+    kneel = dict(
+        root=(0.98, 0.0, 0.52), rootrot=(0.0, 15.0, 0.0), lfoot=(10.0, 65.0, 0.0),
+        rfoot=(-5.0, 65.0, 0.0), lknee=(1.0, 0.1, -0.4), rknee=(1.0, -0.1, -0.4),
+        lhand=(0.30, 0.05, -0.45), rhand=(0.30, -0.05, -0.45),
+    )  # fmt: skip
+    c.at(1.35, **kneel)
+    c.at(
+        1.65,
+        root=(1.12, 0.0, 0.42), rootrot=(0.0, 55.0, 0.0), lhand=(0.30, 0.02, -0.50),
+        rhand=(0.30, -0.02, -0.50), Neck=(0.0, -25.0, 0.0), Head=(0.0, -10.0, 0.0),
+    )  # fmt: skip
+    prone = dict(
+        root=(1.50, 0.0, 0.13), rootrot=(0.0, 88.0, 0.0), Spine=(0.0, -3.0, 0.0),
+        Spine1=(0.0, -3.0, 0.0), Neck=(0.0, -30.0, 0.0), Head=(0.0, -10.0, 0.0),
+        lhand=(0.10, 0.25, -0.05), rhand=(0.10, -0.25, -0.05), lelbow=(-0.3, 1.0, -0.5),
+        relbow=(-0.3, -1.0, -0.5), lknee=(0.0, 0.2, -1.0), rknee=(0.0, -0.2, -1.0),
+    )  # fmt: skip
+    return c.at(2.3, **prone).hold(4.5, *prone)
+
+
+def _fall_sideways() -> _Clip:
+    # pushed from the right: stagger left, buckle onto the left hip, lie on the left side
+    c = _Clip(4.5)
+    c.at(
+        0.12,
+        root=(0.0, 0.06, 0.89), rootrot=(0.0, 3.0, -15.0), Spine=(-8.0, 3.0, -8.0),
+        Spine1=(-6.0, 3.0, -8.0), Neck=(10.0, 0.0, 8.0), lhand=(0.1, 0.3, -0.1),
+        rhand=(0.2, -0.1, 0.05),
+    )  # fmt: skip
+    c.step("l", 0.1, 0.4, (0.30, 0.48), h=0.06)
+    c.at(0.5, root=(0.02, 0.30, 0.84), rootrot=(0.0, 5.0, -20.0))
+    c.step("r", 0.45, 0.8, (0.10, 0.20), foot=(-10.0, 0.0, 0.0), h=0.08)
+    c.at(1.0, root=(0.08, 0.62, 0.45), rootrot=(0.0, 10.0, -40.0), lknee=(1.0, 0.3, 0.2))
+    c.at(1.0, rknee=(1.0, 0.2, 0.2), lhand=(0.25, 0.25, -0.35), lelbow=(0.0, 1.0, 0.0))
+    c.at(1.35, root=(0.12, 0.82, 0.18), rootrot=(0.0, 8.0, -65.0))
+    # legs fold up off the floor as the hip lands, and come down on their sides
+    lie_root, lie_rot = (0.10, 0.92, 0.16), (0.0, 5.0, -88.0)
+    legs = {
+        **_leg(lie_root, lie_rot, "l", (0.0, -45.0, 0.0), 80.0),
+        **_leg(lie_root, lie_rot, "r", (0.0, -55.0, 0.0), 90.0),
+    }
+    c.step("l", 1.0, 1.6, legs["lball"], foot=legs["lfoot"], h=0.12)
+    c.step("r", 1.1, 1.75, legs["rball"], foot=legs["rfoot"], h=0.12)
+    c.at(1.6, lknee=legs["lknee"]).at(1.75, rknee=legs["rknee"])
+    lying = dict(
+        root=lie_root, rootrot=lie_rot, Spine=(6.0, 5.0, 0.0), Spine1=(6.0, 5.0, 0.0),
+        Neck=(5.0, 5.0, 0.0), Head=(0.0, 0.0, 0.0), lhand=(0.45, 0.15, 0.02),
+        rhand=(0.30, 0.0, -0.40), lelbow=(0.0, -1.0, 0.0), relbow=(-0.2, 0.0, 1.0),
+    )  # fmt: skip
+    return c.at(1.9, **lying).hold(4.5, *lying)
+
+
 CLIP_BUILDERS: dict[str, tuple[Callable[[], _Clip], str]] = {
     "guard": (_guard, "fighting guard (left foot forward) with a subtle breathing sway; loops"),
     "step_forward": (_step_forward, "guard shuffle step forward 0.35 m (front foot first)"),
     "step_back": (_step_back, "guard shuffle step back 0.35 m (rear foot first)"),
+    "front_kick": (_front_kick, "attack: right-leg front kick, ball of the foot ~1 m ahead"),
+    "side_kick": (_side_kick, "attack: right-leg side kick, hips turned, foot ~0.9 m ahead"),
+    "punch": (_punch, "attack: right cross, fist ~1 m ahead"),
+    "push": (_push, "attack: two-hand shove with a step, palms ~0.9 m ahead"),
+    "sway": (_sway, "light reaction: torso sways back and recovers, feet stay planted"),
+    "step_back_1": (lambda: _back_steps(1), "medium reaction: knocked one step back"),
+    "step_back_2": (lambda: _back_steps(2), "medium reaction: knocked two steps back"),
+    "step_left": (lambda: _side_steps("l"), "medium reaction: pushed one step to the left"),
+    "step_right": (lambda: _side_steps("r"), "medium reaction: pushed one step to the right"),
+    "step_forward_react": (_stumble_forward, "medium reaction: stumbles one step forward"),
+    "fall_backward": (_fall_backward, "heavy reaction: staggers back, sits down, ends on the back"),
+    "fall_forward": (_fall_forward, "heavy reaction: stumbles, drops to the knees, ends prone"),
+    "fall_sideways": (_fall_sideways, "heavy reaction: staggers left, ends lying on the left side"),
 }
 CLIP_INFO = {k: v[1] for k, v in CLIP_BUILDERS.items()}
 ATTACK_CLIPS = ("front_kick", "side_kick", "punch", "push")

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -39,25 +38,27 @@ _KINDS = ("angle", "torque")
 _BCS = ("not-a-knot", "natural", "clamped")
 
 
-@dataclass(frozen=True, eq=False)
 class ControlFunction:
     """Cubic interpolating spline through ``(times[i], values[i])``; ``dof`` names it in errors.
+
+    Attributes ``times``, ``values`` (read-only float arrays), ``bc_type``, ``dof`` and ``spline``
+    (the ``scipy.interpolate.CubicSpline``).
 
     Raises:
         ConfigError: fewer than 2 points, lengths differ, non-finite entries, times not strictly
             increasing, or an unknown ``bc_type`` (the message names the DOF and the field).
     """
 
-    times: NDArray[np.float64]
-    values: NDArray[np.float64]
-    bc_type: BoundaryCondition = "not-a-knot"
-    dof: str = "control function"
-    spline: CubicSpline = field(init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        where = f"control function {self.dof!r}"
-        t = _vector(self.times, where, "times")
-        v = _vector(self.values, where, "values")
+    def __init__(
+        self,
+        times: ArrayLike,
+        values: ArrayLike,
+        bc_type: BoundaryCondition = "not-a-knot",
+        dof: str = "control function",
+    ) -> None:
+        where = f"control function {dof!r}"
+        t = _vector(times, where, "times")
+        v = _vector(values, where, "values")
         if t.size < 2:
             raise ConfigError(f"{where}: times needs at least 2 control points, got {t.size}")
         if v.size != t.size:
@@ -69,13 +70,18 @@ class ControlFunction:
                 f"{where}: times must be strictly increasing (times[{i}] = {t[i]} <= "
                 f"times[{i - 1}] = {t[i - 1]})"
             )
-        if self.bc_type not in _BCS:
-            raise ConfigError(f"{where}: bc_type must be one of {list(_BCS)}, got {self.bc_type!r}")
+        if bc_type not in _BCS:
+            raise ConfigError(f"{where}: bc_type must be one of {list(_BCS)}, got {bc_type!r}")
         t.setflags(write=False)
         v.setflags(write=False)
-        object.__setattr__(self, "times", t)
-        object.__setattr__(self, "values", v)
-        object.__setattr__(self, "spline", CubicSpline(t, v, bc_type=self.bc_type))
+        self.times: NDArray[np.float64] = t
+        self.values: NDArray[np.float64] = v
+        self.bc_type: BoundaryCondition = bc_type
+        self.dof = dof
+        self.spline = CubicSpline(t, v, bc_type=bc_type)
+
+    def __repr__(self) -> str:
+        return f"ControlFunction(dof={self.dof!r}, points={self.times.size}, bc={self.bc_type!r})"
 
     @property
     def t_start(self) -> float:
@@ -139,7 +145,9 @@ class ControlFunctionSet:
             if not isinstance(name, str) or not name:
                 raise ConfigError(f"control function set: DOF names must be strings, got {name!r}")
             if isinstance(curve, ControlFunction):
-                funcs.append(replace(curve, dof=name) if curve.dof != name else curve)
+                if curve.dof != name:
+                    curve = ControlFunction(curve.times, curve.values, curve.bc_type, name)
+                funcs.append(curve)
             else:
                 try:
                     times, values = curve
@@ -147,7 +155,7 @@ class ControlFunctionSet:
                     raise ConfigError(
                         f"control function {name!r}: expected a ControlFunction or (times, values)"
                     ) from None
-                funcs.append(ControlFunction(times, values, dof=name))  # type: ignore[arg-type]
+                funcs.append(ControlFunction(times, values, dof=name))
         self.kind: ControlKind = kind
         self.names: tuple[str, ...] = tuple(curves)
         self.functions: tuple[ControlFunction, ...] = tuple(funcs)

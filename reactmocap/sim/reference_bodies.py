@@ -48,6 +48,7 @@ from reactmocap.sim.anthropometry import SEXES, listing_body_part
 
 __all__ = [
     "ListingBody",
+    "inertia_matrix",
     "reference_body_model",
     "reference_body_spec",
     "reference_listing",

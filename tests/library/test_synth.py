@@ -31,7 +31,9 @@ MAX_ANGLE = {
 # goes back), elbows about -Y (the hand comes forward); flexion 0..150 deg, nothing off-axis.
 HINGES = {"Leg": np.array([0.0, 1.0, 0.0]), "ForeArm": np.array([0.0, -1.0, 0.0])}
 FOOT_POINTS = ("Foot", "ToeBase")  # plus the toe end sites
-CONTACT_ABOVE_REST = 0.03  # a foot point this close to its standing height is on the ground
+# A foot point this close to its standing height is on the ground; the ankle only with the heel
+# down (a raised heel lifts it ~2.5 cm while the ball stays planted and it may swing about that).
+CONTACT_ABOVE_REST = {"Foot": 0.02, "ToeBase": 0.03, "ToeTip": 0.03}
 CONTACT_SPEED = 0.5  # m/s: faster than this is a swing, not a planted foot
 MAX_SLIDE = 0.02
 
@@ -67,7 +69,8 @@ def planted_slides(m: Motion) -> dict[str, float]:
     for name, (track, rest_z) in _foot_tracks(m).items():
         step = np.linalg.norm(np.diff(track[:, :2], axis=0), axis=1)
         speed = np.concatenate([[0.0], step]) * m.fps
-        planted = (track[:, 2] < rest_z + CONTACT_ABOVE_REST) & (speed < CONTACT_SPEED)
+        above = CONTACT_ABOVE_REST[name.removeprefix("Left").removeprefix("Right")]
+        planted = (track[:, 2] < rest_z + above) & (speed < CONTACT_SPEED)
         worst, run = 0.0, 0.0
         for i in range(1, m.num_frames):
             run = run + step[i - 1] if planted[i] and planted[i - 1] else 0.0

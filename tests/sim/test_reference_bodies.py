@@ -82,9 +82,9 @@ def test_inertias_positive_definite_and_as_listed(sex: str, model: mujoco.MjMode
         assert np.all(np.linalg.eigvalsh(want) > 0), body.name
         a, b, c = np.sort(model.body_inertia[i])
         assert a > 0 and a + b >= c, body.name  # a physical rigid body
-        rot = np.zeros(9)
-        mujoco.mju_quat2Mat(rot, model.body_iquat[i])
-        rot = rot.reshape(3, 3)
+        flat = np.zeros(9)
+        mujoco.mju_quat2Mat(flat, model.body_iquat[i])
+        rot = flat.reshape(3, 3)
         got = rot @ np.diag(model.body_inertia[i]) @ rot.T
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12, err_msg=body.name)
         np.testing.assert_allclose(model.body_ipos[i], -np.asarray(body.body_to_joint))

@@ -1,0 +1,238 @@
+"""The window distance ``D`` and its Euclidean embedding.
+
+**Window frame.** A window of ``L`` frames starting at frame ``s`` is expressed in the frame of
+its first frame's root: positions ``Rz(-h_s) (p - (o_s, 0))`` with ``h_s`` the heading and
+``o_s`` the pelvis ground position at ``s``; orientations ``q_yaw(-h_s) * q``. Height and tilt are
+kept (only yaw and horizontal translation are removed).
+
+**Orientation distance (sign-safe).** ``d_theta(qa, qb) = 2 |vec(conj(qa) * qb)| = 2 sin(phi / 2)``
+with ``phi`` the angle of the relative rotation. It depends on ``(qa . qb)^2`` only, so ``q`` and
+``-q`` are the same rotation; it equals ``phi`` to first order, is monotonic on ``[0, pi]`` and
+equals the chordal distance ``||Ra - Rb||_F / sqrt(2)`` of the rotation matrices. The vector-part
+form keeps full precision near zero.
+
+**D.** ``D = sum_i w_i sum_b (wp_b |dp_b,i| + wq_b d_theta_b,i)``: unsquared norms per body and
+frame, exactly as in the paper. It is reported split into six terms: trunk / limbs / support body
+x position / orientation.
+
+**Embedding.** ``e(W) = concat_{i in E, b} [sqrt(om_i wp_b) p_b,i, sqrt(om_i wq_b / 2) vec(R_b,i)]``
+over a subset ``E`` of the window frames (``om_i`` = the window weights of the frames each embedded
+frame stands for). Then ``||e(Wa) - e(Wb)||^2 = sum om_i (wp_b |dp|^2 + wq_b d_theta^2)``: a
+*squared* (L2) version of ``D`` on fewer frames. With ``c_k`` the per-term weights and ``x_k`` the
+per-term distances, ``D = sum c_k x_k`` and ``E^2 = sum c_k x_k^2``; Cauchy-Schwarz gives
+``E^2 / max x_k <= D <= sqrt(sum c_k) E``, so a small ``E`` means a small ``D`` but the orders can
+differ. The embedding therefore only proposes candidates; they are re-ranked with the exact ``D``
+(with the query's support weight, which the embedding cannot know).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.search.config import SearchWeights
+from reactmocap.search.features import FeatureSet, quat_to_matrix_fast
+
+__all__ = [
+    "BREAKDOWN_TERMS",
+    "QueryWindow",
+    "body_weights",
+    "embed_local",
+    "embedding_body_weights",
+    "embedding_frame_weights",
+    "group_matrix",
+    "localize",
+    "select_support",
+    "window_distances",
+]
+
+F32 = NDArray[np.float32]
+F64 = NDArray[np.float64]
+
+BREAKDOWN_TERMS = (
+    "trunk_position",
+    "trunk_orientation",
+    "limbs_position",
+    "limbs_orientation",
+    "support_position",
+    "support_orientation",
+)
+
+
+@dataclass(frozen=True)
+class QueryWindow:
+    """A query window in its own first-frame root frame, ready to compare."""
+
+    positions: F32  # (L, P, 3)
+    orientations: F32  # (L, P, 4)
+    heading: float
+    origin: F64  # (2,)
+    support: int  # index into the feature set's parts
+    support_part: str
+    com: F64  # (3,) at the first frame, world
+
+
+def localize(
+    positions: NDArray[np.floating],
+    orientations: NDArray[np.floating],
+    heading: NDArray[np.floating],
+    origin: NDArray[np.floating],
+) -> tuple[NDArray[np.floating], NDArray[np.floating]]:
+    """Express windows in their first frame's root frame.
+
+    ``positions (C, L, P, 3)``, ``orientations (C, L, P, 4)``, ``heading (C,)``, ``origin (C, 2)``.
+    """
+    dt = positions.dtype
+    c = np.cos(heading).astype(dt)[:, None, None]
+    s = np.sin(heading).astype(dt)[:, None, None]
+    dx = positions[..., 0] - origin[:, 0].astype(dt)[:, None, None]
+    dy = positions[..., 1] - origin[:, 1].astype(dt)[:, None, None]
+    lp = np.empty_like(positions)
+    lp[..., 0] = c * dx + s * dy
+    lp[..., 1] = -s * dx + c * dy
+    lp[..., 2] = positions[..., 2]
+    # q_yaw(-h) * q with q_yaw(-h) = (cw, 0, 0, -sw)
+    ch = np.cos(0.5 * heading).astype(dt)[:, None, None]
+    sh = np.sin(0.5 * heading).astype(dt)[:, None, None]
+    w, x, y, z = (orientations[..., k] for k in range(4))
+    lq = np.empty_like(orientations)
+    lq[..., 0] = ch * w + sh * z
+    lq[..., 1] = ch * x + sh * y
+    lq[..., 2] = ch * y - sh * x
+    lq[..., 3] = ch * z - sh * w
+    return lp, lq
+
+
+def select_support(
+    positions0: NDArray[np.floating],
+    com0: NDArray[np.floating],
+    feature_set: FeatureSet,
+    weights: SearchWeights,
+) -> int:
+    """Index (into ``feature_set.parts``) of the ground-support body nearest the centre of mass.
+
+    Candidates: the feet always; hands and pelvis when within ``weights.support_height`` of the
+    lowest feature part (a character on the ground). Nearest = smallest horizontal distance from
+    the centre of mass.
+    """
+    parts = feature_set.parts
+    z = positions0[:, 2]
+    low = float(np.min(z))
+    cands = [parts.index(p) for p in feature_set.support_always if p in parts]
+    cands += [
+        parts.index(p)
+        for p in feature_set.support_low
+        if p in parts and z[parts.index(p)] <= low + weights.support_height
+    ]
+    if not cands:
+        return int(np.argmin(z))
+    d = np.linalg.norm(positions0[cands, :2] - com0[None, :2], axis=1)
+    return int(cands[int(np.argmin(d))])
+
+
+def body_weights(
+    feature_set: FeatureSet, weights: SearchWeights, support: int | None
+) -> tuple[F64, F64]:
+    """Per-part ``(wp, wq)``; the support part gets ``max(base, support_*)``."""
+    trunk = feature_set.is_trunk()
+    wp = np.where(trunk, weights.trunk_position, weights.limb_position).astype(np.float64)
+    wq = np.where(trunk, weights.trunk_orientation, weights.limb_orientation).astype(np.float64)
+    if support is not None:
+        wp[support] = max(wp[support], weights.support_position)
+        wq[support] = max(wq[support], weights.support_orientation)
+    return wp, wq
+
+
+def embedding_body_weights(feature_set: FeatureSet, weights: SearchWeights) -> tuple[F64, F64]:
+    """Query-independent weights for the KD embedding: the always-support parts (feet) sit halfway
+    between their base and support weights, since the query will usually up-weight one of them."""
+    wp, wq = body_weights(feature_set, weights, None)
+    for p in feature_set.support_always:
+        if p in feature_set.parts:
+            i = feature_set.parts.index(p)
+            wp[i] = 0.5 * (wp[i] + max(wp[i], weights.support_position))
+            wq[i] = 0.5 * (wq[i] + max(wq[i], weights.support_orientation))
+    return wp, wq
+
+
+def embedding_frame_weights(window_weights: F64, offsets: NDArray[np.int64]) -> F64:
+    """Window weight of each embedded frame: the summed weights of the frames nearest to it."""
+    i = np.arange(len(window_weights))
+    owner = np.argmin(np.abs(i[:, None] - offsets[None, :]), axis=1)
+    return np.bincount(owner, weights=window_weights, minlength=len(offsets))
+
+
+def group_matrix(feature_set: FeatureSet, support: int | None) -> F64:
+    """``(P, 3)`` one-hot: trunk, limbs, support."""
+    trunk = feature_set.is_trunk()
+    g = np.zeros((len(trunk), 3))
+    g[trunk, 0] = 1.0
+    g[~trunk, 1] = 1.0
+    if support is not None:
+        g[support] = (0.0, 0.0, 1.0)
+    return g
+
+
+def embed_local(
+    local_positions: NDArray[np.floating],
+    local_orientations: NDArray[np.floating],
+    frame_weights: F64,
+    wp: F64,
+    wq: F64,
+) -> F32:
+    """Embedding rows ``(C, E*P*12)`` of windows already in local coordinates, ``(C, E, P, 3|4)``."""
+    c, e, p = local_positions.shape[:3]
+    sp = np.sqrt(frame_weights[:, None] * wp[None, :]).astype(np.float32)  # (E, P)
+    sq = np.sqrt(frame_weights[:, None] * wq[None, :] * 0.5).astype(np.float32)
+    out = np.empty((c, e, p, 12), dtype=np.float32)
+    out[..., :3] = local_positions * sp[None, :, :, None]
+    rm = quat_to_matrix_fast(local_orientations.astype(np.float32, copy=False))
+    out[..., 3:] = rm.reshape(c, e, p, 9) * sq[None, :, :, None]
+    return out.reshape(c, -1)
+
+
+def window_distances(
+    positions: F32,
+    orientations: F32,
+    heading: F64,
+    origin: F64,
+    starts: NDArray[np.int64],
+    query: QueryWindow,
+    window_weights: F64,
+    wp: F64,
+    wq: F64,
+    groups: F64 | None = None,
+) -> tuple[F64, F64 | None]:
+    """Exact ``D`` between ``query`` and the library windows starting at ``starts``.
+
+    Returns ``(D (C,), breakdown (C, 6) or None)``; the breakdown (when ``groups`` is given)
+    follows :data:`BREAKDOWN_TERMS` and sums to ``D``.
+    """
+    L = query.positions.shape[0]
+    idx = starts[:, None] + np.arange(L)[None, :]
+    lp, lq = localize(positions[idx], orientations[idx], heading[starts], origin[starts])
+    dpos = np.sqrt(((lp - query.positions[None]) ** 2).sum(-1))  # (C, L, P)
+    a = lq
+    b = query.orientations[None]
+    aw, av = a[..., :1], a[..., 1:]
+    bw, bv = b[..., :1], b[..., 1:]
+    cx = av[..., 1] * bv[..., 2] - av[..., 2] * bv[..., 1]
+    cy = av[..., 2] * bv[..., 0] - av[..., 0] * bv[..., 2]
+    cz = av[..., 0] * bv[..., 1] - av[..., 1] * bv[..., 0]
+    vec = aw * bv - bw * av
+    vec[..., 0] -= cx
+    vec[..., 1] -= cy
+    vec[..., 2] -= cz
+    dang = 2.0 * np.sqrt((vec * vec).sum(-1))  # (C, L, P)
+    wi = window_weights.astype(np.float32)
+    sp = np.einsum("clp,l->cp", dpos, wi).astype(np.float64)  # per part, time-weighted
+    sa = np.einsum("clp,l->cp", dang, wi).astype(np.float64)
+    total = sp @ wp + sa @ wq
+    if groups is None:
+        return total, None
+    bp = (sp * wp[None]) @ groups  # (C, 3)
+    ba = (sa * wq[None]) @ groups
+    br = np.stack([bp[:, 0], ba[:, 0], bp[:, 1], ba[:, 1], bp[:, 2], ba[:, 2]], axis=1)
+    return total, br

@@ -1,0 +1,293 @@
+"""The simulated world: a ground plane, gravity, friction, and one or two characters.
+
+Each character is attached to one MjSpec with a name prefix (``a/``, ``b/``), so body ``chest``
+of the second character is ``b/chest`` in MuJoCo.
+
+Contact settings, and why (measured with ``benchmarks/bench_sim.py`` on this machine, one
+standing 51-DOF character, dt = 0.0005 s; see the report for the figures):
+
+* **Solver Newton, integrator implicitfast, pyramidal cone.** Newton converges in 1-3
+  iterations on a standing character and was the fastest; CG and PGS need many more iterations
+  for the same accuracy, and RK4 costs four model evaluations per step. ``implicitfast`` costs
+  the same as Euler here and treats joint damping implicitly, which keeps light damping and
+  freeze springs stable. The pyramidal cone was faster than the elliptic one and, for the
+  friction-1.0/0.5 Coulomb contacts the papers use, the difference in behaviour is a slightly
+  anisotropic friction limit, invisible at our scale.
+* **Contacts:** ``solref = (0.01, 1.0)`` (critically damped, 10 ms time constant, five times
+  the step and half MuJoCo's 20 ms default) so a 75 kg character standing on two foot boxes
+  sinks about 2 mm instead of about 8 mm, while impacts stay soft enough that the Newton solver
+  does not chatter at dt = 0.0005; ``solimp`` is MuJoCo's default (0.9, 0.95, 0.001): Zordan et
+  al. used ODE's soft constraints "allowing some compliance" in the same way. ``condim = 3``
+  (sliding friction only), friction coefficient per world (paper: 1.0 in Simulation 1, 0.5 in
+  Simulation 2) on every geom (MuJoCo takes the larger of the two geoms' coefficients).
+* **Collision filtering:** the floor collides with everything; two characters collide with
+  each other. Within one character, parent-child pairs are excluded by MuJoCo's default
+  ``filterparent``; with ``self_collision=False`` (default) the character's own geoms do not
+  collide at all, through contype/conaffinity bits (character k has type bit ``2**(k+1)`` and
+  affinity with the floor and the other character). Why off: mocap poses routinely put arms
+  within millimetres of the trunk capsules, and self-contacts would fight the tracking servo.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import ConfigError, SimulationError
+from reactmocap.library.motion import Motion
+from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, Character
+
+__all__ = ["PREFIXES", "World", "WorldCharacter", "WorldConfig"]
+
+F64 = NDArray[np.float64]
+PREFIXES = ("a/", "b/")
+
+_INTEGRATORS = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+}
+_SOLVERS = {
+    "newton": mujoco.mjtSolver.mjSOL_NEWTON,
+    "cg": mujoco.mjtSolver.mjSOL_CG,
+    "pgs": mujoco.mjtSolver.mjSOL_PGS,
+}
+_CONES = {"pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL, "elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC}
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """World parameters (all overridable; defaults from the papers and our measurements)."""
+
+    timestep: float = 0.0005
+    friction: float = 1.0
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    integrator: Literal["euler", "implicitfast", "implicit", "rk4"] = "implicitfast"
+    solver: Literal["newton", "cg", "pgs"] = "newton"
+    cone: Literal["pyramidal", "elliptic"] = "pyramidal"
+    iterations: int = 50
+    contact_solref: tuple[float, float] = (0.01, 1.0)
+    contact_solimp: tuple[float, float, float] = (0.9, 0.95, 0.001)
+    self_collision: bool = False
+    #: light joint damping (Deva: a weak damper everywhere), in 1/s: each ball DOF gets
+    #: ``joint_damping * I_dof`` with ``I_dof`` its outboard inertia in the reference pose
+    joint_damping: float = 1.0
+    #: limit softness for the ball-joint cones
+    limit_solref: tuple[float, float] = (0.02, 1.0)
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.timestep) and 0 < self.timestep <= 0.01):
+            raise ConfigError(f"timestep must be in (0, 0.01] s, got {self.timestep!r}")
+        if not (np.isfinite(self.friction) and self.friction >= 0):
+            raise ConfigError(f"friction must be >= 0, got {self.friction!r}")
+        if self.integrator not in _INTEGRATORS:
+            raise ConfigError(f"integrator must be one of {list(_INTEGRATORS)}, got {self.integrator!r}")
+        if self.solver not in _SOLVERS:
+            raise ConfigError(f"solver must be one of {list(_SOLVERS)}, got {self.solver!r}")
+        if self.cone not in _CONES:
+            raise ConfigError(f"cone must be one of {list(_CONES)}, got {self.cone!r}")
+        if self.contact_solref[0] < 2 * self.timestep:
+            raise ConfigError(
+                f"contact_solref time constant {self.contact_solref[0]} must be at least twice "
+                f"the timestep {self.timestep} (MuJoCo would silently clamp it)"
+            )
+        if self.joint_damping < 0:
+            raise ConfigError(f"joint_damping must be >= 0, got {self.joint_damping!r}")
+
+
+@dataclass(eq=False)
+class WorldCharacter:
+    """One character inside a World: where its bodies, qpos and qvel live."""
+
+    index: int
+    prefix: str
+    character: Character
+    body_ids: NDArray[np.int64]  # (16,) in SIM_BODIES order
+    qpos_adr: int  # free joint start; 7 + 60 contiguous values
+    dof_adr: int  # free joint dof start; 6 + 45 contiguous values
+    geom_ids: NDArray[np.int64]
+    body_lookup: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def qpos_slice(self) -> slice:
+        return slice(self.qpos_adr, self.qpos_adr + 7 + 4 * len(BALL_JOINTS))
+
+    @property
+    def qvel_slice(self) -> slice:
+        return slice(self.dof_adr, self.dof_adr + 6 + 3 * len(BALL_JOINTS))
+
+    @property
+    def ball_qpos_start(self) -> int:
+        return self.qpos_adr + 7
+
+    @property
+    def ball_dof_start(self) -> int:
+        return self.dof_adr + 6
+
+    def body_id(self, name: str) -> int:
+        return self.body_lookup[Character.body_name(name)]
+
+
+class World:
+    """A MuJoCo model and data with a floor and one or two characters."""
+
+    def __init__(self, characters: Character | Sequence[Character], config: WorldConfig | None = None,
+                 **overrides: object) -> None:
+        chars = [characters] if isinstance(characters, Character) else list(characters)
+        if not 1 <= len(chars) <= len(PREFIXES):
+            raise ConfigError(f"a World holds 1 or 2 characters, got {len(chars)}")
+        cfg = config or WorldConfig()
+        if overrides:
+            from dataclasses import replace
+
+            try:
+                cfg = replace(cfg, **overrides)  # type: ignore[arg-type]
+            except TypeError as exc:
+                raise ConfigError(f"unknown world option: {exc}") from None
+        self.config = cfg
+        spec = mujoco.MjSpec()
+        spec.compiler.degree = False
+        opt = spec.option
+        opt.timestep = cfg.timestep
+        opt.gravity = list(cfg.gravity)
+        opt.integrator = _INTEGRATORS[cfg.integrator]
+        opt.solver = _SOLVERS[cfg.solver]
+        opt.cone = _CONES[cfg.cone]
+        opt.iterations = cfg.iterations
+        floor = spec.worldbody.add_geom(
+            name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0]
+        )
+        floor.contype = 1
+        floor.conaffinity = 1
+        for k, ch in enumerate(chars):
+            frame = spec.worldbody.add_frame()
+            spec.attach(ch.make_spec(), prefix=PREFIXES[k], frame=frame)
+        try:
+            self.model = spec.compile()
+        except Exception as exc:  # mujoco raises ValueError with the compiler's message
+            raise SimulationError(f"MuJoCo could not compile the world: {exc}") from exc
+        self.spec = spec
+        m = self.model
+        self.data = mujoco.MjData(m)
+        self.characters: list[WorldCharacter] = []
+        for k, ch in enumerate(chars):
+            pre = PREFIXES[k]
+            ids = np.array([m.body(pre + b).id for b in SIM_BODIES], dtype=np.int64)
+            root = m.joint(pre + "root").id
+            balls = [m.joint(pre + j).id for j in BALL_JOINTS]
+            qadr = int(m.jnt_qposadr[root])
+            dadr = int(m.jnt_dofadr[root])
+            if [int(m.jnt_qposadr[j]) for j in balls] != [qadr + 7 + 4 * i for i in range(15)]:
+                raise SimulationError("ball joints are not contiguous in qpos (internal error)")
+            geoms = np.flatnonzero(np.isin(m.geom_bodyid, ids))
+            self.characters.append(
+                WorldCharacter(k, pre, ch, ids, qadr, dadr, geoms,
+                               {b: int(i) for b, i in zip(SIM_BODIES, ids)})
+            )
+        self._apply_contact_settings()
+        self._apply_joint_settings()
+        self.set_friction(cfg.friction)
+        mujoco.mj_forward(m, self.data)
+
+    # ------------------------------------------------------------------ settings
+    def _apply_contact_settings(self) -> None:
+        m, cfg = self.model, self.config
+        n = len(self.characters)
+        all_bits = 1 | sum(1 << (k + 1) for k in range(n))
+        for wc in self.characters:
+            own = 1 << (wc.index + 1)
+            m.geom_contype[wc.geom_ids] = own
+            m.geom_conaffinity[wc.geom_ids] = all_bits if cfg.self_collision else all_bits & ~own
+        m.geom_conaffinity[m.geom("floor").id] = all_bits
+        m.geom_condim[:] = 3
+        m.geom_solref[:] = cfg.contact_solref
+        m.geom_solimp[:, :3] = cfg.contact_solimp
+
+    def _apply_joint_settings(self) -> None:
+        """Light damping scaled by each DOF's outboard inertia in the reference pose."""
+        m, d, cfg = self.model, self.data, self.config
+        for wc in self.characters:
+            d.qpos[wc.qpos_slice] = wc.character.model.qpos0
+        mujoco.mj_forward(m, d)
+        diag = np.empty(m.nv)
+        diag[:] = d.M[m.M_rowadr + m.M_rownnz - 1]  # diagonal = last entry of each CSR row
+        for wc in self.characters:
+            dofs = np.arange(wc.ball_dof_start, wc.ball_dof_start + 3 * len(BALL_JOINTS))
+            m.dof_damping[dofs] = cfg.joint_damping * diag[dofs]
+        m.jnt_solref[:] = cfg.limit_solref
+        mujoco.mj_resetData(m, d)
+
+    def set_friction(self, mu: float) -> None:
+        """Sliding friction coefficient of every contact (floor and characters)."""
+        if not (np.isfinite(mu) and mu >= 0):
+            raise ConfigError(f"friction must be >= 0, got {mu!r}")
+        self.model.geom_friction[:, 0] = mu
+
+    # ------------------------------------------------------------------ state
+    @property
+    def time(self) -> float:
+        return float(self.data.time)
+
+    @property
+    def timestep(self) -> float:
+        return float(self.model.opt.timestep)
+
+    def set_pose(self, index: int, qpos: F64, qvel: F64 | None = None) -> None:
+        """Set one character's qpos (67) and qvel (51, zero if omitted); run mj_forward."""
+        wc = self.characters[index]
+        qpos = np.asarray(qpos, dtype=np.float64)
+        if qpos.shape != (7 + 4 * len(BALL_JOINTS),) or not np.all(np.isfinite(qpos)):
+            raise SimulationError(f"qpos must be 67 finite numbers, got shape {qpos.shape}")
+        self.data.qpos[wc.qpos_slice] = qpos
+        self.data.qvel[wc.qvel_slice] = 0.0 if qvel is None else qvel
+        mujoco.mj_forward(self.model, self.data)
+
+    def set_from_motion(self, index: int, motion: Motion, frame: int, velocity: bool = True) -> None:
+        """Put a character in a motion frame (pose and finite-difference velocities)."""
+        ch = self.characters[index].character
+        q = ch.qpos_from_motion(motion, [frame])[0]
+        v = ch.qvel_from_motion(motion, [frame])[0] if velocity else None
+        self.set_pose(index, q, v)
+
+    def body_transforms(self, index: int) -> tuple[F64, F64]:
+        """World positions ``(16, 3)`` and rotations ``(16, 4)`` of a character's bodies."""
+        ids = self.characters[index].body_ids
+        return self.data.xpos[ids].copy(), self.data.xquat[ids].copy()
+
+    def get_state(self) -> F64:
+        """Full integration state (time, qpos, qvel, warm start, applied forces...)."""
+        spec = mujoco.mjtState.mjSTATE_INTEGRATION
+        out = np.empty(mujoco.mj_stateSize(self.model, spec))
+        mujoco.mj_getState(self.model, self.data, out, spec)
+        return out
+
+    def set_state(self, state: F64) -> None:
+        spec = mujoco.mjtState.mjSTATE_INTEGRATION
+        mujoco.mj_setState(self.model, self.data, np.asarray(state, dtype=np.float64), spec)
+        mujoco.mj_forward(self.model, self.data)
+
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` steps with the forces currently in qfrc_applied/xfrc_applied."""
+        mujoco.mj_step(self.model, self.data, nstep=n)
+
+    def kinetic_energy(self, index: int | None = None) -> float:
+        """Kinetic energy (J) of one character (or of everything), 0.5 v^T M v."""
+        m, d = self.model, self.data
+        mv = np.empty(m.nv)
+        mujoco.mj_mulM(m, d, mv, d.qvel)
+        if index is None:
+            return 0.5 * float(d.qvel @ mv)
+        s = self.characters[index].qvel_slice
+        return 0.5 * float(d.qvel[s] @ mv[s])
+
+    def com(self, index: int) -> F64:
+        """Centre of mass of a character (world)."""
+        wc = self.characters[index]
+        root = wc.body_ids[0]
+        return self.data.subtree_com[root].copy()
