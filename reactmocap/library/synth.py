@@ -109,6 +109,7 @@ _Y = np.array([0.0, 1.0, 0.0])
 # relative to the shoulder joint and elbow poles (where the elbow points), in the heading
 # (root-yaw) frame so the arms turn with the body. lball/rball: world position of the ball of
 # the foot; knee poles: world direction the knee points (planted feet and knees are world-fixed).
+# lfree/rfree (first value, 0..1): how far a foot in the air relaxes to the neutral ankle.
 GUARD: dict[str, tuple[float, float, float]] = {
     "root": (0.0, 0.0, 0.91),
     "rootrot": (0.0, 3.0, 0.0),
@@ -130,6 +131,8 @@ GUARD: dict[str, tuple[float, float, float]] = {
     "rfoot": (-30.0, 12.0, 0.0),
     "lknee": (1.0, 0.2, 0.0),
     "rknee": (0.8, -0.5, 0.0),
+    "lfree": (0.0, 0.0, 0.0),
+    "rfree": (0.0, 0.0, 0.0),
 }
 
 
@@ -146,17 +149,15 @@ class _Clip:
         }
 
     def now(self, ch: str) -> F64:
+        """The channel's latest key."""
         return self.keys[ch][-1][1].copy()
 
     def at(self, t: float, **chans: ArrayLike) -> _Clip:
-        """Key ``chans`` at time ``t`` (must not precede the channel's last key)."""
+        """Key ``chans`` at time ``t`` (replacing a key at the same time)."""
         for ch, v in chans.items():
-            keys = self.keys[ch]
-            if t < keys[-1][0] - 1e-9:
-                raise ValueError(f"key {ch}@{t} before {keys[-1][0]}")
-            if abs(t - keys[-1][0]) < 1e-9:
-                keys.pop()
+            keys = [k for k in self.keys[ch] if abs(k[0] - t) > 1e-9]
             keys.append((t, np.asarray(v, dtype=float)))
+            self.keys[ch] = sorted(keys, key=lambda k: k[0])
         return self
 
     def hold(self, t: float, *chans: str) -> _Clip:
@@ -180,11 +181,12 @@ class _Clip:
         to: ArrayLike,
         foot: ArrayLike | None = None,
         h: float = 0.08,
+        turn_late: bool = True,
     ) -> _Clip:
         """Swing foot ``side`` ('l'/'r') so its ball lands at ``to`` (x, y[, z]).
 
-        The foot rises before it moves or turns and stops before it lands (no sliding near the
-        ground); ``foot`` is its new yaw/pitch/roll.
+        The foot rises before it moves (and turns, if ``turn_late``) and stops before it lands (no
+        sliding near the ground); ``foot`` is its new yaw/pitch/roll.
         """
         ball, fch = side + "ball", side + "foot"
         a = self.now(ball)
@@ -193,7 +195,11 @@ class _Clip:
         f1 = f0 if foot is None else np.asarray(foot, float)
         d, up = t1 - t0, np.array([0.0, 0.0, h])
         self.at(t0, **{ball: a, fch: f0})
-        self.at(t0 + 0.2 * d, **{ball: a + 0.5 * up, fch: f0})
+        self.at(t0 + 0.2 * d, **({ball: a + 0.5 * up, fch: f0} if turn_late else {ball: a + 0.5 * up}))
+        if not turn_late:  # flying (falls): the ankle goes limp mid-swing
+            z, one = np.zeros(3), np.array([1.0, 0.0, 0.0])
+            self.at(t0, **{side + "free": z}).at(t0 + 0.3 * d, **{side + "free": one})
+            self.at(t1 - 0.4 * d, **{side + "free": one}).at(t1 - 0.15 * d, **{side + "free": z})
         self.at(t0 + 0.5 * d, **{ball: 0.5 * (a + b) + up})
         self.at(t1 - 0.2 * d, **{ball: b + 0.5 * up, fch: f1})
         return self.at(t1, **{ball: b, fch: f1})
@@ -295,6 +301,10 @@ def _locals(c: dict[str, F64], root: F64) -> F64:
         loc[:, thigh] = np.swapaxes(loc[:, 0], -1, -2) @ up
         loc[:, shin] = hinge
         loc[:, foot] = np.swapaxes(up @ hinge, -1, -2) @ rf
+        free = np.clip(c[s + "free"][:, 0], 0.0, 1.0)
+        if free.any():  # a flying foot relaxes toward the neutral ankle (keeps ankles in range)
+            rv = Rotation.from_matrix(loc[:, foot]).as_rotvec()
+            loc[:, foot] = Rotation.from_rotvec(rv * (1.0 - free)[:, None]).as_matrix()
         # toes stay flat on the floor when the heel is raised
         loc[:, toe] = _rotvec(np.outer(-np.maximum(c[s + "foot"][:, 1], 0.0), _Y))
     return loc
@@ -621,21 +631,22 @@ def _fall_sideways() -> _Clip:
     c.at(0.5, root=(0.02, 0.30, 0.84), rootrot=(0.0, 5.0, -20.0))
     c.step("r", 0.45, 0.8, (0.10, 0.20), foot=(-10.0, 0.0, 0.0), h=0.08)
     c.at(1.0, root=(0.08, 0.62, 0.45), rootrot=(0.0, 10.0, -40.0), lknee=(1.0, 0.3, 0.2))
-    c.at(1.0, rknee=(1.0, 0.2, 0.2), lhand=(0.25, 0.25, -0.35), lelbow=(0.0, 1.0, 0.0))
+    c.at(1.0, rknee=(1.0, 0.2, 0.2), lhand=(0.25, 0.15, -0.35), lelbow=(0.0, -0.3, -1.0))
     c.at(1.35, root=(0.12, 0.82, 0.18), rootrot=(0.0, 8.0, -65.0))
     # legs fold up off the floor as the hip lands, and come down on their sides
     lie_root, lie_rot = (0.10, 0.92, 0.16), (0.0, 5.0, -88.0)
     legs = {
-        **_leg(lie_root, lie_rot, "l", (0.0, -45.0, 0.0), 80.0),
+        **_leg(lie_root, lie_rot, "l", (-4.0, -45.0, 0.0), 80.0),
         **_leg(lie_root, lie_rot, "r", (0.0, -55.0, 0.0), 90.0),
     }
-    c.step("l", 1.0, 1.6, legs["lball"], foot=legs["lfoot"], h=0.12)
-    c.step("r", 1.1, 1.75, legs["rball"], foot=legs["rfoot"], h=0.12)
-    c.at(1.6, lknee=legs["lknee"]).at(1.75, rknee=legs["rknee"])
+    c.step("l", 0.85, 1.55, legs["lball"], foot=legs["lfoot"], h=0.12, turn_late=False)
+    c.at(0.85, rfoot=(-10.0, 20.0, 0.0))  # heel up while the hips drop
+    c.step("r", 0.95, 1.7, legs["rball"], foot=legs["rfoot"], h=0.12, turn_late=False)
+    c.at(1.55, lknee=legs["lknee"]).at(1.7, rknee=legs["rknee"])
     lying = dict(
-        root=lie_root, rootrot=lie_rot, Spine=(6.0, 5.0, 0.0), Spine1=(6.0, 5.0, 0.0),
-        Neck=(5.0, 5.0, 0.0), Head=(0.0, 0.0, 0.0), lhand=(0.45, 0.15, 0.02),
-        rhand=(0.30, 0.0, -0.40), lelbow=(0.0, -1.0, 0.0), relbow=(-0.2, 0.0, 1.0),
+        root=lie_root, rootrot=lie_rot, Spine=(4.0, 5.0, 0.0), Spine1=(4.0, 5.0, 0.0),
+        Neck=(-12.0, 5.0, 0.0), Head=(-10.0, 0.0, 0.0), lhand=(0.50, 0.05, 0.0),
+        rhand=(0.35, 0.0, -0.22), lelbow=(0.0, -1.0, 0.3), relbow=(-0.2, 0.0, 1.0),
     )  # fmt: skip
     return c.at(1.9, **lying).hold(4.5, *lying)
 

@@ -204,29 +204,32 @@ def window_distances(
     wp: F64,
     wq: F64,
     groups: F64 | None = None,
+    offsets: NDArray[np.int64] | None = None,
 ) -> tuple[F64, F64 | None]:
-    """Exact ``D`` between ``query`` and the library windows starting at ``starts``.
+    """``D`` between ``query`` and the library windows starting at ``starts``.
 
+    With ``offsets`` (a subset of window frames) and ``window_weights`` given per offset, this is
+    the coarse version of ``D`` used to pre-rank candidates; without, the exact ``D``.
     Returns ``(D (C,), breakdown (C, 6) or None)``; the breakdown (when ``groups`` is given)
     follows :data:`BREAKDOWN_TERMS` and sums to ``D``.
     """
-    L = query.positions.shape[0]
-    idx = starts[:, None] + np.arange(L)[None, :]
+    if offsets is None:
+        offsets = np.arange(query.positions.shape[0])
+        qp, qq = query.positions, query.orientations
+    else:
+        qp, qq = query.positions[offsets], query.orientations[offsets]
+    idx = starts[:, None] + offsets[None, :]
     lp, lq = localize(positions[idx], orientations[idx], heading[starts], origin[starts])
-    dpos = np.sqrt(((lp - query.positions[None]) ** 2).sum(-1))  # (C, L, P)
-    a = lq
-    b = query.orientations[None]
-    aw, av = a[..., :1], a[..., 1:]
-    bw, bv = b[..., :1], b[..., 1:]
-    cx = av[..., 1] * bv[..., 2] - av[..., 2] * bv[..., 1]
-    cy = av[..., 2] * bv[..., 0] - av[..., 0] * bv[..., 2]
-    cz = av[..., 0] * bv[..., 1] - av[..., 1] * bv[..., 0]
-    vec = aw * bv - bw * av
-    vec[..., 0] -= cx
-    vec[..., 1] -= cy
-    vec[..., 2] -= cz
-    dang = 2.0 * np.sqrt((vec * vec).sum(-1))  # (C, L, P)
-    wi = window_weights.astype(np.float32)
+    lp -= qp[None]
+    dpos = np.sqrt(np.einsum("clpk,clpk->clp", lp, lp))  # (C, L, P)
+    # vec(conj(a) * b) = a_w b_v - b_w a_v - a_v x b_v, a = library (local), b = query
+    aw, ax, ay, az = lq[..., 0], lq[..., 1], lq[..., 2], lq[..., 3]
+    bw, bx, by, bz = qq[None, ..., 0], qq[None, ..., 1], qq[None, ..., 2], qq[None, ..., 3]
+    vx = aw * bx - bw * ax - (ay * bz - az * by)
+    vy = aw * by - bw * ay - (az * bx - ax * bz)
+    vz = aw * bz - bw * az - (ax * by - ay * bx)
+    dang = 2.0 * np.sqrt(vx * vx + vy * vy + vz * vz)  # (C, L, P)
+    wi = np.asarray(window_weights, dtype=np.float32)
     sp = np.einsum("clp,l->cp", dpos, wi).astype(np.float64)  # per part, time-weighted
     sa = np.einsum("clp,l->cp", dang, wi).astype(np.float64)
     total = sp @ wp + sa @ wq

@@ -57,6 +57,8 @@ __all__ = [
 FORMAT_VERSION = 1
 MIRROR_SUFFIX = "_mirror"
 _CHUNK = 4096
+#: frames per window in the coarse pre-ranking of KD candidates
+COARSE_FRAMES = 10
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -504,14 +506,27 @@ class MotionIndex:
             cache[key] = calibrate(motion.skeleton, self.feature_set, parts)
         return cache[key]
 
-    def _distances(self, qw: QueryWindow, starts: I64, breakdown: bool = False) -> tuple[F64, F64 | None]:
+    def _distances(
+        self, qw: QueryWindow, starts: I64, breakdown: bool = False, coarse: bool = False
+    ) -> tuple[F64, F64 | None]:
         fs = self.feature_set
         wp, wq = body_weights(fs, self.weights, qw.support)
         groups = group_matrix(fs, qw.support) if breakdown else None
+        ww = self.weights.window_weights(self.length)
+        offsets = None
+        if coarse:
+            offsets = self._coarse_offsets()
+            ww = embedding_frame_weights(ww, offsets)
         return window_distances(
             self.positions, self.orientations, self.heading, self.origin, starts, qw,
-            self.weights.window_weights(self.length), wp, wq, groups,
+            ww, wp, wq, groups, offsets,
         )  # fmt: skip
+
+    def _coarse_offsets(self) -> I64:
+        """Window frames of the coarse pre-ranking: about ``COARSE_FRAMES`` evenly spaced."""
+        L = self.length
+        step = max(1, int(np.ceil((L - 1) / (COARSE_FRAMES - 1))))
+        return np.unique(np.append(np.arange(0, L, step), L - 1)).astype(np.int64)
 
     def _embed_query(self, qw: QueryWindow) -> F32:
         wp, wq, fw, offs = self._embedding_weights()
@@ -519,36 +534,40 @@ class MotionIndex:
         return ((e - self.pca_mean) @ self.pca_components)[0]
 
     def search_window(
-        self, qw: QueryWindow, *, n: int = 1, k: int = 32, refine: int = 4
+        self, qw: QueryWindow, *, n: int = 1, k: int = 32, refine: int = 4, exact: int = 8
     ) -> list[SearchResult]:
-        """Search with a prepared query window: KD candidates -> exact ``D`` -> refinement of the
-        surrounding interval of the ``refine`` best candidates -> ``n`` distinct results."""
+        """Search with a prepared query window.
+
+        1. ``k`` nearest indexed windows in the PCA embedding (KD-tree);
+        2. pre-rank them with a coarse ``D`` (query support weight included) on about
+           ``COARSE_FRAMES`` frames of the window (exact when ``L <= COARSE_FRAMES``);
+        3. exact ``D`` for the best ``exact`` of them and for every window in the surrounding
+           unique-frame interval of the best ``refine`` (the paper's local refinement);
+        4. the ``n`` best distinct windows by exact ``D``.
+        """
         t0 = time.perf_counter()
-        if n < 1 or k < 1 or refine < 0:
-            raise SearchError(f"need n >= 1, k >= 1 and refine >= 0 (got n={n}, k={k}, refine={refine})")
+        if n < 1 or k < 1 or refine < 0 or exact < 1:
+            raise SearchError(
+                f"need n >= 1, k >= 1, refine >= 0, exact >= 1 (got n={n}, k={k}, refine={refine}, exact={exact})"
+            )
         k = min(k, self.num_indexed)
         _, rows = self.tree.query(self._embed_query(qw), k=k)
         rows = np.atleast_1d(np.asarray(rows, dtype=np.int64))
         rows = rows[rows < self.num_indexed]
         cand = self.kept[rows]
-        d, _ = self._distances(qw, cand)
+        coarse = self.length > COARSE_FRAMES
+        d, _ = self._distances(qw, cand, coarse=coarse)
         order = np.argsort(d, kind="stable")
-        best_rows = rows[order[: max(refine, 1)]] if refine > 0 else rows[order[:0]]
-        extra = [
-            np.arange(self.interval_lo[r], self.interval_hi[r] + 1, dtype=np.int64) for r in best_rows
+        pieces = [cand[order[: max(exact, n)]]]
+        pieces += [
+            np.arange(self.interval_lo[r], self.interval_hi[r] + 1, dtype=np.int64)
+            for r in rows[order[:refine]]
         ]
-        starts, dists = cand, d
-        refined = 0
-        if extra:
-            more = np.setdiff1d(np.concatenate(extra), cand)
-            refined = int(more.size)
-            if more.size:
-                d2, _ = self._distances(qw, more)
-                starts = np.concatenate([cand, more])
-                dists = np.concatenate([d, d2])
+        starts = np.unique(np.concatenate(pieces))
+        dists, _ = self._distances(qw, starts)
         results = self._results(qw, starts, dists, n)
         self.last_stats = QueryStats(
-            candidates=int(cand.size), refined_windows=refined, seconds=time.perf_counter() - t0
+            candidates=int(cand.size), refined_windows=int(starts.size), seconds=time.perf_counter() - t0
         )
         return results
 

@@ -1,0 +1,277 @@
+"""The index: self-retrieval, agreement with brute force, weights, persistence, bad input."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reactmocap.errors import SearchError
+from reactmocap.library.motion import Motion
+from reactmocap.rotations import quat_exp, quat_mul
+from reactmocap.search import MotionIndex, SearchWeights, WindowConfig, brute_force, get_feature_set
+
+
+def _wrap(a: float) -> float:
+    return float((a + np.pi) % (2 * np.pi) - np.pi)
+
+
+def _distinctive_windows(index: MotionIndex, clips: dict[str, Motion], n: int, rng, step: int = 1):
+    """Random (clip, frame) whose window has no near-duplicate elsewhere in the library (the
+    synthetic clips share identical stationary stretches, where any copy is a correct answer)."""
+    names = sorted(clips)
+    out = []
+    tries = 0
+    while len(out) < n and tries < 50 * n:
+        tries += 1
+        name = names[int(rng.integers(len(names)))]
+        m = clips[name]
+        span = int(np.ceil((index.length - 1) * m.fps / index.window.fps))
+        if m.num_frames <= span + step:
+            continue
+        f = int(rng.integers(0, (m.num_frames - span) // step)) * step
+        top = brute_force(index, m, f, n=2)
+        if len(top) == 2 and top[0].clip == name and top[1].distance > 0.02:
+            out.append((name, f))
+    assert len(out) == n, "not enough distinctive windows in the test library"
+    return out
+
+
+def _check_self_retrieval(index: MotionIndex, clips: dict[str, Motion], queries, rng) -> None:
+    for name, f in queries:
+        m = clips[name]
+        yaw = float(rng.uniform(-np.pi, np.pi))
+        shift = rng.uniform(-20, 20, 2)
+        r = index.query(m.transformed(yaw, shift), f)
+        assert (r.clip, r.frame) == (name, f), (name, f, r)
+        assert r.distance < 1e-4
+        assert abs(_wrap(r.yaw - yaw)) < 1e-4
+        np.testing.assert_allclose(r.translation, shift, atol=1e-4)
+        # the returned alignment maps the library clip onto the query
+        found = m.transformed(r.yaw, r.translation)
+        span = int(round((index.length - 1) * m.fps / index.window.fps)) + 1
+        qpos = m.transformed(yaw, shift).slice(f, f + span).global_positions()
+        np.testing.assert_allclose(found.slice(f, f + span).global_positions(), qpos, atol=1e-4)
+
+
+def test_self_retrieval_synthetic(synth_index: MotionIndex, synth_clips: dict[str, Motion]) -> None:
+    rng = np.random.default_rng(11)
+    clips = dict(synth_clips)
+    clips.update({n + "_mirror": m.mirror() for n, m in synth_clips.items()})
+    # 60 fps clips, 30 Hz index: even frames fall on index frames
+    queries = _distinctive_windows(synth_index, clips, 40, rng, step=2)
+    assert any(n.endswith("_mirror") for n, _ in queries)
+    _check_self_retrieval(synth_index, clips, queries, rng)
+
+
+def test_self_retrieval_synthetic_at_clip_rate(synth_clips: dict[str, Motion]) -> None:
+    index = MotionIndex.build(synth_clips, window=WindowConfig(fps=60.0, duration=0.25))
+    rng = np.random.default_rng(5)
+    _check_self_retrieval(index, synth_clips, _distinctive_windows(index, synth_clips, 25, rng), rng)
+
+
+def test_self_retrieval_real_clips(real_clips: dict[str, Motion]) -> None:
+    index = MotionIndex.build(real_clips, window=WindowConfig(fps=30.0), mirror=True)
+    clips = dict(real_clips)
+    clips.update({n + "_mirror": m.mirror() for n, m in real_clips.items()})
+    rng = np.random.default_rng(3)
+    _check_self_retrieval(index, clips, _distinctive_windows(index, clips, 40, rng), rng)
+
+
+def _noisy(m: Motion, rng, sigma: float) -> Motion:
+    noise = quat_exp(0.5 * rng.normal(0.0, sigma, m.rotations.shape[:-1] + (3,)))
+    return m.replace(rotations=quat_mul(m.rotations, noise))
+
+
+def test_agreement_with_brute_force(synth_index: MotionIndex, synth_clips: dict[str, Motion]) -> None:
+    """Indexed search vs exact D over *all* windows, 240 perturbed queries. The embedding is
+    approximate, so recall is measured: the indexed D must equal the brute-force optimum for
+    >= 90% of queries and never exceed it by more than 10%. Exhaustive settings must be exact."""
+    rng = np.random.default_rng(2024)
+    names = sorted(synth_clips)
+    hits, ratios = 0, []
+    n = 240
+    for i in range(n):
+        m = synth_clips[names[i % len(names)]]
+        f = int(rng.integers(0, m.num_frames - 20))
+        q = _noisy(m.transformed(float(rng.uniform(-3, 3)), rng.uniform(-5, 5, 2)), rng, 0.1)
+        best = brute_force(synth_index, q, f)[0]
+        got = synth_index.query(q, f)
+        assert got.distance >= best.distance - 1e-9  # brute force is the optimum
+        hits += got.distance <= best.distance * (1 + 1e-6) + 1e-12
+        ratios.append(got.distance / best.distance)
+        if i < 20:  # exhaustive: every indexed window and every interval -> exactly brute force
+            ex = synth_index.query(q, f, k=synth_index.num_indexed, refine=synth_index.num_indexed)
+            assert ex.distance == pytest.approx(best.distance, rel=1e-9, abs=1e-12)
+            assert (ex.clip, ex.index_frame) == (best.clip, best.index_frame)
+    recall = hits / n
+    assert recall >= 0.9, f"recall@1 {recall:.3f}"
+    assert max(ratios) < 1.1, f"worst D ratio {max(ratios):.3f}"
+
+
+def test_weights_matter(synth_index: MotionIndex, synth_clips: dict[str, Motion]) -> None:
+    """Moving one limb body moves D less than moving one trunk body by the same amount; the
+    support body counts more than the other foot."""
+    m = synth_clips["side_kick"]
+    qw = synth_index.prepare_query(m, 20)
+    start = np.array([synth_index.clip_offsets[synth_index.clip_index("side_kick")] + 10])
+    parts = get_feature_set("paper").parts
+    assert synth_index._distances(qw, start)[0][0] < 1e-6
+
+    def moved(part: str, dp=(0.0, 0.0, 0.0), turn: float = 0.0) -> float:
+        b = parts.index(part)
+        pos = np.array(qw.positions)
+        pos[:, b] += np.asarray(dp, dtype=np.float32)
+        ori = np.array(qw.orientations)
+        q = np.array([np.cos(turn / 2), np.sin(turn / 2), 0, 0], dtype=np.float32)
+        ori[:, b] = quat_mul(ori[:, b], q)
+        return float(synth_index._distances(replace(qw, positions=pos, orientations=ori), start)[0][0])
+
+    for trunk, limb in (("chest", "l_forearm"), ("head", "r_hand"), ("waist", "l_shin")):
+        assert moved(limb, dp=(0.05, 0, 0)) < moved(trunk, dp=(0.05, 0, 0))
+        assert moved(limb, turn=0.3) < moved(trunk, turn=0.3)
+    support = qw.support_part
+    assert support in ("l_foot", "r_foot")
+    other = "r_foot" if support == "l_foot" else "l_foot"
+    assert moved(other, dp=(0.05, 0, 0)) < moved(support, dp=(0.05, 0, 0))
+
+    # and at the Motion level: bend the head joint vs the same bend of a wrist
+    def bent(joint: str, angle: float) -> float:
+        j = m.skeleton.index(joint)
+        rot = np.array(m.rotations)
+        rot[:, j] = quat_mul(rot[:, j], quat_exp(np.array([angle / 2, 0, 0])))
+        return synth_index.window_distance(m.replace(rotations=rot), 20, "side_kick", 10).distance
+
+    head = next(n for n in m.skeleton.names if n.lower().endswith("head"))
+    hand = next(n for n in m.skeleton.names if n.lower() in ("lefthand", "lhand", "hand_l", "lwrist"))
+    assert 0 < bent(hand, 0.4) < bent(head, 0.4)
+
+
+def test_breakdown_and_top_k(synth_index: MotionIndex, synth_clips: dict[str, Motion]) -> None:
+    m = _noisy(synth_clips["push"], np.random.default_rng(0), 0.05)
+    res = synth_index.top_k(m, 30, n=5)
+    assert len(res) == 5
+    assert [r.rank for r in res] == list(range(5))
+    d = [r.distance for r in res]
+    assert d == sorted(d)
+    assert res[0].distance == pytest.approx(synth_index.query(m, 30).distance)
+    for r in res:
+        assert r.breakdown.total == pytest.approx(r.distance, rel=1e-6)
+        assert r.breakdown.support_part in ("l_foot", "r_foot")
+        assert abs(r.yaw_deg - np.degrees(r.yaw)) < 1e-9
+    for i, a in enumerate(res):  # runners-up are distinct windows
+        for b in res[:i]:
+            assert a.clip != b.clip or abs(a.index_frame - b.index_frame) >= synth_index.length
+    d = res[0].to_dict()
+    assert {"clip", "frame", "distance", "yaw_deg", "translation", "breakdown"} <= set(d)
+
+
+def test_save_load_round_trip(tmp_path: Path, synth_index: MotionIndex, synth_clips: dict[str, Motion]) -> None:
+    path = synth_index.save(tmp_path / "idx.npz")
+    assert [p.name for p in tmp_path.iterdir()] == ["idx.npz"]  # no temporary left behind
+    loaded = MotionIndex.load(path, clips=synth_clips, weights=SearchWeights(), window=WindowConfig(), mirror=True)
+    assert loaded.fingerprint == synth_index.fingerprint
+    q = synth_clips["sway"].transformed(1.0, (2.0, 3.0))
+    a, b = synth_index.top_k(q, 12, n=3), loaded.top_k(q, 12, n=3)
+    assert [(r.clip, r.frame, r.distance) for r in a] == [(r.clip, r.frame, r.distance) for r in b]
+    for arr in (loaded.positions, loaded.embedding, loaded.kept, synth_index.orientations):
+        with pytest.raises(ValueError):
+            arr[0] = 0
+
+
+def test_stale_index_is_rejected_or_rebuilt(tmp_path: Path, synth_clips: dict[str, Motion]) -> None:
+    small = {k: synth_clips[k] for k in ("guard", "punch", "push")}
+    path = tmp_path / "small.npz"
+    MotionIndex.build(small).save(path)
+    MotionIndex.load(path, clips=small, weights=SearchWeights(), window=WindowConfig(), mirror=False)
+    with pytest.raises(SearchError, match="weights differ"):
+        MotionIndex.load(path, weights=SearchWeights(limb_position=0.3))
+    with pytest.raises(SearchError, match="window settings differ"):
+        MotionIndex.load(path, window=WindowConfig(duration=0.5))
+    with pytest.raises(SearchError, match="mirroring differs"):
+        MotionIndex.load(path, mirror=True)
+    edited = dict(small)
+    g = small["guard"]
+    edited["guard"] = g.replace(root_positions=np.asarray(g.root_positions) + [0, 0, 0.001])
+    with pytest.raises(SearchError, match=r"small\.npz.*clips changed"):
+        MotionIndex.load(path, clips=edited)
+    renamed = {("x_" + k): v for k, v in small.items()}
+    with pytest.raises(SearchError, match="clips changed"):
+        MotionIndex.load(path, clips=renamed)
+    # load_or_build: reuses a matching file, rebuilds a stale one
+    before = path.stat().st_mtime_ns
+    MotionIndex.load_or_build(path, small)
+    assert path.stat().st_mtime_ns == before
+    rebuilt = MotionIndex.load_or_build(path, edited, window=WindowConfig(duration=0.2))
+    assert path.stat().st_mtime_ns != before
+    assert rebuilt.window.duration == 0.2
+    MotionIndex.load(path, clips=edited, window=WindowConfig(duration=0.2))
+
+
+@pytest.mark.parametrize(
+    ("content", "match"),
+    [
+        (b"", "not a readable search index"),
+        (b"this is not a zip file at all", "not a readable search index"),
+        (None, "no such index file"),
+    ],
+)
+def test_bad_index_file(tmp_path: Path, content: bytes | None, match: str) -> None:
+    path = tmp_path / "bad.npz"
+    if content is not None:
+        path.write_bytes(content)
+    with pytest.raises(SearchError, match=match) as err:
+        MotionIndex.load(path)
+    assert "bad.npz" in str(err.value)
+
+
+def test_corrupt_and_foreign_npz(tmp_path: Path, synth_clips: dict[str, Motion]) -> None:
+    foreign = tmp_path / "foreign.npz"
+    np.savez(foreign, a=np.zeros(3))
+    with pytest.raises(SearchError, match=r"foreign\.npz: not a reactmocap search index"):
+        MotionIndex.load(foreign)
+    good = MotionIndex.build({"guard": synth_clips["guard"]}).save(tmp_path / "good.npz")
+    data = good.read_bytes()
+    trunc = tmp_path / "truncated.npz"
+    trunc.write_bytes(data[: len(data) // 2])
+    with pytest.raises(SearchError, match=r"truncated\.npz"):
+        MotionIndex.load(trunc)
+    with np.load(good) as z:
+        arrays = {k: z[k] for k in z.files}
+    arrays["kept"] = arrays["kept"][:-3]
+    bad = tmp_path / "inconsistent.npz"
+    np.savez(bad, **arrays)
+    with pytest.raises(SearchError, match=r"inconsistent\.npz: corrupt search index"):
+        MotionIndex.load(bad)
+
+
+def test_bad_queries(synth_index: MotionIndex, synth_clips: dict[str, Motion]) -> None:
+    m = synth_clips["punch"]
+    with pytest.raises(SearchError, match="out of range"):
+        synth_index.query(m, m.num_frames)
+    with pytest.raises(SearchError, match="out of range"):
+        synth_index.query(m, -1)
+    with pytest.raises(SearchError, match="runs past the end"):
+        synth_index.query(m, m.num_frames - 3)
+    with pytest.raises(SearchError, match="runs past the end"):
+        synth_index.query(m.slice(0, 5), 0)  # window longer than the clip
+    with pytest.raises(SearchError, match="no clip named 'nope'"):
+        synth_index.clip_index("nope")
+    with pytest.raises(SearchError, match="no clip named"):
+        synth_index.window_distance(m, 0, "nope", 0)
+    with pytest.raises(SearchError, match="long enough"):
+        MotionIndex.build({"short": m.slice(0, 8)})
+    with pytest.raises(SearchError, match="empty"):
+        MotionIndex.build({})
+
+
+def test_no_leftover_temp_files_on_failed_save(tmp_path: Path, synth_index: MotionIndex) -> None:
+    target = tmp_path / "dir_not_file"
+    target.mkdir()
+    with pytest.raises(SearchError):
+        synth_index.save(target)  # cannot replace a directory
+    assert [p.name for p in tmp_path.iterdir()] == ["dir_not_file"]
+    assert not os.listdir(target)
