@@ -440,7 +440,7 @@ def run_response(scenario: Scenario) -> ResponseResult:
 def _sim_body(ch: Character, part: str) -> str:
     from reactmocap.sim.character import SIM_BODIES
 
-    alias = {"waist": "abdomen", "chest": "thorax", "back": "thorax"}
+    alias = {"abdomen": "waist", "thorax": "chest", "back": "chest", "torso": "chest"}
     name = alias.get(part, part)
     if name not in SIM_BODIES:
         raise ConfigError(

@@ -160,6 +160,8 @@ class World:
         opt.solver = _SOLVERS[cfg.solver]
         opt.cone = _CONES[cfg.cone]
         opt.iterations = cfg.iterations
+        # never reset silently on divergence: rollouts detect it and raise SimulationError
+        opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
         floor = spec.worldbody.add_geom(
             name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0]
         )

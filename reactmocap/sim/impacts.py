@@ -1,0 +1,328 @@
+"""Impacts (external pushes), contact reports, and first contact between two characters during
+kinematic playback.
+
+An :class:`Impact` is a force (N) or an impulse (N s) on one body part at a point (body-local or
+world), starting at ``start`` seconds after the rollout's start and lasting ``duration``
+seconds. It is applied through MuJoCo's ``xfrc_applied``: the force at the point becomes the
+same force at the body's centre of mass plus the torque ``(p - com) x F``. The window is
+discretised to whole steps: ``n = max(1, round(duration / dt))`` steps from step
+``round(start / dt)``; an impulse ``J`` becomes the force ``J / (n dt)``, so the momentum
+delivered is exactly ``J``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.library.motion import Motion
+from reactmocap.sim.character import BODY_ALIASES, SIM_BODIES, Character
+from reactmocap.sim.world import World
+
+__all__ = [
+    "CharacterContact",
+    "ContactReport",
+    "Impact",
+    "ImpactSchedule",
+    "KinematicContact",
+    "contact_report",
+    "first_contact",
+]
+
+F64 = NDArray[np.float64]
+
+
+def _vec3(value: object, what: str) -> tuple[float, float, float]:
+    try:
+        arr = np.asarray(value, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise ConfigError(f"impact {what} must be 3 numbers, got {value!r}") from None
+    if arr.shape != (3,):
+        raise ConfigError(f"impact {what} must be 3 numbers, got {arr.size}: {value!r}")
+    if not np.all(np.isfinite(arr)):
+        raise ConfigError(f"impact {what} contains NaN or inf: {arr.tolist()}")
+    return (float(arr[0]), float(arr[1]), float(arr[2]))
+
+
+@dataclass(frozen=True)
+class Impact:
+    """A push on one body.
+
+    Args:
+        body: a body part (``chest``, ``l_forearm``, ...; aliases ``thorax``, ``abdomen``,
+            ``neck``).
+        force: ``(3,)`` world force in N; or
+        impulse: ``(3,)`` world impulse in N s (exactly one of the two).
+        point: application point; ``None`` = the body's centre of mass.
+        frame: ``"local"`` (point in the body frame, moves with it) or ``"world"`` (point in
+            world coordinates at the impact's start, then carried with the body).
+        start: seconds after the rollout starts. duration: seconds (> 0; an impulse may use 0,
+            meaning a single step).
+        character: index of the character in the World.
+    """
+
+    body: str
+    force: tuple[float, float, float] | None = None
+    impulse: tuple[float, float, float] | None = None
+    point: tuple[float, float, float] | None = None
+    frame: Literal["local", "world"] = "local"
+    start: float = 0.0
+    duration: float = 0.1
+    character: int = 0
+
+    def __post_init__(self) -> None:
+        try:
+            body = Character.body_name(str(self.body))
+        except UnknownKeyError:
+            raise UnknownKeyError(
+                f"impact on unknown body {self.body!r}; valid bodies are {list(SIM_BODIES)} "
+                f"(aliases {dict(BODY_ALIASES)})"
+            ) from None
+        object.__setattr__(self, "body", body)
+        if (self.force is None) == (self.impulse is None):
+            raise ConfigError("an impact needs exactly one of force (N) or impulse (N s)")
+        if self.force is not None:
+            object.__setattr__(self, "force", _vec3(self.force, "force"))
+        if self.impulse is not None:
+            object.__setattr__(self, "impulse", _vec3(self.impulse, "impulse"))
+        if self.point is not None:
+            object.__setattr__(self, "point", _vec3(self.point, "point"))
+        if self.frame not in ("local", "world"):
+            raise ConfigError(f"impact frame must be 'local' or 'world', got {self.frame!r}")
+        for name in ("start", "duration"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise ConfigError(f"impact {name} must be a finite number of seconds, got {v!r}")
+        if self.start < 0:
+            raise ConfigError(f"impact start must be >= 0 s, got {self.start}")
+        if self.duration < 0:
+            raise ConfigError(f"impact duration must be >= 0 s, got {self.duration}")
+        if self.duration == 0 and self.force is not None:
+            raise ConfigError("a force impact needs a positive duration (use impulse= for a kick)")
+        if not isinstance(self.character, int) or self.character < 0:
+            raise ConfigError(f"impact character must be an index >= 0, got {self.character!r}")
+
+    def steps(self, dt: float) -> tuple[int, int]:
+        """(first step, number of steps) of the impact window."""
+        return round(self.start / dt), max(1, round(self.duration / dt))
+
+    def force_vector(self, dt: float) -> F64:
+        """The world force applied during each step of the window (N)."""
+        if self.force is not None:
+            return np.array(self.force)
+        return np.array(self.impulse) / (self.steps(dt)[1] * dt)
+
+
+@dataclass
+class ImpactSchedule:
+    """Impacts of one rollout, resolved against a World (body ids, step windows)."""
+
+    world: World
+    impacts: Sequence[Impact]
+    _rows: list[tuple[int, int, int, F64, F64 | None, str]] = field(default_factory=list)
+    _local_point: dict[int, F64] = field(default_factory=dict)
+    _touched: set[int] = field(default_factory=set)
+
+    def __post_init__(self) -> None:
+        dt = self.world.timestep
+        for k, imp in enumerate(self.impacts):
+            if imp.character >= len(self.world.characters):
+                raise ConfigError(
+                    f"impact on character {imp.character}, but the world has "
+                    f"{len(self.world.characters)}"
+                )
+            bid = self.world.characters[imp.character].body_id(imp.body)
+            k0, n = imp.steps(dt)
+            pt = None if imp.point is None else np.array(imp.point)
+            self._rows.append((k, bid, k0, imp.force_vector(dt), pt, imp.frame))
+            del n
+
+    def window_end(self) -> int:
+        dt = self.world.timestep
+        return max((sum(i.steps(dt)) for i in self.impacts), default=0)
+
+    def apply(self, step: int) -> None:
+        """Set xfrc_applied for rollout step ``step`` (clears bodies whose window ended)."""
+        d = self.world.data
+        dt = self.world.timestep
+        for bid in self._touched:
+            d.xfrc_applied[bid] = 0.0
+        self._touched.clear()
+        for k, bid, k0, force, pt, frame in self._rows:
+            n = self.impacts[k].steps(dt)[1]
+            if not k0 <= step < k0 + n:
+                continue
+            rot = d.xmat[bid].reshape(3, 3)
+            if pt is None:
+                p = d.xipos[bid]
+            elif frame == "local":
+                p = d.xpos[bid] + rot @ pt
+            else:
+                if k not in self._local_point:  # carried with the body from the start
+                    self._local_point[k] = rot.T @ (pt - d.xpos[bid])
+                p = d.xpos[bid] + rot @ self._local_point[k]
+            d.xfrc_applied[bid, :3] += force
+            d.xfrc_applied[bid, 3:] += np.cross(p - d.xipos[bid], force)
+            self._touched.add(bid)
+
+    def clear(self) -> None:
+        for bid in self._touched:
+            self.world.data.xfrc_applied[bid] = 0.0
+        self._touched.clear()
+
+
+# ---------------------------------------------------------------------------------- contacts
+@dataclass(frozen=True)
+class CharacterContact:
+    """One contact point between two characters. ``force`` is the world force on ``body_b``
+    (character ``b``) from ``body_a`` (equal and opposite on ``body_a``)."""
+
+    character_a: int
+    body_a: str
+    character_b: int
+    body_b: str
+    position: tuple[float, float, float]
+    force: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class ContactReport:
+    """Contacts at one instant.
+
+    ``ground``: per character, the bodies touching the floor (ground-support bodies);
+    ``ground_force``: per character, the total world force from the floor (N);
+    ``between``: character-character contacts.
+    """
+
+    time: float
+    ground: tuple[tuple[str, ...], ...]
+    ground_force: tuple[tuple[float, float, float], ...]
+    between: tuple[CharacterContact, ...]
+
+
+def _owner(world: World) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Per geom: character index (-1 for the floor) and sim-body index."""
+    m = world.model
+    char = np.full(m.ngeom, -1, dtype=np.int64)
+    body = np.full(m.ngeom, -1, dtype=np.int64)
+    for wc in world.characters:
+        for i, bid in enumerate(wc.body_ids):
+            sel = m.geom_bodyid == bid
+            char[sel] = wc.index
+            body[sel] = i
+    return char, body
+
+
+def contact_report(world: World) -> ContactReport:
+    """Who touches what, with forces (``mj_contactForce``), for the current state."""
+    m, d = world.model, world.data
+    owner = getattr(world, "_geom_owner", None)
+    if owner is None:
+        owner = _owner(world)
+        world._geom_owner = owner  # type: ignore[attr-defined]
+    char, body = owner
+    nchar = len(world.characters)
+    ground: list[set[str]] = [set() for _ in range(nchar)]
+    gforce = np.zeros((nchar, 3))
+    between = []
+    f6 = np.zeros(6)
+    for i in range(d.ncon):
+        con = d.contact[i]
+        g1, g2 = int(con.geom1), int(con.geom2)
+        mujoco.mj_contactForce(m, d, i, f6)
+        frame = np.asarray(con.frame).reshape(3, 3)
+        fw = frame.T @ f6[:3]  # on geom2 from geom1, world
+        c1, c2 = int(char[g1]), int(char[g2])
+        if c1 < 0 or c2 < 0:  # floor contact
+            c, g, sign = (c2, g2, 1.0) if c1 < 0 else (c1, g1, -1.0)
+            if c >= 0:
+                ground[c].add(SIM_BODIES[body[g]])
+                gforce[c] += sign * fw
+        elif c1 != c2:
+            between.append(
+                CharacterContact(
+                    c1, SIM_BODIES[body[g1]], c2, SIM_BODIES[body[g2]],
+                    tuple(float(x) for x in con.pos), tuple(float(x) for x in fw),
+                )
+            )
+    return ContactReport(
+        time=float(d.time),
+        ground=tuple(tuple(sorted(g)) for g in ground),
+        ground_force=tuple(tuple(float(x) for x in f) for f in gforce),
+        between=tuple(between),
+    )
+
+
+@dataclass(frozen=True)
+class KinematicContact:
+    """First contact between two characters playing their motions kinematically.
+
+    ``frame``/``time``: first sampled frame with contact; ``rewind_frame``/``rewind_time``: the
+    last sampled (motion-capture) frame before it, where a simulation should start;
+    ``pairs``: (body of character 0, body of character 1) touching at ``frame``.
+    """
+
+    frame: int
+    time: float
+    rewind_frame: int
+    rewind_time: float
+    pairs: tuple[tuple[str, str], ...]
+
+
+def first_contact(
+    world: World,
+    motions: Sequence[Motion],
+    fps: float = 30.0,
+    start: float = 0.0,
+    end: float | None = None,
+    margin: float = 0.0,
+) -> KinematicContact | None:
+    """Scan two characters' motions at ``fps`` (kinematic playback, no dynamics) for the first
+    frame where their geoms touch (penetration deeper than ``-margin``). Times are seconds
+    from the motions' start. Returns None if they never touch. The world's state is
+    overwritten (positions set with ``mj_kinematics`` + ``mj_collision``)."""
+    if len(world.characters) != 2 or len(motions) != 2:
+        raise ConfigError("first_contact needs a world with two characters and two motions")
+    if not (np.isfinite(fps) and fps > 0):
+        raise ConfigError(f"fps must be positive, got {fps!r}")
+    m, d = world.model, world.data
+    stop = min(mo.duration for mo in motions) if end is None else float(end)
+    times = np.arange(start, stop + 1e-9, 1.0 / fps)
+    if times.size == 0:
+        return None
+    qs = [
+        wc.character.qpos_from_motion(mo.sample(times))
+        for wc, mo in zip(world.characters, motions)
+    ]
+    char, body = _owner(world)
+    old_margin = m.geom_margin.copy()
+    m.geom_margin[:] = max(margin, 0.0)
+    try:
+        for k in range(times.size):
+            for wc, q in zip(world.characters, qs):
+                d.qpos[wc.qpos_slice] = q[k]
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_collision(m, d)
+            pairs = set()
+            for i in range(d.ncon):
+                g1, g2 = int(d.contact[i].geom1), int(d.contact[i].geom2)
+                c1, c2 = int(char[g1]), int(char[g2])
+                if c1 >= 0 and c2 >= 0 and c1 != c2 and d.contact[i].dist <= margin:
+                    a, b = (g1, g2) if c1 == 0 else (g2, g1)
+                    pairs.add((SIM_BODIES[body[a]], SIM_BODIES[body[b]]))
+            if pairs:
+                rk = max(k - 1, 0)
+                return KinematicContact(
+                    k + int(round(start * fps)), float(times[k]),
+                    rk + int(round(start * fps)), float(times[rk]), tuple(sorted(pairs)),
+                )
+    finally:
+        m.geom_margin[:] = old_margin
+    return None
