@@ -48,27 +48,39 @@ F64 = NDArray[np.float64]
 # (name, parent, rest offset in the parent's frame: Z-up metres, x forward, y left). Arms hang
 # at the sides in the rest pose; every leg and arm bone points straight down (-Z), which the IK
 # below relies on.
-_LEFT = (
+_Row = tuple[str, str | None, tuple[float, float, float]]
+_LEFT_ARM: tuple[_Row, ...] = (
     ("LeftShoulder", "Spine1", (0.0, 0.03, 0.17)),
-    ("LeftArm", "LeftShoulder", (0.0, 0.17, 0.0)),
+    ("LeftArm", "LeftShoulder", (0.0, 0.17, 0.0)),  # shoulders 0.40 m apart
     ("LeftForeArm", "LeftArm", (0.0, 0.0, -0.29)),
     ("LeftHand", "LeftForeArm", (0.0, 0.0, -0.26)),
+)
+_LEFT_LEG: tuple[_Row, ...] = (
     ("LeftUpLeg", "Hips", (0.0, 0.09, -0.05)),
     ("LeftLeg", "LeftUpLeg", (0.0, 0.0, -0.42)),
     ("LeftFoot", "LeftLeg", (0.0, 0.0, -0.40)),
-    ("LeftToeBase", "LeftFoot", (0.13, 0.0, -0.06)),
+    ("LeftToeBase", "LeftFoot", (0.13, 0.0, -0.06)),  # ball of the foot
 )
-_JOINTS: tuple[tuple[str, str | None, tuple[float, float, float]], ...] = (
+
+
+def _right(rows: tuple[_Row, ...]) -> tuple[_Row, ...]:
+    return tuple(
+        (n.replace("Left", "Right"), str(p).replace("Left", "Right"), (x, -y, z))
+        for n, p, (x, y, z) in rows
+    )
+
+
+_JOINTS: tuple[_Row, ...] = (
     ("Hips", None, (0.0, 0.0, 0.0)),  # rest height 0.95 m: hip joints 0.90, ankles 0.08
     ("Spine", "Hips", (0.0, 0.0, 0.09)),
     ("Spine1", "Spine", (0.0, 0.0, 0.19)),
     ("Neck", "Spine1", (0.0, 0.0, 0.22)),
     ("Head", "Neck", (0.0, 0.0, 0.12)),
-    *_LEFT[:4],
-    *((n.replace("Left", "Right"), p.replace("Left", "Right"), (x, -y, z)) for n, p, (x, y, z) in _LEFT[:4]),
-    *_LEFT[4:],
-    *((n.replace("Left", "Right"), p.replace("Left", "Right"), (x, -y, z)) for n, p, (x, y, z) in _LEFT[4:]),
-)  # fmt: skip
+    *_LEFT_ARM,
+    *_right(_LEFT_ARM),
+    *_LEFT_LEG,
+    *_right(_LEFT_LEG),
+)
 _NAMES = tuple(j[0] for j in _JOINTS)
 _IDX = {n: i for i, n in enumerate(_NAMES)}
 _END_SITES = {
@@ -190,12 +202,18 @@ class _Clip:
         """
         ball, fch = side + "ball", side + "foot"
         a = self.now(ball)
-        b = np.array([*np.asarray(to, float)[:2], a[2]]) if np.size(to) == 2 else np.asarray(to, float)
+        b = (
+            np.array([*np.asarray(to, float)[:2], a[2]])
+            if np.size(to) == 2
+            else np.asarray(to, float)
+        )
         f0 = self.now(fch)
         f1 = f0 if foot is None else np.asarray(foot, float)
         d, up = t1 - t0, np.array([0.0, 0.0, h])
         self.at(t0, **{ball: a, fch: f0})
-        self.at(t0 + 0.2 * d, **({ball: a + 0.5 * up, fch: f0} if turn_late else {ball: a + 0.5 * up}))
+        self.at(
+            t0 + 0.2 * d, **({ball: a + 0.5 * up, fch: f0} if turn_late else {ball: a + 0.5 * up})
+        )
         if not turn_late:  # flying (falls): the ankle goes limp mid-swing
             z, one = np.zeros(3), np.array([1.0, 0.0, 0.0])
             self.at(t0, **{side + "free": z}).at(t0 + 0.3 * d, **{side + "free": one})
@@ -236,7 +254,8 @@ def _unit(v: F64) -> F64:
 
 
 def _mv(m: F64, v: ArrayLike) -> F64:
-    return np.einsum("...ij,...j->...i", m, v)
+    """Matrices ``(..., 3, 3)`` times vectors ``(..., 3)``, broadcasting."""
+    return (m @ np.asarray(v, dtype=float)[..., None])[..., 0]
 
 
 def _two_bone(
@@ -326,19 +345,21 @@ def _reach_clamp(c: dict[str, F64], root: F64) -> F64:
 
 def _motion(clip: _Clip, fps: float, name: str) -> Motion:
     skel = synthetic_skeleton()
-    t = np.arange(int(round(clip.duration * fps)) + 1) / fps
+    t = np.arange(round(clip.duration * fps) + 1) / fps
     c = {k: clip.sample(k, t) for k in clip.keys}
     root = _reach_clamp(c, c["root"])
-    motion = Motion(skel, fps, root, np.zeros((t.size, len(_NAMES), 4)) + (1, 0, 0, 0), name=name)
-    for _ in range(8):  # lift the body onto the floor; re-solving the legs can change the lowest
-        quats = quat_canonical(quat_from_matrix(_locals(c, root)))
-        motion = motion.replace(root_positions=root, rotations=quats)
+
+    def build(root: F64) -> Motion:
+        return Motion(skel, fps, root, quat_canonical(quat_from_matrix(_locals(c, root))), name=name)
+
+    for _ in range(8):  # lift the body onto the floor; re-solving the legs can move the lowest
+        motion = build(root)
         pos = np.concatenate([motion.global_positions(), motion.end_site_positions()], axis=1)
         lift = np.maximum(-pos[..., 2].min(axis=1), 0.0)
         if lift.max() < 1e-6:
-            break
+            return motion
         root = root + np.outer(lift, (0.0, 0.0, 1.0))
-    return motion
+    return build(root)
 
 
 # ------------------------------------------------------------------------------------ clips
@@ -472,7 +493,9 @@ def _side_kick() -> _Clip:
     )  # fmt: skip
     lift = dict(rknee=(0.5, 0.8, 0.3), rfoot=(40.0, 30.0, 0.0))
     c.at(0.55, **turn).at(0.58, **lift)
-    chamber = _leg(turn["root"], turn["rootrot"], "r", (-20.0, -60.0, 0.0), 120.0, (0.0, -10.0, 0.0))
+    chamber = _leg(
+        turn["root"], turn["rootrot"], "r", (-20.0, -60.0, 0.0), 120.0, (0.0, -10.0, 0.0)
+    )
     c.at(0.72, **chamber)
     ext_root, ext_rot = (0.0, 0.10, 0.88), (yaw, 0.0, -25.0)
     ext = dict(

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from reactmocap import __version__
 from reactmocap import metrics as qm
-from reactmocap.errors import ConfigError, SearchError, SimulationError
+from reactmocap.errors import ConfigError, ReactMocapError, SearchError, SimulationError
 from reactmocap.io import atomic_write_text
 from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
 from reactmocap.library.bvh import read_bvh, write_bvh
@@ -43,6 +43,7 @@ from reactmocap.response.scenario import CharacterSpec, Scenario
 from reactmocap.rotations import quat_slerp
 from reactmocap.search import MotionIndex, SearchResult, SearchWeights, WindowConfig
 from reactmocap.sim.character import BALL_JOINTS, Character, build_character
+from reactmocap.sim.impacts import Impact, first_contact
 from reactmocap.sim.pd import PDServo
 from reactmocap.sim.world import World, WorldConfig
 
@@ -180,28 +181,6 @@ class _Sim:
             log.append((step, total))
 
 
-def _scan_first_contact(
-    chars: list[Character], motions: list[Motion], t_end: float
-) -> float | None:
-    """First scenario time (30 Hz kinematic playback) at which the two characters touch."""
-    world = World(chars)
-    m, d = world.model, world.data
-    owner = np.full(m.ngeom, -1)
-    for wc in world.characters:
-        owner[wc.geom_ids] = wc.index
-    times = np.arange(0.0, t_end, 1.0 / SCAN_FPS)
-    qs = [ch.qpos_from_motion(mo.sample(times + 0.0)) for ch, mo in zip(chars, motions)]
-    for i, t in enumerate(times):
-        for wc, q in zip(world.characters, qs):
-            d.qpos[wc.qpos_slice] = q[i]
-        mujoco.mj_fwdPosition(m, d)
-        if d.ncon:
-            own = owner[d.contact.geom[: d.ncon]]
-            if np.any((own[:, 0] >= 0) & (own[:, 1] >= 0) & (own[:, 0] != own[:, 1])):
-                return float(t)
-    return None
-
-
 def _ball_targets(ch: Character, motion: Motion, times: F64) -> F64:
     """``(n, 15, 4)`` ball-joint quaternions of ``motion`` at ``times`` (its own clock)."""
     return ch.qpos_from_motion(motion.sample(times))[:, 7:].reshape(-1, len(BALL_JOINTS), 4)
@@ -242,18 +221,16 @@ def run_response(scenario: Scenario) -> ResponseResult:
         horizon = min(horizon, att_motion.duration - att_t0)
         shifted = [mo.sample(np.arange(0, horizon, 1 / mo.fps) + c0).replace(fps=mo.fps)
                    for mo, c0 in zip(motions, clocks)]  # fmt: skip
-        t_contact = _scan_first_contact(chars, shifted, horizon)
-        if t_contact is None:
-            t_contact = horizon  # never touches: nothing happens, the clip plays on
-        impact_body = "contact"
+        kc = first_contact(World(chars), shifted, fps=SCAN_FPS, end=horizon)
+        # never touching: the scan runs to the end and the clip plays on
+        t_contact = horizon if kc is None else kc.time
+        impact_body = "contact" if kc is None else "/".join(kc.pairs[0])
     else:
         assert scenario.impact is not None
         t_contact = scenario.impact.at
         impact_body = scenario.impact.body
-    t_rewind = np.floor(t_contact * SCAN_FPS - 1e-9) / SCAN_FPS if att_motion else np.floor(
-        t_contact * fps - 1e-9
-    ) / fps
-    t_rewind = max(0.0, float(t_rewind))
+    # rewind to the last mocap frame before the contact
+    t_rewind = max(0.0, float(np.floor(t_contact * fps - 1e-9) / fps))
     timings["scan"] = time.perf_counter() - t
 
     dt = cfg.timestep
@@ -269,13 +246,14 @@ def run_response(scenario: Scenario) -> ResponseResult:
 
     impact = None
     if scenario.impact is not None:
-        imp = scenario.impact
-        body = _sim_body(rec_char, imp.body)
-        wf = np.zeros(6)
-        wf[:3] = imp.force
-        s0 = int(round((imp.at - t_rewind) / dt))
-        s1 = s0 + max(1, int(round(imp.duration / dt)))
-        impact_spec = (body, s0, s1, wf)
+        spec = scenario.impact
+        try:
+            imp = Impact(spec.body, force=spec.force, point=spec.point,
+                         start=spec.at - t_rewind, duration=spec.duration)  # fmt: skip
+        except ReactMocapError as exc:
+            raise ConfigError(f"{scenario.source}: [impact]: {exc}") from None
+        s0, n_imp = imp.steps(dt)
+        impact_spec = (imp.body, s0, s0 + n_imp, imp.force_vector(dt), np.array(spec.point))
     else:
         impact_spec = None
 
@@ -437,22 +415,15 @@ def run_response(scenario: Scenario) -> ResponseResult:
     )
 
 
-def _sim_body(ch: Character, part: str) -> str:
-    from reactmocap.sim.character import SIM_BODIES
-
-    alias = {"abdomen": "waist", "thorax": "chest", "back": "chest", "torso": "chest"}
-    name = alias.get(part, part)
-    if name not in SIM_BODIES:
-        raise ConfigError(
-            f"[impact].body: unknown body {part!r}; valid bodies are "
-            f"{sorted(set(SIM_BODIES) | set(alias))}"
-        )
-    return name
-
-
-def _with_body_id(sim: _Sim, spec: tuple[str, int, int, F64]) -> tuple[int, int, int, F64]:
-    body, s0, s1, wf = spec
-    return sim.world.characters[0].body_id(body), s0, s1, wf
+def _with_body_id(sim: _Sim, spec: tuple[str, int, int, F64, F64]) -> tuple[int, int, int, F64]:
+    """Resolve the impact body in this world; the force acts at ``point`` (body frame), turned
+    into a wrench about the body's centre of mass in the start pose."""
+    body, s0, s1, force, point = spec
+    bid = sim.world.characters[0].body_id(body)
+    d = sim.world.data
+    rot = d.xmat[bid].reshape(3, 3)
+    arm = d.xpos[bid] + rot @ point - d.xipos[bid]
+    return bid, s0, s1, np.concatenate([force, np.cross(arm, force)])
 
 
 def _to_motion(sim: _Sim, k: int, ch: Character, rec: F64, t0: float, dt: float, fps: float,

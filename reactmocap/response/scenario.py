@@ -44,7 +44,7 @@ class CharacterSpec:
 @dataclass(frozen=True)
 class AttackerSpec(CharacterSpec):
     facing_deg: float = 180.0
-    position: tuple[float, float] = (1.1, 0.0)
+    position: tuple[float, float] = (0.9, 0.0)
 
 
 @dataclass(frozen=True)

@@ -565,6 +565,19 @@ class MotionIndex:
         ]
         starts = np.unique(np.concatenate(pieces))
         dists, _ = self._distances(qw, starts)
+        if n > 1:
+            # runners-up must be distinct windows: widen the exact set until n are found
+            while self._pick(starts, dists, n).size < n:
+                if k < self.num_indexed and np.all(np.isin(cand, starts)):
+                    k = min(2 * k, self.num_indexed)
+                    _, rows = self.tree.query(self._embed_query(qw), k=k)
+                    cand = self.kept[np.asarray(rows, dtype=np.int64)]
+                more = cand[~np.isin(cand, starts)][: 8 * n]  # nearest in the embedding first
+                if more.size == 0:
+                    break
+                d2, _ = self._distances(qw, more)
+                starts = np.concatenate([starts, more])
+                dists = np.concatenate([dists, d2])
         results = self._results(qw, starts, dists, n)
         self.last_stats = QueryStats(
             candidates=int(cand.size), refined_windows=int(starts.size), seconds=time.perf_counter() - t0

@@ -1,0 +1,58 @@
+"""Physics simulation on MuJoCo: the character built from a skeleton, the world, the
+inertia-scaled PD servo, impacts and contacts, rollouts, and Motion <-> state conversion."""
+
+from reactmocap.sim.character import (
+    BALL_JOINTS,
+    BODY_ALIASES,
+    SIM_BODIES,
+    Character,
+    build_character,
+)
+from reactmocap.sim.impacts import (
+    CharacterContact,
+    ContactReport,
+    Impact,
+    ImpactSchedule,
+    KinematicContact,
+    contact_report,
+    first_contact,
+)
+from reactmocap.sim.pd import PDServo, critical_kv
+from reactmocap.sim.rollout import (
+    MotionTracker,
+    RolloutResult,
+    RootAssist,
+    TrackReport,
+    push_clip,
+    rollout,
+    track_clip,
+)
+from reactmocap.sim.world import PREFIXES, World, WorldCharacter, WorldConfig
+
+__all__ = [
+    "BALL_JOINTS",
+    "BODY_ALIASES",
+    "PREFIXES",
+    "SIM_BODIES",
+    "Character",
+    "CharacterContact",
+    "ContactReport",
+    "Impact",
+    "ImpactSchedule",
+    "KinematicContact",
+    "MotionTracker",
+    "PDServo",
+    "RolloutResult",
+    "RootAssist",
+    "TrackReport",
+    "World",
+    "WorldCharacter",
+    "WorldConfig",
+    "build_character",
+    "contact_report",
+    "critical_kv",
+    "first_contact",
+    "push_clip",
+    "rollout",
+    "track_clip",
+]

@@ -181,7 +181,9 @@ def test_committed_files_match_generator(clips: dict[str, Motion]) -> None:
     from reactmocap.library.bvh import read_bvh
 
     files = sorted(SYNTHETIC.glob("*.bvh"))
-    assert {f.stem for f in files} == set(clips), "regenerate: reactmocap synth data/synthetic_clips"
+    assert {f.stem for f in files} == set(clips), (
+        "regenerate: reactmocap synth data/synthetic_clips"
+    )
     for f in files:
         disk, gen = read_bvh(f), clips[f.stem]
         assert disk.num_frames == gen.num_frames and disk.fps == pytest.approx(gen.fps)
