@@ -81,7 +81,6 @@ def _build(args: argparse.Namespace) -> int:
 
 
 def _query(args: argparse.Namespace) -> int:
-    from reactmocap.library.clip_library import load_library
     from reactmocap.search import MotionIndex
     from reactmocap.search.index import MIRROR_SUFFIX
 
@@ -92,6 +91,8 @@ def _query(args: argparse.Namespace) -> int:
     source = args.library or (Path(index.info["source"]) if index.info.get("source") else None)
     if source is None:
         raise SearchError(f"{args.index}: no library folder recorded; pass --library")
+    from reactmocap.library.clip_library import load_library
+
     lib = load_library(source)
     problem = index.stale_reason(clips=lib.clips)
     if problem:

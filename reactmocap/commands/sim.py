@@ -42,8 +42,12 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--friction", type=float, default=1.0, help="ground friction coefficient")
     p.add_argument("--fps", type=float, default=60.0, help="output frame rate")
     p.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
-    p.add_argument("--root-assist", type=float, default=0.0,
-                   help="NON-PHYSICAL pelvis stabilisation gain (0 = off)")
+    p.add_argument(
+        "--root-assist",
+        type=float,
+        default=0.0,
+        help="NON-PHYSICAL pelvis stabilisation gain (0 = off)",
+    )
 
 
 def _read(path: Path):  # type: ignore[no-untyped-def]
@@ -65,8 +69,10 @@ def _write_outputs(args: argparse.Namespace, motion, report) -> None:  # type: i
         tmp.replace(args.out)
     data = report.to_dict()
     if args.report is not None:
-        clean = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-                 for k, v in data.items()}
+        clean = {
+            k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+            for k, v in data.items()
+        }
         atomic_write_text(args.report, json.dumps(clean, indent=2) + "\n")
     print(
         f"{data['clip']}: {data['seconds']:.2f} s tracked, fell={data['fell']}, "
@@ -76,15 +82,21 @@ def _write_outputs(args: argparse.Namespace, motion, report) -> None:  # type: i
 
 
 def _kwargs(args: argparse.Namespace) -> dict[str, object]:
-    return {"kp": args.kp, "kv": args.kv, "friction": args.friction, "record_fps": args.fps,
-            "total_mass": args.mass, "root_assist": args.root_assist}
+    return {
+        "kp": args.kp,
+        "kv": args.kv,
+        "friction": args.friction,
+        "record_fps": args.fps,
+        "total_mass": args.mass,
+        "root_assist": args.root_assist,
+    }
 
 
 def _track(args: argparse.Namespace) -> int:
     from reactmocap.sim.rollout import track_clip
 
     motion = _read(args.clip)
-    out, report, _ = track_clip(motion, start=args.start, seconds=args.seconds, **_kwargs(args))
+    out, report, _ = track_clip(motion, start=args.start, seconds=args.seconds, **_kwargs(args))  # type: ignore[arg-type]
     _write_outputs(args, out, report)
     return 0
 
@@ -99,7 +111,14 @@ def _push(args: argparse.Namespace) -> int:
     if len(force) != 3:
         raise ConfigError(f"--force must have 3 components, got {len(force)}: {args.force!r}")
     motion = _read(args.clip)
-    out, report, _ = push_clip(motion, time=args.time, body=args.body, force=force,
-                               duration=args.duration, seconds=args.seconds, **_kwargs(args))
+    out, report, _ = push_clip(
+        motion,
+        time=args.time,
+        body=args.body,
+        force=force,
+        duration=args.duration,
+        seconds=args.seconds,
+        **_kwargs(args),  # type: ignore[arg-type]
+    )
     _write_outputs(args, out, report)
     return 0

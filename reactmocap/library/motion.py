@@ -301,8 +301,9 @@ class Motion:
         return self.replace(rotations=quat_normalize(self.rotations))
 
     def height(self) -> float:
-        """Median over frames of the vertical extent of joints and end sites (m)."""
+        """Largest vertical extent of joints and end sites over the frames (m): the standing
+        height reached in the clip, less any head-top the skeleton lacks an end site for."""
         pos = self.global_positions()
         ends = self.end_site_positions()
         allp = np.concatenate([pos, ends], axis=1)
-        return float(np.median(allp[..., 2].max(axis=1) - allp[..., 2].min(axis=1)))
+        return float(np.max(allp[..., 2].max(axis=1) - allp[..., 2].min(axis=1)))

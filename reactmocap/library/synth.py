@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import PchipInterpolator
+from scipy.ndimage import gaussian_filter1d, maximum_filter1d
 from scipy.spatial.transform import Rotation
 
 from reactmocap.library.motion import Motion
@@ -43,6 +44,7 @@ __all__ = [
 ]
 
 F64 = NDArray[np.float64]
+Pose = dict[str, ArrayLike]  # channel name -> key value
 
 # ----------------------------------------------------------------------------------- skeleton
 # (name, parent, rest offset in the parent's frame: Z-up metres, x forward, y left). Arms hang
@@ -193,31 +195,27 @@ class _Clip:
         to: ArrayLike,
         foot: ArrayLike | None = None,
         h: float = 0.08,
-        turn_late: bool = True,
+        limp: float = 0.0,
     ) -> _Clip:
         """Swing foot ``side`` ('l'/'r') so its ball lands at ``to`` (x, y[, z]).
 
-        The foot rises before it moves (and turns, if ``turn_late``) and stops before it lands (no
-        sliding near the ground); ``foot`` is its new yaw/pitch/roll.
+        The foot rises before it moves and stops before it lands (no sliding near the ground);
+        ``foot`` is its new yaw/pitch/roll. A firm foot (``limp`` 0) turns only in the air; a
+        flying foot (falls) turns at once and its ankle relaxes by ``limp`` (0..1) mid-swing.
         """
-        ball, fch = side + "ball", side + "foot"
-        a = self.now(ball)
-        b = (
-            np.array([*np.asarray(to, float)[:2], a[2]])
-            if np.size(to) == 2
-            else np.asarray(to, float)
-        )
+        ball, fch, free = side + "ball", side + "foot", side + "free"
+        a, b = self.now(ball), np.asarray(to, float)
+        b = np.append(b, a[2]) if b.size == 2 else b
         f0 = self.now(fch)
         f1 = f0 if foot is None else np.asarray(foot, float)
         d, up = t1 - t0, np.array([0.0, 0.0, h])
-        self.at(t0, **{ball: a, fch: f0})
-        self.at(
-            t0 + 0.2 * d, **({ball: a + 0.5 * up, fch: f0} if turn_late else {ball: a + 0.5 * up})
-        )
-        if not turn_late:  # flying (falls): the ankle goes limp mid-swing
-            z, one = np.zeros(3), np.array([1.0, 0.0, 0.0])
-            self.at(t0, **{side + "free": z}).at(t0 + 0.3 * d, **{side + "free": one})
-            self.at(t1 - 0.4 * d, **{side + "free": one}).at(t1 - 0.15 * d, **{side + "free": z})
+        self.at(t0, **{ball: a, fch: f0}).at(t0 + 0.2 * d, **{ball: a + 0.5 * up})
+        if not limp:
+            self.at(t0 + 0.2 * d, **{fch: f0})
+        else:
+            loose, firm = (limp, 0.0, 0.0), (0.0, 0.0, 0.0)
+            self.at(t0 + 0.2 * d, **{free: firm}).at(t0 + 0.45 * d, **{free: loose})
+            self.at(t1 - 0.4 * d, **{free: loose}).at(t1 - 0.15 * d, **{free: firm})
         self.at(t0 + 0.5 * d, **{ball: 0.5 * (a + b) + up})
         self.at(t1 - 0.2 * d, **{ball: b + 0.5 * up, fch: f1})
         return self.at(t1, **{ball: b, fch: f1})
@@ -329,7 +327,16 @@ def _locals(c: dict[str, F64], root: F64) -> F64:
     return loc
 
 
-def _reach_clamp(c: dict[str, F64], root: F64) -> F64:
+def _envelope(d: F64, radius: int) -> F64:
+    """A smooth curve >= ``d``: a running max over +-radius frames, then a Gaussian whose support
+    fits inside that window (so a correction never kinks the root trajectory)."""
+    if radius < 1 or not d.any():
+        return d
+    wide = maximum_filter1d(d, 2 * radius + 1, mode="nearest")
+    return gaussian_filter1d(wide, radius / 3.0, mode="nearest", truncate=3.0)
+
+
+def _reach_clamp(c: dict[str, F64], root: F64, radius: int) -> F64:
     """Lower the pelvis where a leg could not reach its foot (keeps planted feet planted)."""
     rr = _euler(c["rootrot"])
     z = root[:, 2].copy()
@@ -340,25 +347,28 @@ def _reach_clamp(c: dict[str, F64], root: F64) -> F64:
         horiz = np.linalg.norm((ankle - hip)[:, :2], axis=-1)
         top = ankle[:, 2] + np.sqrt(np.maximum(reach**2 - horiz**2, 0.0))
         z = np.minimum(z, z - (hip[:, 2] - top))
-    return np.stack([root[:, 0], root[:, 1], z], axis=-1)
+    return root - np.outer(_envelope(root[:, 2] - z, radius), (0.0, 0.0, 1.0))
 
 
 def _motion(clip: _Clip, fps: float, name: str) -> Motion:
     skel = synthetic_skeleton()
     t = np.arange(round(clip.duration * fps) + 1) / fps
     c = {k: clip.sample(k, t) for k in clip.keys}
-    root = _reach_clamp(c, c["root"])
+    radius = round(0.1 * fps)  # corrections blend in over 0.1 s
+    root = _reach_clamp(c, c["root"], radius)
 
     def build(root: F64) -> Motion:
-        return Motion(skel, fps, root, quat_canonical(quat_from_matrix(_locals(c, root))), name=name)
+        return Motion(
+            skel, fps, root, quat_canonical(quat_from_matrix(_locals(c, root))), name=name
+        )
 
     for _ in range(8):  # lift the body onto the floor; re-solving the legs can move the lowest
         motion = build(root)
         pos = np.concatenate([motion.global_positions(), motion.end_site_positions()], axis=1)
         lift = np.maximum(-pos[..., 2].min(axis=1), 0.0)
-        if lift.max() < 1e-6:
+        if lift.max() < 1e-5:
             return motion
-        root = root + np.outer(lift, (0.0, 0.0, 1.0))
+        root = root + np.outer(_envelope(lift, radius), (0.0, 0.0, 1.0))
     return build(root)
 
 
@@ -381,20 +391,6 @@ def _breathing(c: _Clip, t0: float, t1: float, cycles: int) -> _Clip:
 
 def _guard() -> _Clip:
     return _breathing(_Clip(4.0), 0.0, 4.0, 2)
-
-
-def _step_forward() -> _Clip:
-    c = _Clip(2.0)
-    c.at(0.2, root=(0.03, 0.0, 0.90)).step("l", 0.15, 0.6, (0.65, 0.15))
-    c.at(0.75, root=(0.32, 0.0, 0.90)).step("r", 0.7, 1.15, (0.30, -0.20))
-    return c.at(1.4, root=(0.35, 0.0, 0.91)).guard(1.6).hold(2.0, "root")
-
-
-def _step_back() -> _Clip:
-    c = _Clip(2.0)
-    c.at(0.2, root=(-0.03, 0.0, 0.90)).step("r", 0.15, 0.6, (-0.40, -0.20))
-    c.at(0.75, root=(-0.32, 0.0, 0.90)).step("l", 0.7, 1.15, (-0.05, 0.15))
-    return c.at(1.4, root=(-0.35, 0.0, 0.91)).guard(1.6).hold(2.0, "root")
 
 
 def _heading(v: ArrayLike, yaw: float) -> F64:
@@ -441,7 +437,7 @@ def _push() -> _Clip:
     c = _Clip(2.4).step("l", 0.1, 0.45, (0.62, 0.15))
     c.at(0.25, lhand=(0.2, -0.02, -0.1), rhand=(0.2, 0.02, -0.1), lwrist=(0.0, -30.0, 0.0))
     c.at(0.25, rwrist=(0.0, -30.0, 0.0))
-    peak = dict(
+    peak: Pose = dict(
         root=(0.30, 0.0, 0.87), rootrot=(0.0, 12.0, 0.0), Spine=(0.0, 6.0, 0.0),
         Spine1=(0.0, 6.0, 0.0), Neck=(0.0, -8.0, 0.0), Head=(0.0, -8.0, 0.0),
         lhand=(0.52, -0.10, -0.10), rhand=(0.52, 0.10, -0.10), lwrist=(0.0, -70.0, 0.0),
@@ -457,9 +453,9 @@ def _push() -> _Clip:
 
 def _front_kick() -> _Clip:
     c = _Clip(2.4)
-    lean = dict(root=(0.10, 0.05, 0.90), rootrot=(0.0, -3.0, 0.0), Spine=(0.0, 0.0, -8.0))
+    lean: Pose = dict(root=(0.10, 0.05, 0.90), rootrot=(0.0, -3.0, 0.0), Spine=(0.0, 0.0, -8.0))
     c.at(0.3, **lean).at(0.3, lhand=(0.22, -0.06, 0.0), rhand=(0.16, 0.08, 0.0))
-    chamber = dict(rball=(0.45, -0.10, 0.42), rfoot=(0.0, 30.0, 0.0), rknee=(0.4, 0.0, 1.0))
+    chamber: Pose = dict(rball=(0.45, -0.10, 0.42), rfoot=(0.0, 30.0, 0.0), rknee=(0.4, 0.0, 1.0))
     c.at(0.35, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.04)), rfoot=(-30.0, 20.0, 0.0))
     c.at(0.58, **chamber).at(0.58, rootrot=(0.0, -6.0, 0.0), root=(0.12, 0.05, 0.90))
     c.at(
@@ -482,23 +478,23 @@ def _side_kick() -> _Clip:
     # the kicking foot is off the floor whenever the hips are turned far from it.
     yaw, c = 80.0, _Clip(2.8)
     c.step("l", 0.05, 0.3, GUARD["lball"], foot=(70.0, 0.0, 0.0), h=0.045)
-    half = dict(root=(0.0, 0.03, 0.90), rootrot=(25.0, 0.0, -3.0), Spine=(0.0, 2.0, -10.0))
+    half: Pose = dict(root=(0.0, 0.03, 0.90), rootrot=(25.0, 0.0, -3.0), Spine=(0.0, 2.0, -10.0))
     c.at(0.3, **half, lknee=(0.35, 1.0, 0.0), rknee=(0.87, -0.5, 0.0))
     c.hold(0.3, "rball", "rfoot").at(0.4, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.06)))
-    turn = dict(
+    turn: Pose = dict(
         root=(0.0, 0.04, 0.89), rootrot=(yaw, 0.0, -5.0), Spine=(0.0, 0.0, -10.0),
         Spine1=(0.0, 0.0, -10.0), Neck=(0.0, 0.0, -30.0), Head=(0.0, 0.0, -25.0),
         lhand=_heading((0.22, 0.05, 0.0), yaw), rhand=_heading((0.20, 0.15, 0.0), yaw),
         lknee=(0.35, 1.0, 0.0),
     )  # fmt: skip
-    lift = dict(rknee=(0.5, 0.8, 0.3), rfoot=(40.0, 30.0, 0.0))
+    lift: Pose = dict(rknee=(0.5, 0.8, 0.3), rfoot=(40.0, 30.0, 0.0))
     c.at(0.55, **turn).at(0.58, **lift)
     chamber = _leg(
         turn["root"], turn["rootrot"], "r", (-20.0, -60.0, 0.0), 120.0, (0.0, -10.0, 0.0)
     )
     c.at(0.72, **chamber)
     ext_root, ext_rot = (0.0, 0.10, 0.88), (yaw, 0.0, -25.0)
-    ext = dict(
+    ext: Pose = dict(
         _leg(ext_root, ext_rot, "r", (-62.0, 0.0, 0.0), 4.0, (0.0, -15.0, 0.0)),
         root=ext_root, rootrot=ext_rot, Spine=(-8.0, 0.0, -10.0), Spine1=(-6.0, 0.0, -10.0),
         Neck=(10.0, 0.0, -30.0), Head=(8.0, 0.0, -25.0),
@@ -526,54 +522,71 @@ def _sway() -> _Clip:
     return c.guard(1.3, home=True).hold(2.5, "root")
 
 
-def _back_steps(n: int, dist: float = 0.35) -> _Clip:
+def _shuffle(c: _Clip, t: float, d: tuple[float, float], lead: str, dur: float = 0.35) -> float:
+    """Guard shuffle step by ``d`` (x, y): ``lead`` foot first, the pelvis moves over the new
+    base while both feet are down, the other foot follows. Returns the time it ends."""
+    trail = "r" if lead == "l" else "l"
+    start = c.now("root")[:2]
+    c.hold(t, "root")
+    c.step(lead, t, t + dur, c.now(lead + "ball")[:2] + d, foot=GUARD[lead + "foot"])
+    # the pelvis ends where the guard puts it over the new feet
+    end = np.add(GUARD["root"][:2], c.now(lead + "ball")[:2] - GUARD[lead + "ball"][:2])
+    c.at(t + dur + 0.05, root=(*(start + 0.55 * (end - start)), 0.89))
+    t1 = t + 2 * dur + 0.05
+    c.step(trail, t + dur + 0.05, t1, c.now(trail + "ball")[:2] + d, foot=GUARD[trail + "foot"])
+    c.at(t + 2 * dur + 0.15, root=(*end, 0.90))
+    return t + 2 * dur + 0.15
+
+
+def _step_forward() -> _Clip:
+    c = _Clip(2.0)
+    return c.guard(_shuffle(c, 0.15, (0.3, 0.0), "l") + 0.3).hold(2.0, "root")
+
+
+def _step_back() -> _Clip:
+    c = _Clip(2.0)
+    return c.guard(_shuffle(c, 0.15, (-0.3, 0.0), "r") + 0.3).hold(2.0, "root")
+
+
+def _back_steps(n: int) -> _Clip:
     """Knocked back ``n`` shuffle steps (rear foot first), then recover the guard."""
-    c = _Clip(2.5 + (n - 1) * 0.9)
+    c = _Clip(2.5 + (n - 1) * 0.85)
     c.at(
-        0.15,
-        root=(-0.06, 0.0, 0.90), rootrot=(0.0, -8.0, 0.0), Spine=(0.0, -5.0, -8.0),
+        0.12,
+        root=(-0.04, 0.0, 0.90), rootrot=(0.0, -8.0, 0.0), Spine=(0.0, -5.0, -8.0),
         Spine1=(0.0, -5.0, -8.0), Neck=(0.0, 6.0, 8.0), lhand=(0.26, 0.02, 0.02),
         rhand=(0.16, 0.14, 0.02),
     )  # fmt: skip
-    for i in range(n):
-        t, back = 0.12 + 0.8 * i, (i + 1) * dist
-        c.step("r", t, t + 0.35, np.add(GUARD["rball"], (-back, 0.0, 0.0)))
-        c.at(t + 0.45, root=(-back + 0.1, 0.0, 0.89))
-        c.step("l", t + 0.42, t + 0.77, np.add(GUARD["lball"], (-back, 0.0, 0.0)))
-    t = 0.12 + 0.8 * n
-    c.at(t, root=(-n * dist, 0.0, 0.90), rootrot=(0.0, 0.0, 0.0))
+    t = 0.12
+    for _ in range(n):
+        t = _shuffle(c, t, (-0.3, 0.0), "r", dur=0.3)
+    c.at(t, rootrot=(0.0, 0.0, 0.0))
     return c.guard(t + 0.4).hold(c.duration, "root")
 
 
-def _side_steps(side: str, dist: float = 0.3) -> _Clip:
-    """Pushed sideways: the near foot steps out ``dist`` toward ``side``, the other follows."""
-    sg, lead, trail = (1.0, "l", "r") if side == "l" else (-1.0, "r", "l")
+def _side_steps(side: str) -> _Clip:
+    """Pushed sideways: the near foot steps out toward ``side``, the other follows."""
+    sg = 1.0 if side == "l" else -1.0
     c = _Clip(2.5)
     c.at(
-        0.15,
-        root=(0.0, 0.05 * sg, 0.90), rootrot=(0.0, 3.0, -8.0 * sg), Spine=(-6.0 * sg, 4.0, -8.0),
+        0.12,
+        root=(0.0, 0.04 * sg, 0.90), rootrot=(0.0, 3.0, -8.0 * sg), Spine=(-6.0 * sg, 4.0, -8.0),
         Spine1=(-4.0 * sg, 4.0, -8.0), Neck=(8.0 * sg, -3.0, 8.0),
     )  # fmt: skip
-    c.step(lead, 0.12, 0.47, np.add(GUARD[lead + "ball"], (0.0, dist * sg, 0.0)))
-    c.at(0.6, root=(0.0, 0.22 * sg, 0.89), rootrot=(0.0, 3.0, 0.0))
-    c.step(trail, 0.55, 0.9, np.add(GUARD[trail + "ball"], (0.0, dist * sg, 0.0)))
-    c.at(1.0, root=(0.0, dist * sg, 0.90))
-    return c.guard(1.4).hold(2.5, "root")
+    t = _shuffle(c, 0.12, (0.0, 0.3 * sg), side, dur=0.3)
+    return c.at(t - 0.2, rootrot=(0.0, 3.0, 0.0)).guard(t + 0.35).hold(2.5, "root")
 
 
 def _stumble_forward() -> _Clip:
     c = _Clip(2.5)
     c.at(
-        0.15,
-        root=(0.08, 0.0, 0.89), rootrot=(0.0, 15.0, 0.0), Spine=(0.0, 8.0, -8.0),
+        0.12,
+        root=(0.06, 0.0, 0.89), rootrot=(0.0, 15.0, 0.0), Spine=(0.0, 8.0, -8.0),
         Spine1=(0.0, 6.0, -8.0), Neck=(0.0, -12.0, 8.0), Head=(0.0, -8.0, 8.0),
-        lhand=(0.2, 0.15, -0.15), rhand=(0.15, -0.05, -0.15), rfoot=(-30.0, 30.0, 0.0),
+        lhand=(0.2, 0.15, -0.15), rhand=(0.15, -0.05, -0.15), rfoot=(-30.0, 25.0, 0.0),
     )  # fmt: skip
-    c.step("l", 0.12, 0.42, np.add(GUARD["lball"], (0.40, 0.0, 0.0)), h=0.07)
-    c.at(0.55, root=(0.32, 0.0, 0.87), rootrot=(0.0, 10.0, 0.0))
-    c.step("r", 0.47, 0.85, np.add(GUARD["rball"], (0.40, 0.0, 0.0)), foot=GUARD["rfoot"])
-    c.at(1.0, root=(0.40, 0.0, 0.90), rootrot=(0.0, 3.0, 0.0))
-    return c.guard(1.45).hold(2.5, "root")
+    t = _shuffle(c, 0.12, (0.4, 0.0), "l", dur=0.3)
+    return c.at(t - 0.2, rootrot=(0.0, 5.0, 0.0)).guard(t + 0.35).hold(2.5, "root")
 
 
 def _fall_backward() -> _Clip:
@@ -593,12 +606,13 @@ def _fall_backward() -> _Clip:
     c.at(1.05, lknee=(1.0, 0.2, 0.6), rknee=(0.8, -0.4, 0.6))
     c.at(
         1.3,
-        root=(-0.83, 0.0, 0.15), rootrot=(0.0, -45.0, 0.0), lhand=(-0.25, 0.15, -0.42),
-        rhand=(-0.25, -0.15, -0.42), lelbow=(-1.0, 0.3, 0.0), relbow=(-1.0, -0.3, 0.0),
+        root=(-0.83, 0.0, 0.15), rootrot=(0.0, -45.0, 0.0), lhand=(-0.22, 0.15, -0.30),
+        rhand=(-0.22, -0.15, -0.30), lelbow=(-1.0, 0.3, 0.0), relbow=(-1.0, -0.3, 0.0),
         lknee=(0.4, 0.2, 1.0), rknee=(0.4, -0.3, 1.0),
     )  # fmt: skip
     c.at(1.75, root=(-0.84, 0.0, 0.13), rootrot=(0.0, -70.0, 0.0), Neck=(0.0, 25.0, 0.0))
-    lying = dict(
+    c.at(1.75, lhand=(0.0, 0.35, -0.05), rhand=(0.0, -0.35, -0.05))
+    lying: Pose = dict(
         root=(-0.85, 0.0, 0.12), rootrot=(0.0, -86.0, 0.0), Spine=(0.0, -2.0, 0.0),
         Spine1=(0.0, -2.0, 0.0), Neck=(0.0, 12.0, 0.0), Head=(0.0, 5.0, 0.0),
         lhand=(0.45, 0.15, 0.0), rhand=(0.45, -0.15, 0.0), lelbow=(0.0, 1.0, 0.3),
@@ -619,9 +633,9 @@ def _fall_forward() -> _Clip:
     c.step("l", 0.1, 0.4, (0.70, 0.15), h=0.07)
     c.at(0.5, root=(0.40, 0.0, 0.84), rootrot=(0.0, 25.0, 0.0))
     c.at(0.5, lhand=(0.35, 0.05, -0.25), rhand=(0.35, -0.05, -0.25))
-    c.step("r", 0.45, 0.8, (0.70, -0.13), foot=(-5.0, 0.0, 0.0), h=0.07)
+    c.step("r", 0.45, 0.8, (0.70, -0.13), foot=(-5.0, 0.0, 0.0), h=0.14, limp=0.5)
     c.hold(0.85, "lfoot", "rfoot").at(1.08, lfoot=(10.0, 40.0, 0.0), rfoot=(-5.0, 40.0, 0.0))
-    kneel = dict(
+    kneel: Pose = dict(
         root=(0.98, 0.0, 0.52), rootrot=(0.0, 15.0, 0.0), lfoot=(10.0, 65.0, 0.0),
         rfoot=(-5.0, 65.0, 0.0), lknee=(1.0, 0.1, -0.4), rknee=(1.0, -0.1, -0.4),
         lhand=(0.30, 0.05, -0.45), rhand=(0.30, -0.05, -0.45),
@@ -632,8 +646,8 @@ def _fall_forward() -> _Clip:
         root=(1.12, 0.0, 0.42), rootrot=(0.0, 55.0, 0.0), lhand=(0.30, 0.02, -0.50),
         rhand=(0.30, -0.02, -0.50), Neck=(0.0, -25.0, 0.0), Head=(0.0, -10.0, 0.0),
     )  # fmt: skip
-    prone = dict(
-        root=(1.50, 0.0, 0.13), rootrot=(0.0, 88.0, 0.0), Spine=(0.0, -3.0, 0.0),
+    prone: Pose = dict(
+        root=(1.56, 0.0, 0.13), rootrot=(0.0, 88.0, 0.0), Spine=(0.0, -3.0, 0.0),
         Spine1=(0.0, -3.0, 0.0), Neck=(0.0, -30.0, 0.0), Head=(0.0, -10.0, 0.0),
         lhand=(0.10, 0.25, -0.05), rhand=(0.10, -0.25, -0.05), lelbow=(-0.3, 1.0, -0.5),
         relbow=(-0.3, -1.0, -0.5), lknee=(0.0, 0.2, -1.0), rknee=(0.0, -0.2, -1.0),
@@ -654,7 +668,7 @@ def _fall_sideways() -> _Clip:
     c.at(0.5, root=(0.02, 0.30, 0.84), rootrot=(0.0, 5.0, -20.0))
     c.step("r", 0.45, 0.8, (0.10, 0.20), foot=(-10.0, 0.0, 0.0), h=0.08)
     c.at(1.0, root=(0.08, 0.62, 0.45), rootrot=(0.0, 10.0, -40.0), lknee=(1.0, 0.3, 0.2))
-    c.at(1.0, rknee=(1.0, 0.2, 0.2), lhand=(0.25, 0.15, -0.35), lelbow=(0.0, -0.3, -1.0))
+    c.at(1.0, rknee=(1.0, 0.2, 0.2), lhand=(0.25, 0.15, -0.28), lelbow=(0.0, -0.3, -1.0))
     c.at(1.35, root=(0.12, 0.82, 0.18), rootrot=(0.0, 8.0, -65.0))
     # legs fold up off the floor as the hip lands, and come down on their sides
     lie_root, lie_rot = (0.10, 0.92, 0.16), (0.0, 5.0, -88.0)
@@ -662,11 +676,11 @@ def _fall_sideways() -> _Clip:
         **_leg(lie_root, lie_rot, "l", (-4.0, -45.0, 0.0), 80.0),
         **_leg(lie_root, lie_rot, "r", (0.0, -55.0, 0.0), 90.0),
     }
-    c.step("l", 0.85, 1.55, legs["lball"], foot=legs["lfoot"], h=0.12, turn_late=False)
+    c.step("l", 0.85, 1.55, legs["lball"], foot=legs["lfoot"], h=0.12, limp=1.0)
     c.at(0.85, rfoot=(-10.0, 20.0, 0.0))  # heel up while the hips drop
-    c.step("r", 0.95, 1.7, legs["rball"], foot=legs["rfoot"], h=0.12, turn_late=False)
-    c.at(1.55, lknee=legs["lknee"]).at(1.7, rknee=legs["rknee"])
-    lying = dict(
+    c.step("r", 0.95, 1.7, legs["rball"], foot=legs["rfoot"], h=0.12, limp=1.0)
+    c.at(1.55, lknee=legs["lknee"]).at(1.7, rknee=legs["rknee"]).at(1.15, rfoot=(-70, 25, -75))
+    lying: Pose = dict(
         root=lie_root, rootrot=lie_rot, Spine=(4.0, 5.0, 0.0), Spine1=(4.0, 5.0, 0.0),
         Neck=(-12.0, 5.0, 0.0), Head=(-10.0, 0.0, 0.0), lhand=(0.50, 0.05, 0.0),
         rhand=(0.35, 0.0, -0.22), lelbow=(0.0, -1.0, 0.3), relbow=(-0.2, 0.0, 1.0),
@@ -676,18 +690,27 @@ def _fall_sideways() -> _Clip:
 
 CLIP_BUILDERS: dict[str, tuple[Callable[[], _Clip], str]] = {
     "guard": (_guard, "fighting guard (left foot forward) with a subtle breathing sway; loops"),
-    "step_forward": (_step_forward, "guard shuffle step forward 0.35 m (front foot first)"),
-    "step_back": (_step_back, "guard shuffle step back 0.35 m (rear foot first)"),
+    "step_forward": (_step_forward, "guard shuffle step forward 0.3 m (front foot first)"),
+    "step_back": (_step_back, "guard shuffle step back 0.3 m (rear foot first)"),
     "front_kick": (_front_kick, "attack: right-leg front kick, ball of the foot ~1 m ahead"),
     "side_kick": (_side_kick, "attack: right-leg side kick, hips turned, foot ~0.9 m ahead"),
     "punch": (_punch, "attack: right cross, fist ~1 m ahead"),
-    "push": (_push, "attack: two-hand shove with a step, palms ~0.9 m ahead"),
+    "push": (_push, "attack: two-hand shove with a step, hands ~1 m ahead"),
     "sway": (_sway, "light reaction: torso sways back and recovers, feet stay planted"),
-    "step_back_1": (lambda: _back_steps(1), "medium reaction: knocked one step back"),
-    "step_back_2": (lambda: _back_steps(2), "medium reaction: knocked two steps back"),
-    "step_left": (lambda: _side_steps("l"), "medium reaction: pushed one step to the left"),
-    "step_right": (lambda: _side_steps("r"), "medium reaction: pushed one step to the right"),
-    "step_forward_react": (_stumble_forward, "medium reaction: stumbles one step forward"),
+    "step_back_1": (
+        lambda: _back_steps(1),
+        "medium reaction: knocked back one shuffle step (0.3 m)",
+    ),
+    "step_back_2": (
+        lambda: _back_steps(2),
+        "medium reaction: knocked back two shuffle steps (0.6 m)",
+    ),
+    "step_left": (lambda: _side_steps("l"), "medium reaction: pushed one step (0.3 m) to the left"),
+    "step_right": (
+        lambda: _side_steps("r"),
+        "medium reaction: pushed one step (0.3 m) to the right",
+    ),
+    "step_forward_react": (_stumble_forward, "medium reaction: stumbles one step (0.4 m) forward"),
     "fall_backward": (_fall_backward, "heavy reaction: staggers back, sits down, ends on the back"),
     "fall_forward": (_fall_forward, "heavy reaction: stumbles, drops to the knees, ends prone"),
     "fall_sideways": (_fall_sideways, "heavy reaction: staggers left, ends lying on the left side"),

@@ -338,10 +338,10 @@ def features_from_arrays(
 ) -> FrameFeatures:
     """:func:`frame_features` on raw motion arrays (no Motion construction in the query path)."""
     pos, grot = forward_kinematics_fast(skeleton, root_positions, rotations, translations)
-    gq = matrix_to_quat_fast(grot[:, calib.joints])
-    ori = quat_mul_fast(gq, calib.offsets[None])
+    gq = matrix_to_quat_fast(grot[:, np.append(calib.joints, calib.pelvis)])
+    ori = quat_mul_fast(gq[:, :-1], calib.offsets[None])
     ori = np.where(ori[..., :1] < 0, -ori, ori)
-    body = quat_mul_fast(matrix_to_quat_fast(grot[:, calib.pelvis]), calib.body_frame[None])
+    body = quat_mul_fast(gq[:, -1], calib.body_frame[None])
     heading = 2.0 * np.arctan2(body[:, 3], body[:, 0])
     heading = (heading + np.pi) % (2 * np.pi) - np.pi
     origin = pos[:, calib.pelvis, :2].copy()
@@ -366,15 +366,14 @@ def matrix_to_quat_fast(m: NDArray[np.floating]) -> NDArray[np.floating]:
     """wxyz quaternions (``w >= 0``) of rotation matrices ``(..., 3, 3)`` (Shepperd's method)."""
     m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
     tr = m00 + m11 + m22
-    cands = np.stack(
-        [
-            np.stack([1 + tr, m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]], -1),
-            np.stack([m[..., 2, 1] - m[..., 1, 2], 1 + m00 - m11 - m22, m[..., 0, 1] + m[..., 1, 0], m[..., 0, 2] + m[..., 2, 0]], -1),
-            np.stack([m[..., 0, 2] - m[..., 2, 0], m[..., 0, 1] + m[..., 1, 0], 1 - m00 + m11 - m22, m[..., 1, 2] + m[..., 2, 1]], -1),
-            np.stack([m[..., 1, 0] - m[..., 0, 1], m[..., 0, 2] + m[..., 2, 0], m[..., 1, 2] + m[..., 2, 1], 1 - m00 - m11 + m22], -1),
-        ],
-        axis=-2,
-    )  # (..., 4, 4): row c is 4 q_c-scaled quaternion for case c
+    s21, d21 = m[..., 2, 1] + m[..., 1, 2], m[..., 2, 1] - m[..., 1, 2]
+    s02, d02 = m[..., 0, 2] + m[..., 2, 0], m[..., 0, 2] - m[..., 2, 0]
+    s10, d10 = m[..., 1, 0] + m[..., 0, 1], m[..., 1, 0] - m[..., 0, 1]
+    cands = np.empty(m.shape[:-2] + (4, 4), dtype=m.dtype)  # row c: 4 q_c-scaled quaternion
+    cands[..., 0, 0], cands[..., 0, 1], cands[..., 0, 2], cands[..., 0, 3] = 1 + tr, d21, d02, d10
+    cands[..., 1, 0], cands[..., 1, 1], cands[..., 1, 2], cands[..., 1, 3] = d21, 1 + m00 - m11 - m22, s10, s02
+    cands[..., 2, 0], cands[..., 2, 1], cands[..., 2, 2], cands[..., 2, 3] = d02, s10, 1 - m00 + m11 - m22, s21
+    cands[..., 3, 0], cands[..., 3, 1], cands[..., 3, 2], cands[..., 3, 3] = d10, s02, s21, 1 - m00 - m11 + m22
     choice = np.argmax(np.stack([tr, m00, m11, m22], -1), axis=-1)
     q = np.take_along_axis(cands, choice[..., None, None], axis=-2)[..., 0, :]
     q = q / np.linalg.norm(q, axis=-1, keepdims=True)

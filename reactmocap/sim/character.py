@@ -103,7 +103,7 @@ _RADIUS = {
     "pelvis": 0.095, "waist": 0.09, "chest": 0.105, "neck": 0.05, "head": 0.1,
     "upper_arm": 0.045, "forearm": 0.037, "hand": 0.03, "thigh": 0.075, "shin": 0.05,
 }  # fmt: skip
-_FOOT = {"heel": 0.06, "toe": 0.05, "half_width": 0.045, "half_height": 0.028}
+_FOOT = {"heel": 0.06, "toe": 0.05, "half_width": 0.04, "half_height": 0.025}
 _HAND_LEN = 0.10
 _DENSITY_FALLBACK = {  # kg/m^3, Dempster & Gaughran (used if anthropometry is unavailable)
     "head": 1171.0, "chest": 1009.0, "waist": 1017.0, "pelvis": 1029.0, "thigh": 1040.0,
@@ -265,7 +265,9 @@ class Character:
                 "character from this motion's skeleton"
             )
 
-    def qpos_from_motion(self, motion: Motion, frames: Sequence[int] | NDArray | None = None) -> F64:
+    def qpos_from_motion(
+        self, motion: Motion, frames: Sequence[int] | NDArray | None = None
+    ) -> F64:
         """``(T, 67)`` MuJoCo qpos (free joint then 15 ball quaternions) of motion frames."""
         self._check_motion(motion)
         idx = np.arange(motion.num_frames) if frames is None else np.asarray(frames, int)
@@ -433,7 +435,8 @@ class Character:
         raise SimulationError(
             f"MuJoCo and library FK disagree on frame {frame} of {motion.name!r}: body {body!r} "
             f"(joint {self.skeleton.names[self.anchors[worst]]!r}) is {err[worst] * 1000:.1f} mm "
-            f"off (tolerance {tol * 1000:.1f} mm). Likely cause: {self._diagnose(motion, frame, worst)}"
+            f"off (tolerance {tol * 1000:.1f} mm). Likely cause: "
+            f"{self._diagnose(motion, frame, worst)}"
         )
 
     def _diagnose(self, motion: Motion, frame: int, body: int) -> str:
@@ -457,20 +460,29 @@ class Character:
         tr = motion.local_translations()[frame]
         for k in [*between, a]:
             if np.linalg.norm(tr[k] - self.ref_translations[k]) > 1e-6:
-                causes.append(f"joint {skel.names[k]!r} has a translation that differs from "
-                              "the reference pose (animated bone length)")
+                causes.append(
+                    f"joint {skel.names[k]!r} has a translation that differs from "
+                    "the reference pose (animated bone length)"
+                )
         for k in between:
-            ang = float(np.linalg.norm(quat_log(quat_mul(
-                quat_conj(self.ref_rotations[k]), motion.rotations[frame, k]))))
+            ang = float(
+                np.linalg.norm(
+                    quat_log(quat_mul(quat_conj(self.ref_rotations[k]), motion.rotations[frame, k]))
+                )
+            )
             if ang > 1e-4:
-                causes.append(f"non-simulated joint {skel.names[k]!r} is rotated "
-                              f"{np.degrees(ang):.1f} deg away from the character's reference "
-                              "pose (it is folded into a rigid body); build the character "
-                              "from a reference frame closer to this one")
+                causes.append(
+                    f"non-simulated joint {skel.names[k]!r} is rotated "
+                    f"{np.degrees(ang):.1f} deg away from the character's reference "
+                    "pose (it is folded into a rigid body); build the character "
+                    "from a reference frame closer to this one"
+                )
         if not causes:
-            causes.append("the motion's skeleton offsets differ from the character's, or the "
-                          "qpos conversion is inconsistent (a bug)")
-        return "; ".join(causes)
+            causes.append(
+                "the motion's skeleton offsets differ from the character's, or the "
+                "qpos conversion is inconsistent (a bug)"
+            )
+        return f"the chain first goes wrong at body {SIM_BODIES[first_bad]!r}: " + "; ".join(causes)
 
     # ------------------------------------------------------------------ lookups
     @staticmethod
@@ -533,7 +545,8 @@ def build_character(
         if int(anchors[_PARENT[b]]) not in skeleton.chain(int(anchors[b])):
             raise SimulationError(
                 f"joint {skeleton.names[anchors[b]]!r} ({SIM_BODIES[b]}) is not below "
-                f"{skeleton.names[anchors[_PARENT[b]]]!r} ({SIM_BODIES[_PARENT[b]]}) in the skeleton"
+                f"{skeleton.names[anchors[_PARENT[b]]]!r} ({SIM_BODIES[_PARENT[b]]}) "
+                "in the skeleton"
             )
 
     if reference is None:
@@ -549,8 +562,8 @@ def build_character(
     one = _take_frames(ref, np.array([frame]))
     gpos_all, grot_all = one.forward_kinematics()
     gpos, grot = gpos_all[0], grot_all[0]
-    P = gpos[anchors]  # noqa: N806 - world positions of the body frames
-    G = grot[anchors]  # noqa: N806
+    P = gpos[anchors]
+    G = grot[anchors]
 
     body_quat = np.empty((len(SIM_BODIES), 4))
     body_pos = np.empty((len(SIM_BODIES), 3))
@@ -594,8 +607,8 @@ def _make_geoms(
     anchors: NDArray[np.int64],
     ref: Motion,
     frame: int,
-    P: F64,  # noqa: N803
-    G: F64,  # noqa: N803
+    P: F64,
+    G: F64,
 ) -> tuple[_Geom, ...]:
     """Collision/mass geometry, computed in the reference pose's world frame and converted to
     each body's local frame."""
@@ -671,10 +684,14 @@ def _make_geoms(
     gpos_ref, grot_ref = ref.forward_kinematics()
     for side in "lr":
         # arms
-        out.append(capsule(f"{side}_upper_arm", at(f"{side}_upper_arm"), at(f"{side}_forearm"),
-                           r["upper_arm"]))
-        out.append(capsule(f"{side}_forearm", at(f"{side}_forearm"), at(f"{side}_hand"),
-                           r["forearm"]))
+        out.append(
+            capsule(
+                f"{side}_upper_arm", at(f"{side}_upper_arm"), at(f"{side}_forearm"), r["upper_arm"]
+            )
+        )
+        out.append(
+            capsule(f"{side}_forearm", at(f"{side}_forearm"), at(f"{side}_hand"), r["forearm"])
+        )
         hand_j = int(anchors[idx[f"{side}_hand"]])
         hend = np.asarray(ends.get(hand_j, (0.0, 0.0, 0.0)), dtype=float)
         wrist = at(f"{side}_hand")
@@ -684,13 +701,26 @@ def _make_geoms(
         else:  # straight continuation of the forearm
             hdir_w = _unit(wrist - at(f"{side}_forearm"))
             length = _HAND_LEN * s
-        out.append(capsule(f"{side}_hand", wrist + hdir_w * 0.01 * s, wrist + hdir_w * length,
-                           r["hand"]))
+        out.append(
+            capsule(f"{side}_hand", wrist + hdir_w * 0.01 * s, wrist + hdir_w * length, r["hand"])
+        )
         # legs
         out.append(capsule(f"{side}_thigh", at(f"{side}_thigh"), at(f"{side}_shin"), r["thigh"]))
         out.append(capsule(f"{side}_shin", at(f"{side}_shin"), at(f"{side}_foot"), r["shin"]))
-        out.append(_foot_box(skel, parts, anchors, ref, frame, side, s, G[idx[f"{side}_foot"]],
-                             gpos_ref, grot_ref))
+        out.append(
+            _foot_box(
+                skel,
+                parts,
+                anchors,
+                ref,
+                frame,
+                side,
+                s,
+                G[idx[f"{side}_foot"]],
+                gpos_ref,
+                grot_ref,
+            )
+        )
     return tuple(out)
 
 
@@ -717,13 +747,19 @@ def _foot_box(
     toe = parts.joints.get(f"{side}_toe")
     ankle_z = gpos[:, fj, 2]
     t_low = int(np.argmin(ankle_z))
-    h_a = float(np.clip(ankle_z.min(), 0.05 * s, 0.16 * s)) if ref.num_frames > 1 or \
-        ankle_z.min() > 0.02 else 0.08 * s
+    h_a = (
+        float(np.clip(ankle_z.min(), 0.05 * s, 0.16 * s))
+        if ref.num_frames > 1 or ankle_z.min() > 0.02
+        else 0.08 * s
+    )
     # ankle -> ball, in the foot's local frame (rigid: toes are folded at their reference pose)
     if toe is not None:
         f = quat_rotate(quat_conj(grot[frame, fj]), gpos[frame, toe] - gpos[frame, fj])
-        h_b = float(np.clip(gpos[:, toe, 2].min(), 0.0, h_a - 0.02 * s)) if ref.num_frames > 1 \
+        h_b = (
+            float(np.clip(gpos[:, toe, 2].min(), 0.0, h_a - 0.02 * s))
+            if ref.num_frames > 1
             else 0.02 * s
+        )
     else:
         end = np.asarray(skel.layout.end_sites.get(fj, (0.0, 0.0, 0.0)), dtype=float)
         if np.linalg.norm(end) > 0.05 * s:
@@ -757,6 +793,9 @@ def _foot_box(
     quat = quat_from_matrix(np.stack([fwd, lat, up], axis=1))
     del g_foot
     return _Geom(
-        b, "box", (0.5 * (x1 - x0), _FOOT["half_width"] * s, hz), pos=tuple(centre),
+        b,
+        "box",
+        (0.5 * (x1 - x0), _FOOT["half_width"] * s, hz),
+        pos=tuple(centre),
         quat=tuple(quat),
     )

@@ -207,6 +207,11 @@ class ContactReport:
     between: tuple[CharacterContact, ...]
 
 
+def _t3(v: object) -> tuple[float, float, float]:
+    a = np.asarray(v, dtype=np.float64).reshape(3)
+    return (float(a[0]), float(a[1]), float(a[2]))
+
+
 def _owner(world: World) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Per geom: character index (-1 for the floor) and sim-body index."""
     m = world.model
@@ -248,14 +253,18 @@ def contact_report(world: World) -> ContactReport:
         elif c1 != c2:
             between.append(
                 CharacterContact(
-                    c1, SIM_BODIES[body[g1]], c2, SIM_BODIES[body[g2]],
-                    tuple(float(x) for x in con.pos), tuple(float(x) for x in fw),
+                    c1,
+                    SIM_BODIES[body[g1]],
+                    c2,
+                    SIM_BODIES[body[g2]],
+                    _t3(con.pos),
+                    _t3(fw),
                 )
             )
     return ContactReport(
         time=float(d.time),
         ground=tuple(tuple(sorted(g)) for g in ground),
-        ground_force=tuple(tuple(float(x) for x in f) for f in gforce),
+        ground_force=tuple(_t3(f) for f in gforce),
         between=tuple(between),
     )
 
@@ -298,8 +307,7 @@ def first_contact(
     if times.size == 0:
         return None
     qs = [
-        wc.character.qpos_from_motion(mo.sample(times))
-        for wc, mo in zip(world.characters, motions)
+        wc.character.qpos_from_motion(mo.sample(times)) for wc, mo in zip(world.characters, motions)
     ]
     char, body = _owner(world)
     old_margin = m.geom_margin.copy()
@@ -320,8 +328,11 @@ def first_contact(
             if pairs:
                 rk = max(k - 1, 0)
                 return KinematicContact(
-                    k + int(round(start * fps)), float(times[k]),
-                    rk + int(round(start * fps)), float(times[rk]), tuple(sorted(pairs)),
+                    k + round(start * fps),
+                    float(times[k]),
+                    rk + round(start * fps),
+                    float(times[rk]),
+                    tuple(sorted(pairs)),
                 )
     finally:
         m.geom_margin[:] = old_margin

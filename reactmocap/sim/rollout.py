@@ -20,7 +20,7 @@ from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, build_character
-from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, contact_report
+from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, _t3, contact_report
 from reactmocap.sim.pd import PDServo
 from reactmocap.sim.world import World, WorldConfig
 
@@ -89,12 +89,20 @@ class MotionTracker:
 
 class RootAssist:
     """Optional, NON-PHYSICAL root stabilisation ("hand of god"): an external PD wrench on the
-    pelvis toward the mocap pelvis, ``F = M (kp (p_d - p) - kv (v - v_d))``, ``tau = I_c (kp e - kv w)``
+    pelvis toward the mocap pelvis, ``F = M (kp (p_d - p) - kv (v - v_d))``,
+    ``tau = I_c (kp e - kv w)``
     with ``M`` the character's mass and ``I_c`` its composite inertia about the pelvis.
     Off unless asked for; reports must say when it was used."""
 
-    def __init__(self, world: World, character: int, motion: Motion, start: float = 0.0,
-                 kp: float = 100.0, kv: float | None = None) -> None:
+    def __init__(
+        self,
+        world: World,
+        character: int,
+        motion: Motion,
+        start: float = 0.0,
+        kp: float = 100.0,
+        kv: float | None = None,
+    ) -> None:
         wc = world.characters[character]
         self.world = world
         self.bid = int(wc.body_ids[0])
@@ -104,8 +112,11 @@ class RootAssist:
         self.pos = q[:, :3]
         self.rot = q[:, 3:7]
         # velocity feed-forward: without it a PD lags a walking pelvis by kv v / kp
-        self.vel = np.gradient(self.pos, 1.0 / motion.fps, axis=0) if motion.num_frames > 1 \
+        self.vel = (
+            np.gradient(self.pos, 1.0 / motion.fps, axis=0)
+            if motion.num_frames > 1
             else np.zeros_like(self.pos)
+        )
         self.kp = float(kp)
         self.kv = 2.0 * np.sqrt(kp) if kv is None else float(kv)
         self.mass = float(world.model.body_subtreemass[self.bid])
@@ -114,7 +125,7 @@ class RootAssist:
     def __call__(self, world: World, t: float) -> None:
         d = world.data
         x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
-        i = int(round(x))
+        i = round(x)
         p_d, q_d = self.pos[i], self.rot[i]
         v = d.qvel[self.dof : self.dof + 3]
         w_local = d.qvel[self.dof + 3 : self.dof + 6]
@@ -124,7 +135,8 @@ class RootAssist:
         tau_local = inertia * (self.kp * e - self.kv * w_local)
         rot = d.xmat[self.bid].reshape(3, 3)
         d.xfrc_applied[self.bid, :3] = self.mass * (
-            self.kp * (p_d - d.xpos[self.bid]) - self.kv * (v - self.vel[i]))
+            self.kp * (p_d - d.xpos[self.bid]) - self.kv * (v - self.vel[i])
+        )
         d.xfrc_applied[self.bid, 3:] = rot @ tau_local
 
 
@@ -194,16 +206,16 @@ def rollout(
         raise ConfigError("control_every and check_every must be >= 1")
     m, d = world.model, world.data
     dt = world.timestep
-    nsteps = int(round(duration / dt))
-    every = max(1, int(round(1.0 / (record_fps * dt))))
+    nsteps = round(duration / dt)
+    every = max(1, round(1.0 / (record_fps * dt)))
     nrec = nsteps // every + 1
     nchar = len(world.characters)
     pos = np.empty((nchar, nrec, len(SIM_BODIES), 3))
     quat = np.empty((nchar, nrec, len(SIM_BODIES), 4))
     schedule = ImpactSchedule(world, impacts) if impacts else None
-    ke_limit = np.array([
-        energy_limit_per_kg * float(m.body_subtreemass[wc.body_ids[0]]) for wc in world.characters
-    ])
+    ke_limit = np.array(
+        [energy_limit_per_kg * float(m.body_subtreemass[wc.body_ids[0]]) for wc in world.characters]
+    )
     contacts: list[ContactReport] = []
     t0 = float(d.time)
     _record(world, pos, quat, 0)
@@ -232,12 +244,16 @@ def rollout(
     if schedule is not None:
         schedule.clear()
     wall = _time.perf_counter() - wall
-    times = np.arange(nrec) * every * dt
+    times = (np.arange(nrec) * (every * dt)).astype(np.float64)
     fps = 1.0 / (every * dt)
     refs = list(references) if references is not None else [None] * nchar
     motions = [
         wc.character.motion_from_body_transforms(
-            pos[c], quat[c], fps, refs[c], times + reference_start if refs[c] is not None else None,
+            pos[c],
+            quat[c],
+            fps,
+            refs[c],
+            times + reference_start if refs[c] is not None else None,
             name=f"sim_{wc.prefix.rstrip('/')}",
         )
         for c, wc in enumerate(world.characters)
@@ -283,10 +299,16 @@ def _errors(world: World, result: RolloutResult, motion: Motion, start: float) -
     ref_pos, ref_rot = ch.body_transforms_from_qpos(q_ref)
     sim_pos, sim_rot = result.body_pos[0], result.body_quat[0]
     # joint error: angle between simulated and mocap local rotations of the 15 ball joints
-    par = np.array([SIM_BODIES.index(p) for _, p, _ in __import__(
-        "reactmocap.sim.character", fromlist=["_TREE"])._TREE[1:]])
+    par = np.array(
+        [
+            SIM_BODIES.index(p)
+            for _, p, _ in __import__("reactmocap.sim.character", fromlist=["_TREE"])._TREE[1:]
+        ]
+    )
+
     def local(rot: F64) -> F64:
         return quat_mul(quat_conj(rot[:, par]), rot[:, 1:])
+
     rel = quat_mul(quat_conj(local(sim_rot)), local(ref_rot))
     jerr = np.linalg.norm(quat_log(rel), axis=-1)
     root_err = np.linalg.norm(sim_pos[:, 0] - ref_pos[:, 0], axis=-1)
@@ -337,9 +359,13 @@ def track_clip(
             f"cannot track {seconds} s from {start} s: the clip {motion.name!r} lasts "
             f"{motion.duration:.3f} s"
         )
-    frame = int(round(start * motion.fps))
-    character = build_character(motion, total_mass=total_mass, frame=frame,
-                                **(character_kwargs or {}))  # type: ignore[arg-type]
+    frame = round(start * motion.fps)
+    character = build_character(
+        motion,
+        total_mass=total_mass,
+        frame=frame,
+        **(character_kwargs or {}),  # type: ignore[arg-type]
+    )  # type: ignore[arg-type]
     character.check_fk(motion, frame)
     cfg = config or WorldConfig(friction=friction)
     world = World(character, cfg)
@@ -351,8 +377,15 @@ def track_clip(
         ctrls.append(RootAssist(world, 0, motion, start=start, kp=root_assist))
     tracker(world, 0.0)
     result = rollout(
-        world, seconds, servo=servo, controllers=ctrls, control_every=servo.refresh_every,
-        impacts=impacts, record_fps=record_fps, references=[motion], reference_start=start,
+        world,
+        seconds,
+        servo=servo,
+        controllers=ctrls,
+        control_every=servo.refresh_every,
+        impacts=impacts,
+        record_fps=record_fps,
+        references=[motion],
+        reference_start=start,
     )
     err = _errors(world, result, motion, start)
     report = TrackReport(
@@ -398,6 +431,11 @@ def push_clip(
     s0 = max(0.0, time - 0.5) if start is None else float(start)
     if time < s0:
         raise ConfigError(f"push time {time} s is before the tracking start {s0} s")
-    impact = Impact(body=body, force=tuple(force), point=None if point is None else tuple(point),
-                    start=time - s0, duration=duration)
+    impact = Impact(
+        body=body,
+        force=_t3(force),
+        point=None if point is None else _t3(point),
+        start=time - s0,
+        duration=duration,
+    )
     return track_clip(motion, start=s0, seconds=seconds, impacts=[impact], **kwargs)  # type: ignore[arg-type]

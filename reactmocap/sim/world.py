@@ -87,7 +87,9 @@ class WorldConfig:
         if not (np.isfinite(self.friction) and self.friction >= 0):
             raise ConfigError(f"friction must be >= 0, got {self.friction!r}")
         if self.integrator not in _INTEGRATORS:
-            raise ConfigError(f"integrator must be one of {list(_INTEGRATORS)}, got {self.integrator!r}")
+            raise ConfigError(
+                f"integrator must be one of {list(_INTEGRATORS)}, got {self.integrator!r}"
+            )
         if self.solver not in _SOLVERS:
             raise ConfigError(f"solver must be one of {list(_SOLVERS)}, got {self.solver!r}")
         if self.cone not in _CONES:
@@ -137,8 +139,12 @@ class WorldCharacter:
 class World:
     """A MuJoCo model and data with a floor and one or two characters."""
 
-    def __init__(self, characters: Character | Sequence[Character], config: WorldConfig | None = None,
-                 **overrides: object) -> None:
+    def __init__(
+        self,
+        characters: Character | Sequence[Character],
+        config: WorldConfig | None = None,
+        **overrides: object,
+    ) -> None:
         chars = [characters] if isinstance(characters, Character) else list(characters)
         if not 1 <= len(chars) <= len(PREFIXES):
             raise ConfigError(f"a World holds 1 or 2 characters, got {len(chars)}")
@@ -189,8 +195,9 @@ class World:
                 raise SimulationError("ball joints are not contiguous in qpos (internal error)")
             geoms = np.flatnonzero(np.isin(m.geom_bodyid, ids))
             self.characters.append(
-                WorldCharacter(k, pre, ch, ids, qadr, dadr, geoms,
-                               {b: int(i) for b, i in zip(SIM_BODIES, ids)})
+                WorldCharacter(
+                    k, pre, ch, ids, qadr, dadr, geoms, {b: int(i) for b, i in zip(SIM_BODIES, ids)}
+                )
             )
         self._apply_contact_settings()
         self._apply_joint_settings()
@@ -250,7 +257,9 @@ class World:
         self.data.qvel[wc.qvel_slice] = 0.0 if qvel is None else qvel
         mujoco.mj_forward(self.model, self.data)
 
-    def set_from_motion(self, index: int, motion: Motion, frame: int, velocity: bool = True) -> None:
+    def set_from_motion(
+        self, index: int, motion: Motion, frame: int, velocity: bool = True
+    ) -> None:
         """Put a character in a motion frame (pose and finite-difference velocities)."""
         ch = self.characters[index].character
         q = ch.qpos_from_motion(motion, [frame])[0]

@@ -16,6 +16,7 @@ from reactmocap.library.synth import (
     STRIKERS,
     synthetic_clips,
     synthetic_skeleton,
+    write_synthetic_library,
 )
 from reactmocap.rotations import quat_log
 from tests.conftest import SYNTHETIC
@@ -34,7 +35,7 @@ FOOT_POINTS = ("Foot", "ToeBase")  # plus the toe end sites
 # A foot point this close to its standing height is on the ground; the ankle only with the heel
 # down (a raised heel lifts it ~2.5 cm while the ball stays planted and it may swing about that).
 CONTACT_ABOVE_REST = {"Foot": 0.02, "ToeBase": 0.03, "ToeTip": 0.03}
-CONTACT_SPEED = 0.5  # m/s: faster than this is a swing, not a planted foot
+CONTACT_SPEED = 1.0  # m/s: faster than this is a swing skimming the floor, not a planted foot
 MAX_SLIDE = 0.02
 
 
@@ -137,8 +138,9 @@ def test_guard_size_and_loops(clips: dict[str, Motion]) -> None:
     assert np.ptp(_points(g), axis=0).max() > 0.005  # it does breathe
 
 
-@pytest.mark.parametrize("name", [*ATTACK_CLIPS, "step_forward", "step_back", "sway"])
+@pytest.mark.parametrize("name", sorted(set(CLIP_INFO) - set(FALLS)))
 def test_starts_and_ends_in_guard(clips: dict[str, Motion], name: str) -> None:
+    # local joint rotations match the guard's (steps end displaced, but in the same pose)
     g0 = clips["guard"].rotations[0]
     m = clips[name]
     for frame in (0, -1):
@@ -194,7 +196,6 @@ def test_committed_files_match_generator(clips: dict[str, Motion]) -> None:
 
 def test_write_library(tmp_path: Path) -> None:
     from reactmocap.library.bvh import read_bvh
-    from reactmocap.library.synth import write_synthetic_library
 
     paths = write_synthetic_library(tmp_path / "lib", fps=60.0)
     assert sorted(p.name for p in paths) == sorted(f"{n}.bvh" for n in CLIP_INFO)

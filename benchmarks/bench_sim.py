@@ -1,0 +1,288 @@
+"""Physics benchmarks (prints figures; run ``.venv/bin/python benchmarks/bench_sim.py``).
+
+1. us per step and real-time factor, each next to the bare ``mj_step`` of the same model and
+   state measured in the same run: one character standing under PD, the same passive
+   (ragdoll), two characters in contact under PD.
+2. MuJoCo options (integrator x solver x cone) for the standing PD character.
+3. Tracking robustness: 1 s windows every 0.5 s through each shared walk/run/kick clip (a clip
+   shorter than 1 s is one window): % of windows in which the character stays upright with
+   the pelvis within 10 cm and 15 deg of the mocap at every recorded frame; medians of the
+   errors. Physical (no root help) and, separately labelled, with the non-physical root assist.
+4. The guard stance clip tracked for 10 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from reactmocap.library.motion import Motion
+from reactmocap.library.synth import synthetic_clips
+from reactmocap.sim import PDServo, World, WorldConfig, build_character, rollout, track_clip
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT / ".." / "shared" / "mocap"
+
+
+def _read_bvh(path: Path) -> Motion:
+    try:
+        from reactmocap.library.bvh import read_bvh
+    except ImportError:  # until the library's reader lands: a minimal Y-up cm reader
+        return _fallback_read_bvh(path)
+    return read_bvh(path)
+
+
+def _fallback_read_bvh(path: Path) -> Motion:
+    from reactmocap.conventions import axes_to_z_up
+    from reactmocap.library.skeleton import BVHLayout, Skeleton
+    from reactmocap.rotations import quat_from_euler, quat_mul
+
+    toks = path.read_text().split()
+    i, names, parents, offs, chans, stack, ends, cur = 0, [], [], [], [], [], {}, -1
+    while toks[i] != "MOTION":
+        t = toks[i]
+        if t in ("ROOT", "JOINT"):
+            names.append(toks[i + 1])
+            parents.append(stack[-1] if stack else -1)
+            cur = len(names) - 1
+            i += 2
+        elif t == "End":
+            ends[stack[-1]] = [float(x) for x in toks[i + 4 : i + 7]]
+            i += 8
+        elif t == "{":
+            stack.append(cur)
+            i += 1
+        elif t == "}":
+            stack.pop()
+            i += 1
+        elif t == "OFFSET":
+            offs.append([float(x) for x in toks[i + 1 : i + 4]])
+            i += 4
+        elif t == "CHANNELS":
+            n = int(toks[i + 1])
+            chans.append(tuple(toks[i + 2 : i + 2 + n]))
+            i += 2 + n
+        else:
+            i += 1
+    nf, ft = int(toks[i + 2]), float(toks[i + 5])
+    data = np.array(toks[i + 6 :], float).reshape(nf, -1)
+    r, s = axes_to_z_up("y"), 0.01
+    off = np.array(offs) @ r.T * s
+    qr = np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0])
+    qri = qr * np.array([1.0, -1.0, -1.0, -1.0])
+    rot = np.zeros((nf, len(names), 4))
+    trans = np.zeros((nf, len(names), 3))
+    c = 0
+    for j, ch in enumerate(chans):
+        pos = [k for k, n in enumerate(ch) if n.endswith("position")]
+        rk = [k for k, n in enumerate(ch) if n.endswith("rotation")]
+        d = data[:, c : c + len(ch)]
+        c += len(ch)
+        q = quat_from_euler(np.radians(d[:, rk]), "".join(ch[k][0] for k in rk))
+        rot[:, j] = quat_mul(quat_mul(qr, q), qri)
+        trans[:, j] = (d[:, pos] @ r.T * s) if pos else off[j]
+    layout = BVHLayout(
+        channels=tuple(chans),
+        unit="cm",
+        up="y",
+        end_sites={k: tuple(np.array(v) @ r.T * s) for k, v in ends.items()},
+    )
+    skel = Skeleton(tuple(names), np.array(parents), off, layout)
+    return Motion(skel, 1.0 / ft, trans[:, 0], rot, trans, name=path.stem)
+
+
+def _time_steps(world: World, servo: PDServo | None, n: int) -> float:
+    m, d = world.model, world.data
+    t = time.perf_counter()
+    if servo is None:
+        for _ in range(n):
+            mujoco.mj_step(m, d)
+    else:
+        for _ in range(n):
+            servo.apply()
+            mujoco.mj_step(m, d)
+    return (time.perf_counter() - t) / n
+
+
+def _paired(world: World, servo: PDServo | None, n: int, reps: int = 5) -> tuple[float, float]:
+    """Median us/step with the servo and bare mj_step from the same saved state."""
+    state = world.get_state()
+    with_pd, bare = [], []
+    for _ in range(reps):
+        world.set_state(state)
+        with_pd.append(_time_steps(world, servo, n))
+        world.set_state(state)
+        bare.append(_time_steps(world, None, n))  # same model, forces left as they were
+    return float(np.median(with_pd)) * 1e6, float(np.median(bare)) * 1e6
+
+
+def bench_steps(n: int) -> None:
+    clips = synthetic_clips(30.0)
+    guard = clips["guard"]
+    ch = build_character(guard)
+    dt = WorldConfig().timestep
+    print(f"\n## us per step (dt = {dt} s; medians of 5 runs of {n} steps)")
+    print(f"{'case':<34} {'us/step':>8} {'bare':>8} {'overhead':>9} {'RT factor':>9}")
+
+    world = World(ch)
+    world.set_from_motion(0, guard, 0, velocity=False)
+    servo = PDServo(world, kp=4000.0)
+    rollout(world, 0.1, servo=servo)  # settle on the feet
+    pd, bare = _paired(world, servo, n)
+    print(
+        f"{'1 char standing, PD':<34} {pd:8.1f} {bare:8.1f} {100 * (pd / bare - 1):8.1f}% "
+        f"{dt * 1e6 / pd:8.1f}x"
+    )
+
+    world = World(ch)
+    world.set_from_motion(0, guard, 0, velocity=False)
+    t_rag, _ = _paired(world, None, n)
+    print(
+        f"{'1 char passive (ragdoll)':<34} {t_rag:8.1f} {t_rag:8.1f} {0.0:8.1f}% "
+        f"{dt * 1e6 / t_rag:8.1f}x"
+    )
+
+    world = World([ch, ch])
+    b = guard.transformed(yaw=np.pi, translation=(0.42, 0.0, 0.0))
+    world.set_from_motion(0, guard, 0, velocity=False)
+    world.set_from_motion(1, b, 0, velocity=False)
+    servo = PDServo(world, kp=4000.0)
+    rollout(world, 0.05, servo=servo)
+    from reactmocap.sim import contact_report
+
+    ncc = len(contact_report(world).between)
+    pd, bare = _paired(world, servo, n)
+    print(
+        f"{'2 chars in contact, PD':<34} {pd:8.1f} {bare:8.1f} {100 * (pd / bare - 1):8.1f}% "
+        f"{dt * 1e6 / pd:8.1f}x   ({ncc} char-char contacts at start)"
+    )
+
+
+def bench_options(n: int) -> None:
+    guard = synthetic_clips(30.0)["guard"]
+    ch = build_character(guard)
+    print(f"\n## MuJoCo options, 1 char standing under PD (us/step, median of 3 x {n})")
+    for integ in ("euler", "implicitfast", "rk4"):
+        for solver in ("newton", "cg", "pgs"):
+            for cone in ("pyramidal", "elliptic"):
+                if integ == "rk4" and solver != "newton":
+                    continue
+                world = World(ch, WorldConfig(integrator=integ, solver=solver, cone=cone))
+                world.set_from_motion(0, guard, 0, velocity=False)
+                kp = 400.0 if integ == "rk4" else 4000.0  # RK4 damping is explicit
+                servo = PDServo(world, kp=kp)
+                try:
+                    rollout(world, 0.05, servo=servo)
+                    pd, bare = _paired(world, servo, n, reps=3)
+                    print(
+                        f"{integ:<13} {solver:<7} {cone:<10} PD {pd:7.1f}  bare {bare:7.1f}"
+                        f"  ncon {world.data.ncon}"
+                    )
+                except Exception as exc:
+                    print(f"{integ:<13} {solver:<7} {cone:<10} failed: {exc}")
+
+
+def _windows(motion: Motion) -> list[float]:
+    if motion.duration <= 1.0:
+        return [0.0]
+    return list(np.arange(0.0, motion.duration - 1.0 + 1e-9, 0.5))
+
+
+def bench_tracking(kp: float, assist_gain: float) -> None:
+    clips = sorted(
+        p for p in SHARED.glob("*/*.bvh") if any(k in p.name for k in ("walk", "run", "kick"))
+    )
+    if not clips:
+        print(f"\n(no shared clips under {SHARED.resolve()}: tracking robustness skipped)")
+        return
+    for assist in (0.0, assist_gain):
+        label = (
+            "physical, no root help"
+            if assist == 0
+            else f"WITH non-physical root assist kp={assist:g}"
+        )
+        print(f"\n## tracking robustness, kp={kp:g}, kv critical, {label}")
+        print(
+            f"{'clip':<28} {'windows':>7} {'ok %':>6} {'upright %':>9} {'med root cm':>11} "
+            f"{'med ang deg':>11} {'med joint rad':>13}"
+        )
+        tot_ok = tot = 0
+        for path in clips:
+            motion = _read_bvh(path)
+            ok = up = 0
+            roots, angs, joints = [], [], []
+            wins = _windows(motion)
+            for s in wins:
+                secs = min(1.0, motion.duration - s)
+                try:
+                    from reactmocap.sim.rollout import _errors
+
+                    _, rep, res = track_clip(
+                        motion, start=float(s), seconds=secs, kp=kp, root_assist=assist
+                    )
+                    # recompute per-frame errors for the window criterion
+                    world = World(build_character(motion, frame=round(s * motion.fps)))
+                    err = _errors(world, res, motion, float(s))
+                    good = (
+                        (not rep.fell)
+                        and float(np.max(err["root_err_series"])) <= 0.10
+                        and float(np.max(err["root_ang_series"])) <= np.radians(15.0)
+                    )
+                    ok += good
+                    up += not rep.fell
+                    roots.append(rep.max_root_error_m)
+                    angs.append(float(np.max(err["root_ang_series"])))
+                    joints.append(rep.mean_joint_error_rad)
+                except Exception as exc:
+                    print(f"  {path.name} @ {s:.1f}s failed: {exc}")
+            tot_ok += ok
+            tot += len(wins)
+            print(
+                f"{path.stem:<28} {len(wins):>7} {100 * ok / len(wins):6.0f} "
+                f"{100 * up / len(wins):9.0f} {100 * np.median(roots):11.1f} "
+                f"{np.degrees(np.median(angs)):11.1f} {np.median(joints):13.3f}"
+            )
+        print(f"{'ALL':<28} {tot:>7} {100 * tot_ok / max(tot, 1):6.0f}")
+
+
+def bench_guard(kp: float, assist_gain: float) -> None:
+    guard = synthetic_clips(30.0)["guard"]
+    loop = Motion.concatenate([guard, guard.slice(1), guard.slice(1)], name="guard_x3")
+    for assist in (0.0, assist_gain):
+        _, rep, _ = track_clip(loop, seconds=10.0, kp=kp, root_assist=assist)
+        label = "physical" if assist == 0 else f"root assist kp={assist:g}"
+        print(
+            f"\n## guard 10 s ({label}): fell={rep.fell} (at {rep.fall_time}), "
+            f"mean joint err {rep.mean_joint_error_rad:.3f} rad, root err "
+            f"{100 * rep.root_error_m:.1f} cm, RT factor {rep.realtime_factor:.2f}x"
+        )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=2000)
+    ap.add_argument("--kp", type=float, default=4000.0)
+    ap.add_argument("--assist", type=float, default=100.0)
+    ap.add_argument(
+        "--skip", nargs="*", default=[], choices=["steps", "options", "tracking", "guard"]
+    )
+    args = ap.parse_args(argv)
+    print(f"mujoco {mujoco.__version__}, python {sys.version.split()[0]}")
+    if "steps" not in args.skip:
+        bench_steps(args.steps)
+    if "options" not in args.skip:
+        bench_options(args.steps // 2)
+    if "guard" not in args.skip:
+        bench_guard(args.kp, args.assist)
+    if "tracking" not in args.skip:
+        bench_tracking(args.kp, args.assist)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

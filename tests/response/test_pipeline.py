@@ -1,0 +1,157 @@
+"""End-to-end response pipeline on the bundled synthetic clips (and the shared real clips)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reactmocap.cli import main
+from reactmocap.errors import ReactMocapError
+from reactmocap.library.bodyparts import map_body_parts
+from reactmocap.library.bvh import read_bvh
+from reactmocap.response.pipeline import run_response, run_scenario
+from reactmocap.response.scenario import (
+    AttackerSpec,
+    CharacterSpec,
+    ImpactSpec,
+    Scenario,
+    load_scenario,
+)
+from reactmocap.rotations import quat_conj, quat_log, quat_mul
+from tests.conftest import REPO, SYNTHETIC
+
+EXAMPLES = REPO / "examples"
+
+
+def push(force: tuple[float, float, float], facing: float = 0.0, **response: float) -> Scenario:
+    base = load_scenario(EXAMPLES / "light_push.toml")
+    assert base.impact is not None
+    return replace(
+        base,
+        recipient=replace(base.recipient, facing_deg=facing),
+        impact=replace(base.impact, force=force),
+        response=replace(base.response, **response),
+    )
+
+
+def pelvis_xy(motion, frame: int) -> np.ndarray:  # type: ignore[no-untyped-def]
+    parts = map_body_parts(motion.skeleton)
+    return motion.global_positions()[frame, parts.joint_of("pelvis"), :2]
+
+
+def test_zero_impact_oracle() -> None:
+    res = run_response(push((0.0, 0.0, 0.0)))
+    m = res.matched
+    assert m.clip == "guard"
+    # the found frame is the recipient's own clip time at the match
+    own_time = 0.5 + res.transition_end
+    assert abs(m.time - own_time) <= 2.0 / 30.0
+    assert m.distance < 0.5
+    # the output equals the input motion
+    clip = read_bvh(SYNTHETIC / "guard.bvh")
+    n = res.recipient.num_frames
+    expected = clip.sample(0.5 + np.arange(n) / clip.fps)
+    dpos = np.linalg.norm(res.recipient.global_positions() - expected.global_positions(), axis=-1)
+    assert dpos.max() < 0.03
+    rel = quat_mul(quat_conj(res.recipient.rotations), expected.rotations)
+    assert np.linalg.norm(quat_log(rel), axis=-1).max() < 0.15
+
+
+def test_monotonic_pushes() -> None:
+    disp = {}
+    for f in (-150.0, -400.0, 400.0):
+        res = run_response(push((f, 0.0, 0.0)))
+        i = int(round((res.impact_time + 0.6) * res.sim1.fps)) - int(
+            round(res.report["impact"]["rewind_time"] * res.sim1.fps)
+        )
+        start = pelvis_xy(res.sim1, 0)
+        disp[f] = pelvis_xy(res.sim1, min(i, res.sim1.num_frames - 1)) - start
+    assert abs(disp[-400.0][0]) > abs(disp[-150.0][0])
+    assert disp[-400.0][0] < 0 < disp[400.0][0]
+
+
+def test_exact_landing_and_outputs(tmp_path: Path) -> None:
+    scenario = load_scenario(EXAMPLES / "front_kick.toml")
+    report = run_scenario(scenario, tmp_path, plot=True)
+    for key in ("matched", "candidates", "impact", "timings_s", "quality", "outputs"):
+        assert key in report
+    for key in ("scan", "sim1", "search", "sim2", "blend", "total"):
+        assert report["timings_s"][key] >= 0
+    on_disk = json.loads((tmp_path / "report.json").read_text())
+    assert on_disk["matched"]["clip"] == report["matched"]["clip"]
+    rec = read_bvh(tmp_path / "recipient.bvh")
+    att = read_bvh(tmp_path / "attacker.bvh")
+    assert (tmp_path / "plot.png").stat().st_size > 1000
+    for m in (rec, att):
+        assert np.all(np.isfinite(m.global_positions()))
+    assert report["quality"]["penetration_max_m"] < 0.1
+    # exact landing: at the end of the transition the output is the found clip's pose
+    res = run_response(scenario)
+    fps = res.recipient.fps
+    i_end = int(round(res.transition_end * fps))
+    found = res.found.sample([res.matched.time])
+    np.testing.assert_allclose(
+        res.recipient.global_positions()[i_end], found.global_positions()[0], atol=1e-6
+    )
+
+
+def test_facing_turns_the_outcome() -> None:
+    a = run_response(push((-400.0, 0.0, 0.0), facing=0.0))
+    b = run_response(push((0.0, -400.0, 0.0), facing=90.0))
+    assert a.matched.clip == b.matched.clip
+    assert abs(a.matched.time - b.matched.time) < 0.1
+    rot = np.array([[0.0, -1.0], [1.0, 0.0]])
+    da = pelvis_xy(a.sim1, -1) - pelvis_xy(a.sim1, 0)
+    db = pelvis_xy(b.sim1, -1) - pelvis_xy(b.sim1, 0)
+    np.testing.assert_allclose(rot @ da, db, atol=0.03)
+
+
+def test_failing_run_leaves_no_output(tmp_path: Path) -> None:
+    bad = push((-300.0, 0.0, 0.0))
+    bad = replace(bad, recipient=replace(bad.recipient, clip="no_such_clip"))
+    with pytest.raises(ReactMocapError, match="no_such_clip"):
+        run_scenario(bad, tmp_path / "out")
+    assert not any((tmp_path / "out").glob("*")) if (tmp_path / "out").exists() else True
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.stem)
+def test_every_example_scenario_runs(path: Path, tmp_path: Path) -> None:
+    if path.name.startswith("sweep"):
+        pytest.skip("sweep file")
+    assert main(["respond", str(path), "--out", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert np.isfinite(report["matched"]["distance"])
+    assert read_bvh(tmp_path / "recipient.bvh").num_frames > 10
+
+
+def test_demo_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["demo", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "recipient" in out and str(tmp_path) in out
+    assert (tmp_path / "recipient.bvh").exists()
+
+
+def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    for f in shared_mocap_dir.glob("*.bvh"):
+        (lib / f.name).symlink_to(f)
+    for f in SYNTHETIC.glob("*.bvh"):
+        (lib / f.name).symlink_to(f)
+    scenario = Scenario(
+        library=lib,
+        recipient=CharacterSpec("dataset-1_respond_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.0, facing_deg=180.0,
+                              position=(0.9, 0.0)),  # fmt: skip
+        name="real",
+    )
+    report = run_scenario(scenario, tmp_path / "out")
+    rec = read_bvh(tmp_path / "out" / "recipient.bvh")
+    assert np.all(np.isfinite(rec.global_positions()))
+    assert report["quality"]["penetration_max_m"] < 0.15
+    assert report["matched"]["clip"].startswith("dataset-1")
+    _ = ImpactSpec
