@@ -27,7 +27,11 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     push.add_argument("clip", type=Path, help="input BVH")
     push.add_argument("--time", type=float, required=True, help="clip time of the push (s)")
     push.add_argument("--body", required=True, help="body part, e.g. chest, head, l_forearm")
-    push.add_argument("--force", required=True, help="world force FX,FY,FZ in N (Z up)")
+    push.add_argument(
+        "--force",
+        required=True,
+        help="world force FX,FY,FZ in N (Z up); write --force=-300,0,0 for a leading minus",
+    )
     push.add_argument("--duration", type=float, default=0.1, help="push duration (s)")
     push.add_argument("--seconds", type=float, help="how long to simulate after the start")
     push.add_argument("--out", type=Path, required=True, help="simulated motion as BVH")
