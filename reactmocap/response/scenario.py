@@ -68,7 +68,7 @@ class ResponseConfig:
     kv: float = 50.0  # 1/s, inertia-scaled damping
     friction_sim1: float = 1.0
     friction_sim2: float = 0.5
-    sim1_mode: Literal["passive", "holding"] = "passive"
+    sim1_mode: Literal["passive", "holding"] = "holding"
     sim1_duration: float = 1.0  # s after the impact
     search_start: float = 0.1  # s after the impact
     search_end: float = 1.0

@@ -59,6 +59,10 @@ MIRROR_SUFFIX = "_mirror"
 _CHUNK = 4096
 #: frames per window in the coarse pre-ranking of KD candidates
 COARSE_FRAMES = 10
+#: KD candidates, exactly re-ranked candidates, candidates whose interval is refined
+DEFAULT_K = 64
+DEFAULT_EXACT = 4
+DEFAULT_REFINE = 2
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -217,7 +221,7 @@ class MotionIndex:
     @property
     def tree(self) -> cKDTree:
         if self._tree is None:
-            self._tree = cKDTree(self.embedding, leafsize=16, balanced_tree=False)
+            self._tree = cKDTree(self.embedding, leafsize=32, balanced_tree=False)
         return self._tree
 
     def nbytes(self) -> int:
@@ -519,7 +523,7 @@ class MotionIndex:
             ww = embedding_frame_weights(ww, offsets)
         return window_distances(
             self.positions, self.orientations, self.heading, self.origin, starts, qw,
-            ww, wp, wq, groups, offsets,
+            ww, wp, wq, groups, offsets, precise=not coarse,
         )  # fmt: skip
 
     def _coarse_offsets(self) -> I64:
@@ -534,7 +538,7 @@ class MotionIndex:
         return ((e - self.pca_mean) @ self.pca_components)[0]
 
     def search_window(
-        self, qw: QueryWindow, *, n: int = 1, k: int = 32, refine: int = 4, exact: int = 8
+        self, qw: QueryWindow, *, n: int = 1, k: int = DEFAULT_K, refine: int = DEFAULT_REFINE, exact: int = DEFAULT_EXACT
     ) -> list[SearchResult]:
         """Search with a prepared query window.
 
@@ -564,10 +568,10 @@ class MotionIndex:
             for r in rows[order[:refine]]
         ]
         starts = np.unique(np.concatenate(pieces))
-        dists, _ = self._distances(qw, starts)
+        dists, br = self._distances(qw, starts, breakdown=True)
         if n > 1:
             # runners-up must be distinct windows: widen the exact set until n are found
-            while self._pick(starts, dists, n).size < n:
+            while self._pick(starts, dists, n).size < n:  # noqa: PLR2004
                 if k < self.num_indexed and np.all(np.isin(cand, starts)):
                     k = min(2 * k, self.num_indexed)
                     _, rows = self.tree.query(self._embed_query(qw), k=k)
@@ -575,23 +579,28 @@ class MotionIndex:
                 more = cand[~np.isin(cand, starts)][: 8 * n]  # nearest in the embedding first
                 if more.size == 0:
                     break
-                d2, _ = self._distances(qw, more)
+                d2, br2 = self._distances(qw, more, breakdown=True)
                 starts = np.concatenate([starts, more])
                 dists = np.concatenate([dists, d2])
-        results = self._results(qw, starts, dists, n)
+                br = np.concatenate([br, br2])
+        results = self._results(qw, starts, dists, n, br)
         self.last_stats = QueryStats(
             candidates=int(cand.size), refined_windows=int(starts.size), seconds=time.perf_counter() - t0
         )
         return results
 
     def _pick(self, starts: I64, dists: F64, n: int) -> I64:
-        """The ``n`` best starts, at least one window length apart within a clip."""
+        """Positions (into ``starts``) of the ``n`` best windows, at least one window length
+        apart within a clip."""
         order = np.argsort(dists, kind="stable")
+        if n == 1:
+            return order[:1]
+        clips = np.searchsorted(self.clip_offsets, starts, side="right") - 1
         picked: list[int] = []
         for i in order:
-            s = int(starts[i])
-            if all(abs(s - p) >= self.length or self._clip_of(s) != self._clip_of(p) for p in picked):
-                picked.append(s)
+            s, c = int(starts[i]), int(clips[i])
+            if all(abs(s - int(starts[p])) >= self.length or c != int(clips[p]) for p in picked):
+                picked.append(int(i))
                 if len(picked) == n:
                     break
         return np.asarray(picked, dtype=np.int64)
@@ -599,9 +608,15 @@ class MotionIndex:
     def _clip_of(self, start: int) -> int:
         return int(np.searchsorted(self.clip_offsets, start, side="right") - 1)
 
-    def _results(self, qw: QueryWindow, starts: I64, dists: F64, n: int) -> list[SearchResult]:
-        chosen = self._pick(starts, dists, n)
-        d, br = self._distances(qw, chosen, breakdown=True)
+    def _results(
+        self, qw: QueryWindow, starts: I64, dists: F64, n: int, breakdown: F64 | None = None
+    ) -> list[SearchResult]:
+        sel = self._pick(starts, dists, n)
+        chosen = starts[sel]
+        if breakdown is None:
+            d, br = self._distances(qw, chosen, breakdown=True)
+        else:
+            d, br = dists[sel], breakdown[sel]
         assert br is not None
         out = []
         for rank, (s, dist, row) in enumerate(zip(chosen, d, br)):
@@ -633,12 +648,15 @@ class MotionIndex:
         motion: Motion,
         start_frame: int | None = None,
         *,
-        k: int = 32,
-        refine: int = 4,
+        k: int = DEFAULT_K,
+        refine: int = DEFAULT_REFINE,
+        exact: int = DEFAULT_EXACT,
         parts: BodyPartMap | None = None,
     ) -> SearchResult:
-        """Best library window for the window of ``motion`` starting at ``start_frame``."""
-        return self.search_window(self.prepare_query(motion, start_frame, parts=parts), n=1, k=k, refine=refine)[0]
+        """Best library window for the window of ``motion`` starting at ``start_frame`` (a frame
+        of ``motion`` at its own rate). See :meth:`search_window` for ``k``, ``refine``, ``exact``."""
+        qw = self.prepare_query(motion, start_frame, parts=parts)
+        return self.search_window(qw, n=1, k=k, refine=refine, exact=exact)[0]
 
     def top_k(
         self,
@@ -646,14 +664,15 @@ class MotionIndex:
         start_frame: int | None = None,
         *,
         n: int = 5,
-        k: int = 32,
-        refine: int = 4,
+        k: int = DEFAULT_K,
+        refine: int = DEFAULT_REFINE,
+        exact: int = DEFAULT_EXACT,
         parts: BodyPartMap | None = None,
     ) -> list[SearchResult]:
         """The ``n`` best distinct windows (at least a window length apart within a clip), each
         with its breakdown, so a user can see why the winner won."""
         qw = self.prepare_query(motion, start_frame, parts=parts)
-        return self.search_window(qw, n=n, k=max(k, n), refine=max(refine, min(n, 8)))
+        return self.search_window(qw, n=n, k=max(k, n), refine=max(refine, min(n, 8)), exact=exact)
 
     def window_distance(self, motion: Motion, start_frame: int | None, clip: str, frame: int) -> SearchResult:
         """Exact ``D`` (with breakdown and alignment) between a query window and one library
