@@ -67,7 +67,7 @@ def _build(args: argparse.Namespace) -> int:
         window = replace(window, duration=args.duration)
     weights = SearchWeights() if args.feature_set is None else SearchWeights(feature_set=args.feature_set)
     t0 = time.perf_counter()
-    index = MotionIndex.build(lib.clips, weights, window, mirror=args.mirror)
+    index = MotionIndex.build(lib, weights, window, mirror=args.mirror)
     index.info["source"] = str(Path(args.library).resolve())
     index.save(args.out)
     print(
@@ -94,7 +94,7 @@ def _query(args: argparse.Namespace) -> int:
     from reactmocap.library.clip_library import load_library
 
     lib = load_library(source)
-    problem = index.stale_reason(clips=lib.clips)
+    problem = index.stale_reason(clips=lib)
     if problem:
         raise SearchError(f"{args.index}: stale search index: {problem}; rebuild it")
     name = args.clip

@@ -66,7 +66,8 @@ class Motion:
         norms = np.linalg.norm(rot, axis=-1)
         if np.any(norms < 1e-6):
             raise MotionError("rotations contain zero quaternions")
-        rot = rot / norms[..., None]
+        if np.any(np.abs(norms - 1.0) > 1e-12):  # keep unit inputs bit-exact
+            rot = rot / norms[..., None]
         trans = None
         if self.translations is not None:
             trans = np.array(self.translations, dtype=np.float64)

@@ -269,7 +269,7 @@ def _two_bone(
     flex = np.pi - np.arccos(np.clip((a * a + b * b - d * d) / (2 * a * b), -1.0, 1.0))
     hinge = Rotation.from_rotvec(np.outer(sign * flex, _Y)).as_matrix()
     # the reach vector and the jut direction, in the upper bone's local frame and in the world
-    u = np.stack([-sign * b * np.sin(flex), 0 * flex, -a - b * np.cos(flex)], axis=-1)
+    u = np.stack([-sign * b * np.sin(flex), np.zeros_like(flex), -a - b * np.cos(flex)], axis=-1)
     e1, f1 = _unit(u), _unit(w)
     q = np.broadcast_to([sign, 0.0, 0.0], u.shape)
     e2 = _unit(q - np.sum(q * e1, -1, keepdims=True) * e1)
@@ -375,10 +375,10 @@ def _motion(clip: _Clip, fps: float, name: str) -> Motion:
 # ------------------------------------------------------------------------------------ clips
 def _breathing(c: _Clip, t0: float, t1: float, cycles: int) -> _Clip:
     """Subtle idle sway: weight shift, breathing in the chest, hands bobbing (loops at ends)."""
+    g = {k: np.array(v) for k, v in GUARD.items()}
     for t in np.linspace(t0, t1, 8 * cycles + 1)[1:]:
         ph = 2 * np.pi * cycles * (t - t0) / (t1 - t0)
         s, b = np.sin(ph), np.sin(2 * ph)
-        g = {k: np.array(v) for k, v in GUARD.items()}
         c.at(
             float(t),
             root=g["root"] + (0.012 * s, 0.006 * s, -0.003 * (1 - np.cos(2 * ph))),

@@ -64,8 +64,8 @@ class ResponseConfig:
     """The paper's defaults (Zordan et al. 2005), each overridable from ``[response]``."""
 
     reaction_delay: float = 0.15  # s, human reaction time 0.1-0.2 s
-    kp: float = 600.0  # 1/s^2, inertia-scaled stiffness
-    kv: float = 50.0  # 1/s, inertia-scaled damping
+    kp: float = 4000.0  # 1/s^2, inertia-scaled stiffness
+    kv: float = 126.0  # 1/s, inertia-scaled damping (critical: 2 sqrt(kp))
     friction_sim1: float = 1.0
     friction_sim2: float = 0.5
     sim1_mode: Literal["passive", "holding"] = "holding"

@@ -153,6 +153,16 @@ def library_fingerprint(clips: Mapping[str, Motion]) -> str:
     return h.hexdigest()
 
 
+def _clip_source(clips: Any) -> tuple[Mapping[str, Motion], str]:
+    """``(name -> Motion, fingerprint)`` of a ClipLibrary (fingerprint of its *files*, stable
+    across the clip cache) or of a plain mapping of Motions (fingerprint of the arrays)."""
+    if hasattr(clips, "fingerprint") and hasattr(clips, "clips"):
+        return clips.clips, "files:" + str(clips.fingerprint())
+    if not isinstance(clips, Mapping):
+        raise SearchError(f"clips must be a mapping of name -> Motion or a ClipLibrary, got {type(clips).__name__}")
+    return clips, "arrays:" + library_fingerprint(clips)
+
+
 def _readonly(a: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(a)
     a.setflags(write=False)
@@ -252,7 +262,7 @@ class MotionIndex:
     @classmethod
     def build(
         cls,
-        clips: Mapping[str, Motion],
+        clips: Mapping[str, Motion] | Any,
         weights: SearchWeights | None = None,
         window: WindowConfig | None = None,
         mirror: bool = False,
@@ -263,6 +273,10 @@ class MotionIndex:
     ) -> MotionIndex:
         """Index every window of ``clips`` (resampled to ``window.fps``).
 
+        ``clips`` is a mapping of name -> Motion or a ``ClipLibrary``. The index remembers a
+        fingerprint of it: of the files for a ClipLibrary (stable across the clip cache), of the
+        motion arrays for a mapping; :meth:`load` and :meth:`stale_reason` compare it with the same
+        kind of argument.
         ``mirror=True`` adds a left/right mirrored copy of every clip, named ``NAME_mirror``.
         ``parts`` optionally gives each clip's body-part map (default: automatic mapping).
 
@@ -274,10 +288,10 @@ class MotionIndex:
         window = window if window is not None else WindowConfig()
         if not isinstance(weights, SearchWeights) or not isinstance(window, WindowConfig):
             raise ConfigError("build() takes a SearchWeights and a WindowConfig")
+        clips, lib_hash = _clip_source(clips)
         if not clips:
             raise SearchError("cannot build a search index from an empty library")
         fs = get_feature_set(weights.feature_set)
-        lib_hash = library_fingerprint(clips)
         motions: dict[str, Motion] = dict(clips)
         part_maps = dict(parts) if parts else {}
         if mirror:
@@ -718,7 +732,7 @@ class MotionIndex:
         cls,
         path: str | Path,
         *,
-        clips: Mapping[str, Motion] | None = None,
+        clips: Mapping[str, Motion] | Any | None = None,
         weights: SearchWeights | None = None,
         window: WindowConfig | None = None,
         mirror: bool | None = None,
@@ -808,13 +822,13 @@ class MotionIndex:
     def stale_reason(
         self,
         *,
-        clips: Mapping[str, Motion] | None = None,
+        clips: Mapping[str, Motion] | Any | None = None,
         weights: SearchWeights | None = None,
         window: WindowConfig | None = None,
         mirror: bool | None = None,
     ) -> str | None:
         """Why this index does not match the given library/settings, or ``None``."""
-        if clips is not None and library_fingerprint(clips) != self.library_hash:
+        if clips is not None and _clip_source(clips)[1] != self.library_hash:
             return "the library's clips changed since it was built"
         if weights is not None and weights != self.weights:
             return f"weights differ (index built with {self.weights})"
@@ -828,7 +842,7 @@ class MotionIndex:
     def load_or_build(
         cls,
         path: str | Path,
-        clips: Mapping[str, Motion],
+        clips: Mapping[str, Motion] | Any,
         weights: SearchWeights | None = None,
         window: WindowConfig | None = None,
         mirror: bool = False,

@@ -50,7 +50,8 @@ def _points(m: Motion) -> np.ndarray:
 
 def _foot_tracks(m: Motion) -> dict[str, tuple[np.ndarray, float]]:
     """Name -> ((T, 3) world track, standing height) of each foot contact point."""
-    rest = Motion(m.skeleton, m.fps, [[0.0, 0.0, 0.95]], np.tile([1.0, 0, 0, 0], (1, 21, 1)))
+    ident = np.tile([1.0, 0.0, 0.0, 0.0], (1, m.num_joints, 1))
+    rest = Motion(m.skeleton, m.fps, np.array([[0.0, 0.0, 0.95]]), ident)  # standing at rest
     pos, ends = m.global_positions(), m.end_site_positions()
     rpos, rends = rest.global_positions()[0], rest.end_site_positions()[0]
     sites = list(m.skeleton.layout.end_sites)
