@@ -1,28 +1,36 @@
 """BVH read/write with bulk numpy conversion of the frames.
 
-The hierarchy is tokenised here with line numbers so that every problem is reported as a
-:class:`BVHParseError` with file, line and what was expected (the ``bvh`` package keeps no line
-numbers and walks frames in Python); the resulting tree is cross-checked with ``bvh.Bvh`` for
-joint names, parents and channels. The MOTION block is converted in one ``np.array`` call.
+Reading: a light tokenizer pass checks the HIERARCHY's braces with line numbers and lays it out one
+statement or brace per line; the ``bvh`` package builds the joint tree from that; a walk over the
+tree validates it (every problem is a :class:`BVHParseError` with file, 1-based line and what was
+expected). The ``bvh`` package keeps no line numbers, mis-nests silently on stray braces and
+parses frames one character at a time, hence the pre-pass and ``np.loadtxt`` for the MOTION block.
 
-Conventions: a file is Y-up unless ``up="z"``; its length unit is detected from the body's
-span (``detect_unit``) unless ``unit=`` is given. Internally everything is Z-up metres with wxyz
-quaternions; writing converts back to the source layout recorded in ``Skeleton.layout``.
-Position channels on the root give its position; on other joints they replace the offset.
+Conventions: a file is Y-up unless ``up="z"``; its unit is detected from the body's span in the
+first frames (:func:`reactmocap.conventions.detect_unit`) unless ``unit=`` is given. Channels
+``Zrotation Xrotation Yrotation`` mean the intrinsic rotation ``Rz @ Rx @ Ry``. Position channels
+on the root give its position; on other joints they replace the OFFSET (per-frame translations).
+Internally everything is Z-up metres and wxyz quaternions; the Skeleton's :class:`BVHLayout`
+keeps the source channels, unit and axes so that writing reproduces the source layout.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
+import re
+import warnings
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
 from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
+from bvh import Bvh
 from numpy.typing import NDArray
 
-from reactmocap.conventions import UNIT_SCALE, UpAxis, axes_to_z_up, detect_unit
-from reactmocap.errors import BVHParseError, MotionError
-from reactmocap.io import atomic_write_text
+from reactmocap.conventions import UNIT_SCALE, Unit, UpAxis, axes_to_z_up, detect_unit
+from reactmocap.errors import BVHParseError, ConfigError, MotionError
+from reactmocap.io import atomic_write
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import (
     POSITION_CHANNELS,
@@ -31,392 +39,554 @@ from reactmocap.library.skeleton import (
     BVHLayout,
     Skeleton,
 )
-from reactmocap.rotations import quat_from_euler, quat_mul, quat_rotate, quat_to_euler
+from reactmocap.rotations import (
+    quat_conj,
+    quat_from_euler,
+    quat_from_matrix,
+    quat_mul,
+    quat_to_euler,
+    quat_to_matrix,
+)
 
-__all__ = ["bvh_text", "parse_bvh", "read_bvh", "write_bvh"]
+__all__ = ["ChannelMode", "bvh_text", "parse_bvh", "read_bvh", "write_bvh"]
 
 F64 = NDArray[np.float64]
+ChannelMode = Literal["source", "rotation"]
+Vec3 = tuple[float, float, float]
+_Fail = Callable[..., BVHParseError]  # (message, line, expected) -> error to raise
+
+_CHANNEL_NAMES = {c.lower(): c for c in VALID_CHANNELS}  # files vary in case: XROTATION, xrotation
+_OPENERS = ("ROOT", "JOINT", "End")  # statements that must be followed by '{'
+_BINARY = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
+_UNIT_FRAMES = 10  # frames used to detect the unit
 
 
 @dataclass
 class _Joint:
     name: str
     parent: int
-    offset: tuple[float, float, float]
-    channels: tuple[str, ...] = ()
-    end_site: tuple[float, float, float] | None = None
-    line: int = 0
+    offset: Vec3
+    channels: tuple[str, ...]
+    end_site: Vec3 | None
+    line: int
 
 
-@dataclass
-class _Tokens:
-    items: list[tuple[str, int]]
-    file: str
-    pos: int = 0
-    joints: list[_Joint] = field(default_factory=list)
-
-    def peek(self) -> tuple[str, int]:
-        if self.pos >= len(self.items):
-            last = self.items[-1][1] if self.items else 1
-            raise BVHParseError("unexpected end of file", file=self.file, line=last,
-                                expected="more of the HIERARCHY")  # fmt: skip
-        return self.items[self.pos]
-
-    def take(self, expected: str | None = None) -> tuple[str, int]:
-        tok, line = self.peek()
-        if expected is not None and tok != expected:
-            raise BVHParseError(f"found {tok!r}", file=self.file, line=line,
-                                expected=repr(expected))  # fmt: skip
-        self.pos += 1
-        return tok, line
-
-    def number(self, what: str) -> float:
-        tok, line = self.take()
-        try:
-            v = float(tok)
-        except ValueError:
-            raise BVHParseError(f"non-numeric token {tok!r} in {what}", file=self.file,
-                                line=line, expected="a number") from None  # fmt: skip
-        if not math.isfinite(v):
-            raise BVHParseError(f"{tok} in {what}", file=self.file, line=line,
-                                expected="a finite number")  # fmt: skip
-        return v
+# ---------------------------------------------------------------------------------- reading
+def read_bvh(
+    path: str | Path, *, unit: Unit | None = None, up: UpAxis = "y", name: str | None = None
+) -> Motion:
+    """Read a BVH file into a Motion (Z-up metres, wxyz). Any problem, a missing file included,
+    raises :class:`BVHParseError` naming the file and, where there is one, the line."""
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise BVHParseError(
+            f"cannot read: {exc.strerror or exc}", file=p, expected="a readable BVH file"
+        ) from None
+    return parse_bvh(_decode(raw, p), file=p, unit=unit, up=up, name=name or p.stem)
 
 
-def _parse_joint(tk: _Tokens, parent: int) -> None:
-    kw, line = tk.take()
-    name, _ = tk.take()
-    idx = len(tk.joints)
-    if any(j.name == name for j in tk.joints):
-        raise BVHParseError(f"duplicate joint name {name!r}", file=tk.file, line=line,
-                            expected="unique joint names")  # fmt: skip
-    tk.take("{")
-    tk.take("OFFSET")
-    off = (tk.number("OFFSET"), tk.number("OFFSET"), tk.number("OFFSET"))
-    joint = _Joint(name, parent, off, line=line)
-    tk.joints.append(joint)
-    tok, line = tk.peek()
-    if tok == "CHANNELS":
-        tk.take()
-        count_tok, cl = tk.take()
-        if not count_tok.isdigit():
-            raise BVHParseError(f"channel count {count_tok!r}", file=tk.file, line=cl,
-                                expected="an integer channel count")  # fmt: skip
-        chans = []
-        for _ in range(int(count_tok)):
-            c, cl = tk.take()
-            if c not in VALID_CHANNELS:
-                raise BVHParseError(f"unknown channel name {c!r}", file=tk.file, line=cl,
-                                    expected=f"one of {list(VALID_CHANNELS)}")  # fmt: skip
-            chans.append(c)
-        rot = [c for c in chans if c in ROTATION_CHANNELS]
-        if rot and len(rot) != 3:
-            raise BVHParseError(f"joint {name!r} has {len(rot)} rotation channels", file=tk.file,
-                                line=cl, expected="0 or 3 rotation channels")  # fmt: skip
-        joint.channels = tuple(chans)
-    while True:
-        tok, line = tk.peek()
-        if tok == "}":
-            tk.take()
-            return
-        if tok == "JOINT":
-            _parse_joint(tk, idx)
-        elif tok == "End":
-            tk.take()
-            tk.take("Site")
-            tk.take("{")
-            tk.take("OFFSET")
-            joint.end_site = (tk.number("OFFSET"), tk.number("OFFSET"), tk.number("OFFSET"))
-            tk.take("}")
-        else:
-            raise BVHParseError(f"found {tok!r} in joint {name!r}", file=tk.file, line=line,
-                                expected="JOINT, End Site or '}'")  # fmt: skip
+def _decode(raw: bytes, file: Path) -> str:
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        text = raw.decode("latin-1")  # old exporters write Latin-1 names; binary fails below
+        if not _BINARY.search(text):
+            return text
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise BVHParseError(
+            f"not a text file (byte 0x{raw[exc.start]:02x} is not UTF-8)",
+            file=file, line=line, expected="a UTF-8 text BVH file",
+        ) from None  # fmt: skip
+    return text
 
 
 def parse_bvh(
     text: str,
     *,
     file: str | Path = "<string>",
-    unit: str | None = None,
+    unit: Unit | None = None,
     up: UpAxis = "y",
     name: str | None = None,
 ) -> Motion:
-    """Parse BVH text into a Motion (Z-up metres, wxyz)."""
+    """Parse BVH text into a Motion; ``file`` only names the source in error messages."""
     fname = str(file)
-    lines = text.splitlines()
+    if up not in ("y", "z"):
+        raise ConfigError(f"up must be 'y' or 'z', got {up!r}")
+    if unit is not None and unit not in UNIT_SCALE:
+        raise ConfigError(f"unit must be one of {list(UNIT_SCALE)}, got {unit!r}")
+    if name is None:
+        name = "" if fname == "<string>" else Path(fname).stem
     try:
-        h_line = next(i for i, s in enumerate(lines) if s.strip())
-    except StopIteration:
-        raise BVHParseError("empty file", file=fname, line=1, expected="HIERARCHY") from None
-    if lines[h_line].strip() != "HIERARCHY":
-        raise BVHParseError(f"found {lines[h_line].strip()[:40]!r}", file=fname,
-                            line=h_line + 1, expected="HIERARCHY")  # fmt: skip
-    m_line = next((i for i, s in enumerate(lines) if s.strip() == "MOTION"), None)
-    if m_line is None:
-        raise BVHParseError("no MOTION section", file=fname, line=len(lines),
-                            expected="MOTION after the hierarchy")  # fmt: skip
-    items = [(tok, i + 1) for i in range(h_line + 1, m_line) for tok in lines[i].split()]
-    tk = _Tokens(items, fname)
-    if not items or items[0][0] != "ROOT":
-        raise BVHParseError("no ROOT joint", file=fname, line=h_line + 2, expected="ROOT")
-    _parse_joint(tk, -1)
-    if tk.pos != len(items):
-        tok, line = items[tk.pos]
-        raise BVHParseError(f"found {tok!r} after the root joint", file=fname, line=line,
-                            expected="MOTION")  # fmt: skip
-    joints = tk.joints
+        return _parse(text, fname, unit, up, name)
+    except BVHParseError:
+        raise
+    except (ValueError, IndexError, KeyError, TypeError, AttributeError, RecursionError) as exc:
+        # safety net: every expected problem is reported above with its line
+        raise BVHParseError(f"malformed BVH ({type(exc).__name__}: {exc})", file=fname) from exc
 
-    # MOTION header
-    def header(k: int, key: str) -> str:
-        if k >= len(lines):
-            raise BVHParseError("file ends in the MOTION header", file=fname, line=len(lines),
-                                expected=key)  # fmt: skip
-        s = lines[k].strip()
-        if not s.startswith(key):
-            raise BVHParseError(f"found {s[:40]!r}", file=fname, line=k + 1, expected=key)
-        return s[len(key):].strip()
 
-    frames_txt = header(m_line + 1, "Frames:")
-    ft_txt = header(m_line + 2, "Frame Time:")
-    try:
-        n_frames = int(frames_txt)
-    except ValueError:
-        raise BVHParseError(f"Frames: {frames_txt!r}", file=fname, line=m_line + 2,
-                            expected="an integer frame count") from None  # fmt: skip
+def _parse(text: str, fname: str, unit: Unit | None, up: UpAxis, name: str) -> Motion:
+    def fail(msg: str, line: int | None, expected: str | None = None) -> BVHParseError:
+        return BVHParseError(msg, file=fname, line=line, expected=expected)
+
+    if (bad := _BINARY.search(text)) is not None:
+        line = text.count("\n", 0, bad.start()) + 1
+        raise fail(f"binary data (control character {bad.group()!r})", line, "a text BVH file")
+    if "\r" in text:  # CRLF and old Mac files; split on "\n" only so line numbers match editors'
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    lines = text.split("\n")
+    start = _next_content(lines, 0)
+    if start is None:
+        raise fail("empty file", 1, "HIERARCHY")
+    if lines[start].split()[0] != "HIERARCHY":
+        raise fail(f"found {lines[start].strip()[:40]!r}", start + 1, "HIERARCHY")
+    motion_i = next((i for i in range(start + 1, len(lines)) if lines[i].strip() == "MOTION"), None)
+    if motion_i is None:
+        raise fail("no MOTION section", len(lines), "MOTION after the HIERARCHY")
+    joints = _parse_hierarchy(lines, start, motion_i, fail)
+
+    # MOTION header: "Frames: N" then "Frame Time: dt", each on its own line
+    fr_i = _next_content(lines, motion_i + 1)
+    if fr_i is None:
+        raise fail("file ends after MOTION", len(lines), "Frames: <count>")
+    m = re.fullmatch(r"Frames:\s*(\S+)", lines[fr_i].strip())
+    if not m or not re.fullmatch(r"[+-]?\d+", m.group(1)):
+        raise fail(f"found {lines[fr_i].strip()[:40]!r}", fr_i + 1, "Frames: <count>")
+    n_frames = int(m.group(1))
     if n_frames <= 0:
-        raise BVHParseError(f"Frames: {n_frames}", file=fname, line=m_line + 2,
-                            expected="at least one frame")  # fmt: skip
+        raise fail(f"Frames: {n_frames}", fr_i + 1, "at least one frame")
+    ft_i = _next_content(lines, fr_i + 1)
+    if ft_i is None:
+        raise fail("file ends after Frames:", len(lines), "Frame Time: <seconds>")
+    m = re.fullmatch(r"Frame\s+Time:\s*(\S+)", lines[ft_i].strip())
     try:
-        frame_time = float(ft_txt)
-    except ValueError:
-        raise BVHParseError(f"Frame Time: {ft_txt!r}", file=fname, line=m_line + 3,
-                            expected="a number of seconds") from None  # fmt: skip
-    if not (math.isfinite(frame_time) and frame_time > 0):
-        raise BVHParseError(f"Frame Time: {ft_txt}", file=fname, line=m_line + 3,
-                            expected="a positive number of seconds")  # fmt: skip
+        ft_dec = Decimal(m.group(1)) if m else None
+    except InvalidOperation:
+        ft_dec = None
+    if ft_dec is None:
+        raise fail(f"found {lines[ft_i].strip()[:40]!r}", ft_i + 1, "Frame Time: <seconds>")
+    if not (ft_dec.is_finite() and ft_dec > 0):
+        raise fail(f"Frame Time: {ft_dec}", ft_i + 1, "a positive number of seconds")
     n_ch = sum(len(j.channels) for j in joints)
-    first = m_line + 3
-    rows = [(i, s) for i, s in enumerate(lines[first:], start=first) if s.strip()]
-    if len(rows) < n_frames:
-        line = rows[-1][0] + 2 if rows else first + 1
-        raise BVHParseError(f"truncated motion: {len(rows)} frame lines for Frames: {n_frames}",
-                            file=fname, line=line, expected=f"{n_frames} frame lines")  # fmt: skip
-    if len(rows) > n_frames:
-        raise BVHParseError(f"{len(rows) - n_frames} frame lines beyond Frames: {n_frames}",
-                            file=fname, line=rows[n_frames][0] + 1,
-                            expected=f"{n_frames} frame lines")  # fmt: skip
-    split = [s.split() for _, s in rows]
-    counts = np.fromiter((len(x) for x in split), dtype=np.int64, count=len(split))
-    bad = np.flatnonzero(counts != n_ch)
-    if bad.size:
-        k = int(bad[0])
-        raise BVHParseError(f"frame line has {counts[k]} values", file=fname,
-                            line=rows[k][0] + 1, expected=f"{n_ch} values")  # fmt: skip
+    if n_ch == 0:
+        raise fail("no joint has CHANNELS", joints[0].line, "CHANNELS on at least one joint")
+    data = _frames(lines[ft_i + 1 :], ft_i + 2, n_frames, n_ch, fail)
+    return _to_motion(joints, data, _fps(ft_dec), unit, up, name, fail)
+
+
+def _next_content(lines: Sequence[str], i: int) -> int | None:
+    while i < len(lines):
+        if lines[i].strip():
+            return i
+        i += 1
+    return None
+
+
+def _fps(frame_time: Decimal) -> float:
+    """1 / Frame Time, snapped to a whole fps when the printed frame time is that rounded
+    (``0.0333333`` -> 30, not 30.00003), so clips at the same rate concatenate and resample."""
+    ft = float(frame_time)
+    whole = round(1.0 / ft)
+    half_ulp = 0.5 * 10.0 ** int(frame_time.as_tuple().exponent)
+    if whole > 0 and abs(1.0 / whole - ft) <= half_ulp * (1 + 1e-9):
+        return float(whole)
+    return 1.0 / ft
+
+
+def _parse_hierarchy(lines: list[str], start: int, stop: int, fail: _Fail) -> list[_Joint]:
+    # Pre-pass: braces split onto their own lines (the bvh package only sees a brace at the start
+    # of a line) with the source line of each statement, brace nesting checked where it breaks.
+    norm: list[str] = []
+    where: list[int] = []
+    depth = 0
+    pending: tuple[str, int] | None = None  # a ROOT/JOINT/End statement still waiting for '{'
+    for i in range(start + 1, stop):
+        stmt: list[str] = []
+        for tok in [*lines[i].replace("{", " { ").replace("}", " } ").split(), None]:
+            if tok not in ("{", "}", None):
+                stmt.append(tok)
+                continue
+            if stmt:
+                if pending:
+                    raise fail(f"found {stmt[0]!r} after {pending[0]!r}", i + 1, "'{'")
+                norm.append(" ".join(stmt))
+                where.append(i + 1)
+                pending = (" ".join(stmt), i + 1) if stmt[0] in _OPENERS else None
+                stmt = []
+            if tok == "{":
+                if not pending:
+                    raise fail("'{' without a ROOT, JOINT or End Site before it", i + 1,
+                               "'{' only after ROOT, JOINT or End Site")  # fmt: skip
+                pending = None
+                depth += 1
+            elif tok == "}":
+                if pending:
+                    raise fail(f"found '}}' after {pending[0]!r}", i + 1, "'{'")
+                if depth == 0:
+                    raise fail("'}' without a matching '{'", i + 1, "MOTION")
+                depth -= 1
+            if tok is not None:
+                norm.append(tok)
+    if pending:
+        raise fail(f"{pending[0]!r} has no '{{'", pending[1], "'{'")
+    if depth:
+        raise fail(f"{depth} unclosed '{{'", stop + 1, "'}' before MOTION")
+    if not where:
+        raise fail("empty HIERARCHY", start + 2, "ROOT")
     try:
-        data = np.array(split, dtype=np.float64).reshape(n_frames, n_ch)
+        tree = Bvh("\n".join(norm) + "\n")
+    except Exception as exc:  # the package raises bare IndexError/AttributeError on bad input
+        raise fail(f"hierarchy not understood ({exc})", start + 1, "a BVH HIERARCHY") from None
+
+    def preorder(node: Any) -> Iterator[Any]:
+        for child in node.children:
+            yield child
+            yield from preorder(child)
+
+    # the package appends nodes in document order, so pre-order pairs them with `where`
+    line_of = {id(n): ln for n, ln in zip(preorder(tree.root), where, strict=True)}
+    top = tree.root.children
+    if top[0].value[0] != "ROOT":
+        raise fail(f"found {top[0].value[0]!r}", line_of[id(top[0])], "ROOT")
+    if len(top) > 1:
+        raise fail(f"found {top[1].value[0]!r} after the ROOT joint (one skeleton per file)",
+                   line_of[id(top[1])], "MOTION")  # fmt: skip
+    joints: list[_Joint] = []
+    _walk_joint(top[0], -1, joints, line_of, fail)
+    return joints
+
+
+def _walk_joint(
+    node: Any, parent: int, out: list[_Joint], line_of: dict[int, int], fail: _Fail
+) -> None:
+    line = line_of[id(node)]
+    kind = node.value[0]
+    if len(node.value) < 2:
+        raise fail(f"{kind} without a name", line, f"{kind} <name>")
+    name = " ".join(node.value[1:])
+    if any(j.name == name for j in out):
+        raise fail(f"duplicate joint name {name!r}", line, "unique joint names")
+    offset: Vec3 | None = None
+    channels: tuple[str, ...] | None = None
+    end_site: Vec3 | None = None
+    kids = []
+    for child in node.children:
+        kw, cl = child.value[0], line_of[id(child)]
+        if kw == "OFFSET" and offset is None:
+            offset = _offset(child.value, cl, fail)
+        elif kw == "CHANNELS" and channels is None:
+            channels = _channels(child.value, cl, fail)
+        elif kw == "JOINT":
+            kids.append(child)
+        elif kw == "End" and end_site is None:
+            if child.value != ["End", "Site"]:
+                raise fail(f"found {' '.join(child.value)!r}", cl, "End Site")
+            sub = child.children
+            if len(sub) != 1 or sub[0].value[0] != "OFFSET":
+                raise fail(f"End Site of {name!r} needs exactly one OFFSET", cl, "OFFSET x y z")
+            end_site = _offset(sub[0].value, line_of[id(sub[0])], fail)
+        else:
+            again = kw in ("OFFSET", "CHANNELS", "End")
+            raise fail(f"{'second ' if again else ''}{kw!r} in joint {name!r}", cl,
+                       "OFFSET, CHANNELS, JOINT or End Site, once each")  # fmt: skip
+    if offset is None:
+        raise fail(f"joint {name!r} has no OFFSET", line, "OFFSET x y z")
+    out.append(_Joint(name, parent, offset, channels or (), end_site, line))
+    idx = len(out) - 1
+    for kid in kids:
+        _walk_joint(kid, idx, out, line_of, fail)
+
+
+def _offset(value: list[str], line: int, fail: _Fail) -> Vec3:
+    if len(value) != 4:
+        raise fail(f"OFFSET has {len(value) - 1} values", line, "OFFSET x y z")
+    try:
+        x, y, z = (float(v) for v in value[1:])
     except ValueError:
-        for k, toks in enumerate(split):
+        raise fail(f"non-numeric OFFSET {' '.join(value[1:])!r}", line, "3 numbers") from None
+    if not np.all(np.isfinite((x, y, z))):
+        raise fail(f"OFFSET {' '.join(value[1:])}", line, "finite numbers")
+    return (x, y, z)
+
+
+def _channels(value: list[str], line: int, fail: _Fail) -> tuple[str, ...]:
+    if len(value) < 2 or not value[1].isdigit():
+        raise fail(f"found {' '.join(value)!r}", line, "CHANNELS <count> <names>")
+    names = value[2:]
+    if len(names) != int(value[1]):
+        raise fail(f"CHANNELS {value[1]} lists {len(names)} names", line, f"{value[1]} names")
+    out = []
+    for c in names:
+        if c.lower() not in _CHANNEL_NAMES:
+            raise fail(f"unknown channel name {c!r}", line, f"one of {', '.join(VALID_CHANNELS)}")
+        out.append(_CHANNEL_NAMES[c.lower()])
+    if len(set(out)) != len(out):
+        raise fail(f"repeated channel in {' '.join(names)!r}", line, "each channel once")
+    return tuple(out)
+
+
+def _frames(body: list[str], first: int, n: int, n_ch: int, fail: _Fail) -> F64:
+    """``(n, n_ch)`` frame values of the lines after Frame Time (``first`` = line of body[0])."""
+    data: F64 | None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # loadtxt warns on empty input; checked below
+            data = np.loadtxt(body, dtype=np.float64, comments=None, ndmin=2)
+    except ValueError:
+        data = None
+    if data is None or data.shape != (n, n_ch):
+        # slow path, only for bad files: find the first offending line
+        rows = [(first + k, t) for k, s in enumerate(body) if (t := s.split())]
+        if len(rows) < n:
+            last_ok = rows and len(rows[-1][1]) == n_ch
+            line = (rows[-1][0] + (1 if last_ok else 0)) if rows else first
+            raise fail(f"truncated MOTION: {len(rows)} frame lines but Frames: {n}", line,
+                       f"{n} frame lines")  # fmt: skip
+        for line, toks in rows[:n]:
+            if len(toks) != n_ch:
+                raise fail(f"frame line has {len(toks)} values", line,
+                           f"{n_ch} values, one per channel")  # fmt: skip
             for tok in toks:
                 try:
                     float(tok)
                 except ValueError:
-                    raise BVHParseError(f"non-numeric token {tok!r}", file=fname,
-                                        line=rows[k][0] + 1, expected="a number") from None  # fmt: skip
-        raise
-    if not np.all(np.isfinite(data)):
-        k = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
-        raise BVHParseError("NaN or inf value", file=fname, line=rows[k][0] + 1,
-                            expected="finite numbers")  # fmt: skip
-    _cross_check(text, joints, fname)
-    return _to_motion(joints, data, 1.0 / frame_time, unit, up, name or Path(fname).stem, fname)
+                    raise fail(f"non-numeric value {tok!r}", line, "a number") from None
+        if len(rows) > n:
+            raise fail(f"{len(rows) - n} frame lines beyond Frames: {n}", rows[n][0],
+                       f"{n} frame lines")  # fmt: skip
+        raise fail("unreadable frame data", first, f"{n} lines of {n_ch} numbers")
+    finite = np.isfinite(data).all(axis=1)
+    if not finite.all():
+        row = int(np.flatnonzero(~finite)[0])
+        line = first + [k for k, s in enumerate(body) if s.strip()][row]
+        raise fail("NaN or infinite value in frame data", line, "finite numbers")
+    return data
 
 
-def _cross_check(text: str, joints: list[_Joint], fname: str) -> None:
-    """Agree with the ``bvh`` package on names, parents and channels (guards our tokeniser)."""
-    try:
-        from bvh import Bvh
+def _full_order(channels: Sequence[str]) -> str:
+    """Euler order of a joint's rotation channels, padded with its missing axes (whose angle is 0)
+    so that 0-2 rotation channels convert like 3; no rotation channels -> ZXY."""
+    present = "".join(c[0] for c in channels if c in ROTATION_CHANNELS)
+    return present + "".join(a for a in "XYZ" if a not in present) if present else "ZXY"
 
-        ref = Bvh(text.split("MOTION")[0] + "MOTION\nFrames: 0\nFrame Time: 1\n")
-        names = ref.get_joints_names()
-    except Exception:  # the package chokes on some valid files; our parser already validated
-        return
-    if names != [j.name for j in joints]:
-        raise BVHParseError("hierarchy read inconsistently", file=fname, line=1,
-                            expected=f"joints {names}")  # fmt: skip
+
+def _axes_quat(up: UpAxis) -> F64:
+    return quat_from_matrix(axes_to_z_up(up))
 
 
 def _to_motion(
-    joints: list[_Joint], data: F64, fps: float, unit: str | None, up: UpAxis, name: str,
-    fname: str,
-) -> Motion:  # fmt: skip
-    t = data.shape[0]
-    nj = len(joints)
-    offsets_f = np.array([j.offset for j in joints])
-    parents = np.array([j.parent for j in joints])
+    joints: list[_Joint],
+    data: F64,
+    fps: float,
+    unit: Unit | None,
+    up: UpAxis,
+    name: str,
+    fail: _Fail,
+) -> Motion:
+    t, nj = data.shape[0], len(joints)
+    parents = np.array([j.parent for j in joints], dtype=np.int64)
+    offsets_f = np.array([j.offset for j in joints], dtype=np.float64).reshape(nj, 3)
+    trans_f = np.repeat(offsets_f[None], t, axis=0)
     euler = np.zeros((t, nj, 3))
-    trans_f = np.broadcast_to(offsets_f, (t, nj, 3)).copy()
-    has_pos = np.zeros(nj, dtype=bool)
+    orders = [_full_order(j.channels) for j in joints]
     col = 0
-    orders = []
-    for k, j in enumerate(joints):
-        order = "".join(c[0] for c in j.channels if c in ROTATION_CHANNELS) or "ZXY"
-        orders.append(order)
-        r = 0
+    for k, j in enumerate(joints):  # J iterations: scatter columns, vectorised over frames
         for c in j.channels:
             if c in POSITION_CHANNELS:
                 trans_f[:, k, "XYZ".index(c[0])] = data[:, col]
-                has_pos[k] = True
             else:
-                euler[:, k, r] = data[:, col]
-                r += 1
+                euler[:, k, orders[k].index(c[0])] = data[:, col]
             col += 1
-    # local rotations in file axes, joint by joint (orders may differ)
     rot_f = np.empty((t, nj, 4))
     for order in set(orders):
-        idx = [k for k, o in enumerate(orders) if o == order]
-        rot_f[:, idx] = quat_from_euler(np.radians(euler[:, idx]), order)
+        ks = [k for k in range(nj) if orders[k] == order]
+        rot_f[:, ks] = quat_from_euler(np.radians(euler[:, ks]), order)
+    sites = {k: j.end_site for k, j in enumerate(joints) if j.end_site is not None}
     if unit is None:
-        unit = detect_unit(_span(parents, trans_f[: min(t, 10)], rot_f[: min(t, 10)]))
-    if unit not in UNIT_SCALE:
-        raise BVHParseError(f"unit {unit!r}", file=fname, expected=f"one of {list(UNIT_SCALE)}")
+        n = min(t, _UNIT_FRAMES)
+        unit = detect_unit(_extent(parents, rot_f[:n], trans_f[:n], sites))
     scale = UNIT_SCALE[unit]
     a = axes_to_z_up(up)
-    qa = _axes_quat(a)
-    rot = quat_mul(quat_mul(qa, rot_f), qa * np.array([1, -1, -1, -1]))
+    qa = _axes_quat(up)
+    rot = quat_mul(quat_mul(qa, rot_f), quat_conj(qa))  # R_z = A R_file A^T
     trans = trans_f @ a.T * scale
-    offsets = offsets_f @ a.T * scale
-    sites = {k: tuple(float(x) for x in (np.array(j.end_site) @ a.T * scale))
-             for k, j in enumerate(joints) if j.end_site is not None}  # fmt: skip
-    layout = BVHLayout(tuple(j.channels for j in joints), unit, up, sites)  # type: ignore[arg-type]
+    z_sites = {k: _vec(a @ np.asarray(o) * scale) for k, o in sites.items()}
+    layout = BVHLayout(tuple(j.channels for j in joints), unit, up, z_sites)
+    moving = any(any(c in POSITION_CHANNELS for c in j.channels) for j in joints[1:])
     try:
-        skel = Skeleton(tuple(j.name for j in joints), parents, offsets, layout)
-        nonroot = has_pos.copy()
-        nonroot[0] = False
-        return Motion(skel, fps, trans[:, 0], rot, trans if nonroot.any() else None, name=name)
+        skel = Skeleton(tuple(j.name for j in joints), parents, offsets_f @ a.T * scale, layout)
+        return Motion(skel, fps, trans[:, 0], rot, trans if moving else None, name=name)
     except MotionError as exc:
-        raise BVHParseError(str(exc), file=fname) from None
+        raise fail(str(exc), joints[0].line) from None
 
 
-def _axes_quat(a: F64) -> F64:
-    from reactmocap.rotations import quat_from_matrix
-
-    return quat_from_matrix(a)
+def _vec(x: Any) -> Vec3:
+    return (float(x[0]), float(x[1]), float(x[2]))
 
 
-def _span(parents: NDArray[np.int64], trans: F64, rot: F64) -> float:
-    """Largest distance between any two joints over a few frames (file units)."""
-    t, j = rot.shape[:2]
-    g = np.empty_like(rot)
-    p = np.empty((t, j, 3))
-    g[:, 0] = rot[:, 0]
-    p[:, 0] = trans[:, 0]
-    for k in range(1, j):
+def _extent(parents: NDArray[np.int64], rot: F64, trans: F64, sites: dict[int, Vec3]) -> float:
+    """Largest distance between two points of the body (file units) over the given frames.
+
+    The body is the subtree of the first joint with several children, so a dummy root left at the
+    origin (as in the Bandai Namco files) does not count the actor's distance from the origin.
+    """
+    m = quat_to_matrix(rot)  # matrices: a few numpy calls per joint, not per frame
+    g = np.empty_like(m)
+    p = np.empty(trans.shape)
+    g[:, 0], p[:, 0] = m[:, 0], trans[:, 0]
+    nj = len(parents)
+    for k in range(1, nj):
         q = parents[k]
-        g[:, k] = quat_mul(g[:, q], rot[:, k])
-        p[:, k] = p[:, q] + quat_rotate(g[:, q], trans[:, k])
-    d = np.linalg.norm(p[:, :, None] - p[:, None, :], axis=-1)
-    return float(d.max())
+        g[:, k] = g[:, q] @ m[:, k]
+        p[:, k] = p[:, q] + (g[:, q] @ trans[:, k, :, None])[..., 0]
+    b = 0
+    while len(kids := np.flatnonzero(parents == b)) == 1:
+        b = int(kids[0])
+    body = np.zeros(nj, dtype=bool)
+    body[b] = True
+    for k in range(b + 1, nj):
+        body[k] = body[parents[k]]
+    pts = [p[:, body]] + [
+        (p[:, k] + g[:, k] @ np.asarray(o))[:, None] for k, o in sites.items() if body[k]
+    ]
+    allp = np.concatenate(pts, axis=1)
+    return float(np.linalg.norm(allp[:, :, None] - allp[:, None, :], axis=-1).max())
 
 
-def read_bvh(
-    path: str | Path, *, unit: str | None = None, up: UpAxis = "y", name: str | None = None
-) -> Motion:
-    """Read a BVH file. Raises BVHParseError naming the file and line on any problem."""
-    p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise BVHParseError(f"cannot read: {exc.strerror}", file=p, expected="a readable BVH file") from None
-    if b"\x00" in raw[:4096]:
-        raise BVHParseError("binary file", file=p, line=1, expected="a text BVH file")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError:
-        try:
-            text = raw.decode("latin-1")
-        except UnicodeDecodeError:  # pragma: no cover - latin-1 decodes everything
-            raise BVHParseError("not a text file", file=p, line=1, expected="UTF-8 text") from None
-        if any(ord(c) < 9 for c in text[:4096]):
-            raise BVHParseError("binary file", file=p, line=1, expected="a text BVH file")
-    return parse_bvh(text, file=p, unit=unit, up=up, name=name or p.stem)
-
-
-def bvh_text(
-    motion: Motion, *, unit: str | None = None, up: UpAxis | None = None, precision: int = 6
-) -> str:
-    """BVH text of ``motion`` in its skeleton's source layout (or the given unit/up)."""
-    skel = motion.skeleton
-    lay = skel.layout
-    unit = unit or lay.unit
-    up = up or lay.up
-    if unit not in UNIT_SCALE:
-        raise MotionError(f"unit must be one of {list(UNIT_SCALE)}, got {unit!r}")
-    inv = 1.0 / UNIT_SCALE[unit]
-    a = axes_to_z_up(up)  # file -> internal; we need internal -> file = a.T
-    qa = _axes_quat(a)
-    qa_inv = qa * np.array([1, -1, -1, -1])
-    rot_f = quat_mul(quat_mul(qa_inv, motion.rotations), qa)
-    trans = np.array(motion.local_translations())
-    trans[:, 0] = motion.root_positions
-    trans_f = trans @ a * inv
-    offsets_f = skel.offsets @ a * inv
-    fmt = f"{{:.{precision}f}}"
-    out = ["HIERARCHY"]
-    children = {k: skel.children(k) for k in range(skel.num_joints)}
-
-    def emit(k: int, depth: int) -> None:
-        ind = "  " * depth
-        kw = "ROOT" if k == 0 else "JOINT"
-        out.append(f"{ind}{kw} {skel.names[k]}")
-        out.append(f"{ind}{{")
-        o = offsets_f[k]
-        out.append(f"{ind}  OFFSET {' '.join(fmt.format(x) for x in o)}")
-        ch = lay.channels[k]
-        if ch:
-            out.append(f"{ind}  CHANNELS {len(ch)} {' '.join(ch)}")
-        for c in children[k]:
-            emit(c, depth + 1)
-        if k in lay.end_sites or not children[k]:
-            e = np.array(lay.end_sites.get(k, (0.0, 0.0, 0.0))) @ a * inv
-            out.append(f"{ind}  End Site")
-            out.append(f"{ind}  {{")
-            out.append(f"{ind}    OFFSET {' '.join(fmt.format(x) for x in e)}")
-            out.append(f"{ind}  }}")
-        out.append(f"{ind}}}")
-
-    emit(0, 0)
-    cols = []
-    for k in range(skel.num_joints):
-        ch = lay.channels[k]
-        rot_ch = [c for c in ch if c in ROTATION_CHANNELS]
-        eul = (
-            np.degrees(quat_to_euler(rot_f[:, k], "".join(c[0] for c in rot_ch)))
-            if rot_ch
-            else None
-        )
-        r = 0
-        for c in ch:
-            if c in POSITION_CHANNELS:
-                cols.append(trans_f[:, k, "XYZ".index(c[0])])
-            else:
-                assert eul is not None
-                cols.append(eul[:, r])
-                r += 1
-    data = np.stack(cols, axis=1) if cols else np.zeros((motion.num_frames, 0))
-    out.append("MOTION")
-    out.append(f"Frames: {motion.num_frames}")
-    out.append(f"Frame Time: {1.0 / motion.fps:.9f}")
-    body = "\n".join(" ".join(fmt.format(x) for x in row) for row in data)
-    return "\n".join(out) + "\n" + body + "\n"
-
-
+# ---------------------------------------------------------------------------------- writing
 def write_bvh(
     motion: Motion,
     path: str | Path,
     *,
-    unit: str | None = None,
+    unit: Unit | None = None,
     up: UpAxis | None = None,
+    channels: ChannelMode = "source",
     precision: int = 6,
 ) -> None:
-    """Write ``motion`` atomically (a temporary file renamed into place)."""
-    atomic_write_text(path, bvh_text(motion, unit=unit, up=up, precision=precision))
+    """Write ``motion`` as BVH, atomically (a temporary sibling renamed into place, removed on
+    any error). See :func:`bvh_text` for the options."""
+    chunks = _bvh_chunks(motion, unit, up, channels, precision)
+    first = next(chunks)  # bad arguments raise before any file is created
+    with atomic_write(path, "w") as fh:
+        fh.write(first)
+        for chunk in chunks:
+            fh.write(chunk)
+
+
+def bvh_text(
+    motion: Motion,
+    *,
+    unit: Unit | None = None,
+    up: UpAxis | None = None,
+    channels: ChannelMode = "source",
+    precision: int = 6,
+) -> str:
+    """BVH text of ``motion``.
+
+    ``unit``/``up`` default to the skeleton's source file's. ``channels="source"`` writes each
+    joint's source channels (adding position or rotation channels only where the motion moves a
+    joint in a way they cannot hold); ``"rotation"`` writes 6 channels on the root and 3 rotation
+    channels elsewhere (per-frame translations of other joints are dropped for their offsets).
+    ``precision`` is the number of decimals of every value.
+    """
+    return "".join(_bvh_chunks(motion, unit, up, channels, precision))
+
+
+def _bvh_chunks(
+    motion: Motion, unit: Unit | None, up: UpAxis | None, mode: str, precision: int
+) -> Iterator[str]:
+    skel, lay = motion.skeleton, motion.skeleton.layout
+    unit = unit or lay.unit  # type: ignore[assignment]
+    up = up or lay.up
+    if unit not in UNIT_SCALE:
+        raise MotionError(f"unit must be one of {list(UNIT_SCALE)}, got {unit!r}")
+    if up not in ("y", "z"):
+        raise MotionError(f"up must be 'y' or 'z', got {up!r}")
+    if mode not in ("source", "rotation"):
+        raise MotionError(f"channels must be 'source' or 'rotation', got {mode!r}")
+    if not (isinstance(precision, int) and 0 <= precision <= 17):
+        raise MotionError(f"precision must be an int in 0..17, got {precision!r}")
+    t, nj = motion.num_frames, motion.num_joints
+    inv = 1.0 / UNIT_SCALE[unit]
+    a = axes_to_z_up(up)  # file -> Z-up; row vectors p_file = p_z @ a
+    qa = _axes_quat(up)
+    trans = np.array(motion.local_translations())
+    trans[:, 0] = motion.root_positions
+    trans_f = trans @ a * inv
+    offsets_f = skel.offsets @ a * inv
+    rot_f = quat_mul(quat_mul(quat_conj(qa), motion.rotations), qa)  # R_file = A^T R_z A
+    tol = 0.5 * 10.0**-precision  # what the file cannot show anyway
+
+    if mode == "rotation":
+        chans = [POSITION_CHANNELS + _rot_names(lay.channels[0])] + [
+            _rot_names(lay.channels[k]) for k in range(1, nj)
+        ]
+    else:
+        chans = [tuple(c) for c in lay.channels]
+    # values as [x, y, z, angle0, angle1, angle2] per joint in file axes / degrees, full order
+    vals = np.empty((t, nj, 6))
+    vals[..., :3] = trans_f
+    orders = [_full_order(c) for c in chans]
+    for order in set(orders):
+        ks = [k for k in range(nj) if orders[k] == order]
+        vals[:, ks, 3:] = np.degrees(quat_to_euler(rot_f[:, ks], order))
+    if mode == "source":  # widen channels the data does not fit into
+        moved = np.abs(trans_f - offsets_f).max(axis=0) > tol  # (J, 3) per file axis
+        for k, ch in enumerate(chans):
+            rot = rot0 = tuple(c for c in ch if c in ROTATION_CHANNELS)
+            pos = pos0 = tuple(c for c in ch if c in POSITION_CHANNELS)
+            if any(moved[k, i] and POSITION_CHANNELS[i] not in pos for i in range(3)):
+                pos = POSITION_CHANNELS
+            n_rot = len(rot)
+            if n_rot < 3 and np.abs(vals[:, k, 3 + n_rot :]).max() > tol:
+                rot = tuple(f"{x}rotation" for x in orders[k])
+            if rot != rot0 or pos != pos0:
+                chans[k] = pos + rot
+    cols = [
+        (k, "XYZ".index(c[0]) if c in POSITION_CHANNELS else 3 + orders[k].index(c[0]))
+        for k in range(nj)
+        for c in chans[k]
+    ]
+    data = vals[:, [k for k, _ in cols], [s for _, s in cols]] if cols else np.zeros((t, 0))
+
+    fmt = f"{{:.{precision}f}}"
+
+    def num(x: float) -> str:
+        return fmt.format(round(float(x), precision) + 0.0)  # + 0.0: no "-0.000000"
+
+    out = ["HIERARCHY"]
+    children = [skel.children(k) for k in range(nj)]
+
+    def emit(k: int, ind: str) -> None:
+        out.append(f"{ind}{'ROOT' if k == 0 else 'JOINT'} {skel.names[k]}")
+        out.append(f"{ind}{{")
+        out.append(f"{ind}  OFFSET {' '.join(num(x) for x in offsets_f[k])}")
+        if chans[k]:
+            out.append(f"{ind}  CHANNELS {len(chans[k])} {' '.join(chans[k])}")
+        for c in children[k]:
+            emit(c, ind + "  ")
+        if k in lay.end_sites or not children[k]:  # leaves get an End Site, as readers expect
+            e = np.asarray(lay.end_sites.get(k, (0.0, 0.0, 0.0))) @ a * inv
+            out.append(f"{ind}  End Site")
+            out.append(f"{ind}  {{")
+            out.append(f"{ind}    OFFSET {' '.join(num(x) for x in e)}")
+            out.append(f"{ind}  }}")
+        out.append(f"{ind}}}")
+
+    emit(0, "")
+    out += ["MOTION", f"Frames: {t}", f"Frame Time: {1.0 / motion.fps:.10g}", ""]
+    yield "\n".join(out)
+    data = np.round(data, precision) + 0.0
+    row = " ".join([f"%.{precision}f"] * data.shape[1]) + "\n"
+    for s in range(0, t, 1024):
+        yield _format_rows(data[s : s + 1024], row)
+
+
+def _rot_names(channels: Sequence[str]) -> tuple[str, ...]:
+    return tuple(f"{x}rotation" for x in _full_order(channels))
+
+
+def _format_rows(block: F64, row: str) -> str:
+    return "".join(row % tuple(r) for r in block.tolist())

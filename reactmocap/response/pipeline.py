@@ -72,6 +72,9 @@ class ResponseResult:
     found: Motion
     before: Motion
     report: dict[str, Any] = field(default_factory=dict)
+    #: the simulated world and its pre-impact state (to measure bare stepping of the same model)
+    model: mujoco.MjModel | None = None
+    start_state: F64 | None = None
 
 
 # ----------------------------------------------------------------------------- library
@@ -395,6 +398,7 @@ def run_response(scenario: Scenario) -> ResponseResult:
         },
         "transition": {"start": t_impact, "end": t_match, "reaction_delay": cfg.reaction_delay},
         "timings_s": timings,
+        "steps": {"sim1": n1, "sim2": n2},
         "quality": quality,
         "config": asdict(cfg),
         "outputs": {},
@@ -412,6 +416,8 @@ def run_response(scenario: Scenario) -> ResponseResult:
         found=found,
         before=rec_motion.sample(np.arange(0, int(t_match * fps) + 1) / fps + rec_t0),
         report=report,
+        model=sim2.world.model,
+        start_state=saved,
     )
 
 

@@ -163,6 +163,33 @@ def _clip_source(clips: Any) -> tuple[Mapping[str, Motion], str]:
     return clips, "arrays:" + library_fingerprint(clips)
 
 
+#: frame rates within this relative tolerance of an integer multiple of the index rate are
+#: taken as that multiple (BVH "Frame Time: 0.0333333" is 30.00003 fps), so such clips are
+#: subsampled exactly instead of interpolated
+RATE_TOLERANCE = 1e-4
+
+
+def _rate_step(fps: float, index_fps: float) -> int | None:
+    """Integer frame step from ``fps`` to ``index_fps``, or None when it is not a multiple."""
+    ratio = fps / index_fps
+    step = int(round(ratio))
+    return step if step >= 1 and abs(ratio - step) <= RATE_TOLERANCE * ratio else None
+
+
+def _to_rate(m: Motion, index_fps: float) -> Motion:
+    step = _rate_step(m.fps, index_fps)
+    if step is None:
+        return m.resample(index_fps)
+    if step == 1:
+        return m
+    return m.replace(
+        fps=m.fps / step,
+        root_positions=m.root_positions[::step],
+        rotations=m.rotations[::step],
+        translations=None if m.translations is None else m.translations[::step],
+    )
+
+
 def _readonly(a: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(a)
     a.setflags(write=False)
@@ -308,10 +335,20 @@ class MotionIndex:
         native_fps: list[float] = []
         feats: list[FrameFeatures] = []
         for name, m in motions.items():
-            mr = m if abs(m.fps - fps) < 1e-9 else m.resample(fps)
+            mr = _to_rate(m, fps)
             names.append(name)
             native_fps.append(m.fps)
-            feats.append(frame_features(mr, calibs[name]))
+            ff = frame_features(mr, calibs[name])
+            # float32 as we go: the 1M-frame library must not hold float64 copies of everything
+            feats.append(
+                FrameFeatures(
+                    ff.positions.astype(np.float32),
+                    ff.orientations.astype(np.float32),
+                    ff.heading,
+                    ff.origin,
+                    ff.com[:0],
+                )
+            )
         counts = np.array([f.num_frames for f in feats], dtype=np.int64)
         if not np.any(counts >= L):
             raise SearchError(
@@ -479,17 +516,20 @@ class MotionIndex:
                 f"({motion.num_frames} frames, 0..{motion.num_frames - 1})"
             )
         L = self.length
-        span = (L - 1) / self.window.fps
+        step = _rate_step(motion.fps, self.window.fps)
         t0 = f0 / motion.fps
-        if t0 + span > motion.duration + 1e-9:
+        span = (L - 1) / self.window.fps
+        if step is not None:
+            fits = f0 + (L - 1) * step <= motion.num_frames - 1
+        else:
+            fits = t0 + span <= motion.duration + 1e-9
+        if not fits:
             raise SearchError(
                 f"the {L}-frame search window ({span:.3f} s at {self.window.fps:g} fps) starting at "
                 f"frame {f0} ({t0:.3f} s) runs past the end of {motion.name or 'the query'} "
                 f"({motion.duration:.3f} s, {motion.num_frames} frames)"
             )
-        ratio = motion.fps / self.window.fps
-        if abs(ratio - round(ratio)) < 1e-9:
-            step = int(round(ratio))
+        if step is not None:
             sl = slice(f0, f0 + (L - 1) * step + 1, step)
             root, rot = motion.root_positions[sl], motion.rotations[sl]
             tr = None if motion.translations is None else motion.translations[sl]

@@ -122,3 +122,17 @@ def test_registry_and_config_validation() -> None:
     assert np.all(np.diff(w) < 0)  # highest at the first frame, decreasing
     assert WindowConfig(fps=30, duration=0.3).length == 10
     assert WindowConfig(fps=120, duration=0.3).length == 37
+
+
+def test_heading_of_real_clips_follows_walking_direction(real_clips: dict[str, Motion]) -> None:
+    """Bandai Namco skeleton (rest pose lying along +X, a dummy root joint): the heading of a
+    forward walk matches its direction of travel, and of a backward walk the opposite one."""
+    fs = get_feature_set("paper")
+    for name, sign in (("walk_normal_001", 1.0), ("walk-back_normal_001", -1.0), ("run_normal_001", 1.0)):
+        m = next(v for k, v in real_clips.items() if k.endswith(name))
+        ff = frame_features(m, calibrate(m.skeleton, fs))
+        travel = sign * (ff.origin[-1] - ff.origin[0])
+        mean_heading = np.angle(np.mean(np.exp(1j * ff.heading)))
+        diff = np.angle(np.exp(1j * (mean_heading - np.arctan2(travel[1], travel[0]))))
+        assert abs(diff) < np.radians(20), (name, np.degrees(diff))
+        assert abs(np.degrees(ff.heading[0]) + 90) < 30  # the files face -Y in our Z-up world

@@ -171,12 +171,6 @@ def test_geometry_masses_match_the_tables(make_skeleton: Callable[[], Skeleton])
     assert [v for v in fraction_violations(masses) if "_foot" not in v] == []
 
 
-@pytest.mark.xfail(
-    raises=AssertionError,
-    strict=True,
-    reason="character.py's foot boxes (mass_model='geometry') give 1.75-1.81% of body mass per "
-    "foot vs the thesis's 1.13-1.24% (band upper edge 1.74%)",
-)
 @pytest.mark.parametrize("make_skeleton", SKELETONS)
 def test_geometry_feet_match_the_tables(make_skeleton: Callable[[], Skeleton]) -> None:
     masses = _build(make_skeleton, 75.0, "geometry")
