@@ -122,7 +122,15 @@ def parse_bvh(
         return _parse(text, fname, unit, up, name)
     except BVHParseError:
         raise
-    except (ValueError, IndexError, KeyError, TypeError, AttributeError, RecursionError) as exc:
+    except (
+        ValueError,
+        IndexError,
+        KeyError,
+        TypeError,
+        AttributeError,
+        ArithmeticError,
+        RecursionError,
+    ) as exc:
         # safety net: every expected problem is reported above with its line
         raise BVHParseError(f"malformed BVH ({type(exc).__name__}: {exc})", file=fname) from exc
 
@@ -167,7 +175,7 @@ def _parse(text: str, fname: str, unit: Unit | None, up: UpAxis, name: str) -> M
         ft_dec = None
     if ft_dec is None:
         raise fail(f"found {lines[ft_i].strip()[:40]!r}", ft_i + 1, "Frame Time: <seconds>")
-    if not (ft_dec.is_finite() and ft_dec > 0):
+    if not (ft_dec.is_finite() and 0 < float(ft_dec) < float("inf")):
         raise fail(f"Frame Time: {ft_dec}", ft_i + 1, "a positive number of seconds")
     n_ch = sum(len(j.channels) for j in joints)
     if n_ch == 0:
@@ -344,9 +352,11 @@ def _frames(body: list[str], first: int, n: int, n_ch: int, fail: _Fail) -> F64:
             line = (rows[-1][0] + (1 if last_ok else 0)) if rows else first
             raise fail(f"truncated MOTION: {len(rows)} frame lines but Frames: {n}", line,
                        f"{n} frame lines")  # fmt: skip
-        for line, toks in rows[:n]:
+        for r, (line, toks) in enumerate(rows[:n]):
             if len(toks) != n_ch:
-                raise fail(f"frame line has {len(toks)} values", line,
+                cut = r == n - 1 and len(toks) < n_ch and body[-1].strip() != ""  # no final \n
+                what = "truncated MOTION: last frame line" if cut else "frame line"
+                raise fail(f"{what} has {len(toks)} values", line,
                            f"{n_ch} values, one per channel")  # fmt: skip
             for tok in toks:
                 try:
@@ -486,9 +496,11 @@ def bvh_text(
     """BVH text of ``motion``.
 
     ``unit``/``up`` default to the skeleton's source file's. ``channels="source"`` writes each
-    joint's source channels (adding position or rotation channels only where the motion moves a
-    joint in a way they cannot hold); ``"rotation"`` writes 6 channels on the root and 3 rotation
-    channels elsewhere (per-frame translations of other joints are dropped for their offsets).
+    joint's source channels; ``"rotation"`` writes 6 channels on the root and 3 rotation channels
+    elsewhere. Either way a joint gets the position or rotation channels it lacks where the motion
+    moves it in a way its channels cannot hold (``"rotation"`` ignores translations within 10 um
+    of the offset, such as the rounding noise in the Bandai Namco files' position channels), so
+    writing never loses motion.
     ``precision`` is the number of decimals of every value.
     """
     return "".join(_bvh_chunks(motion, unit, up, channels, precision))
@@ -532,18 +544,18 @@ def _bvh_chunks(
     for order in set(orders):
         ks = [k for k in range(nj) if orders[k] == order]
         vals[:, ks, 3:] = np.degrees(quat_to_euler(rot_f[:, ks], order))
-    if mode == "source":  # widen channels the data does not fit into
-        moved = np.abs(trans_f - offsets_f).max(axis=0) > tol  # (J, 3) per file axis
-        for k, ch in enumerate(chans):
-            rot = rot0 = tuple(c for c in ch if c in ROTATION_CHANNELS)
-            pos = pos0 = tuple(c for c in ch if c in POSITION_CHANNELS)
-            if any(moved[k, i] and POSITION_CHANNELS[i] not in pos for i in range(3)):
-                pos = POSITION_CHANNELS
-            n_rot = len(rot)
-            if n_rot < 3 and np.abs(vals[:, k, 3 + n_rot :]).max() > tol:
-                rot = tuple(f"{x}rotation" for x in orders[k])
-            if rot != rot0 or pos != pos0:
-                chans[k] = pos + rot
+    # widen channels the data does not fit into; "rotation" ignores translation noise < 10 um
+    pos_tol = tol if mode == "source" else max(tol, 1e-5 * inv)
+    moved = np.abs(trans_f - offsets_f).max(axis=0) > pos_tol  # (J, 3) per file axis
+    for k, ch in enumerate(chans):
+        rot = rot0 = tuple(c for c in ch if c in ROTATION_CHANNELS)
+        pos = pos0 = tuple(c for c in ch if c in POSITION_CHANNELS)
+        if any(moved[k, i] and POSITION_CHANNELS[i] not in pos for i in range(3)):
+            pos = POSITION_CHANNELS
+        if len(rot) < 3 and np.abs(vals[:, k, 3 + len(rot) :]).max() > tol:
+            rot = tuple(f"{x}rotation" for x in orders[k])
+        if rot != rot0 or pos != pos0:
+            chans[k] = pos + rot
     cols = [
         (k, "XYZ".index(c[0]) if c in POSITION_CHANNELS else 3 + orders[k].index(c[0]))
         for k in range(nj)

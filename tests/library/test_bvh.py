@@ -110,11 +110,11 @@ def test_shared_clip_rotation_channels(shared_clips: dict[Path, Motion], tmp_pat
     f, m = next(iter(shared_clips.items()))
     write_bvh(m, tmp_path / "rot.bvh", channels="rotation")
     text = (tmp_path / "rot.bvh").read_text()
-    assert text.count("CHANNELS 6") == 1
-    assert text.count("CHANNELS 3 Zrotation Xrotation Yrotation") == m.num_joints - 1
+    # the dummy root and Hips (which carries the root motion) keep positions; the other joints'
+    # position channels only repeat their offsets (to 1e-7 m) and are dropped
+    assert text.count("CHANNELS 6") == 2
+    assert text.count("CHANNELS 3 Zrotation Xrotation Yrotation") == m.num_joints - 2
     back = read_bvh(tmp_path / "rot.bvh")
-    assert back.translations is None
-    # the Bandai position channels hold the offsets, so nothing is lost
     assert np.abs(points(back) - points(m)).max() < 1e-5 * tallest(m)
 
 
@@ -225,11 +225,12 @@ def test_unit_override_and_metres(cmu_file: Path) -> None:
     assert m_cm.skeleton.layout.unit == "cm"
     np.testing.assert_allclose(m_cm.skeleton.offsets * 2.54, m_in.skeleton.offsets)
     # the same body in metres is detected as metres
-    m = m_in.replace(skeleton=m_in.skeleton)
-    text = bvh_text(m, unit="m")
-    back = parse_bvh(text)
+    back = parse_bvh(bvh_text(m_in, unit="m"))
     assert back.skeleton.layout.unit == "m"
-    assert np.abs(points(back) - points(m)).max() < 1e-5
+    assert np.abs(points(back) - points(m_in)).max() < 1e-5
+    back = parse_bvh(bvh_text(m_in, unit="mm", up="z"), up="z")
+    assert back.skeleton.layout.unit == "mm"
+    assert np.abs(points(back) - points(m_in)).max() < 1e-5
 
 
 SMALL = """HIERARCHY
@@ -266,7 +267,7 @@ def test_y_up_becomes_z_up() -> None:
     # Yrotation 90 (yaw about the file's up axis) is a rotation about +Z
     s = np.sqrt(0.5)
     np.testing.assert_allclose(m.rotations[1, 0], [s, 0.0, 0.0, s], atol=1e-12)
-    # Xrotation 90 stays about +X: the spine then points along -Y (x right, y forward? no: -Y)
+    # Xrotation 90 tips the spine from up (+Y) to +Z in the file, which is -Y in Z-up
     np.testing.assert_allclose(pos[2, 1] - pos[2, 0], [0.0, -0.1, 0.0], atol=1e-12)
     z = parse_bvh(SMALL, unit="cm", up="z")
     np.testing.assert_allclose(z.skeleton.offsets[1], [0.0, 0.1, 0.0])
@@ -333,7 +334,9 @@ def test_source_channels_widen_when_needed() -> None:
         m.skeleton.offsets,
         BVHLayout((("Zrotation", "Xrotation", "Yrotation"), ()), lay.unit, lay.up, lay.end_sites),
     )
-    moved = Motion(skel, m.fps, m.root_positions, m.rotations)
+    rot = np.array(m.rotations)
+    rot[:, 1] = quat_from_euler([0.3, 0.2, 0.1], "ZXY")
+    moved = Motion(skel, m.fps, m.root_positions, rot)
     back = parse_bvh(bvh_text(moved), unit="cm")
     assert back.skeleton.layout.channels[0][:3] == ("Xposition", "Yposition", "Zposition")
     assert back.skeleton.layout.channels[1] == ("Zrotation", "Xrotation", "Yrotation")
@@ -394,7 +397,7 @@ def test_truncated_motion(tmp_path: Path) -> None:
     assert e.line == 21 and "truncated" in e.reason and e.expected == "3 frame lines"
     # cut inside the last line: that line is the culprit
     e = bad(SMALL[: SMALL.rindex(" 0 0 0")], tmp_path)
-    assert e.line == 21 and "truncated" in e.reason
+    assert e.line == 21 and "truncated" in e.reason and "9 values" in (e.expected or "")
 
 
 def test_wrong_value_count(tmp_path: Path) -> None:
