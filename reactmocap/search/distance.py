@@ -42,6 +42,7 @@ __all__ = [
     "embed_local",
     "embedding_body_weights",
     "embedding_frame_weights",
+    "frame_pose_steps",
     "group_matrix",
     "localize",
     "select_support",
@@ -264,3 +265,31 @@ def window_distances(
     ba = (sa * wq[None]) @ groups
     br = np.stack([bp[:, 0], ba[:, 0], bp[:, 1], ba[:, 1], bp[:, 2], ba[:, 2]], axis=1)
     return total, br
+
+
+def frame_pose_steps(
+    positions: F32, orientations: F32, heading: F64, origin: F64, wp: F64, wq: F64, chunk: int = 65536
+) -> F32:
+    """``(N,)`` pose distance between each frame and the previous one (0 for frame 0), each in its
+    own root frame: ``sum_b wp_b |dp_b| + wq_b d_theta_b`` (``D`` of a one-frame window).
+    Differences across clip boundaries are meaningless; callers ignore them."""
+    n = positions.shape[0]
+    out = np.zeros(n, dtype=np.float32)
+    prev_p = prev_q = None
+    for i in range(0, n, chunk):
+        sl = slice(i, min(n, i + chunk))
+        lp, lq = localize(positions[sl][:, None], orientations[sl][:, None], heading[sl], origin[sl])
+        lp, lq = lp[:, 0], lq[:, 0]
+        if prev_p is not None:
+            lp = np.concatenate([prev_p, lp])
+            lq = np.concatenate([prev_q, lq])
+        dp = np.sqrt(((lp[1:] - lp[:-1]) ** 2).sum(-1))
+        dot = np.abs((lq[1:] * lq[:-1]).sum(-1))
+        da = 2.0 * np.sqrt(np.maximum(1.0 - dot * dot, 0.0))
+        d = dp @ wp.astype(np.float32) + da @ wq.astype(np.float32)
+        if prev_p is None:
+            out[sl.start + 1 : sl.stop] = d
+        else:
+            out[sl] = d
+        prev_p, prev_q = lp[-1:], lq[-1:]
+    return out

@@ -322,11 +322,30 @@ def forward_kinematics_fast(
     pos[:, 0] = root_positions
     rot[:, 0] = local_r[:, 0]
     parents = skeleton.parents
-    for k in range(1, j):
-        p = parents[k]
-        np.matmul(rot[:, p], local_r[:, k], out=rot[:, k])
-        pos[:, k] = pos[:, p] + np.einsum("tij,tj->ti", rot[:, p], local_t[:, k])
+    for lvl in _depth_levels(parents):  # all joints of one depth at once
+        par = parents[lvl]
+        prot = rot[:, par]
+        rot[:, lvl] = prot @ local_r[:, lvl]
+        pos[:, lvl] = pos[:, par] + (prot @ local_t[:, lvl, :, None])[..., 0]
     return pos, rot
+
+
+_LEVELS: dict[bytes, list[NDArray[np.int64]]] = {}
+
+
+def _depth_levels(parents: NDArray[np.int64]) -> list[NDArray[np.int64]]:
+    """Non-root joints grouped by depth (parents precede children, so depth is one pass)."""
+    key = parents.tobytes()
+    levels = _LEVELS.get(key)
+    if levels is None:
+        depth = np.zeros(len(parents), dtype=np.int64)
+        for k in range(1, len(parents)):
+            depth[k] = depth[parents[k]] + 1
+        levels = [np.flatnonzero(depth == d) for d in range(1, int(depth.max()) + 1)]
+        if len(_LEVELS) > 256:
+            _LEVELS.clear()
+        _LEVELS[key] = levels
+    return levels
 
 
 def features_from_arrays(

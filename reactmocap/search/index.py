@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+import scipy.linalg
 from scipy.spatial import cKDTree
 
 from reactmocap.errors import ConfigError, ReactMocapError, SearchError
@@ -29,6 +30,7 @@ from reactmocap.search.distance import (
     embed_local,
     embedding_body_weights,
     embedding_frame_weights,
+    frame_pose_steps,
     group_matrix,
     localize,
     select_support,
@@ -63,6 +65,8 @@ COARSE_FRAMES = 10
 DEFAULT_K = 64
 DEFAULT_EXACT = 4
 DEFAULT_REFINE = 2
+#: windows sampled to fit the PCA
+PCA_SAMPLE = 8_000
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -408,76 +412,75 @@ class MotionIndex:
         fw = embedding_frame_weights(self.weights.window_weights(self.length), offs)
         return wp, wq, fw, offs
 
-    def _build_embedding(self, rng: np.random.Generator, progress: Callable[[str], None] | None) -> None:
-        wp, wq, fw, offs = self._embedding_weights()
-        valid = self._valid_starts()
-        # 1. PCA fitted on a random sample of windows (covariance + eigh: exact, fast for De ~ 1k)
-        sample = valid if valid.size <= 20_000 else np.sort(rng.choice(valid, 20_000, replace=False))
-        x = np.concatenate(
-            [self._embed_starts(sample[i : i + _CHUNK], wp, wq, fw, offs) for i in range(0, sample.size, _CHUNK)]
-        ).astype(np.float64)
-        mean = x.mean(axis=0)
-        de = x.shape[1]
-        d = self.window.pca_dims
-        if d <= 0 or d >= de:
-            comps = np.eye(de)
-            explained = 1.0
-        else:
-            xc = x - mean
-            cov = (xc.T @ xc) / max(1, xc.shape[0] - 1)
-            evals, evecs = np.linalg.eigh(cov)
-            order = np.argsort(evals)[::-1]
-            evals, evecs = evals[order], evecs[:, order]
-            comps = evecs[:, :d]
-            explained = float(evals[:d].sum() / max(evals.sum(), 1e-300))
-        del x
-        mean32 = mean.astype(np.float32)
-        comps32 = np.ascontiguousarray(comps.astype(np.float32))
-        # 2. every valid window: consecutive embedding distances (full space) and projections
-        n = valid.size
-        proj = np.empty((n, comps32.shape[1]), dtype=np.float32)
-        step = np.zeros(n, dtype=np.float64)
-        prev: F32 | None = None
-        for i in range(0, n, _CHUNK):
-            s = valid[i : i + _CHUNK]
-            e = self._embed_starts(s, wp, wq, fw, offs)
-            proj[i : i + s.size] = (e - mean32) @ comps32
-            full = np.concatenate([prev, e]) if prev is not None else np.concatenate([e[:1], e])
-            step[i : i + s.size] = np.sqrt(((full[1:] - full[:-1]) ** 2).sum(axis=1))
-            prev = e[-1:]
-        # 3. unique starts, clip by clip (arc length along the embedding trajectory)
+    def _unique_starts(self, valid: I64) -> tuple[I64, I64, I64]:
+        """Kept window starts and their refinement intervals (inclusive), clip by clip.
+
+        The paper keeps a frame when it differs from the previous kept frame by more than a
+        tolerance. We measure the per-frame pose distance (``D`` of a one-frame window, base
+        weights, each frame in its own root frame) between consecutive frames and keep a frame
+        whenever the *path length* since the last kept one crosses another multiple of the
+        tolerance. Path length bounds the direct distance, so every dropped frame is within the
+        tolerance of the previous kept frame (vectorised; no sequential scan). A frame is also
+        kept at least every ``max_gap`` seconds, which bounds the refinement interval.
+        """
+        fs = self.feature_set
+        wp, wq = body_weights(fs, self.weights, None)
+        step = frame_pose_steps(self.positions, self.orientations, self.heading, self.origin, wp, wq)
         kept_list, lo_list, hi_list = [], [], []
         tol = self.window.unique_tolerance
         gap = self.window.max_gap_frames
-        pos = 0
         for a, b in zip(self.clip_offsets[:-1], self.clip_offsets[1:]):
             m = int(b - a - self.length + 1)
             if m <= 0:
                 continue
-            st = step[pos : pos + m].copy()
+            st = step[a : a + m].astype(np.float64)
             st[0] = 0.0
             if tol > 0:
                 bucket = np.floor(np.cumsum(st) / tol).astype(np.int64)
                 local = np.flatnonzero(np.diff(bucket, prepend=-1) != 0)
             else:
                 local = np.arange(m)
-            # enforce max gap
             ends = np.append(local, m)
             fill = [np.arange(x + gap, y, gap) for x, y in zip(ends[:-1], ends[1:]) if y - x > gap]
             if fill:
                 local = np.unique(np.concatenate([local, *fill]))
-            lo = np.concatenate([[0], local[:-1] + 1])
-            hi = np.concatenate([local[1:] - 1, [m - 1]])
-            kept_list.append(pos + local)
-            lo_list.append(a + lo)
-            hi_list.append(a + hi)
-            pos += m
-        rows = np.concatenate(kept_list)
-        self.kept = valid[rows]
-        self.interval_lo = np.concatenate(lo_list).astype(np.int64)
-        self.interval_hi = np.concatenate(hi_list).astype(np.int64)
-        self.embedding = np.ascontiguousarray(proj[rows])
-        del proj
+            kept_list.append(a + local)
+            lo_list.append(a + np.concatenate([[0], local[:-1] + 1]))
+            hi_list.append(a + np.concatenate([local[1:] - 1, [m - 1]]))
+        kept = np.concatenate(kept_list).astype(np.int64)
+        return kept, np.concatenate(lo_list).astype(np.int64), np.concatenate(hi_list).astype(np.int64)
+
+    def _build_embedding(self, rng: np.random.Generator, progress: Callable[[str], None] | None) -> None:
+        wp, wq, fw, offs = self._embedding_weights()
+        valid = self._valid_starts()
+        kept, lo, hi = self._unique_starts(valid)
+        # PCA fitted on a random sample of kept windows (covariance + eigh: exact, fast for De ~ 1k)
+        sample = kept if kept.size <= PCA_SAMPLE else np.sort(rng.choice(kept, PCA_SAMPLE, replace=False))
+        x = np.concatenate(
+            [self._embed_starts(sample[i : i + _CHUNK], wp, wq, fw, offs) for i in range(0, sample.size, _CHUNK)]
+        )
+        mean = x.mean(axis=0, dtype=np.float64)
+        de = x.shape[1]
+        d = self.window.pca_dims
+        if d <= 0 or d >= de:
+            comps = np.eye(de)
+            explained = 1.0
+        else:
+            xc = x - mean.astype(np.float32)
+            cov = (xc.T @ xc).astype(np.float64) / max(1, xc.shape[0] - 1)
+            evals, evecs = scipy.linalg.eigh(cov, subset_by_index=[de - d, de - 1])
+            order = np.argsort(evals)[::-1]
+            comps = evecs[:, order]
+            explained = float(evals.sum() / max(np.trace(cov), 1e-300))
+        del x
+        mean32 = mean.astype(np.float32)
+        comps32 = np.ascontiguousarray(comps.astype(np.float32))
+        proj = np.empty((kept.size, comps32.shape[1]), dtype=np.float32)
+        for i in range(0, kept.size, _CHUNK):
+            e = self._embed_starts(kept[i : i + _CHUNK], wp, wq, fw, offs)
+            proj[i : i + e.shape[0]] = (e - mean32) @ comps32
+        self.kept, self.interval_lo, self.interval_hi = kept, lo, hi
+        self.embedding = proj
         self.pca_mean = mean32
         self.pca_components = comps32
         self.info["pca_explained_variance"] = explained
@@ -485,7 +488,9 @@ class MotionIndex:
         self._tree = None
         _ = self.tree
         if progress:
-            progress(f"indexed {self.kept.size} unique windows of {n} ({d} PCA dims, {explained:.3f} variance)")
+            progress(
+                f"indexed {kept.size} unique windows of {valid.size} ({d} PCA dims, {explained:.3f} variance)"
+            )
 
     def _freeze(self) -> None:
         for name in (

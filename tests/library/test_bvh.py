@@ -107,7 +107,7 @@ def test_shared_clips_round_trip(shared_clips: dict[Path, Motion], tmp_path: Pat
 
 
 def test_shared_clip_rotation_channels(shared_clips: dict[Path, Motion], tmp_path: Path) -> None:
-    f, m = next(iter(shared_clips.items()))
+    m = next(iter(shared_clips.values()))
     write_bvh(m, tmp_path / "rot.bvh", channels="rotation")
     text = (tmp_path / "rot.bvh").read_text()
     # the dummy root and Hips (which carries the root motion) keep positions; the other joints'
@@ -152,7 +152,9 @@ def cmu_angles() -> tuple[np.ndarray, np.ndarray]:
     ang = np.round(rng.uniform(-70, 70, size=(CMU_FRAMES, j, 3)), 4)
     ang[:, 0, 1] = np.round(rng.uniform(-179, 179, size=CMU_FRAMES), 4)  # root yaw
     ang[0] = 0.0
-    pos = np.round(np.c_[np.arange(CMU_FRAMES) * 0.5, np.full(CMU_FRAMES, 36.5), np.zeros(CMU_FRAMES)], 4)  # fmt: skip
+    pos = np.zeros((CMU_FRAMES, 3))
+    pos[:, 0] = np.arange(CMU_FRAMES) * 0.5
+    pos[:, 1] = 36.5
     return pos, ang
 
 
@@ -166,13 +168,15 @@ def cmu_bvh_text() -> str:
         out.append(f"{ind}{{")
         out.append(f"{ind}\tOFFSET {off[0]:.4f} {off[1]:.4f} {off[2]:.4f}")
         rot = "Xrotation Yrotation Zrotation"
-        out.append(f"{ind}\tCHANNELS " + (f"6 Xposition Yposition Zposition {rot}" if k == 0 else f"3 {rot}"))  # fmt: skip
+        chans = f"6 Xposition Yposition Zposition {rot}" if k == 0 else f"3 {rot}"
+        out.append(f"{ind}\tCHANNELS {chans}")
         for c, (_, parent, _) in enumerate(CMU_JOINTS):
             if parent == name:
                 emit(c, ind + "\t")
         if name in CMU_ENDS:
             e = CMU_ENDS[name]
-            out += [f"{ind}\tEnd Site", f"{ind}\t{{", f"{ind}\t\tOFFSET {e[0]} {e[1]} {e[2]}", f"{ind}\t}}"]  # fmt: skip
+            out.extend([f"{ind}\tEnd Site", f"{ind}\t{{", f"{ind}\t\tOFFSET {e[0]} {e[1]} {e[2]}"])
+            out.append(f"{ind}\t}}")
         out.append(f"{ind}}}")
 
     emit(0, "")
@@ -317,7 +321,9 @@ def test_channel_variety_round_trips() -> None:
     np.testing.assert_allclose(points(back), points(m), atol=1e-8)
     # a joint without rotation channels is identity; a channel-less joint is allowed
     bare = SMALL.replace("    CHANNELS 3 Zrotation Xrotation Yrotation\n", "")
-    bare = "\n".join(s.rsplit(" 0 0 0", 1)[0] if i >= 18 else s for i, s in enumerate(bare.split("\n")))  # fmt: skip
+    rows = bare.split("\n")
+    rows[17:20] = [r.rsplit(" 0 0 0", 1)[0] for r in rows[17:20]]  # drop the spine's values
+    bare = "\n".join(rows)
     b = parse_bvh(bare, unit="cm")
     assert b.skeleton.layout.channels[1] == ()
     np.testing.assert_allclose(b.rotations[:, 1], [[1, 0, 0, 0]] * 3)
@@ -359,7 +365,8 @@ def test_random_euler_round_trip(order: list[str], angles: list[float], up: str,
         up,  # type: ignore[arg-type]
         {2: (0.0, 0.0, 0.1)},
     )
-    skel = Skeleton(("a", "b", "c"), np.array([-1, 0, 1]), np.array([[0, 0, 0], [0, 0, 0.3], [0.2, 0, 0]]), layout)  # fmt: skip
+    offsets = np.array([[0, 0, 0], [0, 0, 0.3], [0.2, 0, 0]])
+    skel = Skeleton(("a", "b", "c"), np.array([-1, 0, 1]), offsets, layout)
     q = quat_from_euler(np.radians(np.reshape(angles, (2, 3, 3))), o)
     m = Motion(skel, 60.0, np.array([[0.1, 0.2, 0.9], [0.0, 0.0, 1.0]]), q)
     back = parse_bvh(bvh_text(m), unit=unit, up=up)  # type: ignore[arg-type]
@@ -453,7 +460,8 @@ def test_channel_count_mismatch(tmp_path: Path) -> None:
 
 
 def test_lowercase_channels_are_accepted() -> None:
-    m = parse_bvh(SMALL.replace("Zrotation Xrotation Yrotation\n    End", "zrotation XROTATION yrotation\n    End"), unit="cm")  # fmt: skip
+    spine = "Zrotation Xrotation Yrotation\n    End"
+    m = parse_bvh(SMALL.replace(spine, "zrotation XROTATION yrotation\n    End"), unit="cm")
     assert m.skeleton.layout.channels[1] == ("Zrotation", "Xrotation", "Yrotation")
 
 
@@ -571,6 +579,6 @@ def test_write_bad_arguments_create_nothing(tmp_path: Path) -> None:
 def test_write_then_read_file(tmp_path: Path) -> None:
     m = parse_bvh(SMALL, unit="cm")
     write_bvh(m, tmp_path / "sub" / "out.bvh", precision=8)
-    back = read_bvh(tmp_path / "sub" / "out.bvh")
-    assert back.name == "out" and back.skeleton.layout.unit == "cm"
+    back = read_bvh(tmp_path / "sub" / "out.bvh", unit="cm")  # a 20 cm toy: no detection
+    assert back.name == "out"
     np.testing.assert_allclose(points(back), points(m), atol=1e-10)
