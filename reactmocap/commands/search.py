@@ -44,11 +44,15 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     )
     q.add_argument("index", type=Path, metavar="INDEX")
     q.add_argument("--clip", required=True, metavar="NAME")
-    q.add_argument("--frame", type=int, required=True, metavar="F", help="start frame (clip's own fps)")
+    q.add_argument(
+        "--frame", type=int, required=True, metavar="F", help="start frame (clip's own fps)"
+    )
     q.add_argument("--yaw", type=float, default=0.0, metavar="DEG")
     q.add_argument("--shift", type=_shift, default=(0.0, 0.0), metavar="X,Y")
     q.add_argument("--top", type=int, default=5, metavar="K")
-    q.add_argument("--library", type=Path, default=None, help="library folder (default: the one indexed)")
+    q.add_argument(
+        "--library", type=Path, default=None, help="library folder (default: the one indexed)"
+    )
     q.add_argument("--json", action="store_true", help="print one JSON object")
     q.set_defaults(func=_query)
 
@@ -65,7 +69,9 @@ def _build(args: argparse.Namespace) -> int:
         window = replace(window, fps=args.fps)
     if args.duration is not None:
         window = replace(window, duration=args.duration)
-    weights = SearchWeights() if args.feature_set is None else SearchWeights(feature_set=args.feature_set)
+    weights = (
+        SearchWeights() if args.feature_set is None else SearchWeights(feature_set=args.feature_set)
+    )
     t0 = time.perf_counter()
     index = MotionIndex.build(lib, weights, window, mirror=args.mirror)
     index.info["source"] = str(Path(args.library).resolve())
@@ -111,7 +117,12 @@ def _query(args: argparse.Namespace) -> int:
     best = results[0]
     if args.json:
         out = {
-            "query": {"clip": name, "frame": args.frame, "yaw_deg": args.yaw, "shift": list(args.shift)},
+            "query": {
+                "clip": name,
+                "frame": args.frame,
+                "yaw_deg": args.yaw,
+                "shift": list(args.shift),
+            },
             "clip": best.clip,
             "frame": best.frame,
             "time": best.time,
@@ -132,7 +143,8 @@ def _query(args: argparse.Namespace) -> int:
     w = max(4, *(len(r.clip) for r in results))
     print(
         f"{'#':>2}  {'clip':<{w}}  {'frame':>5}  {'D':>8}  {'yaw_deg':>8}  {'tx':>7}  {'ty':>7}  "
-        f"{'trunk_p':>7}  {'trunk_o':>7}  {'limb_p':>7}  {'limb_o':>7}  {'supp_p':>7}  {'supp_o':>7}"
+        f"{'trunk_p':>7}  {'trunk_o':>7}  {'limb_p':>7}  {'limb_o':>7}  "
+        f"{'supp_p':>7}  {'supp_o':>7}"
     )
     for r in results:
         b = r.breakdown

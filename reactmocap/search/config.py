@@ -57,7 +57,9 @@ class SearchWeights:
         from reactmocap.search.features import get_feature_set
 
         if not isinstance(self.feature_set, str):
-            raise ConfigError(f"SearchWeights.feature_set must be a string, got {self.feature_set!r}")
+            raise ConfigError(
+                f"SearchWeights.feature_set must be a string, got {self.feature_set!r}"
+            )
         get_feature_set(self.feature_set)  # UnknownKeyError listing the valid keys
         _check_nonneg(
             self,
@@ -67,8 +69,16 @@ class SearchWeights:
             ),
         )  # fmt: skip
         if self.window_floor > 1:
-            raise ConfigError(f"SearchWeights.window_floor must be in [0, 1], got {self.window_floor}")
-        if self.trunk_position + self.trunk_orientation + self.limb_position + self.limb_orientation == 0:
+            raise ConfigError(
+                f"SearchWeights.window_floor must be in [0, 1], got {self.window_floor}"
+            )
+        if (
+            self.trunk_position
+            + self.trunk_orientation
+            + self.limb_position
+            + self.limb_orientation
+            == 0
+        ):
             raise ConfigError("SearchWeights: all body weights are zero")
 
     def window_weights(self, length: int) -> NDArray[np.float64]:
@@ -85,7 +95,9 @@ class SearchWeights:
         known = {f.name for f in fields(cls)}
         unknown = set(data) - known
         if unknown:
-            raise ConfigError(f"SearchWeights: unknown fields {sorted(unknown)}; known {sorted(known)}")
+            raise ConfigError(
+                f"SearchWeights: unknown fields {sorted(unknown)}; known {sorted(known)}"
+            )
         return cls(**data)
 
 
@@ -96,8 +108,9 @@ class WindowConfig:
     * ``fps``: the index rate. Library clips are resampled to it at build time, queries at query
       time.
     * ``duration``: seconds covered by a window; ``L = round(duration * fps) + 1`` frames.
-    * ``unique_tolerance``: a window start is dropped when its window is closer than this (in the
-      units of ``D``'s first-frame term, along the clip) to the previous kept start.
+    * ``unique_tolerance``: unique-frame tolerance, in units of ``D`` of a one-frame window (base
+      weights, each frame in its own root frame): a frame is dropped as a window start when the
+      pose path length since the previous kept frame is below it. Independent of ``fps``.
     * ``max_gap``: seconds; a start is kept at least this often whatever the tolerance, which
       bounds the refinement interval.
     * ``embed_frames``: window frames that enter the KD embedding (exact ``D`` uses all ``L``).
@@ -106,7 +119,7 @@ class WindowConfig:
 
     fps: float = 30.0
     duration: float = 0.3
-    unique_tolerance: float = 0.02
+    unique_tolerance: float = 0.1
     max_gap: float = 0.2
     embed_frames: int = 6
     pca_dims: int = 32
@@ -127,11 +140,11 @@ class WindowConfig:
     @property
     def length(self) -> int:
         """Frames per window, ``L``."""
-        return int(round(self.duration * self.fps)) + 1
+        return round(self.duration * self.fps) + 1
 
     @property
     def max_gap_frames(self) -> int:
-        return max(1, int(round(self.max_gap * self.fps)))
+        return max(1, round(self.max_gap * self.fps))
 
     def embed_offsets(self) -> NDArray[np.int64]:
         """Frame offsets inside the window that enter the KD embedding (always includes 0)."""
@@ -146,7 +159,9 @@ class WindowConfig:
         known = {f.name for f in fields(cls)}
         unknown = set(data) - known
         if unknown:
-            raise ConfigError(f"WindowConfig: unknown fields {sorted(unknown)}; known {sorted(known)}")
+            raise ConfigError(
+                f"WindowConfig: unknown fields {sorted(unknown)}; known {sorted(known)}"
+            )
         return cls(**data)
 
 

@@ -162,7 +162,9 @@ def embedding_frame_weights(window_weights: F64, offsets: NDArray[np.int64]) -> 
     """Window weight of each embedded frame: the summed weights of the frames nearest to it."""
     i = np.arange(len(window_weights))
     owner = np.argmin(np.abs(i[:, None] - offsets[None, :]), axis=1)
-    return np.bincount(owner, weights=window_weights, minlength=len(offsets))
+    return np.asarray(
+        np.bincount(owner, weights=window_weights, minlength=len(offsets)), dtype=np.float64
+    )
 
 
 def group_matrix(feature_set: FeatureSet, support: int | None) -> F64:
@@ -183,7 +185,7 @@ def embed_local(
     wp: F64,
     wq: F64,
 ) -> F32:
-    """Embedding rows ``(C, E*P*12)`` of windows already in local coordinates, ``(C, E, P, 3|4)``."""
+    """Embedding rows ``(C, E*P*12)`` of windows in local coordinates, ``(C, E, P, 3|4)``."""
     c, e, p = local_positions.shape[:3]
     sp = np.sqrt(frame_weights[:, None] * wp[None, :]).astype(np.float32)  # (E, P)
     sq = np.sqrt(frame_weights[:, None] * wq[None, :] * 0.5).astype(np.float32)
@@ -242,8 +244,16 @@ def window_distances(
         c = np.cos(h).astype(dt)[:, None, None]
         s = np.sin(h).astype(dt)[:, None, None]
         pw = positions[idx]
-        ex = pw[..., 0] - origin[starts, 0].astype(dt)[:, None, None] - (c * qp[None, ..., 0] - s * qp[None, ..., 1])
-        ey = pw[..., 1] - origin[starts, 1].astype(dt)[:, None, None] - (s * qp[None, ..., 0] + c * qp[None, ..., 1])
+        ex = (
+            pw[..., 0]
+            - origin[starts, 0].astype(dt)[:, None, None]
+            - (c * qp[None, ..., 0] - s * qp[None, ..., 1])
+        )
+        ey = (
+            pw[..., 1]
+            - origin[starts, 1].astype(dt)[:, None, None]
+            - (s * qp[None, ..., 0] + c * qp[None, ..., 1])
+        )
         ez = pw[..., 2] - qp[None, ..., 2]
         dpos = np.sqrt(ex * ex + ey * ey + ez * ez)
         a = orientations[idx]
@@ -268,7 +278,13 @@ def window_distances(
 
 
 def frame_pose_steps(
-    positions: F32, orientations: F32, heading: F64, origin: F64, wp: F64, wq: F64, chunk: int = 65536
+    positions: F32,
+    orientations: F32,
+    heading: F64,
+    origin: F64,
+    wp: F64,
+    wq: F64,
+    chunk: int = 65536,
 ) -> F32:
     """``(N,)`` pose distance between each frame and the previous one (0 for frame 0), each in its
     own root frame: ``sum_b wp_b |dp_b| + wq_b d_theta_b`` (``D`` of a one-frame window).
@@ -278,7 +294,9 @@ def frame_pose_steps(
     prev_p = prev_q = None
     for i in range(0, n, chunk):
         sl = slice(i, min(n, i + chunk))
-        lp, lq = localize(positions[sl][:, None], orientations[sl][:, None], heading[sl], origin[sl])
+        lp, lq = localize(
+            positions[sl][:, None], orientations[sl][:, None], heading[sl], origin[sl]
+        )
         lp, lq = lp[:, 0], lq[:, 0]
         if prev_p is not None:
             lp = np.concatenate([prev_p, lp])

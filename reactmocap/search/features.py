@@ -9,7 +9,8 @@ Definitions (documented in ``docs``-style detail because the search must be expl
 * **Body frame and heading.** From the skeleton's rest pose (identity local rotations, skeleton
   offsets) we build an anatomical pelvis frame: ``up`` = pelvis -> chest, ``left`` = right thigh
   joint -> left thigh joint (orthogonalised), ``forward = left x up``. It is stored in the pelvis
-  joint's local frame, so it is body-fixed whatever the rest pose looks like (the Bandai Namco files'
+  joint's local frame, so it is body-fixed whatever the rest pose looks like (the Bandai Namco
+  files'
   rest pose lies along +X; the frame still comes out anatomical). Each frame, the body frame's world
   orientation is ``q_pelvis(t) * B``; the **heading** is its twist about world +Z
   (``yaw = 2 atan2(q_z, q_w)`` of the swing-twist decomposition ``q = twist_z * swing``). Unlike the
@@ -20,7 +21,8 @@ Definitions (documented in ``docs``-style detail because the search must be expl
 * **Part orientations.** Part ``b``'s canonical frame is the rest body frame, swung so that the
   canonical bone direction (trunk: up, arms: out to their side, legs: down, feet: forward) lands on
   the part's rest bone direction. Its world orientation at ``t`` is ``q_b(t) * c_b`` with
-  ``c_b = q_b_rest^-1 * W_rest * S_b^-1``. Within one skeleton family (and its mirror) this is exact;
+  ``c_b = q_b_rest^-1 * W_rest * S_b^-1``. Within one skeleton family (and its mirror) this is
+  exact;
   across families it is the swing-aligned approximation (twist about a bone can differ).
 * **Centre of mass.** Fixed mass fractions (Winter's tables, trunk split into pelvis/abdomen/
   thorax) at segment midpoints (part joint to the next part's joint; hand, foot and head at their
@@ -96,7 +98,16 @@ FEATURE_SETS: dict[str, FeatureSet] = {
     "compact": FeatureSet(
         "compact",
         trunk=("pelvis", "chest", "head"),
-        limbs=("l_forearm", "l_hand", "r_forearm", "r_hand", "l_shin", "l_foot", "r_shin", "r_foot"),
+        limbs=(
+            "l_forearm",
+            "l_hand",
+            "r_forearm",
+            "r_hand",
+            "l_shin",
+            "l_foot",
+            "r_shin",
+            "r_foot",
+        ),
     ),
 }
 
@@ -234,7 +245,7 @@ def calibrate(
             if np.linalg.norm(d) > 1e-6:
                 return d / np.linalg.norm(d)
         par = _PARENT_PART.get(part)
-        return bone_dir(par) if par in jm else None
+        return bone_dir(par) if par is not None and par in jm else None
 
     offs = np.empty((len(feature_set.parts), 4))
     w_inv = quat_conj(w_rest)
@@ -277,8 +288,8 @@ def calibrate(
 class FrameFeatures:
     """World-frame features of every frame of a motion (P = parts of the feature set)."""
 
-    positions: F64  # (T, P, 3) part joint positions, metres
-    orientations: F64  # (T, P, 4) canonical part frames, wxyz, w >= 0
+    positions: NDArray[np.floating]  # (T, P, 3) part joint positions, metres
+    orientations: NDArray[np.floating]  # (T, P, 4) canonical part frames, wxyz, w >= 0
     heading: F64  # (T,) radians
     origin: F64  # (T, 2) pelvis ground position
     com: F64  # (T, 3) approximate centre of mass
@@ -388,11 +399,26 @@ def matrix_to_quat_fast(m: NDArray[np.floating]) -> NDArray[np.floating]:
     s21, d21 = m[..., 2, 1] + m[..., 1, 2], m[..., 2, 1] - m[..., 1, 2]
     s02, d02 = m[..., 0, 2] + m[..., 2, 0], m[..., 0, 2] - m[..., 2, 0]
     s10, d10 = m[..., 1, 0] + m[..., 0, 1], m[..., 1, 0] - m[..., 0, 1]
-    cands = np.empty(m.shape[:-2] + (4, 4), dtype=m.dtype)  # row c: 4 q_c-scaled quaternion
+    cands = np.empty((*m.shape[:-2], 4, 4), dtype=m.dtype)  # row c: 4 q_c-scaled quaternion
     cands[..., 0, 0], cands[..., 0, 1], cands[..., 0, 2], cands[..., 0, 3] = 1 + tr, d21, d02, d10
-    cands[..., 1, 0], cands[..., 1, 1], cands[..., 1, 2], cands[..., 1, 3] = d21, 1 + m00 - m11 - m22, s10, s02
-    cands[..., 2, 0], cands[..., 2, 1], cands[..., 2, 2], cands[..., 2, 3] = d02, s10, 1 - m00 + m11 - m22, s21
-    cands[..., 3, 0], cands[..., 3, 1], cands[..., 3, 2], cands[..., 3, 3] = d10, s02, s21, 1 - m00 - m11 + m22
+    cands[..., 1, 0], cands[..., 1, 1], cands[..., 1, 2], cands[..., 1, 3] = (
+        d21,
+        1 + m00 - m11 - m22,
+        s10,
+        s02,
+    )
+    cands[..., 2, 0], cands[..., 2, 1], cands[..., 2, 2], cands[..., 2, 3] = (
+        d02,
+        s10,
+        1 - m00 + m11 - m22,
+        s21,
+    )
+    cands[..., 3, 0], cands[..., 3, 1], cands[..., 3, 2], cands[..., 3, 3] = (
+        d10,
+        s02,
+        s21,
+        1 - m00 - m11 + m22,
+    )
     choice = np.argmax(np.stack([tr, m00, m11, m22], -1), axis=-1)
     q = np.take_along_axis(cands, choice[..., None, None], axis=-2)[..., 0, :]
     q = q / np.linalg.norm(q, axis=-1, keepdims=True)
@@ -405,7 +431,7 @@ def quat_to_matrix_fast(q: NDArray[np.floating]) -> NDArray[np.floating]:
     xx, yy, zz = x * x, y * y, z * z
     xy, xz, yz = x * y, x * z, y * z
     wx, wy, wz = w * x, w * y, w * z
-    m = np.empty(q.shape[:-1] + (3, 3), dtype=q.dtype)
+    m = np.empty((*q.shape[:-1], 3, 3), dtype=q.dtype)
     m[..., 0, 0] = 1 - 2 * (yy + zz)
     m[..., 0, 1] = 2 * (xy - wz)
     m[..., 0, 2] = 2 * (xz + wy)

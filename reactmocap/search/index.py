@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+import itertools
 import json
 import time
 import zipfile
@@ -14,8 +15,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 import scipy.linalg
+from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from reactmocap.errors import ConfigError, ReactMocapError, SearchError
@@ -63,8 +64,8 @@ _CHUNK = 4096
 COARSE_FRAMES = 10
 #: KD candidates, exactly re-ranked candidates, candidates whose interval is refined
 DEFAULT_K = 64
-DEFAULT_EXACT = 4
-DEFAULT_REFINE = 2
+DEFAULT_EXACT = 8
+DEFAULT_REFINE = 4
 #: windows sampled to fit the PCA
 PCA_SAMPLE = 8_000
 
@@ -134,12 +135,18 @@ class SearchResult:
         }
 
 
+def _breakdown(row: F64, support_part: str) -> Breakdown:
+    v = [float(x) for x in row]
+    return Breakdown(v[0], v[1], v[2], v[3], v[4], v[5], support_part=support_part)
+
+
 @dataclass
 class QueryStats:
     """What the last query did (for reports and benchmarks)."""
 
     candidates: int = 0
-    refined_windows: int = 0
+    refined_windows: int = 0  # windows of the refinement intervals (beyond the candidates)
+    exact_windows: int = 0  # windows whose exact D was computed
     seconds: float = 0.0
 
 
@@ -163,7 +170,10 @@ def _clip_source(clips: Any) -> tuple[Mapping[str, Motion], str]:
     if hasattr(clips, "fingerprint") and hasattr(clips, "clips"):
         return clips.clips, "files:" + str(clips.fingerprint())
     if not isinstance(clips, Mapping):
-        raise SearchError(f"clips must be a mapping of name -> Motion or a ClipLibrary, got {type(clips).__name__}")
+        raise SearchError(
+            "clips must be a mapping of name -> Motion or a ClipLibrary, "
+            f"got {type(clips).__name__}"
+        )
     return clips, "arrays:" + library_fingerprint(clips)
 
 
@@ -176,7 +186,7 @@ RATE_TOLERANCE = 1e-4
 def _rate_step(fps: float, index_fps: float) -> int | None:
     """Integer frame step from ``fps`` to ``index_fps``, or None when it is not a multiple."""
     ratio = fps / index_fps
-    step = int(round(ratio))
+    step = round(ratio)
     return step if step >= 1 and abs(ratio - step) <= RATE_TOLERANCE * ratio else None
 
 
@@ -287,7 +297,9 @@ class MotionIndex:
         except ValueError:
             shown = list(self.clip_names[:20])
             more = f" (+{len(self.clip_names) - 20} more)" if len(self.clip_names) > 20 else ""
-            raise SearchError(f"no clip named {name!r} in the index; clips are {shown}{more}") from None
+            raise SearchError(
+                f"no clip named {name!r} in the index; clips are {shown}{more}"
+            ) from None
 
     # ------------------------------------------------------------------ build
     @classmethod
@@ -406,11 +418,13 @@ class MotionIndex:
         return embed_local(lp, lq, fw, wp, wq)
 
     def _embedding_weights(self) -> tuple[F64, F64, F64, I64]:
-        fs = self.feature_set
-        wp, wq = embedding_body_weights(fs, self.weights)
-        offs = self.window.embed_offsets()
-        fw = embedding_frame_weights(self.weights.window_weights(self.length), offs)
-        return wp, wq, fw, offs
+        def make() -> tuple[F64, F64, F64, I64]:
+            wp, wq = embedding_body_weights(self.feature_set, self.weights)
+            offs = self.window.embed_offsets()
+            fw = embedding_frame_weights(self.weights.window_weights(self.length), offs)
+            return wp, wq, fw, offs
+
+        return self._memo("embed", make)  # type: ignore[no-any-return]
 
     def _unique_starts(self, valid: I64) -> tuple[I64, I64, I64]:
         """Kept window starts and their refinement intervals (inclusive), clip by clip.
@@ -425,7 +439,9 @@ class MotionIndex:
         """
         fs = self.feature_set
         wp, wq = body_weights(fs, self.weights, None)
-        step = frame_pose_steps(self.positions, self.orientations, self.heading, self.origin, wp, wq)
+        step = frame_pose_steps(
+            self.positions, self.orientations, self.heading, self.origin, wp, wq
+        )
         kept_list, lo_list, hi_list = [], [], []
         tol = self.window.unique_tolerance
         gap = self.window.max_gap_frames
@@ -441,23 +457,36 @@ class MotionIndex:
             else:
                 local = np.arange(m)
             ends = np.append(local, m)
-            fill = [np.arange(x + gap, y, gap) for x, y in zip(ends[:-1], ends[1:]) if y - x > gap]
+            fill = [np.arange(x + gap, y, gap) for x, y in itertools.pairwise(ends) if y - x > gap]
             if fill:
                 local = np.unique(np.concatenate([local, *fill]))
             kept_list.append(a + local)
             lo_list.append(a + np.concatenate([[0], local[:-1] + 1]))
             hi_list.append(a + np.concatenate([local[1:] - 1, [m - 1]]))
         kept = np.concatenate(kept_list).astype(np.int64)
-        return kept, np.concatenate(lo_list).astype(np.int64), np.concatenate(hi_list).astype(np.int64)
+        return (
+            kept,
+            np.concatenate(lo_list).astype(np.int64),
+            np.concatenate(hi_list).astype(np.int64),
+        )
 
-    def _build_embedding(self, rng: np.random.Generator, progress: Callable[[str], None] | None) -> None:
+    def _build_embedding(
+        self, rng: np.random.Generator, progress: Callable[[str], None] | None
+    ) -> None:
         wp, wq, fw, offs = self._embedding_weights()
         valid = self._valid_starts()
         kept, lo, hi = self._unique_starts(valid)
         # PCA fitted on a random sample of kept windows (covariance + eigh: exact, fast for De ~ 1k)
-        sample = kept if kept.size <= PCA_SAMPLE else np.sort(rng.choice(kept, PCA_SAMPLE, replace=False))
+        sample = (
+            kept
+            if kept.size <= PCA_SAMPLE
+            else np.sort(rng.choice(kept, PCA_SAMPLE, replace=False))
+        )
         x = np.concatenate(
-            [self._embed_starts(sample[i : i + _CHUNK], wp, wq, fw, offs) for i in range(0, sample.size, _CHUNK)]
+            [
+                self._embed_starts(sample[i : i + _CHUNK], wp, wq, fw, offs)
+                for i in range(0, sample.size, _CHUNK)
+            ]
         )
         mean = x.mean(axis=0, dtype=np.float64)
         de = x.shape[1]
@@ -489,7 +518,8 @@ class MotionIndex:
         _ = self.tree
         if progress:
             progress(
-                f"indexed {kept.size} unique windows of {valid.size} ({d} PCA dims, {explained:.3f} variance)"
+                f"indexed {kept.size} unique windows of {valid.size} "
+                f"({d} PCA dims, {explained:.3f} variance)"
             )
 
     def _freeze(self) -> None:
@@ -530,7 +560,8 @@ class MotionIndex:
             fits = t0 + span <= motion.duration + 1e-9
         if not fits:
             raise SearchError(
-                f"the {L}-frame search window ({span:.3f} s at {self.window.fps:g} fps) starting at "
+                f"the {L}-frame search window ({span:.3f} s at {self.window.fps:g} fps) "
+                f"starting at "
                 f"frame {f0} ({t0:.3f} s) runs past the end of {motion.name or 'the query'} "
                 f"({motion.duration:.3f} s, {motion.num_frames} frames)"
             )
@@ -545,9 +576,7 @@ class MotionIndex:
         ff = features_from_arrays(motion.skeleton, root, rot, tr, calib)
         h0 = float(ff.heading[0])
         o0 = ff.origin[0]
-        lp, lq = localize(
-            ff.positions[None], ff.orientations[None], np.array([h0]), o0[None]
-        )
+        lp, lq = localize(ff.positions[None], ff.orientations[None], np.array([h0]), o0[None])
         fs = self.feature_set
         sup = select_support(ff.positions[0], ff.com[0], fs, self.weights)
         return QueryWindow(
@@ -560,29 +589,49 @@ class MotionIndex:
             com=ff.com[0],
         )
 
+    def _memo(self, key: Any, make: Callable[[], Any]) -> Any:
+        """Per-index cache of query-independent constants (weights, offsets, calibrations)."""
+        memo: dict[Any, Any] = self.__dict__.setdefault("_memo_cache", {})
+        if key not in memo:
+            if len(memo) > 256:
+                memo.clear()
+            memo[key] = make()
+        return memo[key]
+
     def _calibration(self, motion: Motion, parts: BodyPartMap | None):  # type: ignore[no-untyped-def]
-        cache: dict[Any, Any] = self.__dict__.setdefault("_calib_cache", {})
-        key = (skeleton_key(motion.skeleton), id(parts) if parts is not None else None)
-        if key not in cache:
-            if len(cache) > 64:
-                cache.clear()
-            cache[key] = calibrate(motion.skeleton, self.feature_set, parts)
-        return cache[key]
+        skel = motion.skeleton
+        # fast path: the very same Skeleton object (kept alive by the entry, so ids stay unique)
+        hit = self._memo(("calib-id", id(skel), id(parts)), lambda: None)
+        if hit is not None and hit[0] is skel and hit[1] is parts:
+            return hit[2]
+        key = ("calib", skeleton_key(skel), id(parts) if parts is not None else None)
+        cal = self._memo(key, lambda: calibrate(skel, self.feature_set, parts))
+        self.__dict__["_memo_cache"][("calib-id", id(skel), id(parts))] = (skel, parts, cal)
+        return cal
 
     def _distances(
-        self, qw: QueryWindow, starts: I64, breakdown: bool = False, coarse: bool = False
+        self,
+        qw: QueryWindow,
+        starts: I64,
+        breakdown: bool = False,
+        coarse: bool = False,
+        precise: bool | None = None,
     ) -> tuple[F64, F64 | None]:
-        fs = self.feature_set
-        wp, wq = body_weights(fs, self.weights, qw.support)
-        groups = group_matrix(fs, qw.support) if breakdown else None
-        ww = self.weights.window_weights(self.length)
-        offsets = None
-        if coarse:
-            offsets = self._coarse_offsets()
-            ww = embedding_frame_weights(ww, offsets)
+        def consts() -> tuple[Any, ...]:
+            fs = self.feature_set
+            wp, wq = body_weights(fs, self.weights, qw.support)
+            ww = self.weights.window_weights(self.length)
+            offsets = None
+            if coarse:
+                offsets = self._coarse_offsets()
+                ww = embedding_frame_weights(ww, offsets)
+            return wp, wq, ww, offsets, group_matrix(fs, qw.support)
+
+        wp, wq, ww, offsets, groups = self._memo(("dist", qw.support, coarse), consts)
         return window_distances(
             self.positions, self.orientations, self.heading, self.origin, starts, qw,
-            ww, wp, wq, groups, offsets, precise=not coarse,
+            ww, wp, wq, groups if breakdown else None, offsets,
+            precise=(not coarse) if precise is None else precise,
         )  # fmt: skip
 
     def _coarse_offsets(self) -> I64:
@@ -597,7 +646,13 @@ class MotionIndex:
         return ((e - self.pca_mean) @ self.pca_components)[0]
 
     def search_window(
-        self, qw: QueryWindow, *, n: int = 1, k: int = DEFAULT_K, refine: int = DEFAULT_REFINE, exact: int = DEFAULT_EXACT
+        self,
+        qw: QueryWindow,
+        *,
+        n: int = 1,
+        k: int = DEFAULT_K,
+        refine: int = DEFAULT_REFINE,
+        exact: int = DEFAULT_EXACT,
     ) -> list[SearchResult]:
         """Search with a prepared query window.
 
@@ -611,7 +666,8 @@ class MotionIndex:
         t0 = time.perf_counter()
         if n < 1 or k < 1 or refine < 0 or exact < 1:
             raise SearchError(
-                f"need n >= 1, k >= 1, refine >= 0, exact >= 1 (got n={n}, k={k}, refine={refine}, exact={exact})"
+                "need n >= 1, k >= 1, refine >= 0, exact >= 1 "
+                f"(got n={n}, k={k}, refine={refine}, exact={exact})"
             )
         k = min(k, self.num_indexed)
         _, rows = self.tree.query(self._embed_query(qw), k=k)
@@ -621,16 +677,26 @@ class MotionIndex:
         coarse = self.length > COARSE_FRAMES
         d, _ = self._distances(qw, cand, coarse=coarse)
         order = np.argsort(d, kind="stable")
-        pieces = [cand[order[: max(exact, n)]]]
-        pieces += [
+        spans = [
             np.arange(self.interval_lo[r], self.interval_hi[r] + 1, dtype=np.int64)
             for r in rows[order[:refine]]
         ]
-        starts = np.unique(np.concatenate(pieces))
+        extra = np.setdiff1d(np.concatenate(spans), cand) if spans else np.zeros(0, np.int64)
+        m = max(exact, n)
+        if coarse:
+            # the interval windows are pre-ranked like the candidates; exact D for the best m
+            if extra.size:
+                de, _ = self._distances(qw, extra, coarse=True)
+                pool, pd = np.concatenate([cand, extra]), np.concatenate([d, de])
+            else:
+                pool, pd = cand, d
+            starts = pool[np.argsort(pd, kind="stable")[:m]]
+        else:
+            starts = np.unique(np.concatenate([cand[order[:m]], extra]))
         dists, br = self._distances(qw, starts, breakdown=True)
         if n > 1:
             # runners-up must be distinct windows: widen the exact set until n are found
-            while self._pick(starts, dists, n).size < n:  # noqa: PLR2004
+            while self._pick(starts, dists, n).size < n:
                 if k < self.num_indexed and np.all(np.isin(cand, starts)):
                     k = min(2 * k, self.num_indexed)
                     _, rows = self.tree.query(self._embed_query(qw), k=k)
@@ -644,7 +710,10 @@ class MotionIndex:
                 br = np.concatenate([br, br2])
         results = self._results(qw, starts, dists, n, br)
         self.last_stats = QueryStats(
-            candidates=int(cand.size), refined_windows=int(starts.size), seconds=time.perf_counter() - t0
+            candidates=int(cand.size),
+            refined_windows=int(extra.size),
+            exact_windows=int(starts.size),
+            seconds=time.perf_counter() - t0,
         )
         return results
 
@@ -690,13 +759,13 @@ class MotionIndex:
             out.append(
                 SearchResult(
                     clip=self.clip_names[c],
-                    frame=int(round(t * self.clip_fps[c])),
+                    frame=round(t * self.clip_fps[c]),
                     index_frame=fi,
                     time=t,
                     distance=float(dist),
                     yaw=yaw,
                     translation=(tx, ty),
-                    breakdown=Breakdown(*(float(v) for v in row), support_part=qw.support_part),
+                    breakdown=_breakdown(row, qw.support_part),
                     rank=rank,
                 )
             )
@@ -713,7 +782,8 @@ class MotionIndex:
         parts: BodyPartMap | None = None,
     ) -> SearchResult:
         """Best library window for the window of ``motion`` starting at ``start_frame`` (a frame
-        of ``motion`` at its own rate). See :meth:`search_window` for ``k``, ``refine``, ``exact``."""
+        of ``motion`` at its own rate). :meth:`search_window` explains ``k``, ``refine``,
+        ``exact``."""
         qw = self.prepare_query(motion, start_frame, parts=parts)
         return self.search_window(qw, n=1, k=k, refine=refine, exact=exact)[0]
 
@@ -733,14 +803,18 @@ class MotionIndex:
         qw = self.prepare_query(motion, start_frame, parts=parts)
         return self.search_window(qw, n=n, k=max(k, n), refine=max(refine, min(n, 8)), exact=exact)
 
-    def window_distance(self, motion: Motion, start_frame: int | None, clip: str, frame: int) -> SearchResult:
+    def window_distance(
+        self, motion: Motion, start_frame: int | None, clip: str, frame: int
+    ) -> SearchResult:
         """Exact ``D`` (with breakdown and alignment) between a query window and one library
         window, ``frame`` counted at the index rate."""
         qw = self.prepare_query(motion, start_frame)
         c = self.clip_index(clip)
         a, b = int(self.clip_offsets[c]), int(self.clip_offsets[c + 1])
         if not 0 <= frame <= b - a - self.length:
-            raise SearchError(f"index frame {frame} has no full window in clip {clip!r} ({b - a} frames)")
+            raise SearchError(
+                f"index frame {frame} has no full window in clip {clip!r} ({b - a} frames)"
+            )
         s = np.array([a + frame], dtype=np.int64)
         d, _ = self._distances(qw, s)
         return self._results(qw, s, d, 1)[0]
@@ -805,13 +879,23 @@ class MotionIndex:
             raise
         except FileNotFoundError:
             raise SearchError(f"{p}: no such index file") from None
-        except (OSError, ValueError, KeyError, zipfile.BadZipFile, EOFError, UnicodeDecodeError) as exc:
-            raise SearchError(f"{p}: not a readable search index ({type(exc).__name__}: {exc})") from None
+        except (
+            OSError,
+            ValueError,
+            KeyError,
+            zipfile.BadZipFile,
+            EOFError,
+            UnicodeDecodeError,
+        ) as exc:
+            raise SearchError(
+                f"{p}: not a readable search index ({type(exc).__name__}: {exc})"
+            ) from None
         if not isinstance(meta, dict) or meta.get("format") != "reactmocap-search-index":
             raise SearchError(f"{p}: not a reactmocap search index")
         if meta.get("version") != FORMAT_VERSION:
             raise SearchError(
-                f"{p}: search index format version {meta.get('version')} is not {FORMAT_VERSION}; rebuild it"
+                f"{p}: search index format version {meta.get('version')} is not "
+                f"{FORMAT_VERSION}; rebuild it"
             )
         try:
             w = SearchWeights.from_dict(meta["weights"])
@@ -840,6 +924,7 @@ class MotionIndex:
         N = self.positions.shape[0] if self.positions.ndim == 3 else -1
         K = self.kept.shape[0] if self.kept.ndim == 1 else -1
         de = self.pca_mean.shape[0] if self.pca_mean.ndim == 1 else -1
+        dims = self.pca_components.shape[1] if self.pca_components.ndim == 2 else -1
         checks = [
             (self.positions.ndim == 3 and self.positions.shape[1:] == (P, 3), "positions"),
             (self.orientations.shape == (N, P, 4), "orientations"),
@@ -847,22 +932,33 @@ class MotionIndex:
             (self.origin.shape == (N, 2), "origin"),
             (self.clip_offsets.shape == (len(self.clip_names) + 1,), "clip_offsets"),
             (self.clip_fps.shape == (len(self.clip_names),), "clip_fps"),
-            (self.kept.ndim == 1 and self.interval_lo.shape == (K,) and self.interval_hi.shape == (K,), "kept"),
-            (self.pca_components.ndim == 2 and self.pca_components.shape[0] == de, "pca_components"),
-            (self.embedding.shape == (K, self.pca_components.shape[1] if self.pca_components.ndim == 2 else -1), "embedding"),
+            (self.kept.ndim == 1 and self.interval_lo.shape == (K,), "kept"),
+            (self.interval_hi.shape == (K,), "intervals"),
+            (self.pca_components.ndim == 2 and self.pca_components.shape[0] == de, "pca"),
+            (self.embedding.shape == (K, dims), "embedding"),
         ]  # fmt: skip
         bad = [name for ok, name in checks if not ok]
         if not bad:
-            if self.clip_offsets[0] != 0 or self.clip_offsets[-1] != N or np.any(np.diff(self.clip_offsets) < 0):
+            if (
+                self.clip_offsets[0] != 0
+                or self.clip_offsets[-1] != N
+                or np.any(np.diff(self.clip_offsets) < 0)
+            ):
                 bad.append("clip_offsets")
             elif K and (self.kept.min() < 0 or self.kept.max() + self.length > N):
                 bad.append("kept")
-            elif K and (np.any(self.interval_lo > self.kept) or np.any(self.interval_hi < self.kept)):
+            elif K and (
+                np.any(self.interval_lo > self.kept) or np.any(self.interval_hi < self.kept)
+            ):
                 bad.append("intervals")
-            elif not all(np.all(np.isfinite(a)) for a in (self.positions, self.orientations, self.embedding)):
+            elif not all(
+                np.all(np.isfinite(a)) for a in (self.positions, self.orientations, self.embedding)
+            ):
                 bad.append("non-finite values")
         if bad or K == 0:
-            raise SearchError(f"{p}: corrupt search index (inconsistent {', '.join(bad) or 'kept'})")
+            raise SearchError(
+                f"{p}: corrupt search index (inconsistent {', '.join(bad) or 'kept'})"
+            )
 
     def stale_reason(
         self,
@@ -925,16 +1021,18 @@ def brute_force(
 ) -> list[SearchResult]:
     """Exact ``D`` against *every* valid window of the index (no KD-tree, no unique-frame
     reduction): the ground truth for tests and benchmarks."""
-    qw = motion if isinstance(motion, QueryWindow) else index.prepare_query(motion, start_frame, parts=parts)
+    qw = (
+        motion
+        if isinstance(motion, QueryWindow)
+        else index.prepare_query(motion, start_frame, parts=parts)
+    )
     valid = index._valid_starts()
     d = np.empty(valid.size)
     chunk = max(256, 2_000_000 // max(1, index.length * len(index.feature_set.parts)))
     for i in range(0, valid.size, chunk):
-        d[i : i + chunk], _ = index._distances(qw, valid[i : i + chunk])
-    if n == 1:
-        j = int(np.argmin(d))
-        return index._results(qw, valid[j : j + 1], d[j : j + 1], 1)
-    # keep a generous shortlist before the distinctness filter
-    m = min(d.size, max(50 * n, 200))
+        # all frames, cheaper arithmetic (same D to ~1e-5); the shortlist is re-scored precisely
+        d[i : i + chunk], _ = index._distances(qw, valid[i : i + chunk], precise=False)
+    m = min(d.size, max(50 * n, 64))
     short = np.argpartition(d, m - 1)[:m] if m < d.size else np.arange(d.size)
-    return index._results(qw, valid[short], d[short], n)
+    ds, br = index._distances(qw, valid[short], breakdown=True)
+    return index._results(qw, valid[short], ds, n, br)

@@ -44,9 +44,13 @@ def test_build_and_query_json(index_file: Path, capsys: pytest.CaptureFixture[st
     assert out["query_ms"] > 0
 
 
-def test_query_table_and_mirrored_clip(index_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_query_table_and_mirrored_clip(
+    index_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     capsys.readouterr()
-    assert main(["search", "query", str(index_file), "--clip", "punch_mirror", "--frame", "10"]) == 0
+    assert (
+        main(["search", "query", str(index_file), "--clip", "punch_mirror", "--frame", "10"]) == 0
+    )
     text = capsys.readouterr().out
     assert "punch_mirror" in text and "trunk_p" in text
 
@@ -77,4 +81,16 @@ def test_bad_index_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> N
 
 def test_bad_shift_is_a_usage_error(tmp_path: Path) -> None:
     with pytest.raises(SystemExit):
-        main(["search", "query", str(tmp_path / "x.npz"), "--clip", "a", "--frame", "0", "--shift", "1"])
+        main(
+            [
+                "search",
+                "query",
+                str(tmp_path / "x.npz"),
+                "--clip",
+                "a",
+                "--frame",
+                "0",
+                "--shift",
+                "1",
+            ]
+        )

@@ -8,7 +8,13 @@ import pytest
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_exp, quat_mul
-from reactmocap.search import FEATURE_SETS, MotionIndex, SearchWeights, WindowConfig, get_feature_set
+from reactmocap.search import (
+    FEATURE_SETS,
+    MotionIndex,
+    SearchWeights,
+    WindowConfig,
+    get_feature_set,
+)
 from reactmocap.search.distance import localize, select_support
 from reactmocap.search.features import calibrate, frame_features
 
@@ -21,7 +27,9 @@ def test_heading_of_synthetic_clips_starts_at_zero(synth_clips: dict[str, Motion
         assert abs(ff.heading[0]) < np.radians(10), name
 
 
-def test_heading_follows_yaw_and_local_features_are_invariant(synth_clips: dict[str, Motion]) -> None:
+def test_heading_follows_yaw_and_local_features_are_invariant(
+    synth_clips: dict[str, Motion],
+) -> None:
     m = synth_clips["front_kick"]
     cal = calibrate(m.skeleton, get_feature_set("paper"))
     a = frame_features(m, cal)
@@ -44,10 +52,14 @@ def test_heading_ignores_height_and_tilt(synth_clips: dict[str, Motion]) -> None
     m = synth_clips["guard"].slice(0, 5)
     cal = calibrate(m.skeleton, get_feature_set("paper"))
     base = frame_features(m, cal)
-    pitch = quat_exp(np.array([0.0, np.radians(60) / 2, 0.0]))  # about +Y (the left axis at heading 0)
+    pitch = quat_exp(
+        np.array([0.0, np.radians(60) / 2, 0.0])
+    )  # about +Y (the left axis at heading 0)
     rot = np.array(m.rotations)
     rot[:, 0] = quat_mul(pitch, rot[:, 0])
-    tilted = frame_features(m.replace(rotations=rot, root_positions=m.root_positions + [0, 0, 0.5]), cal)
+    tilted = frame_features(
+        m.replace(rotations=rot, root_positions=m.root_positions + np.array([0, 0, 0.5])), cal
+    )
     np.testing.assert_allclose(tilted.heading, base.heading, atol=1e-6)
 
 
@@ -128,7 +140,11 @@ def test_heading_of_real_clips_follows_walking_direction(real_clips: dict[str, M
     """Bandai Namco skeleton (rest pose lying along +X, a dummy root joint): the heading of a
     forward walk matches its direction of travel, and of a backward walk the opposite one."""
     fs = get_feature_set("paper")
-    for name, sign in (("walk_normal_001", 1.0), ("walk-back_normal_001", -1.0), ("run_normal_001", 1.0)):
+    for name, sign in (
+        ("walk_normal_001", 1.0),
+        ("walk-back_normal_001", -1.0),
+        ("run_normal_001", 1.0),
+    ):
         m = next(v for k, v in real_clips.items() if k.endswith(name))
         ff = frame_features(m, calibrate(m.skeleton, fs))
         travel = sign * (ff.origin[-1] - ff.origin[0])

@@ -52,7 +52,7 @@ def _check_self_retrieval(index: MotionIndex, clips: dict[str, Motion], queries,
         np.testing.assert_allclose(r.translation, shift, atol=1e-4)
         # the returned alignment maps the library clip onto the query
         found = m.transformed(r.yaw, r.translation)
-        span = int(round((index.length - 1) * m.fps / index.window.fps)) + 1
+        span = round((index.length - 1) * m.fps / index.window.fps) + 1
         qpos = m.transformed(yaw, shift).slice(f, f + span).global_positions()
         np.testing.assert_allclose(found.slice(f, f + span).global_positions(), qpos, atol=1e-4)
 
@@ -70,7 +70,9 @@ def test_self_retrieval_synthetic(synth_index: MotionIndex, synth_clips: dict[st
 def test_self_retrieval_synthetic_at_clip_rate(synth_clips: dict[str, Motion]) -> None:
     index = MotionIndex.build(synth_clips, window=WindowConfig(fps=60.0, duration=0.25))
     rng = np.random.default_rng(5)
-    _check_self_retrieval(index, synth_clips, _distinctive_windows(index, synth_clips, 15, rng), rng)
+    _check_self_retrieval(
+        index, synth_clips, _distinctive_windows(index, synth_clips, 15, rng), rng
+    )
 
 
 def test_self_retrieval_real_clips(real_clips: dict[str, Motion]) -> None:
@@ -82,7 +84,7 @@ def test_self_retrieval_real_clips(real_clips: dict[str, Motion]) -> None:
 
 
 def _noisy(m: Motion, rng, sigma: float) -> Motion:
-    noise = quat_exp(0.5 * rng.normal(0.0, sigma, m.rotations.shape[:-1] + (3,)))
+    noise = quat_exp(0.5 * rng.normal(0.0, sigma, (*m.rotations.shape[:-1], 3)))
     return m.replace(rotations=quat_mul(m.rotations, noise))
 
 
@@ -107,7 +109,11 @@ def test_agreement_with_brute_force(synth_clips: dict[str, Motion]) -> None:
         if i < 20:  # exhaustive: every indexed window and every interval -> exactly brute force
             ex = synth_index.query(q, f, k=synth_index.num_indexed, refine=synth_index.num_indexed)
             assert ex.distance == pytest.approx(best.distance, rel=1e-9, abs=1e-12)
-            assert (ex.clip, ex.index_frame) == (best.clip, best.index_frame)
+            if (
+                synth_index.window_distance(q, f, best.clip, best.index_frame).distance
+                < ex.distance - 1e-12
+            ):
+                pytest.fail("exhaustive search missed the brute-force optimum")  # ties are fine
     recall = hits / n
     assert recall >= 0.9, f"recall@1 {recall:.3f}"
     assert max(ratios) < 1.1, f"worst D ratio {max(ratios):.3f}"
@@ -129,7 +135,9 @@ def test_weights_matter(synth_index: MotionIndex, synth_clips: dict[str, Motion]
         ori = np.array(qw.orientations)
         q = np.array([np.cos(turn / 2), np.sin(turn / 2), 0, 0], dtype=np.float32)
         ori[:, b] = quat_mul(ori[:, b], q)
-        return float(synth_index._distances(replace(qw, positions=pos, orientations=ori), start)[0][0])
+        return float(
+            synth_index._distances(replace(qw, positions=pos, orientations=ori), start)[0][0]
+        )
 
     for trunk, limb in (("chest", "l_forearm"), ("head", "r_hand"), ("waist", "l_shin")):
         assert moved(limb, dp=(0.05, 0, 0)) < moved(trunk, dp=(0.05, 0, 0))
@@ -137,7 +145,7 @@ def test_weights_matter(synth_index: MotionIndex, synth_clips: dict[str, Motion]
     support = qw.support_part
     assert support in ("l_foot", "r_foot")
     other = "r_foot" if support == "l_foot" else "l_foot"
-    assert moved(other, dp=(0.05, 0, 0)) < moved(support, dp=(0.05, 0, 0))
+    assert 4 * moved(other, dp=(0.05, 0, 0)) < moved(support, dp=(0.05, 0, 0))  # 0.25 vs 2.0
 
     # and at the Motion level: bend the head joint vs the same bend of a wrist
     def bent(joint: str, angle: float) -> float:
@@ -147,7 +155,9 @@ def test_weights_matter(synth_index: MotionIndex, synth_clips: dict[str, Motion]
         return synth_index.window_distance(m.replace(rotations=rot), 20, "side_kick", 10).distance
 
     head = next(n for n in m.skeleton.names if n.lower().endswith("head"))
-    hand = next(n for n in m.skeleton.names if n.lower() in ("lefthand", "lhand", "hand_l", "lwrist"))
+    hand = next(
+        n for n in m.skeleton.names if n.lower() in ("lefthand", "lhand", "hand_l", "lwrist")
+    )
     assert 0 < bent(hand, 0.4) < bent(head, 0.4)
 
 
@@ -170,10 +180,14 @@ def test_breakdown_and_top_k(synth_index: MotionIndex, synth_clips: dict[str, Mo
     assert {"clip", "frame", "distance", "yaw_deg", "translation", "breakdown"} <= set(d)
 
 
-def test_save_load_round_trip(tmp_path: Path, synth_index: MotionIndex, synth_clips: dict[str, Motion]) -> None:
+def test_save_load_round_trip(
+    tmp_path: Path, synth_index: MotionIndex, synth_clips: dict[str, Motion]
+) -> None:
     path = synth_index.save(tmp_path / "idx.npz")
     assert [p.name for p in tmp_path.iterdir()] == ["idx.npz"]  # no temporary left behind
-    loaded = MotionIndex.load(path, clips=synth_clips, weights=SearchWeights(), window=WindowConfig(), mirror=True)
+    loaded = MotionIndex.load(
+        path, clips=synth_clips, weights=SearchWeights(), window=WindowConfig(), mirror=True
+    )
     assert loaded.fingerprint == synth_index.fingerprint
     q = synth_clips["sway"].transformed(1.0, (2.0, 3.0))
     a, b = synth_index.top_k(q, 12, n=3), loaded.top_k(q, 12, n=3)
@@ -187,7 +201,9 @@ def test_stale_index_is_rejected_or_rebuilt(tmp_path: Path, synth_clips: dict[st
     small = {k: synth_clips[k] for k in ("guard", "punch", "push")}
     path = tmp_path / "small.npz"
     MotionIndex.build(small).save(path)
-    MotionIndex.load(path, clips=small, weights=SearchWeights(), window=WindowConfig(), mirror=False)
+    MotionIndex.load(
+        path, clips=small, weights=SearchWeights(), window=WindowConfig(), mirror=False
+    )
     with pytest.raises(SearchError, match="weights differ"):
         MotionIndex.load(path, weights=SearchWeights(limb_position=0.3))
     with pytest.raises(SearchError, match="window settings differ"):
@@ -196,7 +212,8 @@ def test_stale_index_is_rejected_or_rebuilt(tmp_path: Path, synth_clips: dict[st
         MotionIndex.load(path, mirror=True)
     edited = dict(small)
     g = small["guard"]
-    edited["guard"] = g.replace(root_positions=np.asarray(g.root_positions) + [0, 0, 0.001])
+    lifted = np.asarray(g.root_positions) + np.array([0, 0, 0.001])
+    edited["guard"] = g.replace(root_positions=lifted)
     with pytest.raises(SearchError, match=r"small\.npz.*clips changed"):
         MotionIndex.load(path, clips=edited)
     renamed = {("x_" + k): v for k, v in small.items()}
