@@ -150,7 +150,7 @@ def _to_npz(m: Motion) -> bytes:
     if m.translations is not None:
         arrays["translations"] = m.translations
     buf = io.BytesIO()
-    np.savez(buf, **arrays)
+    np.savez(buf, **arrays)  # type: ignore[arg-type]
     return buf.getvalue()
 
 

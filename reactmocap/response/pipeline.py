@@ -190,7 +190,7 @@ class _Sim:
             log.append((step, total))
 
 
-def _ball_targets(ch: Character, motion: Motion, times: F64) -> F64:
+def _ball_targets(ch: Character, motion: Motion, times: NDArray[np.floating]) -> F64:
     """``(n, 15, 4)`` ball-joint quaternions of ``motion`` at ``times`` (its own clock)."""
     return ch.qpos_from_motion(motion.sample(times))[:, 7:].reshape(-1, len(BALL_JOINTS), 4)
 
@@ -281,7 +281,7 @@ def run_response(scenario: Scenario) -> ResponseResult:
         rest: list[F64 | None] = [None, *(h[pre // CONTROL_EVERY :] for h in hold[1:])]
         sim.run(n1 - pre, rest, rec1, pre, impact, contacts)
     else:
-        sim.run(n1, hold, rec1, 0, impact, contacts)
+        sim.run(n1, list[F64 | None](hold), rec1, 0, impact, contacts)
     timings["sim1"] = time.perf_counter() - t
     sim1_motion = _to_motion(sim, 0, rec_char, rec1, t_rewind, dt, fps, rec_motion, rec_t0, "sim1")
 
@@ -336,9 +336,8 @@ def run_response(scenario: Scenario) -> ResponseResult:
     found_q = _ball_targets(rec_char, found, best.time + (ticks2 - t_match))
     w = transition_weights(ticks2, t_impact, cfg.reaction_delay, t_match)
     desired = quat_slerp(prev_q, found_q, w[:, None])
-    targets2: list[F64 | None] = [desired] + [
-        _ball_targets(ch, mo, ticks2 + c0) for ch, mo, c0 in zip(chars[1:], motions[1:], clocks[1:])
-    ]
+    targets2: list[F64 | None] = [desired]
+    targets2 += [_ball_targets(ch, mo, ticks2 + c0) for ch, mo, c0 in zip(chars[1:], motions[1:], clocks[1:])]
     sim2 = _Sim(chars, cfg.friction_sim2, dt, cfg.kp, cfg.kv)
     sim2.world.set_state(saved)
     impact2 = _with_body_id(sim2, impact_spec) if impact_spec is not None else None

@@ -108,7 +108,7 @@ def stick_figure_video(
     ext = out.suffix.lower()
     with atomic_write(out, "wb") as fh:
         if ext == ".gif":
-            iio.imwrite(fh, np.stack(frames), extension=".gif", duration=1000 / fps, loop=0)
+            iio.imwrite(fh, np.stack(frames), extension=".gif", duration=1000 / fps, loop=0)  # type: ignore[call-overload]
         else:
-            iio.imwrite(fh, np.stack(frames), extension=ext, fps=fps)
+            iio.imwrite(fh, np.stack(frames), extension=ext, fps=fps)  # type: ignore[call-overload]
     return out

@@ -129,10 +129,15 @@ def test_every_example_scenario_runs(path: Path, tmp_path: Path) -> None:
 
 
 def test_demo_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["demo", "--out", str(tmp_path)]) == 0
+    assert main(["demo", "--out", str(tmp_path), "--plot", "--video"]) == 0
     out = capsys.readouterr().out
     assert "recipient" in out and str(tmp_path) in out
     assert (tmp_path / "recipient.bvh").exists()
+    import imageio.v3 as iio
+
+    frames = iio.imread(tmp_path / "video.gif")
+    assert frames.ndim == 4 and frames.shape[0] > 30  # an animation, not a still
+    assert frames[0].std() > 1.0  # something was drawn
 
 
 def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
