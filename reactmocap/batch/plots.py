@@ -56,7 +56,9 @@ def _load(results_dir: Path) -> tuple[list[dict[str, Any]], dict[str, list[Any]]
     except (OSError, ValueError, KeyError):
         axes = {}
     if not axes:  # infer from the row keys that are known axes
-        axes = {a: sorted({r[a] for r in rows if a in r}) for a in AXES if any(a in r for r in rows)}
+        axes = {
+            a: sorted({r[a] for r in rows if a in r}) for a in AXES if any(a in r for r in rows)
+        }
     return rows, axes
 
 
@@ -81,8 +83,13 @@ def plot_axes(results_dir: str | Path) -> list[Path]:
         if len(values) < 2:
             continue
         if axis in ANGLE_AXES:
-            fig, axs = plt.subplots(1, len(POLAR_METRICS), subplot_kw={"projection": "polar"},
-                                    figsize=(4.6 * len(POLAR_METRICS), 4.6), dpi=100)  # fmt: skip
+            fig, axs = plt.subplots(
+                1,
+                len(POLAR_METRICS),
+                subplot_kw={"projection": "polar"},
+                figsize=(4.6 * len(POLAR_METRICS), 4.6),
+                dpi=100,
+            )
             for ax, metric in zip(axs, POLAR_METRICS):
                 med = _by_value(rows, axis, metric)
                 keys = sorted(med)
@@ -138,16 +145,18 @@ def contact_sheet(
 
     d = Path(results_dir)
     rows, axes = _load(d)
-    saved = [r for r in rows if r.get("output_dir") and (d / r["output_dir"] / "recipient.bvh")
-             .is_file()]  # fmt: skip
+    saved = [
+        r for r in rows if r.get("output_dir") and (d / r["output_dir"] / "recipient.bvh").is_file()
+    ]
     saved.sort(key=lambda r: [(isinstance(r.get(a), str), r.get(a) or 0) for a in axes])
     if not saved:
         return None
     pick = np.unique(np.linspace(0, len(saved) - 1, min(max_scenarios, len(saved))).round())
     chosen = [saved[int(i)] for i in pick]
     plt = _pyplot()
-    fig, axs = plt.subplots(len(chosen), frames, figsize=(1.6 * frames, 1.9 * len(chosen)),
-                            dpi=100, squeeze=False)  # fmt: skip
+    fig, axs = plt.subplots(
+        len(chosen), frames, figsize=(1.6 * frames, 1.9 * len(chosen)), dpi=100, squeeze=False
+    )
     for row_axes, r in zip(axs, chosen):
         sdir = d / r["output_dir"]
         figs = [(read_bvh(sdir / "recipient.bvh"), "tab:blue")]

@@ -85,16 +85,19 @@ def _tolerances(overrides: Mapping[str, Any] | None, where: str) -> dict[str, To
     tols = dict(DEFAULT_TOLERANCES)
     for name, spec in (overrides or {}).items():
         if name not in tols:
-            raise ConfigError(f"{where}: tolerances.{name}: unknown metric; valid are {sorted(tols)}")
+            raise ConfigError(
+                f"{where}: tolerances.{name}: unknown metric; valid are {sorted(tols)}"
+            )
         if not isinstance(spec, dict) or set(spec) - {"abs", "rel", "direction"}:
             raise ConfigError(f"{where}: tolerances.{name}: expected {{abs, rel, direction}}")
         t = Tolerance(**{**asdict(tols[name]), **spec})
         nums = (t.abs, t.rel)
-        if (t.direction not in ("lower", "higher", "both")
-                or not all(isinstance(v, int | float) and not isinstance(v, bool) and v >= 0
-                           for v in nums)):  # fmt: skip
-            raise ConfigError(f"{where}: tolerances.{name}: abs, rel >= 0 and direction one of "
-                              "lower/higher/both")  # fmt: skip
+        if t.direction not in ("lower", "higher", "both") or not all(
+            isinstance(v, int | float) and not isinstance(v, bool) and v >= 0 for v in nums
+        ):
+            raise ConfigError(
+                f"{where}: tolerances.{name}: abs, rel >= 0 and direction one of lower/higher/both"
+            )
         tols[name] = t
     return tols
 
@@ -104,8 +107,10 @@ def load_results(results_dir: str | Path) -> tuple[list[dict[str, Any]], dict[st
     d = Path(results_dir)
     rows = list(ResultStore(d).load().values())
     if not rows:
-        raise ConfigError(f"{d}: no results (results.jsonl missing or empty); run `reactmocap "
-                          "batch SWEEP.toml --out DIR` first")  # fmt: skip
+        raise ConfigError(
+            f"{d}: no results (results.jsonl missing or empty); run `reactmocap "
+            "batch SWEEP.toml --out DIR` first"
+        )
     try:
         vers = json.loads((d / "sweep.json").read_text()).get("versions") or versions()
     except (OSError, ValueError):
@@ -130,9 +135,11 @@ def make_baseline(
             s.update(matched_clip=r.get("matched_clip"), matched_frame=r.get("matched_frame"))
             s.update({m: r.get(m) for m in QUALITY_METRICS})
         scen[str(r["id"])] = s
-    tols = tolerances if tolerances is not None else {
-        k: asdict(v) for k, v in DEFAULT_TOLERANCES.items()
-    }  # fmt: skip
+    tols = (
+        tolerances
+        if tolerances is not None
+        else {k: asdict(v) for k, v in DEFAULT_TOLERANCES.items()}
+    )
     return {
         "format": BASELINE_FORMAT,
         "versions": dict(vers),
@@ -149,8 +156,9 @@ def load_baseline(path: str | Path) -> dict[str, Any]:
     try:
         doc = json.loads(p.read_text())
     except OSError as exc:
-        raise ConfigError(f"{p}: cannot read baseline: {exc.strerror or exc}; create one with "
-                          "--update") from None  # fmt: skip
+        raise ConfigError(
+            f"{p}: cannot read baseline: {exc.strerror or exc}; create one with --update"
+        ) from None
     except ValueError as exc:
         raise ConfigError(f"{p}: invalid JSON: {exc}") from None
     if not isinstance(doc, dict) or doc.get("format") != BASELINE_FORMAT or "stats" not in doc:
@@ -194,8 +202,12 @@ class Comparison:
 
     @property
     def scenario_drift(self) -> bool:
-        return bool(self.clip_changed or self.newly_failing or self.missing_ids or any(
-            w or b for w, b in self.per_scenario.values()))  # fmt: skip
+        return bool(
+            self.clip_changed
+            or self.newly_failing
+            or self.missing_ids
+            or any(w or b for w, b in self.per_scenario.values())
+        )
 
     @property
     def regressed(self) -> bool:
@@ -224,14 +236,25 @@ def compare(
             lines.append(Line(metric, stat, b, c, tol.allowed(b or 0.0), tol.verdict(b, c)))
     fails = float(sum(r.get("status") != "ok" for r in rows))
     bf = float(baseline.get("failures", 0))
-    lines.append(Line("failures", "count", bf, fails, tols["failures"].allowed(bf),
-                      tols["failures"].verdict(bf, fails)))  # fmt: skip
+    lines.append(
+        Line(
+            "failures",
+            "count",
+            bf,
+            fails,
+            tols["failures"].allowed(bf),
+            tols["failures"].verdict(bf, fails),
+        )
+    )
     cmp = Comparison(lines, strict=strict)
 
     bv = baseline.get("versions", {})
     cv = dict(vers) if vers is not None else versions()
-    diff = [f"{k} {bv.get(k)} (baseline) vs {cv.get(k)} (now)" for k in ("reactmocap", "mujoco")
-            if bv.get(k) != cv.get(k)]  # fmt: skip
+    diff = [
+        f"{k} {bv.get(k)} (baseline) vs {cv.get(k)} (now)"
+        for k in ("reactmocap", "mujoco")
+        if bv.get(k) != cv.get(k)
+    ]
     if diff:
         cmp.notes.append(
             "VERSIONS DIFFER: " + "; ".join(diff) + ". Small simulation differences across "
@@ -239,8 +262,9 @@ def compare(
             "baseline with --update."
         )
     if int(baseline.get("count", 0)) != len(rows):
-        cmp.notes.append(f"scenario count differs: {baseline.get('count')} in the baseline, "
-                         f"{len(rows)} now")  # fmt: skip
+        cmp.notes.append(
+            f"scenario count differs: {baseline.get('count')} in the baseline, {len(rows)} now"
+        )
 
     base_sc: Mapping[str, Mapping[str, Any]] = baseline.get("scenarios", {})
     by_id = {str(r["id"]): r for r in rows}
@@ -257,7 +281,9 @@ def compare(
         if b.get("status") != "ok" or r.get("status") != "ok":
             continue
         if (b.get("matched_clip"), b.get("matched_frame")) != (
-            r.get("matched_clip"), r.get("matched_frame")):  # fmt: skip
+            r.get("matched_clip"),
+            r.get("matched_frame"),
+        ):
             cmp.clip_changed.append(pid)
         for metric in QUALITY_METRICS:
             v = tols[metric].verdict(_num(b.get(metric)), _num(r.get(metric)))
@@ -280,19 +306,27 @@ def _f(v: float | None, signed: bool = False) -> str:
 
 def format_comparison(c: Comparison) -> str:
     out = [*c.notes] + [""] * bool(c.notes)
-    out.append(f"{'metric':32s} {'stat':6s} {'baseline':>10s} {'current':>10s} {'delta':>10s} "
-               f"{'tolerance':>10s}  verdict")  # fmt: skip
+    out.append(
+        f"{'metric':32s} {'stat':6s} {'baseline':>10s} {'current':>10s} {'delta':>10s} "
+        f"{'tolerance':>10s}  verdict"
+    )
     for ln in c.lines:
-        out.append(f"{ln.metric:32s} {ln.stat:6s} {_f(ln.baseline):>10s} {_f(ln.current):>10s} "
-                   f"{_f(ln.delta, True):>10s} {'±' + _f(ln.tolerance):>10s}  {ln.verdict}")
+        out.append(
+            f"{ln.metric:32s} {ln.stat:6s} {_f(ln.baseline):>10s} {_f(ln.current):>10s} "
+            f"{_f(ln.delta, True):>10s} {'±' + _f(ln.tolerance):>10s}  {ln.verdict}"
+        )
     out.append("")
-    out.append(f"per scenario ({c.shared} ids in both): matched clip/frame changed in "
-               f"{len(c.clip_changed)}, newly failing {len(c.newly_failing)}, missing now "
-               f"{len(c.missing_ids)}")  # fmt: skip
+    out.append(
+        f"per scenario ({c.shared} ids in both): matched clip/frame changed in "
+        f"{len(c.clip_changed)}, newly failing {len(c.newly_failing)}, missing now "
+        f"{len(c.missing_ids)}"
+    )
     for metric, (worse, other) in c.per_scenario.items():
         if worse or other:
-            out.append(f"  {metric}: beyond tolerance in {len(worse) + len(other)} "
-                       f"({len(worse)} worse) e.g. {(worse + other)[:3]}")  # fmt: skip
+            out.append(
+                f"  {metric}: beyond tolerance in {len(worse) + len(other)} "
+                f"({len(worse)} worse) e.g. {(worse + other)[:3]}"
+            )
     if c.regressed:
         why = "aggregate metrics got worse" if c.aggregate_regressed else "scenarios drifted"
         out.append(f"REGRESSION ({why}{', strict mode' if c.strict else ''})")
@@ -302,9 +336,12 @@ def format_comparison(c: Comparison) -> str:
 
 
 def regress(
-    results_dir: str | Path, baseline_path: str | Path, *, update: bool = False,
+    results_dir: str | Path,
+    baseline_path: str | Path,
+    *,
+    update: bool = False,
     strict: bool = False,
-) -> tuple[int, str]:  # fmt: skip
+) -> tuple[int, str]:
     """Compare (or with ``update``, rewrite) a baseline; returns (exit code, report text)."""
     rows, vers = load_results(results_dir)
     bp = Path(baseline_path)
@@ -312,7 +349,9 @@ def regress(
         old_tols = load_baseline(bp).get("tolerances") if bp.exists() else None
         doc = make_baseline(rows, vers, old_tols)
         atomic_write_text(bp, json.dumps(doc, indent=1, sort_keys=False) + "\n")
-        return 0, (f"wrote baseline {bp}: {doc['count']} scenarios, {doc['failures']} failed, "
-                   f"versions {doc['versions']}")  # fmt: skip
+        return 0, (
+            f"wrote baseline {bp}: {doc['count']} scenarios, {doc['failures']} failed, "
+            f"versions {doc['versions']}"
+        )
     cmp = compare(rows, load_baseline(bp), vers, strict=strict)
     return (1 if cmp.regressed else 0), format_comparison(cmp)

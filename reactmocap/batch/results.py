@@ -78,8 +78,12 @@ def report_row(
     matched = report.get("matched", {})
     quality = report.get("quality", {})
     timings = report.get("timings_s", {})
-    row.update(status="ok", matched_clip=matched.get("clip"), matched_frame=matched.get("frame"),
-               distance=matched.get("distance"))  # fmt: skip
+    row.update(
+        status="ok",
+        matched_clip=matched.get("clip"),
+        matched_frame=matched.get("frame"),
+        distance=matched.get("distance"),
+    )
     row.update({m: _plain(quality.get(m)) for m in QUALITY_METRICS})
     row.update({f"time_{s}_s": _plain(timings.get(s)) for s in TIMING_STAGES})
     row["matched_frame"] = _plain(row["matched_frame"])
@@ -149,7 +153,9 @@ class ResultStore:
             os.close(self._fd)
             self._fd = None
 
-    def write_csv(self, order: Sequence[str] = (), axes: Sequence[str] = ()) -> list[dict[str, Any]]:
+    def write_csv(
+        self, order: Sequence[str] = (), axes: Sequence[str] = ()
+    ) -> list[dict[str, Any]]:
         """Regenerate results.csv from the jsonl: rows in ``order`` (ids) first, then any others
         (from earlier sweeps into the same folder). Returns the rows written."""
         rows = ordered_rows(self.load(), order)
@@ -158,8 +164,9 @@ class ResultStore:
         for r in rows:  # parameters of other sweeps into the same folder
             cols.extend(k for k in r if k not in cols)
         buf = io.StringIO()
-        w = csv.DictWriter(buf, fieldnames=cols, restval="", extrasaction="ignore",
-                           lineterminator="\n")  # fmt: skip
+        w = csv.DictWriter(
+            buf, fieldnames=cols, restval="", extrasaction="ignore", lineterminator="\n"
+        )
         w.writeheader()
         for r in rows:
             w.writerow({k: ("" if v is None else v) for k, v in r.items()})
@@ -209,8 +216,9 @@ def summarize(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None =
         v = _values(ok, col)
         if v:
             a = np.asarray(v)
-            stats[col] = MetricStats(len(v), float(np.median(a)), float(np.percentile(a, 95)),
-                                     float(a.mean()))  # fmt: skip
+            stats[col] = MetricStats(
+                len(v), float(np.median(a)), float(np.percentile(a, 95)), float(a.mean())
+            )
     return Summary(len(rows), sum(r.get("status") != "ok" for r in rows), stats)
 
 

@@ -13,9 +13,10 @@ import json
 import logging
 import multiprocessing
 import os
+import signal
 import sys
 from collections import deque
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Generator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
@@ -39,9 +40,10 @@ from reactmocap.progress import Progress
 
 __all__ = ["RUNNERS", "BatchResult", "Job", "describe", "get_runner", "run_batch", "versions"]
 
+Rows = Generator[dict[str, Any], None, None]
 #: ``task(scenario, out_dir)`` -> report; the default is the real response pipeline
 Task = Callable[..., Mapping[str, Any]]
-Runner = Callable[[Sequence[SweepPoint], "Job", int, "str | None"], Iterator[dict[str, Any]]]
+Runner = Callable[[Sequence[SweepPoint], "Job", int, "str | None"], Rows]
 #: submissions kept in flight per worker: enough to keep workers busy, few enough that Ctrl-C
 #: stops the batch without a long queue to cancel
 IN_FLIGHT_PER_WORKER = 2
@@ -61,7 +63,7 @@ class Job:
             task = self.task if self.task is not None else _pipeline()
             out = Path(self.out_dir) / rel if self.out_dir is not None and rel else None
             report = task(point.scenario, out)
-        except Exception as exc:  # noqa: BLE001 - isolation is the point
+        except Exception as exc:  # isolation is the point
             return error_row(point.id, point.params, f"{type(exc).__name__}: {exc}", rel)
         return report_row(point.id, point.params, report, rel)
 
@@ -75,10 +77,16 @@ def _pipeline() -> Task:
 # ----------------------------------------------------------------------------- runners
 def run_serial(
     points: Sequence[SweepPoint], job: Job, workers: int = 1, address: str | None = None
-) -> Iterator[dict[str, Any]]:
+) -> Rows:
     """In this process, one after another (debugging, tests, tiny sweeps)."""
     for p in points:
         yield job(p)
+
+
+def _ignore_sigint() -> None:
+    # A terminal's Ctrl-C reaches the whole process group: only the parent should act on it
+    # (it stops the workers itself), or every idle worker dies printing a traceback.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _crashed(p: SweepPoint, job: Job, why: str) -> dict[str, Any]:
@@ -88,7 +96,7 @@ def _crashed(p: SweepPoint, job: Job, why: str) -> dict[str, Any]:
 
 def run_local(
     points: Sequence[SweepPoint], job: Job, workers: int = 1, address: str | None = None
-) -> Iterator[dict[str, Any]]:
+) -> Rows:
     """A local process pool of ``workers`` processes.
 
     'spawn' workers: forking a parent that holds MuJoCo/OpenMP/BLAS threads can deadlock. A worker
@@ -99,7 +107,7 @@ def run_local(
     ctx = multiprocessing.get_context("spawn")
     todo = deque(points)
     suspects: list[SweepPoint] = []
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_ignore_sigint)
     inflight: dict[Future[dict[str, Any]], SweepPoint] = {}
     clean = False
     try:
@@ -108,7 +116,8 @@ def run_local(
                 p = todo.popleft()
                 inflight[pool.submit(job, p)] = p
             done, _ = wait(inflight, return_when=FIRST_COMPLETED)
-            if any(isinstance(f.exception(), BrokenProcessPool) for f in done):
+            broke = any(isinstance(f.exception(), BrokenProcessPool) for f in done)
+            if broke:
                 wait(inflight)  # a broken pool resolves every pending future promptly
                 done = set(inflight)
             for f in done:
@@ -117,17 +126,16 @@ def run_local(
                     suspects.append(p)
                 else:
                     yield _result(f, p, job)
-            if suspects and not inflight and isinstance(pool, ProcessPoolExecutor) and _broken(pool):
+            if broke:
                 pool.shutdown(wait=True)
-                pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+                pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_ignore_sigint)
         for p in suspects:  # one at a time, so a crash is pinned on the point that caused it
-            if _broken(pool):
-                pool.shutdown(wait=True)
-                pool = ProcessPoolExecutor(max_workers=1, mp_context=ctx)
             f = pool.submit(job, p)
             wait([f])
             if isinstance(f.exception(), BrokenProcessPool):
                 yield _crashed(p, job, "the worker process died")
+                pool.shutdown(wait=True)
+                pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_ignore_sigint)
             else:
                 yield _result(f, p, job)
         clean = True
@@ -143,10 +151,6 @@ def _result(f: Future[dict[str, Any]], p: SweepPoint, job: Job) -> dict[str, Any
         raise KeyboardInterrupt
     rel = f"scenarios/{p.id}" if job.out_dir is not None else None
     return error_row(p.id, p.params, f"{type(exc).__name__}: {exc}", rel)  # e.g. unpicklable
-
-
-def _broken(pool: ProcessPoolExecutor) -> bool:
-    return bool(getattr(pool, "_broken", False))
 
 
 def _stop(pool: ProcessPoolExecutor, clean: bool) -> None:
@@ -168,7 +172,7 @@ def _ray_call(job: Job, point: SweepPoint) -> dict[str, Any]:
 
 def run_ray(
     points: Sequence[SweepPoint], job: Job, workers: int = 1, address: str | None = None
-) -> Iterator[dict[str, Any]]:
+) -> Rows:
     """Ray tasks: a local runtime with ``workers`` CPUs, or the cluster at ``address``
     (``"auto"`` or ``host:port``). Reuses a runtime the caller already started. Ray retries a
     task whose worker died once (``max_retries=1``); a second death is recorded."""
@@ -202,8 +206,12 @@ def run_ray(
                 except (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError) as exc:
                     row = _crashed(p, job, f"{type(exc).__name__}: {exc}")
                 except ray.exceptions.RayError as exc:  # e.g. a result that does not unpickle
-                    row = error_row(p.id, p.params, f"{type(exc).__name__}: {exc}",
-                                    f"scenarios/{p.id}" if job.out_dir else None)  # fmt: skip
+                    row = error_row(
+                        p.id,
+                        p.params,
+                        f"{type(exc).__name__}: {exc}",
+                        f"scenarios/{p.id}" if job.out_dir else None,
+                    )
                 yield row
     finally:
         for ref in refs:
@@ -220,7 +228,9 @@ def get_runner(name: str) -> Runner:
     try:
         return RUNNERS[name]
     except KeyError:
-        raise UnknownKeyError(f"unknown runner {name!r}; valid runners are {sorted(RUNNERS)}") from None
+        raise UnknownKeyError(
+            f"unknown runner {name!r}; valid runners are {sorted(RUNNERS)}"
+        ) from None
 
 
 # ----------------------------------------------------------------------------- driver
@@ -294,8 +304,10 @@ def run_batch(
     done = store.load()
     redo = {"ok"} if retry_failed else {"ok", "error"}
     todo = [p for p in points if done.get(p.id, {}).get("status") not in redo]
-    say(f"{sweep.name}: {len(points)} scenarios, {len(points) - len(todo)} already done, "
-        f"running {len(todo)} on {runner} ({workers} worker{'s' * (workers != 1)})")  # fmt: skip
+    say(
+        f"{sweep.name}: {len(points)} scenarios, {len(points) - len(todo)} already done, "
+        f"running {len(todo)} on {runner} ({workers} worker{'s' * (workers != 1)})"
+    )
     job = Job(str(out.resolve()) if save_animations else None, task)
     ran = 0
     rows: list[dict[str, Any]] = []

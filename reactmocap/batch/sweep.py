@@ -113,22 +113,48 @@ def _set_seed(raw: dict[str, Any], v: int) -> None:
 AXES: dict[str, Axis] = {
     a.name: a
     for a in (
-        Axis("facing_deg", "float", "recipient facing (deg)", _setter("recipient", "facing_deg"),
-             "deg"),
-        Axis("force_N", "float", "impact force magnitude (N); needs [impact]", _set_force_magnitude,
-             "N"),
-        Axis("force_dir_deg", "float", "horizontal heading of the impact force (deg)",
-             _set_force_direction, "deg"),
-        Axis("impact_body", "str", "body part hit by the explicit impact",
-             _setter("impact", "body")),
+        Axis(
+            "facing_deg",
+            "float",
+            "recipient facing (deg)",
+            _setter("recipient", "facing_deg"),
+            "deg",
+        ),
+        Axis(
+            "force_N",
+            "float",
+            "impact force magnitude (N); needs [impact]",
+            _set_force_magnitude,
+            "N",
+        ),
+        Axis(
+            "force_dir_deg",
+            "float",
+            "horizontal heading of the impact force (deg)",
+            _set_force_direction,
+            "deg",
+        ),
+        Axis(
+            "impact_body", "str", "body part hit by the explicit impact", _setter("impact", "body")
+        ),
         Axis("attacker_clip", "str", "the attacker's clip", _setter("attacker", "clip")),
-        Axis("recipient_start", "float", "seconds into the recipient's clip at the start",
-             _setter("recipient", "start"), "s"),
-        Axis("reaction_delay", "float", "[response].reaction_delay (s)",
-             _setter("response", "reaction_delay"), "s"),
+        Axis(
+            "recipient_start",
+            "float",
+            "seconds into the recipient's clip at the start",
+            _setter("recipient", "start"),
+            "s",
+        ),
+        Axis(
+            "reaction_delay",
+            "float",
+            "[response].reaction_delay (s)",
+            _setter("response", "reaction_delay"),
+            "s",
+        ),
         Axis("seed", "int", "replicate seed", _set_seed),
     )
-}  # fmt: skip
+}
 
 
 def point_id(params: Mapping[str, Value]) -> str:
@@ -238,8 +264,11 @@ def _axis_values(source: str, axis: Axis, spec: Any) -> tuple[Value, ...]:
         unknown = sorted(set(spec) - {"start", "stop", "step"})
         missing = sorted({"start", "stop", "step"} - set(spec))
         if unknown or missing:
-            raise _fail(source, where, f"a range is {{start, stop, step}}; unknown {unknown}, "
-                        f"missing {missing}")  # fmt: skip
+            raise _fail(
+                source,
+                where,
+                f"a range is {{start, stop, step}}; unknown {unknown}, missing {missing}",
+            )
         start, stop, step = (_typed(source, axis, 0, spec[k]) for k in ("start", "stop", "step"))
         assert isinstance(start, int | float) and isinstance(stop, int | float)
         assert isinstance(step, int | float)
@@ -270,30 +299,46 @@ def parse_sweep(
     base_dir = base_dir if base_dir is not None else Path.cwd()
     unknown = sorted(set(data) - _TOP)
     if unknown:
-        hint = ("; this looks like a scenario file: put it under [base] or write "
-                'base = "scenario.toml"') if {"recipient", "library"} & set(unknown) else ""
-        raise _fail(source, "top level",
-                    f"unknown key(s) {unknown}; valid keys are {sorted(_TOP)}{hint}")
+        hint = (
+            (
+                "; this looks like a scenario file: put it under [base] or write "
+                'base = "scenario.toml"'
+            )
+            if {"recipient", "library"} & set(unknown)
+            else ""
+        )
+        raise _fail(
+            source, "top level", f"unknown key(s) {unknown}; valid keys are {sorted(_TOP)}{hint}"
+        )
     meta = data.get("sweep", {})
     if not isinstance(meta, dict):
         raise _fail(source, "[sweep]", "expected a table")
     bad = sorted(set(meta) - _SWEEP_KEYS)
     if bad:
-        raise _fail(source, "[sweep]", f"unknown key(s) {bad}; valid keys are {sorted(_SWEEP_KEYS)}")
+        raise _fail(
+            source, "[sweep]", f"unknown key(s) {bad}; valid keys are {sorted(_SWEEP_KEYS)}"
+        )
     name = meta.get("name", Path(source).stem)
     if not isinstance(name, str) or not name:
         raise _fail(source, "[sweep].name", f"expected a non-empty string, got {name!r}")
     sub = meta.get("subsample")
-    if sub is not None and (isinstance(sub, bool) or not isinstance(sub, int | float) or sub <= 0
-                            or (isinstance(sub, float) and sub > 1 and not sub.is_integer())):
-        raise _fail(source, "[sweep].subsample", f"expected a count >= 1 or a fraction in (0, 1], "
-                    f"got {sub!r}")  # fmt: skip
+    if sub is not None and (
+        isinstance(sub, bool)
+        or not isinstance(sub, int | float)
+        or sub <= 0
+        or (isinstance(sub, float) and sub > 1 and not sub.is_integer())
+    ):
+        raise _fail(
+            source,
+            "[sweep].subsample",
+            f"expected a count >= 1 or a fraction in (0, 1], got {sub!r}",
+        )
     seed = meta.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int):
         raise _fail(source, "[sweep].seed", f"expected an integer, got {seed!r}")
 
     if "base" not in data:
-        raise _fail(source, "base", "missing: a [base] scenario table or base = \"scenario.toml\"")
+        raise _fail(source, "base", 'missing: a [base] scenario table or base = "scenario.toml"')
     base, scen_dir = _base(source, data["base"], base_dir)
 
     axes_raw = data.get("axes", {})
@@ -308,8 +353,11 @@ def parse_sweep(
         axes[key] = _axis_values(source, AXES[key], spec)
     if "force_N" in axes or "force_dir_deg" in axes or "impact_body" in axes:
         if "impact" not in base:
-            raise _fail(source, "[axes]", "force_N, force_dir_deg and impact_body need an "
-                        "explicit [base.impact]")  # fmt: skip
+            raise _fail(
+                source,
+                "[axes]",
+                "force_N, force_dir_deg and impact_body need an explicit [base.impact]",
+            )
     if "attacker_clip" in axes and "attacker" not in base:
         raise _fail(source, "[axes].attacker_clip", "the base scenario has no [attacker]")
     if isinstance(sub, float) and sub > 1:

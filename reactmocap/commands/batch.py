@@ -23,15 +23,27 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     b.add_argument("target", metavar="SWEEP.toml|plot", help="a sweep file, or `plot`")
     b.add_argument("dir", nargs="?", type=Path, metavar="DIR", help="results folder (for plot)")
     b.add_argument("--out", type=Path, metavar="DIR", help="results folder (for a sweep)")
-    b.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="parallel workers (default: CPU count)")  # fmt: skip
+    b.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="parallel workers (default: CPU count)",
+    )
     ray = b.add_mutually_exclusive_group()
     ray.add_argument("--ray", action="store_true", help="run on a local Ray runtime")
     ray.add_argument("--ray-address", metavar="ADDR", help="join a Ray cluster (e.g. auto)")
-    ray.add_argument("--runner", default=None, metavar="NAME",
-                     help="runner by name: local (default), ray, serial")  # fmt: skip
-    b.add_argument("--save-animations", action="store_true",
-                   help="keep each scenario's outputs under DIR/scenarios/ID/")  # fmt: skip
+    ray.add_argument(
+        "--runner",
+        default=None,
+        metavar="NAME",
+        help="runner by name: local (default), ray, serial",
+    )
+    b.add_argument(
+        "--save-animations",
+        action="store_true",
+        help="keep each scenario's outputs under DIR/scenarios/ID/",
+    )
     b.add_argument("--retry-failed", action="store_true", help="rerun scenarios that failed")
     b.set_defaults(func=_batch, _parser=b)
 
@@ -44,8 +56,9 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     r.add_argument("dir", type=Path, metavar="DIR")
     r.add_argument("--baseline", type=Path, required=True, metavar="BASELINE.json")
     r.add_argument("--update", action="store_true", help="write the baseline from DIR")
-    r.add_argument("--strict", action="store_true",
-                   help="also fail on improvements and per-scenario drift")  # fmt: skip
+    r.add_argument(
+        "--strict", action="store_true", help="also fail on improvements and per-scenario drift"
+    )
     r.set_defaults(func=_regress)
 
 
@@ -73,12 +86,21 @@ def _batch(args: argparse.Namespace) -> int:
     sweep = load_sweep(args.target)
     previous = signal.signal(signal.SIGTERM, _sigterm)
     try:
-        result = run_batch(sweep, args.out, runner=runner, workers=args.workers,
-                           address=args.ray_address, save_animations=args.save_animations,
-                           retry_failed=args.retry_failed)  # fmt: skip
+        result = run_batch(
+            sweep,
+            args.out,
+            runner=runner,
+            workers=args.workers,
+            address=args.ray_address,
+            save_animations=args.save_animations,
+            retry_failed=args.retry_failed,
+        )
     except KeyboardInterrupt:
-        print(f"interrupted: finished rows are in {args.out / 'results.jsonl'} and results.csv; "
-              "rerun the same command to resume", file=sys.stderr)  # fmt: skip
+        print(
+            f"interrupted: finished rows are in {args.out / 'results.jsonl'} and results.csv; "
+            "rerun the same command to resume",
+            file=sys.stderr,
+        )
         return 130
     finally:
         signal.signal(signal.SIGTERM, previous)

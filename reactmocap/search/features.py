@@ -365,8 +365,10 @@ def features_from_arrays(
     rotations: F64,
     translations: F64 | None,
     calib: SkeletonCalibration,
+    com_frames: int | None = None,
 ) -> FrameFeatures:
-    """:func:`frame_features` on raw motion arrays (no Motion construction in the query path)."""
+    """:func:`frame_features` on raw motion arrays (no Motion construction in the query path).
+    ``com_frames``: compute the centre of mass for the first frames only (a query needs one)."""
     pos, grot = forward_kinematics_fast(skeleton, root_positions, rotations, translations)
     gq = matrix_to_quat_fast(grot[:, np.append(calib.joints, calib.pelvis)])
     ori = quat_mul_fast(gq[:, :-1], calib.offsets[None])
@@ -375,7 +377,8 @@ def features_from_arrays(
     heading = 2.0 * np.arctan2(body[:, 3], body[:, 0])
     heading = (heading + np.pi) % (2 * np.pi) - np.pi
     origin = pos[:, calib.pelvis, :2].copy()
-    seg = 0.5 * (pos[:, calib.com_joints] + pos[:, calib.com_next])
+    cp = pos[:com_frames]
+    seg = 0.5 * (cp[:, calib.com_joints] + cp[:, calib.com_next])
     com = np.einsum("tmk,m->tk", seg, calib.com_mass)
     return FrameFeatures(pos[:, calib.joints], ori, heading, origin, com)
 

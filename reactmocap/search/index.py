@@ -63,9 +63,9 @@ _CHUNK = 4096
 #: frames per window in the coarse pre-ranking of KD candidates
 COARSE_FRAMES = 10
 #: KD candidates, exactly re-ranked candidates, candidates whose interval is refined
-DEFAULT_K = 64
-DEFAULT_EXACT = 8
-DEFAULT_REFINE = 4
+DEFAULT_K = 48
+DEFAULT_EXACT = 6
+DEFAULT_REFINE = 3
 #: windows sampled to fit the PCA
 PCA_SAMPLE = 8_000
 
@@ -573,7 +573,7 @@ class MotionIndex:
             sub = motion.sample(t0 + np.arange(L) / self.window.fps)
             root, rot, tr = sub.root_positions, sub.rotations, sub.translations
         calib = self._calibration(motion, parts)
-        ff = features_from_arrays(motion.skeleton, root, rot, tr, calib)
+        ff = features_from_arrays(motion.skeleton, root, rot, tr, calib, com_frames=1)
         h0 = float(ff.heading[0])
         o0 = ff.origin[0]
         lp, lq = localize(ff.positions[None], ff.orientations[None], np.array([h0]), o0[None])

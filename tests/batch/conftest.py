@@ -37,7 +37,9 @@ def warm_cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def write_sweep(tmp_path: Path) -> Callable[..., Path]:
     """write_sweep(axes_toml, base=FRONT_KICK, name="s", extra="") -> path of a sweep file."""
 
-    def write(axes: str, *, base: Path | str = FRONT_KICK, name: str = "s", extra: str = "") -> Path:
+    def write(
+        axes: str, *, base: Path | str = FRONT_KICK, name: str = "s", extra: str = ""
+    ) -> Path:
         p = tmp_path / f"{name}.toml"
         p.write_text(f'base = "{base}"\n{extra}\n[axes]\n{axes}\n')
         return p

@@ -15,12 +15,24 @@ def fake_report(scenario: Scenario, out_dir: Path | None = None) -> dict[str, An
     return {
         "scenario": scenario.name,
         "matched": {"clip": "guard", "frame": int(f), "distance": f / 100},
-        "quality": {"match_distance": f / 100, "blend_root_offset_max_m": 0.01,
-                    "blend_joint_correction_max_rad": f / 1000, "stitch_velocity_jump_rad_s": 1.0,
-                    "foot_skate_m": 0.02, "penetration_max_m": 0.0, "fell": False,
-                    "intended_fall": False},  # fmt: skip
-        "timings_s": {"scan": 0.0, "sim1": 0.0, "search": 0.0, "sim2": 0.0, "blend": 0.0,
-                      "total": 0.0},  # fmt: skip
+        "quality": {
+            "match_distance": f / 100,
+            "blend_root_offset_max_m": 0.01,
+            "blend_joint_correction_max_rad": f / 1000,
+            "stitch_velocity_jump_rad_s": 1.0,
+            "foot_skate_m": 0.02,
+            "penetration_max_m": 0.0,
+            "fell": False,
+            "intended_fall": False,
+        },
+        "timings_s": {
+            "scan": 0.0,
+            "sim1": 0.0,
+            "search": 0.0,
+            "sim2": 0.0,
+            "blend": 0.0,
+            "total": 0.0,
+        },
     }
 
 

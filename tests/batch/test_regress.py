@@ -19,19 +19,32 @@ VERSIONS = {"reactmocap": "0.1.0", "mujoco": "3.2.0"}
 def _rows(scale: float = 1.0, clip: str = "guard") -> list[dict[str, Any]]:
     rows = []
     for i in range(10):
-        rows.append({
-            "id": f"id{i}", "facing_deg": 36.0 * i, "status": "ok", "error": None,
-            "matched_clip": clip, "matched_frame": 80 + i, "distance": 0.3 + 0.02 * i,
-            "match_distance": (0.3 + 0.02 * i) * scale, "blend_root_offset_max_m": 0.01 * scale,
-            "blend_joint_correction_max_rad": (0.05 + 0.01 * i) * scale,
-            "stitch_velocity_jump_rad_s": 1.0 * scale, "foot_skate_m": 0.05 * scale,
-            "penetration_max_m": 0.0, "fell": i == 0, "intended_fall": False,
-        })  # fmt: skip
+        rows.append(
+            {
+                "id": f"id{i}",
+                "facing_deg": 36.0 * i,
+                "status": "ok",
+                "error": None,
+                "matched_clip": clip,
+                "matched_frame": 80 + i,
+                "distance": 0.3 + 0.02 * i,
+                "match_distance": (0.3 + 0.02 * i) * scale,
+                "blend_root_offset_max_m": 0.01 * scale,
+                "blend_joint_correction_max_rad": (0.05 + 0.01 * i) * scale,
+                "stitch_velocity_jump_rad_s": 1.0 * scale,
+                "foot_skate_m": 0.05 * scale,
+                "penetration_max_m": 0.0,
+                "fell": i == 0,
+                "intended_fall": False,
+            }
+        )
     rows.append({"id": "bad", "facing_deg": 400.0, "status": "error", "error": "boom"})
     return rows
 
 
-def _results(tmp_path: Path, rows: list[dict[str, Any]], versions: dict[str, str] = VERSIONS) -> Path:
+def _results(
+    tmp_path: Path, rows: list[dict[str, Any]], versions: dict[str, str] = VERSIONS
+) -> Path:
     d = tmp_path / "res"
     store = ResultStore(d)
     for r in rows:
@@ -57,8 +70,11 @@ def test_regress_passes_own_baseline_and_fails_a_tightened_one(tmp_path: Path, c
     base.write_text(json.dumps(doc))
     assert main(["regress", str(d), "--baseline", str(base)]) == 1
     out = capsys.readouterr().out
-    line = next(ln for ln in out.splitlines() if ln.startswith("blend_joint_correction_max_rad")
-                and "median" in ln)  # fmt: skip
+    line = next(
+        ln
+        for ln in out.splitlines()
+        if ln.startswith("blend_joint_correction_max_rad") and "median" in ln
+    )
     assert line.split()[-1] == "worse"
     assert "REGRESSION" in out
 

@@ -32,11 +32,15 @@ def _run(out: Path) -> tuple[int, str]:
 
 def test_small_sweep_matches_the_committed_baseline(warm_cache, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     code, text = _run(tmp_path / "out")
-    assert code == 0, f"\n{text}\n(regenerate the baseline if this change is intended: see the module docstring)"
+    assert code == 0, (
+        f"\n{text}\n(regenerate the baseline if this change is intended: see the module docstring)"
+    )
 
 
 @pytest.mark.parametrize("delay", [0.1, 0.2])
-def test_a_changed_reaction_delay_default_fails_it(warm_cache, tmp_path: Path, monkeypatch, delay) -> None:  # type: ignore[no-untyped-def]
+def test_a_changed_reaction_delay_default_fails_it(
+    warm_cache, tmp_path: Path, monkeypatch, delay
+) -> None:  # type: ignore[no-untyped-def]
     # Change the default itself, as an edit of ResponseConfig would (sweep_small.toml sets no
     # [response], so the default is what runs); the serial runner runs in this process.
     names = list(ResponseConfig.__dataclass_fields__)

@@ -26,9 +26,20 @@ def _lines(p: Path) -> list[str]:
 
 
 def _start(sweep: Path, out: Path) -> subprocess.Popen[str]:
-    cmd = [sys.executable, "-m", "reactmocap", "batch", str(sweep), "--out", str(out),
-           "--workers", "1"]  # fmt: skip
-    return subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    cmd = [
+        sys.executable,
+        "-m",
+        "reactmocap",
+        "batch",
+        str(sweep),
+        "--out",
+        str(out),
+        "--workers",
+        "1",
+    ]
+    return subprocess.Popen(
+        cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
 
 
 def _run_until(proc: subprocess.Popen[str], jsonl: Path, rows: int, sig: int) -> None:
@@ -67,9 +78,23 @@ def test_killed_sweep_resumes_with_exact_rows(warm_cache, write_sweep, tmp_path:
     assert len(csv_rows) == len(second)
 
     # 3. rerun to the end: exactly N rows, no duplicate ids, nothing left behind
-    done = subprocess.run([sys.executable, "-m", "reactmocap", "batch", str(sweep), "--out",
-                           str(out), "--workers", "1"], cwd=REPO, capture_output=True, text=True,
-                          timeout=120)  # fmt: skip
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "reactmocap",
+            "batch",
+            str(sweep),
+            "--out",
+            str(out),
+            "--workers",
+            "1",
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr
     assert f"{len(second)} already done, running {N - len(second)}" in done.stderr
     rows = [json.loads(ln) for ln in _lines(jsonl)]

@@ -9,7 +9,8 @@ from typing import Any
 
 import pytest
 
-from reactmocap.batch import load_sweep, plot_batch, run_batch
+from reactmocap.batch import load_sweep, run_batch
+from reactmocap.cli import main
 
 from . import fake_tasks
 
@@ -48,7 +49,9 @@ def test_pool_and_ray_give_identical_rows(warm_cache, write_sweep, tmp_path, ray
     assert [ln.split(",")[:10] for ln in pool_csv] == [ln.split(",")[:10] for ln in ray_csv]
 
 
-def test_failing_scenario_is_recorded_and_others_complete(warm_cache, write_sweep, tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_failing_scenario_is_recorded_and_others_complete(
+    warm_cache, write_sweep, tmp_path, capsys
+) -> None:  # type: ignore[no-untyped-def]
     sweep = load_sweep(write_sweep('facing_deg = [0, 90]\nattacker_clip = ["front_kick", "nope"]'))
     out = tmp_path / "out"
     res = run_batch(sweep, out, workers=2, save_animations=True, progress=False)
@@ -66,7 +69,8 @@ def test_failing_scenario_is_recorded_and_others_complete(warm_cache, write_swee
     again = run_batch(sweep, out, workers=1, progress=False)
     assert again.ran == 0 and again.skipped == 4
     # figures: one per axis, and the contact sheet from the saved animations
-    written = {p.name for p in plot_batch(out)}
+    assert main(["batch", "plot", str(out)]) == 0
+    written = {Path(ln).name for ln in capsys.readouterr().out.split()}
     assert written == {"plot_facing_deg.png", "plot_attacker_clip.png", "contact_sheet.png"}
     assert all((out / n).stat().st_size > 1000 for n in written)
 
@@ -87,8 +91,9 @@ def test_ray_worker_crash_is_retried_once_then_recorded(write_sweep, tmp_path, r
     cloudpickle.register_pickle_by_value(fake_tasks)  # Ray workers need not import tests/
     try:
         sweep = load_sweep(write_sweep("facing_deg = [0, 90]"))
-        res = run_batch(sweep, tmp_path / "o", runner="ray", task=fake_tasks.crash_at_90,
-                        progress=False)  # fmt: skip
+        res = run_batch(
+            sweep, tmp_path / "o", runner="ray", task=fake_tasks.crash_at_90, progress=False
+        )
     finally:
         cloudpickle.unregister_pickle_by_value(fake_tasks)
     status = {r["facing_deg"]: r for r in res.rows}

@@ -23,15 +23,27 @@ def test_facing_example_expands_to_36_directions() -> None:
 
 
 def test_grid_is_the_cartesian_product_and_ids_are_stable(write_sweep) -> None:  # type: ignore[no-untyped-def]
-    p = write_sweep('facing_deg = [0, 90.0]\nattacker_clip = ["front_kick", "side_kick"]\n'
-                    "reaction_delay = [0.1, 0.2]\nseed = [1, 2]")  # fmt: skip
+    p = write_sweep(
+        'facing_deg = [0, 90.0]\nattacker_clip = ["front_kick", "side_kick"]\n'
+        "reaction_delay = [0.1, 0.2]\nseed = [1, 2]"
+    )
     points = load_sweep(p).points()
     assert len(points) == 16
-    combos = {(q.params["facing_deg"], q.params["attacker_clip"], q.params["reaction_delay"],
-               q.params["seed"]) for q in points}  # fmt: skip
+    combos = {
+        (
+            q.params["facing_deg"],
+            q.params["attacker_clip"],
+            q.params["reaction_delay"],
+            q.params["seed"],
+        )
+        for q in points
+    }
     assert len(combos) == 16
-    q = next(q for q in points if q.params["attacker_clip"] == "side_kick"
-             and q.params["reaction_delay"] == 0.2)  # fmt: skip
+    q = next(
+        q
+        for q in points
+        if q.params["attacker_clip"] == "side_kick" and q.params["reaction_delay"] == 0.2
+    )
     assert q.scenario.attacker is not None and q.scenario.attacker.clip == "side_kick"
     assert q.scenario.response.reaction_delay == 0.2
     # the id depends on parameter values only: 0 and 0.0 agree, key order does not matter
@@ -52,10 +64,13 @@ def test_subsample_is_deterministic(write_sweep) -> None:  # type: ignore[no-unt
 
 def test_force_axes_scale_and_turn_an_explicit_impact(tmp_path: Path) -> None:
     data = {
-        "base": {"library": "data/synthetic_clips", "recipient": {"clip": "guard"},
-                 "impact": {"body": "chest", "force": [-300.0, 0.0, 40.0]}},
+        "base": {
+            "library": "data/synthetic_clips",
+            "recipient": {"clip": "guard"},
+            "impact": {"body": "chest", "force": [-300.0, 0.0, 40.0]},
+        },
         "axes": {"force_N": [100, 500], "force_dir_deg": [90], "impact_body": ["chest", "head"]},
-    }  # fmt: skip
+    }
     points = parse_sweep(data, base_dir=EXAMPLES.parent).points()
     assert len(points) == 4
     for p in points:
@@ -103,10 +118,20 @@ def test_bad_top_level_and_base(tmp_path: Path, write_sweep) -> None:  # type: i
 
 
 def test_unknown_runner_lists_runners() -> None:
-    with pytest.raises(UnknownKeyError, match=r"unknown runner 'dask'.*\['local', 'ray', 'serial'\]"):
+    with pytest.raises(
+        UnknownKeyError, match=r"unknown runner 'dask'.*\['local', 'ray', 'serial'\]"
+    ):
         get_runner("dask")
-    assert set(AXES) >= {"facing_deg", "force_N", "force_dir_deg", "impact_body", "attacker_clip",
-                         "recipient_start", "reaction_delay", "seed"}  # fmt: skip
+    assert set(AXES) >= {
+        "facing_deg",
+        "force_N",
+        "force_dir_deg",
+        "impact_body",
+        "attacker_clip",
+        "recipient_start",
+        "reaction_delay",
+        "seed",
+    }
 
 
 def test_cli_reports_bad_sweep_without_traceback(write_sweep, tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
