@@ -15,6 +15,8 @@ import multiprocessing
 import os
 import signal
 import sys
+import threading
+import time
 from collections import deque
 from collections.abc import Callable, Generator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -83,10 +85,26 @@ def run_serial(
         yield job(p)
 
 
-def _ignore_sigint() -> None:
+def _new_pool(workers: int) -> ProcessPoolExecutor:
+    ctx = multiprocessing.get_context("spawn")
+    return ProcessPoolExecutor(
+        workers, mp_context=ctx, initializer=_init_worker, initargs=(os.getpid(),)
+    )
+
+
+def _init_worker(parent: int) -> None:
     # A terminal's Ctrl-C reaches the whole process group: only the parent should act on it
     # (it stops the workers itself), or every idle worker dies printing a traceback.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # A pool worker outlives a hard-killed parent (its queue pipe stays open) and would go on
+    # burning a core on queued scenarios whose rows nobody writes: leave when orphaned.
+    threading.Thread(target=_exit_when_orphaned, args=(parent,), daemon=True).start()
+
+
+def _exit_when_orphaned(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(0.5)
+    os._exit(1)
 
 
 def _crashed(p: SweepPoint, job: Job, why: str) -> dict[str, Any]:
@@ -104,10 +122,9 @@ def run_local(
     afterwards one at a time in a fresh pool: an innocent point then succeeds, and a point that
     crashes its worker again is recorded as an error.
     """
-    ctx = multiprocessing.get_context("spawn")
     todo = deque(points)
     suspects: list[SweepPoint] = []
-    pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_ignore_sigint)
+    pool = _new_pool(workers)
     inflight: dict[Future[dict[str, Any]], SweepPoint] = {}
     clean = False
     try:
@@ -128,14 +145,14 @@ def run_local(
                     yield _result(f, p, job)
             if broke:
                 pool.shutdown(wait=True)
-                pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_ignore_sigint)
+                pool = _new_pool(workers)
         for p in suspects:  # one at a time, so a crash is pinned on the point that caused it
             f = pool.submit(job, p)
             wait([f])
             if isinstance(f.exception(), BrokenProcessPool):
                 yield _crashed(p, job, "the worker process died")
                 pool.shutdown(wait=True)
-                pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_ignore_sigint)
+                pool = _new_pool(workers)
             else:
                 yield _result(f, p, job)
         clean = True
@@ -310,8 +327,7 @@ def run_batch(
     )
     job = Job(str(out.resolve()) if save_animations else None, task)
     ran = 0
-    rows: list[dict[str, Any]] = []
-    gen = run_fn(todo, job, workers, address)
+    gen = run_fn(todo, job, workers, address) if todo else run_serial([], job)  # no Ray start
     try:
         with Progress(len(todo), sweep.name, force=False) if progress else _NoBar() as bar:
             for row in gen:

@@ -656,12 +656,17 @@ class MotionIndex:
     ) -> list[SearchResult]:
         """Search with a prepared query window.
 
-        1. ``k`` nearest indexed windows in the PCA embedding (KD-tree);
-        2. pre-rank them with a coarse ``D`` (query support weight included) on about
-           ``COARSE_FRAMES`` frames of the window (exact when ``L <= COARSE_FRAMES``);
-        3. exact ``D`` for the best ``exact`` of them and for every window in the surrounding
-           unique-frame interval of the best ``refine`` (the paper's local refinement);
-        4. the ``n`` best distinct windows by exact ``D``.
+        1. ``k`` nearest indexed (unique-frame) windows in the PCA embedding (KD-tree);
+        2. pre-rank them with ``D`` including the query's support weight: on about
+           ``COARSE_FRAMES`` window frames (weights aggregated) when ``L > COARSE_FRAMES``,
+           otherwise exactly;
+        3. every window in the surrounding unique-frame interval of the best ``refine`` is tested
+           too (the paper's local refinement), pre-ranked the same way;
+        4. exact ``D`` with its breakdown for the best ``max(exact, n)`` of all of these (every
+           tested window when ``L <= COARSE_FRAMES``); the ``n`` best distinct ones are returned.
+
+        ``k = num_indexed`` and ``refine = num_indexed`` with ``L <= COARSE_FRAMES`` is an
+        exhaustive search (equal to :func:`brute_force`).
         """
         t0 = time.perf_counter()
         if n < 1 or k < 1 or refine < 0 or exact < 1:

@@ -51,6 +51,28 @@ def _run_until(proc: subprocess.Popen[str], jsonl: Path, rows: int, sig: int) ->
     proc.send_signal(sig)
 
 
+def _children(pid: int) -> list[int]:
+    kids = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if int(fields[1]) == pid:
+            kids.append(int(stat.parent.name))
+    return kids
+
+
+def _assert_gone(pids: list[int], timeout: float = 10.0) -> None:
+    deadline = time.monotonic() + timeout
+    while any(Path(f"/proc/{p}").exists() for p in pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    alive = [p for p in pids if Path(f"/proc/{p}").exists()]
+    for p in alive:  # do not leak them into the rest of the session
+        os.kill(p, signal.SIGKILL)
+    assert not alive, f"pool workers {alive} outlived their killed parent"
+
+
 def test_killed_sweep_resumes_with_exact_rows(warm_cache, write_sweep, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     angles = ", ".join(str(a) for a in range(0, 360, 360 // N))
     sweep = write_sweep(f"facing_deg = [{angles}]")
@@ -60,7 +82,9 @@ def test_killed_sweep_resumes_with_exact_rows(warm_cache, write_sweep, tmp_path:
     # 1. hard kill: no cleanup at all; then a torn last line as if killed inside a write
     proc = _start(sweep, out)
     _run_until(proc, jsonl, 2, signal.SIGKILL)
+    workers = _children(proc.pid)
     proc.wait(timeout=30)
+    _assert_gone(workers)  # orphaned pool workers leave instead of running on
     first = len(_lines(jsonl))
     assert 2 <= first < N
     with jsonl.open("a") as fh:
