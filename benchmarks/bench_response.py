@@ -38,8 +38,12 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("scenarios", nargs="*", type=Path)
     args = ap.parse_args()
-    paths = args.scenarios or sorted(p for p in EXAMPLES.glob("*.toml") if not p.name.startswith("sweep"))
-    print(f"{'scenario':18s} " + " ".join(f"{s:>7s}" for s in STAGES) + "   steps  bare_s  sim/bare")
+    paths = args.scenarios or sorted(
+        p for p in EXAMPLES.glob("*.toml") if not p.name.startswith("sweep")
+    )
+    print(
+        f"{'scenario':18s} " + " ".join(f"{s:>7s}" for s in STAGES) + "   steps  bare_s  sim/bare"
+    )
     for path in paths:
         sc = load_scenario(path)
         run_response(sc)  # warm: index and library caches

@@ -43,6 +43,7 @@ from reactmocap.response.blend import blend_poses, final_blend, transition_weigh
 from reactmocap.response.scenario import CharacterSpec, Scenario
 from reactmocap.rotations import quat_slerp
 from reactmocap.search import MotionIndex, SearchResult, SearchWeights, WindowConfig
+from reactmocap.search.index import FORMAT_VERSION as INDEX_FORMAT_VERSION
 from reactmocap.sim.character import BALL_JOINTS, Character, build_character
 from reactmocap.sim.impacts import Impact, first_contact
 from reactmocap.sim.pd import PDServo
@@ -80,7 +81,7 @@ class ResponseResult:
 
 
 # ----------------------------------------------------------------------------- library
-_INDEX_MEMO: dict[tuple[str, str], tuple[ClipLibrary, MotionIndex]] = {}
+_INDEX_MEMO: dict[tuple[str, ...], tuple[ClipLibrary, MotionIndex]] = {}
 
 
 def prepare_library(
@@ -96,7 +97,9 @@ def prepare_library(
         clips = {n: m for n, m in clips.items() if m.skeleton.same_structure(skeleton_of.skeleton)}
         if not clips:
             raise SearchError(f"library {path} has no clip on the recipient's skeleton")
-    key = (str(Path(path).resolve()), ",".join(sorted(clips)) + lib.fingerprint())
+    # the code versions are part of the key: an index written by older search code is not reused
+    key = (str(Path(path).resolve()), ",".join(sorted(clips)) + lib.fingerprint(),
+           f"{__version__}/{INDEX_FORMAT_VERSION}")  # fmt: skip
     if key in _INDEX_MEMO:
         return _INDEX_MEMO[key]
     digest = hashlib.sha256("\0".join(key).encode()).hexdigest()[:16]  # stable across processes
@@ -123,7 +126,9 @@ def _placed(motion: Motion, parts: BodyPartMap, spec: CharacterSpec) -> tuple[Mo
         raise ConfigError(
             f"start {spec.start} s is outside clip {motion.name!r} ({motion.duration:.2f} s)"
         )
-    return place(motion, parts, frame, np.radians(spec.facing_deg), spec.position), frame / motion.fps
+    return place(
+        motion, parts, frame, np.radians(spec.facing_deg), spec.position
+    ), frame / motion.fps
 
 
 # ----------------------------------------------------------------------------- simulation
@@ -299,7 +304,9 @@ def run_response(scenario: Scenario) -> ResponseResult:
 
     # 3. search over windows starting 0.1-1.0 s after the impact (later while contact lasts)
     t = time.perf_counter()
-    first = t_impact + float(np.clip(contact_end - t_impact, cfg.search_start, cfg.contact_shift_max))
+    first = t_impact + float(
+        np.clip(contact_end - t_impact, cfg.search_start, cfg.contact_shift_max)
+    )
     first = max(first, t_impact + cfg.search_start)
     last = t_impact + cfg.search_end
     q_fps = index.window.fps
@@ -337,7 +344,9 @@ def run_response(scenario: Scenario) -> ResponseResult:
     w = transition_weights(ticks2, t_impact, cfg.reaction_delay, t_match)
     desired = quat_slerp(prev_q, found_q, w[:, None])
     targets2: list[F64 | None] = [desired]
-    targets2 += [_ball_targets(ch, mo, ticks2 + c0) for ch, mo, c0 in zip(chars[1:], motions[1:], clocks[1:])]
+    targets2 += [
+        _ball_targets(ch, mo, ticks2 + c0) for ch, mo, c0 in zip(chars[1:], motions[1:], clocks[1:])
+    ]
     sim2 = _Sim(chars, cfg.friction_sim2, dt, cfg.kp, cfg.kv)
     sim2.world.set_state(saved)
     impact2 = _with_body_id(sim2, impact_spec) if impact_spec is not None else None
@@ -466,7 +475,11 @@ def _attacker_output(ch: Character, sim: _Sim, rec: F64, motion: Motion, clock0:
 
 # ----------------------------------------------------------------------------- outputs
 def run_scenario(
-    scenario: Scenario, out_dir: str | Path | None = None, *, plot: bool = False, video: bool = False
+    scenario: Scenario,
+    out_dir: str | Path | None = None,
+    *,
+    plot: bool = False,
+    video: bool = False,
 ) -> dict[str, Any]:
     """Run a scenario; with ``out_dir`` write ``recipient.bvh``, ``attacker.bvh``,
     ``report.json`` (and ``plot.png``, a video) atomically. Returns the report."""
@@ -532,4 +545,3 @@ def _jsonable(x: Any) -> Any:
     if isinstance(x, Path):
         return str(x)
     return x
-

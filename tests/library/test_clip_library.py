@@ -93,7 +93,9 @@ def test_mirror_doubles_library(small_lib: Path, tmp_path: Path) -> None:
     assert sum(name.endswith("_mirror") for name in lib) == 3
 
 
-def test_cli_info_check_convert(small_lib: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_info_check_convert(
+    small_lib: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     assert main(["library", "info", str(small_lib)]) == 0
     out = capsys.readouterr().out
     assert "total" in out and "3 clips" in out

@@ -17,7 +17,6 @@ from reactmocap.response.pipeline import run_response, run_scenario
 from reactmocap.response.scenario import (
     AttackerSpec,
     CharacterSpec,
-    ImpactSpec,
     Scenario,
     load_scenario,
 )
@@ -150,8 +149,9 @@ def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
     scenario = Scenario(
         library=lib,
         recipient=CharacterSpec("dataset-1_respond_normal_001", start=0.5),
-        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.0, facing_deg=180.0,
-                              position=(0.9, 0.0)),  # fmt: skip
+        attacker=AttackerSpec(
+            "dataset-1_kick_normal_001", start=0.0, facing_deg=180.0, position=(0.9, 0.0)
+        ),
         name="real",
     )
     report = run_scenario(scenario, tmp_path / "out")
@@ -159,4 +159,4 @@ def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
     assert np.all(np.isfinite(rec.global_positions()))
     assert report["quality"]["penetration_max_m"] < 0.15
     assert report["matched"]["clip"].startswith("dataset-1")
-    _ = ImpactSpec
+

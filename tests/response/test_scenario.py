@@ -46,8 +46,14 @@ def test_good_scenario_and_defaults(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
-        (("facing_deg = 90", 'facing_deg = "north"'), r"\[recipient\].facing_deg: expected a number"),
-        (("start = 0.5", "start = 0.5\ncolour = 3"), r"\[recipient\]: unknown key\(s\) \['colour'\]"),
+        (
+            ("facing_deg = 90", 'facing_deg = "north"'),
+            r"\[recipient\].facing_deg: expected a number",
+        ),
+        (
+            ("start = 0.5", "start = 0.5\ncolour = 3"),
+            r"\[recipient\]: unknown key\(s\) \['colour'\]",
+        ),
         (("force = [-350, 0, 0]", "force = [1, 2]"), r"\[impact\].force: expected a list of 3"),
         (("duration = 0.1", "duration = -1"), r"\[impact\].duration: expected a number > 0"),
         (("reaction_delay = 0.12", "reaction_delay = true"), r"reaction_delay: expected a number"),
