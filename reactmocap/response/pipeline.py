@@ -36,7 +36,12 @@ from reactmocap.errors import ConfigError, ReactMocapError, SearchError, Simulat
 from reactmocap.io import atomic_write_text
 from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
 from reactmocap.library.bvh import read_bvh, write_bvh
-from reactmocap.library.clip_library import ClipLibrary, default_cache_dir, load_library
+from reactmocap.library.clip_library import (
+    ClipLibrary,
+    default_cache_dir,
+    find_bvh_files,
+    load_library,
+)
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import place
 from reactmocap.response.blend import blend_poses, final_blend, transition_weights
@@ -110,12 +115,29 @@ def prepare_library(
     return sub, index
 
 
+_LIBRARY_MEMO: dict[tuple[str, tuple[tuple[str, int, int], ...]], ClipLibrary] = {}
+
+
+def _library(path: Path) -> ClipLibrary:
+    """The clip library, memoised in-process by file names, sizes and mtimes (a batch runs many
+    responses over one library; re-hashing every file costs ~45 ms per response)."""
+    files = find_bvh_files(path)
+    key = (
+        str(Path(path).resolve()),
+        tuple((str(f), (st := f.stat()).st_size, st.st_mtime_ns) for f in files),
+    )
+    if key not in _LIBRARY_MEMO:
+        _LIBRARY_MEMO.clear()
+        _LIBRARY_MEMO[key] = load_library(path)
+    return _LIBRARY_MEMO[key]
+
+
 def _clip(lib_path: Path, spec: CharacterSpec, lib: ClipLibrary | None) -> Motion:
     p = Path(spec.clip)
     if p.suffix.lower() == ".bvh" and p.exists():
         return read_bvh(p)
     if lib is None:
-        lib = load_library(lib_path)
+        lib = _library(lib_path)
     return lib[spec.clip]
 
 
@@ -207,7 +229,7 @@ def run_response(scenario: Scenario) -> ResponseResult:
     timings: dict[str, float] = {}
     t_all = time.perf_counter()
 
-    lib = load_library(scenario.library)
+    lib = _library(scenario.library)
     rec_clip = _clip(scenario.library, scenario.recipient, lib)
     rec_parts = map_body_parts(rec_clip.skeleton)
     rec_motion, rec_t0 = _placed(rec_clip, rec_parts, scenario.recipient)
