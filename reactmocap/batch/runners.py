@@ -129,11 +129,17 @@ def run_local(
     clean = False
     try:
         while todo or inflight:
+            submit_failed = False
             while todo and len(inflight) < IN_FLIGHT_PER_WORKER * workers:
                 p = todo.popleft()
-                inflight[pool.submit(job, p)] = p
+                try:
+                    inflight[pool.submit(job, p)] = p
+                except BrokenProcessPool:  # a worker died between the last wait and now
+                    todo.appendleft(p)
+                    submit_failed = True
+                    break
             done, _ = wait(inflight, return_when=FIRST_COMPLETED)
-            broke = any(isinstance(f.exception(), BrokenProcessPool) for f in done)
+            broke = submit_failed or any(isinstance(f.exception(), BrokenProcessPool) for f in done)
             if broke:
                 wait(inflight)  # a broken pool resolves every pending future promptly
                 done = set(inflight)
