@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 __all__ = ["register"]
@@ -50,7 +49,3 @@ def _respond(args: argparse.Namespace) -> int:
 
 def _demo(args: argparse.Namespace) -> int:
     return _run(DEMO_SCENARIO, args.out, args.plot, args.video)
-
-
-def _dump(report: dict) -> str:  # type: ignore[type-arg]
-    return json.dumps(report, indent=2)

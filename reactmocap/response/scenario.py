@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import MISSING, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -173,8 +173,7 @@ class _Reader:
         missing = [
             n
             for n, f in known.items()
-            if f.default is f.default_factory is __import__("dataclasses").MISSING
-            and n not in kwargs
+            if f.default is f.default_factory is MISSING and n not in kwargs
         ]
         if missing:
             raise self.fail(f"[{section}]", f"missing required key(s) {missing}")

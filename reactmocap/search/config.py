@@ -8,7 +8,7 @@ import hashlib
 import json
 import math
 from dataclasses import asdict, dataclass, fields
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,6 +23,9 @@ def _check_nonneg(obj: object, names: tuple[str, ...]) -> None:
         v = getattr(obj, n)
         if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v) or v < 0:
             raise ConfigError(f"{type(obj).__name__}.{n} must be a finite number >= 0, got {v!r}")
+
+
+_T = TypeVar("_T")
 
 
 @dataclass(frozen=True)
@@ -92,13 +95,7 @@ class SearchWeights:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> SearchWeights:
-        known = {f.name for f in fields(cls)}
-        unknown = set(data) - known
-        if unknown:
-            raise ConfigError(
-                f"SearchWeights: unknown fields {sorted(unknown)}; known {sorted(known)}"
-            )
-        return cls(**data)
+        return _from_dict(cls, data)
 
 
 @dataclass(frozen=True)
@@ -156,13 +153,18 @@ class WindowConfig:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> WindowConfig:
-        known = {f.name for f in fields(cls)}
-        unknown = set(data) - known
-        if unknown:
-            raise ConfigError(
-                f"WindowConfig: unknown fields {sorted(unknown)}; known {sorted(known)}"
-            )
-        return cls(**data)
+        return _from_dict(cls, data)
+
+
+def _from_dict(cls: type[_T], data: dict[str, Any]) -> _T:
+    """Build a config dataclass from a dict, naming any unknown field."""
+    known = {f.name for f in fields(cls)}  # type: ignore[arg-type]
+    unknown = set(data) - known
+    if unknown:
+        raise ConfigError(
+            f"{cls.__name__}: unknown fields {sorted(unknown)}; known {sorted(known)}"
+        )
+    return cls(**data)
 
 
 def settings_hash(weights: SearchWeights, window: WindowConfig, mirror: bool) -> str:

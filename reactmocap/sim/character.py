@@ -88,6 +88,8 @@ SIM_BODIES: tuple[str, ...] = tuple(b for b, _, _ in _TREE)
 BALL_JOINTS: tuple[str, ...] = tuple(j for _, _, j in _TREE if j is not None)
 BODY_ALIASES: Mapping[str, str] = {"abdomen": "waist", "thorax": "chest", "neck": "head"}
 _PARENT = np.array([-1 if p is None else SIM_BODIES.index(p) for _, p, _ in _TREE])
+#: parent body index of each of SIM_BODIES (-1 for the pelvis)
+SIM_PARENTS = _PARENT
 
 #: cone half-angle (rad) of each ball joint around its reference-pose rotation. MuJoCo ball
 #: limits are cones, so these are coarse: they stop wild twists after hard impacts, they do not

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, build_character
+from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, SIM_PARENTS, build_character
 from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, _t3, contact_report
 from reactmocap.sim.pd import PDServo
 from reactmocap.sim.world import World, WorldConfig
@@ -299,12 +299,7 @@ def _errors(world: World, result: RolloutResult, motion: Motion, start: float) -
     ref_pos, ref_rot = ch.body_transforms_from_qpos(q_ref)
     sim_pos, sim_rot = result.body_pos[0], result.body_quat[0]
     # joint error: angle between simulated and mocap local rotations of the 15 ball joints
-    par = np.array(
-        [
-            SIM_BODIES.index(p)
-            for _, p, _ in __import__("reactmocap.sim.character", fromlist=["_TREE"])._TREE[1:]
-        ]
-    )
+    par = SIM_PARENTS[1:]
 
     def local(rot: F64) -> F64:
         return quat_mul(quat_conj(rot[:, par]), rot[:, 1:])
