@@ -132,6 +132,9 @@ class PDServo:
         self._rd = np.empty((n, 4, 4))
         self._a = np.zeros((n, 3, 4))
         self.targets = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+        #: extra joint torques (N m, child frame) added to the servo's output, e.g. gravity
+        #: compensation or a balance controller's; ``(n, 3)``, written in place by controllers
+        self.feedforward = np.zeros((n, 3))
         self._kpcol = np.empty(n)
         self._kvcol = np.empty(n)
         self._enabled = np.ones(n, dtype=bool)
@@ -153,7 +156,8 @@ class PDServo:
             wc = world.characters[i]
             qv = d.qpos[wc.ball_qpos_start : wc.ball_qpos_start + 4 * NJ].reshape(NJ, 4, 1)
             tv = d.qfrc_applied[wc.ball_dof_start : wc.ball_dof_start + 3 * NJ].reshape(NJ, 3, 1)
-            self._views.append((self._a[k * NJ : (k + 1) * NJ], qv, tv))
+            ff = self.feedforward[k * NJ : (k + 1) * NJ].reshape(NJ, 3, 1)
+            self._views.append((self._a[k * NJ : (k + 1) * NJ], qv, tv, ff))
         self.set_gains(kp, critical_kv(kp) if kv is None else kv)
         self.set_targets_to_current()
 
@@ -271,10 +275,11 @@ class PDServo:
             self._dirty = False
         self._count += 1
         lim = self.torque_limit
-        for a, qv, tv in self._views:
+        for a, qv, tv, ff in self._views:
             np.matmul(a, qv, out=tv)
             if lim is not None:
                 np.clip(tv, -lim, lim, out=tv)
+            tv += ff
 
     def torques(self) -> F64:
         """``(n, 3)`` full servo torques ``I (kp e - kv qdot)`` at the current state, with the
