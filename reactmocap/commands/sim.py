@@ -52,6 +52,12 @@ def _common(p: argparse.ArgumentParser) -> None:
         default=0.0,
         help="NON-PHYSICAL pelvis stabilisation gain (0 = off)",
     )
+    p.add_argument(
+        "--no-balance",
+        dest="balance",
+        action="store_false",
+        help="PD tracking only, without the stance-leg balance controller",
+    )
 
 
 def _read(path: Path):  # type: ignore[no-untyped-def]
@@ -93,6 +99,7 @@ def _kwargs(args: argparse.Namespace) -> dict[str, object]:
         "record_fps": args.fps,
         "total_mass": args.mass,
         "root_assist": args.root_assist,
+        "balance": args.balance,
     }
 
 

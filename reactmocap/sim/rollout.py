@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
+from reactmocap.sim.balance import StanceBalance
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, SIM_PARENTS, build_character
 from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, _t3, contact_report
 from reactmocap.sim.pd import PDServo
@@ -282,6 +283,7 @@ class TrackReport:
     friction: float
     timestep: float
     root_assist: float
+    balance: bool
     impacts: int
 
     def to_dict(self) -> dict[str, object]:
@@ -334,6 +336,7 @@ def track_clip(
     impacts: Sequence[Impact] = (),
     record_fps: float = 60.0,
     root_assist: float = 0.0,
+    balance: bool = True,
     total_mass: float = 75.0,
     config: WorldConfig | None = None,
     character_kwargs: dict[str, object] | None = None,
@@ -342,6 +345,8 @@ def track_clip(
     on a simulated character built from the clip (reference = the start frame), optionally
     with impacts (their ``start`` is relative to ``start``). Returns the simulated Motion on
     the clip's skeleton (non-simulated joints from the clip), the report and the raw result.
+    ``balance`` adds the physical :class:`~reactmocap.sim.balance.StanceBalance` (gravity
+    compensation, velocity feed-forward, COM and trunk control through the stance legs);
     ``root_assist > 0`` adds the non-physical :class:`RootAssist` with that kp."""
     if not (np.isfinite(start) and 0 <= start <= motion.duration):
         raise ConfigError(f"start {start!r} s is outside the clip (0..{motion.duration:.3f} s)")
@@ -368,9 +373,12 @@ def track_clip(
     servo = PDServo(world, kp=kp, kv=kv)
     tracker = MotionTracker(servo, 0, motion, start=start)
     ctrls: list[Controller] = [tracker]
+    if balance:
+        ctrls.append(StanceBalance(servo, 0, motion, start=start))
     if root_assist > 0:
         ctrls.append(RootAssist(world, 0, motion, start=start, kp=root_assist))
-    tracker(world, 0.0)
+    for f in ctrls:
+        f(world, 0.0)
     result = rollout(
         world,
         seconds,
@@ -400,6 +408,7 @@ def track_clip(
         friction=cfg.friction,
         timestep=cfg.timestep,
         root_assist=float(root_assist),
+        balance=bool(balance),
         impacts=len(impacts),
     )
     name = f"{motion.name}_tracked" if motion.name else "tracked"

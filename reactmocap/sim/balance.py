@@ -1,0 +1,275 @@
+"""Balance for mocap tracking: gravity compensation plus a virtual force and torque realised by
+the stance legs (Jacobian transpose), added to the PD servo as feed-forward torques.
+
+Why: an inertia-scaled joint PD servo has no notion of balance, and its gains follow the
+*outboard* inertia, which for a stance knee or ankle is a shin and a foot while the load is the
+whole body: a stance leg sags under gravity and the character slowly topples (the guard clip
+fell after 1.4 s). This is the standard fix of Zordan & Hodgins (2002) and Coros et al. (2010),
+and the thesis's balance controller (ch. 7) in Jacobian form:
+
+* **Gravity compensation:** every ball joint gets MuJoCo's bias force ``qfrc_bias`` (gravity
+  plus Coriolis of everything outboard), i.e. the torque that holds its limb up.
+* **Support and COM servo:** the ground force the body needs,
+  ``F = M (g + a_d + kp_c (c_d - c) + kv_c (v_d - v))`` with ``c_d, v_d, a_d`` the mocap centre
+  of mass, is split between the feet touching the ground and produced by the legs alone:
+  ``tau = -J_foot^T F_foot`` (columns of the leg's ball joints), clamped inside the friction
+  cone. Horizontal COM error is therefore corrected by pushing on the ground, as a person does.
+* **Trunk orientation:** a torque ``T = I (kp_o e - kv_o w)`` toward the mocap pelvis
+  orientation. The feet's moments supply ``T`` minus the moment the support forces already
+  make about the COM (centroidal balance), clipped to what a sole can pass on (centre of
+  pressure on the sole), through the rotational foot Jacobians.
+* **Velocity feed-forward:** ``kv I w_d`` with ``w_d`` the mocap joint angular velocity, so
+  the servo damps toward the mocap's joint velocity instead of toward rest (the lag of
+  ``kv/kp * w_d`` otherwise, about 0.15 rad for a swinging leg).
+
+Only internal joint torques are used: nothing is applied to the root, so the result stays
+physical (compare :class:`reactmocap.sim.rollout.RootAssist`, which is not).
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import ConfigError
+from reactmocap.library.motion import Motion
+from reactmocap.rotations import quat_conj, quat_log, quat_mul
+from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
+from reactmocap.sim.pd import PDServo
+from reactmocap.sim.world import World
+
+__all__ = ["StanceBalance"]
+
+F64 = NDArray[np.float64]
+NJ = len(BALL_JOINTS)
+_FEET = ("l_foot", "r_foot")
+
+
+class StanceBalance:
+    """Controller ``f(world, t)`` that writes balance feed-forward torques into
+    ``servo.feedforward`` for one character tracking ``motion`` from clip time ``start``.
+
+    A foot supports when it touches the floor in the simulation *and* is planted in the mocap
+    at that time (sole within ``reach`` m of the floor, moving slower than 0.6 m/s): the
+    mocap's contact timing keeps a swing foot that brushes the floor from taking weight.
+    Runs at the control rate; per call a few small numpy operations and one ``mj_jac`` per
+    supporting foot.
+
+    Args:
+        kp_com, kv_com: horizontal COM servo gains (1/s^2, 1/s); kp_height for the vertical.
+        kp_rot, kv_rot: trunk orientation gains (1/s^2, 1/s).
+        friction: fraction of the friction cone the horizontal support force may use.
+    """
+
+    def __init__(
+        self,
+        servo: PDServo,
+        character: int,
+        motion: Motion,
+        start: float = 0.0,
+        *,
+        kp_com: float = 100.0,
+        kv_com: float | None = None,
+        kp_height: float = 25.0,
+        kp_rot: float = 200.0,
+        kv_rot: float | None = None,
+        friction: float = 0.7,
+        reach: float = 0.02,
+        velocity_feedforward: bool = True,
+    ) -> None:
+        for name, v in (
+            ("kp_com", kp_com), ("kp_height", kp_height), ("kp_rot", kp_rot),
+            ("friction", friction), ("reach", reach),
+        ):  # fmt: skip
+            if not (np.isfinite(v) and v >= 0):
+                raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
+        world = servo.world
+        if character not in servo.character_indices:
+            raise ConfigError(
+                f"character {character} is not driven by the servo {servo.character_indices}"
+            )
+        self.servo = servo
+        self.world = world
+        self.character = character
+        self.motion = motion
+        self.start = float(start)
+        crit = lambda kp: 2.0 * float(np.sqrt(kp))  # noqa: E731
+        self.kp = np.array([kp_com, kp_com, kp_height], dtype=np.float64)
+        self.kv = (
+            np.array([crit(kp_com)] * 2 + [crit(kp_height)])
+            if kv_com is None
+            else (np.array([kv_com, kv_com, crit(kp_height)], dtype=np.float64))
+        )
+        self.kp_rot = float(kp_rot)
+        self.kv_rot = crit(kp_rot) if kv_rot is None else float(kv_rot)
+        self.friction = float(friction)
+        self.reach = float(reach)
+        self.velocity_feedforward = velocity_feedforward
+        m = world.model
+        wc = world.characters[character]
+        self.wc = wc
+        self.root = int(wc.body_ids[0])
+        self.mass = float(m.body_subtreemass[self.root])
+        self.gravity = -np.asarray(m.opt.gravity, dtype=np.float64)  # support per kg
+        self.feet = np.array([wc.body_ids[SIM_BODIES.index(f)] for f in _FEET])
+        foot_geoms = [wc.geom_ids[m.geom_bodyid[wc.geom_ids] == b] for b in self.feet]
+        boxes = [g[m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX] for g in foot_geoms]
+        if any(b.size != 1 for b in boxes):
+            raise ConfigError("StanceBalance needs exactly one box geom per foot")
+        self.sole = np.array([int(b[0]) for b in boxes])
+        half = m.geom_size[self.sole]
+        # the four sole corners of each foot box, in the box frame
+        signs = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=np.float64)
+        self._corners = np.stack(
+            [np.column_stack([signs * h[:2], np.full(4, -h[2])]) for h in half]
+        )  # (2, 4, 3)
+        self.floor_geoms = np.flatnonzero(m.geom_bodyid == 0)
+        self.mu = float(world.config.friction)
+        rows = servo.character_indices.index(character) * NJ
+        self._ff = servo.feedforward[rows : rows + NJ].reshape(-1)  # (45,) view
+        self._dofs = slice(wc.ball_dof_start, wc.ball_dof_start + 3 * NJ)
+        self._jacp = np.zeros((3, m.nv))
+        self._jacr = np.zeros((3, m.nv))
+        self._child = np.asarray(wc.body_ids[1:])
+        self._balls = np.array([m.joint(wc.prefix + j).id for j in BALL_JOINTS])
+        self._weight = m.body_subtreemass[self._child][:, None] * self.gravity  # (15, 3)
+        self._tau = np.empty((NJ, 3))
+        self.stance_log: list[tuple[bool, bool]] = []
+        self._reference(motion)
+
+    def _sole_heights(self, d: mujoco.MjData) -> F64:
+        """``(2,)`` lowest sole corner of each foot above the floor (m)."""
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        z = np.einsum("fj,fkj->fk", rot[:, 2, :], self._corners) + d.geom_xpos[self.sole, 2:3]
+        return z.min(axis=1)
+
+    def _reference(self, motion: Motion) -> None:
+        """Mocap COM (position, velocity, acceleration), pelvis orientation and foot stance
+        per frame."""
+        m = self.world.model
+        d = mujoco.MjData(m)
+        q = self.wc.character.qpos_from_motion(motion)
+        n = motion.num_frames
+        com = np.empty((n, 3))
+        sole = np.empty((n, 2))
+        foot = np.empty((n, 2, 3))
+        for i in range(n):  # once per clip, not in the step loop
+            d.qpos[self.wc.qpos_slice] = q[i]
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            com[i] = d.subtree_com[self.root]
+            sole[i] = self._sole_heights(d)
+            foot[i] = d.xpos[self.feet]
+        h = 1.0 / motion.fps
+        grad = (lambda a: np.gradient(a, h, axis=0)) if n > 2 else (lambda a: 0.0 * a)
+        self.com = com
+        self.com_vel = grad(com)
+        self.com_acc = grad(self.com_vel)
+        speed = np.linalg.norm(grad(foot), axis=-1)
+        self.planted = (sole < self.reach) & (speed < 0.6)  # (n, 2)
+        self.root_quat = q[:, 3:7]
+        # ball-joint angular velocities (child frame) for the servo's velocity feed-forward
+        bq = q[:, 7:].reshape(n, NJ, 4)
+        if n > 1:
+            dq = quat_mul(quat_conj(bq[:-1]), bq[1:])
+            dq *= np.where(dq[..., :1] < 0, -1.0, 1.0)  # shortest arc
+            rel = quat_log(dq) * motion.fps
+            self.joint_vel = np.concatenate([rel, rel[-1:]], axis=0)
+        else:
+            self.joint_vel = np.zeros((n, NJ, 3))
+
+    def _sample(self, t: float) -> tuple[F64, F64, F64, F64, NDArray[np.bool_]]:
+        x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
+        i0 = int(x)
+        i1 = min(i0 + 1, self.motion.num_frames - 1)
+        a = x - i0
+        lerp = lambda arr: (1 - a) * arr[i0] + a * arr[i1]  # noqa: E731
+        i = round(x)
+        return (
+            lerp(self.com), lerp(self.com_vel), lerp(self.com_acc), self.root_quat[i],
+            self.planted[i],
+        )  # fmt: skip
+
+    def _support_points(self, planted: NDArray[np.bool_]) -> tuple[list[int], list[F64]]:
+        """Supporting feet (touching the floor and planted in the mocap) and, for each, where
+        its ground force acts: the centre of its floor contacts."""
+        d = self.world.data
+        feet: list[int] = []
+        points: list[F64] = []
+        n = d.ncon
+        if n == 0:
+            return feet, points
+        geoms = d.contact.geom[:n]
+        floor = np.isin(geoms, self.floor_geoms).any(axis=1)
+        for k in range(2):
+            if not planted[k]:
+                continue
+            hit = floor & (geoms == self.sole[k]).any(axis=1)
+            if not hit.any():  # an ankle torque on a foot in the air only spins the foot
+                continue
+            p = d.contact.pos[:n][hit].mean(axis=0)
+            feet.append(k)
+            points.append(p)
+        return feet, points
+
+    def __call__(self, world: World, t: float) -> None:
+        m, d = world.model, world.data
+        ff = self._ff
+        # gravity compensation: the torque that holds each joint's subtree up,
+        # (subtree com - anchor) x (m g_up), in the child frame. Not qfrc_bias: its Coriolis
+        # part, held between control ticks, destabilised light feet.
+        r = d.subtree_com[self._child] - d.xanchor[self._balls]
+        rot = d.xmat[self._child].reshape(NJ, 3, 3)
+        np.einsum("nji,nj->ni", rot, np.cross(r, self._weight), out=self._tau)
+        ff[:] = self._tau.reshape(-1)
+        if self.velocity_feedforward:
+            x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
+            wd = self.joint_vel[int(x)]
+            rows = self.servo.character_indices.index(self.character) * NJ
+            inertia = d.M[self.servo._midx[rows : rows + NJ]]
+            ff += (self.servo.kv * np.einsum("nij,nj->ni", inertia, wd)).reshape(-1)
+        c_d, v_d, a_d, q_d, planted = self._sample(t)
+        feet, points = self._support_points(planted)
+        if not feet:
+            return
+        mujoco.mj_subtreeVel(m, d)
+        c = d.subtree_com[self.root]
+        v = d.subtree_linvel[self.root]
+        force = self.mass * (self.gravity + a_d + self.kp * (c_d - c) + self.kv * (v_d - v))
+        force[2] = max(force[2], 0.0)
+        q = d.xquat[self.root]
+        e_world = d.xmat[self.root].reshape(3, 3) @ quat_log(quat_mul(quat_conj(q), q_d))
+        w = d.cvel[self.root, :3]  # world-frame angular velocity of the pelvis
+        inertia = 0.1 * self.mass  # scale of the body's inertia about the pelvis (kg m^2)
+        torque = inertia * (self.kp_rot * e_world - self.kv_rot * w)
+        # split between two supporting feet by where the COM lies between them
+        if len(feet) == 2:
+            a, b = points[0][:2], points[1][:2]
+            ab = b - a
+            s = float(np.clip(np.dot(c[:2] - a, ab) / max(np.dot(ab, ab), 1e-9), 0.0, 1.0))
+            shares: tuple[float, ...] = (1.0 - s, s)
+        else:
+            shares = (1.0,)
+        forces = []
+        for share in shares:
+            f = share * force
+            fh = float(np.hypot(f[0], f[1]))
+            lim = self.friction * self.mu * f[2]
+            if fh > lim:
+                f[:2] *= lim / fh
+            forces.append(f)
+        # centroidal balance: the feet's moments make up what the forces' moments about the
+        # COM lack, so the net wrench turns the body as asked and no more
+        moment = torque - sum(np.cross(p - c, f) for p, f in zip(points, forces, strict=True))
+        jp, jr = self._jacp, self._jacr
+        for k, p, f, share in zip(feet, points, forces, shares, strict=True):
+            # what the sole can pass on: the centre of pressure stays on the sole (about its
+            # axes: roll <= Fz * half width, pitch <= Fz * half length), twist by friction
+            g = self.sole[k]
+            rot = d.geom_xmat[g].reshape(3, 3)
+            half = m.geom_size[g]
+            lim = f[2] * np.array([half[1], half[0], self.mu * 0.5 * half[1]])
+            t_local = np.clip(rot.T @ (share * moment), -lim, lim)
+            mujoco.mj_jac(m, d, jp, jr, p, int(self.feet[k]))
+            ff -= jp[:, self._dofs].T @ f + jr[:, self._dofs].T @ (rot @ t_local)

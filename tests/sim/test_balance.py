@@ -1,0 +1,102 @@
+"""Stance-leg balance: gravity compensation is MuJoCo's gravity torque, the controller keeps a
+standing clip up where plain PD tracking falls, and it only touches its own character."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from reactmocap.errors import ConfigError
+from reactmocap.library.motion import Motion
+from reactmocap.library.synth import synthetic_clips
+from reactmocap.sim import World, build_character
+from reactmocap.sim.balance import StanceBalance
+from reactmocap.sim.pd import PDServo
+from reactmocap.sim.rollout import track_clip
+
+
+@pytest.fixture(scope="module")
+def clips() -> dict[str, Motion]:
+    return synthetic_clips(30.0)
+
+
+@pytest.fixture(scope="module")
+def guard_loop(clips: dict[str, Motion]) -> Motion:
+    g = clips["guard"]
+    return Motion.concatenate([g, g.slice(1)], name="guard_x2")
+
+
+def test_gravity_compensation_is_mujocos_gravity_torque(clips: dict[str, Motion]) -> None:
+    kick = clips["front_kick"]
+    world = World(build_character(kick, frame=0))
+    world.set_from_motion(0, kick, 20)
+    m, d = world.model, world.data
+    d.qvel[:] = 0.0
+    d.qpos[2] += 1.0  # in the air: no support, only gravity compensation
+    mujoco.mj_forward(m, d)
+    servo = PDServo(world)
+    bal = StanceBalance(servo, 0, kick, velocity_feedforward=False)
+    bal(world, 0.0)
+    wc = world.characters[0]
+    bias = d.qfrc_bias[wc.ball_dof_start : wc.ball_dof_start + 45]  # gravity only at rest
+    np.testing.assert_allclose(servo.feedforward.reshape(-1), bias, atol=1e-9)
+    assert np.abs(bias).max() > 1.0
+
+
+def test_feedforward_holds_a_standing_pose_with_a_weak_servo(clips: dict[str, Motion]) -> None:
+    """Statics: with a PD servo far too weak to carry the body, the balance feed-forward keeps
+    a standing character up for half a second; without it the character collapses. The
+    other character in the world is left alone."""
+    guard = clips["guard"]
+
+    def pelvis_drop(balance: bool) -> tuple[float, PDServo]:
+        world = World([build_character(guard, frame=0), build_character(guard, frame=0)])
+        world.set_from_motion(0, guard, 0)
+        world.set_from_motion(1, guard, 0)
+        world.data.qpos[world.characters[0].qpos_adr] += 3.0  # apart
+        mujoco.mj_forward(world.model, world.data)
+        servo = PDServo(world, kp=100.0)  # 40x weaker than the default
+        bal = StanceBalance(servo, 1, guard) if balance else None
+        z0 = world.com(1)[2]
+        for k in range(250):  # 0.5 s, control every 2 ms
+            if bal is not None:
+                bal(world, 0.002 * k)
+            for _ in range(4):
+                servo.apply()
+                mujoco.mj_step(world.model, world.data)
+        return z0 - world.com(1)[2], servo
+
+    weak, _ = pelvis_drop(False)
+    held, servo = pelvis_drop(True)
+    assert weak > 0.15, weak
+    assert held < 0.02, held
+    assert np.all(servo.feedforward[:15] == 0.0)
+
+
+def test_balance_keeps_a_standing_clip_up(guard_loop: Motion) -> None:
+    secs = 3.5
+    _, plain, _ = track_clip(guard_loop, seconds=secs, balance=False)
+    _, bal, _ = track_clip(guard_loop, seconds=secs, balance=True)
+    assert plain.fell, "plain PD tracking is expected to topple (no balance control)"
+    assert not bal.fell
+    assert bal.max_root_error_m < 0.03
+    assert bal.mean_joint_error_rad < 0.02
+    assert bal.balance and not plain.balance
+
+
+@pytest.mark.parametrize(
+    ("key", "value"), [("kp_com", -1.0), ("kp_rot", float("nan")), ("friction", -0.1)]
+)
+def test_bad_gains_rejected(clips: dict[str, Motion], key: str, value: float) -> None:
+    world = World(build_character(clips["guard"], frame=0))
+    servo = PDServo(world)
+    with pytest.raises(ConfigError, match=key):
+        StanceBalance(servo, 0, clips["guard"], **{key: value})  # type: ignore[arg-type]
+
+
+def test_unknown_character_rejected(clips: dict[str, Motion]) -> None:
+    world = World(build_character(clips["guard"], frame=0))
+    servo = PDServo(world)
+    with pytest.raises(ConfigError, match="character 3"):
+        StanceBalance(servo, 3, clips["guard"])
