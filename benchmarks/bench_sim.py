@@ -200,12 +200,9 @@ def bench_tracking(kp: float, assist_gain: float) -> None:
     if not clips:
         print(f"\n(no shared clips under {SHARED.resolve()}: tracking robustness skipped)")
         return
-    for assist in (0.0, assist_gain):
-        label = (
-            "physical, no root help"
-            if assist == 0
-            else f"WITH non-physical root assist kp={assist:g}"
-        )
+    modes = [(False, 0.0, "PD only"), (True, 0.0, "PD + stance balance (physical)"),
+             (True, assist_gain, f"PD + balance WITH non-physical root assist kp={assist_gain:g}")]  # fmt: skip
+    for balance, assist, label in modes:
         print(f"\n## tracking robustness, kp={kp:g}, kv critical, {label}")
         print(
             f"{'clip':<28} {'windows':>7} {'ok %':>6} {'upright %':>9} {'med root cm':>11} "
@@ -223,8 +220,9 @@ def bench_tracking(kp: float, assist_gain: float) -> None:
                     from reactmocap.sim.rollout import _errors
 
                     _, rep, res = track_clip(
-                        motion, start=float(s), seconds=secs, kp=kp, root_assist=assist
-                    )
+                        motion, start=float(s), seconds=secs, kp=kp, root_assist=assist,
+                        balance=balance,
+                    )  # fmt: skip
                     # recompute per-frame errors for the window criterion
                     world = World(build_character(motion, frame=round(s * motion.fps)))
                     err = _errors(world, res, motion, float(s))
@@ -253,9 +251,11 @@ def bench_tracking(kp: float, assist_gain: float) -> None:
 def bench_guard(kp: float, assist_gain: float) -> None:
     guard = synthetic_clips(30.0)["guard"]
     loop = Motion.concatenate([guard, guard.slice(1), guard.slice(1)], name="guard_x3")
-    for assist in (0.0, assist_gain):
-        _, rep, _ = track_clip(loop, seconds=10.0, kp=kp, root_assist=assist)
-        label = "physical" if assist == 0 else f"root assist kp={assist:g}"
+    for balance, assist in ((False, 0.0), (True, 0.0), (False, assist_gain)):
+        _, rep, _ = track_clip(loop, seconds=10.0, kp=kp, root_assist=assist, balance=balance)
+        label = (
+            f"root assist kp={assist:g}" if assist else ("PD + balance" if balance else "PD only")
+        )
         print(
             f"\n## guard 10 s ({label}): fell={rep.fell} (at {rep.fall_time}), "
             f"mean joint err {rep.mean_joint_error_rad:.3f} rad, root err "
