@@ -4,8 +4,14 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Sequence
+
+# MuJoCo picks its GL backend when it is imported: without a display, use EGL offscreen
+# (``--video``); a user's own MUJOCO_GL wins.
+if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+    os.environ.setdefault("MUJOCO_GL", "egl")
 
 from reactmocap import __version__
 from reactmocap.errors import ReactMocapError

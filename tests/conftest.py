@@ -3,9 +3,15 @@ CI); tests that need it skip with a clear reason on a user's fresh clone."""
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
 
 import pytest
+
+# as the reactmocap command does: offscreen GL for MuJoCo's renderer where there is no display
+if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+    os.environ.setdefault("MUJOCO_GL", "egl")
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED_MOCAP = REPO.parent / "shared" / "mocap"

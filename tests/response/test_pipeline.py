@@ -136,7 +136,10 @@ def test_demo_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
     assert (tmp_path / "recipient.bvh").exists()
     import imageio.v3 as iio
 
-    frames = iio.imread(tmp_path / "video.gif")
+    report = json.loads((tmp_path / "report.json").read_text())
+    video = Path(report["outputs"]["video"])
+    assert video.parent == tmp_path and report["outputs"]["video_renderer"]
+    frames = iio.imread(video)
     assert frames.ndim == 4 and frames.shape[0] > 30  # an animation, not a still
     assert frames[0].std() > 1.0  # something was drawn
 

@@ -1,0 +1,122 @@
+"""Video of a response rendered with MuJoCo's offscreen renderer: the characters as their
+simulation bodies (capsules and foot boxes), plus an optional translucent "ghost" of the found
+clip, on a floor, from a camera that follows the recipient.
+
+Headless machines need an offscreen GL: set ``MUJOCO_GL=egl`` (or ``osmesa``) before MuJoCo
+is imported; the ``reactmocap`` command does this itself when there is no display. Where no GL
+context can be made, :func:`render_video` raises :class:`RenderUnavailable` and the caller
+falls back to the matplotlib stick figure.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from reactmocap.errors import ReactMocapError
+from reactmocap.library.motion import Motion
+from reactmocap.sim.character import build_character
+
+__all__ = ["RenderUnavailable", "render_video"]
+
+RGBA = tuple[float, float, float, float]
+
+
+class RenderUnavailable(ReactMocapError):
+    """No OpenGL context for MuJoCo's offscreen renderer on this machine."""
+
+
+def _scene(chars: Sequence[mujoco.MjSpec]) -> mujoco.MjModel:
+    spec = mujoco.MjSpec()
+    spec.worldbody.add_light(
+        pos=[0.0, 0.0, 6.0], dir=[0.0, 0.0, -1.0], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
+    )
+    spec.worldbody.add_geom(
+        type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05], rgba=[0.82, 0.84, 0.86, 1.0]
+    )
+    for k, ch in enumerate(chars):
+        spec.attach(ch, prefix=f"c{k}/", frame=spec.worldbody.add_frame())
+    model = spec.compile()
+    model.vis.headlight.ambient[:] = 0.35
+    model.vis.headlight.diffuse[:] = 0.6
+    model.vis.rgba.haze[:] = (0.9, 0.92, 0.95, 1.0)
+    return model
+
+
+def render_video(
+    motions: Sequence[tuple[Motion, RGBA]],
+    path: str | Path,
+    *,
+    fps: float = 30.0,
+    size: tuple[int, int] = (512, 384),
+    ghost: tuple[Motion, RGBA] | None = None,
+) -> Path:
+    """Render ``motions`` (each with a colour; the first is followed by the camera) and an
+    optional ``ghost`` into an MP4 (or GIF, by ``path``'s suffix), written atomically.
+
+    Raises RenderUnavailable if no GL context can be created, ReactMocapError if the video
+    writer (imageio, the ``video`` extra) is missing.
+    """
+    try:
+        import imageio.v3 as iio
+    except ImportError:
+        raise ReactMocapError("videos need imageio: pip install 'reactmocap[video]'") from None
+    items = list(motions) + ([ghost] if ghost is not None else [])
+    if not items:
+        raise ReactMocapError("render_video needs at least one motion")
+    chars = [build_character(m, frame=0) for m, _ in items]
+    model = _scene([c.make_spec() for c in chars])
+    data = mujoco.MjData(model)
+    n = max(int(round(m.duration * fps)) + 1 for m, _ in items)
+    times = np.arange(n) / fps
+    qadr = [int(model.jnt_qposadr[model.joint(f"c{k}/root").id]) for k in range(len(items))]
+    qpos = []
+    for k, (m, rgba) in enumerate(items):
+        qpos.append(chars[k].qpos_from_motion(m.sample(np.minimum(times, m.duration))))
+        bodies = [b for b in range(model.nbody) if model.body(b).name.startswith(f"c{k}/")]
+        model.geom_rgba[np.isin(model.geom_bodyid, bodies)] = rgba
+    width, height = size
+    try:
+        renderer = mujoco.Renderer(model, height=height, width=width)
+    except Exception as exc:  # each GL backend fails in its own way
+        raise RenderUnavailable(
+            f"MuJoCo offscreen rendering unavailable (MUJOCO_GL="
+            f"{os.environ.get('MUJOCO_GL', 'unset')!r}): {exc}"
+        ) from exc
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    cam.distance, cam.elevation, cam.azimuth = 4.0, -15.0, 135.0
+    pelvis = qpos[0][:, :3]
+    # follow the recipient smoothly: the lookat is a 0.5 s moving average of its pelvis
+    k = max(1, int(fps * 0.5))
+    kernel = np.ones(k) / k
+    look = np.stack(
+        [np.convolve(np.pad(pelvis[:, i], (k // 2, k - 1 - k // 2), mode="edge"), kernel, "valid")
+         for i in range(3)], axis=1,
+    )  # fmt: skip
+    frames = np.empty((n, height, width, 3), dtype=np.uint8)
+    try:
+        for i in range(n):
+            for a, q in zip(qadr, qpos, strict=True):
+                data.qpos[a : a + q.shape[1]] = q[min(i, len(q) - 1)]
+            mujoco.mj_kinematics(model, data)
+            cam.lookat[:] = (look[i, 0], look[i, 1], 0.9)
+            renderer.update_scene(data, camera=cam)
+            frames[i] = renderer.render()
+    finally:
+        renderer.close()
+    out = Path(path)
+    tmp = out.with_name(f".{out.stem}.partial{out.suffix}")
+    try:
+        if out.suffix.lower() == ".gif":
+            iio.imwrite(tmp, frames, extension=".gif", duration=1000 / fps, loop=0)  # type: ignore[call-overload]
+        else:
+            iio.imwrite(tmp, frames, extension=out.suffix, fps=fps)  # type: ignore[call-overload]
+        os.replace(tmp, out)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return out
