@@ -13,8 +13,10 @@ Simulation 1 ("naive") modes, measured with ``benchmarks/bench_response.py``:
   as Simulation 2. The trajectory then carries the impact's dynamics on a character that stays
   "alive", which is what the library's reactions were recorded from.
 
-The per-step loop only applies the servo (vectorised, preallocated), steps MuJoCo and copies
-qpos into a preallocated buffer; desired poses are precomputed for all control ticks at once.
+The PD servo runs inside MuJoCo (actuators, see :mod:`reactmocap.sim.pd`), so the simulation
+loop only acts at events: control ticks (new targets, contact logging), the impact's first and
+last steps, and the steps whose qpos the outputs sample; MuJoCo steps in chunks in between.
+Desired poses are precomputed for all control ticks at once.
 """
 
 from __future__ import annotations
@@ -159,7 +161,8 @@ class _Sim:
 
     def __init__(self, chars: list[Character], friction: float, dt: float, kp: float, kv: float):
         self.world = World(chars, WorldConfig(friction=friction, timestep=dt))
-        self.servo = PDServo(self.world, kp=kp, kv=kv)
+        # the servo re-linearises at the control ticks, where the targets change anyway
+        self.servo = PDServo(self.world, kp=kp, kv=kv, refresh_every=CONTROL_EVERY)
         m = self.world.model
         owner = np.full(m.ngeom, -1)
         for wc in self.world.characters:
@@ -171,20 +174,26 @@ class _Sim:
         self,
         steps: int,
         targets: list[F64 | None],
-        record: F64,
+        record: _Recording,
         start: int,
         impact: tuple[int, int, int, F64] | None = None,
         contact_log: list[tuple[int, float]] | None = None,
     ) -> None:
-        """Step ``steps`` times from record row ``start``. ``targets[c]`` is ``(ticks, 15, 4)``
-        per control tick (None: passive). ``impact`` = (body id, first step, last step, 6-vector
-        xfrc). Contacts between characters are logged every ``CONTROL_EVERY`` steps."""
-        m, d = self.world.model, self.world.data
+        """Step ``steps`` times from step ``start``, recording qpos after the steps ``record``
+        samples. ``targets[c]`` is ``(ticks, 15, 4)`` per control tick (None: passive).
+        ``impact`` = (body id, first step, last step, 6-vector xfrc). Contacts between
+        characters are logged every ``CONTROL_EVERY`` steps. MuJoCo steps in chunks between
+        those events (``PDServo.step``), each event at the same step as one step at a time."""
+        d = self.world.data
         servo = self.servo
         for c, tg in enumerate(targets):
             servo.enable(c, on=tg is not None)
-        for i in range(steps):
-            k = start + i
+        rows = record.steps
+        ri = int(np.searchsorted(rows, start))
+        end = start + steps
+        k = start
+        while k < end:
+            i = k - start
             if i % CONTROL_EVERY == 0:
                 tick = i // CONTROL_EVERY
                 for c, tg in enumerate(targets):
@@ -192,14 +201,22 @@ class _Sim:
                         servo.set_targets(c, tg[min(tick, len(tg) - 1)])
                 if contact_log is not None and d.ncon:
                     self._log_contacts(k, contact_log)
+            nxt = min(end, k + CONTROL_EVERY - i % CONTROL_EVERY)
             if impact is not None:
                 if k == impact[1]:
                     d.xfrc_applied[impact[0]] = impact[3]
                 elif k == impact[2]:
                     d.xfrc_applied[impact[0]] = 0.0
-            servo.apply()
-            mujoco.mj_step(m, d)
-            record[k] = d.qpos
+                for s in impact[1:3]:
+                    if k < s < nxt:
+                        nxt = s
+            if ri < rows.size:
+                nxt = min(nxt, int(rows[ri]) + 1)
+            servo.step(nxt - k)
+            k = nxt
+            while ri < rows.size and rows[ri] < k:  # qpos after step k - 1
+                record.qpos[ri] = d.qpos
+                ri += 1
         if not np.all(np.isfinite(d.qpos)):
             raise SimulationError(f"simulation diverged by t={d.time:.3f} s (non-finite state)")
 
@@ -215,6 +232,30 @@ class _Sim:
                 mujoco.mj_contactForce(self.world.model, d, int(c), f6)
                 total += abs(f6[0])
             log.append((step, total))
+
+
+def _sample_rows(n: int, dt: float, fps: float) -> tuple[F64, NDArray[np.intp]]:
+    """Output frame times (from 0, at ``fps``) over ``n`` steps and, for each, the step whose
+    post-step qpos is the frame (step ``j`` ends at ``(j + 1) dt``; frame 0 uses step 0)."""
+    times = np.arange(0, int(np.floor(n * dt * fps)) + 1) / fps
+    return times, np.clip(np.round(times / dt).astype(int) - 1, 0, n - 1)
+
+
+class _Recording:
+    """qpos after the steps that the outputs sample at the given frame rates: the readers
+    (:func:`_to_motion`) only look at those, so the stepping loop records nothing else."""
+
+    def __init__(self, n: int, nq: int, dt: float, fps: list[float]):
+        self.n = n
+        self.steps = np.unique(np.concatenate([_sample_rows(n, dt, f)[1] for f in fps]))
+        self.qpos = np.empty((self.steps.size, nq))
+
+    def at(self, rows: NDArray[np.intp]) -> F64:
+        """Recorded qpos after each of ``rows`` (steps that were asked for)."""
+        i = np.searchsorted(self.steps, rows)
+        if not np.array_equal(self.steps[np.minimum(i, self.steps.size - 1)], rows):
+            raise SimulationError("internal error: a step that was not recorded was read")
+        return self.qpos[i]
 
 
 def _ball_targets(ch: Character, motion: Motion, times: NDArray[np.floating]) -> F64:
@@ -300,7 +341,7 @@ def run_response(scenario: Scenario) -> ResponseResult:
     if impact_spec is not None:
         impact = _with_body_id(sim, impact_spec)
     saved = sim.world.get_state()
-    rec1 = np.empty((n1, sim.world.model.nq))
+    rec1 = _Recording(n1, sim.world.model.nq, dt, [fps])
     contacts: list[tuple[int, float]] = []
     if cfg.sim1_mode == "passive":
         pre = max(0, int(round((t_contact - t_rewind) / dt)))
@@ -372,7 +413,9 @@ def run_response(scenario: Scenario) -> ResponseResult:
     sim2 = _Sim(chars, cfg.friction_sim2, dt, cfg.kp, cfg.kv)
     sim2.world.set_state(saved)
     impact2 = _with_body_id(sim2, impact_spec) if impact_spec is not None else None
-    rec2 = np.empty((n2, sim2.world.model.nq))
+    rec2 = _Recording(
+        n2, sim2.world.model.nq, dt, [fps] + ([att_motion.fps] if att_motion is not None else [])
+    )
     sim2.run(n2, targets2, rec2, 0, impact2)
     timings["sim2"] = time.perf_counter() - t
     sim2_motion = _to_motion(sim2, 0, rec_char, rec2, t_rewind, dt, fps, rec_motion, rec_t0, "sim2")
@@ -468,19 +511,18 @@ def _with_body_id(sim: _Sim, spec: tuple[str, int, int, F64, F64]) -> tuple[int,
     return bid, s0, s1, np.concatenate([force, np.cross(arm, force)])
 
 
-def _to_motion(sim: _Sim, k: int, ch: Character, rec: F64, t0: float, dt: float, fps: float,
-               reference: Motion, ref_t0: float, name: str) -> Motion:  # fmt: skip
-    """Recorded qpos rows (one per step, starting at scenario time t0 + dt) as a Motion at
-    ``fps`` on the character's original skeleton; its frame 0 is scenario time t0."""
+def _to_motion(sim: _Sim, k: int, ch: Character, rec: _Recording, t0: float, dt: float,
+               fps: float, reference: Motion, ref_t0: float, name: str) -> Motion:  # fmt: skip
+    """Recorded qpos (after steps starting at scenario time t0, step j ending at
+    t0 + (j + 1) dt) as a Motion at ``fps`` on the character's original skeleton; its frame 0
+    is scenario time t0."""
     wc = sim.world.characters[k]
-    n = rec.shape[0]
-    times = np.arange(0, int(np.floor(n * dt * fps)) + 1) / fps
-    rows = np.clip(np.round(times / dt).astype(int) - 1, 0, n - 1)
-    q = rec[rows][:, wc.qpos_slice]
+    times, rows = _sample_rows(rec.n, dt, fps)
+    q = rec.at(rows)[:, wc.qpos_slice]
     return ch.motion_from_qpos(q, fps, reference=reference, times=times + t0 + ref_t0, name=name)
 
 
-def _attacker_output(ch: Character, sim: _Sim, rec: F64, motion: Motion, clock0: float,
+def _attacker_output(ch: Character, sim: _Sim, rec: _Recording, motion: Motion, clock0: float,
                      t_rewind: float, t_impact: float, dt: float, cfg: Any,
                      duration: float) -> Motion:  # fmt: skip
     """The attacker follows its simulation for ``attacker_follow`` s after the impact, then
@@ -520,16 +562,39 @@ def run_scenario(
     if plot:
         outputs["plot"] = str(_plot(result, out / "plot.png", scenario))
     if video:
+        outputs.update(_video(result, out))
+    outputs["report"] = str(out / "report.json")
+    report["outputs"] = outputs
+    atomic_write_text(out / "report.json", json.dumps(_jsonable(report), indent=2))
+    return report
+
+
+def _video(result: ResponseResult, out: Path) -> dict[str, str]:
+    """MuJoCo-rendered MP4 with a translucent ghost of the found clip; the matplotlib stick
+    figure GIF where no GL context can be made (the report says which)."""
+    from reactmocap.response.render import RenderUnavailable, render_video
+
+    fps = result.recipient.fps
+    t = result.recipient.times
+    # the found clip on the scenario clock: its matched frame falls on the transition's end
+    ghost = result.found.sample(np.clip(result.matched.time + t - result.transition_end, 0, None))
+    try:
+        path = render_video(
+            [(result.recipient, (0.25, 0.45, 0.85, 1.0))]
+            + ([(result.attacker, (0.85, 0.3, 0.25, 1.0))] if result.attacker is not None else []),
+            out / "video.mp4",
+            fps=min(fps, 30.0),
+            ghost=(ghost.replace(fps=fps), (0.3, 0.8, 0.35, 0.3)),
+        )
+        return {"video": str(path), "video_renderer": "mujoco"}
+    except RenderUnavailable as exc:
         from reactmocap.response.plots import stick_figure_video
 
         motions = [(result.recipient, "tab:blue")]
         if result.attacker is not None:
             motions.append((result.attacker, "tab:red"))
-        outputs["video"] = str(stick_figure_video(motions, out / "video.gif"))
-    outputs["report"] = str(out / "report.json")
-    report["outputs"] = outputs
-    atomic_write_text(out / "report.json", json.dumps(_jsonable(report), indent=2))
-    return report
+        path = stick_figure_video(motions, out / "video.gif")
+        return {"video": str(path), "video_renderer": f"matplotlib stick figure ({exc})"}
 
 
 def _plot(result: ResponseResult, path: Path, scenario: Scenario) -> Path:

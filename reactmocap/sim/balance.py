@@ -226,8 +226,7 @@ class StanceBalance:
         if self.velocity_feedforward:
             x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
             wd = self.joint_vel[int(x)]
-            rows = self.servo.character_indices.index(self.character) * NJ
-            inertia = d.M[self.servo._midx[rows : rows + NJ]]
+            inertia = self.servo.joint_inertia(self.character)
             ff += (self.servo.kv * np.einsum("nij,nj->ni", inertia, wd)).reshape(-1)
         c_d, v_d, a_d, q_d, planted = self._sample(t)
         feet, points = self._support_points(planted)

@@ -8,28 +8,56 @@ which is what the papers mean by "the inertia of the outboard body". One ``kp`` 
 for all joints; per-joint gains exist only for :meth:`PDServo.freeze` (Deva's spring-damper
 clamp) and for switching joints off.
 
-How it is computed, and why (figures from ``benchmarks/bench_sim.py``):
+How it is computed, and why: the servo lives inside MuJoCo, as actuators, so that a rollout
+calls ``mj_step(m, d, nstep=k)`` between control ticks instead of a Python loop around every
+step (the loop, a matmul into ``qfrc_applied`` plus one ``mj_step`` call per step, was the
+remaining 20-45% overhead over bare stepping in ``benchmarks/bench_sim.py`` and
+``benchmarks/bench_response.py``). What is left in Python is one refresh per control tick.
 
-* **Stiffness term, every step, exact 3x3.** At each *refresh* (every ``refresh_every`` steps,
-  default 4 = 2 ms) the servo gathers ``I`` from MuJoCo's sparse ``d.M`` (one ``np.take`` over
-  precomputed CSR indices) and folds ``I``, ``kp``, the target ``q_d`` and the log's angle
-  factor into one ``(3, 4)`` matrix per joint, ``A = 2 kp f I [conj(q) * q_d]_xyz``, with
-  ``f = atan2(|v|, |w|) / |v|`` (sign of ``w``: shortest arc). Every step then costs a single
-  batched ``matmul`` of ``A`` with the ball quaternions, written straight into a view of
-  ``qfrc_applied``: no Python loop over joints, no allocation. Between refreshes the torque
-  is still exact in direction and first-order exact in angle (``f`` changes by < 0.1% per
-  refresh at tracking errors).
-* **Damping term, implicit, per DOF.** ``kv I qdot`` applied explicitly was unstable at
-  dt = 0.5 ms: the 8 kg pelvis sits between the strong hip and waist servos, and
-  ``kv * I_hip / I_pelvis * dt > 2``. MuJoCo integrates joint damping implicitly
-  (implicitfast/Euler), so the servo writes ``kv * diag(I)`` (plus the world's light damping)
-  into ``dof_damping`` at each refresh. This keeps the diagonal of ``I`` exactly and drops the
-  off-diagonal damping coupling, which is small when the joint axes are near the segment's
-  principal axes and never destabilises.
-* Optional per-DOF torque limit (``np.clip`` into the same view) on the stiffness term.
+* **Actuators.** The World gives every ball joint three ``general`` actuators (joint
+  transmission, fixed gain, affine bias; zero until a servo sets them). For a ball joint MuJoCo
+  defines an actuator's length as ``g . r(q)``, with ``r(q)`` the shortest-arc rotation vector
+  of the joint quaternion (``mju_quat2Vel``), its velocity as ``g . qdot``, and its torque on
+  the joint as ``g * force`` in the child frame, ``g`` being the first three gear entries, of
+  any length (checked against MuJoCo 4.0 in ``tests/sim/test_pd.py``).
+* **Refresh (control rate).** Every ``refresh_every`` steps, and before the next step after new
+  targets, gains or a state set through the World, the servo gathers ``I`` from the sparse
+  ``d.M`` (one ``np.take``) and factors it, ``I = L L^T`` (batched Cholesky: exact, ~5 us for
+  15 joints against ~18 us for ``eigh``; and because the factor's columns carry the scale, the
+  gains stay the constants ``kp``, ``kv`` and a refresh writes only gears and ``ctrl``).
+  Actuator ``k`` of a joint gets gear ``l_k`` (column ``k`` of ``L``), gain ``kp``, bias
+  ``(0, -kp, -kv)`` and ``ctrl_k = l_k . (r(q0) + e0)``, ``q0`` the current rotation and
+  ``e0 = log(q0^-1 q_d)``. Summed over ``k``::
 
-A pure per-step numpy implementation (17 ufunc calls) measured ~21 us per step on this
-machine, about 40% of a standing character's mj_step; the scheme above costs a few us.
+      tau = kp I (r(q0) + e0 - r(q)) - kv I qdot
+
+  equal to the reference torque at the refresh (to rounding: :meth:`PDServo.torques`); between
+  refreshes the stiffness is linearised in ``r(q)`` (first order; its direction drifts by about
+  ``(|r0| + |e0|) / 2`` times the rotation since the refresh), the damping is exact. Measured
+  on the front-kick example: p95 deviation from the reference ~1% 3 steps after a refresh,
+  ~4% after 9 (the former per-step servo deviated by 30-45%, from its diagonal damping).
+  A refresh costs ~20 us for 15 joints, ~24 us for 30.
+* **Damping, implicit, full 3x3.** ``implicitfast`` adds each actuator's velocity-bias
+  derivative, ``-kv g g^T``, to ``qDeriv``: the whole ``-kv I`` block is integrated implicitly.
+  Explicit ``kv I qdot`` was unstable at dt = 0.5 ms (the 8 kg pelvis between the strong hip
+  and waist servos: ``kv * I_hip / I_pelvis * dt > 2``). This replaces the former trick of
+  writing ``kv * diag(I)`` into ``dof_damping`` (diagonal only); the World's light joint
+  damping stays in ``dof_damping``. Cost: MuJoCo then builds ``qDeriv`` and factors
+  ``M - dt qDeriv`` each step, ~2.6 us per character per step (~7% of a standing step); the
+  actuators themselves add ~1.3 us. Under the Euler integrator, which treats only joint
+  damping implicitly, the servo falls back to the former scheme for the damping
+  (``kv * diag(I)`` in ``dof_damping`` at each refresh); RK4 is explicit in both.
+* **Half turns.** ``r(q)`` flips when a joint's angle crosses pi, a jump of 2 pi in the lengths
+  between two refreshes. A joint within ``HALF_TURN_MARGIN`` of pi at a refresh gets its
+  stiffness term as a constant torque in ``qfrc_applied`` until the next refresh (zero-order
+  hold) and keeps the actuator damping. MuJoCo 4.0 also wraps a ball-joint position servo's
+  setpoint (gain = -bias[1]) to the representative nearest the current length, modulo
+  ``2 pi |g|``; at a refresh ``|g . e0| <= pi |g|``, so that never changes the torque there.
+* **Feed-forward.** :attr:`PDServo.feedforward` goes into ``qfrc_applied`` (ball DOFs) at each
+  refresh; nothing else of the servo writes ``qfrc_applied`` (but the half-turn hold above).
+* Optional torque limit: the actuators' ``forcerange``, set per refresh so that the torque
+  along each unit axis ``l_k / |l_k|`` stays within the limit. It clamps stiffness and damping
+  together, per Cholesky axis rather than per DOF (the same axes when ``I`` is diagonal).
 """
 
 from __future__ import annotations
@@ -42,7 +70,7 @@ from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, SimulationError, UnknownKeyError
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_normalize
+from reactmocap.rotations import quat_log, quat_normalize
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.world import World
 
@@ -58,31 +86,34 @@ def critical_kv(kp: float) -> float:
     return 2.0 * float(np.sqrt(kp))
 
 
+# conj(q) * qd == R @ q with R[i, j] = _RSIGN[i, j] * qd[_RIDX[i, j]] (Hamilton product)
+_RIDX = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
+_RSIGN = np.array(
+    [[1.0, 1.0, 1.0, 1.0], [1.0, -1.0, -1.0, 1.0], [1.0, 1.0, -1.0, -1.0], [1.0, -1.0, 1.0, -1.0]]
+)
+#: joints closer than this (rad) to a half turn get their stiffness as a held torque (see above)
+HALF_TURN_MARGIN = 0.4
+
+
 def _right_matrix(qd: F64) -> F64:
     """``(n, 4, 4)`` matrices ``R`` with ``conj(q) * qd == R @ q`` (Hamilton product)."""
-    w, x, y, z = qd[:, 0], qd[:, 1], qd[:, 2], qd[:, 3]
-    # right-multiplication matrix of qd: a * qd = Rq(qd) @ a
-    rq = np.stack(
-        [
-            np.stack([w, -x, -y, -z], -1),
-            np.stack([x, w, z, -y], -1),
-            np.stack([y, -z, w, x], -1),
-            np.stack([z, y, -x, w], -1),
-        ],
-        axis=1,
-    )
-    return rq * np.array([1.0, -1.0, -1.0, -1.0])  # conj(q) = diag(1,-1,-1,-1) q
+    return qd[:, _RIDX] * _RSIGN
 
 
 class PDServo:
-    """PD servo over the ball joints of some (default: all) characters of a World.
+    """PD servo over the ball joints of some (default: all) characters of a World, run by the
+    World's servo actuators (see the module docstring).
 
     Args:
         world: the world.
         kp: stiffness (1/s^2); kv: damping (1/s). Defaults: kp 900, kv critical (60).
         characters: indices of the characters to actuate (default all).
-        torque_limit: optional per-DOF torque limit (N m), scalar.
-        refresh_every: refresh ``I``, the log factor and the damping every this many steps.
+        torque_limit: optional torque limit (N m) per actuator axis, scalar.
+        refresh_every: re-linearise (inertia, rotation vectors, gears, ``ctrl``) at least every
+            this many steps; also before the first step after new targets, gains or state.
+
+    Step with :meth:`step` (``mj_step(nstep=...)`` between refreshes), or call :meth:`apply`
+    before each single ``mj_step``.
     """
 
     def __init__(
@@ -102,14 +133,16 @@ class PDServo:
         self.character_indices = tuple(idx)
         n = NJ * len(idx)
         self.n = n
-        m = world.model
-        qidx, didx = [], []
+        m, d = world.model, world.data
+        qidx, didx, aidx = [], [], []
         for i in idx:
             wc = world.characters[i]
             qidx.append(wc.ball_qpos_start + np.arange(4 * NJ))
             didx.append(wc.ball_dof_start + np.arange(3 * NJ))
+            aidx.append(wc.actuator_adr + np.arange(3 * NJ))
         self._qidx = np.concatenate(qidx).astype(np.intp)
         self._didx = np.concatenate(didx).astype(np.intp)
+        self._aidx = np.concatenate(aidx).astype(np.intp)
         # CSR positions of every (row, col) of each 3x3 diagonal block (lower triangle mirrored)
         midx = np.empty((n, 3, 3), dtype=np.intp)
         dofs = self._didx.reshape(n, 3)
@@ -124,40 +157,66 @@ class PDServo:
                         raise SimulationError("unexpected sparsity of MuJoCo's mass matrix")
                     midx[k, a, b] = start + hit[0]
         self._midx = midx
-        # buffers
-        self._r = np.empty((n, 4, 1))
-        self._s = np.empty(n)
-        self._aw = np.empty(n)
+        # views on the actuators' gears and controls: (n, 3, 3) rows = gear of actuator k,
+        # (n, 3, 1) controls; contiguous for the usual (sorted) character lists
+        a0 = int(self._aidx[0])
+        self._contiguous = bool(np.array_equal(self._aidx, np.arange(a0, a0 + 3 * n)))
+        if self._contiguous:
+            self._gear = m.actuator_gear[a0 : a0 + 3 * n, :3].reshape(n, 3, 3)
+            self._ctrl = d.ctrl[a0 : a0 + 3 * n].reshape(n, 3, 1)
+            if not (
+                np.shares_memory(self._gear, m.actuator_gear)
+                and np.shares_memory(self._ctrl, d.ctrl)
+            ):
+                raise SimulationError("actuator views are copies (internal error)")
+        else:
+            self._gear = np.empty((n, 3, 3))
+            self._ctrl = np.empty((n, 3, 1))
+        # buffers, and views on them made once (a refresh is ~20 numpy calls on 15-30 rows,
+        # where Python-level slicing would cost a quarter of the time): rows [0, n) of the
+        # quaternion buffer hold the joint rotations q0, rows [n, 2n) conj(q0) * q_d
+        q = np.empty((2 * n, 4))
+        self._q0_flat, self._q0_col, self._p_col = q[:n].reshape(-1), q[:n, :, None], q[n:, :, None]
+        self._v, self._w = q[:, 1:], q[:, 0]
+        self._v0, self._v1, self._v2 = q[:, 1], q[:, 2], q[:, 3]
+        self._s = np.empty(2 * n)
+        self._half = np.empty(2 * n)
+        self._half0 = self._half[:n]
+        self._f = np.empty(2 * n)
+        self._f_col = self._f[:, None]
+        x = np.empty((2 * n, 3))  # half rotation vectors r0 / 2 and e0 / 2
+        self._x, self._x0, self._x1 = x, x[:n], x[n:]
+        self._sum = np.empty((n, 3, 1))
+        self._sum_flat = self._sum[:, :, 0]
         self._inertia = np.empty((n, 3, 3))
-        self._rd = np.empty((n, 4, 4))
-        self._a = np.zeros((n, 3, 4))
+        self._any_hot = False
         self.targets = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+        self._rd = _right_matrix(self.targets)
         #: extra joint torques (N m, child frame) added to the servo's output, e.g. gravity
         #: compensation or a balance controller's; ``(n, 3)``, written in place by controllers
+        #: and copied into ``qfrc_applied`` at each refresh
         self.feedforward = np.zeros((n, 3))
-        self._kpcol = np.empty(n)
-        self._kvcol = np.empty(n)
+        self._kp = np.zeros(n)  # per-joint effective gains (frozen, off)
+        self._kv = np.zeros(n)
         self._enabled = np.ones(n, dtype=bool)
         self._frozen = np.zeros(n, dtype=bool)
+        self._hot = np.zeros(n, dtype=bool)  # near a half turn: stiffness held in qfrc_applied
         self.freeze_scale = 4.0
         if torque_limit is not None and not (np.isfinite(torque_limit) and torque_limit > 0):
             raise ConfigError(f"torque_limit must be a positive number, got {torque_limit!r}")
         self.torque_limit = torque_limit
+        # Euler integrates only joint damping implicitly: there the damping's diagonal goes to
+        # dof_damping at each refresh (the former scheme); implicit(fast) takes the full 3x3
+        self._diag_damping = m.opt.integrator == int(mujoco.mjtIntegrator.mjINT_EULER)
+        self._base_damping = m.dof_damping[self._didx].copy()
+        m.actuator_forcelimited[self._aidx] = torque_limit is not None
+        m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)  # World: off until now
         if refresh_every < 1:
             raise ConfigError(f"refresh_every must be >= 1, got {refresh_every}")
         self.refresh_every = int(refresh_every)
-        self._count = 0
+        self._since = 0  # steps since the last refresh
         self._dirty = True
-        self._base_damping = m.dof_damping[self._didx].copy()
-        # contiguous per-character views: (15, 4, 1) quaternions, (15, 3, 1) torques
-        d = world.data
-        self._views = []
-        for k, i in enumerate(idx):
-            wc = world.characters[i]
-            qv = d.qpos[wc.ball_qpos_start : wc.ball_qpos_start + 4 * NJ].reshape(NJ, 4, 1)
-            tv = d.qfrc_applied[wc.ball_dof_start : wc.ball_dof_start + 3 * NJ].reshape(NJ, 3, 1)
-            ff = self.feedforward[k * NJ : (k + 1) * NJ].reshape(NJ, 3, 1)
-            self._views.append((self._a[k * NJ : (k + 1) * NJ], qv, tv, ff))
+        self._epoch = world.state_epoch
         self.set_gains(kp, critical_kv(kp) if kv is None else kv)
         self.set_targets_to_current()
 
@@ -172,10 +231,20 @@ class PDServo:
     def _refresh_gains(self) -> None:
         scale = np.where(self._frozen, self.freeze_scale, 1.0)
         on = self._enabled | self._frozen
-        # 2 * kp: the servo computes half the rotation vector (see apply)
-        self._kpcol[:] = np.where(on, 2.0 * self.kp * scale, 0.0)
-        self._kvcol[:] = np.where(on, self.kv * np.sqrt(scale), 0.0)
+        self._kp[:] = np.where(on, self.kp * scale, 0.0)
+        self._kv[:] = np.where(on, self.kv * np.sqrt(scale), 0.0)
+        self._write_gains()
         self._dirty = True
+
+    def _write_gains(self) -> None:
+        """Actuator gains from the per-joint gains; half-turn joints keep only the damping.
+        ``bias[1] = -gain`` exactly: MuJoCo then treats the actuator as a position servo."""
+        m = self.world.model
+        gain = np.repeat(np.where(self._hot, 0.0, self._kp), 3)
+        m.actuator_gainprm[self._aidx, 0] = gain
+        m.actuator_biasprm[self._aidx, 0] = 0.0
+        m.actuator_biasprm[self._aidx, 1] = -gain
+        m.actuator_biasprm[self._aidx, 2] = 0.0 if self._diag_damping else -np.repeat(self._kv, 3)
 
     def _rows(self, character: int, joints: Sequence[str] | None) -> NDArray[np.intp]:
         if character not in self.character_indices:
@@ -193,7 +262,8 @@ class PDServo:
         return np.array(rows, dtype=np.intp)
 
     def enable(self, character: int, joints: Sequence[str] | None = None, on: bool = True) -> None:
-        """Switch the servo on or off for some joints (off = passive, ragdoll)."""
+        """Switch the servo on or off for some joints (off = passive, ragdoll: zero gain and
+        zero damping in their actuators)."""
         self._enabled[self._rows(character, joints)] = on
         self._refresh_gains()
 
@@ -205,7 +275,6 @@ class PDServo:
         self.targets[rows] = q
         self._rd[rows] = _right_matrix(q)
         self._frozen[rows] = True
-        self._dirty = True
         self._refresh_gains()
 
     def unfreeze(self, character: int, joints: Sequence[str] | None = None) -> None:
@@ -221,14 +290,16 @@ class PDServo:
         """Desired local rotations ``(15, 4)`` (wxyz, MuJoCo ball order) of one character.
         Frozen joints keep their clamp targets."""
         rows = self._rows(character, None)
+        sl = slice(int(rows[0]), int(rows[0]) + NJ)  # every control tick: no fancy indexing
         q = np.asarray(quats, dtype=np.float64).reshape(NJ, 4)
-        if not np.all(np.isfinite(q)):
+        if not np.isfinite(q).all():
             raise SimulationError("PD targets contain NaN or inf")
-        q = quat_normalize(q)
-        keep = self._frozen[rows]
-        q = np.where(keep[:, None], self.targets[rows], q)
-        self.targets[rows] = q
-        self._rd[rows] = _right_matrix(q)
+        q = q / np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
+        keep = self._frozen[sl]
+        if keep.any():
+            q = np.where(keep[:, None], self.targets[sl], q)
+        self.targets[sl] = q
+        np.multiply(q[:, _RIDX], _RSIGN, out=self._rd[sl])
         self._dirty = True
 
     def set_targets_from_qpos(self, character: int, qpos: F64) -> None:
@@ -245,62 +316,127 @@ class PDServo:
         self._rd[:] = _right_matrix(q)
         self._dirty = True
 
-    # ------------------------------------------------------------------ per step
+    # ------------------------------------------------------------------ stepping
     def refresh(self) -> None:
-        """Control-rate update: inertia blocks, log factor, stiffness matrices, damping."""
-        d, m = self.world.data, self.world.model
+        """Control-rate update: re-linearise the actuators at the current state (inertia
+        factor into the gears, rotation vectors into ``ctrl``), copy :attr:`feedforward`
+        into ``qfrc_applied``. After it the actuators' torque equals :meth:`torques`."""
+        d = self.world.data
         np.take(d.M, self._midx, out=self._inertia)
-        q = d.qpos[self._qidx].reshape(self.n, 4, 1)
-        np.matmul(self._rd, q, out=self._r)  # conj(q) * q_d
-        v = self._r[:, 1:, 0]
-        w = self._r[:, 0, 0]
-        s = self._s
-        np.sqrt(np.einsum("ij,ij->i", v, v), out=s)
-        np.maximum(s, 1e-12, out=s)
-        np.abs(w, out=self._aw)
-        np.arctan2(s, self._aw, out=self._aw)  # half angle
-        np.divide(self._aw, s, out=s)
-        np.copysign(s, w, out=s)  # shortest arc
-        s *= self._kpcol  # 2 kp f (f carries 1/|q|, so A @ q is right for unnormalised q)
-        # A = (2 kp f) I @ (rows x, y, z of Rd): tau = A @ q is I kp e with e = 2 f v
-        np.matmul(self._inertia, self._rd[:, 1:, :], out=self._a)
-        self._a *= s[:, None, None]
-        diag = np.einsum("nii->ni", self._inertia)
-        m.dof_damping[self._didx] = self._base_damping + (self._kvcol[:, None] * diag).reshape(-1)
+        lt = np.linalg.cholesky(self._inertia).transpose(0, 2, 1)  # row k: column l_k of L
+        np.take(d.qpos, self._qidx, out=self._q0_flat)
+        np.matmul(self._rd, self._q0_col, out=self._p_col)  # conj(q0) * q_d
+        # both logs at once, as mju_quat2Vel: 2 atan2(|v|, |w|) sign(w) v / |v| (shortest arc)
+        s, half, f, w = self._s, self._half, self._f, self._w
+        np.hypot(self._v0, self._v1, out=s)
+        np.hypot(s, self._v2, out=s)
+        np.maximum(s, 1e-300, out=s)
+        np.abs(w, out=half)
+        np.arctan2(s, half, out=half)  # half angle in [0, pi/2]
+        np.divide(half, s, out=f)
+        np.copysign(f, w, out=f)
+        np.multiply(self._v, self._f_col, out=self._x)
+        xs = self._sum
+        np.add(self._x0, self._x1, out=self._sum_flat)
+        xs *= 2.0  # r0 + e0
+        np.matmul(lt, xs, out=self._ctrl)
+        np.copyto(self._gear, lt)
+        if not self._contiguous:
+            m = self.world.model
+            m.actuator_gear[self._aidx, :3] = self._gear.reshape(-1, 3)
+            d.ctrl[self._aidx] = self._ctrl.reshape(-1)
+        if self.torque_limit is not None:
+            self._set_force_range(lt)
+        if self._diag_damping:
+            diag = np.einsum("nii->ni", self._inertia)
+            self.world.model.dof_damping[self._didx] = self._base_damping + (
+                self._kv[:, None] * diag
+            ).reshape(-1)
+        d.qfrc_applied[self._didx] = self.feedforward.reshape(-1)
+        if self._any_hot or self._half0.max() > 0.5 * (np.pi - HALF_TURN_MARGIN):
+            self._half_turns(self._half0 > 0.5 * (np.pi - HALF_TURN_MARGIN), self._x1)
+        self._since = 0
+        self._dirty = False
+        self._epoch = self.world.state_epoch
+
+    def _set_force_range(self, lt: NDArray[np.floating]) -> None:
+        assert self.torque_limit is not None
+        norm = np.sqrt(np.einsum("nij,nij->ni", lt, lt)).reshape(-1)
+        lim = self.torque_limit / np.maximum(norm, 1e-300)
+        fr = self.world.model.actuator_forcerange
+        fr[self._aidx, 0] = -lim
+        fr[self._aidx, 1] = lim
+
+    def _half_turns(self, hot: NDArray[np.bool_], half_e0: F64) -> None:
+        """Joints near a half turn: actuator damping only, stiffness ``kp I e0`` held in
+        ``qfrc_applied`` until the next refresh."""
+        if not np.array_equal(hot, self._hot):
+            self._hot[:] = hot
+            self._write_gains()
+        self._any_hot = bool(hot.any())
+        if not self._any_hot:
+            return
+        rows = np.flatnonzero(hot)
+        e0 = 2.0 * half_e0[rows]
+        tau = self._kp[rows, None] * np.matmul(self._inertia[rows], e0[:, :, None])[:, :, 0]
+        if self.torque_limit is not None:
+            np.clip(tau, -self.torque_limit, self.torque_limit, out=tau)
+        dofs = self._didx.reshape(self.n, 3)[rows]
+        self.world.data.qfrc_applied[dofs] += tau
+
+    def _due(self) -> bool:
+        return (
+            self._dirty
+            or self._since >= self.refresh_every
+            or self._epoch != self.world.state_epoch
+        )
+
+    def step(self, nstep: int = 1) -> None:
+        """Advance ``nstep`` physics steps with the servo on: refresh when due, and
+        ``mj_step(m, d, nstep=k)`` in between (bit-identical to single steps)."""
+        m, d = self.world.model, self.world.data
+        while nstep > 0:
+            if self._due():
+                self.refresh()
+            k = min(nstep, self.refresh_every - self._since)
+            mujoco.mj_step(m, d, nstep=k)
+            self._since += k
+            nstep -= k
 
     def apply(self) -> None:
-        """Write this step's stiffness torques into ``qfrc_applied`` (damping is MuJoCo's)."""
-        if self._dirty or self._count % self.refresh_every == 0:
+        """Compatibility: refresh if due, for a caller that then runs one ``mj_step``."""
+        if self._due():
             self.refresh()
-            self._dirty = False
-        self._count += 1
-        lim = self.torque_limit
-        for a, qv, tv, ff in self._views:
-            np.matmul(a, qv, out=tv)
-            if lim is not None:
-                np.clip(tv, -lim, lim, out=tv)
-            tv += ff
+        self._since += 1
+
+    def joint_inertia(self, character: int) -> F64:
+        """``(15, 3, 3)`` current outboard inertia blocks ``I`` of one character's ball joints
+        (from MuJoCo's mass matrix of the last step)."""
+        rows = self._rows(character, None)
+        return self.world.data.M[self._midx[rows]]
 
     def torques(self) -> F64:
         """``(n, 3)`` full servo torques ``I (kp e - kv qdot)`` at the current state, with the
-        exact log and the full 3x3 damping (reference computation; allocates)."""
-        d, m = self.world.data, self.world.model
+        exact log and the full 3x3 damping (reference computation; allocates). Excludes
+        :attr:`feedforward`."""
+        d = self.world.data
         inertia = d.M[self._midx]
         q = quat_normalize(d.qpos[self._qidx].reshape(self.n, 4))
         r = np.matmul(self._rd, q[:, :, None])[:, :, 0]
-        from reactmocap.rotations import quat_log
-
         e = quat_log(r)
         qd = d.qvel[self._didx].reshape(self.n, 3)
-        kp = self._kpcol[:, None] / 2.0
-        kv = self._kvcol[:, None]
-        del m
-        return np.matmul(inertia, (kp * e - kv * qd)[:, :, None])[:, :, 0]
+        u = self._kp[:, None] * e - self._kv[:, None] * qd
+        return np.matmul(inertia, u[:, :, None])[:, :, 0]
 
     def clear(self) -> None:
-        """Remove the servo's torques and damping (the joints go passive)."""
-        self.world.data.qfrc_applied[self._didx] = 0.0
-        self.world.model.dof_damping[self._didx] = self._base_damping
+        """Remove the servo's torques and damping (the joints go passive) until the next
+        refresh, which :meth:`step` and :meth:`apply` do first."""
+        d, m = self.world.data, self.world.model
+        d.qfrc_applied[self._didx] = 0.0
+        m.actuator_gear[self._aidx, :3] = 0.0
+        m.dof_damping[self._didx] = self._base_damping
+        d.ctrl[self._aidx] = 0.0
+        self._dirty = True
 
     def pose_error(self) -> F64:
         """``(n,)`` current angle (rad) between each joint and its target."""
@@ -311,11 +447,8 @@ class PDServo:
 
 
 def step_with_servo(world: World, servo: PDServo | None, nstep: int) -> None:
-    """Step ``nstep`` times, applying the servo before each step."""
-    m, d = world.model, world.data
+    """Step ``nstep`` times with the servo on (or bare)."""
     if servo is None:
-        mujoco.mj_step(m, d, nstep=nstep)
-        return
-    for _ in range(nstep):
-        servo.apply()
-        mujoco.mj_step(m, d)
+        mujoco.mj_step(world.model, world.data, nstep=nstep)
+    else:
+        servo.step(nstep)

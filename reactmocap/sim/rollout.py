@@ -148,6 +148,17 @@ def _record(world: World, pos: F64, quat: F64, k: int) -> None:
         quat[c, k] = d.xquat[wc.body_ids]
 
 
+def _impact_steps(impacts: Sequence[Impact], dt: float) -> list[int]:
+    """Sorted steps at which ImpactSchedule.apply changes xfrc_applied: the ends of each window
+    (a force at the centre of mass, or ``point=None``, is constant within it), and every step
+    of a window whose point moves with the body (its torque arm turns with the body)."""
+    steps: set[int] = set()
+    for imp in impacts:
+        k0, n = imp.steps(dt)
+        steps.update((k0, k0 + n) if imp.point is None else range(k0, k0 + n + 1))
+    return sorted(steps)
+
+
 def _check(world: World, t: float, ke_limit: F64) -> None:
     d, m = world.model, world.data
     del d
@@ -193,11 +204,16 @@ def rollout(
     """Run ``duration`` seconds from the world's current state.
 
     Each step: controllers (every ``control_every`` steps, called as ``f(world, t)`` with
-    ``t`` seconds since the rollout started), impacts into ``xfrc_applied``, the servo's
-    torques, ``mj_step``. Body transforms are recorded at ``record_fps`` (frame 0 = the
-    initial state). ``references[c]`` supplies character c's non-simulated joints, sampled at
+    ``t`` seconds since the rollout started), impacts into ``xfrc_applied``, the servo, the
+    physics step. Body transforms are recorded at ``record_fps`` (frame 0 = the initial state).
+    ``references[c]`` supplies character c's non-simulated joints, sampled at
     ``reference_start + t``. Raises SimulationError on NaN/inf or kinetic energy above
     ``energy_limit_per_kg`` J/kg (100 J/kg = the whole body at 14 m/s).
+
+    MuJoCo steps in chunks (``mj_step(nstep=k)``, through :meth:`PDServo.step` with a servo)
+    between the steps where something happens: control ticks, impact windows (every step of
+    a window whose force point moves with the body, its ends otherwise), records and energy
+    checks, each at the same step as one step at a time.
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ConfigError(f"duration must be > 0 s, got {duration!r}")
@@ -214,6 +230,7 @@ def rollout(
     pos = np.empty((nchar, nrec, len(SIM_BODIES), 3))
     quat = np.empty((nchar, nrec, len(SIM_BODIES), 4))
     schedule = ImpactSchedule(world, impacts) if impacts else None
+    impact_steps = _impact_steps(impacts, dt)
     ke_limit = np.array(
         [energy_limit_per_kg * float(m.body_subtreemass[wc.body_ids[0]]) for wc in world.characters]
     )
@@ -224,22 +241,34 @@ def rollout(
         contacts.append(contact_report(world))
     wall = _time.perf_counter()
     rec = 1
-    for k in range(nsteps):
+    tick = control_every if controllers else nsteps + 1  # no controllers: no ticks
+    ie = 0
+    k = 0
+    while k < nsteps:
         if controllers and k % control_every == 0:
             t = float(d.time) - t0
             for f in controllers:
                 f(world, t)
         if schedule is not None:
             schedule.apply(k)
+        # next step where something happens
+        nxt = min(nsteps, (k // every + 1) * every, (k // check_every + 1) * check_every)
+        nxt = min(nxt, (k // tick + 1) * tick)
+        while ie < len(impact_steps) and impact_steps[ie] <= k:
+            ie += 1
+        if ie < len(impact_steps):
+            nxt = min(nxt, impact_steps[ie])
         if servo is not None:
-            servo.apply()
-        mujoco.mj_step(m, d)
-        if (k + 1) % every == 0 and rec < nrec:
+            servo.step(nxt - k)
+        else:
+            mujoco.mj_step(m, d, nstep=nxt - k)
+        k = nxt
+        if k % every == 0 and rec < nrec:
             _record(world, pos, quat, rec)
             rec += 1
             if record_contacts:
                 contacts.append(contact_report(world))
-        if (k + 1) % check_every == 0:
+        if k % check_every == 0:
             _check(world, float(d.time) - t0, ke_limit)
     _check(world, float(d.time) - t0, ke_limit)
     if schedule is not None:

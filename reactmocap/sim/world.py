@@ -26,6 +26,14 @@ standing 51-DOF character, dt = 0.0005 s; see the report for the figures):
   collide at all, through contype/conaffinity bits (character k has type bit ``2**(k+1)`` and
   affinity with the floor and the other character). Why off: mocap poses routinely put arms
   within millimetres of the trunk capsules, and self-contacts would fight the tracking servo.
+* **Servo actuators:** every ball joint gets three ``general`` actuators (joint transmission,
+  fixed gain, affine bias), 45 per character, contiguous from :attr:`WorldCharacter.actuator_adr`
+  in :data:`BALL_JOINTS` order. They are built with zero gain and zero bias, so they exert
+  exactly no force and add no implicit damping until a :class:`~reactmocap.sim.pd.PDServo`
+  sets their gears and gains (see that module for why the PD lives inside MuJoCo). Actuation
+  is disabled (``mjDSBL_ACTUATION``) until a servo is attached, which leaves a passive world
+  MuJoCo's transmission pass over the rows: a ragdoll steps ~3% slower than without the
+  actuators (~6% with actuation on). ``ctrl`` is part of :meth:`World.get_state`.
 """
 
 from __future__ import annotations
@@ -59,6 +67,25 @@ _SOLVERS = {
     "pgs": mujoco.mjtSolver.mjSOL_PGS,
 }
 _CONES = {"pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL, "elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC}
+
+
+def _add_servo_actuators(spec: mujoco.MjSpec, prefix: str) -> None:
+    """Three inert actuators per ball joint of one character (``<joint>/servo0..2``): joint
+    transmission, fixed gain, affine bias, all zero; unit gear axes until a servo sets them."""
+    for joint in BALL_JOINTS:
+        for a in range(3):
+            gear = [0.0] * 6
+            gear[a] = 1.0
+            spec.add_actuator(
+                name=f"{prefix}{joint}/servo{a}",
+                target=prefix + joint,
+                trntype=mujoco.mjtTrn.mjTRN_JOINT,
+                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+                gainprm=[0.0] * 10,
+                biasprm=[0.0] * 10,
+                gear=gear,
+            )
 
 
 @dataclass(frozen=True)
@@ -115,6 +142,8 @@ class WorldCharacter:
     dof_adr: int  # free joint dof start; 6 + 45 contiguous values
     geom_ids: NDArray[np.int64]
     body_lookup: dict[str, int] = field(default_factory=dict)
+    #: first of the character's 45 servo actuators: 3 per ball joint, BALL_JOINTS order
+    actuator_adr: int = -1
 
     @property
     def qpos_slice(self) -> slice:
@@ -168,6 +197,8 @@ class World:
         opt.iterations = cfg.iterations
         # never reset silently on divergence: rollouts detect it and raise SimulationError
         opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
+        # the servo actuators are inert until a PDServo switches actuation on (saves ~1 us/step)
+        opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)
         floor = spec.worldbody.add_geom(
             name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0]
         )
@@ -176,6 +207,8 @@ class World:
         for k, ch in enumerate(chars):
             frame = spec.worldbody.add_frame()
             spec.attach(ch.make_spec(), prefix=PREFIXES[k], frame=frame)
+        for k in range(len(chars)):
+            _add_servo_actuators(spec, PREFIXES[k])
         try:
             self.model = spec.compile()
         except Exception as exc:  # mujoco raises ValueError with the compiler's message
@@ -183,6 +216,9 @@ class World:
         self.spec = spec
         m = self.model
         self.data = mujoco.MjData(m)
+        #: bumped whenever the state is set from outside the integrator (set_pose, set_state):
+        #: a PDServo then re-linearises its actuators before the next step
+        self.state_epoch = 0
         self.characters: list[WorldCharacter] = []
         for k, ch in enumerate(chars):
             pre = PREFIXES[k]
@@ -194,9 +230,22 @@ class World:
             if [int(m.jnt_qposadr[j]) for j in balls] != [qadr + 7 + 4 * i for i in range(15)]:
                 raise SimulationError("ball joints are not contiguous in qpos (internal error)")
             geoms = np.flatnonzero(np.isin(m.geom_bodyid, ids))
+            acts = [m.actuator(f"{pre}{j}/servo{a}").id for j in BALL_JOINTS for a in range(3)]
+            if acts != list(range(acts[0], acts[0] + 3 * len(BALL_JOINTS))) or any(
+                int(m.actuator_trnid[a, 0]) != balls[i // 3] for i, a in enumerate(acts)
+            ):
+                raise SimulationError("servo actuators are not contiguous (internal error)")
             self.characters.append(
                 WorldCharacter(
-                    k, pre, ch, ids, qadr, dadr, geoms, {b: int(i) for b, i in zip(SIM_BODIES, ids)}
+                    k,
+                    pre,
+                    ch,
+                    ids,
+                    qadr,
+                    dadr,
+                    geoms,
+                    {b: int(i) for b, i in zip(SIM_BODIES, ids)},
+                    actuator_adr=acts[0],
                 )
             )
         self._apply_contact_settings()
@@ -255,6 +304,7 @@ class World:
             raise SimulationError(f"qpos must be 67 finite numbers, got shape {qpos.shape}")
         self.data.qpos[wc.qpos_slice] = qpos
         self.data.qvel[wc.qvel_slice] = 0.0 if qvel is None else qvel
+        self.state_epoch += 1
         mujoco.mj_forward(self.model, self.data)
 
     def set_from_motion(
@@ -272,7 +322,9 @@ class World:
         return self.data.xpos[ids].copy(), self.data.xquat[ids].copy()
 
     def get_state(self) -> F64:
-        """Full integration state (time, qpos, qvel, warm start, applied forces...)."""
+        """Full integration state (time, qpos, qvel, warm start, ctrl, applied forces...).
+        The servo actuators' gears and gains are model parameters, not state: restoring a
+        state makes a PDServo re-linearise (``state_epoch``) before its next step."""
         spec = mujoco.mjtState.mjSTATE_INTEGRATION
         out = np.empty(mujoco.mj_stateSize(self.model, spec))
         mujoco.mj_getState(self.model, self.data, out, spec)
@@ -281,6 +333,7 @@ class World:
     def set_state(self, state: F64) -> None:
         spec = mujoco.mjtState.mjSTATE_INTEGRATION
         mujoco.mj_setState(self.model, self.data, np.asarray(state, dtype=np.float64), spec)
+        self.state_epoch += 1
         mujoco.mj_forward(self.model, self.data)
 
     def step(self, n: int = 1) -> None:
