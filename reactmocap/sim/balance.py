@@ -240,8 +240,8 @@ class StanceBalance:
         q = d.xquat[self.root]
         e_world = d.xmat[self.root].reshape(3, 3) @ quat_log(quat_mul(quat_conj(q), q_d))
         w = d.cvel[self.root, :3]  # world-frame angular velocity of the pelvis
-        inertia = 0.1 * self.mass  # scale of the body's inertia about the pelvis (kg m^2)
-        torque = inertia * (self.kp_rot * e_world - self.kv_rot * w)
+        trunk_inertia = 0.1 * self.mass  # scale of the body's inertia about the pelvis (kg m^2)
+        torque = trunk_inertia * (self.kp_rot * e_world - self.kv_rot * w)
         # split between two supporting feet by where the COM lies between them
         if len(feet) == 2:
             a, b = points[0][:2], points[1][:2]
