@@ -366,6 +366,7 @@ def track_clip(
     record_fps: float = 60.0,
     root_assist: float = 0.0,
     balance: bool = True,
+    control_every: int = 10,
     total_mass: float = 75.0,
     config: WorldConfig | None = None,
     character_kwargs: dict[str, object] | None = None,
@@ -376,7 +377,9 @@ def track_clip(
     the clip's skeleton (non-simulated joints from the clip), the report and the raw result.
     ``balance`` adds the physical :class:`~reactmocap.sim.balance.StanceBalance` (gravity
     compensation, velocity feed-forward, COM and trunk control through the stance legs);
-    ``root_assist > 0`` adds the non-physical :class:`RootAssist` with that kp."""
+    ``root_assist > 0`` adds the non-physical :class:`RootAssist` with that kp. Targets and
+    feed-forward update every ``control_every`` steps (10 = 200 Hz, as in the response
+    pipeline; the servo's own stiffness and damping act every step inside MuJoCo)."""
     if not (np.isfinite(start) and 0 <= start <= motion.duration):
         raise ConfigError(f"start {start!r} s is outside the clip (0..{motion.duration:.3f} s)")
     remaining = motion.duration - start
@@ -413,7 +416,7 @@ def track_clip(
         seconds,
         servo=servo,
         controllers=ctrls,
-        control_every=servo.refresh_every,
+        control_every=control_every,
         impacts=impacts,
         record_fps=record_fps,
         references=[motion],
