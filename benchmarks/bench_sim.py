@@ -204,7 +204,7 @@ def bench_tracking(kp: float, assist_gain: float) -> None:
         print(f"\n(no shared clips under {SHARED.resolve()}: tracking robustness skipped)")
         return
     modes = [(False, 0.0, "PD only"), (True, 0.0, "PD + stance balance (physical)"),
-             (True, assist_gain, f"PD + balance WITH non-physical root assist kp={assist_gain:g}")]  # fmt: skip
+             (False, assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}")]  # fmt: skip
     for balance, assist, label in modes:
         print(f"\n## tracking robustness, kp={kp:g}, kv critical, {label}")
         print(

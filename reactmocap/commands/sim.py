@@ -50,7 +50,7 @@ def _common(p: argparse.ArgumentParser) -> None:
         "--root-assist",
         type=float,
         default=0.0,
-        help="NON-PHYSICAL pelvis stabilisation gain (0 = off)",
+        help="NON-PHYSICAL pelvis stabilisation gain (0 = off); replaces the balance controller",
     )
     p.add_argument(
         "--no-balance",
@@ -99,7 +99,7 @@ def _kwargs(args: argparse.Namespace) -> dict[str, object]:
         "record_fps": args.fps,
         "total_mass": args.mass,
         "root_assist": args.root_assist,
-        "balance": args.balance,
+        "balance": args.balance and not args.root_assist,
     }
 
 

@@ -391,6 +391,12 @@ def track_clip(
             f"cannot track {seconds} s from {start} s: the clip {motion.name!r} lasts "
             f"{motion.duration:.3f} s"
         )
+    if balance and root_assist > 0:
+        raise ConfigError(
+            "root_assist and balance cannot be combined: the balance controller's support "
+            "forces assume nothing else holds the body up (they went unstable together); "
+            "pass balance=False with root_assist"
+        )
     frame = round(start * motion.fps)
     character = build_character(
         motion,

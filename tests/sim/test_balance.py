@@ -100,3 +100,10 @@ def test_unknown_character_rejected(clips: dict[str, Motion]) -> None:
     servo = PDServo(world)
     with pytest.raises(ConfigError, match="character 3"):
         StanceBalance(servo, 3, clips["guard"])
+
+
+def test_balance_and_root_assist_are_exclusive(guard_loop: Motion) -> None:
+    with pytest.raises(ConfigError, match="root_assist and balance"):
+        track_clip(guard_loop, seconds=0.2, root_assist=100.0, balance=True)
+    _, rep, _ = track_clip(guard_loop, seconds=0.2, root_assist=100.0, balance=False)
+    assert rep.root_assist == 100.0 and not rep.balance
