@@ -422,7 +422,9 @@ def track_clip(
         seconds,
         servo=servo,
         controllers=ctrls,
-        control_every=control_every,
+        # the assist's explicit whole-body PD acts on the light pelvis: held for several steps
+        # it goes unstable, so it runs every step
+        control_every=1 if root_assist > 0 else control_every,
         impacts=impacts,
         record_fps=record_fps,
         references=[motion],
