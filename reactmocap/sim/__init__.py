@@ -1,6 +1,7 @@
 """Physics simulation on MuJoCo: the character built from a skeleton, the world, the
 inertia-scaled PD servo, impacts and contacts, rollouts, and Motion <-> state conversion."""
 
+from reactmocap.sim.balance import StanceBalance
 from reactmocap.sim.character import (
     BALL_JOINTS,
     BODY_ALIASES,
@@ -44,6 +45,7 @@ __all__ = [
     "PDServo",
     "RolloutResult",
     "RootAssist",
+    "StanceBalance",
     "TrackReport",
     "World",
     "WorldCharacter",
