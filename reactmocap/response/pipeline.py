@@ -95,26 +95,56 @@ def prepare_library(
     path: Path, skeleton_of: Motion | None = None, lib: ClipLibrary | None = None
 ) -> tuple[ClipLibrary, MotionIndex]:
     """Load a clip library (unless given) and its search index (cached on disk, keyed by
-    content and by the clips on ``skeleton_of``'s skeleton)."""
+    content and by ``skeleton_of``'s skeleton). With ``skeleton_of``, clips on other skeletons
+    are retargeted onto it (:mod:`reactmocap.sim.retarget`; each side's reference pose is
+    frame 0 of its alphabetically first clip), so every clip can be the continuation."""
     lib = load_library(path) if lib is None else lib
-    clips = lib.clips
+    clips = dict(lib.clips)
+    target = ""
     if skeleton_of is not None:
-        # The continuation is played on the recipient's skeleton; cross-skeleton retargeting is
-        # not implemented, so only clips on that skeleton are candidates.
-        clips = {n: m for n, m in clips.items() if m.skeleton.same_structure(skeleton_of.skeleton)}
-        if not clips:
-            raise SearchError(f"library {path} has no clip on the recipient's skeleton")
+        clips = _retargeted(clips, skeleton_of)
+        sk = skeleton_of.skeleton
+        target = hashlib.sha256(
+            ("\0".join(sk.names) + repr(np.round(sk.offsets, 6).tolist())).encode()
+        ).hexdigest()[:12]
     # the code versions are part of the key: an index written by older search code is not reused
     key = (str(Path(path).resolve()), ",".join(sorted(clips)) + lib.fingerprint(),
-           f"{__version__}/{INDEX_FORMAT_VERSION}")  # fmt: skip
+           f"{__version__}/{INDEX_FORMAT_VERSION}/retarget{RETARGET_VERSION}/{target}")  # fmt: skip
     if key in _INDEX_MEMO:
         return _INDEX_MEMO[key]
     digest = hashlib.sha256("\0".join(key).encode()).hexdigest()[:16]  # stable across processes
     index_path = default_cache_dir().parent / "indexes" / f"{digest}.npz"
     index = MotionIndex.load_or_build(index_path, clips, SearchWeights(), WindowConfig())
-    sub = ClipLibrary(lib.root, dict(clips), lib.paths, lib.hashes, lib.failures)
+    sub = ClipLibrary(lib.root, clips, lib.paths, lib.hashes, lib.failures)
     _INDEX_MEMO[key] = (sub, index)
     return sub, index
+
+
+RETARGET_VERSION = 1
+
+
+def _retargeted(clips: dict[str, Motion], recipient: Motion) -> dict[str, Motion]:
+    """Every clip on ``recipient``'s skeleton: same-structure clips as they are, the rest
+    retargeted (one Retargeter per source skeleton)."""
+    from reactmocap.sim.retarget import Retargeter
+
+    target_char = None
+    by_skeleton: dict[int, Retargeter] = {}
+    out: dict[str, Motion] = {}
+    for name in sorted(clips):
+        m = clips[name]
+        if m.skeleton.same_structure(recipient.skeleton):
+            out[name] = m
+            continue
+        if target_char is None:
+            target_char = build_character(recipient, frame=0)
+        key = next((k for k, r in by_skeleton.items()
+                    if r.source.skeleton.same_structure(m.skeleton)), None)  # fmt: skip
+        if key is None:
+            key = len(by_skeleton)
+            by_skeleton[key] = Retargeter(build_character(m, frame=0), target_char)
+        out[name] = by_skeleton[key](m)
+    return out
 
 
 _LIBRARY_MEMO: dict[tuple[str, tuple[tuple[str, int, int], ...]], ClipLibrary] = {}
@@ -274,7 +304,8 @@ def run_response(scenario: Scenario) -> ResponseResult:
     rec_clip = _clip(scenario.library, scenario.recipient, lib)
     rec_parts = map_body_parts(rec_clip.skeleton)
     rec_motion, rec_t0 = _placed(rec_clip, rec_parts, scenario.recipient)
-    lib, index = prepare_library(scenario.library, rec_clip, lib)
+    # continuations on the recipient's skeleton (others retargeted); the attacker keeps its own
+    search_lib, index = prepare_library(scenario.library, rec_clip, lib)
     fps = rec_clip.fps
     # scenario clock -> clip clock: the placed clip is sampled at rec_t0 + t
     rec_char = build_character(rec_motion, rec_parts, total_mass=cfg.total_mass,
@@ -393,7 +424,7 @@ def run_response(scenario: Scenario) -> ResponseResult:
     t_match = q0 + best_start / q_fps
     timings["search"] = time.perf_counter() - t
 
-    found_clip = lib[best.clip]
+    found_clip = search_lib[best.clip]
     found = found_clip.transformed(best.yaw, best.translation).replace(name=best.clip)
 
     # 4. Simulation 2: same start, same impact, friction 0.5, track slerp(prev, found)

@@ -19,6 +19,7 @@ from reactmocap.sim.impacts import (
     first_contact,
 )
 from reactmocap.sim.pd import PDServo, critical_kv
+from reactmocap.sim.retarget import Retargeter, retarget
 from reactmocap.sim.rollout import (
     MotionTracker,
     RolloutResult,
@@ -44,6 +45,7 @@ __all__ = [
     "MotionTracker",
     "PDServo",
     "RolloutResult",
+    "Retargeter",
     "RootAssist",
     "StanceBalance",
     "TrackReport",
@@ -55,6 +57,7 @@ __all__ = [
     "critical_kv",
     "first_contact",
     "push_clip",
+    "retarget",
     "rollout",
     "track_clip",
 ]

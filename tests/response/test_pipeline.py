@@ -163,4 +163,17 @@ def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
     rec = read_bvh(tmp_path / "out" / "recipient.bvh")
     assert np.all(np.isfinite(rec.global_positions()))
     assert report["quality"]["penetration_max_m"] < 0.15
-    assert report["matched"]["clip"].startswith("dataset-1")
+    names = {f.stem for f in lib.glob("*.bvh")}
+    assert report["matched"]["clip"] in names
+    # every clip is a candidate continuation: the synthetic ones retargeted onto the recipient
+    from reactmocap.response.pipeline import prepare_library
+
+    sub, index = prepare_library(
+        lib, read_bvh(shared_mocap_dir / "dataset-1_respond_normal_001.bvh")
+    )
+    assert set(sub.clips) == names and set(index.clip_names) == names
+    real = sub["dataset-1_walk_normal_001"].skeleton
+    fall = sub["fall_backward"]
+    assert fall.skeleton.same_structure(real)
+    assert np.all(np.isfinite(fall.global_positions()))
+    assert fall.global_positions()[..., 2].min() > -0.05  # retargeted onto the floor, roughly
