@@ -47,6 +47,7 @@ from reactmocap.library.clip_library import (
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import place
 from reactmocap.response.blend import blend_poses, final_blend, transition_weights
+from reactmocap.response.footlock import lock_feet
 from reactmocap.response.scenario import CharacterSpec, Scenario
 from reactmocap.rotations import quat_slerp
 from reactmocap.search import MotionIndex, SearchResult, SearchWeights, WindowConfig
@@ -460,6 +461,8 @@ def run_response(scenario: Scenario) -> ResponseResult:
     sim_part = sim2_motion.sample(trans_times - t_rewind)
     found_part = found.sample(best.time + (trans_times - t_match))
     blended = final_blend(sim_part, found_part)
+    if cfg.foot_lock:
+        blended = lock_feet(blended, rec_parts)
     tail_n = int(np.floor(min(cfg.tail, found.duration - best.time) * fps))
     tail = found.sample(best.time + np.arange(1, tail_n + 1) / fps) if tail_n > 0 else None
     pieces = [p for p in (before, blended, tail) if p is not None]

@@ -79,6 +79,8 @@ class ResponseConfig:
     top_k: int = 5
     timestep: float = 0.0005
     total_mass: float = 75.0
+    #: pin planted feet that slide during the transition (two-bone IK; not in the paper)
+    foot_lock: bool = True
 
 
 @dataclass(frozen=True)
@@ -152,6 +154,10 @@ class _Reader:
             elif name == "sim1_mode":
                 if value not in SIM1_MODES:
                     raise self.fail(where, f"expected one of {list(SIM1_MODES)}, got {value!r}")
+                kwargs[name] = value
+            elif ftype == "bool":
+                if not isinstance(value, bool):
+                    raise self.fail(where, f"expected true or false, got {value!r}")
                 kwargs[name] = value
             elif "tuple[float, float, float]" in ftype:
                 kwargs[name] = self.vector(where, value, 3)
