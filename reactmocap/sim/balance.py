@@ -67,6 +67,9 @@ class StanceBalance:
         kp_com, kv_com: horizontal COM servo gains (1/s^2, 1/s); kp_height for the vertical.
         kp_rot, kv_rot: trunk orientation gains (1/s^2, 1/s).
         friction: fraction of the friction cone the horizontal support force may use.
+        stance_gain_scale: servo stiffness multiplier (damping by its square root) for the
+            hip, knee and ankle of a supporting leg: their inertia-scaled gains follow a thigh,
+            shin or foot, while the load is the whole body (a landing knee buckled ~30 deg).
     """
 
     def __init__(
@@ -84,13 +87,16 @@ class StanceBalance:
         friction: float = 0.7,
         reach: float = 0.02,
         velocity_feedforward: bool = True,
+        stance_gain_scale: float = 16.0,
     ) -> None:
         for name, v in (
             ("kp_com", kp_com), ("kp_height", kp_height), ("kp_rot", kp_rot),
-            ("friction", friction), ("reach", reach),
+            ("friction", friction), ("reach", reach), ("stance_gain_scale", stance_gain_scale),
         ):  # fmt: skip
             if not (np.isfinite(v) and v >= 0):
                 raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
+        if stance_gain_scale <= 0:
+            raise ConfigError(f"stance_gain_scale must be > 0, got {stance_gain_scale!r}")
         world = servo.world
         if character not in servo.character_indices:
             raise ConfigError(
@@ -113,6 +119,8 @@ class StanceBalance:
         self.friction = float(friction)
         self.reach = float(reach)
         self.velocity_feedforward = velocity_feedforward
+        self.stance_gain_scale = float(stance_gain_scale)
+        self._legs = [[f"{s}_hip", f"{s}_knee", f"{s}_ankle"] for s in "lr"]
         m = world.model
         wc = world.characters[character]
         self.wc = wc
@@ -245,6 +253,10 @@ class StanceBalance:
             ff += (self.servo.kv * np.einsum("nij,nj->ni", inertia, wd)).reshape(-1)
         c_d, v_d, a_d, q_d, planted = self._sample(t)
         feet, points = self._support_points(planted)
+        if self.stance_gain_scale != 1.0:
+            for k, leg in enumerate(self._legs):
+                scale = self.stance_gain_scale if k in feet else 1.0
+                self.servo.set_gain_scale(self.character, leg, scale)
         if not feet:
             return
         mujoco.mj_subtreeVel(m, d)

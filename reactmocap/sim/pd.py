@@ -200,6 +200,7 @@ class PDServo:
         self._kv = np.zeros(n)
         self._enabled = np.ones(n, dtype=bool)
         self._frozen = np.zeros(n, dtype=bool)
+        self._gain_scale = np.ones(n)
         self._hot = np.zeros(n, dtype=bool)  # near a half turn: stiffness held in qfrc_applied
         self.freeze_scale = 4.0
         if torque_limit is not None and not (np.isfinite(torque_limit) and torque_limit > 0):
@@ -228,8 +229,19 @@ class PDServo:
         self.kv = float(kv)
         self._refresh_gains()
 
+    def set_gain_scale(self, character: int, joints: Sequence[str] | None, scale: float) -> None:
+        """Multiply kp by ``scale`` (and kv by its square root, staying critical) for some
+        joints, e.g. a stance leg that carries the body on gains scaled by a foot's inertia."""
+        if not (np.isfinite(scale) and scale > 0):
+            raise ConfigError(f"gain scale must be a positive number, got {scale!r}")
+        rows = self._rows(character, joints)
+        if np.all(self._gain_scale[rows] == scale):
+            return
+        self._gain_scale[rows] = scale
+        self._refresh_gains()
+
     def _refresh_gains(self) -> None:
-        scale = np.where(self._frozen, self.freeze_scale, 1.0)
+        scale = np.where(self._frozen, self.freeze_scale, 1.0) * self._gain_scale
         on = self._enabled | self._frozen
         self._kp[:] = np.where(on, self.kp * scale, 0.0)
         self._kv[:] = np.where(on, self.kv * np.sqrt(scale), 0.0)

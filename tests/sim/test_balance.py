@@ -12,6 +12,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.library.synth import synthetic_clips
 from reactmocap.sim import World, build_character
 from reactmocap.sim.balance import StanceBalance
+from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.pd import PDServo
 from reactmocap.sim.rollout import track_clip
 
@@ -107,3 +108,22 @@ def test_balance_and_root_assist_are_exclusive(guard_loop: Motion) -> None:
         track_clip(guard_loop, seconds=0.2, root_assist=100.0, balance=True)
     _, rep, _ = track_clip(guard_loop, seconds=0.2, root_assist=100.0, balance=False)
     assert rep.root_assist == 100.0 and not rep.balance
+
+
+def test_stance_legs_get_stiffer_gains(clips: dict[str, Motion]) -> None:
+    guard = clips["guard"]
+    world = World(build_character(guard, frame=0))
+    world.set_from_motion(0, guard, 0)
+    servo = PDServo(world)
+    bal = StanceBalance(servo, 0, guard, stance_gain_scale=9.0)
+    servo.step(40)  # settle onto the floor
+    bal(world, 0.0)
+    a = world.characters[0].actuator_adr
+    gains = world.model.actuator_gainprm[a : a + 45, 0].reshape(15, 3)[:, 0]
+    knee, elbow = BALL_JOINTS.index("l_knee"), BALL_JOINTS.index("l_elbow")
+    assert gains[knee] == pytest.approx(9.0 * servo.kp)
+    assert gains[elbow] == pytest.approx(servo.kp)
+    with pytest.raises(ConfigError, match="stance_gain_scale"):
+        StanceBalance(servo, 0, guard, stance_gain_scale=0.0)
+    with pytest.raises(ConfigError, match="gain scale"):
+        servo.set_gain_scale(0, ["l_knee"], float("nan"))
