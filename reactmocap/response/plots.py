@@ -14,10 +14,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ReactMocapError
-from reactmocap.io import atomic_write
+from reactmocap.io import atomic_write, atomic_write_bytes
 from reactmocap.library.motion import Motion
 
-__all__ = ["pelvis_height_plot", "stick_figure_video"]
+__all__ = ["pelvis_height_plot", "stick_figure_video", "write_video"]
 
 
 def _pyplot():  # type: ignore[no-untyped-def]
@@ -29,6 +29,28 @@ def _pyplot():  # type: ignore[no-untyped-def]
     except ImportError:
         raise ReactMocapError("plots need matplotlib: pip install 'reactmocap[plot]'") from None
     return plt
+
+
+def _imageio():  # type: ignore[no-untyped-def]
+    try:
+        import imageio.v3 as iio
+    except ImportError:
+        raise ReactMocapError("videos need imageio: pip install 'reactmocap[video]'") from None
+    return iio
+
+
+def write_video(frames: NDArray[np.uint8], path: str | Path, fps: float) -> Path:
+    """Write ``(T, H, W, 3)`` frames as a GIF or MP4 (by ``path``'s suffix), encoded in
+    memory and written atomically: never a half-written video."""
+    iio = _imageio()
+    out = Path(path)
+    ext = out.suffix.lower()
+    if ext == ".gif":
+        data = iio.imwrite("<bytes>", frames, extension=".gif", duration=1000 / fps, loop=0)
+    else:
+        data = iio.imwrite("<bytes>", frames, extension=ext, fps=fps)
+    atomic_write_bytes(out, data)
+    return out
 
 
 def pelvis_height_plot(
@@ -72,10 +94,7 @@ def stick_figure_video(
     """Render motions as coloured stick figures from a fixed 3/4 view into a GIF or MP4
     (by ``path``'s suffix). Used when no GL context is available for MuJoCo's renderer."""
     plt = _pyplot()
-    try:
-        import imageio.v3 as iio
-    except ImportError:
-        raise ReactMocapError("videos need imageio: pip install 'reactmocap[video]'") from None
+    _imageio()  # fail before drawing if the writer is missing
     sampled = []
     n = 0
     for motion, color in motions:
@@ -104,11 +123,4 @@ def stick_figure_video(
         fig.canvas.draw()
         frames.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
     plt.close(fig)
-    out = Path(path)
-    ext = out.suffix.lower()
-    with atomic_write(out, "wb") as fh:
-        if ext == ".gif":
-            iio.imwrite(fh, np.stack(frames), extension=".gif", duration=1000 / fps, loop=0)  # type: ignore[call-overload]
-        else:
-            iio.imwrite(fh, np.stack(frames), extension=ext, fps=fps)  # type: ignore[call-overload]
-    return out
+    return write_video(np.stack(frames), path, fps)

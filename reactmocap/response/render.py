@@ -19,6 +19,7 @@ import numpy as np
 
 from reactmocap.errors import ReactMocapError
 from reactmocap.library.motion import Motion
+from reactmocap.response.plots import _imageio, write_video
 from reactmocap.sim.character import build_character
 
 __all__ = ["RenderUnavailable", "render_video"]
@@ -61,10 +62,7 @@ def render_video(
     Raises RenderUnavailable if no GL context can be created, ReactMocapError if the video
     writer (imageio, the ``video`` extra) is missing.
     """
-    try:
-        import imageio.v3 as iio
-    except ImportError:
-        raise ReactMocapError("videos need imageio: pip install 'reactmocap[video]'") from None
+    _imageio()  # fail before rendering if the writer is missing
     items = list(motions) + ([ghost] if ghost is not None else [])
     if not items:
         raise ReactMocapError("render_video needs at least one motion")
@@ -109,14 +107,4 @@ def render_video(
             frames[i] = renderer.render()
     finally:
         renderer.close()
-    out = Path(path)
-    tmp = out.with_name(f".{out.stem}.partial{out.suffix}")
-    try:
-        if out.suffix.lower() == ".gif":
-            iio.imwrite(tmp, frames, extension=".gif", duration=1000 / fps, loop=0)  # type: ignore[call-overload]
-        else:
-            iio.imwrite(tmp, frames, extension=out.suffix, fps=fps)  # type: ignore[call-overload]
-        os.replace(tmp, out)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return out
+    return write_video(frames, path, fps)

@@ -36,7 +36,7 @@ from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.pd import PDServo
+from reactmocap.sim.pd import PDServo, critical_kv
 from reactmocap.sim.world import World
 
 __all__ = ["StanceBalance"]
@@ -107,20 +107,17 @@ class StanceBalance:
         self.character = character
         self.motion = motion
         self.start = float(start)
-        crit = lambda kp: 2.0 * float(np.sqrt(kp))  # noqa: E731
+        kv_h = critical_kv(kp_com) if kv_com is None else float(kv_com)
         self.kp = np.array([kp_com, kp_com, kp_height], dtype=np.float64)
-        self.kv = (
-            np.array([crit(kp_com)] * 2 + [crit(kp_height)])
-            if kv_com is None
-            else (np.array([kv_com, kv_com, crit(kp_height)], dtype=np.float64))
-        )
+        self.kv = np.array([kv_h, kv_h, critical_kv(kp_height)])
         self.kp_rot = float(kp_rot)
-        self.kv_rot = crit(kp_rot) if kv_rot is None else float(kv_rot)
+        self.kv_rot = critical_kv(kp_rot) if kv_rot is None else float(kv_rot)
         self.friction = float(friction)
         self.reach = float(reach)
         self.velocity_feedforward = velocity_feedforward
         self.stance_gain_scale = float(stance_gain_scale)
         self._legs = [[f"{s}_hip", f"{s}_knee", f"{s}_ankle"] for s in "lr"]
+        self._stance: tuple[int, ...] = ()  # supporting feet at the last tick
         m = world.model
         wc = world.characters[character]
         self.wc = wc
@@ -153,7 +150,6 @@ class StanceBalance:
         self._weight = m.body_subtreemass[self._child] * self.gravity[2]  # (15,) N
         self._tau = np.zeros((NJ, 3))
         self._tau_local = np.empty((NJ, 3))
-        self.stance_log: list[tuple[bool, bool]] = []
         self._reference(motion)
 
     def _sole_heights(self, d: mujoco.MjData) -> F64:
@@ -197,7 +193,9 @@ class StanceBalance:
         else:
             self.joint_vel = np.zeros((n, NJ, 3))
 
-    def _sample(self, t: float) -> tuple[F64, F64, F64, F64, NDArray[np.bool_]]:
+    def _sample(self, t: float) -> tuple[F64, F64, F64, F64, NDArray[np.bool_], F64]:
+        """Mocap COM position, velocity, acceleration, pelvis rotation, planted feet and
+        joint velocities at rollout time ``t``."""
         x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
         i0 = int(x)
         i1 = min(i0 + 1, self.motion.num_frames - 1)
@@ -206,7 +204,7 @@ class StanceBalance:
         i = round(x)
         return (
             lerp(self.com), lerp(self.com_vel), lerp(self.com_acc), self.root_quat[i],
-            self.planted[i],
+            self.planted[i], self.joint_vel[i0],
         )  # fmt: skip
 
     def _support_points(self, planted: NDArray[np.bool_]) -> tuple[list[int], list[F64]]:
@@ -246,17 +244,16 @@ class StanceBalance:
         np.multiply(r[:, 0], -self._weight, out=self._tau[:, 1])
         np.einsum("nji,nj->ni", rot, self._tau, out=self._tau_local)
         ff[:] = self._tau_local.reshape(-1)
+        c_d, v_d, a_d, q_d, planted, wd = self._sample(t)
         if self.velocity_feedforward:
-            x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
-            wd = self.joint_vel[int(x)]
             inertia = self.servo.joint_inertia(self.character)
             ff += (self.servo.kv * np.einsum("nij,nj->ni", inertia, wd)).reshape(-1)
-        c_d, v_d, a_d, q_d, planted = self._sample(t)
         feet, points = self._support_points(planted)
-        if self.stance_gain_scale != 1.0:
+        if tuple(feet) != self._stance and self.stance_gain_scale != 1.0:
             for k, leg in enumerate(self._legs):
                 scale = self.stance_gain_scale if k in feet else 1.0
                 self.servo.set_gain_scale(self.character, leg, scale)
+        self._stance = tuple(feet)
         if not feet:
             return
         mujoco.mj_subtreeVel(m, d)

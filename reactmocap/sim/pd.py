@@ -456,11 +456,3 @@ class PDServo:
         q = quat_normalize(d.qpos[self._qidx].reshape(self.n, 4))
         r = np.matmul(self._rd, q[:, :, None])[:, :, 0]
         return 2.0 * np.arctan2(np.linalg.norm(r[:, 1:], axis=1), np.abs(r[:, 0]))
-
-
-def step_with_servo(world: World, servo: PDServo | None, nstep: int) -> None:
-    """Step ``nstep`` times with the servo on (or bare)."""
-    if servo is None:
-        mujoco.mj_step(world.model, world.data, nstep=nstep)
-    else:
-        servo.step(nstep)
