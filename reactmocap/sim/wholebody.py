@@ -1,0 +1,330 @@
+"""Whole-body mocap tracking by inverse dynamics with optimised ground forces.
+
+Why: a joint PD servo (even with :class:`~reactmocap.sim.balance.StanceBalance`) has no model
+of what the ground can push, so the unactuated pelvis drifts whenever the simulated feet do
+not land exactly as the actor's did. This controller is the standard fix of model-based
+trackers (Macchietto et al. 2009, Lee et al. 2010, Muico et al. 2009): at each control tick it
+solves a small quadratic program for the accelerations ``qdd`` of *all* DOFs (pelvis
+included) and the ground forces ``f`` at the sole corners,
+
+    min  ||W (qdd - qdd_des)||^2 + w_c ||J_c qdd + k_c v_c||^2 + lam ||beta||^2
+    s.t. M_root qdd + h_root = (J_c^T F beta)_root      (the pelvis moves only by ground forces)
+         beta >= 0                                       (friction pyramid, no pulling)
+
+with ``qdd_des = qdd_mocap + kp (q_mocap - q) + kv (qdot_mocap - qdot)`` for every DOF, and
+sets the joint torques to ``tau = (M qdd + h - J_c^T F beta)_joints``. ``J_c`` are the sole
+corners of the feet that support (touching in the simulation and planted in the mocap); the
+soft ``w_c`` term tells the program those corners do not slide, so pelvis corrections are
+made by the stance legs. Only joint torques are applied: the result is physical.
+
+Solved without a general QP library: for fixed ``beta`` the joint accelerations are an
+unconstrained least-squares problem, so they are projected out with one QR and the remaining
+non-negative least squares in ``beta`` (at most 32 unknowns) goes to ``scipy.optimize.nnls``.
+
+The PD servo still runs inside MuJoCo every step as the local stabiliser: the controller
+writes ``tau - tau_servo`` as feed-forward, so at each tick the total equals ``tau`` and
+between ticks the servo's implicit stiffness and damping act on whatever changed since.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import nnls
+
+from reactmocap.errors import ConfigError
+from reactmocap.library.motion import Motion
+from reactmocap.rotations import quat_conj, quat_log, quat_mul
+from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
+from reactmocap.sim.pd import PDServo, critical_kv
+from reactmocap.sim.world import World
+
+__all__ = ["WholeBodyTracker"]
+
+F64 = NDArray[np.float64]
+NJ = len(BALL_JOINTS)
+NV = 6 + 3 * NJ
+_FEET = ("l_foot", "r_foot")
+# friction pyramid edge directions per unit of mu (world x+, x-, y+, y-)
+_PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
+
+
+def _hemisphere(q: F64) -> F64:
+    """Flip quaternions ``(T, ..., 4)`` so consecutive frames lie in one hemisphere."""
+    q = q.copy()
+    flips = np.cumsum(np.sum(q[1:] * q[:-1], axis=-1) < 0, axis=0) % 2
+    q[1:] *= (1 - 2 * flips)[..., None]
+    return q
+
+
+def _velocity(q: F64, fps: float) -> F64:
+    """``(T, 51)`` MuJoCo ``qvel`` (root linear in world, angular in the local frames) of a
+    ``(T, 67)`` qpos path, by central differences."""
+    n = q.shape[0]
+    if n < 2:
+        return np.zeros((n, NV))
+    quats = q[:, 3:].reshape(n, NJ + 1, 4)
+    lo = np.r_[0, np.arange(n - 1)]
+    hi = np.r_[np.arange(1, n), n - 1]
+    span = (hi - lo)[:, None] / fps
+    lin = (q[hi, :3] - q[lo, :3]) / span
+    rel = quat_mul(quat_conj(quats[lo]), quats[hi])
+    rel *= np.where(rel[..., :1] < 0, -1.0, 1.0)
+    ang = quat_log(rel) / span[:, :, None]
+    return np.concatenate([lin, ang.reshape(n, -1)], axis=1)
+
+
+class WholeBodyTracker:
+    """Controller ``f(world, t)`` tracking ``motion`` from clip time ``start`` with inverse
+    dynamics and optimised ground forces (see the module docstring). Writes
+    ``servo.feedforward`` for one character; use it together with a
+    :class:`~reactmocap.sim.rollout.MotionTracker` on the same servo, called first.
+
+    Args:
+        kp_root, kv_root: pelvis position gains (1/s^2, 1/s; kv critical by default).
+        kp_rot, kv_rot: pelvis orientation gains.
+        kp_joint, kv_joint: joint gains inside ``qdd_des`` (default: the servo's).
+        root_weight: weight of the pelvis rows of ``W`` against 1 for joints.
+        contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
+        friction: fraction of the floor's friction coefficient the plan may use.
+        reach: a foot is planted in the mocap when its sole is within ``reach`` m of the floor
+            and it moves slower than 0.6 m/s; a sole corner supports when within ``touch`` m.
+        force_reg: ``lam``, the regulariser on the pyramid coefficients (N^-2 scale).
+    """
+
+    def __init__(
+        self,
+        servo: PDServo,
+        character: int,
+        motion: Motion,
+        start: float = 0.0,
+        *,
+        kp_root: float = 100.0,
+        kv_root: float | None = None,
+        kp_rot: float = 200.0,
+        kv_rot: float | None = None,
+        kp_joint: float | None = None,
+        kv_joint: float | None = None,
+        root_weight: float = 10.0,
+        contact_weight: float = 100.0,
+        contact_kv: float = 20.0,
+        friction: float = 0.7,
+        reach: float = 0.03,
+        touch: float = 0.01,
+        force_reg: float = 1e-6,
+        planted_speed: float = 0.6,
+    ) -> None:
+        values = {
+            "kp_root": kp_root, "kp_rot": kp_rot, "root_weight": root_weight,
+            "contact_weight": contact_weight, "contact_kv": contact_kv, "friction": friction,
+            "reach": reach, "touch": touch, "force_reg": force_reg,
+        }  # fmt: skip
+        for name, v in values.items():
+            if not (np.isfinite(v) and v >= 0):
+                raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
+        if character not in servo.character_indices:
+            raise ConfigError(
+                f"character {character} is not driven by the servo {servo.character_indices}"
+            )
+        world = servo.world
+        m = world.model
+        if np.any(m.opt.gravity[:2]):
+            raise ConfigError("WholeBodyTracker assumes vertical gravity")
+        self.servo = servo
+        self.world = world
+        self.character = character
+        self.motion = motion
+        self.start = float(start)
+        wc = world.characters[character]
+        self.wc = wc
+        kpj = servo.kp if kp_joint is None else float(kp_joint)
+        kvj = servo.kv if kv_joint is None else float(kv_joint)
+        self.kp = np.r_[np.full(3, kp_root), np.full(3, kp_rot), np.full(3 * NJ, kpj)]
+        self.kv = np.r_[
+            np.full(3, critical_kv(kp_root) if kv_root is None else kv_root),
+            np.full(3, critical_kv(kp_rot) if kv_rot is None else kv_rot),
+            np.full(3 * NJ, kvj),
+        ]
+        self.w = np.r_[np.full(6, root_weight), np.ones(3 * NJ)]
+        self.sqrt_wc = float(np.sqrt(contact_weight))
+        self.contact_kv = float(contact_kv)
+        self.mu = float(friction) * float(world.config.friction)
+        self.touch = float(touch)
+        self.sqrt_reg = float(np.sqrt(force_reg))
+        self.feet = np.array([wc.body_ids[SIM_BODIES.index(f)] for f in _FEET])
+        foot_geoms = [wc.geom_ids[m.geom_bodyid[wc.geom_ids] == b] for b in self.feet]
+        boxes = [g[m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX] for g in foot_geoms]
+        if any(b.size != 1 for b in boxes):
+            raise ConfigError("WholeBodyTracker needs exactly one box geom per foot")
+        self.sole = np.array([int(b[0]) for b in boxes])
+        signs = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=np.float64)
+        half = m.geom_size[self.sole]
+        self._corners = np.stack(
+            [np.column_stack([signs * h[:2], np.full(4, -h[2])]) for h in half]
+        )  # (2, 4, 3) sole corners in the box frame
+        self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
+        self._dofs = wc.qvel_slice
+        self._full = np.zeros((m.nv, m.nv))
+        self._jacp = np.zeros((3, m.nv))
+        self._jacr = np.zeros((3, m.nv))
+        rows = servo.character_indices.index(character) * NJ
+        self._ff = servo.feedforward[rows : rows + NJ]  # (15, 3) view
+        self._servo_rows = slice(rows, rows + NJ)
+        edges = np.column_stack([self.mu * _PYRAMID, np.ones(4)])  # (4, 3)
+        self._edges = edges.T  # (3, 4) columns: unnormalised pyramid edges
+        self.last_support: tuple[int, ...] = ()
+        self.last_forces = np.zeros(3)
+        self.planted_speed = float(planted_speed)
+        self._reference(motion, reach)
+
+    # ------------------------------------------------------------------ reference
+    def _reference(self, motion: Motion, reach: float) -> None:
+        m = self.world.model
+        ch = self.wc.character
+        q = ch.qpos_from_motion(motion)
+        n = motion.num_frames
+        q[:, 3:] = _hemisphere(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
+        self.q = q
+        self.v = _velocity(q, motion.fps)
+        self.a = (
+            np.gradient(self.v, 1.0 / motion.fps, axis=0) if n > 2 else np.zeros_like(self.v)
+        )
+        # mocap foot stance, measured on this character's own sole boxes
+        d = mujoco.MjData(m)
+        sole = np.empty((n, 2))
+        foot = np.empty((n, 2, 3))
+        for i in range(n):  # once per clip, not in the step loop
+            d.qpos[self.wc.qpos_slice] = q[i]
+            mujoco.mj_kinematics(m, d)
+            sole[i] = self._corner_pos(d).min(axis=1)[:, 2] - self.floor_z
+            foot[i] = d.xpos[self.feet]
+        speed = (
+            np.linalg.norm(np.gradient(foot, 1.0 / motion.fps, axis=0), axis=-1)
+            if n > 2
+            else np.zeros((n, 2))
+        )
+        self.planted = (sole < reach) & (speed < self.planted_speed)
+
+    def _corner_pos(self, d: mujoco.MjData) -> F64:
+        """``(2, 4, 3)`` world positions of the sole corners."""
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        return np.einsum("fij,fkj->fki", rot, self._corners) + d.geom_xpos[self.sole][:, None]
+
+    def _sample(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
+        x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
+        i0 = int(x)
+        i1 = min(i0 + 1, self.motion.num_frames - 1)
+        a = x - i0
+        q = (1 - a) * self.q[i0] + a * self.q[i1]
+        quats = q[3:].reshape(NJ + 1, 4)
+        quats /= np.linalg.norm(quats, axis=1, keepdims=True)
+        v = (1 - a) * self.v[i0] + a * self.v[i1]
+        acc = (1 - a) * self.a[i0] + a * self.a[i1]
+        return q, v, acc, self.planted[round(x)]
+
+    # ------------------------------------------------------------------ control
+    def _support(
+        self, d: mujoco.MjData, planted: NDArray[np.bool_]
+    ) -> tuple[tuple[int, ...], F64, F64]:
+        """Supporting feet, their touching sole corners ``(k, 3)`` (world) and those corners'
+        translational Jacobians ``(k, 3, 51)`` over the character's DOFs."""
+        m = self.world.model
+        corners = self._corner_pos(d)
+        feet: list[int] = []
+        pts: list[F64] = []
+        jacs: list[F64] = []
+        for f in range(2):
+            if not planted[f]:
+                continue
+            touching = corners[f, :, 2] - self.floor_z < self.touch
+            if not touching.any():
+                continue
+            body = int(self.feet[f])
+            mujoco.mj_jacBody(m, d, self._jacp, self._jacr, body)
+            jp = self._jacp[:, self._dofs]
+            jr = self._jacr[:, self._dofs]
+            p = corners[f, touching]
+            r = p - d.xpos[body]
+            # v_p = v_o + w x r = J_p qdot - [r]x J_r qdot
+            skew = np.zeros((len(r), 3, 3))
+            skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -r[:, 2], r[:, 1], -r[:, 0]
+            skew -= skew.transpose(0, 2, 1)
+            feet.append(f)
+            pts.append(p)
+            jacs.append(jp[None] - skew @ jr[None])
+        if not feet:
+            return (), np.zeros((0, 3)), np.zeros((0, 3, NV))
+        return tuple(feet), np.concatenate(pts), np.concatenate(jacs)
+
+    def __call__(self, world: World, t: float) -> None:
+        m, d = world.model, world.data
+        qr, vr, ar, planted = self._sample(t)
+        sl = self._dofs
+        q = d.qpos[self.wc.qpos_slice]
+        v = d.qvel[sl]
+        # position error in qvel coordinates: world translation, local rotation vectors
+        cur = q[3:].reshape(NJ + 1, 4)
+        ref = qr[3:].reshape(NJ + 1, 4)
+        rel = quat_mul(quat_conj(cur), ref)
+        rel *= np.where(rel[:, :1] < 0, -1.0, 1.0)
+        err = np.r_[qr[:3] - q[:3], quat_log(rel).reshape(-1)]
+        acc_des = ar + self.kp * err + self.kv * (vr - v)
+
+        mujoco.mj_fullM(m, d, self._full)
+        big_m = self._full[sl, sl]
+        h = d.qfrc_bias[sl]
+        feet, corners, jc = self._support(d, planted)
+        self.last_support = feet
+        nc = len(corners)
+        # qdd = G z + g0 with z = [qdd_joints (45), beta (4 nc)]: the pelvis rows solved
+        # from the Newton-Euler equation of the pelvis
+        m_rr = big_m[:6, :6]
+        m_rj = big_m[:6, 6:]
+        nb = 4 * nc
+        if nc:
+            # generalised force of each pyramid coefficient: J_p^T edge
+            qb = np.einsum("cin,ie->nce", jc, self._edges).reshape(NV, nb)
+        else:
+            qb = np.zeros((NV, 0))
+        rhs = np.linalg.solve(m_rr, np.column_stack([m_rj, qb[:6], h[:6]]))
+        g = np.zeros((NV, 3 * NJ + nb))
+        g[:6, : 3 * NJ] = -rhs[:, : 3 * NJ]
+        g[:6, 3 * NJ :] = rhs[:, 3 * NJ : 3 * NJ + nb]
+        g[6:, : 3 * NJ] = np.eye(3 * NJ)
+        g0 = np.zeros(NV)
+        g0[:6] = -rhs[:, -1]
+        # objective rows A z ~ b
+        rows_a = [self.w[:, None] * g]
+        rows_b = [self.w * (acc_des - g0)]
+        if nc:
+            jflat = jc.reshape(3 * nc, NV)
+            rows_a.append(self.sqrt_wc * (jflat @ g))
+            rows_b.append(-self.sqrt_wc * (jflat @ g0 + self.contact_kv * (jflat @ v)))
+        a_mat = np.concatenate(rows_a)
+        b_vec = np.concatenate(rows_b)
+        ay, ab = a_mat[:, : 3 * NJ], a_mat[:, 3 * NJ :]
+        qmat, rmat = np.linalg.qr(ay)
+        if nb:
+            # project the free joint accelerations out; NNLS over the pyramid coefficients
+            pab = ab - qmat @ (qmat.T @ ab)
+            pb = b_vec - qmat @ (qmat.T @ b_vec)
+            scale = float(np.linalg.norm(pab, axis=0).max()) or 1.0
+            lhs = np.concatenate([pab, self.sqrt_reg * scale * np.eye(nb)])
+            beta, _ = nnls(lhs, np.r_[pb, np.zeros(nb)], maxiter=50 * nb)
+        else:
+            beta = np.zeros(0)
+        y = np.linalg.solve(rmat, qmat.T @ (b_vec - ab @ beta))
+        z = np.r_[y, beta]
+        qdd = g @ z + g0
+        self.last_qdd = qdd
+        self.last_des = acc_des
+        self.last_err = err
+        self.last_derr = vr - v
+        self.last_ar = ar
+        tau = big_m[6:] @ qdd + h[6:] - qb[6:] @ beta
+        force = (
+            np.einsum("ie,ce->i", self._edges, beta.reshape(nc, 4)) if nc else np.zeros(3)
+        )
+        self.last_forces = force
+        self._ff[:] = tau.reshape(NJ, 3) - self.servo.torques()[self._servo_rows]
