@@ -196,22 +196,24 @@ def _windows(motion: Motion) -> list[float]:
     return list(np.arange(0.0, motion.duration - 1.0 + 1e-9, 0.5))
 
 
-def bench_tracking(kp: float, assist_gain: float) -> None:
+def bench_tracking(assist_gain: float) -> None:
     clips = sorted(
         p for p in SHARED.glob("*/*.bvh") if any(k in p.name for k in ("walk", "run", "kick"))
     )
     if not clips:
         print(f"\n(no shared clips under {SHARED.resolve()}: tracking robustness skipped)")
         return
-    modes = [(False, 0.0, "PD only"), (True, 0.0, "PD + stance balance (physical)"),
-             (False, assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}")]  # fmt: skip
-    for balance, assist, label in modes:
-        print(f"\n## tracking robustness, kp={kp:g}, kv critical, {label}")
+    modes = [("pd", 0.0, "PD only"), ("balance", 0.0, "PD + stance balance (physical)"),
+             ("wholebody", 0.0, "whole-body inverse dynamics (physical, default)"),
+             ("pd", assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}")]  # fmt: skip
+    for controller, assist, label in modes:
+        print(f"\n## tracking robustness, {label} (controller's default gains)")
         print(
             f"{'clip':<28} {'windows':>7} {'ok %':>6} {'upright %':>9} {'med root cm':>11} "
             f"{'med ang deg':>11} {'med joint rad':>13}"
         )
         tot_ok = tot = 0
+        walls: list[float] = []
         for path in clips:
             motion = _read_bvh(path)
             ok = up = 0
@@ -223,8 +225,8 @@ def bench_tracking(kp: float, assist_gain: float) -> None:
                     from reactmocap.sim.rollout import _errors
 
                     _, rep, res = track_clip(
-                        motion, start=float(s), seconds=secs, kp=kp, root_assist=assist,
-                        balance=balance,
+                        motion, start=float(s), seconds=secs, root_assist=assist,
+                        controller=controller,
                     )  # fmt: skip
                     # recompute per-frame errors for the window criterion
                     world = World(build_character(motion, frame=round(s * motion.fps)))
@@ -239,6 +241,7 @@ def bench_tracking(kp: float, assist_gain: float) -> None:
                     roots.append(rep.max_root_error_m)
                     angs.append(float(np.max(err["root_ang_series"])))
                     joints.append(rep.mean_joint_error_rad)
+                    walls.append(rep.wall_s / secs)
                 except Exception as exc:
                     print(f"  {path.name} @ {s:.1f}s failed: {exc}")
             tot_ok += ok
@@ -248,17 +251,22 @@ def bench_tracking(kp: float, assist_gain: float) -> None:
                 f"{100 * up / len(wins):9.0f} {100 * np.median(roots):11.1f} "
                 f"{np.degrees(np.median(angs)):11.1f} {np.median(joints):13.3f}"
             )
-        print(f"{'ALL':<28} {tot:>7} {100 * tot_ok / max(tot, 1):6.0f}")
+        print(
+            f"{'ALL':<28} {tot:>7} {100 * tot_ok / max(tot, 1):6.0f}   "
+            f"(median real-time factor {1.0 / np.median(walls):.2f}x)"
+        )
 
 
 def bench_guard(kp: float, assist_gain: float) -> None:
     guard = synthetic_clips(30.0)["guard"]
     loop = Motion.concatenate([guard, guard.slice(1), guard.slice(1)], name="guard_x3")
-    for balance, assist in ((False, 0.0), (True, 0.0), (False, assist_gain)):
-        _, rep, _ = track_clip(loop, seconds=10.0, kp=kp, root_assist=assist, balance=balance)
-        label = (
-            f"root assist kp={assist:g}" if assist else ("PD + balance" if balance else "PD only")
-        )
+    for controller, assist in (("pd", 0.0), ("balance", 0.0), ("wholebody", 0.0),
+                               ("pd", assist_gain)):  # fmt: skip
+        _, rep, _ = track_clip(
+            loop, seconds=10.0, kp=None if controller == "wholebody" else kp,
+            root_assist=assist, controller=controller,
+        )  # fmt: skip
+        label = f"root assist kp={assist:g}" if assist else controller
         print(
             f"\n## guard 10 s ({label}): fell={rep.fell} (at {rep.fall_time}), "
             f"mean joint err {rep.mean_joint_error_rad:.3f} rad, root err "
@@ -283,7 +291,7 @@ def main(argv: list[str] | None = None) -> int:
     if "guard" not in args.skip:
         bench_guard(args.kp, args.assist)
     if "tracking" not in args.skip:
-        bench_tracking(args.kp, args.assist)
+        bench_tracking(args.assist)
     return 0
 
 

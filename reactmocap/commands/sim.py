@@ -41,8 +41,19 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
 
 def _common(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--kp", type=float, default=4000.0, help="PD stiffness (1/s^2)")
-    p.add_argument("--kv", type=float, help="PD damping (1/s; default critical)")
+    from reactmocap.sim.rollout import TRACKING_CONTROLLERS
+
+    p.add_argument(
+        "--controller",
+        default="wholebody",
+        help="tracking controller: "
+        + "; ".join(f"{k}: {v.description}" for k, v in TRACKING_CONTROLLERS.items())
+        + " (default: wholebody)",
+    )
+    p.add_argument(
+        "--kp", type=float, help="joint stiffness (1/s^2; default 1000 wholebody, 4000 PD)"
+    )
+    p.add_argument("--kv", type=float, help="joint damping (1/s; default critical)")
     p.add_argument("--friction", type=float, default=1.0, help="ground friction coefficient")
     p.add_argument("--fps", type=float, default=60.0, help="output frame rate")
     p.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
@@ -50,13 +61,7 @@ def _common(p: argparse.ArgumentParser) -> None:
         "--root-assist",
         type=float,
         default=0.0,
-        help="NON-PHYSICAL pelvis stabilisation gain (0 = off); replaces the balance controller",
-    )
-    p.add_argument(
-        "--no-balance",
-        dest="balance",
-        action="store_false",
-        help="PD tracking only, without the stance-leg balance controller",
+        help="NON-PHYSICAL pelvis stabilisation gain (0 = off); only with --controller pd",
     )
 
 
@@ -99,7 +104,7 @@ def _kwargs(args: argparse.Namespace) -> dict[str, object]:
         "record_fps": args.fps,
         "total_mass": args.mass,
         "root_assist": args.root_assist,
-        "balance": args.balance and not args.root_assist,
+        "controller": args.controller,
     }
 
 

@@ -16,20 +16,23 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.errors import ConfigError, SimulationError
+from reactmocap.errors import ConfigError, SimulationError, UnknownKeyError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.balance import StanceBalance
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, SIM_PARENTS, build_character
 from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, _t3, contact_report
-from reactmocap.sim.pd import PDServo
+from reactmocap.sim.pd import PDServo, critical_kv
+from reactmocap.sim.wholebody import WholeBodyTracker
 from reactmocap.sim.world import World, WorldConfig
 
 __all__ = [
     "MotionTracker",
     "RolloutResult",
+    "TRACKING_CONTROLLERS",
     "RootAssist",
     "TrackReport",
+    "TrackingController",
     "push_clip",
     "rollout",
     "track_clip",
@@ -312,13 +315,17 @@ class TrackReport:
     friction: float
     timestep: float
     root_assist: float
-    balance: bool
+    controller: str
     impacts: int
 
     def to_dict(self) -> dict[str, object]:
         from dataclasses import asdict
 
         return asdict(self)
+
+
+def _kv(kp: float, kv: float | None) -> float:
+    return critical_kv(kp) if kv is None else float(kv)
 
 
 def _errors(world: World, result: RolloutResult, motion: Motion, start: float) -> dict[str, object]:
@@ -354,19 +361,84 @@ def _errors(world: World, result: RolloutResult, motion: Motion, start: float) -
     }
 
 
+@dataclass(frozen=True)
+class TrackingController:
+    """A registered way to track a clip: ``build(world, motion, start, kp, kv)`` returns the
+    servo and the controllers for character 0; ``kp``/``kv`` ``None`` mean the defaults."""
+
+    description: str
+    default_kp: float
+    control_every: int
+    physical: bool
+    build: Callable[[World, Motion, float, float, float | None], tuple[PDServo, list[Controller]]]
+
+
+def _build_pd(
+    world: World, motion: Motion, start: float, kp: float, kv: float | None
+) -> tuple[PDServo, list[Controller]]:
+    servo = PDServo(world, kp=kp, kv=kv)
+    return servo, [MotionTracker(servo, 0, motion, start=start)]
+
+
+def _build_balance(
+    world: World, motion: Motion, start: float, kp: float, kv: float | None
+) -> tuple[PDServo, list[Controller]]:
+    servo, ctrls = _build_pd(world, motion, start, kp, kv)
+    return servo, [*ctrls, StanceBalance(servo, 0, motion, start=start)]
+
+
+#: damping of the servo under the whole-body tracker (1/s, inertia-scaled): its stiffness is
+#: off because, held between ticks against a moving target, it fought the plan
+WHOLEBODY_SERVO_KV = 20.0
+
+
+def _build_wholebody(
+    world: World, motion: Motion, start: float, kp: float, kv: float | None
+) -> tuple[PDServo, list[Controller]]:
+    servo = PDServo(world, kp=0.0, kv=WHOLEBODY_SERVO_KV)
+    wb = WholeBodyTracker(servo, 0, motion, start=start, kp_joint=kp, kv_joint=kv)
+    return servo, [wb]
+
+
+TRACKING_CONTROLLERS: dict[str, TrackingController] = {
+    "wholebody": TrackingController(
+        "inverse dynamics with optimised ground forces (pelvis tracked through the feet)",
+        default_kp=1000.0, control_every=4, physical=True, build=_build_wholebody,
+    ),
+    "balance": TrackingController(
+        "inertia-scaled PD servo plus stance-leg balance (StanceBalance)",
+        default_kp=4000.0, control_every=10, physical=True, build=_build_balance,
+    ),
+    "pd": TrackingController(
+        "inertia-scaled PD servo only (the paper's tracker; no balance)",
+        default_kp=4000.0, control_every=10, physical=True, build=_build_pd,
+    ),
+}  # fmt: skip
+
+
+def tracking_controller(name: str) -> TrackingController:
+    """The registered tracking controller ``name``; an unknown name lists the valid ones."""
+    try:
+        return TRACKING_CONTROLLERS[name]
+    except KeyError:
+        raise UnknownKeyError(
+            f"unknown tracking controller {name!r}; valid keys: {sorted(TRACKING_CONTROLLERS)}"
+        ) from None
+
+
 def track_clip(
     motion: Motion,
     *,
     start: float = 0.0,
     seconds: float | None = None,
-    kp: float = 4000.0,
+    kp: float | None = None,
     kv: float | None = None,
     friction: float = 1.0,
     impacts: Sequence[Impact] = (),
     record_fps: float = 60.0,
     root_assist: float = 0.0,
-    balance: bool = True,
-    control_every: int = 10,
+    controller: str = "wholebody",
+    control_every: int | None = None,
     total_mass: float = 75.0,
     config: WorldConfig | None = None,
     character_kwargs: dict[str, object] | None = None,
@@ -375,11 +447,13 @@ def track_clip(
     on a simulated character built from the clip (reference = the start frame), optionally
     with impacts (their ``start`` is relative to ``start``). Returns the simulated Motion on
     the clip's skeleton (non-simulated joints from the clip), the report and the raw result.
-    ``balance`` adds the physical :class:`~reactmocap.sim.balance.StanceBalance` (gravity
-    compensation, velocity feed-forward, COM and trunk control through the stance legs);
-    ``root_assist > 0`` adds the non-physical :class:`RootAssist` with that kp. Targets and
-    feed-forward update every ``control_every`` steps (10 = 200 Hz, as in the response
-    pipeline; the servo's own stiffness and damping act every step inside MuJoCo)."""
+    ``controller`` names an entry of :data:`TRACKING_CONTROLLERS`: ``"wholebody"`` (default,
+    :class:`~reactmocap.sim.wholebody.WholeBodyTracker`), ``"balance"`` (PD servo plus
+    :class:`~reactmocap.sim.balance.StanceBalance`) or ``"pd"`` (the servo alone); ``kp``/``kv``
+    are its joint gains (default: the controller's). ``root_assist > 0`` adds the
+    non-physical :class:`RootAssist` with that kp (only with ``"pd"``). Targets and
+    feed-forward update every ``control_every`` steps (default: the controller's; the servo's
+    own stiffness and damping act every step inside MuJoCo)."""
     if not (np.isfinite(start) and 0 <= start <= motion.duration):
         raise ConfigError(f"start {start!r} s is outside the clip (0..{motion.duration:.3f} s)")
     remaining = motion.duration - start
@@ -391,12 +465,15 @@ def track_clip(
             f"cannot track {seconds} s from {start} s: the clip {motion.name!r} lasts "
             f"{motion.duration:.3f} s"
         )
-    if balance and root_assist > 0:
+    spec = tracking_controller(controller)
+    if root_assist > 0 and controller != "pd":
         raise ConfigError(
-            "root_assist and balance cannot be combined: the balance controller's support "
+            f"root_assist cannot be combined with the {controller!r} controller: its ground "
             "forces assume nothing else holds the body up (they went unstable together); "
-            "pass balance=False with root_assist"
+            "use controller='pd' with root_assist"
         )
+    kp = spec.default_kp if kp is None else float(kp)
+    every = spec.control_every if control_every is None else int(control_every)
     frame = round(start * motion.fps)
     character = build_character(
         motion,
@@ -408,11 +485,7 @@ def track_clip(
     cfg = config or WorldConfig(friction=friction)
     world = World(character, cfg)
     world.set_from_motion(0, motion, frame)
-    servo = PDServo(world, kp=kp, kv=kv)
-    tracker = MotionTracker(servo, 0, motion, start=start)
-    ctrls: list[Controller] = [tracker]
-    if balance:
-        ctrls.append(StanceBalance(servo, 0, motion, start=start))
+    servo, ctrls = spec.build(world, motion, float(start), kp, kv)
     if root_assist > 0:
         ctrls.append(RootAssist(world, 0, motion, start=start, kp=root_assist))
     for f in ctrls:
@@ -424,7 +497,7 @@ def track_clip(
         controllers=ctrls,
         # the assist's explicit whole-body PD acts on the light pelvis: held for several steps
         # it goes unstable, so it runs every step
-        control_every=1 if root_assist > 0 else control_every,
+        control_every=1 if root_assist > 0 else every,
         impacts=impacts,
         record_fps=record_fps,
         references=[motion],
@@ -443,12 +516,12 @@ def track_clip(
         root_angle_error_rad=float(err["root_angle_error_rad"]),  # type: ignore[arg-type]
         wall_s=float(result.wall_s),
         realtime_factor=float(seconds / result.wall_s) if result.wall_s > 0 else float("inf"),
-        kp=servo.kp,
-        kv=servo.kv,
+        kp=kp,
+        kv=_kv(kp, kv),
         friction=cfg.friction,
         timestep=cfg.timestep,
         root_assist=float(root_assist),
-        balance=bool(balance),
+        controller=controller,
         impacts=len(impacts),
     )
     name = f"{motion.name}_tracked" if motion.name else "tracked"

@@ -77,13 +77,13 @@ def test_feedforward_holds_a_standing_pose_with_a_weak_servo(clips: dict[str, Mo
 
 def test_balance_keeps_a_standing_clip_up(guard_loop: Motion) -> None:
     secs = 3.5
-    _, plain, _ = track_clip(guard_loop, seconds=secs, balance=False)
-    _, bal, _ = track_clip(guard_loop, seconds=secs, balance=True)
+    _, plain, _ = track_clip(guard_loop, seconds=secs, controller="pd")
+    _, bal, _ = track_clip(guard_loop, seconds=secs, controller="balance")
     assert plain.fell, "plain PD tracking is expected to topple (no balance control)"
     assert not bal.fell
     assert bal.max_root_error_m < 0.03
     assert bal.mean_joint_error_rad < 0.02
-    assert bal.balance and not plain.balance
+    assert bal.controller == "balance" and plain.controller == "pd"
 
 
 @pytest.mark.parametrize(
@@ -103,11 +103,12 @@ def test_unknown_character_rejected(clips: dict[str, Motion]) -> None:
         StanceBalance(servo, 3, clips["guard"])
 
 
-def test_balance_and_root_assist_are_exclusive(guard_loop: Motion) -> None:
-    with pytest.raises(ConfigError, match="root_assist and balance"):
-        track_clip(guard_loop, seconds=0.2, root_assist=100.0, balance=True)
-    _, rep, _ = track_clip(guard_loop, seconds=0.2, root_assist=100.0, balance=False)
-    assert rep.root_assist == 100.0 and not rep.balance
+@pytest.mark.parametrize("controller", ["balance", "wholebody"])
+def test_root_assist_only_with_plain_pd(guard_loop: Motion, controller: str) -> None:
+    with pytest.raises(ConfigError, match="root_assist cannot be combined"):
+        track_clip(guard_loop, seconds=0.2, root_assist=100.0, controller=controller)
+    _, rep, _ = track_clip(guard_loop, seconds=0.2, root_assist=100.0, controller="pd")
+    assert rep.root_assist == 100.0 and rep.controller == "pd"
 
 
 def test_stance_legs_get_stiffer_gains(clips: dict[str, Motion]) -> None:

@@ -1,0 +1,170 @@
+"""Whole-body tracker: its plan is exact inverse dynamics (MuJoCo's forward dynamics under the
+planned torques and ground forces gives the planned accelerations), the forces respect the
+friction pyramid, it keeps clips up where the PD servo falls, and it is deterministic."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.library.motion import Motion
+from reactmocap.sim import World, build_character
+from reactmocap.sim.pd import PDServo
+from reactmocap.sim.rollout import (
+    TRACKING_CONTROLLERS,
+    WHOLEBODY_SERVO_KV,
+    track_clip,
+    tracking_controller,
+)
+from reactmocap.sim.wholebody import WholeBodyTracker
+
+SHARED = Path(__file__).resolve().parents[3] / "shared" / "mocap"
+
+
+def _standing(motion: Motion, frame: int) -> tuple[World, PDServo, WholeBodyTracker]:
+    world = World(build_character(motion, frame=frame))
+    world.set_from_motion(0, motion, frame)
+    mujoco.mj_forward(world.model, world.data)
+    servo = PDServo(world, kp=0.0, kv=WHOLEBODY_SERVO_KV)
+    return world, servo, WholeBodyTracker(servo, 0, motion, start=frame / motion.fps)
+
+
+@pytest.mark.parametrize(("clip", "frame"), [("guard", 10), ("step_forward", 20)])
+def test_plan_is_inverse_dynamics(request: pytest.FixtureRequest, clip: str, frame: int) -> None:
+    motion: Motion = request.getfixturevalue(clip)
+    world, servo, wb = _standing(motion, frame)
+    plan = wb.plan(0.0)
+    assert plan.support, "a standing frame must have a supporting foot"
+    fz = plan.forces[:, 2]
+    assert np.all(fz >= -1e-9)
+    # pyramid: each horizontal component within mu * normal
+    mu = 0.7 * world.config.friction
+    assert np.all(np.abs(plan.forces[:, :2]) <= mu * fz[:, None] + 1e-6)
+    weight = float(world.model.body_subtreemass[world.characters[0].body_ids[0]]) * 9.81
+    assert 0.3 * weight < fz.sum() < 3.0 * weight
+    # forward dynamics with contacts and limits off, the servo silent, the planned joint
+    # torques applied and the planned ground forces as generalised forces: qacc == plan
+    m, d = world.model, world.data
+    servo.clear()
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_LIMIT)
+    wc = world.characters[0]
+    d.qfrc_applied[:] = 0.0
+    mujoco.mj_forward(m, d)
+    # the plan leaves passive joint damping out on purpose: cancel it here
+    d.qfrc_applied[wc.qvel_slice] = plan.generalized_contact - d.qfrc_passive[wc.qvel_slice]
+    d.qfrc_applied[wc.ball_dof_start : wc.ball_dof_start + 45] += plan.torques.reshape(-1)
+    mujoco.mj_forward(m, d)
+    np.testing.assert_allclose(
+        d.qacc[wc.qvel_slice], plan.qacc, atol=1e-6 * (1 + np.abs(plan.qacc).max())
+    )
+
+
+def test_plan_without_support_conserves_momentum(guard: Motion) -> None:
+    world, _servo, wb = _standing(guard, 10)
+    world.data.qpos[2] += 0.5  # in the air
+    mujoco.mj_forward(world.model, world.data)
+    plan = wb.plan(0.0)
+    assert plan.support == () and plan.forces.shape == (0, 3)
+    # only gravity acts on the whole body: the pelvis rows of M qacc + bias are zero
+    m, d = world.model, world.data
+    full = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, full)
+    root = (full @ plan.qacc + d.qfrc_bias)[:6]
+    np.testing.assert_allclose(root, 0.0, atol=1e-6)
+
+
+def test_wholebody_keeps_the_guard_up_where_pd_falls(guard: Motion) -> None:
+    loop = Motion.concatenate([guard, guard.slice(1)], name="guard_x2")
+    _, pd, _ = track_clip(loop, seconds=3.5, controller="pd")
+    _, wb, _ = track_clip(loop, seconds=3.5)
+    assert pd.fell
+    assert wb.controller == "wholebody" and not wb.fell
+    assert wb.max_root_error_m < 0.03
+    assert wb.mean_joint_error_rad < 0.05
+
+
+def test_wholebody_tracks_a_step_where_pd_and_balance_fall(step_forward: Motion) -> None:
+    _, rep, _ = track_clip(step_forward)
+    for other in ("pd", "balance"):
+        _, o, _ = track_clip(step_forward, controller=other)
+        assert o.fell and o.max_root_error_m > 0.5
+    assert not rep.fell
+    assert rep.max_root_error_m < 0.5
+    assert rep.root_angle_error_rad < np.radians(10.0)
+
+
+def test_wholebody_is_deterministic(step_forward: Motion) -> None:
+    _, _, a = track_clip(step_forward, seconds=0.3)
+    _, _, b = track_clip(step_forward, seconds=0.3)
+    assert np.array_equal(a.body_pos, b.body_pos)
+    assert np.array_equal(a.body_quat, b.body_quat)
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason=f"shared mocap not found at {SHARED}")
+def test_wholebody_tracks_a_real_walk() -> None:
+    from reactmocap.library.bvh import read_bvh
+    from reactmocap.sim.rollout import _errors
+
+    clips = sorted(SHARED.glob("*/*walk_normal_001.bvh"))
+    if not clips:
+        pytest.skip(f"no walk_normal_001 clip under {SHARED}")
+    walk = read_bvh(clips[0])
+    for start in (1.5, 3.5):
+        _, rep, res = track_clip(walk, start=start, seconds=1.0)
+        world = World(build_character(walk, frame=round(start * walk.fps)))
+        err = _errors(world, res, walk, start)
+        assert not rep.fell
+        assert float(np.max(err["root_err_series"])) <= 0.10  # type: ignore[call-overload]
+        assert float(np.max(err["root_ang_series"])) <= np.radians(15.0)  # type: ignore[call-overload]
+
+
+def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
+    with pytest.raises(UnknownKeyError, match="wholebody"):
+        track_clip(guard, seconds=0.1, controller="nope")
+    with pytest.raises(UnknownKeyError, match="balance"):
+        tracking_controller("nope")
+    assert set(TRACKING_CONTROLLERS) == {"wholebody", "balance", "pd"}
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("kp_root", -1.0), ("kp_joint", float("nan")), ("friction", -0.5), ("reach", float("inf"))],
+)
+def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
+    world = World(build_character(guard, frame=0))
+    servo = PDServo(world, kp=0.0)
+    with pytest.raises(ConfigError, match=key):
+        WholeBodyTracker(servo, 0, guard, **{key: value})  # type: ignore[arg-type]
+
+
+def test_unknown_character_rejected(guard: Motion) -> None:
+    world = World(build_character(guard, frame=0))
+    servo = PDServo(world, kp=0.0)
+    with pytest.raises(ConfigError, match="character 2"):
+        WholeBodyTracker(servo, 2, guard)
+
+
+def test_cli_track_controller_choice(
+    guard: Motion, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    from reactmocap.cli import main
+    from reactmocap.library.bvh import write_bvh
+
+    clip = tmp_path / "guard.bvh"
+    write_bvh(guard, clip)
+    for controller in ("pd", "balance", "wholebody"):
+        report = tmp_path / f"{controller}.json"
+        args = ["track", str(clip), "--seconds", "0.3", "--controller", controller]
+        assert main([*args, "--report", str(report)]) == 0
+        assert json.loads(report.read_text())["controller"] == controller
+    assert main(["track", str(clip), "--seconds", "0.3", "--controller", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown tracking controller 'nope'" in err and "wholebody" in err
+    assert not (tmp_path / "nope.json").exists()
