@@ -1,5 +1,6 @@
 """Physics simulation on MuJoCo: the character built from a skeleton, the world, the
-inertia-scaled PD servo, impacts and contacts, rollouts, and Motion <-> state conversion."""
+inertia-scaled PD servo, balance and whole-body tracking controllers, impacts and contacts,
+rollouts, and Motion <-> state conversion."""
 
 from reactmocap.sim.balance import StanceBalance
 from reactmocap.sim.character import (
@@ -21,14 +22,18 @@ from reactmocap.sim.impacts import (
 from reactmocap.sim.pd import PDServo, critical_kv
 from reactmocap.sim.retarget import Retargeter, retarget
 from reactmocap.sim.rollout import (
+    TRACKING_CONTROLLERS,
     MotionTracker,
     RolloutResult,
     RootAssist,
+    TrackingController,
     TrackReport,
     push_clip,
     rollout,
     track_clip,
+    tracking_controller,
 )
+from reactmocap.sim.wholebody import WholeBodyPlan, WholeBodyTracker
 from reactmocap.sim.world import PREFIXES, World, WorldCharacter, WorldConfig
 
 __all__ = [
@@ -36,6 +41,7 @@ __all__ = [
     "BODY_ALIASES",
     "PREFIXES",
     "SIM_BODIES",
+    "TRACKING_CONTROLLERS",
     "Character",
     "CharacterContact",
     "ContactReport",
@@ -49,8 +55,11 @@ __all__ = [
     "RootAssist",
     "StanceBalance",
     "TrackReport",
+    "TrackingController",
     "World",
     "WorldCharacter",
+    "WholeBodyPlan",
+    "WholeBodyTracker",
     "WorldConfig",
     "build_character",
     "contact_report",
@@ -60,4 +69,5 @@ __all__ = [
     "retarget",
     "rollout",
     "track_clip",
+    "tracking_controller",
 ]

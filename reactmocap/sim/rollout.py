@@ -27,15 +27,17 @@ from reactmocap.sim.wholebody import WholeBodyTracker
 from reactmocap.sim.world import World, WorldConfig
 
 __all__ = [
+    "TRACKING_CONTROLLERS",
+    "WHOLEBODY_SERVO_KV",
     "MotionTracker",
     "RolloutResult",
-    "TRACKING_CONTROLLERS",
     "RootAssist",
     "TrackReport",
     "TrackingController",
     "push_clip",
     "rollout",
     "track_clip",
+    "tracking_controller",
 ]
 
 F64 = NDArray[np.float64]
