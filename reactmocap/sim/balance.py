@@ -39,11 +39,38 @@ from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.pd import PDServo, critical_kv
 from reactmocap.sim.world import World
 
-__all__ = ["StanceBalance"]
+__all__ = ["StanceBalance", "foot_soles", "sole_corners_world"]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
 _FEET = ("l_foot", "r_foot")
+
+
+def foot_soles(
+    world: World, character: int, who: str
+) -> tuple[NDArray[np.int64], NDArray[np.int64], F64]:
+    """A character's feet: body ids ``(2,)`` (left, right), their sole box geoms ``(2,)`` and
+    the four sole corners of each box in the box frame ``(2, 4, 3)``. ``who`` names the caller
+    in the error when a foot has no single box."""
+    m = world.model
+    wc = world.characters[character]
+    feet = np.array([wc.body_ids[SIM_BODIES.index(f)] for f in _FEET])
+    foot_geoms = [wc.geom_ids[m.geom_bodyid[wc.geom_ids] == b] for b in feet]
+    boxes = [g[m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX] for g in foot_geoms]
+    if any(b.size != 1 for b in boxes):
+        raise ConfigError(f"{who} needs exactly one box geom per foot")
+    sole = np.array([int(b[0]) for b in boxes])
+    signs = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=np.float64)
+    corners = np.stack(
+        [np.column_stack([signs * h[:2], np.full(4, -h[2])]) for h in m.geom_size[sole]]
+    )
+    return feet, sole, corners
+
+
+def sole_corners_world(d: mujoco.MjData, sole: NDArray[np.int64], corners: F64) -> F64:
+    """``(2, 4, 3)`` world positions of the sole corners from :func:`foot_soles`."""
+    rot = d.geom_xmat[sole].reshape(2, 3, 3)
+    return np.einsum("fij,fkj->fki", rot, corners) + d.geom_xpos[sole][:, None]
 
 
 def _cross(a: F64, b: F64) -> F64:
@@ -124,18 +151,7 @@ class StanceBalance:
         self.root = int(wc.body_ids[0])
         self.mass = float(m.body_subtreemass[self.root])
         self.gravity = -np.asarray(m.opt.gravity, dtype=np.float64)  # support per kg
-        self.feet = np.array([wc.body_ids[SIM_BODIES.index(f)] for f in _FEET])
-        foot_geoms = [wc.geom_ids[m.geom_bodyid[wc.geom_ids] == b] for b in self.feet]
-        boxes = [g[m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX] for g in foot_geoms]
-        if any(b.size != 1 for b in boxes):
-            raise ConfigError("StanceBalance needs exactly one box geom per foot")
-        self.sole = np.array([int(b[0]) for b in boxes])
-        half = m.geom_size[self.sole]
-        # the four sole corners of each foot box, in the box frame
-        signs = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=np.float64)
-        self._corners = np.stack(
-            [np.column_stack([signs * h[:2], np.full(4, -h[2])]) for h in half]
-        )  # (2, 4, 3)
+        self.feet, self.sole, self._corners = foot_soles(world, character, "StanceBalance")
         self.floor_geoms = np.flatnonzero(m.geom_bodyid == 0)
         self.mu = float(world.config.friction)
         rows = servo.character_indices.index(character) * NJ
@@ -154,9 +170,7 @@ class StanceBalance:
 
     def _sole_heights(self, d: mujoco.MjData) -> F64:
         """``(2,)`` lowest sole corner of each foot above the floor (m)."""
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        z = np.einsum("fj,fkj->fk", rot[:, 2, :], self._corners) + d.geom_xpos[self.sole, 2:3]
-        return z.min(axis=1)
+        return sole_corners_world(d, self.sole, self._corners)[:, :, 2].min(axis=1)
 
     def _reference(self, motion: Motion) -> None:
         """Mocap COM (position, velocity, acceleration), pelvis orientation and foot stance

@@ -23,7 +23,7 @@ from reactmocap.sim.balance import StanceBalance
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, SIM_PARENTS, build_character
 from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, _t3, contact_report
 from reactmocap.sim.pd import PDServo, critical_kv
-from reactmocap.sim.wholebody import WholeBodyTracker
+from reactmocap.sim.wholebody import WholeBodyTracker, hemisphere_continuous
 from reactmocap.sim.world import World, WorldConfig
 
 __all__ = [
@@ -74,10 +74,7 @@ class MotionTracker:
         ch = servo.world.characters[character].character
         q = ch.qpos_from_motion(motion)[:, 7:].reshape(motion.num_frames, NJ, 4)
         # hemisphere continuity in time so the blend takes the short way
-        dots = np.sum(q[1:] * q[:-1], axis=-1)
-        flips = np.cumsum(dots < 0, axis=0) % 2
-        q[1:] *= (1 - 2 * flips)[..., None]
-        self.quats = q
+        self.quats = hemisphere_continuous(q)
         self._buf = np.empty((NJ, 4))
 
     def targets_at(self, t: float) -> F64:

@@ -38,7 +38,8 @@ from scipy.optimize import nnls
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
+from reactmocap.sim.balance import foot_soles, sole_corners_world
+from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.pd import PDServo, critical_kv
 from reactmocap.sim.world import World
 
@@ -47,7 +48,6 @@ __all__ = ["WholeBodyPlan", "WholeBodyTracker"]
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
 NV = 6 + 3 * NJ
-_FEET = ("l_foot", "r_foot")
 # friction pyramid edge directions per unit of mu (world x+, x-, y+, y-)
 _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 
@@ -70,7 +70,7 @@ class WholeBodyPlan:
     generalized_contact: F64
 
 
-def _hemisphere(q: F64) -> F64:
+def hemisphere_continuous(q: F64) -> F64:
     """Flip quaternions ``(T, ..., 4)`` so consecutive frames lie in one hemisphere."""
     q = q.copy()
     flips = np.cumsum(np.sum(q[1:] * q[:-1], axis=-1) < 0, axis=0) % 2
@@ -177,17 +177,7 @@ class WholeBodyTracker:
         self.mu = float(friction) * float(world.config.friction)
         self.touch = float(touch)
         self.sqrt_reg = float(np.sqrt(force_reg))
-        self.feet = np.array([wc.body_ids[SIM_BODIES.index(f)] for f in _FEET])
-        foot_geoms = [wc.geom_ids[m.geom_bodyid[wc.geom_ids] == b] for b in self.feet]
-        boxes = [g[m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX] for g in foot_geoms]
-        if any(b.size != 1 for b in boxes):
-            raise ConfigError("WholeBodyTracker needs exactly one box geom per foot")
-        self.sole = np.array([int(b[0]) for b in boxes])
-        signs = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=np.float64)
-        half = m.geom_size[self.sole]
-        self._corners = np.stack(
-            [np.column_stack([signs * h[:2], np.full(4, -h[2])]) for h in half]
-        )  # (2, 4, 3) sole corners in the box frame
+        self.feet, self.sole, self._corners = foot_soles(world, character, "WholeBodyTracker")
         self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
         self._dofs = wc.qvel_slice
         self._full = np.zeros((m.nv, m.nv))
@@ -207,7 +197,7 @@ class WholeBodyTracker:
         ch = self.wc.character
         q = ch.qpos_from_motion(motion)
         n = motion.num_frames
-        q[:, 3:] = _hemisphere(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
+        q[:, 3:] = hemisphere_continuous(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
         self.q = q
         self.v = _velocity(q, motion.fps)
         self.a = np.gradient(self.v, 1.0 / motion.fps, axis=0) if n > 2 else np.zeros_like(self.v)
@@ -217,13 +207,10 @@ class WholeBodyTracker:
         for i in range(n):  # once per clip, not in the step loop
             d.qpos[self.wc.qpos_slice] = q[i]
             mujoco.mj_kinematics(m, d)
-            sole[i] = self._corner_pos(d).min(axis=1)[:, 2] - self.floor_z
+            sole[i] = (
+                sole_corners_world(d, self.sole, self._corners).min(axis=1)[:, 2] - self.floor_z
+            )
         self.planted = sole < reach
-
-    def _corner_pos(self, d: mujoco.MjData) -> F64:
-        """``(2, 4, 3)`` world positions of the sole corners."""
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        return np.einsum("fij,fkj->fki", rot, self._corners) + d.geom_xpos[self.sole][:, None]
 
     def _sample(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
@@ -244,7 +231,7 @@ class WholeBodyTracker:
         """Supporting feet, their touching sole corners ``(k, 3)`` (world) and those corners'
         translational Jacobians ``(k, 3, 51)`` over the character's DOFs."""
         m = self.world.model
-        corners = self._corner_pos(d)
+        corners = sole_corners_world(d, self.sole, self._corners)
         feet: list[int] = []
         pts: list[F64] = []
         jacs: list[F64] = []
