@@ -7,15 +7,17 @@ trackers (Macchietto et al. 2009, Lee et al. 2010, Muico et al. 2009): at each c
 solves a small quadratic program for the accelerations ``qdd`` of *all* DOFs (pelvis
 included) and the ground forces ``f`` at the sole corners,
 
-    min  ||W (qdd - qdd_des)||^2 + w_c ||J_c qdd + k_c v_c||^2 + lam ||beta||^2
+    min  ||W (qdd - qdd_des)||^2 + w_c ||J_c qdd + Jdot_c qdot + k_c v_c||^2 + lam ||beta||^2
     s.t. M_root qdd + h_root = (J_c^T F beta)_root      (the pelvis moves only by ground forces)
          beta >= 0                                       (friction pyramid, no pulling)
 
 with ``qdd_des = qdd_mocap + kp (q_mocap - q) + kv (qdot_mocap - qdot)`` for every DOF, and
 sets the joint torques to ``tau = (M qdd + h - J_c^T F beta)_joints``. ``J_c`` are the sole
-corners of the feet that support (touching in the simulation and planted in the mocap); the
-soft ``w_c`` term tells the program those corners do not slide, so pelvis corrections are
-made by the stance legs. Only joint torques are applied: the result is physical.
+corners in contact (penetrating the floor in the simulation, as MuJoCo's own box-plane contacts
+are) of the feet planted in the mocap; the heavily weighted ``w_c`` term keeps those corners
+still in all three directions, so the planned forces are the ones the contact will produce
+and pelvis corrections are made by the stance legs. Only joint torques are applied: the
+result is physical.
 
 Solved without a general QP library: for fixed ``beta`` the joint accelerations are an
 unconstrained least-squares problem, so they are projected out with one QR and the remaining
@@ -107,12 +109,15 @@ class WholeBodyTracker:
         kp_joint, kv_joint: joint gains inside ``qdd_des`` (1/s^2, 1/s; ``None``: critical).
             A third of critical damping tracked more benchmark windows (64% against 48%) but
             blew up on the synthetic ``sway`` clip, so the default stays critical.
-        root_weight: weight of the pelvis rows of ``W`` against 1 for joints.
+        root_weight: weight of the pelvis rows of ``W`` against 1 for joints (dropped while
+            no foot supports: then only momentum moves the pelvis).
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
             floor (no speed test: a pivoting or rolling foot still carries weight); a sole
-            corner supports when it is within ``touch`` m of the floor in the simulation.
+            corner supports when it is below ``floor + touch`` in the simulation (0: exactly
+            MuJoCo's contact set; a 1 cm band put forces on hovering corners, which the
+            simulation then did not produce).
         force_reg: ``lam``, the regulariser on the pyramid coefficients (relative).
 
     Defaults were chosen on the shared walk, run and kick clips (``benchmarks/bench_sim.py``);
@@ -133,12 +138,12 @@ class WholeBodyTracker:
         kv_rot: float | None = None,
         kp_joint: float = 1000.0,
         kv_joint: float | None = None,
-        root_weight: float = 10.0,
-        contact_weight: float = 100.0,
+        root_weight: float = 30.0,
+        contact_weight: float = 1e4,
         contact_kv: float = 20.0,
         friction: float = 0.7,
         reach: float = 0.05,
-        touch: float = 0.01,
+        touch: float = 0.0,
         force_reg: float = 1e-6,
     ) -> None:
         values = {
@@ -172,6 +177,7 @@ class WholeBodyTracker:
             np.full(3 * NJ, kvj),
         ]
         self.w = np.r_[np.full(6, root_weight), np.ones(3 * NJ)]
+        self._w_air = np.r_[np.zeros(6), np.ones(3 * NJ)]
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
         self.mu = float(friction) * float(world.config.friction)
@@ -182,7 +188,7 @@ class WholeBodyTracker:
         self._dofs = wc.qvel_slice
         self._full = np.zeros((m.nv, m.nv))
         self._jacp = np.zeros((3, m.nv))
-        self._jacr = np.zeros((3, m.nv))
+        self._jacd = np.zeros((3, m.nv))
         rows = servo.character_indices.index(character) * NJ
         self._ff = servo.feedforward[rows : rows + NJ]  # (15, 3) view
         self._servo_rows = slice(rows, rows + NJ)
@@ -227,14 +233,17 @@ class WholeBodyTracker:
     # ------------------------------------------------------------------ control
     def _support(
         self, d: mujoco.MjData, planted: NDArray[np.bool_]
-    ) -> tuple[tuple[int, ...], F64, F64]:
-        """Supporting feet, their touching sole corners ``(k, 3)`` (world) and those corners'
-        translational Jacobians ``(k, 3, 51)`` over the character's DOFs."""
+    ) -> tuple[tuple[int, ...], F64, F64, F64]:
+        """Supporting feet, their sole corners in contact ``(k, 3)`` (world), those corners'
+        translational Jacobians ``(k, 3, 51)`` over the character's DOFs and their velocity
+        product terms ``Jdot qdot`` ``(k, 3)``."""
         m = self.world.model
         corners = sole_corners_world(d, self.sole, self._corners)
+        qdot = d.qvel[self._dofs]
         feet: list[int] = []
         pts: list[F64] = []
         jacs: list[F64] = []
+        bias: list[F64] = []
         for f in range(2):
             if not planted[f]:
                 continue
@@ -242,21 +251,16 @@ class WholeBodyTracker:
             if not touching.any():
                 continue
             body = int(self.feet[f])
-            mujoco.mj_jacBody(m, d, self._jacp, self._jacr, body)
-            jp = self._jacp[:, self._dofs]
-            jr = self._jacr[:, self._dofs]
-            p = corners[f, touching]
-            r = p - d.xpos[body]
-            # v_p = v_o + w x r = J_p qdot - [r]x J_r qdot
-            skew = np.zeros((len(r), 3, 3))
-            skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -r[:, 2], r[:, 1], -r[:, 0]
-            skew -= skew.transpose(0, 2, 1)
             feet.append(f)
-            pts.append(p)
-            jacs.append(jp[None] - skew @ jr[None])
+            for p in corners[f, touching]:
+                mujoco.mj_jac(m, d, self._jacp, None, p, body)
+                mujoco.mj_jacDot(m, d, self._jacd, None, p, body)
+                pts.append(p)
+                jacs.append(self._jacp[:, self._dofs].copy())
+                bias.append(self._jacd[:, self._dofs] @ qdot)
         if not feet:
-            return (), np.zeros((0, 3)), np.zeros((0, 3, NV))
-        return tuple(feet), np.concatenate(pts), np.concatenate(jacs)
+            return (), np.zeros((0, 3)), np.zeros((0, 3, NV)), np.zeros((0, 3))
+        return tuple(feet), np.array(pts), np.array(jacs), np.array(bias)
 
     def plan(self, t: float) -> WholeBodyPlan:
         """Solve the tracking program at rollout time ``t`` for the current state (MuJoCo's
@@ -278,7 +282,7 @@ class WholeBodyTracker:
         # purpose, so it acts as extra damping (compensating it: 50% of the benchmark windows
         # tracked instead of 64%)
         h = d.qfrc_bias[sl]
-        feet, corners, jc = self._support(d, planted)
+        feet, corners, jc, jc_bias = self._support(d, planted)
         nc = len(corners)
         nb = 4 * nc
         nj = 3 * NJ
@@ -295,13 +299,21 @@ class WholeBodyTracker:
         g[6:, :nj] = np.eye(nj)
         g0 = np.zeros(NV)
         g0[:6] = -rhs[:, -1]
-        rows_a = [self.w[:, None] * g]
-        rows_b = [self.w * (acc_des - g0)]
+        # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
+        # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
+        w = self.w if nc else self._w_air
+        rows_a = [w[:, None] * g]
+        rows_b = [w * (acc_des - g0)]
         if nc:
-            # no slip along the floor; the contact itself handles the normal direction
-            jt = jc[:, :2].reshape(2 * nc, NV)
+            # the corners in contact do not move (J_c qdd + Jdot_c qdot = -k_c v_c), so the
+            # planned forces are the ones MuJoCo's rigid-ish contact will produce: with only
+            # the tangential rows and a soft weight, joint accelerations missed the plan by
+            # 100-350 rad/s^2 in double support
+            jt = jc.reshape(3 * nc, NV)
             rows_a.append(self.sqrt_wc * (jt @ g))
-            rows_b.append(-self.sqrt_wc * (jt @ g0 + self.contact_kv * (jt @ v)))
+            rows_b.append(
+                -self.sqrt_wc * (jt @ g0 + jc_bias.reshape(-1) + self.contact_kv * (jt @ v))
+            )
         a_mat = np.concatenate(rows_a)
         b_vec = np.concatenate(rows_b)
         ay, ab = a_mat[:, :nj], a_mat[:, nj:]
