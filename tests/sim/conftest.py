@@ -23,3 +23,8 @@ def guard() -> Motion:
 @pytest.fixture(scope="session")
 def step_forward() -> Motion:
     return _clips()["step_forward"]
+
+
+@pytest.fixture(scope="session")
+def punch() -> Motion:
+    return _clips()["punch"]
