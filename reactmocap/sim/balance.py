@@ -36,7 +36,7 @@ from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.pd import PDServo, critical_kv
+from reactmocap.sim.pd import PDServo, check_controller_args, critical_kv
 from reactmocap.sim.world import World
 
 __all__ = ["StanceBalance", "foot_soles", "sole_corners_world"]
@@ -116,19 +116,17 @@ class StanceBalance:
         velocity_feedforward: bool = True,
         stance_gain_scale: float = 16.0,
     ) -> None:
-        for name, v in (
-            ("kp_com", kp_com), ("kp_height", kp_height), ("kp_rot", kp_rot),
-            ("friction", friction), ("reach", reach), ("stance_gain_scale", stance_gain_scale),
-        ):  # fmt: skip
-            if not (np.isfinite(v) and v >= 0):
-                raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
+        check_controller_args(
+            servo,
+            character,
+            {
+                "kp_com": kp_com, "kp_height": kp_height, "kp_rot": kp_rot, "friction": friction,
+                "reach": reach, "stance_gain_scale": stance_gain_scale,
+            },
+        )  # fmt: skip
         if stance_gain_scale <= 0:
             raise ConfigError(f"stance_gain_scale must be > 0, got {stance_gain_scale!r}")
         world = servo.world
-        if character not in servo.character_indices:
-            raise ConfigError(
-                f"character {character} is not driven by the servo {servo.character_indices}"
-            )
         self.servo = servo
         self.world = world
         self.character = character

@@ -74,7 +74,7 @@ from reactmocap.rotations import quat_log, quat_normalize
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.world import World
 
-__all__ = ["PDServo", "critical_kv"]
+__all__ = ["PDServo", "check_controller_args", "critical_kv"]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
@@ -84,6 +84,18 @@ def critical_kv(kp: float) -> float:
     """kv giving critical damping for ``kp`` on an isolated joint (``kv = 2 sqrt(kp)``):
     with tau = I (kp e - kv qdot) each joint behaves as a unit-mass oscillator."""
     return 2.0 * float(np.sqrt(kp))
+
+
+def check_controller_args(servo: PDServo, character: int, params: dict[str, float]) -> None:
+    """Constructor checks shared by the controllers that write a servo's feed-forward: every
+    value in ``params`` is finite and >= 0, and ``character`` is driven by ``servo``."""
+    for name, v in params.items():
+        if not (np.isfinite(v) and v >= 0):
+            raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
+    if character not in servo.character_indices:
+        raise ConfigError(
+            f"character {character} is not driven by the servo {servo.character_indices}"
+        )
 
 
 # conj(q) * qd == R @ q with R[i, j] = _RSIGN[i, j] * qd[_RIDX[i, j]] (Hamilton product)

@@ -42,7 +42,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.balance import foot_soles, sole_corners_world
 from reactmocap.sim.character import BALL_JOINTS
-from reactmocap.sim.pd import PDServo, critical_kv
+from reactmocap.sim.pd import PDServo, check_controller_args, critical_kv
 from reactmocap.sim.world import World
 
 __all__ = ["WholeBodyPlan", "WholeBodyTracker"]
@@ -107,7 +107,8 @@ class WholeBodyTracker:
         kp_root, kv_root: pelvis position gains (1/s^2, 1/s; kv critical by default).
         kp_rot, kv_rot: pelvis orientation gains.
         kp_joint, kv_joint: joint gains inside ``qdd_des`` (1/s^2, 1/s; ``None``: critical).
-            A third of critical damping tracked more benchmark windows (64% against 48%) but
+            A third of critical damping tracked more benchmark windows (64% against 48%, first
+            version of this controller) but
             blew up on the synthetic ``sway`` clip, so the default stays critical.
         root_weight: weight of the pelvis rows of ``W`` against 1 for joints (dropped while
             no foot supports: then only momentum moves the pelvis).
@@ -146,18 +147,16 @@ class WholeBodyTracker:
         touch: float = 0.0,
         force_reg: float = 1e-6,
     ) -> None:
-        values = {
-            "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint, "root_weight": root_weight,
-            "contact_weight": contact_weight, "contact_kv": contact_kv, "friction": friction,
-            "reach": reach, "touch": touch, "force_reg": force_reg,
-        }  # fmt: skip
-        for name, v in values.items():
-            if not (np.isfinite(v) and v >= 0):
-                raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
-        if character not in servo.character_indices:
-            raise ConfigError(
-                f"character {character} is not driven by the servo {servo.character_indices}"
-            )
+        check_controller_args(
+            servo,
+            character,
+            {
+                "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint,
+                "root_weight": root_weight, "contact_weight": contact_weight,
+                "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
+                "force_reg": force_reg,
+            },
+        )  # fmt: skip
         world = servo.world
         m = world.model
         if np.any(m.opt.gravity[:2]):
@@ -279,7 +278,7 @@ class WholeBodyTracker:
         mujoco.mj_fullM(m, d, self._full)
         big_m = self._full[sl, sl]
         # gravity and Coriolis; MuJoCo's passive joint damping is left out of the plan on
-        # purpose, so it acts as extra damping (compensating it: 50% of the benchmark windows
+        # purpose, so it acts as extra damping (compensating it, first version: 50% of the benchmark windows
         # tracked instead of 64%)
         h = d.qfrc_bias[sl]
         feet, corners, jc, jc_bias = self._support(d, planted)
