@@ -55,11 +55,9 @@ def foot_soles(
     m = world.model
     wc = world.characters[character]
     feet = np.array([wc.body_ids[SIM_BODIES.index(f)] for f in _FEET])
-    foot_geoms = [wc.geom_ids[m.geom_bodyid[wc.geom_ids] == b] for b in feet]
-    boxes = [g[m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX] for g in foot_geoms]
-    if any(b.size != 1 for b in boxes):
-        raise ConfigError(f"{who} needs exactly one box geom per foot")
-    sole = np.array([int(b[0]) for b in boxes])
+    sole = wc.sole_ids
+    if sole.shape != (2,) or np.any(m.geom_type[sole] != mujoco.mjtGeom.mjGEOM_BOX):
+        raise ConfigError(f"{who} needs a sole box geom per foot")
     signs = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=np.float64)
     corners = np.stack(
         [np.column_stack([signs * h[:2], np.full(4, -h[2])]) for h in m.geom_size[sole]]

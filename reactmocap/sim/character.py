@@ -56,8 +56,10 @@ from reactmocap.rotations import (
 
 __all__ = [
     "BALL_JOINTS",
+    "BALL_PATCH_HALF_SIZE",
     "BODY_ALIASES",
     "SIM_BODIES",
+    "PATCH_GEOM_GROUP",
     "Character",
     "build_character",
 ]
@@ -107,6 +109,12 @@ _RADIUS = {
 }  # fmt: skip
 _FOOT = {"heel": 0.06, "toe": 0.05, "half_width": 0.04, "half_height": 0.025}
 _HAND_LEN = 0.10
+#: half-size (m) of the ball-of-foot contact patch each foot carries switched off: a tracking
+#: controller turns it on, and the foot box off, while the actor pivots on that foot (a box's
+#: corners hold a yaw torque of mu N times half its width; a pivoting forefoot holds little)
+BALL_PATCH_HALF_SIZE = 0.005
+#: MuJoCo geom group of the patch: hidden by the default visualisation (groups 0-2)
+PATCH_GEOM_GROUP = 3
 _DENSITY_FALLBACK = {  # kg/m^3, Dempster & Gaughran (used if anthropometry is unavailable)
     "head": 1171.0, "chest": 1009.0, "waist": 1017.0, "pelvis": 1029.0, "thigh": 1040.0,
     "shin": 1079.0, "foot": 1066.0, "upper_arm": 1068.0, "forearm": 1102.0, "hand": 1070.0,
@@ -171,6 +179,10 @@ class _Geom:
     fromto: tuple[float, ...] | None = None  # capsule, body-local
     pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
     quat: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    #: a massless, hidden contact geom (see :data:`BALL_PATCH_HALF_SIZE`); compiled colliding
+    #: (MuJoCo leaves geoms that cannot collide at compile time out of the body's collision
+    #: tree for good), and switched off by the World
+    patch: bool = False
 
 
 @dataclass(eq=False)
@@ -232,6 +244,16 @@ class Character:
                     size=size,
                     fromto=list(g.fromto or ()),
                     density=rho,
+                )
+            elif g.patch:
+                body.add_geom(
+                    name=f"{g.body}_ball",
+                    type=mujoco.mjtGeom.mjGEOM_BOX,
+                    size=size,
+                    pos=list(g.pos),
+                    quat=list(g.quat),
+                    density=0.0,
+                    group=PATCH_GEOM_GROUP,
                 )
             else:
                 body.add_geom(
@@ -709,21 +731,31 @@ def _make_geoms(
         # legs
         out.append(capsule(f"{side}_thigh", at(f"{side}_thigh"), at(f"{side}_shin"), r["thigh"]))
         out.append(capsule(f"{side}_shin", at(f"{side}_shin"), at(f"{side}_foot"), r["shin"]))
-        out.append(
-            _foot_box(
-                skel,
-                parts,
-                anchors,
-                ref,
-                frame,
-                side,
-                s,
-                G[idx[f"{side}_foot"]],
-                gpos_ref,
-                grot_ref,
-            )
+        box, ball_x = _foot_box(
+            skel,
+            parts,
+            anchors,
+            ref,
+            frame,
+            side,
+            s,
+            G[idx[f"{side}_foot"]],
+            gpos_ref,
+            grot_ref,
         )
+        out.append(box)
+        out.append(_ball_patch(box, ball_x))
     return tuple(out)
+
+
+def _ball_patch(box: _Geom, ball_x: float) -> _Geom:
+    """The ball-of-foot contact patch: a small cube, aligned with the foot box, whose bottom
+    face lies in the sole plane under the ball (``ball_x`` along the box's x axis from its
+    centre), in the foot's local frame: flat on the floor like the box it stands in for."""
+    hz, r = box.size[2], BALL_PATCH_HALF_SIZE
+    local = np.array([ball_x, 0.0, -hz + r])
+    pos = np.asarray(box.pos) + quat_rotate(np.asarray(box.quat), local)
+    return _Geom(box.body, "box", (r, r, r), pos=tuple(pos), quat=box.quat, patch=True)
 
 
 def _foot_box(
@@ -737,8 +769,9 @@ def _foot_box(
     g_foot: F64,
     gpos: F64,
     grot: F64,
-) -> _Geom:
-    """The foot box in the foot's local frame.
+) -> tuple[_Geom, float]:
+    """The foot box in the foot's local frame, and the ball's (toe joint's) offset from the
+    box centre along the box's x axis.
 
     The sole is placed from the clip: the ankle's lowest height over the reference motion is its
     height above the sole, and the ball (toe joint) sits its own lowest height above it; the
@@ -794,10 +827,11 @@ def _foot_box(
     centre = fwd * 0.5 * (x0 + x1) + up * (-h_a + hz)
     quat = quat_from_matrix(np.stack([fwd, lat, up], axis=1))
     del g_foot
-    return _Geom(
+    box = _Geom(
         b,
         "box",
         (0.5 * (x1 - x0), _FOOT["half_width"] * s, hz),
         pos=tuple(centre),
         quat=tuple(quat),
     )
+    return box, float(f @ fwd) - 0.5 * (x0 + x1)

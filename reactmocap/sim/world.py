@@ -20,6 +20,14 @@ standing 51-DOF character, dt = 0.0005 s; see the report for the figures):
   al. used ODE's soft constraints "allowing some compliance" in the same way. ``condim = 3``
   (sliding friction only), friction coefficient per world (paper: 1.0 in Simulation 1, 0.5 in
   Simulation 2) on every geom (MuJoCo takes the larger of the two geoms' coefficients).
+* **Ball-of-foot patch:** each foot also carries a small massless cube under the ball of the
+  foot, switched off (no contype/conaffinity) until a controller calls
+  :meth:`World.set_foot_patch`, which moves the foot's floor contact from its box to the patch.
+  The patch has ``condim = 6``: sliding friction as above, a torsional arm of
+  :data:`PATCH_TORSION` (a spinning forefoot resists little; the box's corners hold
+  ``mu N`` times half the foot width, so a box foot cannot pivot as actors do in spinning
+  kicks) and a rolling arm of :data:`PATCH_ROLL` (the centre of pressure may move that far
+  from the ball, as over the real forefoot's width).
 * **Collision filtering:** the floor collides with everything; two characters collide with
   each other. Within one character, parent-child pairs are excluded by MuJoCo's default
   ``filterparent``; with ``self_collision=False`` (default) the character's own geoms do not
@@ -50,7 +58,7 @@ from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, Character
 
-__all__ = ["PREFIXES", "World", "WorldCharacter", "WorldConfig"]
+__all__ = ["PATCH_ROLL", "PATCH_TORSION", "PREFIXES", "World", "WorldCharacter", "WorldConfig"]
 
 F64 = NDArray[np.float64]
 PREFIXES = ("a/", "b/")
@@ -142,6 +150,9 @@ class WorldCharacter:
     dof_adr: int  # free joint dof start; 6 + 45 contiguous values
     geom_ids: NDArray[np.int64]
     body_lookup: dict[str, int] = field(default_factory=dict)
+    #: (2,) left, right: each foot's sole box and ball-of-foot patch geoms
+    sole_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    patch_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     #: first of the character's 45 servo actuators: 3 per ball joint, BALL_JOINTS order
     actuator_adr: int = -1
 
@@ -163,6 +174,12 @@ class WorldCharacter:
 
     def body_id(self, name: str) -> int:
         return self.body_lookup[Character.body_name(name)]
+
+
+#: torsional friction arm (m) of the ball-of-foot patch
+PATCH_TORSION = 0.005
+#: rolling friction arm (m) of the ball-of-foot patch: how far the centre of pressure may move
+PATCH_ROLL = 0.03
 
 
 class World:
@@ -230,6 +247,15 @@ class World:
             if [int(m.jnt_qposadr[j]) for j in balls] != [qadr + 7 + 4 * i for i in range(15)]:
                 raise SimulationError("ball joints are not contiguous in qpos (internal error)")
             geoms = np.flatnonzero(np.isin(m.geom_bodyid, ids))
+            feet = [m.body(f"{pre}{side}_foot").id for side in "lr"]
+            patches = [m.geom(f"{pre}{side}_foot_ball").id for side in "lr"]
+            soles = [
+                g for f in feet for g in geoms
+                if m.geom_bodyid[g] == f and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
+                and g not in patches
+            ]  # fmt: skip
+            if len(soles) != 2:
+                raise SimulationError("each foot needs exactly one sole box (internal error)")
             acts = [m.actuator(f"{pre}{j}/servo{a}").id for j in BALL_JOINTS for a in range(3)]
             if acts != list(range(acts[0], acts[0] + 3 * len(BALL_JOINTS))) or any(
                 int(m.actuator_trnid[a, 0]) != balls[i // 3] for i, a in enumerate(acts)
@@ -246,6 +272,8 @@ class World:
                     geoms,
                     {b: int(i) for b, i in zip(SIM_BODIES, ids)},
                     actuator_adr=acts[0],
+                    sole_ids=np.array(soles, dtype=np.int64),
+                    patch_ids=np.array(patches, dtype=np.int64),
                 )
             )
         self._apply_contact_settings()
@@ -264,6 +292,11 @@ class World:
             m.geom_conaffinity[wc.geom_ids] = all_bits if cfg.self_collision else all_bits & ~own
         m.geom_conaffinity[m.geom("floor").id] = all_bits
         m.geom_condim[:] = 3
+        for wc in self.characters:
+            m.geom_contype[wc.patch_ids] = 0
+            m.geom_conaffinity[wc.patch_ids] = 0
+            m.geom_condim[wc.patch_ids] = 6
+            m.geom_friction[wc.patch_ids, 1:] = (PATCH_TORSION, PATCH_ROLL)
         m.geom_solref[:] = cfg.contact_solref
         m.geom_solimp[:, :3] = cfg.contact_solimp
 
@@ -280,6 +313,23 @@ class World:
             m.dof_damping[dofs] = cfg.joint_damping * diag[dofs]
         m.jnt_solref[:] = cfg.limit_solref
         mujoco.mj_resetData(m, d)
+
+    def set_foot_patch(self, character: int, foot: int, on: bool) -> None:
+        """Move a foot's contact (``foot`` 0 left, 1 right) from its sole box to its ball-of-foot
+        patch (``on``) or back. Takes effect at the next collision pass."""
+        m = self.model
+        wc = self.characters[character]
+        box, patch = int(wc.sole_ids[foot]), int(wc.patch_ids[foot])
+        live, dead = (patch, box) if on else (box, patch)
+        if m.geom_contype[live] == 0:
+            m.geom_contype[live] = m.geom_contype[dead]
+            m.geom_conaffinity[live] = m.geom_conaffinity[dead]
+            m.geom_contype[dead] = 0
+            m.geom_conaffinity[dead] = 0
+
+    def foot_patch_on(self, character: int) -> NDArray[np.bool_]:
+        """``(2,)`` whether each foot (left, right) currently touches through its patch."""
+        return self.model.geom_contype[self.characters[character].patch_ids] != 0
 
     def set_friction(self, mu: float) -> None:
         """Sliding friction coefficient of every contact (floor and characters)."""
