@@ -13,6 +13,7 @@ import pytest
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.motion import Motion
 from reactmocap.sim import World, build_character, rollout
+from reactmocap.sim.character import PATCH_GEOM_GROUP
 from reactmocap.sim.pd import PDServo
 from reactmocap.sim.rollout import (
     TRACKING_CONTROLLERS,
@@ -157,6 +158,77 @@ def test_wholebody_tracks_a_real_walk() -> None:
         assert float(np.max(err["root_ang_series"])) <= np.radians(15.0)  # type: ignore[call-overload]
 
 
+def _stance_yaw_lag(
+    kick: Motion, start: float, seconds: float, pivot_rate: float | None
+) -> tuple[float, int]:
+    """Largest gap (deg) between the simulated and the mocap left-sole yaw while tracking, and
+    the number of control ticks the left foot spent on its ball patch."""
+    world = World(build_character(kick, frame=round(start * kick.fps)))
+    world.set_from_motion(0, kick, round(start * kick.fps))
+    servo = PDServo(world, kp=0.0, kv=20.0)
+    wb = WholeBodyTracker(servo, 0, kick, start=start, pivot_rate=pivot_rate)
+    sole = int(world.characters[0].sole_ids[0])
+    ref = mujoco.MjData(world.model)
+    sim_yaw: list[float] = []
+    ref_yaw: list[float] = []
+    ticks = [0]
+
+    def spy(w: World, t: float) -> None:
+        wb(w, t)
+        ticks[0] += int(w.foot_patch_on(0)[0])
+        ref.qpos[world.characters[0].qpos_slice] = wb._sample(t)[0]
+        mujoco.mj_kinematics(world.model, ref)
+        for data, out in ((w.data, sim_yaw), (ref, ref_yaw)):
+            x = data.geom_xmat[sole]
+            out.append(float(np.arctan2(x[3], x[0])))
+
+    rollout(world, seconds, servo=servo, controllers=[spy], control_every=4)
+    gap = np.abs(np.unwrap(sim_yaw) - np.unwrap(ref_yaw))
+    return float(np.degrees(gap.max())), ticks[0]
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason=f"shared mocap not found at {SHARED}")
+def test_a_pivoting_stance_foot_turns_on_its_ball_patch() -> None:
+    """The kick clip turns the planted left foot by about 84 degrees in 0.25 s from 1.35 s: on
+    its ball patch the simulated foot follows, a box foot under friction 1.0 lags behind."""
+    from reactmocap.library.bvh import read_bvh
+
+    clips = sorted(SHARED.glob("*/*kick_normal_001.bvh"))
+    if not clips:
+        pytest.skip(f"no kick_normal_001 clip under {SHARED}")
+    kick = read_bvh(clips[0])
+    lag_patch, ticks = _stance_yaw_lag(kick, 1.35, 0.25, pivot_rate=2.0)
+    lag_box, no_ticks = _stance_yaw_lag(kick, 1.35, 0.25, pivot_rate=None)
+    assert ticks > 20 and no_ticks == 0
+    assert lag_patch < 10.0  # measured 3.4
+    assert lag_box > 25.0  # measured 39.4
+
+
+def test_foot_patch_moves_the_contact(guard: Motion) -> None:
+    """The ball patch is hidden and off until switched on; then it, not the box,
+    touches the floor, and switching back restores the box."""
+    world = World(build_character(guard, frame=0))
+    world.set_from_motion(0, guard, 0)
+    m, d = world.model, world.data
+    wc = world.characters[0]
+    assert np.all(m.geom_group[wc.patch_ids] == PATCH_GEOM_GROUP)
+    d.qpos[wc.qpos_slice.start + 2] -= 0.005  # press the feet into the floor
+
+    def touching() -> set[int]:
+        mujoco.mj_forward(m, d)
+        return {int(d.contact[i].geom[j]) for i in range(d.ncon) for j in range(2)}
+
+    assert not world.foot_patch_on(0).any()
+    assert set(wc.sole_ids) <= touching() and not set(wc.patch_ids) & touching()
+    world.set_foot_patch(0, 0, True)
+    assert world.foot_patch_on(0).tolist() == [True, False]
+    on = touching()
+    assert int(wc.patch_ids[0]) in on and int(wc.sole_ids[0]) not in on
+    assert int(wc.sole_ids[1]) in on
+    world.set_foot_patch(0, 0, False)
+    assert set(wc.sole_ids) <= touching() and not set(wc.patch_ids) & touching()
+
+
 def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
     with pytest.raises(UnknownKeyError, match="wholebody"):
         track_clip(guard, seconds=0.1, controller="nope")
@@ -167,7 +239,13 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
 
 @pytest.mark.parametrize(
     ("key", "value"),
-    [("kp_root", -1.0), ("kp_joint", float("nan")), ("friction", -0.5), ("reach", float("inf"))],
+    [
+        ("kp_root", -1.0),
+        ("kp_joint", float("nan")),
+        ("friction", -0.5),
+        ("reach", float("inf")),
+        ("pivot_rate", -2.0),
+    ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
     world = World(build_character(guard, frame=0))
