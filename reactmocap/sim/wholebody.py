@@ -283,7 +283,8 @@ class WholeBodyTracker:
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
-        """Give both feet back their sole boxes (undo any pivot)."""
+        """Give both feet back their sole boxes (undo any pivot). The tracker switches patches
+        at each tick; call this when done with a world that lives on."""
         for f in range(2):
             self.world.set_foot_patch(self.character, f, False)
 

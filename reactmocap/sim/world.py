@@ -316,7 +316,8 @@ class World:
 
     def set_foot_patch(self, character: int, foot: int, on: bool) -> None:
         """Move a foot's contact (``foot`` 0 left, 1 right) from its sole box to its ball-of-foot
-        patch (``on``) or back. Takes effect at the next collision pass."""
+        patch (``on``) or back. Takes effect at the next collision pass. A model setting, not
+        part of :meth:`get_state`: whoever switches a patch on switches it back."""
         m = self.model
         wc = self.characters[character]
         box, patch = int(wc.sole_ids[foot]), int(wc.patch_ids[foot])
