@@ -8,6 +8,7 @@
    shorter than 1 s is one window): % of windows in which the character stays upright with
    the pelvis within 10 cm and 15 deg of the mocap at every recorded frame; medians of the
    errors. Physical (no root help) and, separately labelled, with the non-physical root assist.
+   Windows run in ``--jobs`` processes (the predictive tracker takes ~8 s per window).
 4. The guard stance clip tracked for 10 s.
 """
 
@@ -16,6 +17,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import mujoco
@@ -196,74 +198,87 @@ def _windows(motion: Motion) -> list[float]:
     return list(np.arange(0.0, motion.duration - 1.0 + 1e-9, 0.5))
 
 
-def bench_tracking(assist_gain: float) -> None:
+def _track_window(
+    job: tuple[Path, float, str, float],
+) -> tuple[bool, bool, float, float, float, float] | str:
+    """One window: (ok, upright, max root error m, max angle rad, mean joint error rad,
+    wall seconds per simulated second), or the error message."""
+    from reactmocap.sim.rollout import _errors
+
+    path, s, controller, assist = job
+    motion = _read_bvh(path)
+    secs = min(1.0, motion.duration - s)
+    try:
+        _, rep, res = track_clip(
+            motion, start=float(s), seconds=secs, root_assist=assist, controller=controller
+        )
+    except Exception as exc:
+        return f"{path.name} @ {s:.1f}s failed: {exc}"
+    # recompute per-frame errors for the window criterion
+    world = World(build_character(motion, frame=round(s * motion.fps)))
+    err = _errors(world, res, motion, float(s))
+    ang = float(np.max(err["root_ang_series"]))  # type: ignore[call-overload]
+    ok = (not rep.fell) and rep.max_root_error_m <= 0.10 and ang <= np.radians(15.0)
+    return ok, not rep.fell, rep.max_root_error_m, ang, rep.mean_joint_error_rad, rep.wall_s / secs
+
+
+def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> None:
     clips = sorted(
         p for p in SHARED.glob("*/*.bvh") if any(k in p.name for k in ("walk", "run", "kick"))
     )
     if not clips:
         print(f"\n(no shared clips under {SHARED.resolve()}: tracking robustness skipped)")
         return
-    modes = [("pd", 0.0, "PD only"), ("balance", 0.0, "PD + stance balance (physical)"),
-             ("wholebody", 0.0, "whole-body inverse dynamics (physical, default)"),
-             ("pd", assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}")]  # fmt: skip
-    for controller, assist, label in modes:
-        print(f"\n## tracking robustness, {label} (controller's default gains)")
-        print(
-            f"{'clip':<28} {'windows':>7} {'ok %':>6} {'upright %':>9} {'med root cm':>11} "
-            f"{'med ang deg':>11} {'med joint rad':>13}"
-        )
-        tot_ok = tot = 0
-        walls: list[float] = []
-        for path in clips:
-            motion = _read_bvh(path)
-            ok = up = 0
-            roots, angs, joints = [], [], []
-            wins = _windows(motion)
-            for s in wins:
-                secs = min(1.0, motion.duration - s)
-                try:
-                    from reactmocap.sim.rollout import _errors
-
-                    _, rep, res = track_clip(
-                        motion, start=float(s), seconds=secs, root_assist=assist,
-                        controller=controller,
-                    )  # fmt: skip
-                    # recompute per-frame errors for the window criterion
-                    world = World(build_character(motion, frame=round(s * motion.fps)))
-                    err = _errors(world, res, motion, float(s))
-                    good = (
-                        (not rep.fell)
-                        and float(np.max(err["root_err_series"])) <= 0.10
-                        and float(np.max(err["root_ang_series"])) <= np.radians(15.0)
-                    )
-                    ok += good
-                    up += not rep.fell
-                    roots.append(rep.max_root_error_m)
-                    angs.append(float(np.max(err["root_ang_series"])))
-                    joints.append(rep.mean_joint_error_rad)
-                    walls.append(rep.wall_s / secs)
-                except Exception as exc:
-                    print(f"  {path.name} @ {s:.1f}s failed: {exc}")
-            tot_ok += ok
-            tot += len(wins)
+    labels = {"pd": "PD only", "balance": "PD + stance balance (physical)",
+              "wholebody": "whole-body inverse dynamics (physical, default)",
+              "predictive": "whole-body + predictive sampling (physical)"}  # fmt: skip
+    modes = [(c, 0.0, labels.get(c, c)) for c in controllers]
+    modes.append(("pd", assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}"))
+    windows = {p: _windows(_read_bvh(p)) for p in clips}
+    print(f"\n(windows run in {jobs} processes: real-time factors are per process)")
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+        for controller, assist, label in modes:
+            print(f"\n## tracking robustness, {label} (controller's default gains)")
             print(
-                f"{path.stem:<28} {len(wins):>7} {100 * ok / len(wins):6.0f} "
-                f"{100 * up / len(wins):9.0f} {100 * np.median(roots):11.1f} "
-                f"{np.degrees(np.median(angs)):11.1f} {np.median(joints):13.3f}"
+                f"{'clip':<28} {'windows':>7} {'ok %':>6} {'upright %':>9} {'med root cm':>11} "
+                f"{'med ang deg':>11} {'med joint rad':>13}"
             )
-        print(
-            f"{'ALL':<28} {tot:>7} {100 * tot_ok / max(tot, 1):6.0f}   "
-            f"(median real-time factor {1.0 / np.median(walls):.2f}x)"
-        )
+            t0 = time.perf_counter()
+            work = [(p, s, controller, assist) for p in clips for s in windows[p]]
+            results = list(pool.map(_track_window, work))
+            tot_ok = tot = 0
+            walls: list[float] = []
+            for path in clips:
+                rows = [r for (p, _, _, _), r in zip(work, results) if p == path]
+                for r in rows:
+                    if isinstance(r, str):
+                        print(f"  {r}")
+                good = [r for r in rows if not isinstance(r, str)]
+                ok = sum(r[0] for r in good)
+                up = sum(r[1] for r in good)
+                walls += [r[5] for r in good]
+                tot_ok += ok
+                tot += len(rows)
+                print(
+                    f"{path.stem:<28} {len(rows):>7} {100 * ok / len(rows):6.0f} "
+                    f"{100 * up / len(rows):9.0f} {100 * np.median([r[2] for r in good]):11.1f} "
+                    f"{np.degrees(np.median([r[3] for r in good])):11.1f} "
+                    f"{np.median([r[4] for r in good]):13.3f}"
+                )
+            print(
+                f"{'ALL':<28} {tot:>7} {100 * tot_ok / max(tot, 1):6.0f}   "
+                f"(median real-time factor {1.0 / np.median(walls):.2f}x; "
+                f"{time.perf_counter() - t0:.0f} s wall)"
+            )
 
 
 def bench_guard(kp: float, assist_gain: float) -> None:
     guard = synthetic_clips(30.0)["guard"]
     loop = Motion.concatenate([guard, guard.slice(1), guard.slice(1)], name="guard_x3")
-    for controller, assist in (("pd", 0.0), ("balance", 0.0), ("wholebody", 0.0),
-                               ("pd", assist_gain)):  # fmt: skip
+    runs = [(c, 0.0) for c in ("pd", "balance", "wholebody", "predictive")]
+    for controller, assist in [*runs, ("pd", assist_gain)]:
         _, rep, _ = track_clip(
-            loop, seconds=10.0, kp=None if controller == "wholebody" else kp,
+            loop, seconds=10.0, kp=None if controller in ("wholebody", "predictive") else kp,
             root_assist=assist, controller=controller,
         )  # fmt: skip
         label = f"root assist kp={assist:g}" if assist else controller
@@ -282,6 +297,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--skip", nargs="*", default=[], choices=["steps", "options", "tracking", "guard"]
     )
+    ap.add_argument(
+        "--controllers",
+        nargs="*",
+        default=["pd", "balance", "wholebody", "predictive"],
+        help="tracking controllers for the robustness windows (the root-assist run is added)",
+    )
+    ap.add_argument("--jobs", type=int, default=2, help="processes for the tracking windows")
     args = ap.parse_args(argv)
     print(f"mujoco {mujoco.__version__}, python {sys.version.split()[0]}")
     if "steps" not in args.skip:
@@ -291,7 +313,7 @@ def main(argv: list[str] | None = None) -> int:
     if "guard" not in args.skip:
         bench_guard(args.kp, args.assist)
     if "tracking" not in args.skip:
-        bench_tracking(args.assist)
+        bench_tracking(args.assist, args.controllers, args.jobs)
     return 0
 
 

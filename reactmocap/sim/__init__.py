@@ -20,6 +20,7 @@ from reactmocap.sim.impacts import (
     first_contact,
 )
 from reactmocap.sim.pd import PDServo, critical_kv
+from reactmocap.sim.predictive import PredictiveTracker
 from reactmocap.sim.retarget import Retargeter, retarget
 from reactmocap.sim.rollout import (
     TRACKING_CONTROLLERS,
@@ -50,6 +51,7 @@ __all__ = [
     "KinematicContact",
     "MotionTracker",
     "PDServo",
+    "PredictiveTracker",
     "RolloutResult",
     "Retargeter",
     "RootAssist",

@@ -23,6 +23,7 @@ from reactmocap.sim.balance import StanceBalance
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, SIM_PARENTS, build_character
 from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, _t3, contact_report
 from reactmocap.sim.pd import PDServo, critical_kv
+from reactmocap.sim.predictive import PredictiveTracker
 from reactmocap.sim.wholebody import WholeBodyTracker, hemisphere_continuous
 from reactmocap.sim.world import World, WorldConfig
 
@@ -391,18 +392,40 @@ def _build_balance(
 WHOLEBODY_SERVO_KV = 20.0
 
 
+def _wholebody(
+    world: World, motion: Motion, start: float, kp: float, kv: float | None
+) -> tuple[PDServo, WholeBodyTracker]:
+    servo = PDServo(world, kp=0.0, kv=WHOLEBODY_SERVO_KV)
+    return servo, WholeBodyTracker(servo, 0, motion, start=start, kp_joint=kp, kv_joint=kv)
+
+
 def _build_wholebody(
     world: World, motion: Motion, start: float, kp: float, kv: float | None
 ) -> tuple[PDServo, list[Controller]]:
-    servo = PDServo(world, kp=0.0, kv=WHOLEBODY_SERVO_KV)
-    wb = WholeBodyTracker(servo, 0, motion, start=start, kp_joint=kp, kv_joint=kv)
+    servo, wb = _wholebody(world, motion, start, kp, kv)
     return servo, [wb]
+
+
+#: control ticks of the whole-body trackers (steps): every 2 ms at dt = 0.0005
+WHOLEBODY_EVERY = 4
+
+
+def _build_predictive(
+    world: World, motion: Motion, start: float, kp: float, kv: float | None
+) -> tuple[PDServo, list[Controller]]:
+    servo, wb = _wholebody(world, motion, start, kp, kv)
+    return servo, [PredictiveTracker(wb, control_every=WHOLEBODY_EVERY)]
 
 
 TRACKING_CONTROLLERS: dict[str, TrackingController] = {
     "wholebody": TrackingController(
         "inverse dynamics with optimised ground forces (pelvis tracked through the feet)",
-        default_kp=1000.0, control_every=4, physical=True, build=_build_wholebody,
+        default_kp=1000.0, control_every=WHOLEBODY_EVERY, physical=True, build=_build_wholebody,
+    ),
+    "predictive": TrackingController(
+        "the whole-body tracker steered by predictive sampling (looks 0.5 s ahead; ~40x slower)",
+        default_kp=1000.0, control_every=WHOLEBODY_EVERY, physical=True,
+        build=_build_predictive,
     ),
     "balance": TrackingController(
         "inertia-scaled PD servo plus stance-leg balance (StanceBalance)",

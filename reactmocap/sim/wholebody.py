@@ -234,6 +234,10 @@ class WholeBodyTracker:
         edges = np.column_stack([self.mu * _PYRAMID, np.ones(4)])  # (4, 3)
         self._edges = edges.T  # (3, 4) columns: unnormalised pyramid edges
         self.last_plan: WholeBodyPlan | None = None
+        #: ``(6,)`` extra pelvis acceleration asked of the plan (world linear m/s^2, local
+        #: angular rad/s^2), on top of its feedback; set by
+        #: :class:`~reactmocap.sim.predictive.PredictiveTracker`, zero otherwise
+        self.root_bias = np.zeros(6)
         self._reference(motion, reach, np.inf if pivot_rate is None else float(pivot_rate))
         self.release()
 
@@ -373,6 +377,7 @@ class WholeBodyTracker:
         rel *= np.where(rel[:, :1] < 0, -1.0, 1.0)
         err = np.r_[qr[:3] - q[:3], quat_log(rel).reshape(-1)]
         acc_des = ar + self.kp * err + self.kv * (vr - v)
+        acc_des[:6] += self.root_bias
 
         mujoco.mj_fullM(m, d, self._full)
         big_m = self._full[sl, sl]

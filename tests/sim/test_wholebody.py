@@ -234,7 +234,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         track_clip(guard, seconds=0.1, controller="nope")
     with pytest.raises(UnknownKeyError, match="balance"):
         tracking_controller("nope")
-    assert set(TRACKING_CONTROLLERS) == {"wholebody", "balance", "pd"}
+    assert set(TRACKING_CONTROLLERS) == {"wholebody", "predictive", "balance", "pd"}
 
 
 @pytest.mark.parametrize(
@@ -271,7 +271,7 @@ def test_cli_track_controller_choice(
 
     clip = tmp_path / "guard.bvh"
     write_bvh(guard, clip)
-    for controller in ("pd", "balance", "wholebody"):
+    for controller in ("pd", "balance", "wholebody", "predictive"):
         report = tmp_path / f"{controller}.json"
         args = ["track", str(clip), "--seconds", "0.3", "--controller", controller]
         assert main([*args, "--report", str(report)]) == 0
