@@ -6,9 +6,11 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 from reactmocap.errors import ConfigError, ReactMocapError
+from reactmocap.progress import Progress
 
 __all__ = ["register"]
 
@@ -108,11 +110,40 @@ def _kwargs(args: argparse.Namespace) -> dict[str, object]:
     }
 
 
+class _SimProgress:
+    """Progress bar over simulated milliseconds (quiet unless stderr is a terminal)."""
+
+    def __init__(self, label: str) -> None:
+        self.label = label
+        self.bar: Progress | None = None
+
+    def __enter__(self) -> Callable[[float, float], None]:
+        return self.tick
+
+    def tick(self, t: float, seconds: float) -> None:
+        if self.bar is None:
+            self.bar = Progress(round(1000 * seconds), f"{self.label} (ms simulated)")
+        self.bar.update(round(1000 * t) - self.bar.done)
+
+    def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
+        if self.bar is not None:
+            if exc_type is None:
+                self.bar.update(self.bar.total - self.bar.done)
+            self.bar.__exit__(None, None, None)
+
+
 def _track(args: argparse.Namespace) -> int:
     from reactmocap.sim.rollout import track_clip
 
     motion = _read(args.clip)
-    out, report, _ = track_clip(motion, start=args.start, seconds=args.seconds, **_kwargs(args))  # type: ignore[arg-type]
+    with _SimProgress("track") as tick:
+        out, report, _ = track_clip(
+            motion,
+            start=args.start,
+            seconds=args.seconds,
+            on_tick=tick,
+            **_kwargs(args),  # type: ignore[arg-type]
+        )
     _write_outputs(args, out, report)
     return 0
 
@@ -127,14 +158,16 @@ def _push(args: argparse.Namespace) -> int:
     if len(force) != 3:
         raise ConfigError(f"--force must have 3 components, got {len(force)}: {args.force!r}")
     motion = _read(args.clip)
-    out, report, _ = push_clip(
-        motion,
-        time=args.time,
-        body=args.body,
-        force=force,
-        duration=args.duration,
-        seconds=args.seconds,
-        **_kwargs(args),  # type: ignore[arg-type]
-    )
+    with _SimProgress("push") as tick:
+        out, report, _ = push_clip(
+            motion,
+            time=args.time,
+            body=args.body,
+            force=force,
+            duration=args.duration,
+            seconds=args.seconds,
+            on_tick=tick,
+            **_kwargs(args),  # type: ignore[arg-type]
+        )
     _write_outputs(args, out, report)
     return 0

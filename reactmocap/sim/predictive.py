@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.errors import ConfigError
+from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.wholebody import WholeBodyPlan, WholeBodyTracker
 from reactmocap.sim.world import World
@@ -43,9 +43,26 @@ F64 = NDArray[np.float64]
 POSITION_SCALE = 0.10
 #: pelvis angle error (rad) that costs 1 (the tracking benchmark's tolerance)
 ANGLE_SCALE = float(np.radians(15.0))
-_BADQACC = int(mujoco.mjtWarning.mjWARN_BADQACC)
+#: MuJoCo's divergence warnings (each resets the simulation)
+_DIVERGED = [
+    int(w)
+    for w in (
+        mujoco.mjtWarning.mjWARN_BADQPOS,
+        mujoco.mjtWarning.mjWARN_BADQVEL,
+        mujoco.mjtWarning.mjWARN_BADQACC,
+        mujoco.mjtWarning.mjWARN_BADCTRL,
+    )
+]
 #: cost of one scored sample with the pelvis below half its start height
 FALL_PENALTY = 100.0
+
+
+def _quiet(message: str) -> None:
+    del message
+
+
+def _diverged_count(d: mujoco.MjData) -> NDArray[np.int64]:
+    return np.array([d.warning[w].number for w in _DIVERGED], dtype=np.int64)
 
 
 class PredictiveTracker:
@@ -105,7 +122,7 @@ class PredictiveTracker:
         self._horizon_steps = round(horizon / dt)
         self._cost_steps = max(1, round(cost_dt / dt))
         self._next = 0.0
-        self._warnings = 0
+        self._warnings = np.zeros(len(_DIVERGED), dtype=np.int64)
         wc = tracker.wc
         self._qpos = wc.qpos_slice
         self._z0 = float(self.world.data.qpos[self._qpos][2])
@@ -128,40 +145,58 @@ class PredictiveTracker:
         fallen = FALL_PENALTY if q[2] < 0.5 * self._z0 else 0.0
         return pos * pos + ang * ang + fallen
 
+    def _diverged(self, d: mujoco.MjData) -> bool:
+        # a reset zeroes the counters before counting its warning, so compare for change
+        return bool(np.any(_diverged_count(d) != self._warnings))
+
     def _predict(self, bias: F64, t: float) -> float:
-        """Run the tracker with ``bias`` for the horizon from the current state; its cost."""
+        """Run the tracker with ``bias`` for the horizon from the current state; its cost
+        (infinite if the simulation diverges)."""
         d = self.world.data
         dt = self.world.timestep
+        t0 = float(d.time)
         self.tracker.root_bias[:] = bias
         total = 0.0
         k = 0
         while k < self._horizon_steps:
             if k % self.every == 0:
-                self.tracker(self.world, t + k * dt)
+                try:
+                    self.tracker(self.world, t + k * dt)
+                except SimulationError:
+                    return np.inf
             n = min(self.every - k % self.every, self._cost_steps - k % self._cost_steps)
             self.servo.step(n)
             k += n
+            # MuJoCo resets a diverged simulation (rewinding the clock) and counts a warning
+            if d.time < t0 + (k - 0.5) * dt or self._diverged(d):
+                return np.inf
             if k % self._cost_steps == 0:
-                # MuJoCo resets a diverged simulation and counts a warning
-                if d.warning[_BADQACC].number > self._warnings or not np.isfinite(d.qvel).all():
-                    return np.inf
                 total += self.cost(t + k * dt)
-        return total
+        return total if np.isfinite(total) else np.inf
 
     def plan(self, t: float) -> None:
         """Choose :attr:`choice` by predicting from the current state; leaves the state as
         it found it."""
         world = self.world
         state = world.get_state()
-        self._warnings = world.data.warning[_BADQACC].number
+        d = world.data
+        self._warnings = _diverged_count(d)
         noise = self.sigma * self._rng.standard_normal((self.samples - 2, 6))
         candidates = np.concatenate([self.choice[None], np.zeros((1, 6)), self.choice + noise])
         costs = np.empty(len(candidates))
-        for i, bias in enumerate(candidates):
+        # a discarded candidate may diverge: keep MuJoCo's printed warnings (and its log file)
+        # for the real simulation
+        handler = mujoco.get_mju_user_warning()
+        mujoco.set_mju_user_warning(_quiet)
+        try:
+            for i, bias in enumerate(candidates):
+                world.set_state(state)
+                costs[i] = self._predict(bias, t)
+        finally:
+            mujoco.set_mju_user_warning(handler)
             world.set_state(state)
-            costs[i] = self._predict(bias, t)
-        world.set_state(state)
-        world.data.warning[_BADQACC].number = self._warnings
+            for w, n in zip(_DIVERGED, self._warnings):
+                d.warning[w].number = n
         self.last_costs = costs
         self.choice = candidates[int(np.argmin(costs))].copy()
 

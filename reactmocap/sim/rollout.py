@@ -464,6 +464,7 @@ def track_clip(
     total_mass: float = 75.0,
     config: WorldConfig | None = None,
     character_kwargs: dict[str, object] | None = None,
+    on_tick: Callable[[float, float], None] | None = None,
 ) -> tuple[Motion, TrackReport, RolloutResult]:
     """Track ``motion`` from ``start`` for ``seconds`` (default: to its end) with the PD servo
     on a simulated character built from the clip (reference = the start frame), optionally
@@ -475,7 +476,8 @@ def track_clip(
     are its joint gains (default: the controller's). ``root_assist > 0`` adds the
     non-physical :class:`RootAssist` with that kp (only with ``"pd"``). Targets and
     feed-forward update every ``control_every`` steps (default: the controller's; the servo's
-    own stiffness and damping act every step inside MuJoCo)."""
+    own stiffness and damping act every step inside MuJoCo). ``on_tick(t, seconds)`` is
+    called at every control tick (a progress bar)."""
     if not (np.isfinite(start) and 0 <= start <= motion.duration):
         raise ConfigError(f"start {start!r} s is outside the clip (0..{motion.duration:.3f} s)")
     remaining = motion.duration - start
@@ -512,6 +514,9 @@ def track_clip(
         ctrls.append(RootAssist(world, 0, motion, start=start, kp=root_assist))
     for f in ctrls:
         f(world, 0.0)
+    if on_tick is not None:
+        tick = on_tick
+        ctrls.append(lambda _w, t: tick(t, seconds))
     result = rollout(
         world,
         seconds,

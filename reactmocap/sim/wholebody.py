@@ -47,7 +47,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import nnls
 
-from reactmocap.errors import ConfigError
+from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.balance import foot_soles, sole_corners_world
@@ -372,6 +372,8 @@ class WholeBodyTracker:
         sl = self._dofs
         q = d.qpos[self.wc.qpos_slice]
         v = d.qvel[sl]
+        if not (np.isfinite(q).all() and np.isfinite(v).all()):
+            raise SimulationError(f"WholeBodyTracker: the state at t = {t:.4f} s is not finite")
         # position error in qvel coordinates: world translation, local rotation vectors
         rel = quat_mul(quat_conj(q[3:].reshape(NJ + 1, 4)), qr[3:].reshape(NJ + 1, 4))
         rel *= np.where(rel[:, :1] < 0, -1.0, 1.0)

@@ -115,3 +115,29 @@ def test_predictive_holds_a_real_run_the_greedy_tracker_loses() -> None:
     pos, ang = worst["predictive"]
     assert pos <= 0.10 and ang <= 15.0, worst
     assert ang < worst["wholebody"][1], worst
+
+
+def test_track_reports_every_control_tick(guard: Motion) -> None:
+    ticks: list[tuple[float, float]] = []
+    track_clip(guard, seconds=0.1, on_tick=lambda t, total: ticks.append((t, total)))
+    times = np.array([t for t, _ in ticks])
+    assert len(ticks) == 50  # every 4 steps of 0.5 ms
+    assert np.all(np.diff(times) > 0) and times[-1] < 0.1
+    assert {total for _, total in ticks} == {0.1}
+
+
+def test_a_diverging_candidate_is_discarded_quietly(
+    step_forward: Motion, capfd: pytest.CaptureFixture[str]
+) -> None:
+    # absurd perturbations make MuJoCo diverge (and reset) inside the predictions
+    world, _, pt = _predictive(step_forward, 20, samples=6, horizon=0.1, sigma_rotation=1e7)
+    before = world.get_state()
+    warnings = [w.number for w in world.data.warning]
+    pt.plan(0.0)
+    assert np.all(np.isfinite(pt.last_costs[:2]))  # the last choice and zero
+    assert np.all(np.isinf(pt.last_costs[2:]))
+    assert np.array_equal(pt.choice, np.zeros(6))
+    assert np.array_equal(world.get_state(), before)
+    assert [w.number for w in world.data.warning] == warnings
+    out, err = capfd.readouterr()
+    assert "WARNING" not in out + err
