@@ -10,6 +10,7 @@ from reactmocap.sim.character import (
     Character,
     build_character,
 )
+from reactmocap.sim.feasibility import SupportFeasibility, support_feasibility
 from reactmocap.sim.impacts import (
     CharacterContact,
     ContactReport,
@@ -56,6 +57,7 @@ __all__ = [
     "Retargeter",
     "RootAssist",
     "StanceBalance",
+    "SupportFeasibility",
     "TrackReport",
     "TrackingController",
     "World",
@@ -70,6 +72,7 @@ __all__ = [
     "push_clip",
     "retarget",
     "rollout",
+    "support_feasibility",
     "track_clip",
     "tracking_controller",
 ]

@@ -510,6 +510,9 @@ def track_clip(
     world = World(character, cfg)
     world.set_from_motion(0, motion, frame)
     servo, ctrls = spec.build(world, motion, float(start), kp, kv)
+    for c in ctrls:
+        if isinstance(c, PredictiveTracker):
+            c.every = every  # its predictions tick as the rollout will
     if root_assist > 0:
         ctrls.append(RootAssist(world, 0, motion, start=start, kp=root_assist))
     for f in ctrls:

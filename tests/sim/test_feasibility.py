@@ -1,0 +1,65 @@
+"""Single-support feasibility: a physically simulated motion passes it, the same poses played
+faster do not, the shared kick's spinning back kicks are flagged and the walks are not."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reactmocap.errors import ConfigError
+from reactmocap.library.motion import Motion
+from reactmocap.sim import support_feasibility, track_clip
+
+SHARED = Path(__file__).resolve().parents[3] / "shared" / "mocap"
+
+
+@pytest.fixture(scope="module")
+def simulated_step(step_forward: Motion) -> Motion:
+    """A physical motion: the whole-body tracker's step, recorded at the clip's rate."""
+    sim, rep, _ = track_clip(step_forward, seconds=step_forward.duration, record_fps=30.0)
+    assert not rep.fell
+    return sim
+
+
+def test_a_simulated_motion_is_feasible(simulated_step: Motion) -> None:
+    check = support_feasibility(simulated_step)
+    single = check.single_support
+    assert single.sum() >= 5  # the step has a single-support phase to check
+    assert np.all(np.isnan(check.residual[~single])) and np.all(check.foot[~single] == -1)
+    assert not check.infeasible(2.0).any()
+    assert check.stretches() == []
+
+
+def test_the_same_poses_played_faster_are_not(simulated_step: Motion) -> None:
+    # 3x the speed: 9x the accelerations through the same single-support poses
+    fast = support_feasibility(simulated_step.replace(fps=3 * simulated_step.fps))
+    slow = support_feasibility(simulated_step)
+    single = slow.single_support
+    assert np.array_equal(fast.single_support, single)
+    assert np.median(fast.residual[single]) > 3 * np.median(slow.residual[single])
+    assert fast.infeasible(2.0).any()
+
+
+def test_bad_input_rejected(step_forward: Motion, simulated_step: Motion) -> None:
+    with pytest.raises(ConfigError, match="3 frames"):
+        support_feasibility(step_forward.slice(0, 2))
+    with pytest.raises(ConfigError, match="factor"):
+        support_feasibility(simulated_step).infeasible(-1.0)
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason=f"shared mocap not found at {SHARED}")
+def test_the_kicks_spins_are_flagged_and_the_walk_is_not() -> None:
+    from reactmocap.library.bvh import read_bvh
+
+    kick = sorted(SHARED.glob("*/*kick_normal_001.bvh"))
+    walk = sorted(SHARED.glob("*/*walk_normal_001.bvh"))
+    if not kick or not walk:
+        pytest.skip(f"kick_normal_001 / walk_normal_001 not under {SHARED}")
+    spins = support_feasibility(read_bvh(kick[0])).stretches(2.0, 0.3)
+    # measured: 1.80-2.47, 6.10-6.87 and 10.67-11.20 s
+    assert len(spins) == 3
+    for (a, b), t in zip(spins, (2.2, 6.5, 11.0)):
+        assert a < t < b
+    assert not support_feasibility(read_bvh(walk[0])).infeasible(2.0).any()
