@@ -40,6 +40,48 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     push.add_argument("--report", type=Path, help="JSON report")
     _common(push)
     push.set_defaults(func=_push)
+    _register_feasibility(sub)
+
+
+def _register_feasibility(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    feas = sub.add_parser(
+        "feasibility",
+        help="can the ground produce a clip? stretches of single support needing more moment "
+        "than a foot can give (reactmocap.sim.support_feasibility)",
+    )
+    feas.add_argument("clip", type=Path, help="input BVH")
+    feas.add_argument(
+        "--factor", type=float, default=2.0, help="flag residuals above this times the bound"
+    )
+    feas.add_argument("--min-seconds", type=float, default=0.1, help="shortest stretch to list (s)")
+    feas.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
+    feas.add_argument("--report", type=Path, help="JSON report")
+    feas.set_defaults(func=_feasibility)
+
+
+def _feasibility(args: argparse.Namespace) -> int:
+    from reactmocap.io import atomic_write_text
+    from reactmocap.sim.feasibility import support_feasibility
+
+    motion = _read(args.clip)
+    if not (math.isfinite(args.min_seconds) and args.min_seconds >= 0):
+        raise ConfigError(f"--min-seconds must be >= 0, got {args.min_seconds!r}")
+    check = support_feasibility(motion, total_mass=args.mass)
+    data = {"clip": motion.name, **check.summary(args.factor, args.min_seconds)}
+    if args.report is not None:
+        atomic_write_text(args.report, json.dumps(data, indent=2) + "\n")
+    ratio = data["median_residual_over_bound"]
+    print(
+        f"{motion.name}: single support {data['single_support_fraction']:.0%} of frames, "
+        f"median residual/bound {'-' if ratio is None else f'{ratio:.2f}'}, "
+        f"{data['infeasible_fraction_of_single_support']:.0%} above {args.factor:g}x the bound"
+    )
+    for st in data["stretches"]:  # type: ignore[attr-defined]
+        print(
+            f"  {st['start_s']:.2f}-{st['end_s']:.2f} s: residual up to "
+            f"{st['max_residual_nm']:.0f} N m, bound up to {st['max_bound_nm']:.0f} N m"
+        )
+    return 0
 
 
 def _common(p: argparse.ArgumentParser) -> None:

@@ -75,6 +75,33 @@ class SupportFeasibility:
         runs = [(a / self.fps, b / self.fps) for a, b in zip(edges[::2], edges[1::2])]
         return [(a, b) for a, b in runs if b - a >= min_seconds - 1e-9]
 
+    def summary(self, factor: float = 2.0, min_seconds: float = 0.1) -> dict[str, object]:
+        """JSON-ready figures: shares of single-support and infeasible frames, the median
+        residual/bound ratio, and each stretch with its largest residual and bound."""
+        s = self.single_support
+        bad = self.infeasible(factor)
+        ratio = self.residual[s] / np.maximum(self.bound[s], 1e-9)
+        stretches = []
+        for a, b in self.stretches(factor, min_seconds):
+            rows = slice(round(a * self.fps), round(b * self.fps))
+            stretches.append(
+                {
+                    "start_s": round(a, 4),
+                    "end_s": round(b, 4),
+                    "max_residual_nm": float(np.nanmax(self.residual[rows])),
+                    "max_bound_nm": float(np.nanmax(self.bound[rows])),
+                }
+            )
+        return {
+            "frames": len(self.foot),
+            "fps": self.fps,
+            "factor": float(factor),
+            "single_support_fraction": float(s.mean()),
+            "infeasible_fraction_of_single_support": float(bad.sum() / max(int(s.sum()), 1)),
+            "median_residual_over_bound": float(np.median(ratio)) if ratio.size else None,
+            "stretches": stretches,
+        }
+
 
 def support_feasibility(
     motion: Motion, *, total_mass: float = 75.0, reach: float = 0.05

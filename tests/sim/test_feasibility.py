@@ -63,3 +63,40 @@ def test_the_kicks_spins_are_flagged_and_the_walk_is_not() -> None:
     for (a, b), t in zip(spins, (2.2, 6.5, 11.0)):
         assert a < t < b
     assert not support_feasibility(read_bvh(walk[0])).infeasible(2.0).any()
+
+
+def test_summary_matches_the_arrays(simulated_step: Motion) -> None:
+    fast = support_feasibility(simulated_step.replace(fps=3 * simulated_step.fps))
+    data = fast.summary(2.0, 0.0)
+    single = fast.single_support
+    assert data["frames"] == simulated_step.num_frames
+    assert data["single_support_fraction"] == pytest.approx(single.mean())
+    bad = fast.infeasible(2.0)
+    assert data["infeasible_fraction_of_single_support"] == pytest.approx(bad.sum() / single.sum())
+    stretches = data["stretches"]
+    assert isinstance(stretches, list) and len(stretches) == len(fast.stretches(2.0, 0.0)) > 0
+    for st, (a, b) in zip(stretches, fast.stretches(2.0, 0.0)):
+        assert (st["start_s"], st["end_s"]) == (round(a, 4), round(b, 4)) and a < b
+        rows = slice(round(a * fast.fps), round(b * fast.fps))
+        assert st["max_residual_nm"] == float(np.max(fast.residual[rows]))
+
+
+def test_cli_feasibility(
+    step_forward: Motion, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    from reactmocap.cli import main
+    from reactmocap.library.bvh import write_bvh
+
+    clip = tmp_path / "step.bvh"
+    write_bvh(step_forward, clip)
+    report = tmp_path / "feasibility.json"
+    assert main(["feasibility", str(clip), "--report", str(report)]) == 0
+    data = json.loads(report.read_text())
+    assert data["clip"] == "step" and data["frames"] == step_forward.num_frames
+    assert 0 < data["single_support_fraction"] < 1
+    assert "single support" in capsys.readouterr().out
+    bad = tmp_path / "bad.json"
+    assert main(["feasibility", str(clip), "--min-seconds", "-1", "--report", str(bad)]) == 2
+    assert "--min-seconds" in capsys.readouterr().err and not bad.exists()
