@@ -498,6 +498,8 @@ def track_clip(
         )
     kp = spec.default_kp if kp is None else float(kp)
     every = spec.control_every if control_every is None else int(control_every)
+    if every < 1:
+        raise ConfigError(f"control_every must be >= 1, got {control_every!r}")
     frame = round(start * motion.fps)
     character = build_character(
         motion,

@@ -141,3 +141,8 @@ def test_a_diverging_candidate_is_discarded_quietly(
     assert [w.number for w in world.data.warning] == warnings
     out, err = capfd.readouterr()
     assert "WARNING" not in out + err
+
+
+def test_bad_control_every_rejected_before_anything_runs(step_forward: Motion) -> None:
+    with pytest.raises(ConfigError, match="control_every"):
+        track_clip(step_forward, seconds=0.1, controller="predictive", control_every=0)
