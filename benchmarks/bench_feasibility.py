@@ -19,6 +19,7 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+from bench_sim import _windows  # the tracking benchmark's windows (this script's folder)
 
 from reactmocap.library.bvh import read_bvh
 from reactmocap.library.motion import Motion
@@ -26,13 +27,6 @@ from reactmocap.sim import support_feasibility, track_clip
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT / ".." / "shared" / "mocap"
-
-
-def _windows(motion: Motion) -> list[float]:
-    """The tracking benchmark's windows (``bench_sim.py``): 1 s every 0.5 s."""
-    if motion.duration <= 1.0:
-        return [0.0]
-    return list(np.arange(0.0, motion.duration - 1.0 + 1e-9, 0.5))
 
 
 def report(motion: Motion, name: str) -> list[float]:

@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
+from reactmocap.sim.pd import check_controller_args
 from reactmocap.sim.wholebody import WholeBodyPlan, WholeBodyTracker
 from reactmocap.sim.world import World
 
@@ -107,9 +108,11 @@ class PredictiveTracker:
             raise ConfigError(f"horizon ({horizon} s) must be at least segment ({segment} s)")
         if samples < 2:
             raise ConfigError(f"samples must be >= 2 (the last choice and zero), got {samples!r}")
-        for name, value in (("sigma_position", sigma_position), ("sigma_rotation", sigma_rotation)):
-            if not (np.isfinite(value) and value >= 0):
-                raise ConfigError(f"{name} must be >= 0, got {value!r}")
+        check_controller_args(
+            tracker.servo,
+            tracker.character,
+            {"sigma_position": sigma_position, "sigma_rotation": sigma_rotation},
+        )
         if control_every < 1:
             raise ConfigError(f"control_every must be >= 1, got {control_every!r}")
         self.tracker = tracker

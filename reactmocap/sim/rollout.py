@@ -363,27 +363,30 @@ def _errors(world: World, result: RolloutResult, motion: Motion, start: float) -
 
 @dataclass(frozen=True)
 class TrackingController:
-    """A registered way to track a clip: ``build(world, motion, start, kp, kv)`` returns the
-    servo and the controllers for character 0; ``kp``/``kv`` ``None`` mean the defaults."""
+    """A registered way to track a clip: ``build(world, motion, start, kp, kv, every)`` returns
+    the servo and the controllers for character 0; ``kp``/``kv`` ``None`` mean the defaults,
+    ``every`` is the rollout's steps between control ticks."""
 
     description: str
     default_kp: float
     control_every: int
     physical: bool
-    build: Callable[[World, Motion, float, float, float | None], tuple[PDServo, list[Controller]]]
+    build: Callable[
+        [World, Motion, float, float, float | None, int], tuple[PDServo, list[Controller]]
+    ]
 
 
 def _build_pd(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None
+    world: World, motion: Motion, start: float, kp: float, kv: float | None, every: int
 ) -> tuple[PDServo, list[Controller]]:
     servo = PDServo(world, kp=kp, kv=kv)
     return servo, [MotionTracker(servo, 0, motion, start=start)]
 
 
 def _build_balance(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None
+    world: World, motion: Motion, start: float, kp: float, kv: float | None, every: int
 ) -> tuple[PDServo, list[Controller]]:
-    servo, ctrls = _build_pd(world, motion, start, kp, kv)
+    servo, ctrls = _build_pd(world, motion, start, kp, kv, every)
     return servo, [*ctrls, StanceBalance(servo, 0, motion, start=start)]
 
 
@@ -400,7 +403,7 @@ def _wholebody(
 
 
 def _build_wholebody(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None
+    world: World, motion: Motion, start: float, kp: float, kv: float | None, every: int
 ) -> tuple[PDServo, list[Controller]]:
     servo, wb = _wholebody(world, motion, start, kp, kv)
     return servo, [wb]
@@ -411,10 +414,11 @@ WHOLEBODY_EVERY = 4
 
 
 def _build_predictive(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None
+    world: World, motion: Motion, start: float, kp: float, kv: float | None, every: int
 ) -> tuple[PDServo, list[Controller]]:
     servo, wb = _wholebody(world, motion, start, kp, kv)
-    return servo, [PredictiveTracker(wb, control_every=WHOLEBODY_EVERY)]
+    # its predictions tick as the rollout will
+    return servo, [PredictiveTracker(wb, control_every=every)]
 
 
 TRACKING_CONTROLLERS: dict[str, TrackingController] = {
@@ -511,10 +515,7 @@ def track_clip(
     cfg = config or WorldConfig(friction=friction)
     world = World(character, cfg)
     world.set_from_motion(0, motion, frame)
-    servo, ctrls = spec.build(world, motion, float(start), kp, kv)
-    for c in ctrls:
-        if isinstance(c, PredictiveTracker):
-            c.every = every  # its predictions tick as the rollout will
+    servo, ctrls = spec.build(world, motion, float(start), kp, kv, every)
     if root_assist > 0:
         ctrls.append(RootAssist(world, 0, motion, start=start, kp=root_assist))
     for f in ctrls:
