@@ -35,7 +35,12 @@ from reactmocap.sim.rollout import (
     track_clip,
     tracking_controller,
 )
-from reactmocap.sim.wholebody import WholeBodyPlan, WholeBodyTracker
+from reactmocap.sim.wholebody import (
+    ReferencePath,
+    WholeBodyPlan,
+    WholeBodyTracker,
+    reference_path,
+)
 from reactmocap.sim.world import PREFIXES, World, WorldCharacter, WorldConfig
 
 __all__ = [
@@ -53,6 +58,7 @@ __all__ = [
     "MotionTracker",
     "PDServo",
     "PredictiveTracker",
+    "ReferencePath",
     "RolloutResult",
     "Retargeter",
     "RootAssist",
@@ -70,6 +76,7 @@ __all__ = [
     "critical_kv",
     "first_contact",
     "push_clip",
+    "reference_path",
     "retarget",
     "rollout",
     "support_feasibility",

@@ -18,8 +18,8 @@ simulated walk at 0.74, the kick clip's three spinning back kicks at 3-15x it fo
 
 ``c`` and ``L`` are MuJoCo's ``subtree_com`` and ``subtree_angmom`` at the clip's poses with
 finite-difference velocities; their rates are central differences at the clip's frame rate.
-A foot is planted as :class:`~reactmocap.sim.wholebody.WholeBodyTracker` decides it (sole
-within ``reach`` of the floor).
+A foot is planted as the whole-body tracker decides it
+(:func:`~reactmocap.sim.wholebody.reference_path`: sole within ``reach`` of the floor).
 """
 
 from __future__ import annotations
@@ -33,8 +33,7 @@ from numpy.typing import NDArray
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import build_character
-from reactmocap.sim.pd import PDServo
-from reactmocap.sim.wholebody import WholeBodyTracker
+from reactmocap.sim.wholebody import reference_path
 from reactmocap.sim.world import World
 
 __all__ = ["SupportFeasibility", "support_feasibility"]
@@ -114,7 +113,7 @@ def support_feasibility(
             f"{motion.name!r} has {motion.num_frames}"
         )
     world = World(build_character(motion, total_mass=total_mass, frame=0))
-    ref = WholeBodyTracker(PDServo(world, kp=0.0), 0, motion, reach=reach)
+    ref = reference_path(world, 0, motion, reach=reach)
     m = world.model
     d = mujoco.MjData(m)
     wc = world.characters[0]

@@ -141,7 +141,7 @@ class PredictiveTracker:
 
     def cost(self, t: float) -> float:
         """Cost of the current state at rollout time ``t`` (one scored sample)."""
-        q_ref = self.tracker._sample(t)[0]
+        q_ref = self.tracker.reference(t)[0]
         q = self.world.data.qpos[self._qpos]
         pos = float(np.linalg.norm(q[:3] - q_ref[:3])) / POSITION_SCALE
         rel = quat_mul(quat_conj(q[3:7]), q_ref[3:7])

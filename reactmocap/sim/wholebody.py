@@ -55,7 +55,7 @@ from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.pd import PDServo, check_controller_args, critical_kv
 from reactmocap.sim.world import World
 
-__all__ = ["WholeBodyPlan", "WholeBodyTracker"]
+__all__ = ["ReferencePath", "WholeBodyPlan", "WholeBodyTracker", "reference_path"]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
@@ -125,6 +125,75 @@ def _velocity(q: F64, fps: float) -> F64:
     rel *= np.where(rel[..., :1] < 0, -1.0, 1.0)
     ang = quat_log(rel) / span[:, :, None]
     return np.concatenate([lin, ang.reshape(n, -1)], axis=1)
+
+
+@dataclass(frozen=True)
+class ReferencePath:
+    """A clip as the whole-body tracker follows it on one character, per clip frame (read-only
+    arrays): ``q`` ``(T, 67)`` qpos with hemisphere-continuous quaternions, ``v`` ``(T, 51)``
+    qvel and ``a`` ``(T, 51)`` qacc by central differences, ``planted`` ``(T, 2)`` the feet
+    (left, right) whose sole is within ``reach`` of the floor, ``pivoting`` ``(T, 2)`` the
+    planted feet turning faster than ``pivot_rate``; ``fps`` the clip's rate."""
+
+    q: F64
+    v: F64
+    a: F64
+    planted: NDArray[np.bool_]
+    pivoting: NDArray[np.bool_]
+    fps: float
+
+    def sample(self, x: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
+        """``q``, ``v``, ``a`` interpolated linearly at fractional frame ``x`` (quaternions
+        renormalised) and ``planted`` at the nearest frame."""
+        i0 = int(x)
+        i1 = min(i0 + 1, len(self.q) - 1)
+        w = x - i0
+        q = (1 - w) * self.q[i0] + w * self.q[i1]
+        quats = q[3:].reshape(NJ + 1, 4)
+        quats /= np.linalg.norm(quats, axis=1, keepdims=True)
+        v = (1 - w) * self.v[i0] + w * self.v[i1]
+        acc = (1 - w) * self.a[i0] + w * self.a[i1]
+        return q, v, acc, self.planted[round(x)]
+
+
+def reference_path(
+    world: World,
+    character: int,
+    motion: Motion,
+    *,
+    reach: float = 0.05,
+    pivot_rate: float | None = 2.0,
+) -> ReferencePath:
+    """``motion`` mapped onto ``world``'s ``character`` as a :class:`ReferencePath`, with the
+    mocap's foot stance measured on the character's own sole boxes (``pivot_rate`` rad/s,
+    ``None``: no pivots)."""
+    m = world.model
+    wc = world.characters[character]
+    _, sole_ids, corners = foot_soles(world, character, "reference_path")
+    floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
+    q = wc.character.qpos_from_motion(motion)
+    n = motion.num_frames
+    q[:, 3:] = hemisphere_continuous(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
+    v = _velocity(q, motion.fps)
+    a = np.gradient(v, 1.0 / motion.fps, axis=0) if n > 2 else np.zeros_like(v)
+    d = mujoco.MjData(m)
+    sole = np.empty((n, 2))
+    yaw = np.empty((n, 2))
+    for i in range(n):  # once per clip, not in the step loop
+        d.qpos[wc.qpos_slice] = q[i]
+        mujoco.mj_kinematics(m, d)
+        sole[i] = sole_corners_world(d, sole_ids, corners).min(axis=1)[:, 2] - floor_z
+        rot = d.geom_xmat[sole_ids].reshape(2, 3, 3)
+        yaw[i] = np.arctan2(rot[:, 1, 0], rot[:, 0, 0])
+    planted = sole < reach
+    rate = np.zeros((n, 2))
+    if n > 1:
+        rate = np.abs(np.gradient(np.unwrap(yaw, axis=0), 1.0 / motion.fps, axis=0))
+    pivoting = planted & (rate > (np.inf if pivot_rate is None else float(pivot_rate)))
+    arrays = (q, v, a, planted, pivoting)
+    for arr in arrays:
+        arr.flags.writeable = False
+    return ReferencePath(*arrays, fps=float(motion.fps))
 
 
 class WholeBodyTracker:
@@ -238,52 +307,18 @@ class WholeBodyTracker:
         #: angular rad/s^2), on top of its feedback; set by
         #: :class:`~reactmocap.sim.predictive.PredictiveTracker`, zero otherwise
         self.root_bias = np.zeros(6)
-        self._reference(motion, reach, np.inf if pivot_rate is None else float(pivot_rate))
+        #: the clip as this tracker follows it
+        self.path = reference_path(world, character, motion, reach=reach, pivot_rate=pivot_rate)
         self.release()
 
     # ------------------------------------------------------------------ reference
-    def _reference(self, motion: Motion, reach: float, pivot_rate: float) -> None:
-        m = self.world.model
-        ch = self.wc.character
-        q = ch.qpos_from_motion(motion)
-        n = motion.num_frames
-        q[:, 3:] = hemisphere_continuous(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
-        self.q = q
-        self.v = _velocity(q, motion.fps)
-        self.a = np.gradient(self.v, 1.0 / motion.fps, axis=0) if n > 2 else np.zeros_like(self.v)
-        # mocap foot stance, measured on this character's own sole boxes
-        d = mujoco.MjData(m)
-        sole = np.empty((n, 2))
-        yaw = np.empty((n, 2))
-        for i in range(n):  # once per clip, not in the step loop
-            d.qpos[self.wc.qpos_slice] = q[i]
-            mujoco.mj_kinematics(m, d)
-            sole[i] = (
-                sole_corners_world(d, self.sole, self._corners).min(axis=1)[:, 2] - self.floor_z
-            )
-            rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-            yaw[i] = np.arctan2(rot[:, 1, 0], rot[:, 0, 0])
-        self.planted = sole < reach
-        rate = np.zeros((n, 2))
-        if n > 1:
-            rate = np.abs(np.gradient(np.unwrap(yaw, axis=0), 1.0 / motion.fps, axis=0))
-        #: (T, 2) frames where a planted mocap foot spins: it touches through its ball patch
-        self.pivoting = self.planted & (rate > pivot_rate)
+    def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
+        """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
+        the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
+        return self.path.sample(self._frame(t))
 
     def _frame(self, t: float) -> float:
-        return min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
-
-    def _sample(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
-        x = self._frame(t)
-        i0 = int(x)
-        i1 = min(i0 + 1, self.motion.num_frames - 1)
-        a = x - i0
-        q = (1 - a) * self.q[i0] + a * self.q[i1]
-        quats = q[3:].reshape(NJ + 1, 4)
-        quats /= np.linalg.norm(quats, axis=1, keepdims=True)
-        v = (1 - a) * self.v[i0] + a * self.v[i1]
-        acc = (1 - a) * self.a[i0] + a * self.a[i1]
-        return q, v, acc, self.planted[round(x)]
+        return min(max((self.start + t) * self.path.fps, 0.0), len(self.path.q) - 1.0)
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
@@ -368,7 +403,7 @@ class WholeBodyTracker:
         """Solve the tracking program at rollout time ``t`` for the current state (MuJoCo's
         quantities of the last step). Does not touch the simulation."""
         m, d = self.world.model, self.world.data
-        qr, vr, ar, planted = self._sample(t)
+        qr, vr, ar, planted = self.reference(t)
         sl = self._dofs
         q = d.qpos[self.wc.qpos_slice]
         v = d.qvel[sl]
@@ -438,7 +473,7 @@ class WholeBodyTracker:
         )  # fmt: skip
 
     def __call__(self, world: World, t: float) -> None:
-        pivoting = self.pivoting[round(self._frame(t))]
+        pivoting = self.path.pivoting[round(self._frame(t))]
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(pivoting[f]))
         plan = self.plan(t)

@@ -21,7 +21,7 @@ from reactmocap.sim.rollout import (
     track_clip,
     tracking_controller,
 )
-from reactmocap.sim.wholebody import WholeBodyTracker
+from reactmocap.sim.wholebody import WholeBodyTracker, reference_path
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "mocap"
 
@@ -32,6 +32,36 @@ def _standing(motion: Motion, frame: int) -> tuple[World, PDServo, WholeBodyTrac
     mujoco.mj_forward(world.model, world.data)
     servo = PDServo(world, kp=0.0, kv=WHOLEBODY_SERVO_KV)
     return world, servo, WholeBodyTracker(servo, 0, motion, start=frame / motion.fps)
+
+
+def test_reference_path_is_the_clip_on_the_character(step_forward: Motion) -> None:
+    """The path's poses are the clip's (MuJoCo body positions match the character's forward
+    kinematics), its velocities integrate back to the poses, its arrays are read-only, and
+    its stance is a single-support step: each foot lifts while the other stays planted."""
+    world = World(build_character(step_forward))
+    path = reference_path(world, 0, step_forward)
+    n = step_forward.num_frames
+    assert path.q.shape == (n, 67) and path.v.shape == path.a.shape == (n, 51)
+    assert path.planted.shape == path.pivoting.shape == (n, 2) and path.fps == step_forward.fps
+    for arr in (path.q, path.v, path.a, path.planted, path.pivoting):
+        assert not arr.flags.writeable
+    # central differences: the root moves by v dt between neighbouring frames
+    dx = (path.q[2:, :3] - path.q[:-2, :3]) * step_forward.fps / 2
+    assert np.allclose(dx, path.v[1:-1, :3])
+    # a frame samples exactly; half-way is the mean (positions) with unit quaternions
+    q5, v5, a5, planted5 = path.sample(5.0)
+    assert np.allclose(q5, path.q[5], rtol=0, atol=1e-12)
+    assert np.array_equal(v5, path.v[5]) and np.array_equal(a5, path.a[5])
+    assert np.array_equal(planted5, path.planted[5])
+    qh = path.sample(5.5)[0]
+    assert np.allclose(qh[:3], (path.q[5, :3] + path.q[6, :3]) / 2)
+    assert np.allclose(np.linalg.norm(qh[3:].reshape(-1, 4), axis=1), 1.0)
+    assert path.planted.all(axis=1).any() and not path.planted.all()
+    assert not (~path.planted).all(axis=1).any()  # a step: never both feet up
+    # the tracker follows its path on the rollout's clock (time 0 = its start frame)
+    _, _, wb = _standing(step_forward, 20)
+    for t, frame in ((0.0, 20.0), (0.5 / step_forward.fps, 20.5), (-1.0, 0.0), (1e3, n - 1.0)):
+        assert np.array_equal(wb.reference(t)[0], wb.path.sample(frame)[0])
 
 
 @pytest.mark.parametrize(("clip", "frame"), [("guard", 10), ("step_forward", 20)])
@@ -176,7 +206,7 @@ def _stance_yaw_lag(
     def spy(w: World, t: float) -> None:
         wb(w, t)
         ticks[0] += int(w.foot_patch_on(0)[0])
-        ref.qpos[world.characters[0].qpos_slice] = wb._sample(t)[0]
+        ref.qpos[world.characters[0].qpos_slice] = wb.reference(t)[0]
         mujoco.mj_kinematics(world.model, ref)
         for data, out in ((w.data, sim_yaw), (ref, ref_yaw)):
             x = data.geom_xmat[sole]
