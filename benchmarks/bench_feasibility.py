@@ -19,7 +19,9 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-from bench_sim import _windows  # the tracking benchmark's windows (this script's folder)
+
+# the tracking benchmark's windows (this script's folder)
+from bench_sim import INFEASIBLE_SECONDS, _infeasible_seconds
 
 from reactmocap.library.bvh import read_bvh
 from reactmocap.library.motion import Motion
@@ -48,10 +50,7 @@ def report(motion: Motion, name: str) -> list[float]:
             f"    {a:5.2f}-{b:5.2f} s: r {np.nanmin(res[seg]):4.0f}-{np.nanmax(res[seg]):4.0f} "
             f"N m against cap {np.nanmin(cap[seg]):3.0f}-{np.nanmax(cap[seg]):3.0f} N m"
         )
-    fps = motion.fps
-    return [
-        float(bad[round(s * fps) : round((s + 1.0) * fps)].sum() / fps) for s in _windows(motion)
-    ]
+    return _infeasible_seconds(motion, bad)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -70,8 +69,9 @@ def main(argv: list[str] | None = None) -> int:
         inside += report(read_bvh(path), path.stem)
     over = np.array(inside)
     print(
-        f"\nbenchmark windows (1 s every 0.5 s): {len(over)}; with >= 0.3 s of frames r > 2 cap: "
-        f"{int((over >= 0.3).sum())}; with any: {int((over > 0).sum())}"
+        f"\nbenchmark windows (1 s every 0.5 s): {len(over)}; with >= {INFEASIBLE_SECONDS} s of "
+        f"frames r > 2 cap: {int((over >= INFEASIBLE_SECONDS).sum())}; with any: "
+        f"{int((over > 0).sum())}"
     )
     if args.check:
         walk = read_bvh(next(p for p in clips if "walk_normal_001" in p.name))

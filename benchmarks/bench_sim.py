@@ -25,7 +25,15 @@ import numpy as np
 
 from reactmocap.library.motion import Motion
 from reactmocap.library.synth import synthetic_clips
-from reactmocap.sim import PDServo, World, WorldConfig, build_character, rollout, track_clip
+from reactmocap.sim import (
+    PDServo,
+    World,
+    WorldConfig,
+    build_character,
+    rollout,
+    support_feasibility,
+    track_clip,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT / ".." / "shared" / "mocap"
@@ -198,6 +206,22 @@ def _windows(motion: Motion) -> list[float]:
     return list(np.arange(0.0, motion.duration - 1.0 + 1e-9, 0.5))
 
 
+#: a window whose clip has this many seconds of single-support frames needing more than twice
+#: the moment the foot can give (``support_feasibility``) asks the impossible of a physical
+#: tracker for a while (``bench_feasibility.py``)
+INFEASIBLE_SECONDS = 0.3
+
+
+def _infeasible_seconds(motion: Motion, mask: np.ndarray | None = None) -> list[float]:
+    """Seconds of ``mask`` (default: the clip's single-support frames above 2x the bound)
+    inside each of :func:`_windows`."""
+    bad = support_feasibility(motion).infeasible(2.0) if mask is None else mask
+    fps = motion.fps
+    return [
+        float(bad[round(s * fps) : round((s + 1.0) * fps)].sum() / fps) for s in _windows(motion)
+    ]
+
+
 def _track_window(
     job: tuple[Path, float, str, float],
 ) -> tuple[bool, bool, float, float, float, float] | str:
@@ -235,6 +259,9 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
     modes = [(c, 0.0, labels.get(c, c)) for c in controllers]
     modes.append(("pd", assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}"))
     windows = {p: _windows(_read_bvh(p)) for p in clips}
+    feasible = {
+        p: [x < INFEASIBLE_SECONDS for x in _infeasible_seconds(_read_bvh(p))] for p in clips
+    }
     print(f"\n(windows run in {jobs} processes: real-time factors are per process)")
     with ProcessPoolExecutor(max_workers=jobs) as pool:
         for controller, assist, label in modes:
@@ -246,7 +273,7 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
             t0 = time.perf_counter()
             work = [(p, s, controller, assist) for p in clips for s in windows[p]]
             results = list(pool.map(_track_window, work))
-            tot_ok = tot = 0
+            tot_ok = tot = feas_ok = feas = 0
             walls: list[float] = []
             for path in clips:
                 rows = [r for (p, _, _, _), r in zip(work, results) if p == path]
@@ -259,6 +286,9 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
                 walls += [r[5] for r in good]
                 tot_ok += ok
                 tot += len(rows)
+                for r, clear in zip(rows, feasible[path]):
+                    feas += clear
+                    feas_ok += clear and not isinstance(r, str) and r[0]
                 print(
                     f"{path.stem:<28} {len(rows):>7} {100 * ok / len(rows):6.0f} "
                     f"{100 * up / len(rows):9.0f} {100 * np.median([r[2] for r in good]):11.1f} "
@@ -269,6 +299,10 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
                 f"{'ALL':<28} {tot:>7} {100 * tot_ok / max(tot, 1):6.0f}   "
                 f"(median real-time factor {1.0 / np.median(walls):.2f}x; "
                 f"{time.perf_counter() - t0:.0f} s wall)"
+            )
+            print(
+                f"{'FEASIBLE':<28} {feas:>7} {100 * feas_ok / max(feas, 1):6.0f}   (windows with "
+                f"< {INFEASIBLE_SECONDS} s of single support needing > 2x the foot's moment)"
             )
 
 
