@@ -50,7 +50,7 @@ def report(motion: Motion, name: str) -> list[float]:
             f"    {a:5.2f}-{b:5.2f} s: r {np.nanmin(res[seg]):4.0f}-{np.nanmax(res[seg]):4.0f} "
             f"N m against cap {np.nanmin(cap[seg]):3.0f}-{np.nanmax(cap[seg]):3.0f} N m"
         )
-    return _infeasible_seconds(motion, bad)
+    return _infeasible_seconds(motion, check)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -27,6 +27,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.library.synth import synthetic_clips
 from reactmocap.sim import (
     PDServo,
+    SupportFeasibility,
     World,
     WorldConfig,
     build_character,
@@ -212,14 +213,11 @@ def _windows(motion: Motion) -> list[float]:
 INFEASIBLE_SECONDS = 0.3
 
 
-def _infeasible_seconds(motion: Motion, mask: np.ndarray | None = None) -> list[float]:
-    """Seconds of ``mask`` (default: the clip's single-support frames above 2x the bound)
-    inside each of :func:`_windows`."""
-    bad = support_feasibility(motion).infeasible(2.0) if mask is None else mask
-    fps = motion.fps
-    return [
-        float(bad[round(s * fps) : round((s + 1.0) * fps)].sum() / fps) for s in _windows(motion)
-    ]
+def _infeasible_seconds(motion: Motion, check: SupportFeasibility | None = None) -> list[float]:
+    """Seconds of single support needing more than twice the foot's moment inside each of
+    :func:`_windows` (``check``: the clip's :func:`support_feasibility`, computed if absent)."""
+    check = support_feasibility(motion) if check is None else check
+    return [check.infeasible_seconds(s, 1.0) for s in _windows(motion)]
 
 
 def _track_window(

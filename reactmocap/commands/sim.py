@@ -117,7 +117,23 @@ def _read(path: Path):  # type: ignore[no-untyped-def]
     return read_bvh(path)
 
 
-def _write_outputs(args: argparse.Namespace, motion, report) -> None:  # type: ignore[no-untyped-def]
+#: seconds of a tracked span needing more moment than a foot can give that earn a printed note
+#: (the default ``--min-seconds`` of ``reactmocap feasibility``)
+FEASIBILITY_NOTE_S = 0.1
+
+
+def _infeasible_seconds(clip, report, mass: float) -> float | None:  # type: ignore[no-untyped-def]
+    """Seconds of the tracked span where the clip asks for more moment than a foot can give
+    (``support_feasibility``, 2x its bound); None for clips too short to differentiate."""
+    from reactmocap.sim.feasibility import support_feasibility
+
+    if clip.num_frames < 3:
+        return None
+    check = support_feasibility(clip, total_mass=mass)
+    return check.infeasible_seconds(report.start, report.seconds)
+
+
+def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # type: ignore[no-untyped-def]
     from reactmocap.io import atomic_write_text
 
     if args.out is not None:
@@ -127,6 +143,8 @@ def _write_outputs(args: argparse.Namespace, motion, report) -> None:  # type: i
         write_bvh(motion, tmp)  # then renamed into place: never a half-written output
         tmp.replace(args.out)
     data = report.to_dict()
+    infeasible = _infeasible_seconds(clip, report, args.mass)
+    data["infeasible_single_support_s"] = infeasible
     if args.report is not None:
         clean = {
             k: (None if isinstance(v, float) and not math.isfinite(v) else v)
@@ -138,6 +156,12 @@ def _write_outputs(args: argparse.Namespace, motion, report) -> None:  # type: i
         f"mean joint error {data['mean_joint_error_rad']:.3f} rad, root error "
         f"{data['root_error_m']:.3f} m, {data['realtime_factor']:.2f}x real time"
     )
+    if infeasible is not None and infeasible >= FEASIBILITY_NOTE_S:
+        print(
+            f"note: for {infeasible:.2f} s of this span the clip asks for more moment than one "
+            "foot can give this character (`reactmocap feasibility`): no physical tracker "
+            "holds the mocap exactly there"
+        )
 
 
 def _kwargs(args: argparse.Namespace) -> dict[str, object]:
@@ -186,7 +210,7 @@ def _track(args: argparse.Namespace) -> int:
             on_tick=tick,
             **_kwargs(args),  # type: ignore[arg-type]
         )
-    _write_outputs(args, out, report)
+    _write_outputs(args, motion, out, report)
     return 0
 
 
@@ -211,5 +235,5 @@ def _push(args: argparse.Namespace) -> int:
             on_tick=tick,
             **_kwargs(args),  # type: ignore[arg-type]
         )
-    _write_outputs(args, out, report)
+    _write_outputs(args, motion, out, report)
     return 0

@@ -74,6 +74,19 @@ class SupportFeasibility:
         runs = [(a / self.fps, b / self.fps) for a, b in zip(edges[::2], edges[1::2])]
         return [(a, b) for a, b in runs if b - a >= min_seconds - 1e-9]
 
+    def infeasible_seconds(
+        self, start: float = 0.0, seconds: float | None = None, factor: float = 2.0
+    ) -> float:
+        """Seconds of infeasible frames (:meth:`infeasible`) in ``[start, start + seconds)``
+        of the clip (default: to its end)."""
+        for name, value in (("start", start), ("seconds", 0.0 if seconds is None else seconds)):
+            if not (np.isfinite(value) and value >= 0):
+                raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
+        bad = self.infeasible(factor)
+        a = round(start * self.fps)
+        b = len(bad) if seconds is None else round((start + seconds) * self.fps)
+        return float(bad[a:b].sum() / self.fps)
+
     def summary(self, factor: float = 2.0, min_seconds: float = 0.1) -> dict[str, object]:
         """JSON-ready figures: shares of single-support and infeasible frames, the median
         residual/bound ratio, and each stretch with its largest residual and bound."""

@@ -154,6 +154,7 @@ def test_cli_track_and_push(bvh_clip: Path, tmp_path: Path) -> None:
         assert key in data
     for key in ("mean_joint_error_rad", "root_error_m", "wall_s", "realtime_factor"):
         assert np.isfinite(data[key])
+    assert data["infeasible_single_support_s"] == 0.0  # a two-footed stance
     assert out.stat().st_size > 0
     pushed = tmp_path / "p.bvh"
     assert (

@@ -57,12 +57,50 @@ def test_the_kicks_spins_are_flagged_and_the_walk_is_not() -> None:
     walk = sorted(SHARED.glob("*/*walk_normal_001.bvh"))
     if not kick or not walk:
         pytest.skip(f"kick_normal_001 / walk_normal_001 not under {SHARED}")
-    spins = support_feasibility(read_bvh(kick[0])).stretches(2.0, 0.3)
+    check = support_feasibility(read_bvh(kick[0]))
+    spins = check.stretches(2.0, 0.3)
     # measured: 1.80-2.47, 6.10-6.87 and 10.67-11.20 s
     assert len(spins) == 3
     for (a, b), t in zip(spins, (2.2, 6.5, 11.0)):
         assert a < t < b
+    # the tracking benchmark's window at 2.0 s lies in the first spin
+    assert check.infeasible_seconds(2.0, 1.0) >= 0.3
     assert not support_feasibility(read_bvh(walk[0])).infeasible(2.0).any()
+
+
+def test_infeasible_seconds_counts_the_frames(simulated_step: Motion) -> None:
+    fast = support_feasibility(simulated_step.replace(fps=3 * simulated_step.fps))
+    bad = fast.infeasible(2.0)
+    assert bad.any() and fast.infeasible_seconds() == pytest.approx(bad.sum() / fast.fps)
+    a, b = fast.stretches(2.0, 0.0)[0]
+    assert fast.infeasible_seconds(a, b - a) == pytest.approx(b - a)
+    assert fast.infeasible_seconds(0.0, a) == 0.0
+    assert fast.infeasible_seconds(factor=20.0) < fast.infeasible_seconds(factor=2.0)
+    for bad_args in ({"start": -1.0}, {"seconds": float("nan")}):
+        with pytest.raises(ConfigError, match=next(iter(bad_args))):
+            fast.infeasible_seconds(**bad_args)  # type: ignore[arg-type]
+
+
+def test_cli_track_notes_an_infeasible_span(
+    simulated_step: Motion, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``track`` reports how much of the span asks for more moment than a foot can give, and
+    says so: the same poses played 3x faster are flagged."""
+    import json
+
+    from reactmocap.cli import main
+    from reactmocap.library.bvh import read_bvh, write_bvh
+
+    clip = tmp_path / "fast.bvh"
+    write_bvh(simulated_step.replace(fps=3 * simulated_step.fps), clip)
+    fast = read_bvh(clip)
+    report = tmp_path / "track.json"
+    seconds = 0.5
+    assert main(["track", str(clip), "--seconds", str(seconds), "--report", str(report)]) == 0
+    data = json.loads(report.read_text())
+    expected = support_feasibility(fast).infeasible_seconds(0.0, seconds)
+    assert data["infeasible_single_support_s"] == pytest.approx(expected) and expected >= 0.1
+    assert f"for {expected:.2f} s of this span" in capsys.readouterr().out
 
 
 def test_summary_matches_the_arrays(simulated_step: Motion) -> None:
