@@ -143,8 +143,9 @@ class ReferencePath:
     fps: float
 
     def sample(self, x: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
-        """``q``, ``v``, ``a`` interpolated linearly at fractional frame ``x`` (quaternions
-        renormalised) and ``planted`` at the nearest frame."""
+        """``q``, ``v``, ``a`` interpolated linearly at fractional frame ``x`` (clamped to
+        the clip; quaternions renormalised) and ``planted`` at the nearest frame."""
+        x = min(max(x, 0.0), len(self.q) - 1.0)
         i0 = int(x)
         i1 = min(i0 + 1, len(self.q) - 1)
         w = x - i0
@@ -167,6 +168,12 @@ def reference_path(
     """``motion`` mapped onto ``world``'s ``character`` as a :class:`ReferencePath`, with the
     mocap's foot stance measured on the character's own sole boxes (``pivot_rate`` rad/s,
     ``None``: no pivots)."""
+    for name, value in (
+        ("reach", reach),
+        ("pivot_rate", 0.0 if pivot_rate is None else pivot_rate),
+    ):
+        if not (np.isfinite(value) and value >= 0):
+            raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
     m = world.model
     wc = world.characters[character]
     _, sole_ids, corners = foot_soles(world, character, "reference_path")

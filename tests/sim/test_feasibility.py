@@ -47,6 +47,8 @@ def test_bad_input_rejected(step_forward: Motion, simulated_step: Motion) -> Non
         support_feasibility(step_forward.slice(0, 2))
     with pytest.raises(ConfigError, match="factor"):
         support_feasibility(simulated_step).infeasible(-1.0)
+    with pytest.raises(ConfigError, match="reach"):
+        support_feasibility(simulated_step, reach=-0.01)
 
 
 @pytest.mark.skipif(not SHARED.is_dir(), reason=f"shared mocap not found at {SHARED}")

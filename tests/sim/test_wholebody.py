@@ -58,6 +58,10 @@ def test_reference_path_is_the_clip_on_the_character(step_forward: Motion) -> No
     assert np.allclose(np.linalg.norm(qh[3:].reshape(-1, 4), axis=1), 1.0)
     assert path.planted.all(axis=1).any() and not path.planted.all()
     assert not (~path.planted).all(axis=1).any()  # a step: never both feet up
+    assert np.array_equal(path.sample(-3.0)[0], path.sample(0.0)[0])  # clamped to the clip
+    assert np.array_equal(path.sample(n + 5.0)[1], path.v[-1])
+    with pytest.raises(ConfigError, match="pivot_rate"):
+        reference_path(world, 0, step_forward, pivot_rate=float("nan"))
     # the tracker follows its path on the rollout's clock (time 0 = its start frame)
     _, _, wb = _standing(step_forward, 20)
     for t, frame in ((0.0, 20.0), (0.5 / step_forward.fps, 20.5), (-1.0, 0.0), (1e3, n - 1.0)):
