@@ -256,9 +256,10 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
               "predictive": "whole-body + predictive sampling (physical)"}  # fmt: skip
     modes = [(c, 0.0, labels.get(c, c)) for c in controllers]
     modes.append(("pd", assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}"))
-    windows = {p: _windows(_read_bvh(p)) for p in clips}
+    motions = {p: _read_bvh(p) for p in clips}
+    windows = {p: _windows(m) for p, m in motions.items()}
     feasible = {
-        p: [x < INFEASIBLE_SECONDS for x in _infeasible_seconds(_read_bvh(p))] for p in clips
+        p: [x < INFEASIBLE_SECONDS for x in _infeasible_seconds(m)] for p, m in motions.items()
     }
     print(f"\n(windows run in {jobs} processes: real-time factors are per process)")
     with ProcessPoolExecutor(max_workers=jobs) as pool:

@@ -8,6 +8,7 @@ import json
 import math
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from reactmocap.errors import ConfigError, ReactMocapError
 from reactmocap.progress import Progress
@@ -198,20 +199,22 @@ class _SimProgress:
             self.bar.__exit__(None, None, None)
 
 
+def _simulate(
+    args: argparse.Namespace, label: str, run: Callable[..., tuple[Any, Any, Any]], **call: object
+) -> int:
+    """Read the clip, run ``run`` (``track_clip`` or ``push_clip``) on it with a progress bar
+    and the shared flags, write the outputs."""
+    motion = _read(args.clip)
+    with _SimProgress(label) as tick:
+        out, report, _ = run(motion, on_tick=tick, **call, **_kwargs(args))
+    _write_outputs(args, motion, out, report)
+    return 0
+
+
 def _track(args: argparse.Namespace) -> int:
     from reactmocap.sim.rollout import track_clip
 
-    motion = _read(args.clip)
-    with _SimProgress("track") as tick:
-        out, report, _ = track_clip(
-            motion,
-            start=args.start,
-            seconds=args.seconds,
-            on_tick=tick,
-            **_kwargs(args),  # type: ignore[arg-type]
-        )
-    _write_outputs(args, motion, out, report)
-    return 0
+    return _simulate(args, "track", track_clip, start=args.start, seconds=args.seconds)
 
 
 def _push(args: argparse.Namespace) -> int:
@@ -223,17 +226,7 @@ def _push(args: argparse.Namespace) -> int:
         raise ConfigError(f"--force must be FX,FY,FZ numbers, got {args.force!r}") from None
     if len(force) != 3:
         raise ConfigError(f"--force must have 3 components, got {len(force)}: {args.force!r}")
-    motion = _read(args.clip)
-    with _SimProgress("push") as tick:
-        out, report, _ = push_clip(
-            motion,
-            time=args.time,
-            body=args.body,
-            force=force,
-            duration=args.duration,
-            seconds=args.seconds,
-            on_tick=tick,
-            **_kwargs(args),  # type: ignore[arg-type]
-        )
-    _write_outputs(args, motion, out, report)
-    return 0
+    return _simulate(
+        args, "push", push_clip, time=args.time, body=args.body, force=force,
+        duration=args.duration, seconds=args.seconds,
+    )  # fmt: skip

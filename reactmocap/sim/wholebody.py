@@ -275,7 +275,6 @@ class WholeBodyTracker:
         self.servo = servo
         self.world = world
         self.character = character
-        self.motion = motion
         self.start = float(start)
         wc = world.characters[character]
         self.wc = wc
