@@ -75,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     if args.check:
         walk = read_bvh(next(p for p in clips if "walk_normal_001" in p.name))
-        sim, _, _ = track_clip(walk, start=2.5, seconds=2.0, record_fps=walk.fps)
+        sim = track_clip(walk, start=2.5, seconds=2.0, record_fps=walk.fps).motion
         print("\n## check: the same analysis on the simulated walk (2.5-4.5 s, whole-body tracker)")
         report(sim, "walk_normal_001 simulated")
     return 0

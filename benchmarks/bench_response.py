@@ -21,7 +21,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from reactmocap.response.pipeline import run_response
+from reactmocap.response.pipeline import LibraryCache, run_response
 from reactmocap.response.scenario import load_scenario
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -54,13 +54,14 @@ def main() -> None:
     print(
         f"{'scenario':18s} " + " ".join(f"{s:>7s}" for s in STAGES) + "   steps  bare_s  sim/bare"
     )
+    cache = LibraryCache()
     for path in paths:
         sc = load_scenario(path)
-        run_response(sc)  # warm: index and library caches
+        run_response(sc, cache)  # warm: index and library caches
         rows = []
         ratio = []
         for _ in range(args.repeats):
-            res = run_response(sc)
+            res = run_response(sc, cache)
             t = res.report["timings_s"]
             rows.append([t[s] for s in STAGES])
             steps = res.report["steps"]["sim1"] + res.report["steps"]["sim2"]

@@ -41,70 +41,9 @@ SHARED = ROOT / ".." / "shared" / "mocap"
 
 
 def _read_bvh(path: Path) -> Motion:
-    try:
-        from reactmocap.library.bvh import read_bvh
-    except ImportError:  # until the library's reader lands: a minimal Y-up cm reader
-        return _fallback_read_bvh(path)
+    from reactmocap.library.bvh import read_bvh
+
     return read_bvh(path)
-
-
-def _fallback_read_bvh(path: Path) -> Motion:
-    from reactmocap.conventions import axes_to_z_up
-    from reactmocap.library.skeleton import BVHLayout, Skeleton
-    from reactmocap.rotations import quat_from_euler, quat_mul
-
-    toks = path.read_text().split()
-    i, names, parents, offs, chans, stack, ends, cur = 0, [], [], [], [], [], {}, -1
-    while toks[i] != "MOTION":
-        t = toks[i]
-        if t in ("ROOT", "JOINT"):
-            names.append(toks[i + 1])
-            parents.append(stack[-1] if stack else -1)
-            cur = len(names) - 1
-            i += 2
-        elif t == "End":
-            ends[stack[-1]] = [float(x) for x in toks[i + 4 : i + 7]]
-            i += 8
-        elif t == "{":
-            stack.append(cur)
-            i += 1
-        elif t == "}":
-            stack.pop()
-            i += 1
-        elif t == "OFFSET":
-            offs.append([float(x) for x in toks[i + 1 : i + 4]])
-            i += 4
-        elif t == "CHANNELS":
-            n = int(toks[i + 1])
-            chans.append(tuple(toks[i + 2 : i + 2 + n]))
-            i += 2 + n
-        else:
-            i += 1
-    nf, ft = int(toks[i + 2]), float(toks[i + 5])
-    data = np.array(toks[i + 6 :], float).reshape(nf, -1)
-    r, s = axes_to_z_up("y"), 0.01
-    off = np.array(offs) @ r.T * s
-    qr = np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0])
-    qri = qr * np.array([1.0, -1.0, -1.0, -1.0])
-    rot = np.zeros((nf, len(names), 4))
-    trans = np.zeros((nf, len(names), 3))
-    c = 0
-    for j, ch in enumerate(chans):
-        pos = [k for k, n in enumerate(ch) if n.endswith("position")]
-        rk = [k for k, n in enumerate(ch) if n.endswith("rotation")]
-        d = data[:, c : c + len(ch)]
-        c += len(ch)
-        q = quat_from_euler(np.radians(d[:, rk]), "".join(ch[k][0] for k in rk))
-        rot[:, j] = quat_mul(quat_mul(qr, q), qri)
-        trans[:, j] = (d[:, pos] @ r.T * s) if pos else off[j]
-    layout = BVHLayout(
-        channels=tuple(chans),
-        unit="cm",
-        up="y",
-        end_sites={k: tuple(np.array(v) @ r.T * s) for k, v in ends.items()},
-    )
-    skel = Skeleton(tuple(names), np.array(parents), off, layout)
-    return Motion(skel, 1.0 / ft, trans[:, 0], rot, trans, name=path.stem)
 
 
 def _time_steps(world: World, servo: PDServo | None, n: int) -> float:
@@ -146,7 +85,7 @@ def bench_steps(n: int) -> None:
     world = World(ch)
     world.set_from_motion(0, guard, 0, velocity=False)
     servo = PDServo(world, kp=4000.0)
-    rollout(world, 0.1, servo=servo)  # settle on the feet
+    rollout(world, 0.1)  # settle on the feet
     pd, bare = _paired(world, servo, n)
     print(
         f"{'1 char standing, PD':<34} {pd:8.1f} {bare:8.1f} {100 * (pd / bare - 1):8.1f}% "
@@ -166,7 +105,7 @@ def bench_steps(n: int) -> None:
     world.set_from_motion(0, guard, 0, velocity=False)
     world.set_from_motion(1, b, 0, velocity=False)
     servo = PDServo(world, kp=4000.0)
-    rollout(world, 0.05, servo=servo)
+    rollout(world, 0.05)
     from reactmocap.sim import contact_report
 
     ncc = len(contact_report(world).between)
@@ -191,7 +130,7 @@ def bench_options(n: int) -> None:
                 kp = 400.0 if integ == "rk4" else 4000.0  # RK4 damping is explicit
                 servo = PDServo(world, kp=kp)
                 try:
-                    rollout(world, 0.05, servo=servo)
+                    rollout(world, 0.05)
                     pd, bare = _paired(world, servo, n, reps=3)
                     print(
                         f"{integ:<13} {solver:<7} {cone:<10} PD {pd:7.1f}  bare {bare:7.1f}"
@@ -225,21 +164,17 @@ def _track_window(
 ) -> tuple[bool, bool, float, float, float, float] | str:
     """One window: (ok, upright, max root error m, max angle rad, mean joint error rad,
     wall seconds per simulated second), or the error message."""
-    from reactmocap.sim.rollout import _errors
-
     path, s, controller, assist = job
     motion = _read_bvh(path)
     secs = min(1.0, motion.duration - s)
     try:
-        _, rep, res = track_clip(
+        res = track_clip(
             motion, start=float(s), seconds=secs, root_assist=assist, controller=controller
         )
     except Exception as exc:
         return f"{path.name} @ {s:.1f}s failed: {exc}"
-    # recompute per-frame errors for the window criterion
-    world = World(build_character(motion, frame=round(s * motion.fps)))
-    err = _errors(world, res, motion, float(s))
-    ang = float(np.max(err["root_ang_series"]))  # type: ignore[call-overload]
+    rep = res.report
+    ang = float(np.max(res.errors.angle))
     ok = (not rep.fell) and rep.max_root_error_m <= 0.10 and ang <= np.radians(15.0)
     return ok, not rep.fell, rep.max_root_error_m, ang, rep.mean_joint_error_rad, rep.wall_s / secs
 
@@ -310,10 +245,10 @@ def bench_guard(kp: float, assist_gain: float) -> None:
     loop = Motion.concatenate([guard, guard.slice(1), guard.slice(1)], name="guard_x3")
     runs = [(c, 0.0) for c in ("pd", "balance", "wholebody", "predictive")]
     for controller, assist in [*runs, ("pd", assist_gain)]:
-        _, rep, _ = track_clip(
+        rep = track_clip(
             loop, seconds=10.0, kp=None if controller in ("wholebody", "predictive") else kp,
             root_assist=assist, controller=controller,
-        )  # fmt: skip
+        ).report  # fmt: skip
         label = f"root assist kp={assist:g}" if assist else controller
         print(
             f"\n## guard 10 s ({label}): fell={rep.fell} (at {rep.fall_time}), "

@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from reactmocap.errors import ConfigError, ReactMocapError
+from reactmocap.errors import ConfigError
 from reactmocap.progress import Progress
 
 __all__ = ["register"]
@@ -85,20 +85,20 @@ def _feasibility(args: argparse.Namespace) -> int:
     return 0
 
 
+#: the controllers ``track`` and ``push`` offer (the registry's tracking controllers)
+TRACKERS = ("wholebody", "predictive", "balance", "pd")
+
+
 def _common(p: argparse.ArgumentParser) -> None:
-    from reactmocap.sim.rollout import TRACKING_CONTROLLERS
+    from reactmocap.sim.controllers import controller_help
 
     p.add_argument(
         "--controller",
         default="wholebody",
-        help="tracking controller: "
-        + "; ".join(f"{k}: {v.description}" for k, v in TRACKING_CONTROLLERS.items())
-        + " (default: wholebody)",
+        help="tracking controller (default: wholebody): " + controller_help(TRACKERS),
     )
-    p.add_argument(
-        "--kp", type=float, help="joint stiffness (1/s^2; default 1000 wholebody, 4000 PD)"
-    )
-    p.add_argument("--kv", type=float, help="joint damping (1/s; default critical)")
+    p.add_argument("--kp", type=float, help="joint stiffness (1/s^2; default: the controller's)")
+    p.add_argument("--kv", type=float, help="joint damping (1/s; default: critical)")
     p.add_argument("--friction", type=float, default=1.0, help="ground friction coefficient")
     p.add_argument("--fps", type=float, default=60.0, help="output frame rate")
     p.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
@@ -111,10 +111,8 @@ def _common(p: argparse.ArgumentParser) -> None:
 
 
 def _read(path: Path):  # type: ignore[no-untyped-def]
-    try:
-        from reactmocap.library.bvh import read_bvh
-    except ImportError:
-        raise ReactMocapError("BVH reading is not available (reactmocap.library.bvh)") from None
+    from reactmocap.library.bvh import read_bvh
+
     return read_bvh(path)
 
 
@@ -199,26 +197,24 @@ class _SimProgress:
             self.bar.__exit__(None, None, None)
 
 
-def _simulate(
-    args: argparse.Namespace, label: str, run: Callable[..., tuple[Any, Any, Any]], **call: object
-) -> int:
+def _simulate(args: argparse.Namespace, label: str, run: Callable[..., Any], **call: object) -> int:
     """Read the clip, run ``run`` (``track_clip`` or ``push_clip``) on it with a progress bar
     and the shared flags, write the outputs."""
     motion = _read(args.clip)
     with _SimProgress(label) as tick:
-        out, report, _ = run(motion, on_tick=tick, **call, **_kwargs(args))
-    _write_outputs(args, motion, out, report)
+        result = run(motion, on_tick=tick, **call, **_kwargs(args))
+    _write_outputs(args, motion, result.motion, result.report)
     return 0
 
 
 def _track(args: argparse.Namespace) -> int:
-    from reactmocap.sim.rollout import track_clip
+    from reactmocap.sim.tracking import track_clip
 
     return _simulate(args, "track", track_clip, start=args.start, seconds=args.seconds)
 
 
 def _push(args: argparse.Namespace) -> int:
-    from reactmocap.sim.rollout import push_clip
+    from reactmocap.sim.tracking import push_clip
 
     try:
         force = [float(x) for x in args.force.split(",")]

@@ -64,8 +64,15 @@ class ResponseConfig:
     """The paper's defaults (Zordan et al. 2005), each overridable from ``[response]``."""
 
     reaction_delay: float = 0.15  # s, human reaction time 0.1-0.2 s
-    kp: float = 4000.0  # 1/s^2, inertia-scaled stiffness
-    kv: float = 126.0  # 1/s, inertia-scaled damping (critical: 2 sqrt(kp))
+    #: the recipient's controller in Simulation 1 and 2, and the attacker's in both (keys of
+    #: ``reactmocap.sim.controllers.CONTROLLERS``); the paper's PD servo by default
+    sim1_controller: str = "pd"
+    sim2_controller: str = "pd"
+    attacker_controller: str = "pd"
+    #: joint stiffness (1/s^2) and damping (1/s) of those controllers; unset: each
+    #: controller's own default (the registry's table; ``pd``: kp 4000, kv critical)
+    kp: float | None = None
+    kv: float | None = None
     friction_sim1: float = 1.0
     friction_sim2: float = 0.5
     sim1_mode: Literal["passive", "holding"] = "holding"
@@ -132,6 +139,13 @@ class _Reader:
             raise self.fail(where, f"expected a list of {n} numbers, got {value!r}")
         return tuple(self.number(f"{where}[{i}]", v) for i, v in enumerate(value))
 
+    def controller(self, where: str, value: Any) -> str:
+        from reactmocap.sim.controllers import CONTROLLERS
+
+        if value not in CONTROLLERS:
+            raise self.fail(where, f"expected one of {sorted(CONTROLLERS)}, got {value!r}")
+        return str(value)
+
     def string(self, where: str, value: Any) -> str:
         if not isinstance(value, str) or not value:
             raise self.fail(where, f"expected a non-empty string, got {value!r}")
@@ -151,6 +165,8 @@ class _Reader:
             ftype = str(defaults[name].type)
             if name == "clip" or name == "body":
                 kwargs[name] = self.string(where, value)
+            elif name.endswith("_controller"):
+                kwargs[name] = self.controller(where, value)
             elif name == "sim1_mode":
                 if value not in SIM1_MODES:
                     raise self.fail(where, f"expected one of {list(SIM1_MODES)}, got {value!r}")

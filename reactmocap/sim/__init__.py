@@ -1,14 +1,33 @@
-"""Physics simulation on MuJoCo: the character built from a skeleton, the world, the
-inertia-scaled PD servo, balance and whole-body tracking controllers, impacts and contacts,
-rollouts, and Motion <-> state conversion."""
+"""Physics simulation on MuJoCo: the character built from a skeleton, the world and its servo,
+the engine (:func:`rollout`), controllers and their registry, impacts and contacts, tracking,
+and Motion <-> state conversion."""
 
-from reactmocap.sim.balance import StanceBalance
 from reactmocap.sim.character import (
     BALL_JOINTS,
     BODY_ALIASES,
     SIM_BODIES,
     Character,
     build_character,
+    qvel_from_qpos,
+)
+from reactmocap.sim.controllers import (
+    CONTROLLERS,
+    Controller,
+    ControllerSpec,
+    FunctionController,
+    Group,
+    Passive,
+    PDTracker,
+    PredictiveTracker,
+    RootAssist,
+    StanceBalance,
+    State,
+    StateMachine,
+    WholeBodyPlan,
+    WholeBodyTracker,
+    build,
+    controller_help,
+    controller_spec,
 )
 from reactmocap.sim.feasibility import SupportFeasibility, support_feasibility
 from reactmocap.sim.impacts import (
@@ -20,66 +39,71 @@ from reactmocap.sim.impacts import (
     contact_report,
     first_contact,
 )
-from reactmocap.sim.pd import PDServo, critical_kv
-from reactmocap.sim.predictive import PredictiveTracker
+from reactmocap.sim.reference import ClipClock, ReferencePath, reference_path
 from reactmocap.sim.retarget import Retargeter, retarget
-from reactmocap.sim.rollout import (
-    TRACKING_CONTROLLERS,
-    MotionTracker,
-    RolloutResult,
-    RootAssist,
-    TrackingController,
+from reactmocap.sim.rollout import ContactLog, RolloutResult, rollout
+from reactmocap.sim.servo import PDServo, critical_kv
+from reactmocap.sim.tracking import (
+    TrackErrors,
     TrackReport,
+    TrackResult,
     push_clip,
-    rollout,
     track_clip,
-    tracking_controller,
-)
-from reactmocap.sim.wholebody import (
-    ReferencePath,
-    WholeBodyPlan,
-    WholeBodyTracker,
-    reference_path,
+    tracking_errors,
 )
 from reactmocap.sim.world import PREFIXES, World, WorldCharacter, WorldConfig
 
 __all__ = [
     "BALL_JOINTS",
     "BODY_ALIASES",
+    "CONTROLLERS",
     "PREFIXES",
     "SIM_BODIES",
-    "TRACKING_CONTROLLERS",
     "Character",
     "CharacterContact",
+    "ClipClock",
+    "ContactLog",
     "ContactReport",
+    "Controller",
+    "ControllerSpec",
+    "FunctionController",
+    "Group",
     "Impact",
     "ImpactSchedule",
     "KinematicContact",
-    "MotionTracker",
     "PDServo",
+    "PDTracker",
+    "Passive",
     "PredictiveTracker",
     "ReferencePath",
-    "RolloutResult",
     "Retargeter",
+    "RolloutResult",
     "RootAssist",
     "StanceBalance",
+    "State",
+    "StateMachine",
     "SupportFeasibility",
+    "TrackErrors",
     "TrackReport",
-    "TrackingController",
-    "World",
-    "WorldCharacter",
+    "TrackResult",
     "WholeBodyPlan",
     "WholeBodyTracker",
+    "World",
+    "WorldCharacter",
     "WorldConfig",
+    "build",
     "build_character",
     "contact_report",
+    "controller_help",
+    "controller_spec",
     "critical_kv",
     "first_contact",
     "push_clip",
+    "qvel_from_qpos",
     "reference_path",
     "retarget",
     "rollout",
     "support_feasibility",
     "track_clip",
-    "tracking_controller",
+    "tracking_errors",
 ]

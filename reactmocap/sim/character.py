@@ -1,34 +1,9 @@
-"""The physics character: a 51-DOF MuJoCo body built from any mapped Skeleton, and the exact
-mapping between Motion frames and MuJoCo state.
-
-Structure (as in Zordan et al. 2005, section 5): a free root at the pelvis and 15 ball joints:
-waist, back, neck, shoulders, elbows, wrists, hips, knees, ankles (6 + 15 * 3 = 51 DOF). The 16
-bodies are named by the canonical body parts of :mod:`reactmocap.library.bodyparts`:
-``pelvis, waist, chest, head, {l,r}_{upper_arm, forearm, hand, thigh, shin, foot}`` (the aliases
-``abdomen``, ``thorax`` and ``neck`` are accepted wherever a body is looked up).
-
-Frames, and why the mapping is exact: every sim body's frame *is* the global frame of one
-skeleton joint (its *anchor*: the joint that rotates that segment) in a reference pose. A ball
-joint's quaternion is then ``q = R0^-1 * G_parent^-1 * G_anchor`` (``R0`` the body's rest
-rotation relative to its parent body), so skeleton joints that are not simulated (a dummy root
-above the hips, clavicles, twist bones, toes, fingers) are simply in-between rotations that get
-folded. Positions are exact as long as the folded joints hold their reference-pose rotation;
-:meth:`Character.check_fk` measures that for any frame and explains any disagreement.
-
-Geometry: capsules along the bones (lateral capsules for the pelvis, abdomen and thorax), a sphere
-for the head and boxes for the feet, radii from human proportions scaled by leg length. The foot
-box's sole is placed from the clip (the lowest ankle and ball heights over the reference motion,
-i.e. where the feet stand on the ground) so a standing character neither floats nor sinks.
-
-Mass: geoms carry the thesis's per-segment densities (Dempster & Gaughran, via
-:mod:`reactmocap.sim.anthropometry`). ``mass_model="table"`` (default) then rescales each body's
-density so its mass is the human segment fraction (mean of the thesis's male and female Tables
-3.1/3.2) of ``total_mass``; the inertia tensor keeps the geometry's shape. Why: our capsule radii
-are a guess per segment (a 10% radius error is 20% mass), and the segmentation of the trunk
-follows each skeleton's spine joints, which vary a lot between skeletons, while the PD servo's
-inertia scaling and every impact response depend directly on the mass distribution.
-``mass_model="geometry"`` keeps volume x density, scaled uniformly to ``total_mass``.
-"""
+"""The physics character: a 51-DOF MuJoCo body (free pelvis, 15 ball joints) built from any mapped
+Skeleton, and the exact mapping between Motion frames and MuJoCo state: every body's frame is
+the global frame of one skeleton joint in a reference pose, so joints that are not simulated are
+folded in-between rotations and :meth:`Character.check_fk` can diagnose any disagreement.
+Geometry follows human proportions scaled by leg length; segment masses follow
+:data:`reactmocap.library.anthropometry.MASS_FRACTIONS`. Details: ``docs/design.md``."""
 
 from __future__ import annotations
 
@@ -41,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import SimulationError, UnknownKeyError
+from reactmocap.library.anthropometry import MASS_FRACTIONS, PART_DENSITY
 from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import Skeleton
@@ -62,6 +38,7 @@ __all__ = [
     "PATCH_GEOM_GROUP",
     "Character",
     "build_character",
+    "qvel_from_qpos",
 ]
 
 F64 = NDArray[np.float64]
@@ -115,41 +92,16 @@ _HAND_LEN = 0.10
 BALL_PATCH_HALF_SIZE = 0.005
 #: MuJoCo geom group of the patch: hidden by the default visualisation (groups 0-2)
 PATCH_GEOM_GROUP = 3
-_DENSITY_FALLBACK = {  # kg/m^3, Dempster & Gaughran (used if anthropometry is unavailable)
-    "head": 1171.0, "chest": 1009.0, "waist": 1017.0, "pelvis": 1029.0, "thigh": 1040.0,
-    "shin": 1079.0, "foot": 1066.0, "upper_arm": 1068.0, "forearm": 1102.0, "hand": 1070.0,
-}  # fmt: skip
-# Dempster/Winter-like fractions, used only if anthropometry cannot be imported.
-_FRACTION_FALLBACK = {
-    "pelvis": 0.114, "waist": 0.119, "chest": 0.207, "head": 0.080, "upper_arm": 0.0367,
-    "forearm": 0.0164, "hand": 0.0065, "thigh": 0.123, "shin": 0.046, "foot": 0.0119,
-}  # fmt: skip
 
 
 def _kind(part: str) -> str:
     return part[2:] if part[:2] in ("l_", "r_") else part
 
 
-def _densities() -> dict[str, float]:
-    try:
-        from reactmocap.sim.anthropometry import PART_DENSITY
-
-        return {k: float(PART_DENSITY[k]) for k in _DENSITY_FALLBACK}
-    except (ImportError, KeyError):
-        return dict(_DENSITY_FALLBACK)
-
-
 def _target_fractions() -> dict[str, float]:
-    """Mass fraction per sim body: mean of the thesis's male and female tables."""
-    try:
-        from reactmocap.sim.anthropometry import SEXES, part_mass_fractions
-
-        tables = [part_mass_fractions(s) for s in SEXES]
-        out = {b: float(np.mean([t[b] for t in tables])) for b in SIM_BODIES}
-    except (ImportError, KeyError):
-        out = {b: _FRACTION_FALLBACK[_kind(b)] for b in SIM_BODIES}
-    total = sum(out.values())
-    return {b: v / total for b, v in out.items()}
+    """Mass fraction per sim body (the one table, over the bodies the character has)."""
+    total = sum(MASS_FRACTIONS[b] for b in SIM_BODIES)
+    return {b: MASS_FRACTIONS[b] / total for b in SIM_BODIES}
 
 
 def _unit(v: F64) -> F64:
@@ -159,16 +111,31 @@ def _unit(v: F64) -> F64:
     return v / n
 
 
-def _frame_quat(x: F64, y: F64) -> F64:
-    """Quaternion of the frame whose x axis is ``x`` and y axis is ``y`` (re-orthogonalised)."""
-    x = _unit(x)
-    y = _unit(y - x * float(x @ y))
-    return quat_from_matrix(np.stack([x, y, np.cross(x, y)], axis=1))
-
-
 def _perp(v: F64) -> F64:
     a = np.array([1.0, 0.0, 0.0]) if abs(v[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     return np.cross(v, a)
+
+
+def qvel_from_qpos(q: F64, fps: float) -> F64:
+    """``(T, 51)`` MuJoCo ``qvel`` of a ``(T, 67)`` qpos path sampled at ``fps`` (central
+    differences, one-sided at the ends): root linear velocity in the world, root and ball
+    angular velocities in their local frames, as ``mj_differentiatePos`` defines them."""
+    q = np.asarray(q, dtype=np.float64)
+    n = q.shape[0]
+    if n < 2:
+        return np.zeros((n, 6 + 3 * len(BALL_JOINTS)))
+    lo = np.r_[0, np.arange(n - 1)]
+    hi = np.r_[np.arange(1, n), n - 1]
+    return _differentiate(q[lo], q[hi], (hi - lo) / fps)
+
+
+def _differentiate(qa: F64, qb: F64, span: F64) -> F64:
+    """qvel taking qpos rows ``qa`` to ``qb`` in ``span`` seconds each."""
+    n = qa.shape[0]
+    lin = (qb[:, :3] - qa[:, :3]) / span[:, None]
+    rel = quat_mul(quat_conj(qa[:, 3:].reshape(n, -1, 4)), qb[:, 3:].reshape(n, -1, 4))
+    ang = quat_log(rel) / span[:, None, None]
+    return np.concatenate([lin, ang.reshape(n, -1)], axis=1)
 
 
 @dataclass(frozen=True)
@@ -220,7 +187,7 @@ class Character:
         """A fresh MjSpec of this character alone (bodies, joints, geoms; no floor, no options)."""
         spec = mujoco.MjSpec()
         spec.compiler.degree = False
-        dens = _densities()
+        dens = PART_DENSITY
         bodies: dict[str, mujoco.MjsBody] = {}
         for i, (name, parent, joint) in enumerate(_TREE):
             parent_body = spec.worldbody if parent is None else bodies[parent]
@@ -309,30 +276,19 @@ class Character:
     def qvel_from_motion(
         self, motion: Motion, frames: Sequence[int] | NDArray | None = None
     ) -> F64:
-        """``(T, 51)`` MuJoCo qvel by central finite differences (one-sided at the ends).
-
-        MuJoCo's conventions (free joint: linear velocity in world, angular velocity in the body
-        frame; ball joints: angular velocity in the child frame) come from
-        ``mj_differentiatePos``, which is their definition.
-        """
+        """``(T, 51)`` MuJoCo qvel of motion frames (:func:`qvel_from_qpos` of the frames and
+        their neighbours)."""
         self._check_motion(motion)
         n = motion.num_frames
         idx = np.arange(n) if frames is None else np.asarray(frames, int)
         if n < 2:
             return np.zeros((idx.size, 6 + 3 * len(BALL_JOINTS)))
+        if frames is None:
+            return qvel_from_qpos(self.qpos_from_motion(motion), motion.fps)
         lo = np.clip(idx - 1, 0, n - 1)
         hi = np.clip(idx + 1, 0, n - 1)
-        both = np.unique(np.concatenate([lo, idx, hi]))
-        qs = self.qpos_from_motion(motion, both)
-        where = {int(f): k for k, f in enumerate(both)}
-        m = self.model
-        out = np.zeros((idx.size, m.nv))
-        tmp = np.zeros(m.nv)
-        for r, (a, b) in enumerate(zip(lo, hi)):
-            dt = (b - a) / motion.fps
-            mujoco.mj_differentiatePos(m, tmp, dt, qs[where[int(a)]], qs[where[int(b)]])
-            out[r] = tmp
-        return out
+        q_lo, q_hi = self.qpos_from_motion(motion, lo), self.qpos_from_motion(motion, hi)
+        return _differentiate(q_lo, q_hi, (hi - lo) / motion.fps)
 
     # ------------------------------------------------------------------ state -> Motion
     def body_transforms_from_qpos(self, qpos: F64) -> tuple[F64, F64]:

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import build_character
-from reactmocap.sim.wholebody import reference_path
+from reactmocap.sim.reference import reference_path
 from reactmocap.sim.world import World
 
 __all__ = ["SupportFeasibility", "support_feasibility"]

@@ -1,20 +1,14 @@
-"""Impacts (external pushes), contact reports, and first contact between two characters during
-kinematic playback.
-
-An :class:`Impact` is a force (N) or an impulse (N s) on one body part at a point (body-local or
-world), starting at ``start`` seconds after the rollout's start and lasting ``duration``
-seconds. It is applied through MuJoCo's ``xfrc_applied``: the force at the point becomes the
-same force at the body's centre of mass plus the torque ``(p - com) x F``. The window is
-discretised to whole steps: ``n = max(1, round(duration / dt))`` steps from step
-``round(start / dt)``; an impulse ``J`` becomes the force ``J / (n dt)``, so the momentum
-delivered is exactly ``J``.
-"""
+"""Impacts (external pushes) and contacts: an :class:`Impact` is a force or an impulse on one body
+at a point; :class:`ImpactSchedule` applies a rollout's impacts through ``xfrc_applied`` with one
+lever-arm rule, recomputed every step: the force at the point becomes the same force at the
+body's centre of mass plus ``(p - com) x F``. Also contact reports and the kinematic scan for the
+first contact between two characters."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 import mujoco
@@ -120,44 +114,46 @@ class Impact:
         return np.array(self.impulse) / (self.steps(dt)[1] * dt)
 
 
-@dataclass
 class ImpactSchedule:
-    """Impacts of one rollout, resolved against a World (body ids, step windows)."""
+    """A rollout's impacts resolved against a World: body ids and step windows. A window is
+    ``n = max(1, round(duration / dt))`` steps from step ``round(start / dt)``; an impulse ``J``
+    becomes the force ``J / (n dt)``, so the momentum delivered is exactly ``J``."""
 
-    world: World
-    impacts: Sequence[Impact]
-    _rows: list[tuple[int, int, int, F64, F64 | None, str]] = field(default_factory=list)
-    _local_point: dict[int, F64] = field(default_factory=dict)
-    _touched: set[int] = field(default_factory=set)
-
-    def __post_init__(self) -> None:
-        dt = self.world.timestep
-        for k, imp in enumerate(self.impacts):
-            if imp.character >= len(self.world.characters):
+    def __init__(self, world: World, impacts: Sequence[Impact]) -> None:
+        self.world = world
+        self.impacts = tuple(impacts)
+        dt = world.timestep
+        self._rows: list[tuple[int, int, int, F64, F64 | None, str]] = []
+        for imp in self.impacts:
+            if imp.character >= len(world.characters):
                 raise ConfigError(
                     f"impact on character {imp.character}, but the world has "
-                    f"{len(self.world.characters)}"
+                    f"{len(world.characters)}"
                 )
-            bid = self.world.characters[imp.character].body_id(imp.body)
+            bid = world.characters[imp.character].body_id(imp.body)
             k0, n = imp.steps(dt)
             pt = None if imp.point is None else np.array(imp.point)
-            self._rows.append((k, bid, k0, imp.force_vector(dt), pt, imp.frame))
-            del n
+            self._rows.append((bid, k0, k0 + n, imp.force_vector(dt), pt, imp.frame))
+        self._local_point: dict[int, F64] = {}
+        self._touched: set[int] = set()
 
-    def window_end(self) -> int:
-        dt = self.world.timestep
-        return max((sum(i.steps(dt)) for i in self.impacts), default=0)
+    def event_steps(self) -> list[int]:
+        """Sorted steps at which :meth:`apply` changes ``xfrc_applied``: the ends of each window
+        (a force at the centre of mass is constant within it), and every step of a window
+        whose point moves with the body (its lever arm turns with the body)."""
+        steps: set[int] = set()
+        for _, k0, k1, _, pt, _ in self._rows:
+            steps.update((k0, k1) if pt is None else range(k0, k1 + 1))
+        return sorted(steps)
 
     def apply(self, step: int) -> None:
-        """Set xfrc_applied for rollout step ``step`` (clears bodies whose window ended)."""
+        """Set ``xfrc_applied`` for rollout step ``step`` (clears bodies whose window ended)."""
         d = self.world.data
-        dt = self.world.timestep
         for bid in self._touched:
             d.xfrc_applied[bid] = 0.0
         self._touched.clear()
-        for k, bid, k0, force, pt, frame in self._rows:
-            n = self.impacts[k].steps(dt)[1]
-            if not k0 <= step < k0 + n:
+        for k, (bid, k0, k1, force, pt, frame) in enumerate(self._rows):
+            if not k0 <= step < k1:
                 continue
             rot = d.xmat[bid].reshape(3, 3)
             if pt is None:
@@ -212,27 +208,10 @@ def _t3(v: object) -> tuple[float, float, float]:
     return (float(a[0]), float(a[1]), float(a[2]))
 
 
-def _owner(world: World) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """Per geom: character index (-1 for the floor) and sim-body index."""
-    m = world.model
-    char = np.full(m.ngeom, -1, dtype=np.int64)
-    body = np.full(m.ngeom, -1, dtype=np.int64)
-    for wc in world.characters:
-        for i, bid in enumerate(wc.body_ids):
-            sel = m.geom_bodyid == bid
-            char[sel] = wc.index
-            body[sel] = i
-    return char, body
-
-
 def contact_report(world: World) -> ContactReport:
     """Who touches what, with forces (``mj_contactForce``), for the current state."""
     m, d = world.model, world.data
-    owner = getattr(world, "_geom_owner", None)
-    if owner is None:
-        owner = _owner(world)
-        world._geom_owner = owner  # type: ignore[attr-defined]
-    char, body = owner
+    char, body = world.geom_character, world.geom_body
     nchar = len(world.characters)
     ground: list[set[str]] = [set() for _ in range(nchar)]
     gforce = np.zeros((nchar, 3))
@@ -309,7 +288,7 @@ def first_contact(
     qs = [
         wc.character.qpos_from_motion(mo.sample(times)) for wc, mo in zip(world.characters, motions)
     ]
-    char, body = _owner(world)
+    char, body = world.geom_character, world.geom_body
     old_margin = m.geom_margin.copy()
     m.geom_margin[:] = max(margin, 0.0)
     try:

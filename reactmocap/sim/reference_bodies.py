@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import UnknownKeyError
-from reactmocap.sim.anthropometry import SEXES, listing_body_part
+from reactmocap.library.anthropometry import SEXES, listing_body_part
 
 __all__ = [
     "ListingBody",

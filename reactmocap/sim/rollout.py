@@ -1,9 +1,14 @@
-"""Rollouts: run a World for a duration with a controller callback, record body transforms at
-an output rate as Motions on the original skeletons, detect instability; plus the two
-high-level operations behind the CLI, :func:`track_clip` and :func:`push_clip`.
+"""The simulation engine: the one stepping loop behind tracking, pushes, both passes of the
+response pipeline and the athletic controllers.
 
-Determinism: MuJoCo is deterministic on one thread and nothing here draws random numbers or
-depends on wall-clock time, so the same inputs give bit-identical outputs.
+Each step: the controllers that tick (every ``control_every`` steps, ``t`` seconds since the
+rollout started), the impacts (:class:`~reactmocap.sim.impacts.ImpactSchedule`), the physics
+step. States are recorded at exact output frame times (frame ``k`` of a rate ``fps`` is the
+state after ``round(k / (fps dt))`` steps; frame 0 is the initial state), contacts between
+characters are logged, and instability (NaN, runaway kinetic energy) either raises or ends the
+rollout with a partial result. MuJoCo steps in chunks (``mj_step(nstep=k)``) between the steps
+where something happens, each event at the same step as one step at a time. MuJoCo is
+deterministic on one thread and nothing here draws random numbers: same inputs, same outputs.
 """
 
 from __future__ import annotations
@@ -11,581 +16,364 @@ from __future__ import annotations
 import time as _time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Literal
 
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.errors import ConfigError, SimulationError, UnknownKeyError
+from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from reactmocap.sim.balance import StanceBalance
-from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, SIM_PARENTS, build_character
-from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, _t3, contact_report
-from reactmocap.sim.pd import PDServo, critical_kv
-from reactmocap.sim.predictive import PredictiveTracker
-from reactmocap.sim.wholebody import WholeBodyTracker, hemisphere_continuous
-from reactmocap.sim.world import World, WorldConfig
+from reactmocap.sim.character import SIM_BODIES
+from reactmocap.sim.controllers.base import Controller
+from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, contact_report
+from reactmocap.sim.world import World
 
-__all__ = [
-    "TRACKING_CONTROLLERS",
-    "WHOLEBODY_SERVO_KV",
-    "MotionTracker",
-    "RolloutResult",
-    "RootAssist",
-    "TrackReport",
-    "TrackingController",
-    "push_clip",
-    "rollout",
-    "track_clip",
-    "tracking_controller",
-]
+__all__ = ["ContactLog", "RolloutResult", "rollout"]
 
 F64 = NDArray[np.float64]
-Controller = Callable[[World, float], None]
-NJ = len(BALL_JOINTS)
+I64 = NDArray[np.int64]
+Status = Literal["ok", "unstable"]
+
+
+@dataclass(frozen=True)
+class ContactLog:
+    """Contacts between characters, sampled every ``period`` seconds while any exist:
+    ``times`` ``(n,)`` seconds from the rollout's start, ``normal`` ``(n,)`` the summed normal
+    force between characters (N), ``force`` ``(n, 3)`` the world force on character 0 from the
+    others (N), ``depth`` ``(n,)`` the deepest interpenetration between characters (m)."""
+
+    times: F64
+    normal: F64
+    force: F64
+    depth: F64
+    period: float
+
+    @property
+    def empty(self) -> bool:
+        return self.times.size == 0
+
+    @property
+    def impulse(self) -> F64:
+        """``(3,)`` world impulse on character 0 from the others (N s), by the rectangle rule."""
+        return self.force.sum(axis=0) * self.period
+
+    @property
+    def peak_force(self) -> float:
+        return float(self.normal.max()) if self.normal.size else 0.0
 
 
 @dataclass
 class RolloutResult:
-    """What a rollout recorded. ``times`` are seconds from the rollout's start; ``body_pos``
-    ``(C, T, 16, 3)`` and ``body_quat`` ``(C, T, 16, 4)`` world transforms per character;
-    ``motions`` the same as Motions on each character's original skeleton."""
+    """What a rollout recorded: ``qpos`` ``(R, nq)`` after each of ``record_steps`` ``(R,)``
+    step counts, for the frame rates ``fps`` (the first is the primary rate); ``status``
+    ``"ok"`` or ``"unstable"`` (with ``reason``; then the records stop at the last stable
+    frame); ``seconds`` simulated; ``contacts``: a report per primary frame when asked for;
+    ``references``: per character the motion its non-simulated joints come from, sampled at
+    ``reference_starts + t``."""
 
-    times: F64
-    body_pos: F64
-    body_quat: F64
-    motions: list[Motion]
+    world: World
+    fps: tuple[float, ...]
+    qpos: F64
+    record_steps: I64
+    duration: float
     steps: int
+    seconds: float
     wall_s: float
+    status: Status = "ok"
+    reason: str | None = None
     contacts: list[ContactReport] = field(default_factory=list)
+    contact_log: ContactLog | None = None
     final_state: F64 | None = None
+    references: tuple[Motion | None, ...] = ()
+    reference_starts: tuple[float, ...] = ()
+    #: MuJoCo's warnings during the rollout (caught, not printed)
+    warnings: tuple[str, ...] = ()
+
+    def frames(self, fps: float | None = None) -> tuple[F64, F64]:
+        """Frame times ``(T,)`` (seconds from the start) and qpos rows ``(T, nq)`` at ``fps``
+        (default: the primary rate; it must be one of the recorded rates)."""
+        rate = self.fps[0] if fps is None else float(fps)
+        if rate not in self.fps:
+            raise ConfigError(f"rate {rate} fps was not recorded (recorded: {self.fps})")
+        steps = _frame_steps(self.duration, rate, self.world.timestep)
+        steps = steps[np.isin(steps, self.record_steps)]  # a prefix: records stop, never skip
+        rows = np.searchsorted(self.record_steps, steps)
+        return np.arange(steps.size) / rate, self.qpos[rows]
+
+    @property
+    def times(self) -> F64:
+        return self.frames()[0]
+
+    def body_transforms(self, character: int, fps: float | None = None) -> tuple[F64, F64]:
+        """World positions ``(T, 16, 3)`` and rotations ``(T, 16, 4)`` of a character's bodies."""
+        wc = self.world.characters[character]
+        _, q = self.frames(fps)
+        return wc.character.body_transforms_from_qpos(q[:, wc.qpos_slice])
+
+    def motion(self, character: int, fps: float | None = None, name: str | None = None) -> Motion:
+        """A character's recorded states as a Motion on its own skeleton; joints that are not
+        simulated come from its reference motion (given to :func:`rollout`), if any."""
+        wc = self.world.characters[character]
+        times, q = self.frames(fps)
+        rate = self.fps[0] if fps is None else float(fps)
+        ref = self.references[character] if character < len(self.references) else None
+        start = self.reference_starts[character] if ref is not None else 0.0
+        return wc.character.motion_from_qpos(
+            q[:, wc.qpos_slice], rate, ref, times + start if ref is not None else None,
+            name=name or f"sim_{wc.prefix.rstrip('/')}",
+        )  # fmt: skip
+
+    @property
+    def motions(self) -> list[Motion]:
+        return [self.motion(c) for c in range(len(self.world.characters))]
 
 
-class MotionTracker:
-    """Controller that makes a servo follow a Motion: at rollout time ``t`` the targets are the
-    motion's ball-joint rotations at ``start + t`` (normalised linear blend of the two
-    neighbouring frames, hemisphere-aligned: within 0.2% of slerp at 30 fps)."""
-
-    def __init__(self, servo: PDServo, character: int, motion: Motion, start: float = 0.0) -> None:
-        self.servo = servo
-        self.character = character
-        self.motion = motion
-        self.start = float(start)
-        ch = servo.world.characters[character].character
-        q = ch.qpos_from_motion(motion)[:, 7:].reshape(motion.num_frames, NJ, 4)
-        # hemisphere continuity in time so the blend takes the short way
-        self.quats = hemisphere_continuous(q)
-        self._buf = np.empty((NJ, 4))
-
-    def targets_at(self, t: float) -> F64:
-        x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
-        i0 = int(x)
-        i1 = min(i0 + 1, self.motion.num_frames - 1)
-        a = x - i0
-        np.multiply(self.quats[i0], 1.0 - a, out=self._buf)
-        self._buf += a * self.quats[i1]
-        return self._buf
-
-    def __call__(self, world: World, t: float) -> None:
-        self.servo.set_targets(self.character, self.targets_at(t))
+def _frame_steps(duration: float, fps: float, dt: float) -> I64:
+    """Step counts of the frames ``k / fps`` within ``duration``."""
+    n = int(np.floor(duration * fps + 1e-9)) + 1
+    return np.round(np.arange(n) / (fps * dt)).astype(np.int64)
 
 
-class RootAssist:
-    """Optional, NON-PHYSICAL root stabilisation ("hand of god"): an external PD wrench on the
-    pelvis toward the mocap pelvis, ``F = M (kp (p_d - p) - kv (v - v_d))``,
-    ``tau = I_c (kp e - kv w)``
-    with ``M`` the character's mass and ``I_c`` its composite inertia about the pelvis.
-    Off unless asked for; reports must say when it was used."""
+class _Guard:
+    """Instability detection: non-finite state, or kinetic energy per kg above a limit."""
 
-    def __init__(
-        self,
-        world: World,
-        character: int,
-        motion: Motion,
-        start: float = 0.0,
-        kp: float = 100.0,
-        kv: float | None = None,
-    ) -> None:
-        wc = world.characters[character]
+    def __init__(self, world: World, energy_limit_per_kg: float) -> None:
+        m = world.model
         self.world = world
-        self.bid = int(wc.body_ids[0])
-        self.start = float(start)
-        self.motion = motion
-        q = wc.character.qpos_from_motion(motion)
-        self.pos = q[:, :3]
-        self.rot = q[:, 3:7]
-        # velocity feed-forward: without it a PD lags a walking pelvis by kv v / kp
-        self.vel = (
-            np.gradient(self.pos, 1.0 / motion.fps, axis=0)
-            if motion.num_frames > 1
-            else np.zeros_like(self.pos)
-        )
-        self.kp = float(kp)
-        self.kv = 2.0 * np.sqrt(kp) if kv is None else float(kv)
-        self.mass = float(world.model.body_subtreemass[self.bid])
-        self.dof = wc.dof_adr
+        self.limit = np.array(
+            [energy_limit_per_kg * float(m.body_subtreemass[wc.body_ids[0]])
+             for wc in world.characters]
+        )  # fmt: skip
 
-    def __call__(self, world: World, t: float) -> None:
-        d = world.data
-        x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
-        i = round(x)
-        p_d, q_d = self.pos[i], self.rot[i]
-        v = d.qvel[self.dof : self.dof + 3]
-        w_local = d.qvel[self.dof + 3 : self.dof + 6]
-        q = d.xquat[self.bid]
-        e = quat_log(quat_mul(quat_conj(q), q_d))  # body frame
-        inertia = 0.1 * self.mass  # ~ composite inertia about the pelvis (kg m^2), scale only
-        tau_local = inertia * (self.kp * e - self.kv * w_local)
-        rot = d.xmat[self.bid].reshape(3, 3)
-        d.xfrc_applied[self.bid, :3] = self.mass * (
-            self.kp * (p_d - d.xpos[self.bid]) - self.kv * (v - self.vel[i])
-        )
-        d.xfrc_applied[self.bid, 3:] = rot @ tau_local
+    def problem(self, t: float) -> str | None:
+        w, d = self.world, self.world.data
+        if not (np.isfinite(d.qvel).all() and np.isfinite(d.qpos).all()):
+            bad = "unknown"
+            for wc in w.characters:
+                if not (np.isfinite(d.xpos[wc.body_ids]).all() and
+                        np.isfinite(d.qvel[wc.qvel_slice]).all()):  # fmt: skip
+                    rows = np.flatnonzero(~np.all(np.isfinite(d.cvel[wc.body_ids]), axis=1))
+                    bad = wc.prefix + (SIM_BODIES[int(rows[0])] if rows.size else "pelvis")
+                    break
+            return f"simulation went unstable at t = {t:.4f} s: NaN/inf at body {bad}"
+        for wc in w.characters:
+            ke = w.kinetic_energy(wc.index)
+            if ke > self.limit[wc.index]:
+                speeds = np.linalg.norm(d.cvel[wc.body_ids, 3:], axis=1)
+                body = SIM_BODIES[int(np.argmax(speeds))]
+                return (
+                    f"simulation went unstable at t = {t:.4f} s: kinetic energy of character "
+                    f"{wc.index} is {ke:.0f} J (limit {self.limit[wc.index]:.0f} J); fastest "
+                    f"body {wc.prefix}{body} at {speeds.max():.1f} m/s"
+                )
+        return None
 
 
-def _record(world: World, pos: F64, quat: F64, k: int) -> None:
-    d = world.data
-    for c, wc in enumerate(world.characters):
-        pos[c, k] = d.xpos[wc.body_ids]
-        quat[c, k] = d.xquat[wc.body_ids]
+class _ContactLogger:
+    def __init__(self, world: World) -> None:
+        self.world = world
+        self.rows: list[tuple[float, float, F64, float]] = []
+        self._f6 = np.zeros(6)
+
+    def log(self, t: float) -> None:
+        w = self.world
+        m, d = w.model, w.data
+        n = d.ncon
+        if n == 0:
+            return
+        geoms = d.contact.geom[:n]
+        own = w.geom_character[geoms]
+        between = np.flatnonzero((own[:, 0] >= 0) & (own[:, 1] >= 0) & (own[:, 0] != own[:, 1]))
+        if not between.size:
+            return
+        total = 0.0
+        force = np.zeros(3)
+        for i in between:  # a handful of contacts, only while the characters touch
+            mujoco.mj_contactForce(m, d, int(i), self._f6)
+            total += abs(self._f6[0])
+            fw = d.contact.frame[i].reshape(3, 3).T @ self._f6[:3]  # on geom2 from geom1
+            if own[i, 1] == 0:
+                force += fw
+            elif own[i, 0] == 0:
+                force -= fw
+        depth = float(max(0.0, -d.contact.dist[between].min()))
+        self.rows.append((t, total, force, depth))
+
+    def result(self, period: float) -> ContactLog:
+        if not self.rows:
+            z = np.zeros(0)
+            return ContactLog(z, z, np.zeros((0, 3)), z, period)
+        t, f, v, dep = zip(*self.rows)
+        return ContactLog(np.array(t), np.array(f), np.array(v), np.array(dep), period)
 
 
-def _impact_steps(impacts: Sequence[Impact], dt: float) -> list[int]:
-    """Sorted steps at which ImpactSchedule.apply changes xfrc_applied: the ends of each window
-    (a force at the centre of mass, or ``point=None``, is constant within it), and every step
-    of a window whose point moves with the body (its torque arm turns with the body)."""
-    steps: set[int] = set()
-    for imp in impacts:
-        k0, n = imp.steps(dt)
-        steps.update((k0, k0 + n) if imp.point is None else range(k0, k0 + n + 1))
-    return sorted(steps)
+@dataclass
+class _Plan:
+    """What one rollout does at which step (built once, read by the loop)."""
 
-
-def _check(world: World, t: float, ke_limit: F64) -> None:
-    d, m = world.model, world.data
-    del d
-    qv = m.qvel
-    if not (np.all(np.isfinite(qv)) and np.all(np.isfinite(m.qpos))):
-        bad = "unknown"
-        for wc in world.characters:
-            xp = m.xpos[wc.body_ids]
-            v = qv[wc.qvel_slice]
-            if not np.all(np.isfinite(xp)) or not np.all(np.isfinite(v)):
-                rows = np.flatnonzero(~np.all(np.isfinite(m.cvel[wc.body_ids]), axis=1))
-                body = SIM_BODIES[int(rows[0])] if rows.size else "pelvis"
-                bad = f"{wc.prefix}{body}"
-                break
-        raise SimulationError(f"simulation went unstable at t = {t:.4f} s: NaN/inf at body {bad}")
-    for wc in world.characters:
-        ke = world.kinetic_energy(wc.index)
-        if ke > ke_limit[wc.index]:
-            speeds = np.linalg.norm(m.cvel[wc.body_ids, 3:], axis=1)
-            body = SIM_BODIES[int(np.argmax(speeds))]
-            raise SimulationError(
-                f"simulation went unstable at t = {t:.4f} s: kinetic energy of character "
-                f"{wc.index} is {ke:.0f} J (limit {ke_limit[wc.index]:.0f} J); fastest body "
-                f"{wc.prefix}{body} at {speeds.max():.1f} m/s"
-            )
+    nsteps: int
+    controllers: Sequence[Controller]
+    schedule: ImpactSchedule | None
+    events: I64  # steps where impacts change, records are taken or checks made
+    periods: list[int]  # control, contact-log and progress periods (steps)
+    rec_steps: I64
+    primary: set[int]
+    check_every: int
+    logger: _ContactLogger | None
+    contact_every: int
+    on_tick: Callable[[float], None] | None
+    tick_every: int
+    record_contacts: bool
 
 
 def rollout(
     world: World,
     duration: float,
     *,
-    servo: PDServo | None = None,
     controllers: Sequence[Controller] = (),
-    control_every: int = 4,
     impacts: Sequence[Impact] = (),
-    record_fps: float = 60.0,
-    references: Sequence[Motion | None] | None = None,
-    reference_start: float = 0.0,
+    record_fps: float | Sequence[float] = 60.0,
+    references: Sequence[Motion | None] = (),
+    reference_start: float | Sequence[float] = 0.0,
     record_contacts: bool = False,
+    contact_every: int | None = None,
     energy_limit_per_kg: float = 100.0,
     check_every: int = 20,
+    on_unstable: Literal["raise", "stop"] = "raise",
+    on_tick: Callable[[float], None] | None = None,
+    tick_every: int = 100,
 ) -> RolloutResult:
-    """Run ``duration`` seconds from the world's current state.
+    """Run ``duration`` seconds from the world's current state (see the module docstring).
 
-    Each step: controllers (every ``control_every`` steps, called as ``f(world, t)`` with
-    ``t`` seconds since the rollout started), impacts into ``xfrc_applied``, the servo, the
-    physics step. Body transforms are recorded at ``record_fps`` (frame 0 = the initial state).
-    ``references[c]`` supplies character c's non-simulated joints, sampled at
-    ``reference_start + t``. Raises SimulationError on NaN/inf or kinetic energy above
-    ``energy_limit_per_kg`` J/kg (100 J/kg = the whole body at 14 m/s).
-
-    MuJoCo steps in chunks (``mj_step(nstep=k)``, through :meth:`PDServo.step` with a servo)
-    between the steps where something happens: control ticks, impact windows (every step of
-    a window whose force point moves with the body, its ends otherwise), records and energy
-    checks, each at the same step as one step at a time.
+    Args:
+        controllers: reset once, then ticked every ``control_every`` steps each, in order.
+        impacts: pushes, their ``start`` relative to the rollout's start.
+        record_fps: output frame rate(s); the first is the primary one.
+        references: per character, the motion whose non-simulated joints the recorded
+            Motions take, sampled at ``reference_start + t``.
+        record_contacts: a :class:`ContactReport` per primary frame.
+        contact_every: log contacts between characters every this many steps.
+        energy_limit_per_kg: kinetic energy (J/kg) taken as unstable (100: the whole body at
+            14 m/s); checked with finiteness every ``check_every`` steps and at every frame.
+        on_unstable: ``"raise"`` a SimulationError, or ``"stop"`` and return what was recorded
+            with ``status = "unstable"``. MuJoCo's own warnings join the reason.
+        on_tick: called with ``t`` every ``tick_every`` steps (a progress bar).
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ConfigError(f"duration must be > 0 s, got {duration!r}")
-    if not (np.isfinite(record_fps) and record_fps > 0):
+    rates = (record_fps,) if isinstance(record_fps, int | float) else tuple(record_fps)
+    if not rates or not all(np.isfinite(r) and r > 0 for r in rates):
         raise ConfigError(f"record_fps must be > 0, got {record_fps!r}")
-    if control_every < 1 or check_every < 1:
-        raise ConfigError("control_every and check_every must be >= 1")
-    m, d = world.model, world.data
+    if check_every < 1 or tick_every < 1 or (contact_every is not None and contact_every < 1):
+        raise ConfigError("check_every, tick_every and contact_every must be >= 1")
+    if on_unstable not in ("raise", "stop"):
+        raise ConfigError(f"on_unstable must be 'raise' or 'stop', got {on_unstable!r}")
+    for c in controllers:
+        if not (isinstance(c.control_every, int) and c.control_every >= 1):
+            raise ConfigError(f"{type(c).__name__}.control_every must be an int >= 1")
+    nchar = len(world.characters)
+    starts = (
+        (float(reference_start),) * nchar
+        if isinstance(reference_start, int | float)
+        else tuple(float(s) for s in reference_start)
+    )
     dt = world.timestep
     nsteps = round(duration / dt)
-    every = max(1, round(1.0 / (record_fps * dt)))
-    nrec = nsteps // every + 1
-    nchar = len(world.characters)
-    pos = np.empty((nchar, nrec, len(SIM_BODIES), 3))
-    quat = np.empty((nchar, nrec, len(SIM_BODIES), 4))
+    rec_steps = np.unique(np.concatenate([_frame_steps(duration, r, dt) for r in rates]))
+    rec_steps = rec_steps[rec_steps <= nsteps]
     schedule = ImpactSchedule(world, impacts) if impacts else None
-    impact_steps = _impact_steps(impacts, dt)
-    ke_limit = np.array(
-        [energy_limit_per_kg * float(m.body_subtreemass[wc.body_ids[0]]) for wc in world.characters]
-    )
+    events = sorted(set(schedule.event_steps() if schedule else []) | set(rec_steps.tolist())
+                    | {nsteps})  # fmt: skip
+    periods = {check_every} | {c.control_every for c in controllers}
+    periods |= ({contact_every} if contact_every else set()) | ({tick_every} if on_tick else set())
+    plan = _Plan(
+        nsteps, controllers, schedule, np.array(events, dtype=np.int64), sorted(periods),
+        rec_steps, set(_frame_steps(duration, rates[0], dt).tolist()), check_every,
+        _ContactLogger(world) if contact_every else None, contact_every or 0, on_tick,
+        tick_every, record_contacts,
+    )  # fmt: skip
+    qpos = np.empty((rec_steps.size, world.model.nq))
     contacts: list[ContactReport] = []
-    t0 = float(d.time)
-    _record(world, pos, quat, 0)
-    if record_contacts:
-        contacts.append(contact_report(world))
+    guard = _Guard(world, energy_limit_per_kg)
+    warnings: list[str] = []
+    handler = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda msg: warnings.append(str(msg).strip()))
     wall = _time.perf_counter()
-    rec = 1
-    tick = control_every if controllers else nsteps + 1  # no controllers: no ticks
-    ie = 0
-    k = 0
-    while k < nsteps:
-        if controllers and k % control_every == 0:
-            t = float(d.time) - t0
-            for f in controllers:
-                f(world, t)
-        if schedule is not None:
-            schedule.apply(k)
-        # next step where something happens
-        nxt = min(nsteps, (k // every + 1) * every, (k // check_every + 1) * check_every)
-        nxt = min(nxt, (k // tick + 1) * tick)
-        while ie < len(impact_steps) and impact_steps[ie] <= k:
-            ie += 1
-        if ie < len(impact_steps):
-            nxt = min(nxt, impact_steps[ie])
-        if servo is not None:
-            servo.step(nxt - k)
-        else:
-            mujoco.mj_step(m, d, nstep=nxt - k)
-        k = nxt
-        if k % every == 0 and rec < nrec:
-            _record(world, pos, quat, rec)
-            rec += 1
-            if record_contacts:
-                contacts.append(contact_report(world))
-        if k % check_every == 0:
-            _check(world, float(d.time) - t0, ke_limit)
-    _check(world, float(d.time) - t0, ke_limit)
-    if schedule is not None:
-        schedule.clear()
-    wall = _time.perf_counter() - wall
-    times = (np.arange(nrec) * (every * dt)).astype(np.float64)
-    fps = 1.0 / (every * dt)
-    refs = list(references) if references is not None else [None] * nchar
-    motions = [
-        wc.character.motion_from_body_transforms(
-            pos[c],
-            quat[c],
-            fps,
-            refs[c],
-            times + reference_start if refs[c] is not None else None,
-            name=f"sim_{wc.prefix.rstrip('/')}",
-        )
-        for c, wc in enumerate(world.characters)
-    ]
-    return RolloutResult(times, pos, quat, motions, nsteps, wall, contacts, world.get_state())
-
-
-# ---------------------------------------------------------------------------------- tracking
-@dataclass(frozen=True)
-class TrackReport:
-    """Summary of a tracking run (what ``reactmocap track`` writes as JSON)."""
-
-    clip: str
-    start: float
-    seconds: float
-    fell: bool
-    fall_time: float | None
-    mean_joint_error_rad: float
-    root_error_m: float
-    max_root_error_m: float
-    root_angle_error_rad: float
-    wall_s: float
-    realtime_factor: float
-    kp: float
-    kv: float
-    friction: float
-    timestep: float
-    root_assist: float
-    controller: str
-    impacts: int
-
-    def to_dict(self) -> dict[str, object]:
-        from dataclasses import asdict
-
-        return asdict(self)
-
-
-def _kv(kp: float, kv: float | None) -> float:
-    return critical_kv(kp) if kv is None else float(kv)
-
-
-def _errors(world: World, result: RolloutResult, motion: Motion, start: float) -> dict[str, object]:
-    """Compare the simulated character 0 with the mocap at the recorded times."""
-    ch = world.characters[0].character
-    times = result.times + start
-    ref = motion.sample(times)
-    q_ref = ch.qpos_from_motion(ref)
-    ref_pos, ref_rot = ch.body_transforms_from_qpos(q_ref)
-    sim_pos, sim_rot = result.body_pos[0], result.body_quat[0]
-    # joint error: angle between simulated and mocap local rotations of the 15 ball joints
-    par = SIM_PARENTS[1:]
-
-    def local(rot: F64) -> F64:
-        return quat_mul(quat_conj(rot[:, par]), rot[:, 1:])
-
-    rel = quat_mul(quat_conj(local(sim_rot)), local(ref_rot))
-    jerr = np.linalg.norm(quat_log(rel), axis=-1)
-    root_err = np.linalg.norm(sim_pos[:, 0] - ref_pos[:, 0], axis=-1)
-    ang = np.linalg.norm(quat_log(quat_mul(quat_conj(sim_rot[:, 0]), ref_rot[:, 0])), axis=-1)
-    z0 = sim_pos[0, 0, 2]
-    fallen = np.flatnonzero(sim_pos[:, 0, 2] < 0.5 * z0)
-    return {
-        "fell": bool(fallen.size),
-        "fall_time": float(result.times[fallen[0]]) if fallen.size else None,
-        "mean_joint_error_rad": float(jerr.mean()),
-        "root_error_m": float(root_err.mean()),
-        "max_root_error_m": float(root_err.max()),
-        "root_angle_error_rad": float(ang.mean()),
-        "root_err_series": root_err,
-        "root_ang_series": ang,
-        "upright_series": sim_pos[:, 0, 2] >= 0.5 * z0,
-    }
-
-
-@dataclass(frozen=True)
-class TrackingController:
-    """A registered way to track a clip: ``build(world, motion, start, kp, kv, every)`` returns
-    the servo and the controllers for character 0; ``kp``/``kv`` ``None`` mean the defaults,
-    ``every`` is the rollout's steps between control ticks."""
-
-    description: str
-    default_kp: float
-    control_every: int
-    physical: bool
-    build: Callable[
-        [World, Motion, float, float, float | None, int], tuple[PDServo, list[Controller]]
-    ]
-
-
-def _build_pd(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None, every: int
-) -> tuple[PDServo, list[Controller]]:
-    servo = PDServo(world, kp=kp, kv=kv)
-    return servo, [MotionTracker(servo, 0, motion, start=start)]
-
-
-def _build_balance(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None, every: int
-) -> tuple[PDServo, list[Controller]]:
-    servo, ctrls = _build_pd(world, motion, start, kp, kv, every)
-    return servo, [*ctrls, StanceBalance(servo, 0, motion, start=start)]
-
-
-#: damping of the servo under the whole-body tracker (1/s, inertia-scaled): its stiffness is
-#: off because, held between ticks against a moving target, it fought the plan
-WHOLEBODY_SERVO_KV = 20.0
-
-
-def _wholebody(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None
-) -> tuple[PDServo, WholeBodyTracker]:
-    servo = PDServo(world, kp=0.0, kv=WHOLEBODY_SERVO_KV)
-    return servo, WholeBodyTracker(servo, 0, motion, start=start, kp_joint=kp, kv_joint=kv)
-
-
-def _build_wholebody(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None, every: int
-) -> tuple[PDServo, list[Controller]]:
-    servo, wb = _wholebody(world, motion, start, kp, kv)
-    return servo, [wb]
-
-
-#: control ticks of the whole-body trackers (steps): every 2 ms at dt = 0.0005
-WHOLEBODY_EVERY = 4
-
-
-def _build_predictive(
-    world: World, motion: Motion, start: float, kp: float, kv: float | None, every: int
-) -> tuple[PDServo, list[Controller]]:
-    servo, wb = _wholebody(world, motion, start, kp, kv)
-    # its predictions tick as the rollout will
-    return servo, [PredictiveTracker(wb, control_every=every)]
-
-
-TRACKING_CONTROLLERS: dict[str, TrackingController] = {
-    "wholebody": TrackingController(
-        "inverse dynamics with optimised ground forces (pelvis tracked through the feet)",
-        default_kp=1000.0, control_every=WHOLEBODY_EVERY, physical=True, build=_build_wholebody,
-    ),
-    "predictive": TrackingController(
-        "the whole-body tracker steered by predictive sampling (looks 0.5 s ahead; ~40x slower)",
-        default_kp=1000.0, control_every=WHOLEBODY_EVERY, physical=True,
-        build=_build_predictive,
-    ),
-    "balance": TrackingController(
-        "inertia-scaled PD servo plus stance-leg balance (StanceBalance)",
-        default_kp=4000.0, control_every=10, physical=True, build=_build_balance,
-    ),
-    "pd": TrackingController(
-        "inertia-scaled PD servo only (the paper's tracker; no balance)",
-        default_kp=4000.0, control_every=10, physical=True, build=_build_pd,
-    ),
-}  # fmt: skip
-
-
-def tracking_controller(name: str) -> TrackingController:
-    """The registered tracking controller ``name``; an unknown name lists the valid ones."""
     try:
-        return TRACKING_CONTROLLERS[name]
-    except KeyError:
-        raise UnknownKeyError(
-            f"unknown tracking controller {name!r}; valid keys: {sorted(TRACKING_CONTROLLERS)}"
-        ) from None
-
-
-def track_clip(
-    motion: Motion,
-    *,
-    start: float = 0.0,
-    seconds: float | None = None,
-    kp: float | None = None,
-    kv: float | None = None,
-    friction: float = 1.0,
-    impacts: Sequence[Impact] = (),
-    record_fps: float = 60.0,
-    root_assist: float = 0.0,
-    controller: str = "wholebody",
-    control_every: int | None = None,
-    total_mass: float = 75.0,
-    config: WorldConfig | None = None,
-    character_kwargs: dict[str, object] | None = None,
-    on_tick: Callable[[float, float], None] | None = None,
-) -> tuple[Motion, TrackReport, RolloutResult]:
-    """Track ``motion`` from ``start`` for ``seconds`` (default: to its end) with the PD servo
-    on a simulated character built from the clip (reference = the start frame), optionally
-    with impacts (their ``start`` is relative to ``start``). Returns the simulated Motion on
-    the clip's skeleton (non-simulated joints from the clip), the report and the raw result.
-    ``controller`` names an entry of :data:`TRACKING_CONTROLLERS`: ``"wholebody"`` (default,
-    :class:`~reactmocap.sim.wholebody.WholeBodyTracker`), ``"balance"`` (PD servo plus
-    :class:`~reactmocap.sim.balance.StanceBalance`) or ``"pd"`` (the servo alone); ``kp``/``kv``
-    are its joint gains (default: the controller's). ``root_assist > 0`` adds the
-    non-physical :class:`RootAssist` with that kp (only with ``"pd"``). Targets and
-    feed-forward update every ``control_every`` steps (default: the controller's; the servo's
-    own stiffness and damping act every step inside MuJoCo). ``on_tick(t, seconds)`` is
-    called at every control tick (a progress bar)."""
-    if not (np.isfinite(start) and 0 <= start <= motion.duration):
-        raise ConfigError(f"start {start!r} s is outside the clip (0..{motion.duration:.3f} s)")
-    remaining = motion.duration - start
-    seconds = remaining if seconds is None else float(seconds)
-    if not (np.isfinite(seconds) and seconds > 0):
-        raise ConfigError(f"seconds must be > 0, got {seconds!r}")
-    if seconds > remaining + 1e-9:
-        raise ConfigError(
-            f"cannot track {seconds} s from {start} s: the clip {motion.name!r} lasts "
-            f"{motion.duration:.3f} s"
-        )
-    spec = tracking_controller(controller)
-    if root_assist > 0 and controller != "pd":
-        raise ConfigError(
-            f"root_assist cannot be combined with the {controller!r} controller: its ground "
-            "forces assume nothing else holds the body up (they went unstable together); "
-            "use controller='pd' with root_assist"
-        )
-    kp = spec.default_kp if kp is None else float(kp)
-    every = spec.control_every if control_every is None else int(control_every)
-    if every < 1:
-        raise ConfigError(f"control_every must be >= 1, got {control_every!r}")
-    frame = round(start * motion.fps)
-    character = build_character(
-        motion,
-        total_mass=total_mass,
-        frame=frame,
-        **(character_kwargs or {}),  # type: ignore[arg-type]
-    )  # type: ignore[arg-type]
-    character.check_fk(motion, frame)
-    cfg = config or WorldConfig(friction=friction)
-    world = World(character, cfg)
-    world.set_from_motion(0, motion, frame)
-    servo, ctrls = spec.build(world, motion, float(start), kp, kv, every)
-    if root_assist > 0:
-        ctrls.append(RootAssist(world, 0, motion, start=start, kp=root_assist))
-    for f in ctrls:
-        f(world, 0.0)
-    if on_tick is not None:
-        tick = on_tick
-        ctrls.append(lambda _w, t: tick(t, seconds))
-    result = rollout(
-        world,
-        seconds,
-        servo=servo,
-        controllers=ctrls,
-        # the assist's explicit whole-body PD acts on the light pelvis: held for several steps
-        # it goes unstable, so it runs every step
-        control_every=1 if root_assist > 0 else every,
-        impacts=impacts,
-        record_fps=record_fps,
-        references=[motion],
-        reference_start=start,
+        reason, ri, k = _loop(world, plan, guard, qpos, contacts)
+    finally:
+        mujoco.set_mju_user_warning(handler)
+        if schedule is not None:
+            schedule.clear()
+    wall = _time.perf_counter() - wall
+    status: Status = "ok"
+    if reason is not None:
+        if warnings:
+            reason += f" (MuJoCo: {warnings[0]})"
+        if on_unstable == "raise":
+            raise SimulationError(reason)
+        status = "unstable"
+    return RolloutResult(
+        world=world,
+        fps=rates,
+        qpos=qpos[:ri],
+        record_steps=rec_steps[:ri],
+        duration=float(duration),
+        steps=k,
+        seconds=k * dt,
+        wall_s=wall,
+        status=status,
+        reason=reason,
+        contacts=contacts,
+        contact_log=plan.logger.result(plan.contact_every * dt) if plan.logger else None,
+        final_state=world.get_state(),
+        references=tuple(references) + (None,) * (nchar - len(references)),
+        reference_starts=starts + (0.0,) * (nchar - len(starts)),
+        warnings=tuple(warnings),
     )
-    err = _errors(world, result, motion, start)
-    report = TrackReport(
-        clip=motion.name,
-        start=float(start),
-        seconds=float(seconds),
-        fell=bool(err["fell"]),
-        fall_time=err["fall_time"],  # type: ignore[arg-type]
-        mean_joint_error_rad=float(err["mean_joint_error_rad"]),  # type: ignore[arg-type]
-        root_error_m=float(err["root_error_m"]),  # type: ignore[arg-type]
-        max_root_error_m=float(err["max_root_error_m"]),  # type: ignore[arg-type]
-        root_angle_error_rad=float(err["root_angle_error_rad"]),  # type: ignore[arg-type]
-        wall_s=float(result.wall_s),
-        realtime_factor=float(seconds / result.wall_s) if result.wall_s > 0 else float("inf"),
-        kp=kp,
-        kv=_kv(kp, kv),
-        friction=cfg.friction,
-        timestep=cfg.timestep,
-        root_assist=float(root_assist),
-        controller=controller,
-        impacts=len(impacts),
-    )
-    name = f"{motion.name}_tracked" if motion.name else "tracked"
-    return result.motions[0].replace(name=name), report, result
 
 
-def push_clip(
-    motion: Motion,
-    *,
-    time: float,
-    body: str,
-    force: Sequence[float],
-    duration: float = 0.1,
-    point: Sequence[float] | None = None,
-    start: float | None = None,
-    seconds: float | None = None,
-    **kwargs: object,
-) -> tuple[Motion, TrackReport, RolloutResult]:
-    """Track ``motion`` and push ``body`` with ``force`` (N, world) at clip time ``time`` for
-    ``duration`` s. Tracking starts at ``start`` (default: 0.5 s before the push, or 0) and
-    runs ``seconds`` (default: to the clip's end)."""
-    if not (np.isfinite(time) and 0 <= time <= motion.duration):
-        raise ConfigError(f"push time {time!r} s is outside the clip (0..{motion.duration:.3f} s)")
-    s0 = max(0.0, time - 0.5) if start is None else float(start)
-    if time < s0:
-        raise ConfigError(f"push time {time} s is before the tracking start {s0} s")
-    impact = Impact(
-        body=body,
-        force=_t3(force),
-        point=None if point is None else _t3(point),
-        start=time - s0,
-        duration=duration,
-    )
-    return track_clip(motion, start=s0, seconds=seconds, impacts=[impact], **kwargs)  # type: ignore[arg-type]
+def _loop(
+    world: World, plan: _Plan, guard: _Guard, qpos: F64, contacts: list[ContactReport]
+) -> tuple[str | None, int, int]:
+    """The stepping loop; returns the instability (or None), the records made, the steps."""
+    d = world.data
+    t0 = float(d.time)
+    for c in plan.controllers:
+        c.reset(world)
+    rec, events, nsteps = plan.rec_steps, plan.events, plan.nsteps
+    ri = 0  # next record
+    ei = 0  # next event
+    k = 0
+    while True:
+        is_record = ri < rec.size and rec[ri] == k
+        if is_record or k % plan.check_every == 0 or k >= nsteps:
+            reason = guard.problem(float(d.time) - t0)
+            if reason is not None:
+                return reason, ri, k
+        if is_record:
+            qpos[ri] = d.qpos
+            if plan.record_contacts and k in plan.primary:
+                contacts.append(contact_report(world))
+            ri += 1
+        if k >= nsteps:
+            return None, ri, k
+        t = float(d.time) - t0
+        for c in plan.controllers:
+            if k % c.control_every == 0:
+                c.control(world, t)
+        if plan.logger is not None and k % plan.contact_every == 0:
+            plan.logger.log(t)
+        if plan.on_tick is not None and k % plan.tick_every == 0:
+            plan.on_tick(t)
+        if plan.schedule is not None:
+            plan.schedule.apply(k)
+        # the next step where something happens
+        while ei < events.size and events[ei] <= k:
+            ei += 1
+        nxt = int(events[ei]) if ei < events.size else nsteps
+        for p in plan.periods:
+            nxt = min(nxt, (k // p + 1) * p)
+        world.step(nxt - k)
+        k = nxt

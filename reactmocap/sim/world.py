@@ -1,54 +1,13 @@
-"""The simulated world: a ground plane, gravity, friction, and one or two characters.
-
-Each character is attached to one MjSpec with a name prefix (``a/``, ``b/``), so body ``chest``
-of the second character is ``b/chest`` in MuJoCo.
-
-Contact settings, and why (measured with ``benchmarks/bench_sim.py`` on this machine, one
-standing 51-DOF character, dt = 0.0005 s; see the report for the figures):
-
-* **Solver Newton, integrator implicitfast, pyramidal cone.** Newton converges in 1-3
-  iterations on a standing character and was the fastest; CG and PGS need many more iterations
-  for the same accuracy, and RK4 costs four model evaluations per step. ``implicitfast`` costs
-  the same as Euler here and treats joint damping implicitly, which keeps light damping and
-  freeze springs stable. The pyramidal cone was faster than the elliptic one and, for the
-  friction-1.0/0.5 Coulomb contacts the papers use, the difference in behaviour is a slightly
-  anisotropic friction limit, invisible at our scale.
-* **Contacts:** ``solref = (0.01, 1.0)`` (critically damped, 10 ms time constant, five times
-  the step and half MuJoCo's 20 ms default) so a 75 kg character standing on two foot boxes
-  sinks about 2 mm instead of about 8 mm, while impacts stay soft enough that the Newton solver
-  does not chatter at dt = 0.0005; ``solimp`` is MuJoCo's default (0.9, 0.95, 0.001): Zordan et
-  al. used ODE's soft constraints "allowing some compliance" in the same way. ``condim = 3``
-  (sliding friction only), friction coefficient per world (paper: 1.0 in Simulation 1, 0.5 in
-  Simulation 2) on every geom (MuJoCo takes the larger of the two geoms' coefficients).
-* **Ball-of-foot patch:** each foot also carries a small massless cube under the ball of the
-  foot, switched off (no contype/conaffinity) until a controller calls
-  :meth:`World.set_foot_patch`, which moves the foot's floor contact from its box to the patch.
-  The patch has ``condim = 6``: sliding friction as above, a torsional arm of
-  :data:`PATCH_TORSION` (a spinning forefoot resists little; the box's corners hold
-  ``mu N`` times half the foot width, so a box foot cannot pivot as actors do in spinning
-  kicks) and a rolling arm of :data:`PATCH_ROLL` (the centre of pressure may move that far
-  from the ball, as over the real forefoot's width).
-* **Collision filtering:** the floor collides with everything; two characters collide with
-  each other. Within one character, parent-child pairs are excluded by MuJoCo's default
-  ``filterparent``; with ``self_collision=False`` (default) the character's own geoms do not
-  collide at all, through contype/conaffinity bits (character k has type bit ``2**(k+1)`` and
-  affinity with the floor and the other character). Why off: mocap poses routinely put arms
-  within millimetres of the trunk capsules, and self-contacts would fight the tracking servo.
-* **Servo actuators:** every ball joint gets three ``general`` actuators (joint transmission,
-  fixed gain, affine bias), 45 per character, contiguous from :attr:`WorldCharacter.actuator_adr`
-  in :data:`BALL_JOINTS` order. They are built with zero gain and zero bias, so they exert
-  exactly no force and add no implicit damping until a :class:`~reactmocap.sim.pd.PDServo`
-  sets their gears and gains (see that module for why the PD lives inside MuJoCo). Actuation
-  is disabled (``mjDSBL_ACTUATION``) until a servo is attached, which leaves a passive world
-  MuJoCo's transmission pass over the rows: a ragdoll steps ~3% slower than without the
-  actuators (~6% with actuation on). ``ctrl`` is part of :meth:`World.get_state`.
-"""
+"""The simulated world: a floor, gravity, friction, one or two characters (each attached to one
+MjSpec under a prefix, ``a/`` and ``b/``), the servo actuators every ball joint carries, and
+which character and body each geom belongs to. Why the contact and solver settings are what
+they are: ``docs/design.md``."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import mujoco
 import numpy as np
@@ -57,6 +16,9 @@ from numpy.typing import NDArray
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, Character
+
+if TYPE_CHECKING:
+    from reactmocap.sim.servo import PDServo
 
 __all__ = ["PATCH_ROLL", "PATCH_TORSION", "PREFIXES", "World", "WorldCharacter", "WorldConfig"]
 
@@ -236,6 +198,7 @@ class World:
         #: bumped whenever the state is set from outside the integrator (set_pose, set_state):
         #: a PDServo then re-linearises its actuators before the next step
         self.state_epoch = 0
+        self._servo: PDServo | None = None
         self.characters: list[WorldCharacter] = []
         for k, ch in enumerate(chars):
             pre = PREFIXES[k]
@@ -276,6 +239,19 @@ class World:
                     patch_ids=np.array(patches, dtype=np.int64),
                 )
             )
+        char = np.full(m.ngeom, -1, dtype=np.int64)
+        body = np.full(m.ngeom, -1, dtype=np.int64)
+        for wc in self.characters:
+            for i, bid in enumerate(wc.body_ids):
+                sel = m.geom_bodyid == bid
+                char[sel] = wc.index
+                body[sel] = i
+        char.flags.writeable = False
+        body.flags.writeable = False
+        #: ``(ngeom,)`` the character each geom belongs to (-1: the floor)
+        self.geom_character = char
+        #: ``(ngeom,)`` the index into SIM_BODIES of each geom's body (-1: the floor)
+        self.geom_body = body
         self._apply_contact_settings()
         self._apply_joint_settings()
         self.set_friction(cfg.friction)
@@ -388,8 +364,27 @@ class World:
         mujoco.mj_forward(self.model, self.data)
 
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` steps with the forces currently in qfrc_applied/xfrc_applied."""
-        mujoco.mj_step(self.model, self.data, nstep=n)
+        """Advance ``n`` physics steps with the servo (if any) and the forces currently in
+        ``qfrc_applied``/``xfrc_applied``."""
+        if self._servo is not None:
+            self._servo.step(n)
+        else:
+            mujoco.mj_step(self.model, self.data, nstep=n)
+
+    @property
+    def has_servo(self) -> bool:
+        return self._servo is not None
+
+    @property
+    def servo(self) -> PDServo:
+        """The world's PD servo over every character's ball joints, made on first use (inert
+        until a controller sets gains; actuation stays off in a world that never asks)."""
+        if self._servo is None:
+            from reactmocap.sim.servo import PDServo
+
+            PDServo(self)  # registers itself
+        assert self._servo is not None
+        return self._servo
 
     def kinetic_energy(self, index: int | None = None) -> float:
         """Kinetic energy (J) of one character (or of everything), 0.5 v^T M v."""

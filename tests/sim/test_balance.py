@@ -10,11 +10,8 @@ import pytest
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
 from reactmocap.library.synth import synthetic_clips
-from reactmocap.sim import World, build_character
-from reactmocap.sim.balance import StanceBalance
+from reactmocap.sim import PDServo, StanceBalance, World, build_character, track_clip
 from reactmocap.sim.character import BALL_JOINTS
-from reactmocap.sim.pd import PDServo
-from reactmocap.sim.rollout import track_clip
 
 
 @pytest.fixture(scope="module")
@@ -36,9 +33,9 @@ def test_gravity_compensation_is_mujocos_gravity_torque(clips: dict[str, Motion]
     d.qvel[:] = 0.0
     d.qpos[2] += 1.0  # in the air: no support, only gravity compensation
     mujoco.mj_forward(m, d)
-    servo = PDServo(world)
-    bal = StanceBalance(servo, 0, kick, velocity_feedforward=False)
-    bal(world, 0.0)
+    servo = world.servo
+    bal = StanceBalance(world, 0, kick, velocity_feedforward=False, control_every=10)
+    bal.control(world, 0.0)
     wc = world.characters[0]
     bias = d.qfrc_bias[wc.ball_dof_start : wc.ball_dof_start + 45]  # gravity only at rest
     np.testing.assert_allclose(servo.feedforward.reshape(-1), bias, atol=1e-9)
@@ -58,11 +55,11 @@ def test_feedforward_holds_a_standing_pose_with_a_weak_servo(clips: dict[str, Mo
         world.data.qpos[world.characters[0].qpos_adr] += 3.0  # apart
         mujoco.mj_forward(world.model, world.data)
         servo = PDServo(world, kp=100.0)  # 40x weaker than the default
-        bal = StanceBalance(servo, 1, guard) if balance else None
+        bal = StanceBalance(world, 1, guard, control_every=4) if balance else None
         z0 = world.com(1)[2]
         for k in range(250):  # 0.5 s, control every 2 ms
             if bal is not None:
-                bal(world, 0.002 * k)
+                bal.control(world, 0.002 * k)
             for _ in range(4):
                 servo.apply()
                 mujoco.mj_step(world.model, world.data)
@@ -77,8 +74,8 @@ def test_feedforward_holds_a_standing_pose_with_a_weak_servo(clips: dict[str, Mo
 
 def test_balance_keeps_a_standing_clip_up(guard_loop: Motion) -> None:
     secs = 3.5
-    _, plain, _ = track_clip(guard_loop, seconds=secs, controller="pd")
-    _, bal, _ = track_clip(guard_loop, seconds=secs, controller="balance")
+    plain = track_clip(guard_loop, seconds=secs, controller="pd").report
+    bal = track_clip(guard_loop, seconds=secs, controller="balance").report
     assert plain.fell, "plain PD tracking is expected to topple (no balance control)"
     assert not bal.fell
     assert bal.max_root_error_m < 0.03
@@ -91,23 +88,21 @@ def test_balance_keeps_a_standing_clip_up(guard_loop: Motion) -> None:
 )
 def test_bad_gains_rejected(clips: dict[str, Motion], key: str, value: float) -> None:
     world = World(build_character(clips["guard"], frame=0))
-    servo = PDServo(world)
     with pytest.raises(ConfigError, match=key):
-        StanceBalance(servo, 0, clips["guard"], **{key: value})  # type: ignore[arg-type]
+        StanceBalance(world, 0, clips["guard"], control_every=10, **{key: value})  # type: ignore[arg-type]
 
 
 def test_unknown_character_rejected(clips: dict[str, Motion]) -> None:
     world = World(build_character(clips["guard"], frame=0))
-    servo = PDServo(world)
     with pytest.raises(ConfigError, match="character 3"):
-        StanceBalance(servo, 3, clips["guard"])
+        StanceBalance(world, 3, clips["guard"], control_every=10)
 
 
 @pytest.mark.parametrize("controller", ["balance", "wholebody"])
 def test_root_assist_only_with_plain_pd(guard_loop: Motion, controller: str) -> None:
     with pytest.raises(ConfigError, match="root_assist cannot be combined"):
         track_clip(guard_loop, seconds=0.2, root_assist=100.0, controller=controller)
-    _, rep, _ = track_clip(guard_loop, seconds=0.2, root_assist=100.0, controller="pd")
+    rep = track_clip(guard_loop, seconds=0.2, root_assist=100.0, controller="pd").report
     assert rep.root_assist == 100.0 and rep.controller == "pd"
 
 
@@ -115,16 +110,16 @@ def test_stance_legs_get_stiffer_gains(clips: dict[str, Motion]) -> None:
     guard = clips["guard"]
     world = World(build_character(guard, frame=0))
     world.set_from_motion(0, guard, 0)
-    servo = PDServo(world)
-    bal = StanceBalance(servo, 0, guard, stance_gain_scale=9.0)
+    servo = PDServo(world, kp=4000.0)
+    bal = StanceBalance(world, 0, guard, stance_gain_scale=9.0, control_every=10)
     servo.step(40)  # settle onto the floor
-    bal(world, 0.0)
+    bal.control(world, 0.0)
     a = world.characters[0].actuator_adr
     gains = world.model.actuator_gainprm[a : a + 45, 0].reshape(15, 3)[:, 0]
     knee, elbow = BALL_JOINTS.index("l_knee"), BALL_JOINTS.index("l_elbow")
-    assert gains[knee] == pytest.approx(9.0 * servo.kp)
-    assert gains[elbow] == pytest.approx(servo.kp)
+    assert gains[knee] == pytest.approx(9.0 * 4000.0)
+    assert gains[elbow] == pytest.approx(4000.0)
     with pytest.raises(ConfigError, match="stance_gain_scale"):
-        StanceBalance(servo, 0, guard, stance_gain_scale=0.0)
+        StanceBalance(world, 0, guard, stance_gain_scale=0.0, control_every=10)
     with pytest.raises(ConfigError, match="gain scale"):
         servo.set_gain_scale(0, ["l_knee"], float("nan"))

@@ -118,14 +118,15 @@ def test_first_contact_and_rewind(guard: Motion) -> None:
 
 
 def test_track_and_push_functions(guard: Motion) -> None:
-    out, rep, res = track_clip(guard, seconds=0.5, root_assist=0.0)
+    tracked = track_clip(guard, seconds=0.5, root_assist=0.0)
+    out, rep, res = tracked.motion, tracked.report, tracked.rollout
     assert out.skeleton is guard.skeleton and out.num_frames == res.times.size
     for key in ("mean_joint_error_rad", "root_error_m", "wall_s", "realtime_factor"):
         assert np.isfinite(getattr(rep, key))
     assert rep.mean_joint_error_rad < 0.2 and not rep.fell
-    _out2, rep2, _ = push_clip(
+    rep2 = push_clip(
         guard, time=0.2, body="chest", force=(-400.0, 0.0, 0.0), duration=0.1, seconds=0.6
-    )
+    ).report
     assert rep2.impacts == 1 and rep2.root_error_m > rep.root_error_m
 
 

@@ -18,7 +18,8 @@ SHARED = Path(__file__).resolve().parents[3] / "shared" / "mocap"
 @pytest.fixture(scope="module")
 def simulated_step(step_forward: Motion) -> Motion:
     """A physical motion: the whole-body tracker's step, recorded at the clip's rate."""
-    sim, rep, _ = track_clip(step_forward, seconds=step_forward.duration, record_fps=30.0)
+    tracked = track_clip(step_forward, seconds=step_forward.duration, record_fps=30.0)
+    sim, rep = tracked.motion, tracked.report
     assert not rep.fell
     return sim
 

@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from reactmocap.library import synth
+from reactmocap.library.anthropometry import REFERENCE_PARTS, SEXES, part_mass_fractions
 from reactmocap.library.bodyparts import map_body_parts
 from reactmocap.library.skeleton import Skeleton
-from reactmocap.sim.anthropometry import REFERENCE_PARTS, SEXES, part_mass_fractions
 from reactmocap.sim.character import build_character
 from reactmocap.sim.reference_bodies import reference_part_masses
 

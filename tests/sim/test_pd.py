@@ -1,6 +1,6 @@
 """The PD servo as MuJoCo actuators: MuJoCo's ball-joint actuator semantics the servo relies on,
 exactness against the reference torque at a refresh, passivity, chunked stepping and
-determinism (see the docstring of reactmocap.sim.pd)."""
+determinism (see reactmocap.sim.servo and docs/design.md)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ import pytest
 
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_normalize
-from reactmocap.sim import Impact, MotionTracker, PDServo, World, WorldConfig, build_character
+from reactmocap.sim import Impact, PDServo, PDTracker, World, WorldConfig, build_character
 from reactmocap.sim import rollout as run_rollout
-from reactmocap.sim.pd import HALF_TURN_MARGIN, _right_matrix
+from reactmocap.sim.servo import HALF_TURN_MARGIN, _right_matrix
 
 NJ = 15
 
@@ -157,10 +157,10 @@ def test_actuator_torque_equals_reference_at_refresh(guard: Motion, seed: int) -
     servo.refresh()
     mujoco.mj_forward(world.model, world.data)
     ref = servo.torques()
-    act = world.data.qfrc_actuator[servo._didx].reshape(-1, 3)
+    act = world.data.qfrc_actuator[servo.dof_indices].reshape(-1, 3)
     assert np.abs(act - ref).max() <= 1e-9 * np.abs(ref).max()
-    assert np.array_equal(world.data.qfrc_applied[servo._didx], np.zeros(3 * servo.n))
-    off = ~(servo._enabled | servo._frozen)
+    assert np.array_equal(world.data.qfrc_applied[servo.dof_indices], np.zeros(3 * servo.n))
+    off = ~(servo.enabled | servo.frozen)
     assert off.any() and np.all(act[off] == 0.0) and np.all(ref[off] == 0.0)
 
 
@@ -169,20 +169,20 @@ def test_half_turn_joints_are_held_exactly_at_refresh(guard: Motion) -> None:
     actuators; their sum is still the reference torque at the refresh."""
     world, servo = _random_world(guard, np.pi, seed=5)
     servo.refresh()
-    assert servo._hot.any() and not servo._hot.all()
+    assert servo.hot.any() and not servo.hot.all()
     mujoco.mj_forward(world.model, world.data)
     ref = servo.torques()
     d = world.data
-    total = (d.qfrc_actuator + d.qfrc_applied)[servo._didx].reshape(-1, 3)
+    total = (d.qfrc_actuator + d.qfrc_applied)[servo.dof_indices].reshape(-1, 3)
     assert np.abs(total - ref).max() <= 1e-9 * np.abs(ref).max()
     # back from the half turn: gains restored, qfrc_applied back to the feed-forward only
-    q = d.qpos[servo._qidx].reshape(-1, 4)
-    q[servo._hot] = [1.0, 0.0, 0.0, 0.0]
-    d.qpos[servo._qidx] = q.ravel()
+    q = d.qpos[servo.qpos_indices].reshape(-1, 4)
+    q[servo.hot] = [1.0, 0.0, 0.0, 0.0]
+    d.qpos[servo.qpos_indices] = q.ravel()
     mujoco.mj_forward(world.model, d)
     servo.refresh()
-    assert not servo._hot.any()
-    assert np.all(d.qfrc_applied[servo._didx] == 0.0)
+    assert not servo.hot.any()
+    assert np.all(d.qfrc_applied[servo.dof_indices] == 0.0)
 
 
 def test_feedforward_goes_to_qfrc_applied_at_refresh(guard: Motion) -> None:
@@ -190,11 +190,11 @@ def test_feedforward_goes_to_qfrc_applied_at_refresh(guard: Motion) -> None:
     d = world.data
     servo.refresh()
     servo.feedforward[:] = np.arange(servo.n * 3).reshape(-1, 3)  # in place, as a controller
-    assert np.all(d.qfrc_applied[servo._didx] == 0.0)  # only at the next refresh
+    assert np.all(d.qfrc_applied[servo.dof_indices] == 0.0)  # only at the next refresh
     servo.refresh()
-    np.testing.assert_array_equal(d.qfrc_applied[servo._didx], np.arange(servo.n * 3))
+    np.testing.assert_array_equal(d.qfrc_applied[servo.dof_indices], np.arange(servo.n * 3))
     servo.clear()
-    assert np.all(d.qfrc_applied[servo._didx] == 0.0)
+    assert np.all(d.qfrc_applied[servo.dof_indices] == 0.0)
     mujoco.mj_forward(world.model, d)
     assert np.all(d.qfrc_actuator == 0.0)
 
@@ -265,11 +265,11 @@ def test_state_restore_relinearises(guard: Motion) -> None:
     servo.step(7)
     world.set_state(state)
     servo.step(0)  # nothing
-    assert servo._due()
+    assert servo.due
     servo.apply()  # refresh at the restored state
     mujoco.mj_forward(world.model, world.data)
     ref = servo.torques()
-    act = world.data.qfrc_actuator[servo._didx].reshape(-1, 3)
+    act = world.data.qfrc_actuator[servo.dof_indices].reshape(-1, 3)
     assert np.abs(act - ref).max() <= 1e-9 * np.abs(ref).max()
 
 
@@ -306,14 +306,14 @@ def test_tracking_rollout_is_deterministic(step_forward: Motion, guard: Motion) 
         world = World([ch, ch], WorldConfig(friction=0.5))
         world.set_from_motion(0, step_forward, 0)
         world.set_from_motion(1, guard.transformed(yaw=np.pi, translation=(0.5, 0.0, 0.0)), 0)
-        servo = PDServo(world, kp=4000.0, refresh_every=3)
-        ctrls = [MotionTracker(servo, 0, step_forward), MotionTracker(servo, 1, guard)]
+        ctrls = [
+            PDTracker(world, 0, step_forward, kp=4000.0, control_every=5, refresh_every=3),
+            PDTracker(world, 1, guard, kp=4000.0, control_every=5, refresh_every=3),
+        ]
         res = run_rollout(
             world,
             0.25,
-            servo=servo,
             controllers=ctrls,
-            control_every=5,
             record_fps=70,
             check_every=7,
             impacts=[
@@ -322,7 +322,7 @@ def test_tracking_rollout_is_deterministic(step_forward: Motion, guard: Motion) 
             ],
         )
         assert res.final_state is not None
-        return np.concatenate([res.body_pos.ravel(), res.body_quat.ravel(), res.final_state])
+        return np.concatenate([res.qpos.ravel(), res.final_state])
 
     assert np.array_equal(run(), run())
 
@@ -334,10 +334,10 @@ def test_euler_worlds_take_the_damping_diagonal_in_dof_damping(guard: Motion) ->
     world.set_from_motion(0, guard, 0, velocity=False)
     base = world.model.dof_damping.copy()
     servo = PDServo(world, kp=4000.0)
-    run_rollout(world, 0.2, servo=servo)
+    run_rollout(world, 0.2)
     m = world.model
     assert np.all(m.actuator_biasprm[:, 2] == 0.0) and np.all(m.actuator_gainprm[:, 0] == 4000.0)
-    assert np.all(m.dof_damping[servo._didx] > base[servo._didx])
+    assert np.all(m.dof_damping[servo.dof_indices] > base[servo.dof_indices])
     assert world.kinetic_energy(0) < 5.0  # standing, not flailing
     servo.clear()
     np.testing.assert_array_equal(m.dof_damping, base)

@@ -24,7 +24,7 @@ from reactmocap.sim import (
 # 33 N s impulse over 0.1 s of violent joint motion at dt = 0.5 ms). RK4 shows what the model
 # itself does: any spurious external force (a bad impact torque, a floor contact) still fails.
 ZERO_G = WorldConfig(gravity=(0.0, 0.0, 0.0), joint_damping=0.0, integrator="rk4")
-# the servo's damping needs implicit integration at high gains (see reactmocap.sim.pd)
+# the servo's damping needs implicit integration at high gains (see reactmocap.sim.servo)
 ZERO_G_IMPLICIT = WorldConfig(gravity=(0.0, 0.0, 0.0), joint_damping=0.0)
 
 
@@ -122,15 +122,14 @@ def test_two_runs_are_bit_identical(guard: Motion) -> None:
     def run() -> np.ndarray:
         world = World(build_character(guard), WorldConfig(friction=0.5))
         world.set_from_motion(0, guard, 0)
-        servo = PDServo(world, kp=4000.0)
+        PDServo(world, kp=4000.0)
         res = rollout(
             world,
             0.3,
-            servo=servo,
             record_fps=120,
             impacts=[Impact(body="head", force=(200.0, 50.0, 0.0), start=0.05, duration=0.05)],
         )
-        return np.concatenate([res.body_pos.ravel(), res.body_quat.ravel(), res.final_state])
+        return np.concatenate([res.qpos.ravel(), res.final_state])
 
     a, b = run(), run()
     assert np.array_equal(a, b)
@@ -170,8 +169,8 @@ def test_instability_is_reported_with_time_and_body(guard: Motion) -> None:
 def test_standing_contacts_support_the_weight(guard: Motion) -> None:
     world = World(build_character(guard))
     world.set_from_motion(0, guard, 0, velocity=False)
-    servo = PDServo(world, kp=4000.0)
-    rollout(world, 0.2, servo=servo)
+    PDServo(world, kp=4000.0)
+    rollout(world, 0.2)
     rep = contact_report(world)
     assert {"l_foot", "r_foot"} <= set(rep.ground[0])
     weight = 75.0 * 9.81

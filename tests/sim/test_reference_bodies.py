@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from reactmocap.errors import UnknownKeyError
-from reactmocap.sim.anthropometry import (
+from reactmocap.library.anthropometry import (
     CAPTION_TOTAL_MASS,
     REFERENCE_PARTS,
     SEXES,

@@ -12,60 +12,38 @@ import pytest
 
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.motion import Motion
-from reactmocap.sim import World, build_character, rollout
-from reactmocap.sim.character import PATCH_GEOM_GROUP
-from reactmocap.sim.pd import PDServo
-from reactmocap.sim.rollout import (
-    TRACKING_CONTROLLERS,
-    WHOLEBODY_SERVO_KV,
+from reactmocap.sim import (
+    CONTROLLERS,
+    FunctionController,
+    PDServo,
+    WholeBodyTracker,
+    World,
+    build_character,
+    controller_spec,
+    rollout,
     track_clip,
-    tracking_controller,
 )
-from reactmocap.sim.wholebody import WholeBodyTracker, reference_path
+from reactmocap.sim.character import PATCH_GEOM_GROUP
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "mocap"
+
+
+def _tracker(world: World, motion: Motion, start: float, **kw: float | None) -> WholeBodyTracker:
+    """The registry's whole-body tracker, its servo gains set as a rollout would."""
+    spec = controller_spec("wholebody")
+    args = {"kp_joint": spec.defaults["kp"], "servo_kv": spec.defaults["servo_kv"],
+            "control_every": 4, **kw}  # fmt: skip
+    wb = WholeBodyTracker(world, 0, motion, start=start, **args)  # type: ignore[arg-type]
+    wb.reset(world)
+    return wb
 
 
 def _standing(motion: Motion, frame: int) -> tuple[World, PDServo, WholeBodyTracker]:
     world = World(build_character(motion, frame=frame))
     world.set_from_motion(0, motion, frame)
     mujoco.mj_forward(world.model, world.data)
-    servo = PDServo(world, kp=0.0, kv=WHOLEBODY_SERVO_KV)
-    return world, servo, WholeBodyTracker(servo, 0, motion, start=frame / motion.fps)
-
-
-def test_reference_path_is_the_clip_on_the_character(step_forward: Motion) -> None:
-    """The path's poses are the clip's (MuJoCo body positions match the character's forward
-    kinematics), its velocities integrate back to the poses, its arrays are read-only, and
-    its stance is a single-support step: each foot lifts while the other stays planted."""
-    world = World(build_character(step_forward))
-    path = reference_path(world, 0, step_forward)
-    n = step_forward.num_frames
-    assert path.q.shape == (n, 67) and path.v.shape == path.a.shape == (n, 51)
-    assert path.planted.shape == path.pivoting.shape == (n, 2) and path.fps == step_forward.fps
-    for arr in (path.q, path.v, path.a, path.planted, path.pivoting):
-        assert not arr.flags.writeable
-    # central differences: the root moves by v dt between neighbouring frames
-    dx = (path.q[2:, :3] - path.q[:-2, :3]) * step_forward.fps / 2
-    assert np.allclose(dx, path.v[1:-1, :3])
-    # a frame samples exactly; half-way is the mean (positions) with unit quaternions
-    q5, v5, a5, planted5 = path.sample(5.0)
-    assert np.allclose(q5, path.q[5], rtol=0, atol=1e-12)
-    assert np.array_equal(v5, path.v[5]) and np.array_equal(a5, path.a[5])
-    assert np.array_equal(planted5, path.planted[5])
-    qh = path.sample(5.5)[0]
-    assert np.allclose(qh[:3], (path.q[5, :3] + path.q[6, :3]) / 2)
-    assert np.allclose(np.linalg.norm(qh[3:].reshape(-1, 4), axis=1), 1.0)
-    assert path.planted.all(axis=1).any() and not path.planted.all()
-    assert not (~path.planted).all(axis=1).any()  # a step: never both feet up
-    assert np.array_equal(path.sample(-3.0)[0], path.sample(0.0)[0])  # clamped to the clip
-    assert np.array_equal(path.sample(n + 5.0)[1], path.v[-1])
-    with pytest.raises(ConfigError, match="pivot_rate"):
-        reference_path(world, 0, step_forward, pivot_rate=float("nan"))
-    # the tracker follows its path on the rollout's clock (time 0 = its start frame)
-    _, _, wb = _standing(step_forward, 20)
-    for t, frame in ((0.0, 20.0), (0.5 / step_forward.fps, 20.5), (-1.0, 0.0), (1e3, n - 1.0)):
-        assert np.array_equal(wb.reference(t)[0], wb.path.sample(frame)[0])
+    wb = _tracker(world, motion, frame / motion.fps)
+    return world, world.servo, wb
 
 
 @pytest.mark.parametrize(("clip", "frame"), [("guard", 10), ("step_forward", 20)])
@@ -115,8 +93,8 @@ def test_plan_without_support_conserves_momentum(guard: Motion) -> None:
 
 def test_wholebody_keeps_the_guard_up_where_pd_falls(guard: Motion) -> None:
     loop = Motion.concatenate([guard, guard.slice(1)], name="guard_x2")
-    _, pd, _ = track_clip(loop, seconds=3.5, controller="pd")
-    _, wb, _ = track_clip(loop, seconds=3.5)
+    pd = track_clip(loop, seconds=3.5, controller="pd").report
+    wb = track_clip(loop, seconds=3.5).report
     assert pd.fell
     assert wb.controller == "wholebody" and not wb.fell
     assert wb.max_root_error_m < 0.03
@@ -124,9 +102,9 @@ def test_wholebody_keeps_the_guard_up_where_pd_falls(guard: Motion) -> None:
 
 
 def test_wholebody_tracks_a_step_where_pd_and_balance_fall(step_forward: Motion) -> None:
-    _, rep, _ = track_clip(step_forward)
+    rep = track_clip(step_forward).report
     for other in ("pd", "balance"):
-        _, o, _ = track_clip(step_forward, controller=other)
+        o = track_clip(step_forward, controller=other).report
         assert o.fell and o.max_root_error_m > 0.5
     assert not rep.fell
     assert rep.max_root_error_m < 0.5
@@ -139,14 +117,14 @@ def test_planned_forces_are_the_simulated_ones(request: pytest.FixtureRequest, c
     planned torques (within 15% at the 90th percentile of control ticks). Planning on corners
     hovering within 1 cm with a soft tangential-only no-slip term gave 26-34% here."""
     motion: Motion = request.getfixturevalue(clip)
-    world, servo, wb = _standing(motion, 0)
+    world, _servo, wb = _standing(motion, 0)
     m = world.model
     probe = mujoco.MjData(m)
     f6 = np.zeros(6)
     errors: list[float] = []
 
     def check(w: World, t: float) -> None:
-        wb(w, t)
+        wb.control(w, t)
         plan = wb.last_plan
         assert plan is not None
         if not plan.support or t < 0.01:
@@ -162,34 +140,30 @@ def test_planned_forces_are_the_simulated_ones(request: pytest.FixtureRequest, c
         planned = plan.forces.sum(axis=0)
         errors.append(float(np.linalg.norm(total - planned) / np.linalg.norm(planned)))
 
-    rollout(world, 1.0, servo=servo, controllers=[check], control_every=4)
+    rollout(world, 1.0, controllers=[FunctionController(check, 4)])
     assert len(errors) > 100
     assert np.percentile(errors, 90) < 0.15, np.percentile(errors, [50, 90])
 
 
 def test_wholebody_is_deterministic(step_forward: Motion) -> None:
-    _, _, a = track_clip(step_forward, seconds=0.3)
-    _, _, b = track_clip(step_forward, seconds=0.3)
-    assert np.array_equal(a.body_pos, b.body_pos)
-    assert np.array_equal(a.body_quat, b.body_quat)
+    a = track_clip(step_forward, seconds=0.3).rollout
+    b = track_clip(step_forward, seconds=0.3).rollout
+    assert np.array_equal(a.qpos, b.qpos)
 
 
 @pytest.mark.skipif(not SHARED.is_dir(), reason=f"shared mocap not found at {SHARED}")
 def test_wholebody_tracks_a_real_walk() -> None:
     from reactmocap.library.bvh import read_bvh
-    from reactmocap.sim.rollout import _errors
 
     clips = sorted(SHARED.glob("*/*walk_normal_001.bvh"))
     if not clips:
         pytest.skip(f"no walk_normal_001 clip under {SHARED}")
     walk = read_bvh(clips[0])
     for start in (2.5, 3.5):
-        _, rep, res = track_clip(walk, start=start, seconds=1.0)
-        world = World(build_character(walk, frame=round(start * walk.fps)))
-        err = _errors(world, res, walk, start)
-        assert not rep.fell
-        assert float(np.max(err["root_err_series"])) <= 0.10  # type: ignore[call-overload]
-        assert float(np.max(err["root_ang_series"])) <= np.radians(15.0)  # type: ignore[call-overload]
+        res = track_clip(walk, start=start, seconds=1.0)
+        assert not res.report.fell
+        assert float(np.max(res.errors.root)) <= 0.10
+        assert float(np.max(res.errors.angle)) <= np.radians(15.0)
 
 
 def _stance_yaw_lag(
@@ -199,8 +173,7 @@ def _stance_yaw_lag(
     the number of control ticks the left foot spent on its ball patch."""
     world = World(build_character(kick, frame=round(start * kick.fps)))
     world.set_from_motion(0, kick, round(start * kick.fps))
-    servo = PDServo(world, kp=0.0, kv=20.0)
-    wb = WholeBodyTracker(servo, 0, kick, start=start, pivot_rate=pivot_rate)
+    wb = _tracker(world, kick, start, pivot_rate=pivot_rate)
     sole = int(world.characters[0].sole_ids[0])
     ref = mujoco.MjData(world.model)
     sim_yaw: list[float] = []
@@ -208,7 +181,7 @@ def _stance_yaw_lag(
     ticks = [0]
 
     def spy(w: World, t: float) -> None:
-        wb(w, t)
+        wb.control(w, t)
         ticks[0] += int(w.foot_patch_on(0)[0])
         ref.qpos[world.characters[0].qpos_slice] = wb.reference(t)[0]
         mujoco.mj_kinematics(world.model, ref)
@@ -216,7 +189,7 @@ def _stance_yaw_lag(
             x = data.geom_xmat[sole]
             out.append(float(np.arctan2(x[3], x[0])))
 
-    rollout(world, seconds, servo=servo, controllers=[spy], control_every=4)
+    rollout(world, seconds, controllers=[FunctionController(spy, 4)])
     gap = np.abs(np.unwrap(sim_yaw) - np.unwrap(ref_yaw))
     return float(np.degrees(gap.max())), ticks[0]
 
@@ -267,8 +240,8 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
     with pytest.raises(UnknownKeyError, match="wholebody"):
         track_clip(guard, seconds=0.1, controller="nope")
     with pytest.raises(UnknownKeyError, match="balance"):
-        tracking_controller("nope")
-    assert set(TRACKING_CONTROLLERS) == {"wholebody", "predictive", "balance", "pd"}
+        controller_spec("nope")
+    assert {"wholebody", "predictive", "balance", "pd"} <= set(CONTROLLERS)
 
 
 @pytest.mark.parametrize(
@@ -283,16 +256,14 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
     world = World(build_character(guard, frame=0))
-    servo = PDServo(world, kp=0.0)
     with pytest.raises(ConfigError, match=key):
-        WholeBodyTracker(servo, 0, guard, **{key: value})  # type: ignore[arg-type]
+        _tracker(world, guard, 0.0, **{key: value})
 
 
 def test_unknown_character_rejected(guard: Motion) -> None:
     world = World(build_character(guard, frame=0))
-    servo = PDServo(world, kp=0.0)
     with pytest.raises(ConfigError, match="character 2"):
-        WholeBodyTracker(servo, 2, guard)
+        WholeBodyTracker(world, 2, guard, kp_joint=1000.0, servo_kv=20.0, control_every=4)
 
 
 def test_cli_track_controller_choice(
@@ -312,5 +283,5 @@ def test_cli_track_controller_choice(
         assert json.loads(report.read_text())["controller"] == controller
     assert main(["track", str(clip), "--seconds", "0.3", "--controller", "nope"]) == 2
     err = capsys.readouterr().err
-    assert "unknown tracking controller 'nope'" in err and "wholebody" in err
+    assert "unknown controller 'nope'" in err and "wholebody" in err
     assert not (tmp_path / "nope.json").exists()

@@ -1,63 +1,9 @@
-"""Inertia-scaled PD servo for every ball joint (Zordan & Hodgins 2002; Zordan et al. 2005):
-
-    tau = I (kp * e - kv * qdot),   e = log(q^-1 q_d)  (rotation vector, child frame)
-
-``I`` is the 3x3 diagonal block of MuJoCo's joint-space inertia matrix for the ball joint: the
-composite inertia of everything outboard of the joint about the joint, in the joint's frame,
-which is what the papers mean by "the inertia of the outboard body". One ``kp`` and one ``kv``
-for all joints; per-joint gains exist only for :meth:`PDServo.freeze` (Deva's spring-damper
-clamp) and for switching joints off.
-
-How it is computed, and why: the servo lives inside MuJoCo, as actuators, so that a rollout
-calls ``mj_step(m, d, nstep=k)`` between control ticks instead of a Python loop around every
-step (the loop, a matmul into ``qfrc_applied`` plus one ``mj_step`` call per step, was the
-remaining 20-45% overhead over bare stepping in ``benchmarks/bench_sim.py`` and
-``benchmarks/bench_response.py``). What is left in Python is one refresh per control tick.
-
-* **Actuators.** The World gives every ball joint three ``general`` actuators (joint
-  transmission, fixed gain, affine bias; zero until a servo sets them). For a ball joint MuJoCo
-  defines an actuator's length as ``g . r(q)``, with ``r(q)`` the shortest-arc rotation vector
-  of the joint quaternion (``mju_quat2Vel``), its velocity as ``g . qdot``, and its torque on
-  the joint as ``g * force`` in the child frame, ``g`` being the first three gear entries, of
-  any length (checked against MuJoCo 4.0 in ``tests/sim/test_pd.py``).
-* **Refresh (control rate).** Every ``refresh_every`` steps, and before the next step after new
-  targets, gains or a state set through the World, the servo gathers ``I`` from the sparse
-  ``d.M`` (one ``np.take``) and factors it, ``I = L L^T`` (batched Cholesky: exact, ~5 us for
-  15 joints against ~18 us for ``eigh``; and because the factor's columns carry the scale, the
-  gains stay the constants ``kp``, ``kv`` and a refresh writes only gears and ``ctrl``).
-  Actuator ``k`` of a joint gets gear ``l_k`` (column ``k`` of ``L``), gain ``kp``, bias
-  ``(0, -kp, -kv)`` and ``ctrl_k = l_k . (r(q0) + e0)``, ``q0`` the current rotation and
-  ``e0 = log(q0^-1 q_d)``. Summed over ``k``::
-
-      tau = kp I (r(q0) + e0 - r(q)) - kv I qdot
-
-  equal to the reference torque at the refresh (to rounding: :meth:`PDServo.torques`); between
-  refreshes the stiffness is linearised in ``r(q)`` (first order; its direction drifts by about
-  ``(|r0| + |e0|) / 2`` times the rotation since the refresh), the damping is exact. Measured
-  on the front-kick example: p95 deviation from the reference ~1% 3 steps after a refresh,
-  ~4% after 9 (the former per-step servo deviated by 30-45%, from its diagonal damping).
-  A refresh costs ~20 us for 15 joints, ~24 us for 30.
-* **Damping, implicit, full 3x3.** ``implicitfast`` adds each actuator's velocity-bias
-  derivative, ``-kv g g^T``, to ``qDeriv``: the whole ``-kv I`` block is integrated implicitly.
-  Explicit ``kv I qdot`` was unstable at dt = 0.5 ms (the 8 kg pelvis between the strong hip
-  and waist servos: ``kv * I_hip / I_pelvis * dt > 2``). This replaces the former trick of
-  writing ``kv * diag(I)`` into ``dof_damping`` (diagonal only); the World's light joint
-  damping stays in ``dof_damping``. Cost: MuJoCo then builds ``qDeriv`` and factors
-  ``M - dt qDeriv`` each step, ~2.6 us per character per step (~7% of a standing step); the
-  actuators themselves add ~1.3 us. Under the Euler integrator, which treats only joint
-  damping implicitly, the servo falls back to the former scheme for the damping
-  (``kv * diag(I)`` in ``dof_damping`` at each refresh); RK4 is explicit in both.
-* **Half turns.** ``r(q)`` flips when a joint's angle crosses pi, a jump of 2 pi in the lengths
-  between two refreshes. A joint within ``HALF_TURN_MARGIN`` of pi at a refresh gets its
-  stiffness term as a constant torque in ``qfrc_applied`` until the next refresh (zero-order
-  hold) and keeps the actuator damping. MuJoCo 4.0 also wraps a ball-joint position servo's
-  setpoint (gain = -bias[1]) to the representative nearest the current length, modulo
-  ``2 pi |g|``; at a refresh ``|g . e0| <= pi |g|``, so that never changes the torque there.
-* **Feed-forward.** :attr:`PDServo.feedforward` goes into ``qfrc_applied`` (ball DOFs) at each
-  refresh; nothing else of the servo writes ``qfrc_applied`` (but the half-turn hold above).
-* Optional torque limit: the actuators' ``forcerange``, set per refresh so that the torque
-  along each unit axis ``l_k / |l_k|`` stays within the limit. It clamps stiffness and damping
-  together, per Cholesky axis rather than per DOF (the same axes when ``I`` is diagonal).
+"""The inertia-scaled PD servo over every ball joint (Zordan & Hodgins 2002; Zordan et al. 2005),
+``tau = I (kp e - kv qdot)`` with ``I`` the outboard inertia block of the joint and
+``e = log(q^-1 q_d)``, run inside MuJoCo as the World's servo actuators so that a rollout steps
+``mj_step(nstep=k)`` between control ticks. Each World has at most one servo
+(:attr:`World.servo`); controllers set its targets, gains and feed-forward. Why it is built this
+way (actuator gears from a Cholesky factor, implicit damping, half turns): ``docs/design.md``.
 """
 
 from __future__ import annotations
@@ -69,12 +15,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, SimulationError, UnknownKeyError
-from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_log, quat_normalize
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.world import World
 
-__all__ = ["PDServo", "check_controller_args", "critical_kv"]
+__all__ = ["PDServo", "critical_kv"]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
@@ -84,18 +29,6 @@ def critical_kv(kp: float) -> float:
     """kv giving critical damping for ``kp`` on an isolated joint (``kv = 2 sqrt(kp)``):
     with tau = I (kp e - kv qdot) each joint behaves as a unit-mass oscillator."""
     return 2.0 * float(np.sqrt(kp))
-
-
-def check_controller_args(servo: PDServo, character: int, params: dict[str, float]) -> None:
-    """Constructor checks shared by the controllers that write a servo's feed-forward: every
-    value in ``params`` is finite and >= 0, and ``character`` is driven by ``servo``."""
-    for name, v in params.items():
-        if not (np.isfinite(v) and v >= 0):
-            raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
-    if character not in servo.character_indices:
-        raise ConfigError(
-            f"character {character} is not driven by the servo {servo.character_indices}"
-        )
 
 
 # conj(q) * qd == R @ q with R[i, j] = _RSIGN[i, j] * qd[_RIDX[i, j]] (Hamilton product)
@@ -113,13 +46,14 @@ def _right_matrix(qd: F64) -> F64:
 
 
 class PDServo:
-    """PD servo over the ball joints of some (default: all) characters of a World, run by the
-    World's servo actuators (see the module docstring).
+    """The PD servo of a World's characters, run by the World's servo actuators. A World has at
+    most one: use :attr:`World.servo`, which makes it on first use (constructing one directly
+    registers it as the World's).
 
     Args:
         world: the world.
-        kp: stiffness (1/s^2); kv: damping (1/s). Defaults: kp 900, kv critical (60).
-        characters: indices of the characters to actuate (default all).
+        kp: stiffness (1/s^2) of every joint; kv: damping (1/s; ``None``: critical). Both 0 by
+            default: the servo is inert until a controller sets gains (:meth:`set_gains`).
         torque_limit: optional torque limit (N m) per actuator axis, scalar.
         refresh_every: re-linearise (inertia, rotation vectors, gears, ``ctrl``) at least every
             this many steps; also before the first step after new targets, gains or state.
@@ -131,17 +65,15 @@ class PDServo:
     def __init__(
         self,
         world: World,
-        kp: float = 900.0,
+        kp: float = 0.0,
         kv: float | None = None,
-        characters: Sequence[int] | None = None,
         torque_limit: float | None = None,
         refresh_every: int = 4,
     ) -> None:
+        if world.has_servo:
+            raise ConfigError("this World already has a servo: use world.servo")
         self.world = world
-        idx = list(range(len(world.characters))) if characters is None else list(characters)
-        for i in idx:
-            if not 0 <= i < len(world.characters):
-                raise ConfigError(f"character index {i} outside 0..{len(world.characters) - 1}")
+        idx = list(range(len(world.characters)))
         self.character_indices = tuple(idx)
         n = NJ * len(idx)
         self.n = n
@@ -208,6 +140,8 @@ class PDServo:
         #: compensation or a balance controller's; ``(n, 3)``, written in place by controllers
         #: and copied into ``qfrc_applied`` at each refresh
         self.feedforward = np.zeros((n, 3))
+        self._kp_base = np.zeros(n)  # per-joint gains as set
+        self._kv_base = np.zeros(n)
         self._kp = np.zeros(n)  # per-joint effective gains (frozen, off)
         self._kv = np.zeros(n)
         self._enabled = np.ones(n, dtype=bool)
@@ -230,16 +164,26 @@ class PDServo:
         self._since = 0  # steps since the last refresh
         self._dirty = True
         self._epoch = world.state_epoch
-        self.set_gains(kp, critical_kv(kp) if kv is None else kv)
+        self.set_gains(kp, kv)
         self.set_targets_to_current()
+        world._servo = self
 
     # ------------------------------------------------------------------ configuration
-    def set_gains(self, kp: float, kv: float) -> None:
+    def set_gains(self, kp: float, kv: float | None = None, character: int | None = None) -> None:
+        """Stiffness ``kp`` (1/s^2) and damping ``kv`` (1/s; ``None``: critical) of one
+        character's joints, or of every character's."""
+        kv = critical_kv(kp) if kv is None else kv
         if not (np.isfinite(kp) and np.isfinite(kv) and kp >= 0 and kv >= 0):
             raise ConfigError(f"kp and kv must be finite and >= 0, got kp={kp!r}, kv={kv!r}")
-        self.kp = float(kp)
-        self.kv = float(kv)
+        rows = slice(None) if character is None else self._rows(character, None)
+        self._kp_base[rows] = float(kp)
+        self._kv_base[rows] = float(kv)
         self._refresh_gains()
+
+    def gains(self, character: int) -> tuple[float, float]:
+        """``(kp, kv)`` last set for ``character`` (before gain scales, freezes and switches)."""
+        row = int(self._rows(character, None)[0])
+        return float(self._kp_base[row]), float(self._kv_base[row])
 
     def set_gain_scale(self, character: int, joints: Sequence[str] | None, scale: float) -> None:
         """Multiply kp by ``scale`` (and kv by its square root, staying critical) for some
@@ -255,8 +199,8 @@ class PDServo:
     def _refresh_gains(self) -> None:
         scale = np.where(self._frozen, self.freeze_scale, 1.0) * self._gain_scale
         on = self._enabled | self._frozen
-        self._kp[:] = np.where(on, self.kp * scale, 0.0)
-        self._kv[:] = np.where(on, self.kv * np.sqrt(scale), 0.0)
+        self._kp[:] = np.where(on, self._kp_base * scale, 0.0)
+        self._kv[:] = np.where(on, self._kv_base * np.sqrt(scale), 0.0)
         self._write_gains()
         self._dirty = True
 
@@ -307,7 +251,33 @@ class PDServo:
 
     @property
     def frozen(self) -> NDArray[np.bool_]:
+        """``(n,)`` joints clamped by :meth:`freeze`."""
         return self._frozen.copy()
+
+    @property
+    def enabled(self) -> NDArray[np.bool_]:
+        """``(n,)`` joints the servo drives (not switched off by :meth:`enable`)."""
+        return self._enabled.copy()
+
+    @property
+    def hot(self) -> NDArray[np.bool_]:
+        """``(n,)`` joints near a half turn at the last refresh (stiffness held as a torque)."""
+        return self._hot.copy()
+
+    @property
+    def dof_indices(self) -> NDArray[np.intp]:
+        """``(3 n,)`` the ball-joint DOFs the servo drives, in its joint order."""
+        return self._didx.copy()
+
+    @property
+    def qpos_indices(self) -> NDArray[np.intp]:
+        """``(4 n,)`` the ball-joint quaternion entries of ``qpos``, in its joint order."""
+        return self._qidx.copy()
+
+    @property
+    def due(self) -> bool:
+        """Whether the next step re-linearises first (new targets, gains or state)."""
+        return self._due()
 
     # ------------------------------------------------------------------ targets
     def set_targets(self, character: int, quats: F64) -> None:
@@ -328,10 +298,6 @@ class PDServo:
 
     def set_targets_from_qpos(self, character: int, qpos: F64) -> None:
         self.set_targets(character, np.asarray(qpos)[7:].reshape(NJ, 4))
-
-    def set_targets_from_motion(self, character: int, motion: Motion, frame: int) -> None:
-        ch = self.world.characters[character].character
-        self.set_targets_from_qpos(character, ch.qpos_from_motion(motion, [frame])[0])
 
     def set_targets_to_current(self) -> None:
         q = quat_normalize(self.world.data.qpos[self._qidx].reshape(self.n, 4))

@@ -1,28 +1,7 @@
-"""Predictive sampling on top of the whole-body tracker: look ahead with MuJoCo itself.
-
-Why: :class:`~reactmocap.sim.wholebody.WholeBodyTracker` is greedy. Each tick it does the best
-it can with the feet already on the ground, so an error that only a different action 0.2 s
-earlier could have prevented (a walk drifting sideways in single support, a run landing low
-after its flight) is caught too late. Model-predictive control fixes this by simulating ahead.
-This is the *predictive sampling* planner of MuJoCo MPC (Howell et al. 2022), with the tracker
-as the policy being perturbed:
-
-* every ``segment`` seconds, from the current state, roll the world forward ``horizon``
-  seconds under the tracker for ``samples`` candidate values of the tracker's
-  :attr:`~reactmocap.sim.wholebody.WholeBodyTracker.root_bias` (an extra pelvis acceleration
-  request, 6-D, held over the horizon): the last choice, zero, and Gaussian perturbations of
-  the last choice;
-* score each by the pelvis's distance from the mocap every ``cost_dt`` seconds, in units of
-  the tracking tolerances (:data:`POSITION_SCALE`, :data:`ANGLE_SCALE`), plus
-  :data:`FALL_PENALTY` for each sample where the pelvis is below half its start height;
-* restore the state and track with the cheapest candidate until the next segment.
-
-Only the tracker's joint torques reach the simulation: the result is as physical as the
-tracker's. The candidates come from a generator seeded at construction, so runs are
-deterministic. The predictions hold the external forces of the current step (a running push
-is assumed to go on; a future one is not known). Cost: ``samples * horizon / segment`` times
-the tracker's (40x with the defaults).
-"""
+"""Predictive sampling (MuJoCo MPC, Howell et al. 2022) on top of the whole-body tracker: every
+``segment`` seconds, simulate ``samples`` candidate pelvis requests ``horizon`` seconds ahead with
+MuJoCo itself, keep the cheapest. Only the tracker's joint torques act. Why and how it was
+tuned: ``docs/design.md``."""
 
 from __future__ import annotations
 
@@ -32,8 +11,8 @@ from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from reactmocap.sim.pd import check_controller_args
-from reactmocap.sim.wholebody import WholeBodyPlan, WholeBodyTracker
+from reactmocap.sim.controllers.base import check_params
+from reactmocap.sim.controllers.wholebody import WholeBodyPlan, WholeBodyTracker
 from reactmocap.sim.world import World
 
 __all__ = ["ANGLE_SCALE", "FALL_PENALTY", "POSITION_SCALE", "PredictiveTracker"]
@@ -67,19 +46,17 @@ def _diverged_count(d: mujoco.MjData) -> NDArray[np.int64]:
 
 
 class PredictiveTracker:
-    """Controller ``f(world, t)``: ``tracker`` with its pelvis request chosen by predictive
-    sampling (see the module docstring). Called every control tick in place of the tracker.
+    """``tracker`` with its pelvis request chosen by predictive sampling (see the module
+    docstring); it ticks with the tracker, in its place.
 
     Args:
-        tracker: the whole-body tracker to steer (its servo steps the predictions).
+        tracker: the whole-body tracker to steer.
         segment: seconds between plans (each plan's choice is held this long).
         horizon: seconds each candidate is simulated ahead (>= ``segment``).
         samples: candidates per plan (>= 2: the last choice and zero come first).
         sigma_position, sigma_rotation: standard deviation of the perturbations of the
             pelvis request (m/s^2 linear, rad/s^2 angular).
         cost_dt: seconds between scored samples of a prediction.
-        control_every: physics steps between the tracker's ticks in the predictions (use
-            the rollout's).
         seed: seed of the candidate generator.
 
     Defaults were chosen on the benchmark windows (``benchmarks/bench_sim.py``): the defaults
@@ -97,7 +74,6 @@ class PredictiveTracker:
         sigma_position: float = 1.0,
         sigma_rotation: float = 10.0,
         cost_dt: float = 0.05,
-        control_every: int = 4,
         seed: int = 0,
     ) -> None:
         dt = tracker.world.timestep
@@ -108,19 +84,13 @@ class PredictiveTracker:
             raise ConfigError(f"horizon ({horizon} s) must be at least segment ({segment} s)")
         if samples < 2:
             raise ConfigError(f"samples must be >= 2 (the last choice and zero), got {samples!r}")
-        check_controller_args(
-            tracker.servo,
-            tracker.character,
-            {"sigma_position": sigma_position, "sigma_rotation": sigma_rotation},
-        )
-        if control_every < 1:
-            raise ConfigError(f"control_every must be >= 1, got {control_every!r}")
+        check_params({"sigma_position": sigma_position, "sigma_rotation": sigma_rotation})
         self.tracker = tracker
         self.world = tracker.world
-        self.servo = tracker.servo
         self.segment = float(segment)
         self.samples = int(samples)
-        self.every = int(control_every)
+        self.control_every = tracker.control_every
+        self.seed = int(seed)
         self.sigma = np.r_[np.full(3, sigma_position), np.full(3, sigma_rotation)]
         self._rng = np.random.default_rng(seed)
         self._horizon_steps = round(horizon / dt)
@@ -163,13 +133,14 @@ class PredictiveTracker:
         total = 0.0
         k = 0
         while k < self._horizon_steps:
-            if k % self.every == 0:
+            if k % self.control_every == 0:
                 try:
-                    self.tracker(self.world, t + k * dt)
+                    self.tracker.control(self.world, t + k * dt)
                 except SimulationError:
                     return np.inf
-            n = min(self.every - k % self.every, self._cost_steps - k % self._cost_steps)
-            self.servo.step(n)
+            every = self.control_every
+            n = min(every - k % every, self._cost_steps - k % self._cost_steps)
+            self.world.step(n)
             k += n
             # MuJoCo resets a diverged simulation (rewinding the clock) and counts a warning
             if d.time < t0 + (k - 0.5) * dt or self._diverged(d):
@@ -204,9 +175,16 @@ class PredictiveTracker:
         self.last_costs = costs
         self.choice = candidates[int(np.argmin(costs))].copy()
 
-    def __call__(self, world: World, t: float) -> None:
+    def reset(self, world: World) -> None:
+        self.tracker.reset(world)
+        self._rng = np.random.default_rng(self.seed)
+        self._next = 0.0
+        self.choice = np.zeros(6)
+        self._z0 = float(world.data.qpos[self._qpos][2])
+
+    def control(self, world: World, t: float) -> None:
         if t >= self._next - 1e-9:
             self._next = t + self.segment
             self.plan(t)
         self.tracker.root_bias[:] = self.choice
-        self.tracker(world, t)
+        self.tracker.control(world, t)

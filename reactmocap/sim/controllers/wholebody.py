@@ -1,42 +1,9 @@
-"""Whole-body mocap tracking by inverse dynamics with optimised ground forces.
-
-Why: a joint PD servo (even with :class:`~reactmocap.sim.balance.StanceBalance`) has no model
-of what the ground can push, so the unactuated pelvis drifts whenever the simulated feet do
-not land exactly as the actor's did. This controller is the standard fix of model-based
-trackers (Macchietto et al. 2009, Lee et al. 2010, Muico et al. 2009): at each control tick it
-solves a small quadratic program for the accelerations ``qdd`` of *all* DOFs (pelvis
-included) and the ground forces ``f`` at the sole corners,
-
-    min  ||W (qdd - qdd_des)||^2 + w_c ||J_c qdd + Jdot_c qdot + k_c v_c||^2 + lam ||beta||^2
-    s.t. M_root qdd + h_root = (J_c^T F beta)_root      (the pelvis moves only by ground forces)
-         beta >= 0                                       (friction pyramid, no pulling)
-
-with ``qdd_des = qdd_mocap + kp (q_mocap - q) + kv (qdot_mocap - qdot)`` for every DOF, and
-sets the joint torques to ``tau = (M qdd + h - J_c^T F beta)_joints``. ``J_c`` are the sole
-corners in contact (penetrating the floor in the simulation, as MuJoCo's own box-plane contacts
-are) of the feet planted in the mocap; the heavily weighted ``w_c`` term keeps those corners
-still in all three directions, so the planned forces are the ones the contact will produce
-and pelvis corrections are made by the stance legs. Only joint torques are applied: the
-result is physical.
-
-**Pivots.** While the actor spins on a planted foot (its yaw rate above ``pivot_rate``), that
-foot touches the floor through its ball-of-foot patch instead of its box (see
-:meth:`~reactmocap.sim.world.World.set_foot_patch`): one contact point with little torsional
-friction and a rolling arm, so the foot can turn as the actor's does. The plan models the patch
-the same way: a friction pyramid at the point (no yaw moment), pure normal forces at
-``PATCH_ROLL`` either side of it along the foot's axes (the centre-of-pressure range), and
-no-slip rows for the point's translation and the foot's roll and pitch, not its yaw. A flat box
-foot under friction 1.0 could not follow the kick clip's pivots (up to 190 degrees in 0.25 s),
-and the body twisted off the mocap.
-
-Solved without a general QP library: for fixed ``beta`` the joint accelerations are an
-unconstrained least-squares problem, so they are projected out with one QR and the remaining
-non-negative least squares in ``beta`` (at most 32 unknowns) goes to ``scipy.optimize.nnls``.
-
-The PD servo still runs inside MuJoCo every step as the local stabiliser: the controller
-writes ``tau - tau_servo`` as feed-forward, so at each tick the total equals ``tau`` and
-between ticks the servo's implicit stiffness and damping act on whatever changed since.
-"""
+"""Whole-body mocap tracking by inverse dynamics with optimised ground forces (Macchietto et al.
+2009, Lee et al. 2010, Muico et al. 2009): each tick a small least-squares program for every
+DOF's acceleration (the pelvis moved only by ground forces at the sole corners in contact,
+inside friction pyramids), realised as joint torques. Only joint torques act: the result is
+physical. A foot pivoting in the mocap touches through its ball-of-foot patch. The program,
+and why: ``docs/design.md``."""
 
 from __future__ import annotations
 
@@ -50,12 +17,14 @@ from scipy.optimize import nnls
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from reactmocap.sim.balance import foot_soles, sole_corners_world
 from reactmocap.sim.character import BALL_JOINTS
-from reactmocap.sim.pd import PDServo, check_controller_args, critical_kv
+from reactmocap.sim.controllers.base import check_character, check_params
+from reactmocap.sim.feet import foot_soles, sole_corners_world
+from reactmocap.sim.reference import ReferencePath, reference_path
+from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
 
-__all__ = ["ReferencePath", "WholeBodyPlan", "WholeBodyTracker", "reference_path"]
+__all__ = ["WholeBodyPlan", "WholeBodyTracker"]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
@@ -102,112 +71,11 @@ class WholeBodyPlan:
     generalized_contact: F64
 
 
-def hemisphere_continuous(q: F64) -> F64:
-    """Flip quaternions ``(T, ..., 4)`` so consecutive frames lie in one hemisphere."""
-    q = q.copy()
-    flips = np.cumsum(np.sum(q[1:] * q[:-1], axis=-1) < 0, axis=0) % 2
-    q[1:] *= (1 - 2 * flips)[..., None]
-    return q
-
-
-def _velocity(q: F64, fps: float) -> F64:
-    """``(T, 51)`` MuJoCo ``qvel`` (root linear in world, angular in the local frames) of a
-    ``(T, 67)`` qpos path, by central differences."""
-    n = q.shape[0]
-    if n < 2:
-        return np.zeros((n, NV))
-    quats = q[:, 3:].reshape(n, NJ + 1, 4)
-    lo = np.r_[0, np.arange(n - 1)]
-    hi = np.r_[np.arange(1, n), n - 1]
-    span = (hi - lo)[:, None] / fps
-    lin = (q[hi, :3] - q[lo, :3]) / span
-    rel = quat_mul(quat_conj(quats[lo]), quats[hi])
-    rel *= np.where(rel[..., :1] < 0, -1.0, 1.0)
-    ang = quat_log(rel) / span[:, :, None]
-    return np.concatenate([lin, ang.reshape(n, -1)], axis=1)
-
-
-@dataclass(frozen=True)
-class ReferencePath:
-    """A clip as the whole-body tracker follows it on one character, per clip frame (read-only
-    arrays): ``q`` ``(T, 67)`` qpos with hemisphere-continuous quaternions, ``v`` ``(T, 51)``
-    qvel and ``a`` ``(T, 51)`` qacc by central differences, ``planted`` ``(T, 2)`` the feet
-    (left, right) whose sole is within ``reach`` of the floor, ``pivoting`` ``(T, 2)`` the
-    planted feet turning faster than ``pivot_rate``; ``fps`` the clip's rate."""
-
-    q: F64
-    v: F64
-    a: F64
-    planted: NDArray[np.bool_]
-    pivoting: NDArray[np.bool_]
-    fps: float
-
-    def sample(self, x: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
-        """``q``, ``v``, ``a`` interpolated linearly at fractional frame ``x`` (clamped to
-        the clip; quaternions renormalised) and ``planted`` at the nearest frame."""
-        x = min(max(x, 0.0), len(self.q) - 1.0)
-        i0 = int(x)
-        i1 = min(i0 + 1, len(self.q) - 1)
-        w = x - i0
-        q = (1 - w) * self.q[i0] + w * self.q[i1]
-        quats = q[3:].reshape(NJ + 1, 4)
-        quats /= np.linalg.norm(quats, axis=1, keepdims=True)
-        v = (1 - w) * self.v[i0] + w * self.v[i1]
-        acc = (1 - w) * self.a[i0] + w * self.a[i1]
-        return q, v, acc, self.planted[round(x)]
-
-
-def reference_path(
-    world: World,
-    character: int,
-    motion: Motion,
-    *,
-    reach: float = 0.05,
-    pivot_rate: float | None = 2.0,
-) -> ReferencePath:
-    """``motion`` mapped onto ``world``'s ``character`` as a :class:`ReferencePath`, with the
-    mocap's foot stance measured on the character's own sole boxes (``pivot_rate`` rad/s,
-    ``None``: no pivots)."""
-    for name, value in (
-        ("reach", reach),
-        ("pivot_rate", 0.0 if pivot_rate is None else pivot_rate),
-    ):
-        if not (np.isfinite(value) and value >= 0):
-            raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
-    m = world.model
-    wc = world.characters[character]
-    _, sole_ids, corners = foot_soles(world, character, "reference_path")
-    floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
-    q = wc.character.qpos_from_motion(motion)
-    n = motion.num_frames
-    q[:, 3:] = hemisphere_continuous(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
-    v = _velocity(q, motion.fps)
-    a = np.gradient(v, 1.0 / motion.fps, axis=0) if n > 2 else np.zeros_like(v)
-    d = mujoco.MjData(m)
-    sole = np.empty((n, 2))
-    yaw = np.empty((n, 2))
-    for i in range(n):  # once per clip, not in the step loop
-        d.qpos[wc.qpos_slice] = q[i]
-        mujoco.mj_kinematics(m, d)
-        sole[i] = sole_corners_world(d, sole_ids, corners).min(axis=1)[:, 2] - floor_z
-        rot = d.geom_xmat[sole_ids].reshape(2, 3, 3)
-        yaw[i] = np.arctan2(rot[:, 1, 0], rot[:, 0, 0])
-    planted = sole < reach
-    rate = np.zeros((n, 2))
-    if n > 1:
-        rate = np.abs(np.gradient(np.unwrap(yaw, axis=0), 1.0 / motion.fps, axis=0))
-    pivoting = planted & (rate > (np.inf if pivot_rate is None else float(pivot_rate)))
-    arrays = (q, v, a, planted, pivoting)
-    for arr in arrays:
-        arr.flags.writeable = False
-    return ReferencePath(*arrays, fps=float(motion.fps))
-
-
 class WholeBodyTracker:
-    """Controller ``f(world, t)`` tracking ``motion`` from clip time ``start`` with inverse
-    dynamics and optimised ground forces (see the module docstring). Writes
-    ``servo.feedforward`` for one character; use it together with a
-    :class:`~reactmocap.sim.rollout.MotionTracker` on the same servo, called first.
+    """Tracks ``reference`` from clip time ``start`` with inverse dynamics and optimised ground
+    forces (see the module docstring), through the servo's feed-forward of one character. The
+    servo itself is damping only (``servo_kv``, inertia-scaled): its stiffness, held between
+    ticks against a moving target, fought the plan.
 
     Args:
         kp_root, kv_root: pelvis position gains (1/s^2, 1/s; kv critical by default).
@@ -228,25 +96,25 @@ class WholeBodyTracker:
         force_reg: ``lam``, the regulariser on the pyramid coefficients (relative).
         pivot_rate: a planted foot pivots (touches through its ball patch) while the mocap
             foot's yaw rate is above this (rad/s); ``None``: feet never pivot. Measured on the
-            benchmark windows: 80% tracked with 2.0 or 3.0, 74% without pivots.
+            benchmark windows: 80% tracked with 2.0 or 3.0, 74% without pivots. With a
+            :class:`ReferencePath` given, its own ``planted`` and ``pivoting`` are used.
+        servo_kv: the servo's damping (1/s).
 
-    Defaults were chosen on the shared walk, run and kick clips (``benchmarks/bench_sim.py``);
-    the servo should be damping-only (``kp=0``): its stiffness, held between ticks against a
-    moving target, fought the plan (see ``track_clip``).
+    Defaults were chosen on the shared walk, run and kick clips (``benchmarks/bench_sim.py``).
     """
 
     def __init__(
         self,
-        servo: PDServo,
+        world: World,
         character: int,
-        motion: Motion,
+        reference: Motion | ReferencePath,
         start: float = 0.0,
         *,
         kp_root: float = 100.0,
         kv_root: float | None = None,
         kp_rot: float = 500.0,
         kv_rot: float | None = None,
-        kp_joint: float = 1000.0,
+        kp_joint: float,
         kv_joint: float | None = None,
         root_weight: float = 30.0,
         contact_weight: float = 1e4,
@@ -256,26 +124,28 @@ class WholeBodyTracker:
         touch: float = 0.0,
         force_reg: float = 1e-6,
         pivot_rate: float | None = 2.0,
+        servo_kv: float,
+        control_every: int,
     ) -> None:
-        check_controller_args(
-            servo,
-            character,
+        check_character(world, character)
+        check_params(
             {
                 "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint,
                 "root_weight": root_weight, "contact_weight": contact_weight,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
-                "force_reg": force_reg,
-                "pivot_rate": 0.0 if pivot_rate is None else pivot_rate,
+                "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
+                "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint,
             },
         )  # fmt: skip
-        world = servo.world
+        servo = world.servo
         m = world.model
         if np.any(m.opt.gravity[:2]):
             raise ConfigError("WholeBodyTracker assumes vertical gravity")
         self.servo = servo
         self.world = world
         self.character = character
-        self.start = float(start)
+        self.servo_kv = float(servo_kv)
+        self.control_every = int(control_every)
         wc = world.characters[character]
         self.wc = wc
         kvj = critical_kv(kp_joint) if kv_joint is None else float(kv_joint)
@@ -303,7 +173,7 @@ class WholeBodyTracker:
         self.patch = wc.patch_ids
         self.patch_half = m.geom_size[self.patch, 2].copy()
         self.patch_arm = m.geom_friction[self.patch, 2].copy()
-        rows = servo.character_indices.index(character) * NJ
+        rows = character * NJ
         self._ff = servo.feedforward[rows : rows + NJ]  # (15, 3) view
         self._servo_rows = slice(rows, rows + NJ)
         edges = np.column_stack([self.mu * _PYRAMID, np.ones(4)])  # (4, 3)
@@ -311,20 +181,22 @@ class WholeBodyTracker:
         self.last_plan: WholeBodyPlan | None = None
         #: ``(6,)`` extra pelvis acceleration asked of the plan (world linear m/s^2, local
         #: angular rad/s^2), on top of its feedback; set by
-        #: :class:`~reactmocap.sim.predictive.PredictiveTracker`, zero otherwise
+        #: :class:`~reactmocap.sim.controllers.predictive.PredictiveTracker`, zero otherwise
         self.root_bias = np.zeros(6)
         #: the clip as this tracker follows it
-        self.path = reference_path(world, character, motion, reach=reach, pivot_rate=pivot_rate)
+        self.path = (
+            reference
+            if isinstance(reference, ReferencePath)
+            else reference_path(world, character, reference, reach=reach, pivot_rate=pivot_rate)
+        )
+        self.clock = self.path.clock(start)
         self.release()
 
     # ------------------------------------------------------------------ reference
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
         the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
-        return self.path.sample(self._frame(t))
-
-    def _frame(self, t: float) -> float:
-        return min(max((self.start + t) * self.path.fps, 0.0), len(self.path.q) - 1.0)
+        return self.path.sample(self.clock.frame(t))
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
@@ -478,8 +350,14 @@ class WholeBodyTracker:
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
 
-    def __call__(self, world: World, t: float) -> None:
-        pivoting = self.path.pivoting[round(self._frame(t))]
+    def reset(self, world: World) -> None:
+        servo = world.servo
+        servo.enable(self.character, on=True)
+        servo.set_gains(0.0, self.servo_kv, self.character)
+        servo.refresh_every = self.control_every
+
+    def control(self, world: World, t: float) -> None:
+        pivoting = self.path.pivoting[self.clock.nearest(t)]
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(pivoting[f]))
         plan = self.plan(t)

@@ -34,6 +34,7 @@ from reactmocap.errors import UnknownKeyError
 
 __all__ = [
     "CAPTION_TOTAL_MASS",
+    "MASS_FRACTIONS",
     "PART_DENSITY",
     "REFERENCE_PARTS",
     "SEGMENT_TO_PART",
@@ -263,3 +264,15 @@ def _part_density() -> dict[str, float]:
 #: segment density per canonical part kind (kg/m^3), from the Dempster & Gaughran values the
 #: thesis prints (identical for both sexes)
 PART_DENSITY: MappingProxyType[str, float] = MappingProxyType(_part_density())
+
+
+def _mean_fractions() -> dict[str, float]:
+    tables = [part_mass_fractions(s) for s in SEXES]
+    out = {p: sum(t[p] for t in tables) / len(tables) for p in REFERENCE_PARTS}
+    total = sum(out.values())
+    return {p: v / total for p, v in out.items()}
+
+
+#: the one mass-fraction table: fraction of total body mass in each canonical body part, the
+#: mean of the thesis's male and female tables (sums to 1)
+MASS_FRACTIONS: MappingProxyType[str, float] = MappingProxyType(_mean_fractions())

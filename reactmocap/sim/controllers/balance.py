@@ -1,30 +1,7 @@
-"""Balance for mocap tracking: gravity compensation plus a virtual force and torque realised by
-the stance legs (Jacobian transpose), added to the PD servo as feed-forward torques.
-
-Why: an inertia-scaled joint PD servo has no notion of balance, and its gains follow the
-*outboard* inertia, which for a stance knee or ankle is a shin and a foot while the load is the
-whole body: a stance leg sags under gravity and the character slowly topples (the guard clip
-fell after 1.4 s). This is the standard fix of Zordan & Hodgins (2002) and Coros et al. (2010),
-and the thesis's balance controller (ch. 7) in Jacobian form:
-
-* **Gravity compensation:** every ball joint gets MuJoCo's bias force ``qfrc_bias`` (gravity
-  plus Coriolis of everything outboard), i.e. the torque that holds its limb up.
-* **Support and COM servo:** the ground force the body needs,
-  ``F = M (g + a_d + kp_c (c_d - c) + kv_c (v_d - v))`` with ``c_d, v_d, a_d`` the mocap centre
-  of mass, is split between the feet touching the ground and produced by the legs alone:
-  ``tau = -J_foot^T F_foot`` (columns of the leg's ball joints), clamped inside the friction
-  cone. Horizontal COM error is therefore corrected by pushing on the ground, as a person does.
-* **Trunk orientation:** a torque ``T = I (kp_o e - kv_o w)`` toward the mocap pelvis
-  orientation. The feet's moments supply ``T`` minus the moment the support forces already
-  make about the COM (centroidal balance), clipped to what a sole can pass on (centre of
-  pressure on the sole), through the rotational foot Jacobians.
-* **Velocity feed-forward:** ``kv I w_d`` with ``w_d`` the mocap joint angular velocity, so
-  the servo damps toward the mocap's joint velocity instead of toward rest (the lag of
-  ``kv/kp * w_d`` otherwise, about 0.15 rad for a swinging leg).
-
-Only internal joint torques are used: nothing is applied to the root, so the result stays
-physical (compare :class:`reactmocap.sim.rollout.RootAssist`, which is not).
-"""
+"""Stance balance for mocap tracking (Zordan & Hodgins 2002; Coros et al. 2010; the thesis's
+ch. 7 in Jacobian form): gravity compensation, a centre-of-mass servo and a trunk orientation
+servo realised by the stance legs as feed-forward torques on top of the PD servo. Only joint
+torques act, so the result is physical. Details: ``docs/design.md``."""
 
 from __future__ import annotations
 
@@ -35,40 +12,17 @@ from numpy.typing import NDArray
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.pd import PDServo, check_controller_args, critical_kv
+from reactmocap.sim.character import BALL_JOINTS
+from reactmocap.sim.controllers.base import check_character, check_params
+from reactmocap.sim.feet import foot_soles, sole_corners_world
+from reactmocap.sim.reference import ReferencePath, reference_path
+from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
 
-__all__ = ["StanceBalance", "foot_soles", "sole_corners_world"]
+__all__ = ["StanceBalance"]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
-_FEET = ("l_foot", "r_foot")
-
-
-def foot_soles(
-    world: World, character: int, who: str
-) -> tuple[NDArray[np.int64], NDArray[np.int64], F64]:
-    """A character's feet: body ids ``(2,)`` (left, right), their sole box geoms ``(2,)`` and
-    the four sole corners of each box in the box frame ``(2, 4, 3)``. ``who`` names the caller
-    in the error when a foot has no single box."""
-    m = world.model
-    wc = world.characters[character]
-    feet = np.array([wc.body_ids[SIM_BODIES.index(f)] for f in _FEET])
-    sole = wc.sole_ids
-    if sole.shape != (2,) or np.any(m.geom_type[sole] != mujoco.mjtGeom.mjGEOM_BOX):
-        raise ConfigError(f"{who} needs a sole box geom per foot")
-    signs = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=np.float64)
-    corners = np.stack(
-        [np.column_stack([signs * h[:2], np.full(4, -h[2])]) for h in m.geom_size[sole]]
-    )
-    return feet, sole, corners
-
-
-def sole_corners_world(d: mujoco.MjData, sole: NDArray[np.int64], corners: F64) -> F64:
-    """``(2, 4, 3)`` world positions of the sole corners from :func:`foot_soles`."""
-    rot = d.geom_xmat[sole].reshape(2, 3, 3)
-    return np.einsum("fij,fkj->fki", rot, corners) + d.geom_xpos[sole][:, None]
 
 
 def _cross(a: F64, b: F64) -> F64:
@@ -79,14 +33,12 @@ def _cross(a: F64, b: F64) -> F64:
 
 
 class StanceBalance:
-    """Controller ``f(world, t)`` that writes balance feed-forward torques into
-    ``servo.feedforward`` for one character tracking ``motion`` from clip time ``start``.
+    """Writes balance feed-forward torques into the servo of one ``character`` tracking
+    ``reference`` from clip time ``start``; use it after a PD tracker of the same character.
 
     A foot supports when it touches the floor in the simulation *and* is planted in the mocap
     at that time (sole within ``reach`` m of the floor, moving slower than 0.6 m/s): the
     mocap's contact timing keeps a swing foot that brushes the floor from taking weight.
-    Runs at the control rate; per call a few small numpy operations and one ``mj_jac`` per
-    supporting foot.
 
     Args:
         kp_com, kv_com: horizontal COM servo gains (1/s^2, 1/s); kp_height for the vertical.
@@ -95,13 +47,15 @@ class StanceBalance:
         stance_gain_scale: servo stiffness multiplier (damping by its square root) for the
             hip, knee and ankle of a supporting leg: their inertia-scaled gains follow a thigh,
             shin or foot, while the load is the whole body (a landing knee buckled ~30 deg).
+        velocity_feedforward: add ``kv I w_d`` so the servo damps toward the mocap's joint
+            velocity instead of toward rest.
     """
 
     def __init__(
         self,
-        servo: PDServo,
+        world: World,
         character: int,
-        motion: Motion,
+        reference: Motion | ReferencePath,
         start: float = 0.0,
         *,
         kp_com: float = 100.0,
@@ -113,23 +67,23 @@ class StanceBalance:
         reach: float = 0.02,
         velocity_feedforward: bool = True,
         stance_gain_scale: float = 16.0,
+        control_every: int,
     ) -> None:
-        check_controller_args(
-            servo,
-            character,
+        check_character(world, character)
+        check_params(
             {
-                "kp_com": kp_com, "kp_height": kp_height, "kp_rot": kp_rot, "friction": friction,
-                "reach": reach, "stance_gain_scale": stance_gain_scale,
+                "kp_com": kp_com, "kv_com": kv_com, "kp_height": kp_height, "kp_rot": kp_rot,
+                "kv_rot": kv_rot, "friction": friction, "reach": reach,
+                "stance_gain_scale": stance_gain_scale,
             },
         )  # fmt: skip
         if stance_gain_scale <= 0:
             raise ConfigError(f"stance_gain_scale must be > 0, got {stance_gain_scale!r}")
-        world = servo.world
+        servo = world.servo
         self.servo = servo
         self.world = world
         self.character = character
-        self.motion = motion
-        self.start = float(start)
+        self.control_every = int(control_every)
         kv_h = critical_kv(kp_com) if kv_com is None else float(kv_com)
         self.kp = np.array([kp_com, kp_com, kp_height], dtype=np.float64)
         self.kv = np.array([kv_h, kv_h, critical_kv(kp_height)])
@@ -150,7 +104,7 @@ class StanceBalance:
         self.feet, self.sole, self._corners = foot_soles(world, character, "StanceBalance")
         self.floor_geoms = np.flatnonzero(m.geom_bodyid == 0)
         self.mu = float(world.config.friction)
-        rows = servo.character_indices.index(character) * NJ
+        rows = character * NJ
         self._ff = servo.feedforward[rows : rows + NJ].reshape(-1)  # (45,) view
         self._dofs = slice(wc.ball_dof_start, wc.ball_dof_start + 3 * NJ)
         self._jacp = np.zeros((3, m.nv))
@@ -162,19 +116,25 @@ class StanceBalance:
         self._weight = m.body_subtreemass[self._child] * self.gravity[2]  # (15,) N
         self._tau = np.zeros((NJ, 3))
         self._tau_local = np.empty((NJ, 3))
-        self._reference(motion)
+        path = (
+            reference
+            if isinstance(reference, ReferencePath)
+            else reference_path(world, character, reference)
+        )
+        self.clock = path.clock(start)
+        self._reference(path)
 
-    def _sole_heights(self, d: mujoco.MjData) -> F64:
-        """``(2,)`` lowest sole corner of each foot above the floor (m)."""
-        return sole_corners_world(d, self.sole, self._corners)[:, :, 2].min(axis=1)
+    def reset(self, world: World) -> None:
+        del world
+        self._stance = ()
 
-    def _reference(self, motion: Motion) -> None:
-        """Mocap COM (position, velocity, acceleration), pelvis orientation and foot stance
-        per frame."""
+    def _reference(self, path: ReferencePath) -> None:
+        """Mocap COM (position, velocity, acceleration), pelvis orientation, foot stance and
+        joint velocities per frame."""
         m = self.world.model
         d = mujoco.MjData(m)
-        q = self.wc.character.qpos_from_motion(motion)
-        n = motion.num_frames
+        q = path.q
+        n = path.num_frames
         com = np.empty((n, 3))
         sole = np.empty((n, 2))
         foot = np.empty((n, 2, 3))
@@ -183,9 +143,9 @@ class StanceBalance:
             mujoco.mj_kinematics(m, d)
             mujoco.mj_comPos(m, d)
             com[i] = d.subtree_com[self.root]
-            sole[i] = self._sole_heights(d)
+            sole[i] = sole_corners_world(d, self.sole, self._corners)[:, :, 2].min(axis=1)
             foot[i] = d.xpos[self.feet]
-        h = 1.0 / motion.fps
+        h = 1.0 / path.fps
         grad = (lambda a: np.gradient(a, h, axis=0)) if n > 2 else (lambda a: 0.0 * a)
         self.com = com
         self.com_vel = grad(com)
@@ -193,25 +153,14 @@ class StanceBalance:
         speed = np.linalg.norm(grad(foot), axis=-1)
         self.planted = (sole < self.reach) & (speed < 0.6)  # (n, 2)
         self.root_quat = q[:, 3:7]
-        # ball-joint angular velocities (child frame) for the servo's velocity feed-forward
-        bq = q[:, 7:].reshape(n, NJ, 4)
-        if n > 1:
-            dq = quat_mul(quat_conj(bq[:-1]), bq[1:])
-            dq *= np.where(dq[..., :1] < 0, -1.0, 1.0)  # shortest arc
-            rel = quat_log(dq) * motion.fps
-            self.joint_vel = np.concatenate([rel, rel[-1:]], axis=0)
-        else:
-            self.joint_vel = np.zeros((n, NJ, 3))
+        self.joint_vel = path.v[:, 6:].reshape(n, NJ, 3)
 
     def _sample(self, t: float) -> tuple[F64, F64, F64, F64, NDArray[np.bool_], F64]:
         """Mocap COM position, velocity, acceleration, pelvis rotation, planted feet and
         joint velocities at rollout time ``t``."""
-        x = min(max((self.start + t) * self.motion.fps, 0.0), self.motion.num_frames - 1.0)
-        i0 = int(x)
-        i1 = min(i0 + 1, self.motion.num_frames - 1)
-        a = x - i0
+        i0, i1, a = self.clock.bracket(t)
         lerp = lambda arr: (1 - a) * arr[i0] + a * arr[i1]  # noqa: E731
-        i = round(x)
+        i = round(i0 + a)
         return (
             lerp(self.com), lerp(self.com_vel), lerp(self.com_acc), self.root_quat[i],
             self.planted[i], self.joint_vel[i0],
@@ -241,7 +190,7 @@ class StanceBalance:
             points.append(p)
         return feet, points
 
-    def __call__(self, world: World, t: float) -> None:
+    def control(self, world: World, t: float) -> None:
         m, d = world.model, world.data
         ff = self._ff
         # gravity compensation: the torque that holds each joint's subtree up,
@@ -257,7 +206,9 @@ class StanceBalance:
         c_d, v_d, a_d, q_d, planted, wd = self._sample(t)
         if self.velocity_feedforward:
             inertia = self.servo.joint_inertia(self.character)
-            ff += (self.servo.kv * np.einsum("nij,nj->ni", inertia, wd)).reshape(-1)
+            ff += (
+                self.servo.gains(self.character)[1] * np.einsum("nij,nj->ni", inertia, wd)
+            ).reshape(-1)
         feet, points = self._support_points(planted)
         if tuple(feet) != self._stance and self.stance_gain_scale != 1.0:
             for k, leg in enumerate(self._legs):

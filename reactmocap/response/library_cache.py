@@ -1,0 +1,131 @@
+"""Clip libraries and their search indexes for the response pipeline, loaded once and kept in a
+:class:`LibraryCache` that its caller owns (a batch job holds one per worker). Clips on other
+skeletons than the recipient's are retargeted onto it, so any clip can be the continuation."""
+
+from __future__ import annotations
+
+import hashlib
+from collections import OrderedDict
+from pathlib import Path
+from typing import Generic, TypeVar
+
+import numpy as np
+
+from reactmocap import __version__
+from reactmocap.library.clip_library import (
+    ClipLibrary,
+    default_cache_dir,
+    find_bvh_files,
+    load_library,
+)
+from reactmocap.library.motion import Motion
+from reactmocap.search import MotionIndex, SearchWeights, WindowConfig
+from reactmocap.search.index import FORMAT_VERSION as INDEX_FORMAT_VERSION
+from reactmocap.sim.character import build_character
+from reactmocap.sim.retarget import Retargeter
+
+__all__ = ["RETARGET_VERSION", "LibraryCache", "prepare_library"]
+
+#: bump when retargeting changes, so indexes of retargeted clips are rebuilt
+RETARGET_VERSION = 1
+K = TypeVar("K")
+V = TypeVar("V")
+
+
+class _Lru(Generic[K, V]):
+    def __init__(self, size: int) -> None:
+        self.size = size
+        self.items: OrderedDict[K, V] = OrderedDict()
+
+    def get(self, key: K) -> V | None:
+        if key in self.items:
+            self.items.move_to_end(key)
+            return self.items[key]
+        return None
+
+    def put(self, key: K, value: V) -> V:
+        self.items[key] = value
+        self.items.move_to_end(key)
+        while len(self.items) > self.size:
+            self.items.popitem(last=False)
+        return value
+
+
+class LibraryCache:
+    """The last ``size`` clip libraries (keyed by their files' names, sizes and mtimes: a batch
+    runs many responses over one library, and re-hashing every file costs ~45 ms) and search
+    indexes (keyed by content and recipient skeleton; also cached on disk) a caller used."""
+
+    def __init__(self, size: int = 4) -> None:
+        self._libraries: _Lru[tuple[object, ...], ClipLibrary] = _Lru(size)
+        self._indexes: _Lru[tuple[str, ...], tuple[ClipLibrary, MotionIndex]] = _Lru(size)
+
+    def library(self, path: Path) -> ClipLibrary:
+        files = find_bvh_files(path)
+        key = (str(Path(path).resolve()),
+               tuple((str(f), (st := f.stat()).st_size, st.st_mtime_ns) for f in files))  # fmt: skip
+        return self._libraries.get(key) or self._libraries.put(key, load_library(path))
+
+    def search(self, path: Path, recipient: Motion) -> tuple[ClipLibrary, MotionIndex]:
+        """The library as continuations for ``recipient`` (retargeted onto its skeleton) and
+        their index."""
+        return prepare_library(path, recipient, self.library(path), self)
+
+    def _index(
+        self, key: tuple[str, ...], build: tuple[ClipLibrary, dict[str, Motion]]
+    ) -> tuple[ClipLibrary, MotionIndex]:
+        hit = self._indexes.get(key)
+        if hit is not None:
+            return hit
+        lib, clips = build
+        digest = hashlib.sha256("\0".join(key).encode()).hexdigest()[:16]  # stable across runs
+        index_path = default_cache_dir().parent / "indexes" / f"{digest}.npz"
+        index = MotionIndex.load_or_build(index_path, clips, SearchWeights(), WindowConfig())
+        sub = ClipLibrary(lib.root, clips, lib.paths, lib.hashes, lib.failures)
+        return self._indexes.put(key, (sub, index))
+
+
+def prepare_library(
+    path: Path,
+    skeleton_of: Motion | None = None,
+    lib: ClipLibrary | None = None,
+    cache: LibraryCache | None = None,
+) -> tuple[ClipLibrary, MotionIndex]:
+    """A clip library (loaded unless given) and its search index (cached on disk, keyed by
+    content and by ``skeleton_of``'s skeleton). With ``skeleton_of``, clips on other skeletons
+    are retargeted onto it (each side's reference pose is frame 0 of its alphabetically first
+    clip)."""
+    lib = load_library(path) if lib is None else lib
+    clips = dict(lib.clips)
+    target = ""
+    if skeleton_of is not None:
+        clips = _retargeted(clips, skeleton_of)
+        sk = skeleton_of.skeleton
+        target = hashlib.sha256(
+            ("\0".join(sk.names) + repr(np.round(sk.offsets, 6).tolist())).encode()
+        ).hexdigest()[:12]
+    # the code versions are part of the key: an index written by older search code is not reused
+    key = (str(Path(path).resolve()), ",".join(sorted(clips)) + lib.fingerprint(),
+           f"{__version__}/{INDEX_FORMAT_VERSION}/retarget{RETARGET_VERSION}/{target}")  # fmt: skip
+    return (cache or LibraryCache(1))._index(key, (lib, clips))
+
+
+def _retargeted(clips: dict[str, Motion], recipient: Motion) -> dict[str, Motion]:
+    """Every clip on ``recipient``'s skeleton: same-structure clips as they are, the rest
+    retargeted (one Retargeter per source skeleton)."""
+    target_char = None
+    by_skeleton: list[Retargeter] = []
+    out: dict[str, Motion] = {}
+    for name in sorted(clips):
+        m = clips[name]
+        if m.skeleton.same_structure(recipient.skeleton):
+            out[name] = m
+            continue
+        if target_char is None:
+            target_char = build_character(recipient, frame=0)
+        r = next((r for r in by_skeleton if r.source.skeleton.same_structure(m.skeleton)), None)
+        if r is None:
+            r = Retargeter(build_character(m, frame=0), target_char)
+            by_skeleton.append(r)
+        out[name] = r(m)
+    return out

@@ -1,0 +1,172 @@
+"""The controller registry: every way to drive a character, keyed by name, with the one table of
+its parameters' defaults. ``build(name, world, reference, params)`` makes one; an unknown name
+or parameter lists the valid ones. Adding a controller is a module plus a row here."""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Any
+
+from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.library.motion import Motion
+from reactmocap.sim.controllers.balance import StanceBalance
+from reactmocap.sim.controllers.base import Controller, Group
+from reactmocap.sim.controllers.pd import Passive, PDTracker
+from reactmocap.sim.controllers.predictive import PredictiveTracker
+from reactmocap.sim.controllers.root_assist import RootAssist
+from reactmocap.sim.controllers.wholebody import WholeBodyTracker
+from reactmocap.sim.reference import ReferencePath
+from reactmocap.sim.world import World
+
+__all__ = ["CONTROLLERS", "ControllerSpec", "build", "controller_help", "controller_spec"]
+
+Param = float | int | None
+Reference = Motion | ReferencePath
+#: ``factory(world, character, reference, start, params)``; ``params`` complete (defaults filled)
+Factory = Callable[[World, int, Reference, float, dict[str, Any]], Controller]
+
+
+def _options(*classes: type) -> tuple[str, ...]:
+    """Keyword-only constructor parameters that have defaults of their own (tuning options)."""
+    return tuple(
+        p.name
+        for cls in classes
+        for p in inspect.signature(cls).parameters.values()
+        if p.kind is p.KEYWORD_ONLY
+        and p.default is not p.empty
+        and p.name not in ("kv", "kv_joint")
+    )
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """A registered controller: what it is, its gains and rates with their defaults (``None``:
+    derived, e.g. critical damping), its other options (their defaults live in the
+    constructors), how to build it, and whether only joint torques act."""
+
+    name: str
+    description: str
+    defaults: Mapping[str, Param]
+    factory: Factory
+    options: tuple[str, ...] = ()
+    physical: bool = True
+
+    def params(self, given: Mapping[str, Any] | None) -> dict[str, Any]:
+        """``given`` over the defaults; ``None`` values mean the default."""
+        out = dict(self.defaults)
+        for key, value in (given or {}).items():
+            if key not in self.defaults and key not in self.options:
+                raise ConfigError(
+                    f"controller {self.name!r} has no parameter {key!r}; its parameters are "
+                    f"{sorted({*self.defaults, *self.options})}"
+                )
+            if value is not None:
+                out[key] = value
+        return out
+
+    def help(self) -> str:
+        shown = ", ".join(
+            f"{k} {'critical' if v is None and k.startswith('kv') else v}"
+            for k, v in self.defaults.items()
+            if k in ("kp", "kv", "control_every")
+        )
+        return f"{self.name}: {self.description} ({shown})"
+
+
+def _pd(world: World, c: int, ref: Reference, start: float, p: dict[str, Any]) -> Controller:
+    return PDTracker(world, c, ref, start, **p)
+
+
+def _balance(world: World, c: int, ref: Reference, start: float, p: dict[str, Any]) -> Controller:
+    pd = {k: p.pop(k) for k in ("kp", "kv", "refresh_every")}
+    every = p["control_every"]
+    return Group([PDTracker(world, c, ref, start, control_every=every, **pd),
+                  StanceBalance(world, c, ref, start, **p)])  # fmt: skip
+
+
+def _wholebody(world: World, c: int, ref: Reference, start: float, p: dict[str, Any]) -> Controller:
+    return WholeBodyTracker(world, c, ref, start, kp_joint=p.pop("kp"), kv_joint=p.pop("kv"), **p)
+
+
+def _predictive(
+    world: World, c: int, ref: Reference, start: float, p: dict[str, Any]
+) -> Controller:
+    wb = {k: p.pop(k) for k in ("kp", "kv", "servo_kv", "control_every")}
+    tracker = WholeBodyTracker(
+        world, c, ref, start, kp_joint=wb["kp"], kv_joint=wb["kv"],
+        servo_kv=wb["servo_kv"], control_every=wb["control_every"],
+    )  # fmt: skip
+    return PredictiveTracker(tracker, **p)
+
+
+def _passive(world: World, c: int, ref: Reference, start: float, p: dict[str, Any]) -> Controller:
+    del ref, start
+    return Passive(world, c, **p)
+
+
+def _root_assist(
+    world: World, c: int, ref: Reference, start: float, p: dict[str, Any]
+) -> Controller:
+    return RootAssist(world, c, ref, start, **p)
+
+
+_PD = {"kp": 4000.0, "kv": None, "control_every": 10, "refresh_every": 10}
+_WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
+
+#: every registered controller; the gains and rates here are the only defaults (the CLI help
+#: and the scenario docs print them from this table)
+CONTROLLERS: Mapping[str, ControllerSpec] = MappingProxyType({
+    "pd": ControllerSpec(
+        "pd", "the paper's inertia-scaled PD servo toward the reference joints (no balance)",
+        _PD, _pd),
+    "balance": ControllerSpec(
+        "balance", "the PD servo plus stance-leg balance (COM and trunk servos)",
+        _PD, _balance, _options(StanceBalance)),
+    "wholebody": ControllerSpec(
+        "wholebody", "inverse dynamics with optimised ground forces (pelvis tracked through "
+        "the feet)", _WHOLEBODY, _wholebody, _options(WholeBodyTracker)),
+    "predictive": ControllerSpec(
+        "predictive", "the whole-body tracker steered by predictive sampling (looks 0.5 s "
+        "ahead; ~40x slower)", _WHOLEBODY, _predictive, _options(PredictiveTracker)),
+    "passive": ControllerSpec(
+        "passive", "no control: the servo off, joint damping and limits only (a ragdoll)",
+        {"control_every": 10}, _passive),
+    "root_assist": ControllerSpec(
+        "root_assist", "NON-PHYSICAL external pelvis wrench toward the reference (an add-on "
+        "to another controller)", {"kp": 100.0, "kv": None, "control_every": 1}, _root_assist,
+        physical=False),
+})  # fmt: skip
+
+
+def controller_spec(name: str) -> ControllerSpec:
+    """The registered controller ``name``; an unknown name lists the valid ones."""
+    try:
+        return CONTROLLERS[name]
+    except KeyError:
+        raise UnknownKeyError(
+            f"unknown controller {name!r}; valid controllers are {sorted(CONTROLLERS)}"
+        ) from None
+
+
+def build(
+    name: str,
+    world: World,
+    reference: Reference,
+    params: Mapping[str, Any] | None = None,
+    *,
+    character: int = 0,
+    start: float = 0.0,
+) -> Controller:
+    """The controller ``name`` for ``character`` of ``world``, following ``reference`` (a
+    Motion on the character's skeleton or a :class:`ReferencePath`) from its time ``start``
+    at rollout time 0, with ``params`` over the table's defaults."""
+    spec = controller_spec(name)
+    return spec.factory(world, character, reference, float(start), spec.params(params))
+
+
+def controller_help(names: tuple[str, ...] | None = None) -> str:
+    """One line per controller with its default gains (for ``--help`` texts)."""
+    return "; ".join(CONTROLLERS[n].help() for n in (names or tuple(CONTROLLERS)))

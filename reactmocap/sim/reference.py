@@ -1,0 +1,145 @@
+"""What a controller follows: a clip as a path of MuJoCo states (:class:`ReferencePath`) and the
+clock that maps rollout time onto it (:class:`ClipClock`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import ConfigError
+from reactmocap.library.motion import Motion
+from reactmocap.rotations import quat_continuous
+from reactmocap.sim.character import BALL_JOINTS, qvel_from_qpos
+from reactmocap.sim.feet import foot_soles, sole_corners_world
+from reactmocap.sim.world import World
+
+__all__ = ["ClipClock", "ReferencePath", "reference_path"]
+
+F64 = NDArray[np.float64]
+NJ = len(BALL_JOINTS)
+NQ = 7 + 4 * NJ
+NV = 6 + 3 * NJ
+
+
+@dataclass(frozen=True)
+class ClipClock:
+    """Rollout time ``t`` -> fractional frame ``(start + t) fps`` of a clip of ``frames``
+    frames, clamped to the clip."""
+
+    fps: float
+    frames: int
+    start: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.fps) and self.fps > 0) or self.frames < 1:
+            raise ConfigError(f"a clip clock needs fps > 0 and frames >= 1, got {self!r}")
+        if not np.isfinite(self.start):
+            raise ConfigError(f"clip clock start must be finite, got {self.start!r}")
+
+    def frame(self, t: float) -> float:
+        return min(max((self.start + t) * self.fps, 0.0), self.frames - 1.0)
+
+    def bracket(self, t: float) -> tuple[int, int, float]:
+        """The frames either side of ``t`` and the weight of the later one."""
+        x = self.frame(t)
+        i0 = int(x)
+        return i0, min(i0 + 1, self.frames - 1), x - i0
+
+    def nearest(self, t: float) -> int:
+        return round(self.frame(t))
+
+
+@dataclass(frozen=True)
+class ReferencePath:
+    """A clip on one character, per frame (read-only arrays): ``q`` ``(T, 67)`` qpos with
+    sign-continuous quaternions, ``v`` ``(T, 51)`` qvel and ``a`` ``(T, 51)`` qacc by central
+    differences, ``planted`` ``(T, 2)`` the feet (left, right) whose sole is within ``reach`` of
+    the floor, ``pivoting`` ``(T, 2)`` the planted feet turning faster than ``pivot_rate``;
+    ``fps`` the frame rate."""
+
+    q: F64
+    v: F64
+    a: F64
+    planted: NDArray[np.bool_]
+    pivoting: NDArray[np.bool_]
+    fps: float
+
+    @property
+    def num_frames(self) -> int:
+        return int(self.q.shape[0])
+
+    def clock(self, start: float = 0.0) -> ClipClock:
+        return ClipClock(self.fps, self.num_frames, start)
+
+    def sample(self, x: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
+        """``q``, ``v``, ``a`` interpolated linearly at fractional frame ``x`` (clamped to
+        the path; quaternions renormalised) and ``planted`` at the nearest frame."""
+        x = min(max(x, 0.0), self.num_frames - 1.0)
+        i0 = int(x)
+        i1 = min(i0 + 1, self.num_frames - 1)
+        w = x - i0
+        q = (1 - w) * self.q[i0] + w * self.q[i1]
+        quats = q[3:].reshape(NJ + 1, 4)
+        quats /= np.linalg.norm(quats, axis=1, keepdims=True)
+        v = (1 - w) * self.v[i0] + w * self.v[i1]
+        acc = (1 - w) * self.a[i0] + w * self.a[i1]
+        return q, v, acc, self.planted[round(x)]
+
+
+def reference_path(
+    world: World,
+    character: int,
+    source: Motion | F64,
+    *,
+    fps: float | None = None,
+    reach: float = 0.05,
+    pivot_rate: float | None = 2.0,
+) -> ReferencePath:
+    """``source`` on ``world``'s ``character`` as a :class:`ReferencePath`: a Motion on the
+    character's skeleton, or a ``(T, 67)`` qpos path sampled at ``fps``. Foot stance is
+    measured on the character's own sole boxes (``pivot_rate`` rad/s; ``None``: no pivots)."""
+    for name, value in (
+        ("reach", reach),
+        ("pivot_rate", 0.0 if pivot_rate is None else pivot_rate),
+    ):
+        if not (np.isfinite(value) and value >= 0):
+            raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
+    wc = world.characters[character]
+    if isinstance(source, Motion):
+        q = wc.character.qpos_from_motion(source)
+        rate = float(source.fps)
+    else:
+        q = np.array(source, dtype=np.float64)
+        if q.ndim != 2 or q.shape[1] != NQ or not np.isfinite(q).all():
+            raise ConfigError(f"a qpos path must be (T, {NQ}) finite numbers, got {q.shape}")
+        if fps is None or not (np.isfinite(fps) and fps > 0):
+            raise ConfigError(f"a qpos path needs its frame rate fps > 0, got {fps!r}")
+        rate = float(fps)
+    n = q.shape[0]
+    q[:, 3:] = quat_continuous(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
+    v = qvel_from_qpos(q, rate)
+    a = np.gradient(v, 1.0 / rate, axis=0) if n > 2 else np.zeros_like(v)
+    m = world.model
+    _, sole_ids, corners = foot_soles(world, character, "reference_path")
+    floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
+    d = mujoco.MjData(m)
+    sole = np.empty((n, 2))
+    yaw = np.empty((n, 2))
+    for i in range(n):  # once per clip, not in the step loop
+        d.qpos[wc.qpos_slice] = q[i]
+        mujoco.mj_kinematics(m, d)
+        sole[i] = sole_corners_world(d, sole_ids, corners).min(axis=1)[:, 2] - floor_z
+        rot = d.geom_xmat[sole_ids].reshape(2, 3, 3)
+        yaw[i] = np.arctan2(rot[:, 1, 0], rot[:, 0, 0])
+    planted = sole < reach
+    rate_yaw = np.zeros((n, 2))
+    if n > 1:
+        rate_yaw = np.abs(np.gradient(np.unwrap(yaw, axis=0), 1.0 / rate, axis=0))
+    pivoting = planted & (rate_yaw > (np.inf if pivot_rate is None else float(pivot_rate)))
+    arrays = (q, v, a, planted, pivoting)
+    for arr in arrays:
+        arr.flags.writeable = False
+    return ReferencePath(*arrays, fps=rate)

@@ -1,0 +1,234 @@
+"""Physical tracking of a clip (``reactmocap track``) and pushes while tracking
+(``reactmocap push``): a character built from the clip, a registered controller, the engine,
+and a report of how closely the simulation followed the clip."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import ConfigError
+from reactmocap.library.motion import Motion
+from reactmocap.metrics import FALL_FRACTION
+from reactmocap.rotations import quat_conj, quat_log, quat_mul
+from reactmocap.sim.character import SIM_PARENTS, build_character
+from reactmocap.sim.controllers.registry import build, controller_spec
+from reactmocap.sim.impacts import Impact
+from reactmocap.sim.reference import reference_path
+from reactmocap.sim.rollout import RolloutResult, rollout
+from reactmocap.sim.servo import critical_kv
+from reactmocap.sim.world import World, WorldConfig
+
+__all__ = [
+    "TrackErrors",
+    "TrackReport",
+    "TrackResult",
+    "push_clip",
+    "track_clip",
+    "tracking_errors",
+]
+
+F64 = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class TrackReport:
+    """Summary of a tracking run (what ``reactmocap track`` writes as JSON)."""
+
+    clip: str
+    start: float
+    seconds: float
+    fell: bool
+    fall_time: float | None
+    mean_joint_error_rad: float
+    root_error_m: float
+    max_root_error_m: float
+    root_angle_error_rad: float
+    wall_s: float
+    realtime_factor: float
+    kp: float
+    kv: float
+    friction: float
+    timestep: float
+    root_assist: float
+    controller: str
+    impacts: int
+
+    def to_dict(self) -> dict[str, object]:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class TrackErrors:
+    """How a simulated character 0 followed the clip, per recorded frame: ``root`` ``(T,)``
+    pelvis position error (m), ``angle`` ``(T,)`` pelvis orientation error (rad), ``joint``
+    ``(T, 15)`` ball-joint rotation errors (rad), ``upright`` ``(T,)`` pelvis above
+    :data:`~reactmocap.metrics.FALL_FRACTION` of its start height; ``times`` ``(T,)``."""
+
+    times: F64
+    root: F64
+    angle: F64
+    joint: F64
+    upright: NDArray[np.bool_]
+
+    @property
+    def fall_time(self) -> float | None:
+        fallen = np.flatnonzero(~self.upright)
+        return float(self.times[fallen[0]]) if fallen.size else None
+
+
+@dataclass(frozen=True)
+class TrackResult:
+    """A tracking run: the simulated Motion on the clip's skeleton (joints that are not
+    simulated come from the clip), its report, errors and the raw rollout."""
+
+    motion: Motion
+    report: TrackReport
+    errors: TrackErrors
+    rollout: RolloutResult
+
+
+def tracking_errors(result: RolloutResult, motion: Motion, start: float) -> TrackErrors:
+    """Compare the simulated character 0 of ``result`` with ``motion`` (clip time ``start`` at
+    rollout time 0) at the recorded frames."""
+    ch = result.world.characters[0].character
+    times, _ = result.frames()
+    ref_pos, ref_rot = ch.body_transforms_from_qpos(
+        ch.qpos_from_motion(motion.sample(times + start))
+    )
+    sim_pos, sim_rot = result.body_transforms(0)
+    par = SIM_PARENTS[1:]
+
+    def local(rot: F64) -> F64:
+        return quat_mul(quat_conj(rot[:, par]), rot[:, 1:])
+
+    joint = np.linalg.norm(quat_log(quat_mul(quat_conj(local(sim_rot)), local(ref_rot))), axis=-1)
+    root = np.linalg.norm(sim_pos[:, 0] - ref_pos[:, 0], axis=-1)
+    angle = np.linalg.norm(quat_log(quat_mul(quat_conj(sim_rot[:, 0]), ref_rot[:, 0])), axis=-1)
+    upright = sim_pos[:, 0, 2] >= FALL_FRACTION * sim_pos[0, 0, 2]
+    return TrackErrors(times, root, angle, joint, upright)
+
+
+def track_clip(
+    motion: Motion,
+    *,
+    start: float = 0.0,
+    seconds: float | None = None,
+    controller: str = "wholebody",
+    params: dict[str, Any] | None = None,
+    kp: float | None = None,
+    kv: float | None = None,
+    friction: float = 1.0,
+    impacts: Sequence[Impact] = (),
+    record_fps: float = 60.0,
+    root_assist: float = 0.0,
+    total_mass: float = 75.0,
+    config: WorldConfig | None = None,
+    character_kwargs: dict[str, Any] | None = None,
+    on_tick: Callable[[float, float], None] | None = None,
+) -> TrackResult:
+    """Track ``motion`` from ``start`` for ``seconds`` (default: to its end) with the registered
+    ``controller`` (``params`` over its defaults; ``kp``/``kv`` are shortcuts for those) on a
+    character built from the clip, optionally with impacts (their ``start`` relative to
+    ``start``). ``root_assist > 0`` adds the NON-PHYSICAL root assist with that kp (only with
+    ``"pd"``). ``on_tick(t, seconds)`` reports progress."""
+    if not (np.isfinite(start) and 0 <= start <= motion.duration):
+        raise ConfigError(f"start {start!r} s is outside the clip (0..{motion.duration:.3f} s)")
+    remaining = motion.duration - start
+    seconds = remaining if seconds is None else float(seconds)
+    if not (np.isfinite(seconds) and seconds > 0):
+        raise ConfigError(f"seconds must be > 0, got {seconds!r}")
+    if seconds > remaining + 1e-9:
+        raise ConfigError(
+            f"cannot track {seconds} s from {start} s: the clip {motion.name!r} lasts "
+            f"{motion.duration:.3f} s"
+        )
+    spec = controller_spec(controller)
+    if root_assist > 0 and controller != "pd":
+        raise ConfigError(
+            f"root_assist cannot be combined with the {controller!r} controller: its ground "
+            "forces assume nothing else holds the body up (they went unstable together); "
+            "use controller='pd' with root_assist"
+        )
+    given = {**(params or {}), **{k: v for k, v in (("kp", kp), ("kv", kv)) if v is not None}}
+    resolved = spec.params(given)
+    frame = round(start * motion.fps)
+    character = build_character(motion, total_mass=total_mass, frame=frame,
+                                **(character_kwargs or {}))  # fmt: skip
+    character.check_fk(motion, frame)
+    cfg = config or WorldConfig(friction=friction)
+    world = World(character, cfg)
+    world.set_from_motion(0, motion, frame)
+    path = reference_path(world, 0, motion)
+    ctrls = [build(controller, world, path, given, start=start)]
+    if root_assist > 0:
+        ctrls.append(build("root_assist", world, path, {"kp": root_assist}, start=start))
+    result = rollout(
+        world,
+        seconds,
+        controllers=ctrls,
+        impacts=impacts,
+        record_fps=record_fps,
+        references=[motion],
+        reference_start=start,
+        on_tick=None if on_tick is None else (lambda t: on_tick(t, seconds)),
+    )
+    err = tracking_errors(result, motion, start)
+    kp_used = float(resolved.get("kp", 0.0))
+    kv_used = resolved.get("kv")
+    report = TrackReport(
+        clip=motion.name,
+        start=float(start),
+        seconds=float(seconds),
+        fell=err.fall_time is not None,
+        fall_time=err.fall_time,
+        mean_joint_error_rad=float(err.joint.mean()),
+        root_error_m=float(err.root.mean()),
+        max_root_error_m=float(err.root.max()),
+        root_angle_error_rad=float(err.angle.mean()),
+        wall_s=float(result.wall_s),
+        realtime_factor=float(seconds / result.wall_s) if result.wall_s > 0 else float("inf"),
+        kp=kp_used,
+        kv=critical_kv(kp_used) if kv_used is None else float(kv_used),
+        friction=cfg.friction,
+        timestep=cfg.timestep,
+        root_assist=float(root_assist),
+        controller=controller,
+        impacts=len(impacts),
+    )
+    name = f"{motion.name}_tracked" if motion.name else "tracked"
+    return TrackResult(result.motion(0, name=name), report, err, result)
+
+
+def push_clip(
+    motion: Motion,
+    *,
+    time: float,
+    body: str,
+    force: Sequence[float],
+    duration: float = 0.1,
+    point: Sequence[float] | None = None,
+    start: float | None = None,
+    seconds: float | None = None,
+    **kwargs: Any,
+) -> TrackResult:
+    """Track ``motion`` and push ``body`` with ``force`` (N, world) at clip time ``time`` for
+    ``duration`` s. Tracking starts at ``start`` (default: 0.5 s before the push, or 0) and
+    runs ``seconds`` (default: to the clip's end)."""
+    if not (np.isfinite(time) and 0 <= time <= motion.duration):
+        raise ConfigError(f"push time {time!r} s is outside the clip (0..{motion.duration:.3f} s)")
+    s0 = max(0.0, time - 0.5) if start is None else float(start)
+    if time < s0:
+        raise ConfigError(f"push time {time} s is before the tracking start {s0} s")
+    impact = Impact(
+        body=body,
+        force=tuple(force),  # type: ignore[arg-type]
+        point=None if point is None else tuple(point),  # type: ignore[arg-type]
+        start=time - s0,
+        duration=duration,
+    )
+    return track_clip(motion, start=s0, seconds=seconds, impacts=[impact], **kwargs)
