@@ -22,13 +22,26 @@ from reactmocap.batch.results import (
     summarize,
 )
 from reactmocap.batch.runners import RUNNERS, BatchResult, Job, describe, get_runner, run_batch
-from reactmocap.batch.sweep import AXES, Axis, Sweep, SweepPoint, load_sweep, parse_sweep, point_id
+from reactmocap.batch.sweep import (
+    ALIASES,
+    AXES,
+    TABLES,
+    Axis,
+    Sweep,
+    SweepPoint,
+    describe_axes,
+    load_sweep,
+    parse_sweep,
+    point_id,
+)
 
 __all__ = [
+    "ALIASES",
     "AXES",
     "DEFAULT_TOLERANCES",
     "QUALITY_METRICS",
     "RUNNERS",
+    "TABLES",
     "TIMING_COLUMNS",
     "Axis",
     "BatchResult",
@@ -42,6 +55,7 @@ __all__ = [
     "compare",
     "contact_sheet",
     "describe",
+    "describe_axes",
     "format_comparison",
     "format_summary",
     "get_runner",

@@ -57,9 +57,22 @@ def _load(results_dir: Path) -> tuple[list[dict[str, Any]], dict[str, list[Any]]
         axes = {}
     if not axes:  # infer from the row keys that are known axes
         axes = {
-            a: sorted({r[a] for r in rows if a in r}) for a in AXES if any(a in r for r in rows)
+            a: sorted({_hashable(r[a]) for r in rows if a in r})
+            for a in AXES
+            if any(a in r for r in rows)
         }
     return rows, axes
+
+
+def _hashable(v: Any) -> Any:
+    """A vector axis value (a JSON list) as a tuple, so it can group rows."""
+    return tuple(_hashable(x) for x in v) if isinstance(v, list) else v
+
+
+def _categorical(axis: str) -> bool:
+    """Names, flags and vectors get bars; numbers get lines."""
+    a = AXES.get(axis)
+    return a is not None and a.kind not in ("float", "int")
 
 
 def _by_value(rows: Sequence[Mapping[str, Any]], axis: str, metric: str) -> dict[Any, float]:
@@ -68,7 +81,7 @@ def _by_value(rows: Sequence[Mapping[str, Any]], axis: str, metric: str) -> dict
     for r in rows:
         v = r.get(metric)
         if r.get("status") == "ok" and axis in r and isinstance(v, int | float):
-            groups[r[axis]].append(float(v))
+            groups[_hashable(r[axis])].append(float(v))
     return {k: float(np.median(v)) for k, v in groups.items()}
 
 
@@ -82,7 +95,7 @@ def plot_axes(results_dir: str | Path) -> list[Path]:
     for axis, values in axes.items():
         if len(values) < 2:
             continue
-        if axis in ANGLE_AXES:
+        if axis in ANGLE_AXES or (axis in AXES and AXES[axis].unit == "deg"):
             fig, axs = plt.subplots(
                 1,
                 len(POLAR_METRICS),
@@ -109,7 +122,7 @@ def plot_axes(results_dir: str | Path) -> list[Path]:
         for ax, metric in zip(np.ravel(axs), LINE_METRICS):
             med = _by_value(rows, axis, metric)
             keys = sorted(med, key=lambda k: (isinstance(k, str), k))
-            if AXES.get(axis) is not None and AXES[axis].kind == "str":
+            if _categorical(axis):
                 ax.bar(range(len(keys)), [med[k] for k in keys])
                 ax.set_xticks(range(len(keys)), [str(k) for k in keys], rotation=30, fontsize=7)
             else:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from reactmocap.cli import main
 from reactmocap.errors import ReactMocapError
 from reactmocap.library.bodyparts import map_body_parts
 from reactmocap.library.bvh import read_bvh
+from reactmocap.response import pipeline
 from reactmocap.response.pipeline import run_response, run_scenario
 from reactmocap.response.scenario import (
     AttackerSpec,
@@ -109,12 +111,31 @@ def test_facing_turns_the_outcome() -> None:
     np.testing.assert_allclose(rot @ da, db, atol=0.03)
 
 
-def test_failing_run_leaves_no_output(tmp_path: Path) -> None:
-    bad = push((-300.0, 0.0, 0.0))
-    bad = replace(bad, recipient=replace(bad.recipient, clip="no_such_clip"))
-    with pytest.raises(ReactMocapError, match="no_such_clip"):
-        run_scenario(bad, tmp_path / "out")
-    assert not any((tmp_path / "out").glob("*")) if (tmp_path / "out").exists() else True
+@pytest.mark.xfail(
+    strict=True,
+    reason="run_scenario writes each output in place and does not remove the ones already "
+    "written when a later one fails (recipient.bvh stays behind)",
+)
+def test_failing_run_leaves_no_output(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A run that fails late, after the simulation, with its output folder made and one BVH
+    file written, leaves no partial files behind."""
+    real_write_bvh = pipeline.write_bvh
+    calls: list[str] = []
+
+    def failing_second_write(motion: Any, path: str | Path, *args: Any, **kwargs: Any) -> Any:
+        # the second write whatever the order, so one file is always written before the failure
+        calls.append(Path(path).name)
+        if len(calls) == 2:
+            raise ReactMocapError(f"cannot write {path}: disk full (test)")
+        return real_write_bvh(motion, path, *args, **kwargs)
+
+    monkeypatch.setattr(pipeline, "write_bvh", failing_second_write)
+    out = tmp_path / "out"
+    with pytest.raises(ReactMocapError, match="disk full"):
+        run_scenario(load_scenario(EXAMPLES / "front_kick.toml"), out)
+    assert len(calls) == 2  # the failure came late: after a BVH file was written
+    left = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*"))
+    assert left in ([], ["out"]), f"partial outputs left behind: {left}"
 
 
 @pytest.mark.parametrize(

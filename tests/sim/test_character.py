@@ -83,7 +83,8 @@ def _shared_clips() -> list[Path]:
 def test_fk_on_shared_clips_first_frame(path: Path | None) -> None:
     if path is None:
         pytest.skip(f"no shared clips at {SHARED.resolve()}")
-    bvh = pytest.importorskip("reactmocap.library.bvh", reason="BVH reader not available yet")
+    from reactmocap.library import bvh
+
     motion = bvh.read_bvh(path)
     ch = build_character(motion)
     assert ch.check_fk(motion, 0) < 1e-3
@@ -132,7 +133,7 @@ def test_track_and_push_functions(guard: Motion) -> None:
 
 @pytest.fixture(scope="module")
 def bvh_clip(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    bvh = pytest.importorskip("reactmocap.library.bvh", reason="BVH writer not available yet")
+    from reactmocap.library import bvh
     from reactmocap.library.synth import synthetic_clips
 
     path = tmp_path_factory.mktemp("clips") / "guard.bvh"
