@@ -53,8 +53,10 @@ IN_FLIGHT_PER_WORKER = 2
 
 @dataclass(frozen=True)
 class Job:
-    """What a worker does with one sweep point. Picklable: it travels to pool and Ray workers.
-    Any exception of the scenario becomes an error row, so one bad scenario never stops a batch."""
+    """What a worker does with one sweep point. Picklable: it travels to pool and Ray workers,
+    where it keeps one :class:`~reactmocap.response.library_cache.LibraryCache` for all the
+    points it runs (the cache itself never travels). Any exception of the scenario becomes an
+    error row, so one bad scenario never stops a batch."""
 
     out_dir: str | None = None  # the batch folder when per-scenario outputs are saved
     task: Task | None = None  # None: reactmocap.response.pipeline.run_scenario
@@ -62,12 +64,29 @@ class Job:
     def __call__(self, point: SweepPoint) -> dict[str, Any]:
         rel = f"scenarios/{point.id}" if self.out_dir is not None else None
         try:
-            task = self.task if self.task is not None else _pipeline()
             out = Path(self.out_dir) / rel if self.out_dir is not None and rel else None
-            report = task(point.scenario, out)
+            if self.task is not None:
+                report = self.task(point.scenario, out)
+            else:
+                report = _pipeline()(point.scenario, out, cache=self._cache())
         except Exception as exc:  # isolation is the point
             return error_row(point.id, point.params, f"{type(exc).__name__}: {exc}", rel)
         return report_row(point.id, point.params, report, rel)
+
+    def _cache(self) -> Any:
+        cache = self.__dict__.get("_library_cache")
+        if cache is None:
+            from reactmocap.response.library_cache import LibraryCache
+
+            cache = LibraryCache()
+            object.__setattr__(self, "_library_cache", cache)
+        return cache
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {k: v for k, v in self.__dict__.items() if k != "_library_cache"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
 
 
 def _pipeline() -> Task:

@@ -14,7 +14,7 @@ from reactmocap.cli import main
 from reactmocap.errors import ReactMocapError
 from reactmocap.library.bodyparts import map_body_parts
 from reactmocap.library.bvh import read_bvh
-from reactmocap.response import pipeline
+from reactmocap.response import outputs
 from reactmocap.response.pipeline import run_response, run_scenario
 from reactmocap.response.scenario import (
     AttackerSpec,
@@ -111,15 +111,10 @@ def test_facing_turns_the_outcome() -> None:
     np.testing.assert_allclose(rot @ da, db, atol=0.03)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="run_scenario writes each output in place and does not remove the ones already "
-    "written when a later one fails (recipient.bvh stays behind)",
-)
 def test_failing_run_leaves_no_output(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A run that fails late, after the simulation, with its output folder made and one BVH
     file written, leaves no partial files behind."""
-    real_write_bvh = pipeline.write_bvh
+    real_write_bvh = outputs.write_bvh
     calls: list[str] = []
 
     def failing_second_write(motion: Any, path: str | Path, *args: Any, **kwargs: Any) -> Any:
@@ -129,7 +124,7 @@ def test_failing_run_leaves_no_output(tmp_path: Path, monkeypatch: pytest.Monkey
             raise ReactMocapError(f"cannot write {path}: disk full (test)")
         return real_write_bvh(motion, path, *args, **kwargs)
 
-    monkeypatch.setattr(pipeline, "write_bvh", failing_second_write)
+    monkeypatch.setattr(outputs, "write_bvh", failing_second_write)
     out = tmp_path / "out"
     with pytest.raises(ReactMocapError, match="disk full"):
         run_scenario(load_scenario(EXAMPLES / "front_kick.toml"), out)
