@@ -1,11 +1,9 @@
 """BVH read/write with bulk numpy conversion of the frames.
 
-Reading: a light tokenizer pass checks the HIERARCHY's keywords and braces with line numbers and
-lays it out one statement or brace per line; the ``bvh`` package builds the joint tree from that;
-a walk over the tree validates it (every problem is a :class:`BVHParseError` with file, 1-based
-line and what was expected). The ``bvh`` package keeps no line numbers, mis-nests silently on
-stray braces and parses frames one character at a time, hence the pre-pass and ``np.loadtxt`` for
-the MOTION block.
+Reading: a tokenizer pre-pass checks the HIERARCHY with line numbers (the ``bvh`` package keeps
+none and mis-nests on stray braces), the ``bvh`` package builds the joint tree, a walk validates
+it (a :class:`BVHParseError` names file, line and what was expected); ``np.loadtxt`` reads the
+MOTION block.
 
 Conventions: a file is Y-up unless ``up="z"``; its unit is detected from the body's span in the
 first frames (:func:`reactmocap.conventions.detect_unit`) unless ``unit=`` is given. Channels
@@ -496,10 +494,8 @@ def bvh_text(
 
     ``unit``/``up`` default to the skeleton's source file's. ``channels="source"`` writes each
     joint's source channels; ``"rotation"`` writes 6 channels on the root and 3 rotation channels
-    elsewhere. Either way a joint gets the position or rotation channels it lacks where the motion
-    moves it in a way its channels cannot hold (``"rotation"`` ignores translations within 10 um
-    of the offset, such as the rounding noise in the Bandai Namco files' position channels), so
-    writing never loses motion.
+    elsewhere; a joint gets the channels it lacks where the motion needs them (``"rotation"``
+    ignores translations within 10 um of the offset), so writing never loses motion.
     ``precision`` is the number of decimals of every value.
     """
     return "".join(_bvh_chunks(motion, unit, up, channels, precision))

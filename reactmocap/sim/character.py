@@ -7,7 +7,7 @@ Geometry follows human proportions scaled by leg length; segment masses follow
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -23,18 +23,27 @@ from reactmocap.library.skeleton import Skeleton
 from reactmocap.rotations import (
     quat_canonical,
     quat_conj,
-    quat_from_matrix,
     quat_log,
     quat_mul,
     quat_normalize,
     quat_rotate,
 )
+from reactmocap.sim.bodies import (
+    BALL_JOINTS,
+    BODY_ALIASES,
+    JOINT_RANGE,
+    SIM_BODIES,
+    SIM_PARENTS,
+    TREE,
+)
+from reactmocap.sim.geometry import BALL_PATCH_HALF_SIZE, PATCH_GEOM_GROUP, GeomSpec, make_geoms
 
 __all__ = [
     "BALL_JOINTS",
     "BALL_PATCH_HALF_SIZE",
     "BODY_ALIASES",
     "SIM_BODIES",
+    "SIM_PARENTS",
     "PATCH_GEOM_GROUP",
     "Character",
     "build_character",
@@ -43,55 +52,6 @@ __all__ = [
 
 F64 = NDArray[np.float64]
 MassModel = Literal["table", "geometry"]
-
-# (body = part, parent body, ball joint name); preorder, which is MuJoCo's body/joint order.
-_TREE: tuple[tuple[str, str | None, str | None], ...] = (
-    ("pelvis", None, None),
-    ("waist", "pelvis", "waist"),
-    ("chest", "waist", "back"),
-    ("head", "chest", "neck"),
-    ("l_upper_arm", "chest", "l_shoulder"),
-    ("l_forearm", "l_upper_arm", "l_elbow"),
-    ("l_hand", "l_forearm", "l_wrist"),
-    ("r_upper_arm", "chest", "r_shoulder"),
-    ("r_forearm", "r_upper_arm", "r_elbow"),
-    ("r_hand", "r_forearm", "r_wrist"),
-    ("l_thigh", "pelvis", "l_hip"),
-    ("l_shin", "l_thigh", "l_knee"),
-    ("l_foot", "l_shin", "l_ankle"),
-    ("r_thigh", "pelvis", "r_hip"),
-    ("r_shin", "r_thigh", "r_knee"),
-    ("r_foot", "r_shin", "r_ankle"),
-)
-SIM_BODIES: tuple[str, ...] = tuple(b for b, _, _ in _TREE)
-BALL_JOINTS: tuple[str, ...] = tuple(j for _, _, j in _TREE if j is not None)
-BODY_ALIASES: Mapping[str, str] = {"abdomen": "waist", "thorax": "chest", "neck": "head"}
-_PARENT = np.array([-1 if p is None else SIM_BODIES.index(p) for _, p, _ in _TREE])
-#: parent body index of each of SIM_BODIES (-1 for the pelvis)
-SIM_PARENTS = _PARENT
-
-#: cone half-angle (rad) of each ball joint around its reference-pose rotation. MuJoCo ball
-#: limits are cones, so these are coarse: they stop wild twists after hard impacts, they do not
-#: model anatomy (a knee cone also allows hyperextension).
-JOINT_RANGE: Mapping[str, float] = {
-    "waist": 1.0, "back": 1.0, "neck": 1.3, "shoulder": 2.9, "elbow": 2.7, "wrist": 1.7,
-    "hip": 2.4, "knee": 2.7, "ankle": 1.3,
-}  # fmt: skip
-
-# Human proportions (fractions of a 0.85 m hip-to-ankle leg, i.e. a 1.75 m adult).
-_LEG_REF = 0.85
-_RADIUS = {
-    "pelvis": 0.095, "waist": 0.09, "chest": 0.105, "neck": 0.05, "head": 0.1,
-    "upper_arm": 0.045, "forearm": 0.037, "hand": 0.03, "thigh": 0.075, "shin": 0.05,
-}  # fmt: skip
-_FOOT = {"heel": 0.06, "toe": 0.05, "half_width": 0.04, "half_height": 0.025}
-_HAND_LEN = 0.10
-#: half-size (m) of the ball-of-foot contact patch each foot carries switched off: a tracking
-#: controller turns it on, and the foot box off, while the actor pivots on that foot (a box's
-#: corners hold a yaw torque of mu N times half its width; a pivoting forefoot holds little)
-BALL_PATCH_HALF_SIZE = 0.005
-#: MuJoCo geom group of the patch: hidden by the default visualisation (groups 0-2)
-PATCH_GEOM_GROUP = 3
 
 
 def _kind(part: str) -> str:
@@ -102,18 +62,6 @@ def _target_fractions() -> dict[str, float]:
     """Mass fraction per sim body (the one table, over the bodies the character has)."""
     total = sum(MASS_FRACTIONS[b] for b in SIM_BODIES)
     return {b: MASS_FRACTIONS[b] / total for b in SIM_BODIES}
-
-
-def _unit(v: F64) -> F64:
-    n = float(np.linalg.norm(v))
-    if n < 1e-9:
-        raise SimulationError("degenerate geometry: zero-length axis while building the character")
-    return v / n
-
-
-def _perp(v: F64) -> F64:
-    a = np.array([1.0, 0.0, 0.0]) if abs(v[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    return np.cross(v, a)
 
 
 def qvel_from_qpos(q: F64, fps: float) -> F64:
@@ -136,20 +84,6 @@ def _differentiate(qa: F64, qb: F64, span: F64) -> F64:
     rel = quat_mul(quat_conj(qa[:, 3:].reshape(n, -1, 4)), qb[:, 3:].reshape(n, -1, 4))
     ang = quat_log(rel) / span[:, None, None]
     return np.concatenate([lin, ang.reshape(n, -1)], axis=1)
-
-
-@dataclass(frozen=True)
-class _Geom:
-    body: str
-    kind: Literal["capsule", "sphere", "box"]
-    size: tuple[float, ...]
-    fromto: tuple[float, ...] | None = None  # capsule, body-local
-    pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    quat: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
-    #: a massless, hidden contact geom (see :data:`BALL_PATCH_HALF_SIZE`); compiled colliding
-    #: (MuJoCo leaves geoms that cannot collide at compile time out of the body's collision
-    #: tree for good), and switched off by the World
-    patch: bool = False
 
 
 @dataclass(eq=False)
@@ -178,7 +112,7 @@ class Character:
     total_mass: float
     mass_model: MassModel
     joint_limits: bool
-    geoms: tuple[_Geom, ...]
+    geoms: tuple[GeomSpec, ...]
     density_scale: dict[str, float]
     _model: mujoco.MjModel | None = field(default=None, repr=False)
 
@@ -189,7 +123,7 @@ class Character:
         spec.compiler.degree = False
         dens = PART_DENSITY
         bodies: dict[str, mujoco.MjsBody] = {}
-        for i, (name, parent, joint) in enumerate(_TREE):
+        for i, (name, parent, joint) in enumerate(TREE):
             parent_body = spec.worldbody if parent is None else bodies[parent]
             body = parent_body.add_body(name=name, pos=self.body_pos[i], quat=self.body_quat[i])
             bodies[name] = body
@@ -268,7 +202,7 @@ class Character:
         q = np.empty((idx.size, 7 + 4 * len(BALL_JOINTS)))
         q[:, :3] = pos[:, self.anchors[0]]
         q[:, 3:7] = quat_canonical(g[:, 0])
-        parent_g = g[:, _PARENT[1:]]
+        parent_g = g[:, SIM_PARENTS[1:]]
         rel = quat_mul(quat_conj(self.body_quat[1:]), quat_mul(quat_conj(parent_g), g[:, 1:]))
         q[:, 7:] = quat_canonical(quat_normalize(rel)).reshape(idx.size, -1)
         return q
@@ -302,7 +236,7 @@ class Character:
         rot[:, 0] = quat_normalize(qpos[:, 3:7])
         balls = quat_normalize(qpos[:, 7:].reshape(t, -1, 4))
         for b in range(1, len(SIM_BODIES)):
-            p = _PARENT[b]
+            p = SIM_PARENTS[b]
             pos[:, b] = pos[:, p] + quat_rotate(rot[:, p], self.body_pos[b])
             rot[:, b] = quat_mul(rot[:, p], quat_mul(self.body_quat[b], balls[:, b - 1]))
         return pos, rot
@@ -428,13 +362,13 @@ class Character:
         b = body
         while b >= 0:
             chain.append(b)
-            b = int(_PARENT[b])
+            b = int(SIM_PARENTS[b])
         for b in reversed(chain):
             if errs[b] > 1e-3:
                 first_bad = b
                 break
         a = int(self.anchors[first_bad])
-        pa = int(self.anchors[_PARENT[first_bad]]) if first_bad > 0 else -1
+        pa = int(self.anchors[SIM_PARENTS[first_bad]]) if first_bad > 0 else -1
         between = [k for k in skel.chain(a)[:-1] if k not in skel.chain(pa)] if pa >= 0 else []
         causes = []
         tr = motion.local_translations()[frame]
@@ -522,10 +456,10 @@ def build_character(
     if len(set(anchors.tolist())) != len(anchors):
         raise SimulationError(f"two sim bodies map to the same skeleton joint: {anchors.tolist()}")
     for b in range(1, len(SIM_BODIES)):
-        if int(anchors[_PARENT[b]]) not in skeleton.chain(int(anchors[b])):
+        if int(anchors[SIM_PARENTS[b]]) not in skeleton.chain(int(anchors[b])):
             raise SimulationError(
                 f"joint {skeleton.names[anchors[b]]!r} ({SIM_BODIES[b]}) is not below "
-                f"{skeleton.names[anchors[_PARENT[b]]]!r} ({SIM_BODIES[_PARENT[b]]}) "
+                f"{skeleton.names[anchors[SIM_PARENTS[b]]]!r} ({SIM_BODIES[SIM_PARENTS[b]]}) "
                 "in the skeleton"
             )
 
@@ -549,11 +483,11 @@ def build_character(
     body_pos = np.empty((len(SIM_BODIES), 3))
     body_quat[0], body_pos[0] = G[0], P[0]
     for b in range(1, len(SIM_BODIES)):
-        p = _PARENT[b]
+        p = SIM_PARENTS[b]
         body_quat[b] = quat_normalize(quat_mul(quat_conj(G[p]), G[b]))
         body_pos[b] = quat_rotate(quat_conj(G[p]), P[b] - P[p])
 
-    geoms = _make_geoms(skeleton, parts, anchors, ref, frame, P, G)
+    geoms = make_geoms(skeleton, parts, anchors, ref, frame, P, G)
     char = Character(
         skeleton=skeleton,
         parts=parts,
@@ -579,215 +513,3 @@ def build_character(
     char.density_scale = scale
     char._model = None
     return char
-
-
-def _make_geoms(
-    skel: Skeleton,
-    parts: BodyPartMap,
-    anchors: NDArray[np.int64],
-    ref: Motion,
-    frame: int,
-    P: F64,
-    G: F64,
-) -> tuple[_Geom, ...]:
-    """Collision/mass geometry, computed in the reference pose's world frame and converted to
-    each body's local frame."""
-    idx = {b: i for i, b in enumerate(SIM_BODIES)}
-
-    def at(b: str) -> F64:
-        return P[idx[b]]
-
-    leg = 0.5 * sum(
-        np.linalg.norm(at(f"{s}_thigh") - at(f"{s}_shin"))
-        + np.linalg.norm(at(f"{s}_shin") - at(f"{s}_foot"))
-        for s in "lr"
-    )
-    s = float(leg) / _LEG_REF
-    if not 0.3 < s < 3.0:
-        raise SimulationError(
-            f"implausible leg length {leg:.3f} m (hip to ankle); is the skeleton in metres?"
-        )
-    r = {k: v * s for k, v in _RADIUS.items()}
-
-    def local(b: str, x: F64) -> F64:
-        return quat_rotate(quat_conj(G[idx[b]]), x - P[idx[b]])
-
-    def local_dir(b: str, v: F64) -> F64:
-        return quat_rotate(quat_conj(G[idx[b]]), v)
-
-    def capsule(b: str, a: F64, c: F64, radius: float) -> _Geom:
-        la, lc = local(b, a), local(b, c)
-        if np.linalg.norm(lc - la) < 1e-4:  # degenerate bone: a sphere
-            return _Geom(b, "sphere", (radius,), pos=tuple(la))
-        return _Geom(b, "capsule", (radius,), fromto=(*la, *lc))
-
-    out: list[_Geom] = []
-    # trunk: lateral capsules
-    hip_l, hip_r = at("l_thigh"), at("r_thigh")
-    hip_mid = 0.5 * (hip_l + hip_r)
-    lat_p = _unit(hip_l - hip_r)
-    up_p = at("waist") - hip_mid
-    up_p = _unit(up_p - lat_p * float(lat_p @ up_p))
-    half = max(0.5 * float(np.linalg.norm(hip_l - hip_r)) - 0.01 * s, 0.03 * s)
-    c = hip_mid + up_p * 0.045 * s
-    out.append(capsule("pelvis", c - lat_p * half, c + lat_p * half, r["pelvis"]))
-
-    sh_l, sh_r = at("l_upper_arm"), at("r_upper_arm")
-    lat_c = _unit(sh_l - sh_r)
-    lat_w = _unit(lat_p + lat_c)
-    c = 0.5 * (at("waist") + at("chest"))
-    out.append(capsule("waist", c - lat_w * 0.06 * s, c + lat_w * 0.06 * s, r["waist"]))
-
-    neck_base = at("head")  # the head body's anchor (neck joint, or head if no neck)
-    c = at("chest") + 0.55 * (neck_base - at("chest"))
-    half = max(0.5 * float(np.linalg.norm(sh_l - sh_r)) - 0.6 * r["chest"], 0.04 * s)
-    out.append(capsule("chest", c - lat_c * half, c + lat_c * half, r["chest"]))
-
-    # head (+ neck)
-    head_j = parts.joint_of("head")
-    head_p = ref.global_positions()[frame, head_j]
-    ends = skel.layout.end_sites
-    up_chest = _unit(neck_base - at("chest"))
-    if np.linalg.norm(head_p - neck_base) > 1e-3:
-        out.append(capsule("head", neck_base, head_p, r["neck"]))
-        hdir = _unit(head_p - neck_base)
-    else:
-        hdir = up_chest
-    grot_head = ref.forward_kinematics()[1][frame, head_j]
-    end = np.asarray(ends.get(head_j, (0.0, 0.0, 0.0)), dtype=float)
-    if np.linalg.norm(end) > 0.05 * s:
-        centre = head_p + 0.5 * quat_rotate(grot_head, end)
-    else:
-        centre = head_p + hdir * 0.09 * s
-    out.append(_Geom("head", "sphere", (r["head"],), pos=tuple(local("head", centre))))
-
-    gpos_ref, grot_ref = ref.forward_kinematics()
-    for side in "lr":
-        # arms
-        out.append(
-            capsule(
-                f"{side}_upper_arm", at(f"{side}_upper_arm"), at(f"{side}_forearm"), r["upper_arm"]
-            )
-        )
-        out.append(
-            capsule(f"{side}_forearm", at(f"{side}_forearm"), at(f"{side}_hand"), r["forearm"])
-        )
-        hand_j = int(anchors[idx[f"{side}_hand"]])
-        hend = np.asarray(ends.get(hand_j, (0.0, 0.0, 0.0)), dtype=float)
-        wrist = at(f"{side}_hand")
-        if np.linalg.norm(hend) > 0.05 * s:
-            hdir_w = _unit(quat_rotate(grot_ref[frame, hand_j], hend))
-            length = min(0.6 * float(np.linalg.norm(hend)), 0.14 * s)
-        else:  # straight continuation of the forearm
-            hdir_w = _unit(wrist - at(f"{side}_forearm"))
-            length = _HAND_LEN * s
-        out.append(
-            capsule(f"{side}_hand", wrist + hdir_w * 0.01 * s, wrist + hdir_w * length, r["hand"])
-        )
-        # legs
-        out.append(capsule(f"{side}_thigh", at(f"{side}_thigh"), at(f"{side}_shin"), r["thigh"]))
-        out.append(capsule(f"{side}_shin", at(f"{side}_shin"), at(f"{side}_foot"), r["shin"]))
-        box, ball_x = _foot_box(
-            skel,
-            parts,
-            anchors,
-            ref,
-            frame,
-            side,
-            s,
-            G[idx[f"{side}_foot"]],
-            gpos_ref,
-            grot_ref,
-        )
-        out.append(box)
-        out.append(_ball_patch(box, ball_x))
-    return tuple(out)
-
-
-def _ball_patch(box: _Geom, ball_x: float) -> _Geom:
-    """The ball-of-foot contact patch: a small cube, aligned with the foot box, whose bottom
-    face lies in the sole plane under the ball (``ball_x`` along the box's x axis from its
-    centre), in the foot's local frame: flat on the floor like the box it stands in for."""
-    hz, r = box.size[2], BALL_PATCH_HALF_SIZE
-    local = np.array([ball_x, 0.0, -hz + r])
-    pos = np.asarray(box.pos) + quat_rotate(np.asarray(box.quat), local)
-    return _Geom(box.body, "box", (r, r, r), pos=tuple(pos), quat=box.quat, patch=True)
-
-
-def _foot_box(
-    skel: Skeleton,
-    parts: BodyPartMap,
-    anchors: NDArray[np.int64],
-    ref: Motion,
-    frame: int,
-    side: str,
-    s: float,
-    g_foot: F64,
-    gpos: F64,
-    grot: F64,
-) -> tuple[_Geom, float]:
-    """The foot box in the foot's local frame, and the ball's (toe joint's) offset from the
-    box centre along the box's x axis.
-
-    The sole is placed from the clip: the ankle's lowest height over the reference motion is its
-    height above the sole, and the ball (toe joint) sits its own lowest height above it; the
-    box's roll comes from the frame where the ankle is lowest (most likely flat on the floor).
-    """
-    b = f"{side}_foot"
-    fj = int(anchors[SIM_BODIES.index(b)])
-    toe = parts.joints.get(f"{side}_toe")
-    ankle_z = gpos[:, fj, 2]
-    t_low = int(np.argmin(ankle_z))
-    h_a = (
-        float(np.clip(ankle_z.min(), 0.05 * s, 0.16 * s))
-        if ref.num_frames > 1 or ankle_z.min() > 0.02
-        else 0.08 * s
-    )
-    # ankle -> ball, in the foot's local frame (rigid: toes are folded at their reference pose)
-    if toe is not None:
-        f = quat_rotate(quat_conj(grot[frame, fj]), gpos[frame, toe] - gpos[frame, fj])
-        h_b = (
-            float(np.clip(gpos[:, toe, 2].min(), 0.0, h_a - 0.02 * s))
-            if ref.num_frames > 1
-            else 0.02 * s
-        )
-    else:
-        end = np.asarray(skel.layout.end_sites.get(fj, (0.0, 0.0, 0.0)), dtype=float)
-        if np.linalg.norm(end) > 0.05 * s:
-            f = end
-        else:  # forward of the pelvis, expressed in the foot frame
-            fwd = np.cross(
-                gpos[frame, parts.joint_of("l_thigh")] - gpos[frame, parts.joint_of("r_thigh")],
-                [0.0, 0.0, 1.0],
-            )
-            f = quat_rotate(quat_conj(grot[frame, fj]), _unit(-fwd) * 0.13 * s)
-        h_b = 0.02 * s
-    # world up at the flattest frame, in foot-local coordinates
-    u0 = quat_rotate(quat_conj(grot[t_low, fj]), np.array([0.0, 0.0, 1.0]))
-    lateral = np.cross(f, u0)
-    if np.linalg.norm(lateral) < 1e-6:
-        lateral = _perp(f)
-    lateral = _unit(lateral)
-    fhat = _unit(f - lateral * float(lateral @ f))
-    n = np.cross(lateral, fhat)
-    if n @ u0 < 0:
-        n = -n
-    flen = float(np.linalg.norm(f))
-    k = float(np.clip((h_a - h_b) / max(flen, 1e-6), 0.0, 0.8))
-    up = np.sqrt(1.0 - k * k) * n - k * fhat  # sole normal: the ball is (h_a - h_b) below
-    fwd = _unit(fhat - up * float(up @ fhat))
-    lat = np.cross(up, fwd)
-    x0 = -_FOOT["heel"] * s
-    x1 = float(f @ fwd) + _FOOT["toe"] * s
-    hz = _FOOT["half_height"] * s
-    centre = fwd * 0.5 * (x0 + x1) + up * (-h_a + hz)
-    quat = quat_from_matrix(np.stack([fwd, lat, up], axis=1))
-    del g_foot
-    box = _Geom(
-        b,
-        "box",
-        (0.5 * (x1 - x0), _FOOT["half_width"] * s, hz),
-        pos=tuple(centre),
-        quat=tuple(quat),
-    )
-    return box, float(f @ fwd) - 0.5 * (x0 + x1)

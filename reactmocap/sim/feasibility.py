@@ -1,26 +1,9 @@
-"""Can the ground produce a clip's motion? A single-support momentum check, per frame.
-
-Why: a physical tracker can only follow a clip whose whole-body momentum the ground can
-produce. In single support all external force but gravity comes through one foot, so the rate
-of angular momentum about the centre of mass must equal ``(p - c) x f`` with
-``f = m (a_c + g)`` and ``p`` the centre of pressure, up to the foot's small free moment.
-:func:`support_feasibility` computes, on the character built from the clip, the horizontal
-moment left over with ``p`` at the centre of the supporting sole,
-
-    residual = | (dL/dt - (p - c) x f)_xy |
-
-and the most a centre of pressure anywhere on the sole could add,
-``bound = f_z * (half-diagonal of the sole box)`` (generous). Stretches where the residual is
-well above the bound (2x by default) need a moment no foot can give: no physical tracker
-follows them for long, whatever its gains. Measured on the shared clips
-(``benchmarks/bench_feasibility.py``): the walks stay at 0.72-0.86 of the bound (median), a
-simulated walk at 0.74, the kick clip's three spinning back kicks at 3-15x it for 0.5-0.7 s.
-
-``c`` and ``L`` are MuJoCo's ``subtree_com`` and ``subtree_angmom`` at the clip's poses with
-finite-difference velocities; their rates are central differences at the clip's frame rate.
-A foot is planted as the whole-body tracker decides it
-(:func:`~reactmocap.sim.wholebody.reference_path`: sole within ``reach`` of the floor).
-"""
+"""Can the ground produce a clip's motion? In single support all external force but gravity comes
+through one foot, so the rate of whole-body angular momentum about the centre of mass must be
+``(p - c) x f`` (``f = m (a_c + g)``, ``p`` the centre of pressure) up to what moving ``p`` over
+the sole can add. :func:`support_feasibility` measures, per frame on the character built from the
+clip, the horizontal moment left over with ``p`` at the sole's centre against that bound: where
+it is well above (2x by default), no physical tracker follows the clip for long."""
 
 from __future__ import annotations
 

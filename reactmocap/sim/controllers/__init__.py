@@ -26,6 +26,7 @@ from reactmocap.sim.controllers.registry import (
     build,
     controller_help,
     controller_spec,
+    register,
 )
 from reactmocap.sim.controllers.root_assist import RootAssist
 from reactmocap.sim.controllers.wholebody import WholeBodyPlan, WholeBodyTracker
@@ -53,5 +54,6 @@ __all__ = [
     "check_params",
     "controller_help",
     "controller_spec",
+    "register",
     "when",
 ]

@@ -21,7 +21,15 @@ from reactmocap.sim.controllers.wholebody import WholeBodyTracker
 from reactmocap.sim.reference import ReferencePath
 from reactmocap.sim.world import World
 
-__all__ = ["CONTROLLERS", "ControllerSpec", "build", "controller_help", "controller_spec"]
+__all__ = [
+    "CONTROLLERS",
+    "ControllerSpec",
+    "Factory",
+    "build",
+    "controller_help",
+    "controller_spec",
+    "register",
+]
 
 Param = float | int | None
 Reference = Motion | ReferencePath
@@ -116,9 +124,7 @@ def _root_assist(
 _PD = {"kp": 4000.0, "kv": None, "control_every": 10, "refresh_every": 10}
 _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 
-#: every registered controller; the gains and rates here are the only defaults (the CLI help
-#: and the scenario docs print them from this table)
-CONTROLLERS: Mapping[str, ControllerSpec] = MappingProxyType({
+_REGISTRY: dict[str, ControllerSpec] = {
     "pd": ControllerSpec(
         "pd", "the paper's inertia-scaled PD servo toward the reference joints (no balance)",
         _PD, _pd),
@@ -138,7 +144,21 @@ CONTROLLERS: Mapping[str, ControllerSpec] = MappingProxyType({
         "root_assist", "NON-PHYSICAL external pelvis wrench toward the reference (an add-on "
         "to another controller)", {"kp": 100.0, "kv": None, "control_every": 1}, _root_assist,
         physical=False),
-})  # fmt: skip
+}  # fmt: skip
+#: every registered controller (read-only view; :func:`register` adds); the gains and rates
+#: here are the only defaults (the CLI help and the scenario docs print them from this table)
+CONTROLLERS: Mapping[str, ControllerSpec] = MappingProxyType(_REGISTRY)
+
+
+def register(spec: ControllerSpec) -> ControllerSpec:
+    """Add a controller defined outside this package (a plugin; the package's own are rows of
+    the table above). Its name must be new."""
+    if not isinstance(spec, ControllerSpec):
+        raise ConfigError(f"register() takes a ControllerSpec, got {type(spec).__name__}")
+    if spec.name in _REGISTRY:
+        raise ConfigError(f"a controller named {spec.name!r} is already registered")
+    _REGISTRY[spec.name] = spec
+    return spec
 
 
 def controller_spec(name: str) -> ControllerSpec:
