@@ -16,7 +16,7 @@ from reactmocap.sim.character import BALL_JOINTS, qvel_from_qpos
 from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.world import World
 
-__all__ = ["ClipClock", "ReferencePath", "reference_path"]
+__all__ = ["ClipClock", "ReferencePath", "as_path", "reference_path"]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
@@ -143,3 +143,10 @@ def reference_path(
     for arr in arrays:
         arr.flags.writeable = False
     return ReferencePath(*arrays, fps=rate)
+
+
+def as_path(world: World, character: int, reference: Motion | ReferencePath) -> ReferencePath:
+    """``reference`` as a path on ``character``: a ReferencePath as it is, a Motion converted."""
+    if isinstance(reference, ReferencePath):
+        return reference
+    return reference_path(world, character, reference)

@@ -15,7 +15,7 @@ from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.feet import foot_soles, sole_corners_world
-from reactmocap.sim.reference import ReferencePath, reference_path
+from reactmocap.sim.reference import ReferencePath, as_path
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
 
@@ -116,11 +116,7 @@ class StanceBalance:
         self._weight = m.body_subtreemass[self._child] * self.gravity[2]  # (15,) N
         self._tau = np.zeros((NJ, 3))
         self._tau_local = np.empty((NJ, 3))
-        path = (
-            reference
-            if isinstance(reference, ReferencePath)
-            else reference_path(world, character, reference)
-        )
+        path = as_path(world, character, reference)
         self.clock = path.clock(start)
         self._reference(path)
 

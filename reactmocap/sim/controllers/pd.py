@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.controllers.base import check_character, check_params
-from reactmocap.sim.reference import ReferencePath, reference_path
+from reactmocap.sim.reference import ReferencePath, as_path
 from reactmocap.sim.world import World
 
 __all__ = ["PDTracker", "Passive"]
@@ -42,11 +42,7 @@ class PDTracker:
         self.kv = kv
         self.control_every = int(control_every)
         self.refresh_every = int(refresh_every)
-        path = (
-            reference
-            if isinstance(reference, ReferencePath)
-            else reference_path(world, character, reference)
-        )
+        path = as_path(world, character, reference)
         self.path = path
         self.clock = path.clock(start)
         self.quats = path.q[:, 7:].reshape(path.num_frames, NJ, 4)

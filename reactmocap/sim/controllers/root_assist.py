@@ -6,7 +6,7 @@ from __future__ import annotations
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.controllers.base import check_character, check_params
-from reactmocap.sim.reference import ReferencePath, reference_path
+from reactmocap.sim.reference import ReferencePath, as_path
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
 
@@ -33,11 +33,7 @@ class RootAssist:
         check_character(world, character)
         check_params({"kp": kp, "kv": kv})
         wc = world.characters[character]
-        path = (
-            reference
-            if isinstance(reference, ReferencePath)
-            else reference_path(world, character, reference)
-        )
+        path = as_path(world, character, reference)
         self.clock = path.clock(start)
         self.pos = path.q[:, :3]
         self.rot = path.q[:, 3:7]
