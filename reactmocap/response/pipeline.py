@@ -22,6 +22,8 @@ from reactmocap.response import stages
 from reactmocap.response.library_cache import LibraryCache, prepare_library
 from reactmocap.response.scenario import Scenario
 from reactmocap.search import SearchResult
+from reactmocap.sim.impacts import overlap_depths
+from reactmocap.sim.world import World
 
 __all__ = ["LibraryCache", "ResponseResult", "prepare_library", "run_response", "run_scenario"]
 
@@ -102,8 +104,19 @@ def _report(
     timings: dict[str, float],
 ) -> dict[str, Any]:
     cfg = scenario.response
-    parts = cast.recipient.parts
+    rec = cast.recipient
+    parts = rec.parts
     best = cont.best
+    fps = rec.motion.fps
+    undisturbed = rec.motion.sample(out.recipient.times + rec.clock0).replace(fps=fps)
+    impact_frame = int(np.ceil(naive.impact_time * fps - 1e-9))
+    shift = qm.reaction_displacement(out.recipient, undisturbed, parts, impact_frame)
+    impulse = _impulse(scenario, sim2)
+    overlap = 0.0
+    if cast.attacker is not None and out.attacker is not None:
+        att = out.attacker.sample(out.recipient.times).replace(fps=fps)
+        world = World([rec.character, cast.attacker.character])
+        overlap = float(overlap_depths(world, [out.recipient, att]).max())
     quality = {
         "match_distance": qm.match_distance(best.distance),
         "blend_root_offset_max_m": qm.blend_root_offset_max_m(out.simulated, out.blended),
@@ -115,6 +128,16 @@ def _report(
         "penetration_max_m": qm.penetration_max_m(out.recipient),
         "fell": qm.fell(out.recipient, parts),
         "intended_fall": qm.intended_fall(cont.found_clip, parts, best.frame),
+        "reaction_displacement_m": float(np.linalg.norm(shift)),
+        "reaction_direction_error_deg": qm.direction_error_deg(shift, impulse),
+        "transition_s": cont.time - naive.impact_time,
+        "contact_impulse_Ns": float(np.linalg.norm(impulse)),
+        "character_overlap_max_m": overlap,
+        "attacker_speed_ratio": (
+            qm.speed_ratio(out.attacker, cast.attacker.motion)
+            if out.attacker is not None and cast.attacker is not None
+            else None
+        ),
     }
     return {
         "scenario": scenario.name,
@@ -137,6 +160,7 @@ def _report(
             "peak_force_N": naive.peak_force,
             "rewind_time": contact.rewind,
             "contact_end": naive.contact_end,
+            "impulse_Ns": impulse.tolist(),
         },
         "transition": {
             "start": naive.impact_time,
@@ -149,6 +173,14 @@ def _report(
         "config": asdict(cfg),
         "outputs": {},
     }
+
+
+def _impulse(scenario: Scenario, sim2: stages.TransitionSimulation) -> F64:
+    """``(3,)`` the world impulse on the recipient (N s): the explicit impact's, or what the
+    attacker's contacts delivered in Simulation 2."""
+    if scenario.impact is not None:
+        return np.asarray(scenario.impact.force) * scenario.impact.duration
+    return sim2.contacts.impulse
 
 
 def run_scenario(

@@ -134,19 +134,23 @@ def estimate_contact(scenario: Scenario, cast: Cast) -> ContactEstimate:
     """The explicit impact's time, or the first kinematic contact of the two clips scanned at
     :data:`SCAN_FPS`; then rewind to the last recipient frame before it."""
     rec, att = cast.recipient, cast.attacker
+    fps = rec.motion.fps
     if att is not None:
         horizon = min(rec.motion.duration - rec.clock0, att.motion.duration - att.clock0)
         shifted = [a.motion.sample(np.arange(0, horizon, 1 / a.motion.fps) + a.clock0)
                    .replace(fps=a.motion.fps) for a in (rec, att)]  # fmt: skip
         world = World([rec.character, att.character])
         kc = first_contact(world, shifted, fps=SCAN_FPS, end=horizon)
-        # never touching: the scan runs to the end and the clip plays on
-        t, body = (horizon, "contact") if kc is None else (kc.time, "/".join(kc.pairs[0]))
-    else:
-        assert scenario.impact is not None
-        t, body = scenario.impact.at, scenario.impact.body
-    fps = rec.motion.fps
-    return ContactEstimate(t, max(0.0, float(np.floor(t * fps - 1e-9) / fps)), body)
+        if kc is None:  # never touching: the scan runs to the end and the clip plays on
+            return ContactEstimate(horizon, max(0.0, np.floor(horizon * fps - 1e-9) / fps),
+                                   "contact")  # fmt: skip
+        # the last scanned frame without contact, on the recipient's frames: apart at the start
+        rewind = np.floor(kc.rewind_time * fps + 1e-9) / fps
+        return ContactEstimate(kc.time, max(0.0, float(rewind)), "/".join(kc.pairs[0]))
+    assert scenario.impact is not None
+    t = scenario.impact.at
+    return ContactEstimate(t, max(0.0, float(np.floor(t * fps - 1e-9) / fps)),
+                           scenario.impact.body)  # fmt: skip
 
 
 def _world(cast: Cast, friction: float, cfg: ResponseConfig) -> World:
@@ -294,6 +298,7 @@ class TransitionSimulation:
     attacker: Motion | None
     steps: int
     world: World
+    contacts: ContactLog
 
 
 def _desired_path(cast: Cast, cfg: ResponseConfig, naive: NaiveSimulation, cont: Continuation,
@@ -338,10 +343,12 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     res = rollout(
         world, seconds, controllers=ctrls, impacts=_impacts(scenario, rewind), record_fps=fps,
         references=[a.motion for a in cast.actors],
-        reference_start=[rewind + a.clock0 for a in cast.actors],
+        reference_start=[rewind + a.clock0 for a in cast.actors], contact_every=CONTACT_EVERY,
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
-    return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world)
+    assert res.contact_log is not None
+    return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
+                                res.contact_log)  # fmt: skip
 
 
 @dataclass(frozen=True)

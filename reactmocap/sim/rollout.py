@@ -38,16 +38,19 @@ Status = Literal["ok", "unstable"]
 
 @dataclass(frozen=True)
 class ContactLog:
-    """Contacts between characters, sampled every ``period`` seconds while any exist:
-    ``times`` ``(n,)`` seconds from the rollout's start, ``normal`` ``(n,)`` the summed normal
-    force between characters (N), ``force`` ``(n, 3)`` the world force on character 0 from the
-    others (N), ``depth`` ``(n,)`` the deepest interpenetration between characters (m)."""
+    """Contacts between characters while any exist, sampled at every step (the engine looks
+    for them every ``period`` seconds and samples every step from the first it finds until
+    they part): ``times`` ``(n,)`` seconds from the rollout's start, ``normal`` ``(n,)`` the
+    summed normal force between characters (N), ``force`` ``(n, 3)`` the world force on
+    character 0 from the others (N), ``depth`` ``(n,)`` the deepest interpenetration between
+    characters (m)."""
 
     times: F64
     normal: F64
     force: F64
     depth: F64
     period: float
+    dt: float  # seconds per sample (the physics step)
 
     @property
     def empty(self) -> bool:
@@ -55,8 +58,10 @@ class ContactLog:
 
     @property
     def impulse(self) -> F64:
-        """``(3,)`` world impulse on character 0 from the others (N s), by the rectangle rule."""
-        return self.force.sum(axis=0) * self.period
+        """``(3,)`` world impulse on character 0 from the others (N s), by the rectangle rule
+        over the sampled steps."""
+        return self.force.sum(axis=0) * self.dt
+
 
     @property
     def peak_force(self) -> float:
@@ -176,17 +181,18 @@ class _ContactLogger:
         self.rows: list[tuple[float, float, F64, float]] = []
         self._f6 = np.zeros(6)
 
-    def log(self, t: float) -> None:
+    def log(self, t: float) -> bool:
+        """Log the contacts between characters now; whether there are any."""
         w = self.world
         m, d = w.model, w.data
         n = d.ncon
         if n == 0:
-            return
+            return False
         geoms = d.contact.geom[:n]
         own = w.geom_character[geoms]
         between = np.flatnonzero((own[:, 0] >= 0) & (own[:, 1] >= 0) & (own[:, 0] != own[:, 1]))
         if not between.size:
-            return
+            return False
         total = 0.0
         force = np.zeros(3)
         for i in between:  # a handful of contacts, only while the characters touch
@@ -199,13 +205,15 @@ class _ContactLogger:
                 force -= fw
         depth = float(max(0.0, -d.contact.dist[between].min()))
         self.rows.append((t, total, force, depth))
+        return True
 
     def result(self, period: float) -> ContactLog:
+        dt = self.world.timestep
         if not self.rows:
             z = np.zeros(0)
-            return ContactLog(z, z, np.zeros((0, 3)), z, period)
+            return ContactLog(z, z, np.zeros((0, 3)), z, period, dt)
         t, f, v, dep = zip(*self.rows)
-        return ContactLog(np.array(t), np.array(f), np.array(v), np.array(dep), period)
+        return ContactLog(np.array(t), np.array(f), np.array(v), np.array(dep), period, dt)
 
 
 @dataclass
@@ -346,6 +354,7 @@ def _loop(
     ri = 0  # next record
     ei = 0  # next event
     k = 0
+    touching = False  # contacts between characters: logged every step while they last
     while True:
         is_record = ri < rec.size and rec[ri] == k
         if is_record or k % plan.check_every == 0 or k >= nsteps:
@@ -363,8 +372,8 @@ def _loop(
         for c in plan.controllers:
             if k % c.control_every == 0:
                 c.control(world, t)
-        if plan.logger is not None and k % plan.contact_every == 0:
-            plan.logger.log(t)
+        if plan.logger is not None and (touching or k % plan.contact_every == 0):
+            touching = plan.logger.log(t)
         if plan.on_tick is not None and k % plan.tick_every == 0:
             plan.on_tick(t)
         if plan.schedule is not None:
@@ -375,5 +384,7 @@ def _loop(
         nxt = int(events[ei]) if ei < events.size else nsteps
         for p in plan.periods:
             nxt = min(nxt, (k // p + 1) * p)
+        if touching:
+            nxt = k + 1
         world.step(nxt - k)
         k = nxt
