@@ -27,7 +27,7 @@ __all__ = [
     "parse_scenario",
 ]
 
-SIM1_MODES = ("passive", "holding")
+SIM1_MODES = ("yielding", "holding", "passive")
 
 
 @dataclass(frozen=True)
@@ -75,9 +75,20 @@ class ResponseConfig:
     kv: float | None = None
     friction_sim1: float = 1.0
     friction_sim2: float = 0.5
-    sim1_mode: Literal["passive", "holding"] = "holding"
+    #: Simulation 1: ``yielding`` (the recipient gives way to the hit with its stiffness cut to
+    #: ``yield_gain`` for the reaction delay, holding its pose at impact, then recovers over
+    #: ``yield_recover`` s; Simulation 2 keeps the same passive phase), ``holding`` (keeps
+    #: tracking the old clip at full stiffness) or ``passive`` (a ragdoll from the impact on)
+    sim1_mode: Literal["yielding", "holding", "passive"] = "yielding"
+    yield_gain: float = 0.1
+    yield_recover: float = 0.3
     sim1_duration: float = 1.0  # s after the impact
     search_start: float = 0.1  # s after the impact
+    #: an impulse (N s) from which the recipient reacts: its own clip cannot be the
+    #: continuation within ``reaction_delay + active_min`` s of the impact (below it, carrying
+    #: on with the own clip is right)
+    react_impulse: float = 5.0
+    active_min: float = 0.2
     search_end: float = 1.0
     contact_shift_max: float = 0.25  # s the search start moves later while contact lasts
     attacker_follow: float = 0.1  # s the attacker follows its own simulation
@@ -186,7 +197,9 @@ class _Reader:
             else:
                 nonneg = name in {"start", "at", "reaction_delay", "search_start", "tail",
                                   "contact_shift_max", "attacker_follow", "attacker_blend",
-                                  "friction_sim1", "friction_sim2", "kv"}  # fmt: skip
+                                  "friction_sim1", "friction_sim2", "kv", "yield_gain",
+                                  "react_impulse", "active_min",
+                                  "yield_recover"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
                                     "total_mass"}  # fmt: skip
                 kwargs[name] = self.number(

@@ -20,11 +20,20 @@ from reactmocap.library.placement import place
 from reactmocap.response.blend import blend_poses, final_blend, transition_weights
 from reactmocap.response.footlock import lock_feet
 from reactmocap.response.library_cache import LibraryCache
+from reactmocap.response.reaction import YieldOnImpact, yield_schedule
 from reactmocap.response.scenario import CharacterSpec, ResponseConfig, Scenario
 from reactmocap.rotations import quat_slerp
 from reactmocap.search import MotionIndex, SearchResult
 from reactmocap.sim.character import Character, build_character
-from reactmocap.sim.controllers import Controller, State, StateMachine, after, build
+from reactmocap.sim.controllers import (
+    Controller,
+    GainScalable,
+    Scheduled,
+    State,
+    StateMachine,
+    after,
+    build,
+)
 from reactmocap.sim.controllers.registry import controller_spec
 from reactmocap.sim.impacts import Impact, first_contact
 from reactmocap.sim.reference import reference_path
@@ -153,9 +162,12 @@ def estimate_contact(scenario: Scenario, cast: Cast) -> ContactEstimate:
                            scenario.impact.body)  # fmt: skip
 
 
-def _world(cast: Cast, friction: float, cfg: ResponseConfig) -> World:
+def _world(cast: Cast, cfg: ResponseConfig, recipient_friction: float) -> World:
+    """The simulations' world: the attacker always on ``friction_sim1`` (its strike should not
+    depend on the pass), the recipient on ``recipient_friction``."""
     world = World([a.character for a in cast.actors],
-                  WorldConfig(friction=friction, timestep=cfg.timestep))  # fmt: skip
+                  WorldConfig(friction=cfg.friction_sim1, timestep=cfg.timestep))  # fmt: skip
+    world.set_friction(recipient_friction, character=0)
     return world
 
 
@@ -198,6 +210,7 @@ class NaiveSimulation:
     peak_force: float
     contacts: ContactLog
     steps: int
+    impulse: float  # |impulse| on the recipient (N s)
 
 
 def _start(world: World, cast: Cast, rewind: float) -> None:
@@ -205,19 +218,44 @@ def _start(world: World, cast: Cast, rewind: float) -> None:
         world.set_from_motion(k, a.motion, a.frame_at(rewind))
 
 
+def _recipient_path(cast: Cast, cfg: ResponseConfig, rewind: float, seconds: float, every: int,
+                    impact: float, target: Continuation) -> tuple[F64, float]:  # fmt: skip
+    """Simulation 2's desired qpos for the recipient at each control tick from the rewind, and
+    its rate: the old clip until ``impact``; from there (``yielding``) its pose at the impact,
+    held through the reaction delay (or, ``holding``/``passive``: the old clip on), eased
+    (smoothstep) into the found clip by the match time."""
+    rec = cast.recipient
+    ch = rec.character
+    n = int(np.ceil(seconds / cfg.timestep / every)) + 1
+    ticks = np.arange(n) * every * cfg.timestep + rewind
+    clock = np.minimum(ticks, impact) if cfg.sim1_mode == "yielding" else ticks
+    prev = ch.qpos_from_motion(rec.motion.sample(clock + rec.clock0))
+    found = ch.qpos_from_motion(target.found.sample(target.best.time + (ticks - target.time)))
+    w = transition_weights(ticks, impact, cfg.reaction_delay, target.time)
+    q = np.empty_like(prev)
+    q[:, :3] = prev[:, :3] + w[:, None] * (found[:, :3] - prev[:, :3])
+    quats = quat_slerp(prev[:, 3:].reshape(n, -1, 4), found[:, 3:].reshape(n, -1, 4), w[:, None])
+    q[:, 3:] = quats.reshape(n, -1)
+    return q, 1.0 / (every * cfg.timestep)
+
+
 def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -> NaiveSimulation:
-    """Simulation 1 (friction ``friction_sim1``): ``holding`` tracks the old clip on with
-    ``sim1_controller``; ``passive`` lets go at the contact (a ragdoll)."""
+    """Simulation 1 (friction ``friction_sim1``) with ``sim1_controller``: the recipient
+    ``yielding`` to the hit (the default), ``holding`` its old clip or ``passive`` from the
+    contact (see :class:`~reactmocap.response.scenario.ResponseConfig`)."""
     cfg = scenario.response
     rewind = contact.rewind
     end = contact.time + cfg.sim1_duration + cast.index.window.length / cast.index.window.fps
-    world = _world(cast, cfg.friction_sim1, cfg)
+    world = _world(cast, cfg, cfg.friction_sim1)
     _start(world, cast, rewind)
     state = world.get_state()
+    fps = cast.recipient.motion.fps
     rec = cast.recipient
-    fps = rec.motion.fps
     hold = _controller(cfg.sim1_controller, cfg, world, 0, rec.motion, rewind + rec.clock0, fps)
-    if cfg.sim1_mode == "passive":
+    if cfg.sim1_mode == "yielding":
+        explicit = scenario.impact.at - rewind if scenario.impact is not None else None
+        hold = YieldOnImpact(hold, cfg, explicit)
+    elif cfg.sim1_mode == "passive":
         hold = StateMachine(
             [State("holding", hold, exits=((after(contact.time - rewind), "passive"),)),
              State("passive", on_enter=lambda w, _t: w.servo.enable(0, on=False))],
@@ -238,15 +276,16 @@ def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -
     assert log is not None
     if not log.empty:
         t_impact, contact_end = rewind + log.times[0], rewind + log.times[-1]
-        peak = log.peak_force
+        peak, impulse = log.peak_force, float(np.linalg.norm(log.impulse))
     elif scenario.impact is not None:
         t_impact = scenario.impact.at
         contact_end = t_impact + scenario.impact.duration
         peak = float(np.linalg.norm(scenario.impact.force))
+        impulse = peak * scenario.impact.duration
     else:
-        t_impact, contact_end, peak = contact.time, contact.time, 0.0
+        t_impact, contact_end, peak, impulse = contact.time, contact.time, 0.0, 0.0
     return NaiveSimulation(res.motion(0, name="sim1"), state, t_impact, contact_end, peak, log,
-                           res.steps)  # fmt: skip
+                           res.steps, impulse)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -272,6 +311,10 @@ def search_continuation(
     t_impact = naive.impact_time
     first = t_impact + float(np.clip(naive.contact_end - t_impact, cfg.search_start,
                                      cfg.contact_shift_max))  # fmt: skip
+    if naive.impulse >= cfg.react_impulse:
+        # a real hit: the active response after the reaction delay needs time to show, so the
+        # recipient's own clip right after the hit cannot win by being closest
+        first = max(first, t_impact + cfg.reaction_delay + cfg.active_min)
     last = t_impact + cfg.search_end
     q_fps = index.window.fps
     query = naive.motion.resample(q_fps)
@@ -301,39 +344,26 @@ class TransitionSimulation:
     contacts: ContactLog
 
 
-def _desired_path(cast: Cast, cfg: ResponseConfig, naive: NaiveSimulation, cont: Continuation,
-                  rewind: float, seconds: float, every: int) -> tuple[F64, float]:  # fmt: skip
-    """The recipient's desired qpos at each control tick from the rewind: the old clip until
-    the reaction delay, then eased into the found clip (root lerped, rotations slerped)."""
-    ch = cast.recipient.character
-    dt = cfg.timestep
-    n = int(np.ceil(seconds / dt / every)) + 1
-    ticks = np.arange(n) * every * dt + rewind
-    prev = ch.qpos_from_motion(cast.recipient.motion.sample(ticks + cast.recipient.clock0))
-    found = ch.qpos_from_motion(cont.found.sample(cont.best.time + (ticks - cont.time)))
-    w = transition_weights(ticks, naive.impact_time, cfg.reaction_delay, cont.time)
-    q = np.empty_like(prev)
-    q[:, :3] = prev[:, :3] + w[:, None] * (found[:, :3] - prev[:, :3])
-    quats = quat_slerp(prev[:, 3:].reshape(n, -1, 4), found[:, 3:].reshape(n, -1, 4), w[:, None])
-    q[:, 3:] = quats.reshape(n, -1)
-    return q, 1.0 / (every * dt)
-
-
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
                           naive: NaiveSimulation, cont: Continuation) -> TransitionSimulation:  # fmt: skip
     """Simulation 2 (friction ``friction_sim2``) from the same start and impact: the recipient
-    tracks the desired path with ``sim2_controller`` (the reaction delay is in the path)."""
+    follows the desired path to the found clip with ``sim2_controller``, yielding through the
+    reaction delay as in Simulation 1 (the passive response), then recovering (the active)."""
     cfg = scenario.response
     rewind = contact.rewind
     end = cont.time
     if cast.attacker is not None:
         end = max(end, naive.impact_time + cfg.attacker_follow + cfg.attacker_blend)
     seconds = max(end - rewind, cfg.timestep)
-    world = _world(cast, cfg.friction_sim2, cfg)
+    world = _world(cast, cfg, cfg.friction_sim2)
     world.set_state(naive.start_state)
-    every = int(controller_spec(cfg.sim2_controller).defaults["control_every"] or 1)
-    q, rate = _desired_path(cast, cfg, naive, cont, rewind, seconds, every)
-    ctrls = [_controller(cfg.sim2_controller, cfg, world, 0, q, 0.0, rate)]
+    name = cfg.sim2_controller
+    every = int(controller_spec(name).defaults["control_every"] or 1)
+    q, rate = _recipient_path(cast, cfg, rewind, seconds, every, naive.impact_time, cont)
+    recipient = _controller(name, cfg, world, 0, q, 0.0, rate)
+    if cfg.sim1_mode == "yielding" and isinstance(recipient, GainScalable):
+        recipient = Scheduled(recipient, yield_schedule(cfg, naive.impact_time - rewind))
+    ctrls = [recipient]
     fps = [cast.recipient.motion.fps]
     if cast.attacker is not None:
         att = cast.attacker

@@ -3,7 +3,7 @@ clock that maps rollout time onto it (:class:`ClipClock`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -26,12 +26,13 @@ NV = 6 + 3 * NJ
 
 @dataclass(frozen=True)
 class ClipClock:
-    """Rollout time ``t`` -> fractional frame ``(start + t) fps`` of a clip of ``frames``
-    frames, clamped to the clip."""
+    """Rollout time ``t`` -> fractional frame ``(start + min(t, until)) fps`` of a clip of
+    ``frames`` frames, clamped to the clip (``until``: the clip stops there, its pose held)."""
 
     fps: float
     frames: int
     start: float = 0.0
+    until: float = float("inf")
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.fps) and self.fps > 0) or self.frames < 1:
@@ -40,7 +41,11 @@ class ClipClock:
             raise ConfigError(f"clip clock start must be finite, got {self.start!r}")
 
     def frame(self, t: float) -> float:
-        return min(max((self.start + t) * self.fps, 0.0), self.frames - 1.0)
+        return min(max((self.start + min(t, self.until)) * self.fps, 0.0), self.frames - 1.0)
+
+    def held_from(self, t: float) -> ClipClock:
+        """This clock with the clip stopped at rollout time ``t``."""
+        return replace(self, until=float(t))
 
     def bracket(self, t: float) -> tuple[int, int, float]:
         """The frames either side of ``t`` and the weight of the later one."""

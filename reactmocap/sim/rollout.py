@@ -62,7 +62,6 @@ class ContactLog:
         over the sampled steps."""
         return self.force.sum(axis=0) * self.dt
 
-
     @property
     def peak_force(self) -> float:
         return float(self.normal.max()) if self.normal.size else 0.0

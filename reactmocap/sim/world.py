@@ -320,11 +320,29 @@ class World:
         """``(2,)`` whether each foot (left, right) currently touches through its patch."""
         return self.model.geom_contype[self.characters[character].patch_ids] != 0
 
-    def set_friction(self, mu: float) -> None:
-        """Sliding friction coefficient of every contact (floor and characters)."""
+    def set_friction(self, mu: float, character: int | None = None) -> None:
+        """Sliding friction coefficient of every contact, or of one character's contacts.
+        MuJoCo takes the larger of two geoms' coefficients, so the floor keeps the smallest
+        any character has and each character's geoms carry its own."""
         if not (np.isfinite(mu) and mu >= 0):
             raise ConfigError(f"friction must be >= 0, got {mu!r}")
-        self.model.geom_friction[:, 0] = mu
+        m = self.model
+        if character is None:
+            m.geom_friction[:, 0] = mu
+            return
+        m.geom_friction[self.characters[character].geom_ids, 0] = mu
+        floor = m.geom("floor").id
+        m.geom_friction[floor, 0] = min(
+            float(m.geom_friction[wc.geom_ids, 0].min()) for wc in self.characters
+        )
+
+    def characters_touching(self) -> bool:
+        """Whether two characters are in contact now (MuJoCo's contacts of the last step)."""
+        d = self.data
+        if d.ncon == 0 or len(self.characters) < 2:
+            return False
+        own = self.geom_character[d.contact.geom[: d.ncon]]
+        return bool(np.any((own[:, 0] >= 0) & (own[:, 1] >= 0) & (own[:, 0] != own[:, 1])))
 
     # ------------------------------------------------------------------ state
     @property

@@ -120,6 +120,10 @@ class StanceBalance:
         self.clock = path.clock(start)
         self._reference(path)
 
+    def hold(self, t: float) -> None:
+        """From rollout time ``t`` on, follow the reference's pose at ``t``."""
+        self.clock = self.clock.held_from(t)
+
     def reset(self, world: World) -> None:
         del world
         self._stance = ()
