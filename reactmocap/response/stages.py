@@ -21,9 +21,10 @@ from reactmocap.response.blend import blend_poses, final_blend, transition_weigh
 from reactmocap.response.footlock import lock_feet
 from reactmocap.response.library_cache import LibraryCache
 from reactmocap.response.reaction import YieldOnImpact, yield_schedule
-from reactmocap.response.scenario import CharacterSpec, ResponseConfig, Scenario
+from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
 from reactmocap.rotations import quat_slerp
 from reactmocap.search import MotionIndex, SearchResult
+from reactmocap.sim.bodies import SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.character import Character, build_character
 from reactmocap.sim.controllers import (
     Controller,
@@ -35,7 +36,7 @@ from reactmocap.sim.controllers import (
     build,
 )
 from reactmocap.sim.controllers.registry import controller_spec
-from reactmocap.sim.impacts import Impact, first_contact
+from reactmocap.sim.impacts import Impact, first_contact, overlap_depths
 from reactmocap.sim.reference import reference_path
 from reactmocap.sim.rollout import ContactLog, rollout
 from reactmocap.sim.world import World, WorldConfig
@@ -213,22 +214,31 @@ class NaiveSimulation:
     impulse: float  # |impulse| on the recipient (N s)
 
 
+def _impulse_of(impact: ImpactSpec) -> float:
+    return float(np.linalg.norm(impact.force)) * impact.duration
+
+
+def _yields(cfg: ResponseConfig, impulse: float) -> bool:
+    """Whether the recipient gives way to a hit of ``impulse`` N s (``yielding`` mode)."""
+    return cfg.sim1_mode == "yielding" and impulse >= cfg.react_impulse
+
+
 def _start(world: World, cast: Cast, rewind: float) -> None:
     for k, a in enumerate(cast.actors):
         world.set_from_motion(k, a.motion, a.frame_at(rewind))
 
 
 def _recipient_path(cast: Cast, cfg: ResponseConfig, rewind: float, seconds: float, every: int,
-                    impact: float, target: Continuation) -> tuple[F64, float]:  # fmt: skip
+                    impact: float, yields: bool, target: Continuation) -> tuple[F64, float]:  # fmt: skip
     """Simulation 2's desired qpos for the recipient at each control tick from the rewind, and
-    its rate: the old clip until ``impact``; from there (``yielding``) its pose at the impact,
-    held through the reaction delay (or, ``holding``/``passive``: the old clip on), eased
+    its rate: the old clip until ``impact``; from there (``yields``) its pose at the impact,
+    held through the reaction delay (or the old clip on), eased
     (smoothstep) into the found clip by the match time."""
     rec = cast.recipient
     ch = rec.character
     n = int(np.ceil(seconds / cfg.timestep / every)) + 1
     ticks = np.arange(n) * every * cfg.timestep + rewind
-    clock = np.minimum(ticks, impact) if cfg.sim1_mode == "yielding" else ticks
+    clock = np.minimum(ticks, impact) if yields else ticks
     prev = ch.qpos_from_motion(rec.motion.sample(clock + rec.clock0))
     found = ch.qpos_from_motion(target.found.sample(target.best.time + (ticks - target.time)))
     w = transition_weights(ticks, impact, cfg.reaction_delay, target.time)
@@ -252,9 +262,9 @@ def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -
     fps = cast.recipient.motion.fps
     rec = cast.recipient
     hold = _controller(cfg.sim1_controller, cfg, world, 0, rec.motion, rewind + rec.clock0, fps)
-    if cfg.sim1_mode == "yielding":
-        explicit = scenario.impact.at - rewind if scenario.impact is not None else None
-        hold = YieldOnImpact(hold, cfg, explicit)
+    imp = scenario.impact
+    if (imp is None and cfg.sim1_mode == "yielding") or (imp and _yields(cfg, _impulse_of(imp))):
+        hold = YieldOnImpact(hold, cfg, imp.at - rewind if imp is not None else None)
     elif cfg.sim1_mode == "passive":
         hold = StateMachine(
             [State("holding", hold, exits=((after(contact.time - rewind), "passive"),)),
@@ -281,7 +291,7 @@ def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -
         t_impact = scenario.impact.at
         contact_end = t_impact + scenario.impact.duration
         peak = float(np.linalg.norm(scenario.impact.force))
-        impulse = peak * scenario.impact.duration
+        impulse = _impulse_of(scenario.impact)
     else:
         t_impact, contact_end, peak, impulse = contact.time, contact.time, 0.0, 0.0
     return NaiveSimulation(res.motion(0, name="sim1"), state, t_impact, contact_end, peak, log,
@@ -342,6 +352,9 @@ class TransitionSimulation:
     steps: int
     world: World
     contacts: ContactLog
+    #: scenario time from which the attacker's own clip no longer runs into the recipient: its
+    #: output follows the simulation until then (or the end of ``attacker_follow``)
+    attacker_release: float = 0.0
 
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
@@ -352,16 +365,20 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     cfg = scenario.response
     rewind = contact.rewind
     end = cont.time
+    release = 0.0
     if cast.attacker is not None:
-        end = max(end, naive.impact_time + cfg.attacker_follow + cfg.attacker_blend)
+        release = max(naive.impact_time + cfg.attacker_follow,
+                      _attacker_clear(cast, cfg, naive, cont))  # fmt: skip
+        end = max(end, release + cfg.attacker_blend)
     seconds = max(end - rewind, cfg.timestep)
     world = _world(cast, cfg, cfg.friction_sim2)
     world.set_state(naive.start_state)
     name = cfg.sim2_controller
     every = int(controller_spec(name).defaults["control_every"] or 1)
-    q, rate = _recipient_path(cast, cfg, rewind, seconds, every, naive.impact_time, cont)
+    yields = _yields(cfg, naive.impulse)
+    q, rate = _recipient_path(cast, cfg, rewind, seconds, every, naive.impact_time, yields, cont)
     recipient = _controller(name, cfg, world, 0, q, 0.0, rate)
-    if cfg.sim1_mode == "yielding" and isinstance(recipient, GainScalable):
+    if yields and isinstance(recipient, GainScalable):
         recipient = Scheduled(recipient, yield_schedule(cfg, naive.impact_time - rewind))
     ctrls = [recipient]
     fps = [cast.recipient.motion.fps]
@@ -378,7 +395,69 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
     assert res.contact_log is not None
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
-                                res.contact_log)  # fmt: skip
+                                res.contact_log, release)  # fmt: skip
+
+
+def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
+    """The last time after ``impact`` at which the attacker's own clip runs into the recipient's
+    output (``impact`` if never)."""
+    att = cast.attacker
+    assert att is not None
+    fps = recipient.fps
+    i0 = int(np.ceil(impact * fps))
+    t = np.arange(i0, recipient.num_frames) / fps
+    if t.size == 0:
+        return impact
+    own = att.motion.sample(t + att.clock0).replace(fps=fps)
+    world = World([cast.recipient.character, att.character])
+    depth = overlap_depths(world, [recipient.sample(t).replace(fps=fps), own])
+    hit = np.flatnonzero(depth > 0.0)
+    return float(t[hit[-1]] + 1.0 / fps) if hit.size else impact
+
+
+def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
+                     sim2: TransitionSimulation, duration: float, shift_times: F64,
+                     shift: F64, release: float) -> Motion:  # fmt: skip
+    """The attacker's output: its clip until the rewind, its simulation (moved by the
+    recipient's blend ``shift`` at ``shift_times``, held after) until ``release``, then
+    blended back to its clip over ``attacker_blend``."""
+    assert sim2.attacker is not None
+    afps = att.motion.fps
+    t = np.arange(0, int(np.floor(duration * afps)) + 1) / afps
+    own = att.motion.sample(t + att.clock0).replace(fps=afps)
+    sim = sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration))
+    if shift_times.size:
+        moved = np.stack([np.interp(t, shift_times, shift[:, k]) for k in range(3)], axis=1)
+        moved[t < shift_times[0]] = 0.0
+        sim = sim.replace(root_positions=sim.root_positions + moved)
+    w = np.where(t < contact.rewind, 1.0, np.clip(
+        (t - release) / max(cfg.attacker_blend, 1e-9), 0, 1))  # fmt: skip
+    return blend_poses(sim, own, w).replace(name="attacker")
+
+
+def _output_end(cfg: ResponseConfig, cont: Continuation) -> float:
+    """Scenario time of the recipient output's last frame (the found clip's tail included)."""
+    return cont.time + min(cfg.tail, cont.found.duration - cont.best.time)
+
+
+def _attacker_clear(cast: Cast, cfg: ResponseConfig, naive: NaiveSimulation,
+                    cont: Continuation) -> float:  # fmt: skip
+    """The last scenario time at which the attacker's own clip still runs into the recipient's
+    planned output (its clip eased into the found clip), scanned at :data:`SCAN_FPS` from the
+    impact: until then the attacker's output must stay simulated (physical), not its clip."""
+    att, rec = cast.attacker, cast.recipient
+    assert att is not None
+    t = np.arange(naive.impact_time, _output_end(cfg, cont), 1.0 / SCAN_FPS)
+    if t.size == 0:
+        return naive.impact_time
+    w = transition_weights(t, naive.impact_time, cfg.reaction_delay, cont.time)
+    planned = blend_poses(rec.motion.sample(t + rec.clock0),
+                          cont.found.sample(cont.best.time + (t - cont.time)), w)  # fmt: skip
+    own = att.motion.sample(t + att.clock0)
+    world = World([rec.character, att.character])
+    depth = overlap_depths(world, [planned.replace(fps=SCAN_FPS), own.replace(fps=SCAN_FPS)])
+    hit = np.flatnonzero(depth > 0.0)
+    return float(t[hit[-1]] + 1.0 / SCAN_FPS) if hit.size else naive.impact_time
 
 
 @dataclass(frozen=True)
@@ -397,7 +476,8 @@ class Blend:
 def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
           cont: Continuation, sim2: TransitionSimulation) -> Blend:  # fmt: skip
     """The paper's final blend over [impact, match], then the found clip plays on; the attacker
-    follows its simulation briefly, then blends back to its clip."""
+    follows its simulation from the rewind until its own clip no longer runs into the recipient
+    (:attr:`TransitionSimulation.attacker_release`), then blends back to its clip."""
     cfg = scenario.response
     rec = cast.recipient
     fps = rec.motion.fps
@@ -406,24 +486,80 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     before = rec.motion.sample(np.arange(0, i_imp) / fps + rec.clock0) if i_imp > 0 else None
     times = np.arange(i_imp, i_end + 1) / fps
     simulated = sim2.motion.sample(times - contact.rewind)
-    blended = final_blend(simulated, cont.found.sample(cont.best.time + (times - cont.time)))
-    if cfg.foot_lock:
-        blended = lock_feet(blended, rec.parts)
+    found = cont.found.sample(cont.best.time + (times - cont.time))
     tail_n = int(np.floor(min(cfg.tail, cont.found.duration - cont.best.time) * fps))
     tail = (cont.found.sample(cont.best.time + np.arange(1, tail_n + 1) / fps)
             if tail_n > 0 else None)  # fmt: skip
-    pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]
-    recipient = Motion.concatenate(pieces, name="recipient")
-    attacker = None
-    if cast.attacker is not None and sim2.attacker is not None:
-        att = cast.attacker
-        afps = att.motion.fps
-        t = np.arange(0, int(np.floor(recipient.duration * afps)) + 1) / afps
-        own = att.motion.sample(t + att.clock0).replace(fps=afps)
-        simulated_att = sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration))
-        t1 = naive.impact_time + cfg.attacker_follow
-        w = np.where(t < naive.impact_time, 1.0,
-                     np.clip((t - t1) / max(cfg.attacker_blend, 1e-9), 0, 1))  # fmt: skip
-        attacker = blend_poses(simulated_att, own, w).replace(name="attacker")
-    seams = [i_imp, i_end + 1] if before is not None else [i_end + 1]
-    return Blend(recipient, attacker, blended, simulated, seams)
+    start = np.zeros(rec.motion.num_joints)
+    for _ in range(6):  # limbs still touching the attacker keep their simulated pose longer
+        blended = final_blend(simulated, found, start)
+        if cfg.foot_lock:
+            blended = lock_feet(blended, rec.parts)
+        pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]
+        recipient = Motion.concatenate(pieces, name="recipient")
+        if cast.attacker is None or sim2.attacker is None:
+            return Blend(recipient, None, blended, simulated, _seams(i_imp, i_end, before))
+        # the blend moved the recipient off its simulation: the attacker's simulated part
+        # moves with the body it hit, so the two keep the spacing the physics gave them
+        hit = int(rec.character.anchors[SIM_BODIES.index(_hit_body(contact))])
+        shift = blended.global_positions()[:, hit] - simulated.global_positions()[:, hit]
+        shift[:, 2] = 0.0
+        release = max(sim2.attacker_release, _clear_of(cast, recipient, naive.impact_time))
+        attacker = _attacker_output(cfg, cast.attacker, contact, sim2, recipient.duration,
+                                    times, shift, release)  # fmt: skip
+        later = _blend_later(cast, blended, attacker, times, start)
+        if later is None:
+            break
+        start = later
+    return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
+
+
+def _hit_body(contact: ContactEstimate) -> str:
+    """The recipient's body the hit landed on (the pelvis when unknown)."""
+    body = contact.body.split("/")[0]
+    return body if body in SIM_BODIES else "pelvis"
+
+
+def _seams(i_imp: int, i_end: int, before: Motion | None) -> list[int]:
+    return [i_imp, i_end + 1] if before is not None else [i_end + 1]
+
+
+def _limb_root(body: int) -> int:
+    """The first body of the chain whose blend an overlap of ``body`` delays: a leg from its
+    thigh; anything above the pelvis from the waist (holding an arm alone still lets the
+    blended trunk carry it into the other character)."""
+    name = SIM_BODIES[body]
+    if name == "pelvis":
+        return body
+    if name.endswith(("thigh", "shin", "foot")):
+        return SIM_BODIES.index(name[:2] + "thigh")
+    return SIM_BODIES.index("waist")
+
+
+def _blend_later(cast: Cast, blended: Motion, attacker: Motion, times: F64,
+                 start: F64) -> F64 | None:  # fmt: skip
+    """New per-joint blend starts when limbs of the blended transition run into the attacker's
+    output: each such limb (its joints and the folded ones above it) keeps its simulated pose
+    until two frames after its last overlap. None when nothing overlaps (or nothing changes)."""
+    rec = cast.recipient
+    assert cast.attacker is not None
+    att = attacker.sample(times).replace(fps=blended.fps)
+    world = World([rec.character, cast.attacker.character])
+    depth = overlap_depths(world, [blended, att], per_body=True)  # (n, 16)
+    hit = depth > 0.005
+    if not hit.any():
+        return None
+    out = start.copy()
+    skel = rec.motion.skeleton
+    anchors = rec.character.anchors
+    for b in np.flatnonzero(hit.any(axis=0)):
+        root = _limb_root(int(b))
+        a = int(anchors[root])
+        parent = int(anchors[SIM_PARENTS[root]]) if root > 0 else -1
+        above = [j for j in skel.chain(a) if parent < 0 or j not in skel.chain(parent)]
+        joints = above + [j for j in range(skel.num_joints) if a in skel.chain(j)]
+        if SIM_BODIES[root] == "waist":  # the pelvis's turn carries the trunk too
+            joints += skel.chain(int(anchors[0]))
+        last = int(np.flatnonzero(hit[:, b])[-1]) + 2
+        out[joints] = np.maximum(out[joints], last)
+    return None if np.array_equal(out, start) else out

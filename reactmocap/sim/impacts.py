@@ -323,12 +323,16 @@ def first_contact(
     return None
 
 
-def overlap_depths(world: World, motions: Sequence[Motion]) -> F64:
-    """``(T,)`` per frame of two same-rate motions, the deepest interpenetration (m) between the
-    two characters' bodies playing them (0 where apart)."""
+def overlap_depths(world: World, motions: Sequence[Motion], per_body: bool = False) -> F64:
+    """Per frame of two same-rate motions, the deepest interpenetration (m) between the two
+    characters' bodies playing them (0 where apart): ``(T,)``, or with ``per_body`` ``(T, 16)``
+    for each body of the first character."""
     n = min(mo.num_frames for mo in motions)
     times = np.arange(n) / motions[0].fps
-    out = np.zeros(n)
+    out = np.zeros((n, len(SIM_BODIES)))
+    body = world.geom_body
     for k, hits in _kinematic_contacts(world, motions, times):
-        out[k] = max((-dist for *_, dist in hits), default=0.0)
-    return out
+        for g0, _, dist in hits:
+            b = body[g0]
+            out[k, b] = max(out[k, b], -dist)
+    return out if per_body else out.max(axis=1)
