@@ -89,7 +89,7 @@ class QueryConstants:
         step = max(1, int(np.ceil((L - 1) / (COARSE_FRAMES - 1))))
         coarse = np.unique(np.append(np.arange(0, L, step), L - 1)).astype(np.int64)
         per_support = [body_weights(fs, weights, s) for s in range(len(fs.parts))]
-        return cls(
+        c = cls(
             feature_set=fs,
             embedding=embedding_weights(weights, window),
             window_weights=ww,
@@ -99,6 +99,10 @@ class QueryConstants:
             wq=np.stack([w[1] for w in per_support]),
             groups=np.stack([group_matrix(fs, s) for s in range(len(fs.parts))]),
         )
+        shared = (c.window_weights, c.coarse_offsets, c.coarse_weights, c.wp, c.wq, c.groups)
+        for a in (*c.embedding, *shared):
+            a.setflags(write=False)  # every query of the cache shares them
+        return c
 
 
 def _put(table: dict[_K, _V], key: _K, value: _V, limit: int) -> _V:
