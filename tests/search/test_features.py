@@ -53,9 +53,7 @@ def test_heading_ignores_height_and_tilt(synth_clips: dict[str, Motion]) -> None
     m = synth_clips["guard"].slice(0, 5)
     cal = calibrate(m.skeleton, get_feature_set("paper"))
     base = frame_features(m, cal)
-    pitch = quat_exp(
-        np.array([0.0, np.radians(60) / 2, 0.0])
-    )  # about +Y (the left axis at heading 0)
+    pitch = quat_exp(np.array([0.0, np.radians(60), 0.0]))  # about +Y (left, at heading 0)
     rot = np.array(m.rotations)
     rot[:, 0] = quat_mul(pitch, rot[:, 0])
     tilted = frame_features(
