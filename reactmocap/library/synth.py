@@ -137,13 +137,13 @@ def _front_kick() -> Clip:
     lean: Pose = dict(root=(0.10, 0.05, 0.90), rootrot=(0.0, -3.0, 0.0), Spine=(0.0, 0.0, -8.0))
     c.at(0.3, **lean).at(0.3, lhand=(0.22, -0.06, 0.0), rhand=(0.16, 0.08, 0.0))
     # a high chamber: the snap then travels at the height of the target's abdomen
-    chamber: Pose = dict(rball=(0.40, -0.10, 0.72), rfoot=(0.0, 10.0, 0.0), rknee=(0.6, 0.0, 1.0))
+    chamber: Pose = dict(rball=(0.40, -0.10, 0.58), rfoot=(0.0, 20.0, 0.0), rknee=(1.0, 0.0, 0.3))
     c.at(0.35, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.04)), rfoot=(-30.0, 20.0, 0.0))
     c.at(0.58, **chamber).at(0.58, rootrot=(0.0, -6.0, 0.0), root=(0.12, 0.05, 0.90))
     # the snap: ~0.5 m in 0.1 s, the foot near 9 m/s mid-way, as in measured front kicks
     c.at(
         0.68,
-        rball=(0.93, -0.08, 1.02), rfoot=(0.0, -50.0, 0.0), root=(0.15, 0.05, 0.90),
+        rball=(0.93, -0.08, 0.95), rfoot=(0.0, -50.0, 0.0), root=(0.15, 0.05, 0.90),
         rootrot=(0.0, -15.0, 0.0), Spine=(0.0, -4.0, -8.0), Spine1=(0.0, -2.0, -8.0),
         Neck=(0.0, 8.0, 8.0), Head=(0.0, 5.0, 8.0), rhand=(0.0, 0.15, -0.25),
     )  # fmt: skip

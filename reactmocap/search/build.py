@@ -95,7 +95,7 @@ def clip_source(clips: Any) -> tuple[Mapping[str, Motion], str]:
 
 
 class EmbeddingWeights(NamedTuple):
-    """Query-independent weights of the KD embedding (``docs/design-search.md``)."""
+    """Query-independent weights of the KD embedding (``docs/design.md (Search)``)."""
 
     wp: F64  # (P,) position weight per part
     wq: F64  # (P,) orientation weight per part

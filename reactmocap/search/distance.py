@@ -1,6 +1,6 @@
 """The window distance ``D`` (with its six-term breakdown) and the Euclidean embedding whose
 squared norm approximates it, so a KD-tree can propose candidates for the exact ``D``. Both
-compare windows in their first frame's root frame; ``docs/design-search.md`` defines them."""
+compare windows in their first frame's root frame; ``docs/design.md (Search)`` defines them."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """Per-frame body features of a Motion for the search: positions and canonical orientations of
 the mapped body parts, the heading and ground origin of the body frame, and an approximate centre
 of mass (to pick the support body). A simulated trajectory read back as a Motion goes through the
-same code. The definitions are in ``docs/design-search.md``."""
+same code. The definitions are in ``docs/design.md (Search)``."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import BodyPartMappingError, SearchError, UnknownKeyError
+from reactmocap.library.anthropometry import MASS_FRACTIONS
 from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import body_frame, body_heading, rest_pose
@@ -27,7 +28,6 @@ from reactmocap.rotations import (
 
 __all__ = [
     "FEATURE_SETS",
-    "MASS_FRACTIONS",
     "FeatureSet",
     "FrameFeatures",
     "SkeletonCalibration",
@@ -101,15 +101,6 @@ def get_feature_set(name: str) -> FeatureSet:
             f"unknown feature set {name!r}; valid feature sets are {sorted(FEATURE_SETS)}"
         ) from None
 
-
-#: mass fraction of each part (Winter; trunk 0.497 split into pelvis/abdomen/thorax; the neck is
-#: folded into the head). Sums to 1 over the required parts.
-MASS_FRACTIONS: dict[str, float] = {
-    "pelvis": 0.142, "waist": 0.139, "chest": 0.216, "head": 0.081,
-    **{f"{s}_{p}": m for s in ("l", "r") for p, m in (
-        ("upper_arm", 0.028), ("forearm", 0.016), ("hand", 0.006),
-        ("thigh", 0.100), ("shin", 0.0465), ("foot", 0.0145))},
-}  # fmt: skip
 
 # Next part down each chain (bone direction and segment midpoint); the first present one is used.
 _NEXT_PART: dict[str, tuple[str, ...]] = {

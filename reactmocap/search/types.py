@@ -28,7 +28,7 @@ __all__ = [
 ]
 
 #: version of the saved index; bumped whenever the stored features or embedding change
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: centre of mass from the one mass-fraction table
 MIRROR_SUFFIX = "_mirror"
 #: windows embedded (or localised) per batch: bounds the temporary arrays
 _CHUNK = 4096
