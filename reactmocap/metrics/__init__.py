@@ -14,6 +14,10 @@ from reactmocap.rotations import quat_conj, quat_log, quat_mul
 
 __all__ = [
     "REACTION_WINDOW_S",
+    "WARN_ATTACKER_SPEED_RATIO",
+    "WARN_JOINT_CORRECTION_RAD",
+    "WARN_OVERLAP_M",
+    "WARN_ROOT_OFFSET_M",
     "blend_joint_correction_max_rad",
     "direction_error_deg",
     "blend_root_offset_max_m",
@@ -160,3 +164,10 @@ def speed_ratio(output: Motion, source: Motion) -> float:
     """``output``'s fastest joint over ``source``'s (e.g. the attacker's output against its
     source clip): above 1 means the output moves a joint faster than the capture ever did."""
     return joint_speed_max_m_s(output) / max(joint_speed_max_m_s(source), 1e-9)
+
+
+#: report warnings fire above these (the report's ``warnings`` list; ``respond --strict``)
+WARN_OVERLAP_M = 0.02
+WARN_ROOT_OFFSET_M = 0.3
+WARN_JOINT_CORRECTION_RAD = 0.6
+WARN_ATTACKER_SPEED_RATIO = 1.5

@@ -139,8 +139,10 @@ def _report(
             else None
         ),
     }
+    warnings = _warnings(scenario, cast, naive, cont, quality)
     return {
         "scenario": scenario.name,
+        "warnings": warnings,
         "reactmocap_version": __version__,
         "mujoco_version": mujoco.__version__,
         "matched": {
@@ -173,6 +175,44 @@ def _report(
         "config": asdict(cfg),
         "outputs": {},
     }
+
+
+def _warnings(
+    scenario: Scenario,
+    cast: stages.Cast,
+    naive: stages.NaiveSimulation,
+    cont: stages.Continuation,
+    quality: dict[str, Any],
+) -> list[str]:
+    """What a user should know before trusting the animation (thresholds in
+    :mod:`reactmocap.metrics`)."""
+    out = []
+    q = quality
+    if q["character_overlap_max_m"] > qm.WARN_OVERLAP_M:
+        out.append(f"the characters overlap by {100 * q['character_overlap_max_m']:.1f} cm in "
+                   f"the output (more than {100 * qm.WARN_OVERLAP_M:.0f} cm)")  # fmt: skip
+    if q["blend_root_offset_max_m"] > qm.WARN_ROOT_OFFSET_M:
+        out.append(f"the final blend moves the root by {q['blend_root_offset_max_m']:.2f} m "
+                   f"(more than {qm.WARN_ROOT_OFFSET_M} m): the simulation ended far from the "
+                   "found clip")  # fmt: skip
+    if q["blend_joint_correction_max_rad"] > qm.WARN_JOINT_CORRECTION_RAD:
+        out.append(f"the final blend turns a joint by {q['blend_joint_correction_max_rad']:.2f} "
+                   f"rad (more than {qm.WARN_JOINT_CORRECTION_RAD})")  # fmt: skip
+    ratio = q["attacker_speed_ratio"]
+    if ratio is not None and ratio > qm.WARN_ATTACKER_SPEED_RATIO:
+        out.append(f"the attacker moves a joint {ratio:.2f}x faster than its clip ever does "
+                   f"(more than {qm.WARN_ATTACKER_SPEED_RATIO}x)")  # fmt: skip
+    if cast.attacker is not None and naive.contacts.empty:
+        out.append("the attacker never touched the recipient: nothing was hit")
+    rec = cast.recipient
+    if naive.impact_time > rec.motion.duration - rec.clock0:
+        out.append(f"the impact ({naive.impact_time:.2f} s) comes after the recipient's clip "
+                   f"ends ({rec.motion.duration - rec.clock0:.2f} s into the scenario)")  # fmt: skip
+    react = scenario.response.react_impulse
+    if naive.impulse >= react and cont.best.clip == rec.clip.name:
+        out.append(f"the recipient carries on with its own clip after an impulse of "
+                   f"{naive.impulse:.1f} N s (from {react} N s it should react)")  # fmt: skip
+    return out
 
 
 def _impulse(scenario: Scenario, sim2: stages.TransitionSimulation) -> F64:

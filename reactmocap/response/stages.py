@@ -503,7 +503,6 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
         # moves with the body it hit, so the two keep the spacing the physics gave them
         hit = int(rec.character.anchors[SIM_BODIES.index(_hit_body(contact))])
         shift = blended.global_positions()[:, hit] - simulated.global_positions()[:, hit]
-        shift[:, 2] = 0.0
         release = max(sim2.attacker_release, _clear_of(cast, recipient, naive.impact_time))
         attacker = _attacker_output(cfg, cast.attacker, contact, sim2, recipient.duration,
                                     times, shift, release)  # fmt: skip
