@@ -47,6 +47,7 @@ __all__ = [
     "PATCH_GEOM_GROUP",
     "Character",
     "build_character",
+    "qvel_between",
     "qvel_from_qpos",
 ]
 
@@ -74,11 +75,12 @@ def qvel_from_qpos(q: F64, fps: float) -> F64:
         return np.zeros((n, 6 + 3 * len(BALL_JOINTS)))
     lo = np.r_[0, np.arange(n - 1)]
     hi = np.r_[np.arange(1, n), n - 1]
-    return _differentiate(q[lo], q[hi], (hi - lo) / fps)
+    return qvel_between(q[lo], q[hi], (hi - lo) / fps)
 
 
-def _differentiate(qa: F64, qb: F64, span: F64) -> F64:
-    """qvel taking qpos rows ``qa`` to ``qb`` in ``span`` seconds each."""
+def qvel_between(qa: F64, qb: F64, span: F64) -> F64:
+    """``(N, 51)`` the constant qvel taking qpos rows ``qa`` ``(N, 67)`` to ``qb`` in ``span``
+    ``(N,)`` seconds each (MuJoCo's ``mj_differentiatePos``)."""
     n = qa.shape[0]
     lin = (qb[:, :3] - qa[:, :3]) / span[:, None]
     rel = quat_mul(quat_conj(qa[:, 3:].reshape(n, -1, 4)), qb[:, 3:].reshape(n, -1, 4))
@@ -222,7 +224,7 @@ class Character:
         lo = np.clip(idx - 1, 0, n - 1)
         hi = np.clip(idx + 1, 0, n - 1)
         q_lo, q_hi = self.qpos_from_motion(motion, lo), self.qpos_from_motion(motion, hi)
-        return _differentiate(q_lo, q_hi, (hi - lo) / motion.fps)
+        return qvel_between(q_lo, q_hi, (hi - lo) / motion.fps)
 
     # ------------------------------------------------------------------ state -> Motion
     def body_transforms_from_qpos(self, qpos: F64) -> tuple[F64, F64]:
