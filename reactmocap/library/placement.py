@@ -17,9 +17,16 @@ from reactmocap.errors import BodyPartMappingError
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import Skeleton
-from reactmocap.rotations import quat_conj, quat_from_matrix, quat_mul, quat_yaw
+from reactmocap.rotations import (
+    quat_conj,
+    quat_from_matrix,
+    quat_from_yaw,
+    quat_mul,
+    quat_rotate,
+    quat_yaw,
+)
 
-__all__ = ["body_frame", "body_heading", "heading", "place", "rest_pose"]
+__all__ = ["body_frame", "body_heading", "ground_root", "heading", "place", "rest_pose"]
 
 F64 = NDArray[np.float64]
 
@@ -87,3 +94,27 @@ def place(
     px, py = pos[0, pelvis, :2]
     shift = np.asarray(position, dtype=np.float64) - (c * px - s * py, s * px + c * py)
     return motion.transformed(yaw, (shift[0], shift[1], 0.0))
+
+
+def ground_root(motion: Motion, parts: BodyPartMap) -> Motion:
+    """``motion`` with a dummy top joint above the pelvis (e.g. Bandai's ``joint_Root``) on the
+    ground under the pelvis, turned to the body's heading: the root path game engines extract
+    follows the body smoothly and never jumps, whatever clips were stitched or blended. Every
+    other joint keeps its world transform (the pelvis's local transform absorbs the change).
+    Motions whose top joint is the pelvis, or whose pelvis has no per-frame translation to
+    absorb it, come back unchanged."""
+    skel = motion.skeleton
+    pelvis = parts.joint_of("pelvis")
+    if pelvis == 0 or motion.translations is None or int(skel.parents[pelvis]) != 0:
+        return motion
+    pos, grot = motion.forward_kinematics()
+    yaw = np.unwrap(body_heading(grot[:, pelvis], body_frame(skel, parts)))
+    root_q = quat_from_yaw(yaw)
+    root_p = np.column_stack([pos[:, pelvis, :2], np.zeros(motion.num_frames)])
+    inv = quat_conj(root_q)
+    rot = np.array(motion.rotations)
+    tr = np.array(motion.translations)
+    rot[:, 0] = root_q
+    rot[:, pelvis] = quat_mul(inv, grot[:, pelvis])
+    tr[:, pelvis] = quat_rotate(inv, pos[:, pelvis] - root_p)
+    return motion.replace(root_positions=root_p, rotations=rot, translations=tr)

@@ -45,10 +45,11 @@ def match_distance(distance: float) -> float:
     return float(distance)
 
 
-def blend_root_offset_max_m(simulated: Motion, blended: Motion) -> float:
-    """Largest root displacement the final blend applied (m): how far Simulation 2 ended from
+def blend_root_offset_max_m(simulated: Motion, blended: Motion, parts: BodyPartMap) -> float:
+    """Largest pelvis displacement the final blend applied (m): how far Simulation 2 ended from
     the found clip on its own. 0 means the simulation landed exactly."""
-    d = blended.global_positions()[:, 0] - simulated.global_positions()[:, 0]
+    p = parts.joint_of("pelvis")
+    d = blended.global_positions()[:, p] - simulated.global_positions()[:, p]
     return float(np.max(np.linalg.norm(d, axis=-1)))
 
 

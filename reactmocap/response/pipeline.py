@@ -119,7 +119,7 @@ def _report(
         overlap = float(overlap_depths(world, [out.recipient, att]).max())
     quality = {
         "match_distance": qm.match_distance(best.distance),
-        "blend_root_offset_max_m": qm.blend_root_offset_max_m(out.simulated, out.blended),
+        "blend_root_offset_max_m": qm.blend_root_offset_max_m(out.simulated, out.blended, parts),
         "blend_joint_correction_max_rad": qm.blend_joint_correction_max_rad(
             out.simulated, out.blended
         ),
@@ -139,7 +139,7 @@ def _report(
             else None
         ),
     }
-    warnings = _warnings(scenario, cast, naive, cont, quality)
+    warnings = _warnings(scenario, cast, contact, naive, cont, quality)
     return {
         "scenario": scenario.name,
         "warnings": warnings,
@@ -180,6 +180,7 @@ def _report(
 def _warnings(
     scenario: Scenario,
     cast: stages.Cast,
+    contact: stages.ContactEstimate,
     naive: stages.NaiveSimulation,
     cont: stages.Continuation,
     quality: dict[str, Any],
@@ -202,6 +203,8 @@ def _warnings(
     if ratio is not None and ratio > qm.WARN_ATTACKER_SPEED_RATIO:
         out.append(f"the attacker moves a joint {ratio:.2f}x faster than its clip ever does "
                    f"(more than {qm.WARN_ATTACKER_SPEED_RATIO}x)")  # fmt: skip
+    if cast.attacker is not None and contact.time <= 0.0:
+        out.append("the characters already touch when the scenario starts (place them apart)")
     if cast.attacker is not None and naive.contacts.empty:
         out.append("the attacker never touched the recipient: nothing was hit")
     rec = cast.recipient

@@ -14,7 +14,7 @@ from reactmocap.response.scenario import ResponseConfig
 from reactmocap.sim.controllers import Controller, GainScalable, Holdable
 from reactmocap.sim.world import World
 
-__all__ = ["YieldOnImpact", "yield_schedule"]
+__all__ = ["AssistUntilHit", "YieldOnImpact", "yield_schedule"]
 
 
 def yield_schedule(cfg: ResponseConfig, impact: float) -> Callable[[float], float]:
@@ -59,3 +59,30 @@ class YieldOnImpact:
             self._scale = yield_schedule(self.cfg, t)
         self.inner.scale_gains(self._scale(t))  # type: ignore[attr-defined]
         self.inner.control(world, t)
+
+
+class AssistUntilHit:
+    """NON-PHYSICAL help for an attacker whose strike a body cannot perform on its own (the
+    spinning kicks of real capture need several times the moment a foot can give): ``assist``
+    (a root assist) holds the attacker's pelvis on its clip's path until it first touches the
+    recipient, then lets go, so it never drives the strike through the body it hits. Ticks
+    every step (the assist's rate)."""
+
+    def __init__(self, assist: Controller, body: int) -> None:
+        self.assist = assist
+        self.body = body
+        self.control_every = assist.control_every
+        self.released = False
+
+    def reset(self, world: World) -> None:
+        self.released = False
+        self.assist.reset(world)
+
+    def control(self, world: World, t: float) -> None:
+        if self.released:
+            return
+        if world.characters_touching():
+            self.released = True
+            world.data.xfrc_applied[self.body] = 0.0
+            return
+        self.assist.control(world, t)

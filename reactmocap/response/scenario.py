@@ -89,9 +89,15 @@ class ResponseConfig:
     #: on with the own clip is right)
     react_impulse: float = 5.0
     active_min: float = 0.2
+    #: after a hit from ``react_impulse`` on, windows of the recipient's own clip within this
+    #: many seconds of its undisturbed time cannot be the continuation (s)
+    own_clip_margin: float = 1.0
     search_end: float = 1.0
     contact_shift_max: float = 0.25  # s the search start moves later while contact lasts
     attacker_follow: float = 0.1  # s the attacker follows its own simulation
+    #: kp (1/s^2) of a NON-PHYSICAL root assist holding the attacker on its clip's path until
+    #: it first touches the recipient (0: off), for strikes no body performs on its own
+    attacker_assist: float = 0.0
     attacker_blend: float = 0.3  # s to blend the attacker back to its clip
     tail: float = 1.0  # s of the found clip played after landing
     top_k: int = 5
@@ -198,7 +204,7 @@ class _Reader:
                 nonneg = name in {"start", "at", "reaction_delay", "search_start", "tail",
                                   "contact_shift_max", "attacker_follow", "attacker_blend",
                                   "friction_sim1", "friction_sim2", "kv", "yield_gain",
-                                  "react_impulse", "active_min",
+                                  "react_impulse", "active_min", "own_clip_margin", "attacker_assist",
                                   "yield_recover"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
                                     "total_mass"}  # fmt: skip

@@ -16,11 +16,12 @@ from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
 from reactmocap.library.bvh import read_bvh
 from reactmocap.library.clip_library import ClipLibrary
 from reactmocap.library.motion import Motion
-from reactmocap.library.placement import place
+from reactmocap.library.placement import ground_root, place
+from reactmocap.metrics import joint_speed_max_m_s
 from reactmocap.response.blend import blend_poses, final_blend, transition_weights
 from reactmocap.response.footlock import lock_feet
 from reactmocap.response.library_cache import LibraryCache
-from reactmocap.response.reaction import YieldOnImpact, yield_schedule
+from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_schedule
 from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
 from reactmocap.rotations import quat_slerp
 from reactmocap.search import MotionIndex, SearchResult
@@ -214,6 +215,20 @@ class NaiveSimulation:
     impulse: float  # |impulse| on the recipient (N s)
 
 
+def _attacker(world: World, cast: Cast, cfg: ResponseConfig, rewind: float) -> list[Controller]:
+    """The attacker's controllers: ``attacker_controller`` on its clip, and the root assist
+    until the hit when ``attacker_assist`` asks for it."""
+    att = cast.attacker
+    assert att is not None
+    out = [_controller(cfg.attacker_controller, cfg, world, 1, att.motion, rewind + att.clock0,
+                       att.motion.fps)]  # fmt: skip
+    if cfg.attacker_assist > 0:
+        assist = build("root_assist", world, att.motion, {"kp": cfg.attacker_assist},
+                       character=1, start=rewind + att.clock0)  # fmt: skip
+        out.append(AssistUntilHit(assist, int(world.characters[1].body_ids[0])))
+    return out
+
+
 def _impulse_of(impact: ImpactSpec) -> float:
     return float(np.linalg.norm(impact.force)) * impact.duration
 
@@ -240,6 +255,12 @@ def _recipient_path(cast: Cast, cfg: ResponseConfig, rewind: float, seconds: flo
     ticks = np.arange(n) * every * cfg.timestep + rewind
     clock = np.minimum(ticks, impact) if yields else ticks
     prev = ch.qpos_from_motion(rec.motion.sample(clock + rec.clock0))
+    if yields:  # the held pose moves on with the body's velocity at the impact
+        rate = rec.motion.fps
+        step = ch.qpos_from_motion(
+            rec.motion.sample(impact + rec.clock0 + np.array([-0.5, 0.5]) / rate)
+        )
+        prev[:, :3] += np.maximum(ticks - impact, 0.0)[:, None] * (step[1, :3] - step[0, :3]) * rate
     found = ch.qpos_from_motion(target.found.sample(target.best.time + (ticks - target.time)))
     w = transition_weights(ticks, impact, cfg.reaction_delay, target.time)
     q = np.empty_like(prev)
@@ -273,9 +294,7 @@ def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -
         )  # fmt: skip
     ctrls = [hold]
     if cast.attacker is not None:
-        att = cast.attacker
-        ctrls.append(_controller(cfg.attacker_controller, cfg, world, 1, att.motion,
-                                 rewind + att.clock0, fps))  # fmt: skip
+        ctrls += _attacker(world, cast, cfg, rewind)
     res = rollout(
         world, end - rewind, controllers=ctrls, impacts=_impacts(scenario, rewind),
         record_fps=fps, references=[a.motion for a in cast.actors],
@@ -334,7 +353,24 @@ def search_continuation(
     if starts.size == 0:
         raise SearchError("the simulated trajectory is too short for one search window")
     parts = cast.recipient.parts
-    results = [(index.query(query, int(s), parts=parts), int(s)) for s in starts]
+    rec = cast.recipient
+    hit = naive.impulse >= cfg.react_impulse
+
+    def allowed(r: SearchResult, start: float) -> bool:
+        # after a real hit the recipient's own clip around its undisturbed time is no reaction
+        own = rec.clock0 + contact.rewind + start / q_fps
+        return not (hit and r.clip == rec.clip.name and abs(r.time - own) < cfg.own_clip_margin)
+
+    results = []
+    for s in starts.tolist():
+        r: SearchResult | None = index.query(query, s, parts=parts)
+        if r is not None and not allowed(r, s):
+            r = next((c for c in index.top_k(query, s, n=4, parts=parts) if allowed(c, s)), None)
+        if r is not None:
+            results.append((r, s))
+    if not results:
+        raise SearchError("no library window continues the response (only the recipient's own "
+                          "clip matched, and a real hit rules it out)")  # fmt: skip
     best, best_start = min(results, key=lambda r: r[0].distance)
     candidates = index.top_k(query, best_start, n=cfg.top_k, parts=parts)
     found_clip = cast.library[best.clip]
@@ -383,10 +419,8 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     ctrls = [recipient]
     fps = [cast.recipient.motion.fps]
     if cast.attacker is not None:
-        att = cast.attacker
-        ctrls.append(_controller(cfg.attacker_controller, cfg, world, 1, att.motion,
-                                 rewind + att.clock0, att.motion.fps))  # fmt: skip
-        fps.append(att.motion.fps)
+        ctrls += _attacker(world, cast, cfg, rewind)
+        fps.append(cast.attacker.motion.fps)
     res = rollout(
         world, seconds, controllers=ctrls, impacts=_impacts(scenario, rewind), record_fps=fps,
         references=[a.motion for a in cast.actors],
@@ -424,14 +458,19 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     assert sim2.attacker is not None
     afps = att.motion.fps
     t = np.arange(0, int(np.floor(duration * afps)) + 1) / afps
-    own = att.motion.sample(t + att.clock0).replace(fps=afps)
-    sim = sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration))
+    own = ground_root(att.motion.sample(t + att.clock0).replace(fps=afps), att.parts)
+    sim = ground_root(sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration)),
+                      att.parts)  # fmt: skip
     if shift_times.size:
         moved = np.stack([np.interp(t, shift_times, shift[:, k]) for k in range(3)], axis=1)
         moved[t < shift_times[0]] = 0.0
         sim = sim.replace(root_positions=sim.root_positions + moved)
-    w = np.where(t < contact.rewind, 1.0, np.clip(
-        (t - release) / max(cfg.attacker_blend, 1e-9), 0, 1))  # fmt: skip
+    # back to the clip no faster than the capture moves: the blend adds (gap / duration) to
+    # the joints' speed, kept within half the clip's fastest joint speed
+    i = min(int(np.searchsorted(t, release)), t.size - 1)
+    gap = float(np.linalg.norm(sim.global_positions()[i] - own.global_positions()[i], axis=1).max())
+    span = max(cfg.attacker_blend, gap / max(0.5 * joint_speed_max_m_s(att.motion), 1e-9))
+    w = np.where(t < contact.rewind, 1.0, np.clip((t - release) / span, 0, 1))
     return blend_poses(sim, own, w).replace(name="attacker")
 
 
@@ -483,12 +522,16 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     fps = rec.motion.fps
     i_imp = int(np.ceil(naive.impact_time * fps - 1e-9))
     i_end = int(round(cont.time * fps))
-    before = rec.motion.sample(np.arange(0, i_imp) / fps + rec.clock0) if i_imp > 0 else None
+    # every piece with a dummy top joint on the ground under the pelvis (ground_root): the
+    # blend then moves the body, not meters of offset between the clips' dummy roots
+    grounded = lambda m: ground_root(m, rec.parts)  # noqa: E731
+    before = (grounded(rec.motion.sample(np.arange(0, i_imp) / fps + rec.clock0))
+              if i_imp > 0 else None)  # fmt: skip
     times = np.arange(i_imp, i_end + 1) / fps
-    simulated = sim2.motion.sample(times - contact.rewind)
-    found = cont.found.sample(cont.best.time + (times - cont.time))
+    simulated = grounded(sim2.motion.sample(times - contact.rewind))
+    found = grounded(cont.found.sample(cont.best.time + (times - cont.time)))
     tail_n = int(np.floor(min(cfg.tail, cont.found.duration - cont.best.time) * fps))
-    tail = (cont.found.sample(cont.best.time + np.arange(1, tail_n + 1) / fps)
+    tail = (grounded(cont.found.sample(cont.best.time + np.arange(1, tail_n + 1) / fps))
             if tail_n > 0 else None)  # fmt: skip
     start = np.zeros(rec.motion.num_joints)
     for _ in range(6):  # limbs still touching the attacker keep their simulated pose longer

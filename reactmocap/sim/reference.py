@@ -47,6 +47,10 @@ class ClipClock:
         """This clock with the clip stopped at rollout time ``t``."""
         return replace(self, until=float(t))
 
+    def coast(self, t: float) -> float:
+        """Seconds past the hold at rollout time ``t`` (0 before it)."""
+        return max(0.0, t - self.until)
+
     def bracket(self, t: float) -> tuple[int, int, float]:
         """The frames either side of ``t`` and the weight of the later one."""
         x = self.frame(t)
@@ -79,9 +83,11 @@ class ReferencePath:
     def clock(self, start: float = 0.0) -> ClipClock:
         return ClipClock(self.fps, self.num_frames, start)
 
-    def sample(self, x: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
+    def sample(self, x: float, coast: float = 0.0) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """``q``, ``v``, ``a`` interpolated linearly at fractional frame ``x`` (clamped to
-        the path; quaternions renormalised) and ``planted`` at the nearest frame."""
+        the path; quaternions renormalised) and ``planted`` at the nearest frame. ``coast``
+        seconds past a held frame: the pose is held but the root keeps its linear velocity
+        (a held pose of a walking body moves on with it); joints and root turn no more."""
         x = min(max(x, 0.0), self.num_frames - 1.0)
         i0 = int(x)
         i1 = min(i0 + 1, self.num_frames - 1)
@@ -91,6 +97,10 @@ class ReferencePath:
         quats /= np.linalg.norm(quats, axis=1, keepdims=True)
         v = (1 - w) * self.v[i0] + w * self.v[i1]
         acc = (1 - w) * self.a[i0] + w * self.a[i1]
+        if coast > 0:
+            q[:3] += coast * v[:3]
+            v[3:] = 0.0
+            acc[:] = 0.0
         return q, v, acc, self.planted[round(x)]
 
 

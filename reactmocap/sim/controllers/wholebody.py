@@ -197,7 +197,7 @@ class WholeBodyTracker:
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
         the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
-        return self.path.sample(self.clock.frame(t))
+        return self.path.sample(self.clock.frame(t), self.clock.coast(t))
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
