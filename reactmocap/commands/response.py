@@ -17,6 +17,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     )  # fmt: skip
     rsp.add_argument("scenario", type=Path)
     rsp.add_argument("--out", type=Path, required=True, help="output folder")
+    rsp.add_argument("--parts", type=Path, help="body-part rules TOML (over the scenario's)")
     _flags(rsp)
     rsp.set_defaults(func=_respond)
 
@@ -47,11 +48,19 @@ def _flags(p: argparse.ArgumentParser) -> None:
     p.add_argument("--strict", action="store_true", help="exit 3 when the report has warnings")
 
 
-def _run(scenario_path: Path, out: Path, plot: bool, video: bool, strict: bool) -> int:
+def _run(scenario_path: Path, out: Path, plot: bool, video: bool, strict: bool,
+         parts: Path | None = None) -> int:  # fmt: skip
     from reactmocap.response.pipeline import run_scenario
     from reactmocap.response.scenario import load_scenario
 
     scenario = load_scenario(scenario_path)
+    if parts is not None:
+        from dataclasses import replace
+
+        from reactmocap.library.bodyparts import load_rules
+
+        load_rules(parts)
+        scenario = replace(scenario, parts=parts.resolve())
     report = run_scenario(scenario, out, plot=plot, video=video)
     m = report["matched"]
     q = report["quality"]
@@ -73,7 +82,7 @@ def _run(scenario_path: Path, out: Path, plot: bool, video: bool, strict: bool) 
 
 
 def _respond(args: argparse.Namespace) -> int:
-    return _run(args.scenario, args.out, args.plot, args.video, args.strict)
+    return _run(args.scenario, args.out, args.plot, args.video, args.strict, args.parts)
 
 
 def _demo(args: argparse.Namespace) -> int:

@@ -101,6 +101,7 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--kv", type=float, help="joint damping (1/s; default: critical)")
     p.add_argument("--friction", type=float, default=1.0, help="ground friction coefficient")
     p.add_argument("--fps", type=float, default=60.0, help="output frame rate")
+    p.add_argument("--parts", type=Path, help="body-part rules TOML ([parts], [aliases])")
     p.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
     p.add_argument(
         "--root-assist",
@@ -200,9 +201,12 @@ class _SimProgress:
 def _simulate(args: argparse.Namespace, label: str, run: Callable[..., Any], **call: object) -> int:
     """Read the clip, run ``run`` (``track_clip`` or ``push_clip``) on it with a progress bar
     and the shared flags, write the outputs."""
+    from reactmocap.library.bodyparts import load_rules, parts_for
+
     motion = _read(args.clip)
+    parts = parts_for(motion.skeleton, load_rules(args.parts)) if args.parts else None
     with _SimProgress(label) as tick:
-        result = run(motion, on_tick=tick, **call, **_kwargs(args))
+        result = run(motion, on_tick=tick, parts=parts, **call, **_kwargs(args))
     _write_outputs(args, motion, result.motion, result.report)
     return 0
 

@@ -17,11 +17,14 @@ from numpy.typing import NDArray
 
 from reactmocap import __version__
 from reactmocap import metrics as qm
+from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.response import stages
 from reactmocap.response.library_cache import LibraryCache, prepare_library
 from reactmocap.response.scenario import Scenario
 from reactmocap.search import SearchResult
+from reactmocap.sim.bodies import SIM_BODIES
+from reactmocap.sim.character import Character
 from reactmocap.sim.impacts import overlap_depths
 from reactmocap.sim.world import World
 
@@ -50,6 +53,13 @@ class ResponseResult:
     #: the simulated world and its pre-impact state (to measure bare stepping of the same model)
     model: mujoco.MjModel | None = None
     start_state: F64 | None = None
+    #: the recipient's body parts
+    parts: BodyPartMap | None = None
+    #: the hit over time, for the video: scenario times ``(n,)``, contact points and the world
+    #: forces on the recipient ``(n, 3)``
+    hit: tuple[F64, F64, F64] | None = None
+    #: the recipient's own clip over the output's frames, as if nothing had happened
+    undisturbed: Motion | None = None
 
 
 def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> ResponseResult:
@@ -90,6 +100,9 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
         report=report,
         model=sim2.world.model,
         start_state=naive.start_state,
+        parts=rec.parts,
+        hit=_hit_marks(scenario, cast, contact, sim2, out),
+        undisturbed=rec.motion.sample(out.recipient.times + rec.clock0).replace(fps=fps),
     )
 
 
@@ -156,6 +169,9 @@ def _report(
             "breakdown": best.breakdown.to_dict(),
         },
         "candidates": [c.to_dict() for c in cont.candidates],
+        "library_skipped": [
+            {"clip": str(f.path), "reason": f.reason} for f in cast.library.failures
+        ],
         "impact": {
             "time": naive.impact_time,
             "body": contact.body,
@@ -216,6 +232,24 @@ def _warnings(
         out.append(f"the recipient carries on with its own clip after an impulse of "
                    f"{naive.impulse:.1f} N s (from {react} N s it should react)")  # fmt: skip
     return out
+
+
+def _hit_marks(scenario: Scenario, cast: stages.Cast, contact: stages.ContactEstimate,
+               sim2: stages.TransitionSimulation, out: stages.Blend) -> tuple[F64, F64, F64]:  # fmt: skip
+    """Where and how hard the recipient was hit, over time (for the video)."""
+    if scenario.impact is not None:
+        imp = scenario.impact
+        fps = out.recipient.fps
+        frames = np.arange(
+            int(np.ceil(imp.at * fps)), int(np.floor((imp.at + imp.duration) * fps)) + 1
+        )
+        frames = frames[frames < out.recipient.num_frames]
+        joint = cast.recipient.character.anchors[SIM_BODIES.index(Character.body_name(imp.body))]
+        points = out.recipient.global_positions()[frames, int(joint)]
+        forces = np.tile(np.asarray(imp.force, dtype=np.float64), (frames.size, 1))
+        return frames / fps, points, forces
+    log = sim2.contacts
+    return log.times + contact.rewind, log.point, log.force
 
 
 def _impulse(scenario: Scenario, sim2: stages.TransitionSimulation) -> F64:

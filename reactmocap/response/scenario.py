@@ -116,12 +116,14 @@ class Scenario:
     response: ResponseConfig = field(default_factory=ResponseConfig)
     source: Path | None = None
     name: str = "scenario"
+    #: body-part rules TOML for skeletons the name rules cannot map
+    parts: Path | None = None
 
     def with_changes(self, **changes: Any) -> Scenario:
         return replace(self, **changes)
 
 
-_TOP_KEYS = {"library", "recipient", "attacker", "impact", "response", "name"}
+_TOP_KEYS = {"library", "recipient", "attacker", "impact", "response", "name", "parts"}
 
 
 class _Reader:
@@ -239,6 +241,14 @@ def parse_scenario(
         r.build(AttackerSpec, "attacker", r.table(data, "attacker")) if "attacker" in data else None
     )
     impact = r.build(ImpactSpec, "impact", r.table(data, "impact")) if "impact" in data else None
+    if impact is not None:
+        from reactmocap.errors import ReactMocapError
+        from reactmocap.sim.impacts import Impact
+
+        try:  # the body, the force's size: checked as the simulation will
+            Impact(impact.body, force=impact.force, point=impact.point, duration=impact.duration)
+        except ReactMocapError as exc:
+            raise r.fail("[impact]", str(exc)) from None
     if attacker is None and impact is None:
         raise r.fail("top level", "give either an [attacker] or an [impact]")
     if attacker is not None and impact is not None:
@@ -251,7 +261,13 @@ def parse_scenario(
     if response.search_end <= response.search_start:
         raise r.fail("[response].search_end", "must be greater than search_start")
     name = r.string("name", data["name"]) if "name" in data else Path(source).stem
-    return Scenario(library, recipient, attacker, impact, response, Path(source), name)
+    parts = None
+    if "parts" in data:
+        parts = _resolve(r, "parts", r.string("parts", data["parts"]), base_dir)
+        from reactmocap.library.bodyparts import load_rules
+
+        load_rules(parts)  # a bad rules file fails here, naming it
+    return Scenario(library, recipient, attacker, impact, response, Path(source), name, parts)
 
 
 def _resolve(r: _Reader, where: str, value: str, base_dir: Path | None) -> Path:

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, ReactMocapError, SearchError
-from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
+from reactmocap.library.bodyparts import BodyPartMap, parts_for
 from reactmocap.library.bvh import read_bvh
 from reactmocap.library.clip_library import ClipLibrary
 from reactmocap.library.motion import Motion
@@ -112,7 +112,7 @@ def _clip(scenario: Scenario, spec: CharacterSpec, cache: LibraryCache) -> Motio
 
 def _actor(scenario: Scenario, spec: CharacterSpec, cache: LibraryCache) -> Actor:
     clip = _clip(scenario, spec, cache)
-    parts = map_body_parts(clip.skeleton)
+    parts = parts_for(clip.skeleton, scenario.parts)
     frame = int(round(spec.start * clip.fps))
     if not 0 <= frame < clip.num_frames:
         raise ConfigError(
@@ -127,7 +127,7 @@ def cast(scenario: Scenario, cache: LibraryCache) -> Cast:
     """Load and place the clips, build the characters, prepare the search library."""
     recipient = _actor(scenario, scenario.recipient, cache)
     attacker = _actor(scenario, scenario.attacker, cache) if scenario.attacker else None
-    library, index = cache.search(scenario.library, recipient.clip)
+    library, index = cache.search(scenario.library, recipient.clip, scenario.parts)
     return Cast(recipient, attacker, library, index)
 
 

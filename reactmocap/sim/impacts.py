@@ -27,11 +27,20 @@ __all__ = [
     "ImpactSchedule",
     "KinematicContact",
     "contact_report",
+    "MAX_FORCE_N",
+    "MAX_IMPULSE_NS",
     "first_contact",
     "overlap_depths",
 ]
 
 F64 = NDArray[np.float64]
+
+
+#: the largest push accepted: beyond this a character is not pushed but destroyed (the hardest
+#: human strikes peak near 10 kN; the simulation would only diverge)
+MAX_FORCE_N = 20_000.0
+#: the largest momentum an impact may deliver (a 75 kg body thrown at over 13 m/s)
+MAX_IMPULSE_NS = 1_000.0
 
 
 def _vec3(value: object, what: str) -> tuple[float, float, float]:
@@ -101,6 +110,16 @@ class Impact:
             raise ConfigError(f"impact duration must be >= 0 s, got {self.duration}")
         if self.duration == 0 and self.force is not None:
             raise ConfigError("a force impact needs a positive duration (use impulse= for a kick)")
+        dt = 0.0005
+        force = np.linalg.norm(self.force_vector(dt)) if self.force is not None else 0.0
+        total = (np.linalg.norm(self.impulse) if self.impulse is not None
+                 else force * max(self.duration, dt))  # fmt: skip
+        if force > MAX_FORCE_N or total > MAX_IMPULSE_NS:
+            raise ConfigError(
+                f"impact of {force:.0f} N / {total:.0f} N s is beyond the physical limit this "
+                f"simulation accepts ({MAX_FORCE_N:.0f} N, {MAX_IMPULSE_NS:.0f} N s): it would "
+                "destroy a human body, and the simulation would diverge"
+            )
         if not isinstance(self.character, int) or self.character < 0:
             raise ConfigError(f"impact character must be an index >= 0, got {self.character!r}")
 

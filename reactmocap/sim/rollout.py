@@ -43,7 +43,7 @@ class ContactLog:
     they part): ``times`` ``(n,)`` seconds from the rollout's start, ``normal`` ``(n,)`` the
     summed normal force between characters (N), ``force`` ``(n, 3)`` the world force on
     character 0 from the others (N), ``depth`` ``(n,)`` the deepest interpenetration between
-    characters (m)."""
+    characters (m), ``point`` ``(n, 3)`` the contacts' centre, weighted by normal force."""
 
     times: F64
     normal: F64
@@ -51,6 +51,7 @@ class ContactLog:
     depth: F64
     period: float
     dt: float  # seconds per sample (the physics step)
+    point: F64 = field(default_factory=lambda: np.zeros((0, 3)))
 
     @property
     def empty(self) -> bool:
@@ -177,7 +178,7 @@ class _Guard:
 class _ContactLogger:
     def __init__(self, world: World) -> None:
         self.world = world
-        self.rows: list[tuple[float, float, F64, float]] = []
+        self.rows: list[tuple[float, float, F64, float, F64]] = []
         self._f6 = np.zeros(6)
 
     def log(self, t: float) -> bool:
@@ -194,16 +195,19 @@ class _ContactLogger:
             return False
         total = 0.0
         force = np.zeros(3)
+        point = np.zeros(3)
         for i in between:  # a handful of contacts, only while the characters touch
             mujoco.mj_contactForce(m, d, int(i), self._f6)
             total += abs(self._f6[0])
+            point += abs(self._f6[0]) * d.contact.pos[i]
             fw = d.contact.frame[i].reshape(3, 3).T @ self._f6[:3]  # on geom2 from geom1
             if own[i, 1] == 0:
                 force += fw
             elif own[i, 0] == 0:
                 force -= fw
         depth = float(max(0.0, -d.contact.dist[between].min()))
-        self.rows.append((t, total, force, depth))
+        point = point / total if total > 0 else d.contact.pos[between].mean(axis=0)
+        self.rows.append((t, total, force, depth, point))
         return True
 
     def result(self, period: float) -> ContactLog:
@@ -211,8 +215,9 @@ class _ContactLogger:
         if not self.rows:
             z = np.zeros(0)
             return ContactLog(z, z, np.zeros((0, 3)), z, period, dt)
-        t, f, v, dep = zip(*self.rows)
-        return ContactLog(np.array(t), np.array(f), np.array(v), np.array(dep), period, dt)
+        t, f, v, dep, pt = zip(*self.rows)
+        return ContactLog(np.array(t), np.array(f), np.array(v), np.array(dep), period, dt,
+                          np.array(pt))  # fmt: skip
 
 
 @dataclass

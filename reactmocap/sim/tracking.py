@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError
+from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.metrics import FALL_FRACTION
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
@@ -129,13 +130,15 @@ def track_clip(
     total_mass: float = 75.0,
     config: WorldConfig | None = None,
     character_kwargs: dict[str, Any] | None = None,
+    parts: BodyPartMap | None = None,
     on_tick: Callable[[float, float], None] | None = None,
 ) -> TrackResult:
     """Track ``motion`` from ``start`` for ``seconds`` (default: to its end) with the registered
     ``controller`` (``params`` over its defaults; ``kp``/``kv`` are shortcuts for those) on a
     character built from the clip, optionally with impacts (their ``start`` relative to
     ``start``). ``root_assist > 0`` adds the NON-PHYSICAL root assist with that kp (only with
-    ``"pd"``). ``on_tick(t, seconds)`` reports progress."""
+    ``"pd"``). ``parts``: the clip's body parts (default: mapped by name). ``on_tick(t,
+    seconds)`` reports progress."""
     if not (np.isfinite(start) and 0 <= start <= motion.duration):
         raise ConfigError(f"start {start!r} s is outside the clip (0..{motion.duration:.3f} s)")
     remaining = motion.duration - start
@@ -157,7 +160,7 @@ def track_clip(
     given = {**(params or {}), **{k: v for k, v in (("kp", kp), ("kv", kv)) if v is not None}}
     resolved = spec.params(given)
     frame = round(start * motion.fps)
-    character = build_character(motion, total_mass=total_mass, frame=frame,
+    character = build_character(motion, parts, total_mass=total_mass, frame=frame,
                                 **(character_kwargs or {}))  # fmt: skip
     character.check_fk(motion, frame)
     cfg = config or WorldConfig(friction=friction)
