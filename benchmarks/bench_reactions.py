@@ -108,9 +108,12 @@ def _library() -> Path:
     return lib
 
 
-def _kick_aim(kick: Path, rec: CharacterSpec, hit: float, rec_clip: Path) -> AttackerSpec:
+def _kick_aim(
+    kick: Path, rec: CharacterSpec, hit: float, rec_clip: Path, side: float = 0.0
+) -> AttackerSpec:
     """The attacker's spec so that the first kick of ``kick`` reaches its full extension at
-    the recipient's pelvis at scenario time ``hit``, coming from in front of the recipient."""
+    the recipient's pelvis at scenario time ``hit``, coming from ``side`` (radians from the
+    recipient's front, counter-clockwise)."""
     m = read_bvh(kick)
     parts = map_body_parts(m.skeleton)
     g = m.global_positions()
@@ -125,7 +128,7 @@ def _kick_aim(kick: Path, rec: CharacterSpec, hit: float, rec_clip: Path) -> Att
     target = placed.global_positions()[f, rparts.joint_of("pelvis"), :2]
     front = float(heading(placed.slice(f, f + 1), rparts)[0])
     offset = (g[k, foot] - g[k, pel])[:2]
-    yaw = (front + np.pi) - np.arctan2(offset[1], offset[0])  # the kick travels toward -front
+    yaw = (front + side + np.pi) - np.arctan2(offset[1], offset[0])  # travels toward -side
     c, s = np.cos(yaw), np.sin(yaw)
     rot = np.array([[c, -s], [s, c]])
     pelvis_k = target - rot @ offset
@@ -139,7 +142,8 @@ def _kick_aim(kick: Path, rec: CharacterSpec, hit: float, rec_clip: Path) -> Att
     )
 
 
-def _apart(att: AttackerSpec, rec: CharacterSpec, rec_clip: Path, kick: Path) -> bool:
+def _gap(att: AttackerSpec, rec: CharacterSpec, rec_clip: Path, kick: Path) -> float:
+    """Pelvis distance (m) of the two characters when the scenario starts."""
     pel = []
     for spec, path in ((rec, rec_clip), (att, kick)):
         m = read_bvh(path)
@@ -147,7 +151,7 @@ def _apart(att: AttackerSpec, rec: CharacterSpec, rec_clip: Path, kick: Path) ->
         f = round(spec.start * m.fps)
         placed = place(m, parts, f, np.radians(spec.facing_deg), spec.position)
         pel.append(placed.global_positions()[f, parts.joint_of("pelvis"), :2])
-    return bool(np.linalg.norm(pel[0] - pel[1]) >= 0.7)
+    return float(np.linalg.norm(pel[0] - pel[1]))
 
 
 def real(cache: LibraryCache) -> None:
@@ -163,10 +167,14 @@ def real(cache: LibraryCache) -> None:
         m = read_bvh(clip)
         start = 0.2 if m.duration < 2.5 else 0.5
         rec = CharacterSpec(str(clip), start, 0.0, (0.0, 0.0))
-        # the latest hit time at which the two stand apart (>= 0.7 m) when the scenario starts
-        hit, att = next((h, a) for h in (1.0, 0.75, 0.5, 0.35, 0.25)
-                        if h + start < m.duration - 0.5
-                        and _apart(a := _kick_aim(kick, rec, h, clip), rec, clip, kick))  # fmt: skip
+        # the latest hit time, from the front first, at which the two stand furthest apart
+        # when the scenario starts (a recipient walking backwards is kicked from behind)
+        options = [(h, _kick_aim(kick, rec, h, clip, side))
+                   for side in (0.0, np.pi, np.pi / 2, -np.pi / 2)
+                   for h in (1.0, 0.75, 0.5, 0.35, 0.25) if h + start < m.duration - 0.4]  # fmt: skip
+        gaps = [_gap(a, rec, clip, kick) for _, a in options]
+        hit, att = options[next((i for i, g in enumerate(gaps) if g >= 0.7),
+                                int(np.argmax(gaps)))]  # fmt: skip
         runs: list[tuple[str, Scenario]] = [
             ("kick", Scenario(lib, rec, attacker=att, response=REAL, name=f"{key}-kick"))
         ]
@@ -189,6 +197,8 @@ def real(cache: LibraryCache) -> None:
                 rows.append(None)
                 continue
             print(_row(f"{key[:16]} {label}", rep), f"(wall {time.perf_counter() - t:.1f} s)")
+            for w in rep["warnings"]:
+                print(f"    warning: {w}")
             rows.append(rep)
     done = [r for r in rows if r is not None]
     clean = sum(not r["warnings"] for r in done)
