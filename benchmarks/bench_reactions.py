@@ -165,7 +165,7 @@ def real(cache: LibraryCache) -> None:
     for key in RECIPIENTS:
         clip = next(SHARED.glob(f"*{key}*.bvh"))
         m = read_bvh(clip)
-        start = 0.2 if m.duration < 2.5 else 0.5
+        start = 0.1 if m.duration < 1.5 else 0.5
         rec = CharacterSpec(str(clip), start, 0.0, (0.0, 0.0))
         # the latest hit time, from the front first, at which the two stand furthest apart
         # when the scenario starts (a recipient walking backwards is kicked from behind)

@@ -227,10 +227,12 @@ def _warnings(
     if naive.impact_time > rec.motion.duration - rec.clock0:
         out.append(f"the impact ({naive.impact_time:.2f} s) comes after the recipient's clip "
                    f"ends ({rec.motion.duration - rec.clock0:.2f} s into the scenario)")  # fmt: skip
-    react = scenario.response.react_impulse
-    if naive.impulse >= react and cont.best.clip == rec.clip.name:
+    cfg = scenario.response
+    own = rec.clock0 + cont.time  # the recipient's own clip time had nothing happened
+    if (naive.impulse >= cfg.react_impulse and cont.best.clip == rec.clip.name
+            and abs(cont.best.time - own) < cfg.own_clip_margin):  # fmt: skip
         out.append(f"the recipient carries on with its own clip after an impulse of "
-                   f"{naive.impulse:.1f} N s (from {react} N s it should react)")  # fmt: skip
+                   f"{naive.impulse:.1f} N s (from {cfg.react_impulse} N s it should react)")  # fmt: skip
     return out
 
 
