@@ -82,7 +82,9 @@ def test_no_overlap_when_the_recipient_walks_into_a_kick() -> None:
     assert q["attacker_speed_ratio"] <= 1.5
 
 
-def test_strict_exits_non_zero_on_warnings(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_strict_exits_non_zero_on_warnings(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     far = tmp_path / "miss.toml"
     far.write_text(
         f'library = "{SYNTHETIC}"\n[recipient]\nclip = "guard"\nstart = 0.5\n'
