@@ -23,7 +23,6 @@ from reactmocap.response.footlock import lock_feet
 from reactmocap.response.library_cache import LibraryCache
 from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_schedule
 from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
-from reactmocap.rotations import quat_slerp
 from reactmocap.search import MotionIndex, SearchResult
 from reactmocap.sim.bodies import SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.character import Character, build_character
@@ -54,6 +53,7 @@ __all__ = [
     "TransitionSimulation",
     "blend",
     "cast",
+    "desired_motion",
     "estimate_contact",
     "naive_simulation",
     "search_continuation",
@@ -243,31 +243,36 @@ def _start(world: World, cast: Cast, rewind: float) -> None:
         world.set_from_motion(k, a.motion, a.frame_at(rewind))
 
 
+def desired_motion(cast: Cast, cfg: ResponseConfig, times: F64, impact: float, yields: bool,
+                   target: Continuation) -> Motion:  # fmt: skip
+    """What Simulation 2 asks of the recipient at scenario ``times``: the old clip until
+    ``impact``; from there (``yields``) its pose at the impact, held through the reaction delay
+    while moving on with the body's velocity (or the old clip on); eased (smoothstep) into the
+    found clip by the match time, where it is exactly the found clip."""
+    rec = cast.recipient
+    times = np.asarray(times, dtype=np.float64)
+    prev = rec.motion.sample((np.minimum(times, impact) if yields else times) + rec.clock0)
+    prev = ground_root(prev, rec.parts)
+    if yields:
+        pelvis = rec.parts.joint_of("pelvis")
+        ends = rec.motion.sample(impact + rec.clock0 + np.array([-0.5, 0.5]) / rec.motion.fps)
+        g = ends.global_positions()[:, pelvis]
+        velocity = (g[1] - g[0]) * rec.motion.fps
+        coast = np.maximum(times - impact, 0.0)[:, None] * velocity
+        prev = prev.replace(root_positions=prev.root_positions + coast)
+    found = ground_root(target.found.sample(target.best.time + (times - target.time)), rec.parts)
+    return blend_poses(prev, found, transition_weights(times, impact, cfg.reaction_delay,
+                                                       target.time))  # fmt: skip
+
+
 def _recipient_path(cast: Cast, cfg: ResponseConfig, rewind: float, seconds: float, every: int,
                     impact: float, yields: bool, target: Continuation) -> tuple[F64, float]:  # fmt: skip
-    """Simulation 2's desired qpos for the recipient at each control tick from the rewind, and
-    its rate: the old clip until ``impact``; from there (``yields``) its pose at the impact,
-    held through the reaction delay (or the old clip on), eased
-    (smoothstep) into the found clip by the match time."""
-    rec = cast.recipient
-    ch = rec.character
+    """Simulation 2's desired qpos (:func:`desired_motion`) at each control tick from the rewind,
+    and its rate."""
     n = int(np.ceil(seconds / cfg.timestep / every)) + 1
-    ticks = np.arange(n) * every * cfg.timestep + rewind
-    clock = np.minimum(ticks, impact) if yields else ticks
-    prev = ch.qpos_from_motion(rec.motion.sample(clock + rec.clock0))
-    if yields:  # the held pose moves on with the body's velocity at the impact
-        rate = rec.motion.fps
-        step = ch.qpos_from_motion(
-            rec.motion.sample(impact + rec.clock0 + np.array([-0.5, 0.5]) / rate)
-        )
-        prev[:, :3] += np.maximum(ticks - impact, 0.0)[:, None] * (step[1, :3] - step[0, :3]) * rate
-    found = ch.qpos_from_motion(target.found.sample(target.best.time + (ticks - target.time)))
-    w = transition_weights(ticks, impact, cfg.reaction_delay, target.time)
-    q = np.empty_like(prev)
-    q[:, :3] = prev[:, :3] + w[:, None] * (found[:, :3] - prev[:, :3])
-    quats = quat_slerp(prev[:, 3:].reshape(n, -1, 4), found[:, 3:].reshape(n, -1, 4), w[:, None])
-    q[:, 3:] = quats.reshape(n, -1)
-    return q, 1.0 / (every * cfg.timestep)
+    ticks = np.arange(n, dtype=np.float64) * every * cfg.timestep + rewind
+    motion = desired_motion(cast, cfg, ticks, impact, yields, target)
+    return cast.recipient.character.qpos_from_motion(motion), 1.0 / (every * cfg.timestep)
 
 
 def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -> NaiveSimulation:
@@ -529,7 +534,9 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
               if i_imp > 0 else None)  # fmt: skip
     times = np.arange(i_imp, i_end + 1) / fps
     simulated = grounded(sim2.motion.sample(times - contact.rewind))
-    found = grounded(cont.found.sample(cont.best.time + (times - cont.time)))
+    # the blend corrects the simulation toward what it was asked to do, which ends exactly on
+    # the found clip: it then corrects only the tracking error, not the whole way to the clip
+    found = desired_motion(cast, cfg, times, naive.impact_time, _yields(cfg, naive.impulse), cont)
     tail_n = int(np.floor(min(cfg.tail, cont.found.duration - cont.best.time) * fps))
     tail = (grounded(cont.found.sample(cont.best.time + np.arange(1, tail_n + 1) / fps))
             if tail_n > 0 else None)  # fmt: skip

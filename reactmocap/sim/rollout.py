@@ -29,11 +29,13 @@ from reactmocap.sim.controllers.base import Controller
 from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, contact_report
 from reactmocap.sim.world import World
 
-__all__ = ["ContactLog", "RolloutResult", "rollout"]
+__all__ = ["ContactLog", "RolloutResult", "StopCondition", "rollout"]
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
-Status = Literal["ok", "unstable"]
+Status = Literal["ok", "unstable", "stopped"]
+#: ``stop(world, t)``: a reason to end the rollout early (e.g. "fell"), or None to go on
+StopCondition = Callable[[World, float], str | None]
 
 
 @dataclass(frozen=True)
@@ -72,8 +74,8 @@ class ContactLog:
 class RolloutResult:
     """What a rollout recorded: ``qpos`` ``(R, nq)`` after each of ``record_steps`` ``(R,)``
     step counts, for the frame rates ``fps`` (the first is the primary rate); ``status``
-    ``"ok"`` or ``"unstable"`` (with ``reason``; then the records stop at the last stable
-    frame); ``seconds`` simulated; ``contacts``: a report per primary frame when asked for;
+    ``"ok"``, ``"unstable"`` or ``"stopped"`` by a stop condition (with ``reason``; the
+    records end there); ``seconds`` simulated; ``contacts``: a report per primary frame when asked for;
     ``references``: per character the motion its non-simulated joints come from, sampled at
     ``reference_starts + t``."""
 
@@ -237,6 +239,7 @@ class _Plan:
     on_tick: Callable[[float], None] | None
     tick_every: int
     record_contacts: bool
+    stop: StopCondition | None = None
 
 
 def rollout(
@@ -255,6 +258,7 @@ def rollout(
     on_unstable: Literal["raise", "stop"] = "raise",
     on_tick: Callable[[float], None] | None = None,
     tick_every: int = 100,
+    stop: StopCondition | None = None,
 ) -> RolloutResult:
     """Run ``duration`` seconds from the world's current state (see the module docstring).
 
@@ -271,6 +275,8 @@ def rollout(
         on_unstable: ``"raise"`` a SimulationError, or ``"stop"`` and return what was recorded
             with ``status = "unstable"``. MuJoCo's own warnings join the reason.
         on_tick: called with ``t`` every ``tick_every`` steps (a progress bar).
+        stop: checked at every primary frame; a reason it returns ends the rollout there
+            with ``status = "stopped"``.
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ConfigError(f"duration must be > 0 s, got {duration!r}")
@@ -303,7 +309,7 @@ def rollout(
         nsteps, controllers, schedule, np.array(events, dtype=np.int64), sorted(periods),
         rec_steps, set(_frame_steps(duration, rates[0], dt).tolist()), check_every,
         _ContactLogger(world) if contact_every else None, contact_every or 0, on_tick,
-        tick_every, record_contacts,
+        tick_every, record_contacts, stop,
     )  # fmt: skip
     qpos = np.empty((rec_steps.size, world.model.nq))
     contacts: list[ContactReport] = []
@@ -313,14 +319,16 @@ def rollout(
     mujoco.set_mju_user_warning(lambda msg: warnings.append(str(msg).strip()))
     wall = _time.perf_counter()
     try:
-        reason, ri, k = _loop(world, plan, guard, qpos, contacts)
+        reason, ri, k, stopped = _loop(world, plan, guard, qpos, contacts)
     finally:
         mujoco.set_mju_user_warning(handler)
         if schedule is not None:
             schedule.clear()
     wall = _time.perf_counter() - wall
     status: Status = "ok"
-    if reason is not None:
+    if stopped:
+        status = "stopped"
+    elif reason is not None:
         if warnings:
             reason += f" (MuJoCo: {warnings[0]})"
         if on_unstable == "raise":
@@ -348,8 +356,9 @@ def rollout(
 
 def _loop(
     world: World, plan: _Plan, guard: _Guard, qpos: F64, contacts: list[ContactReport]
-) -> tuple[str | None, int, int]:
-    """The stepping loop; returns the instability (or None), the records made, the steps."""
+) -> tuple[str | None, int, int, bool]:
+    """The stepping loop; returns the instability or stop reason (or None), the records made,
+    the steps, and whether a stop condition ended it."""
     d = world.data
     t0 = float(d.time)
     for c in plan.controllers:
@@ -364,14 +373,19 @@ def _loop(
         if is_record or k % plan.check_every == 0 or k >= nsteps:
             reason = guard.problem(float(d.time) - t0)
             if reason is not None:
-                return reason, ri, k
+                return reason, ri, k, False
         if is_record:
             qpos[ri] = d.qpos
-            if plan.record_contacts and k in plan.primary:
+            primary = k in plan.primary
+            if plan.record_contacts and primary:
                 contacts.append(contact_report(world))
             ri += 1
+            if primary and plan.stop is not None:
+                why = plan.stop(world, float(d.time) - t0)
+                if why is not None:
+                    return why, ri, k, True
         if k >= nsteps:
-            return None, ri, k
+            return None, ri, k, False
         t = float(d.time) - t0
         for c in plan.controllers:
             if k % c.control_every == 0:
