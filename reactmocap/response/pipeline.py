@@ -43,6 +43,8 @@ class ResponseResult:
     matched: SearchResult
     candidates: list[SearchResult]
     impact_time: float
+    #: the match time: the scenario time at which ``found`` is at ``matched.time`` (the
+    #: physical mode lands later, at the report's ``transition.end``)
     transition_end: float
     sim1: Motion
     sim2: Motion
@@ -143,7 +145,7 @@ def _report(
         "intended_fall": qm.intended_fall(cont.found_clip, parts, best.frame),
         "reaction_displacement_m": float(np.linalg.norm(shift)),
         "reaction_direction_error_deg": qm.direction_error_deg(shift, impulse),
-        "transition_s": cont.time - naive.impact_time,
+        "transition_s": sim2.landed - naive.impact_time,
         "contact_impulse_Ns": float(np.linalg.norm(impulse)),
         "character_overlap_max_m": overlap,
         "attacker_speed_ratio": (
@@ -153,6 +155,14 @@ def _report(
         ),
     }
     warnings = _warnings(scenario, cast, contact, naive, cont, quality)
+    if not sim2.on_clip:
+        gap = sim2.landing_gap
+        warnings.append(
+            f"physical mode: the body did not reach the found clip within {cfg.land_within} s "
+            f"(pelvis {gap[0]:.2f} m, root {gap[1]:.2f} rad, a joint {gap[2]:.2f} rad off; "
+            f"tolerances {cfg.land_position} m, {cfg.land_angle} rad, {cfg.land_joint} rad): "
+            "the blend closed the rest"
+        )
     return {
         "scenario": scenario.name,
         "warnings": warnings,
@@ -182,8 +192,12 @@ def _report(
         },
         "transition": {
             "start": naive.impact_time,
-            "end": cont.time,
+            "end": sim2.landed,
+            "match": cont.time,
             "reaction_delay": cfg.reaction_delay,
+            "mode": cfg.mode,
+            "landed_on_clip": sim2.on_clip,
+            "landing_gap": dict(zip(("pelvis_m", "root_rad", "joint_rad"), sim2.landing_gap)),
         },
         "timings_s": timings,
         "steps": {"sim1": naive.steps, "sim2": sim2.steps},

@@ -17,6 +17,7 @@ from typing import Any, Literal
 from reactmocap.errors import ConfigError
 
 __all__ = [
+    "MODES",
     "SIM1_MODES",
     "AttackerSpec",
     "CharacterSpec",
@@ -28,6 +29,7 @@ __all__ = [
 ]
 
 SIM1_MODES = ("yielding", "holding", "passive")
+MODES = ("blend", "physical")
 
 
 @dataclass(frozen=True)
@@ -105,6 +107,17 @@ class ResponseConfig:
     total_mass: float = 75.0
     #: pin planted feet that slide during the transition (two-bone IK; not in the paper)
     foot_lock: bool = True
+    #: ``blend``: the paper's final blend lands on the found clip at the match time, whatever
+    #: the simulation did; ``physical``: Simulation 2 runs on past the match, tracking the
+    #: found clip, until the body is within ``land_position`` m (pelvis), ``land_angle`` rad
+    #: (root turn) and ``land_joint`` rad (every joint) of it; the blend then only closes that
+    #: small gap. If it is not there within ``land_within`` s, the report warns and the blend
+    #: closes what is left
+    mode: Literal["blend", "physical"] = "blend"
+    land_position: float = 0.05
+    land_angle: float = 0.17
+    land_joint: float = 0.1
+    land_within: float = 1.5
 
 
 @dataclass(frozen=True)
@@ -186,9 +199,10 @@ class _Reader:
                 kwargs[name] = self.string(where, value)
             elif name.endswith("_controller"):
                 kwargs[name] = self.controller(where, value)
-            elif name == "sim1_mode":
-                if value not in SIM1_MODES:
-                    raise self.fail(where, f"expected one of {list(SIM1_MODES)}, got {value!r}")
+            elif name in ("sim1_mode", "mode"):
+                options = SIM1_MODES if name == "sim1_mode" else MODES
+                if value not in options:
+                    raise self.fail(where, f"expected one of {list(options)}, got {value!r}")
                 kwargs[name] = value
             elif ftype == "bool":
                 if not isinstance(value, bool):
@@ -207,9 +221,10 @@ class _Reader:
                                   "contact_shift_max", "attacker_follow", "attacker_blend",
                                   "friction_sim1", "friction_sim2", "kv", "yield_gain",
                                   "react_impulse", "active_min", "own_clip_margin", "attacker_assist",
-                                  "yield_recover"}  # fmt: skip
+                                  "yield_recover", "land_within"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
-                                    "total_mass"}  # fmt: skip
+                                    "total_mass", "land_position", "land_angle",
+                                    "land_joint"}  # fmt: skip
                 kwargs[name] = self.number(
                     where, value, positive=positive, min_=0.0 if nonneg else None
                 )

@@ -23,6 +23,7 @@ from reactmocap.response.footlock import lock_feet
 from reactmocap.response.library_cache import LibraryCache
 from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_schedule
 from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
+from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.search import MotionIndex, SearchResult
 from reactmocap.sim.bodies import SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.character import Character, build_character
@@ -43,6 +44,7 @@ from reactmocap.sim.world import World, WorldConfig
 
 __all__ = [
     "CONTACT_EVERY",
+    "PHYSICAL_TRACKERS",
     "SCAN_FPS",
     "Actor",
     "Blend",
@@ -383,6 +385,37 @@ def search_continuation(
     return Continuation(best, candidates, contact.rewind + best_start / q_fps, found, found_clip)
 
 
+#: Simulation 2's controllers in the physical mode: trackers that keep a free-rooted body
+#: balanced while it follows the found clip (the joint-only ``pd`` servo cannot)
+PHYSICAL_TRACKERS = ("wholebody", "predictive")
+
+
+class _Landing:
+    """The physical mode's stop condition: from ``after`` s into the rollout, the recipient is
+    within the landing tolerances of the desired path ``q`` (qpos per control tick, ``rate``
+    Hz from the rollout's start); ``at`` is then that time (None until it is)."""
+
+    def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float) -> None:
+        self.cfg, self.q, self.rate, self.after = cfg, q, rate, after
+        self.at: float | None = None
+        self.gap = np.full(3, np.inf)  # the last check's pelvis (m), root and joint (rad) gaps
+
+    def __call__(self, world: World, t: float) -> str | None:
+        if t < self.after - 1e-9:
+            return None
+        want = self.q[min(int(round(t * self.rate)), len(self.q) - 1)]
+        cur = world.data.qpos[world.characters[0].qpos_slice]
+        turn = np.linalg.norm(
+            quat_log(quat_mul(quat_conj(want[3:].reshape(-1, 4)), cur[3:].reshape(-1, 4))), axis=1
+        )
+        self.gap = np.array([np.linalg.norm(cur[:3] - want[:3]), turn[0], turn[1:].max()])
+        cfg = self.cfg
+        if np.all(self.gap <= (cfg.land_position, cfg.land_angle, cfg.land_joint)):
+            self.at = t
+            return "landed on the found clip"
+        return None
+
+
 @dataclass(frozen=True)
 class TransitionSimulation:
     """Simulation 2 from the rewind: the recipient ``motion`` (frame 0 at the rewind) and the
@@ -396,16 +429,28 @@ class TransitionSimulation:
     #: scenario time from which the attacker's own clip no longer runs into the recipient: its
     #: output follows the simulation until then (or the end of ``attacker_follow``)
     attacker_release: float = 0.0
+    #: scenario time the blend lands on the found clip: the match time in the ``blend`` mode;
+    #: in the ``physical`` mode when the body got there (or the simulation's end)
+    landed: float = 0.0
+    #: physical mode: the body reached the found clip within the landing tolerances
+    on_clip: bool = True
+    #: physical mode: the pelvis (m), root and largest joint (rad) gaps to the found clip at
+    #: the landing (or the simulation's end)
+    landing_gap: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
                           naive: NaiveSimulation, cont: Continuation) -> TransitionSimulation:  # fmt: skip
     """Simulation 2 (friction ``friction_sim2``) from the same start and impact: the recipient
     follows the desired path to the found clip with ``sim2_controller``, yielding through the
-    reaction delay as in Simulation 1 (the passive response), then recovering (the active)."""
+    reaction delay as in Simulation 1 (the passive response), then recovering (the active).
+    In the ``physical`` mode it runs on along the found clip until the body lands on it."""
     cfg = scenario.response
     rewind = contact.rewind
     end = cont.time
+    physical = cfg.mode == "physical"
+    if physical:  # no further than the found clip goes
+        end += max(0.0, min(cfg.land_within, cont.found.duration - cont.best.time))
     release = 0.0
     if cast.attacker is not None:
         release = max(naive.impact_time + cfg.attacker_follow,
@@ -415,6 +460,8 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     world = _world(cast, cfg, cfg.friction_sim2)
     world.set_state(naive.start_state)
     name = cfg.sim2_controller
+    if physical and name not in PHYSICAL_TRACKERS:
+        name = PHYSICAL_TRACKERS[0]
     every = int(controller_spec(name).defaults["control_every"] or 1)
     yields = _yields(cfg, naive.impulse)
     q, rate = _recipient_path(cast, cfg, rewind, seconds, every, naive.impact_time, yields, cont)
@@ -426,15 +473,22 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     if cast.attacker is not None:
         ctrls += _attacker(world, cast, cfg, rewind)
         fps.append(cast.attacker.motion.fps)
+    landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind) if physical else None
     res = rollout(
         world, seconds, controllers=ctrls, impacts=_impacts(scenario, rewind), record_fps=fps,
         references=[a.motion for a in cast.actors],
         reference_start=[rewind + a.clock0 for a in cast.actors], contact_every=CONTACT_EVERY,
+        stop=landing,
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
     assert res.contact_log is not None
+    landed, on_clip, gap = cont.time, True, (0.0, 0.0, 0.0)
+    if landing is not None:
+        on_clip = landing.at is not None
+        landed = rewind + (landing.at if landing.at is not None else res.duration)
+        gap = (float(landing.gap[0]), float(landing.gap[1]), float(landing.gap[2]))
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
-                                res.contact_log, release)  # fmt: skip
+                                res.contact_log, release, landed, on_clip, gap)  # fmt: skip
 
 
 def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
@@ -479,9 +533,11 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     return blend_poses(sim, own, w).replace(name="attacker")
 
 
-def _output_end(cfg: ResponseConfig, cont: Continuation) -> float:
-    """Scenario time of the recipient output's last frame (the found clip's tail included)."""
-    return cont.time + min(cfg.tail, cont.found.duration - cont.best.time)
+def _output_end(cfg: ResponseConfig, cont: Continuation, landed: float | None = None) -> float:
+    """Scenario time of the recipient output's last frame (the found clip's tail included)
+    when the blend lands on the found clip at ``landed`` (the match time if None)."""
+    land = cont.time if landed is None else landed
+    return land + max(0.0, min(cfg.tail, cont.found.duration - cont.best.time - (land - cont.time)))
 
 
 def _attacker_clear(cast: Cast, cfg: ResponseConfig, naive: NaiveSimulation,
@@ -526,7 +582,7 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     rec = cast.recipient
     fps = rec.motion.fps
     i_imp = int(np.ceil(naive.impact_time * fps - 1e-9))
-    i_end = int(round(cont.time * fps))
+    i_end = int(round(sim2.landed * fps))
     # every piece with a dummy top joint on the ground under the pelvis (ground_root): the
     # blend then moves the body, not meters of offset between the clips' dummy roots
     grounded = lambda m: ground_root(m, rec.parts)  # noqa: E731
@@ -537,8 +593,9 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     # the blend corrects the simulation toward what it was asked to do, which ends exactly on
     # the found clip: it then corrects only the tracking error, not the whole way to the clip
     found = desired_motion(cast, cfg, times, naive.impact_time, _yields(cfg, naive.impulse), cont)
-    tail_n = int(np.floor(min(cfg.tail, cont.found.duration - cont.best.time) * fps))
-    tail = (grounded(cont.found.sample(cont.best.time + np.arange(1, tail_n + 1) / fps))
+    on = cont.best.time + (sim2.landed - cont.time)  # the found clip's time at the landing
+    tail_n = int(np.floor(max(0.0, min(cfg.tail, cont.found.duration - on)) * fps))
+    tail = (grounded(cont.found.sample(on + np.arange(1, tail_n + 1) / fps))
             if tail_n > 0 else None)  # fmt: skip
     start = np.zeros(rec.motion.num_joints)
     for _ in range(6):  # limbs still touching the attacker keep their simulated pose longer
