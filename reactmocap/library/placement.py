@@ -96,11 +96,14 @@ def place(
     return motion.transformed(yaw, (shift[0], shift[1], 0.0))
 
 
-def ground_root(motion: Motion, parts: BodyPartMap) -> Motion:
+def ground_root(motion: Motion, parts: BodyPartMap, *, turn: bool = True) -> Motion:
     """``motion`` with a dummy top joint above the pelvis (e.g. Bandai's ``joint_Root``) on the
     ground under the pelvis, turned to the body's heading: the root path game engines extract
     follows the body smoothly and never jumps, whatever clips were stitched or blended. Every
     other joint keeps its world transform (the pelvis's local transform absorbs the change).
+    ``turn=False`` leaves the dummy root unturned, so the pelvis's local rotation is its world
+    one: blend in that form (a lying body's heading is arbitrary, and slerping the root's yaw
+    and the pelvis's local rotation separately would swing the pelvis), then ground again.
     Motions whose top joint is the pelvis, or whose pelvis has no per-frame translation to
     absorb it, come back unchanged."""
     skel = motion.skeleton
@@ -108,7 +111,8 @@ def ground_root(motion: Motion, parts: BodyPartMap) -> Motion:
     if pelvis == 0 or motion.translations is None or int(skel.parents[pelvis]) != 0:
         return motion
     pos, grot = motion.forward_kinematics()
-    yaw = np.unwrap(body_heading(grot[:, pelvis], body_frame(skel, parts)))
+    yaw = (np.unwrap(body_heading(grot[:, pelvis], body_frame(skel, parts))) if turn
+           else np.zeros(motion.num_frames))  # fmt: skip
     root_q = quat_from_yaw(yaw)
     root_p = np.column_stack([pos[:, pelvis, :2], np.zeros(motion.num_frames)])
     inv = quat_conj(root_q)

@@ -254,7 +254,7 @@ def desired_motion(cast: Cast, cfg: ResponseConfig, times: F64, impact: float, y
     rec = cast.recipient
     times = np.asarray(times, dtype=np.float64)
     prev = rec.motion.sample((np.minimum(times, impact) if yields else times) + rec.clock0)
-    prev = ground_root(prev, rec.parts)
+    prev = ground_root(prev, rec.parts, turn=False)
     if yields:
         pelvis = rec.parts.joint_of("pelvis")
         ends = rec.motion.sample(impact + rec.clock0 + np.array([-0.5, 0.5]) / rec.motion.fps)
@@ -262,7 +262,8 @@ def desired_motion(cast: Cast, cfg: ResponseConfig, times: F64, impact: float, y
         velocity = (g[1] - g[0]) * rec.motion.fps
         coast = np.maximum(times - impact, 0.0)[:, None] * velocity
         prev = prev.replace(root_positions=prev.root_positions + coast)
-    found = ground_root(target.found.sample(target.best.time + (times - target.time)), rec.parts)
+    found = ground_root(target.found.sample(target.best.time + (times - target.time)), rec.parts,
+                        turn=False)  # fmt: skip
     return blend_poses(prev, found, transition_weights(times, impact, cfg.reaction_delay,
                                                        target.time))  # fmt: skip
 
@@ -517,9 +518,9 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     assert sim2.attacker is not None
     afps = att.motion.fps
     t = np.arange(0, int(np.floor(duration * afps)) + 1) / afps
-    own = ground_root(att.motion.sample(t + att.clock0).replace(fps=afps), att.parts)
+    own = ground_root(att.motion.sample(t + att.clock0).replace(fps=afps), att.parts, turn=False)
     sim = ground_root(sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration)),
-                      att.parts)  # fmt: skip
+                      att.parts, turn=False)  # fmt: skip
     if shift_times.size:
         moved = np.stack([np.interp(t, shift_times, shift[:, k]) for k in range(3)], axis=1)
         moved[t < shift_times[0]] = 0.0
@@ -530,7 +531,7 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     gap = float(np.linalg.norm(sim.global_positions()[i] - own.global_positions()[i], axis=1).max())
     span = max(cfg.attacker_blend, gap / max(0.5 * joint_speed_max_m_s(att.motion), 1e-9))
     w = np.where(t < contact.rewind, 1.0, np.clip((t - release) / span, 0, 1))
-    return blend_poses(sim, own, w).replace(name="attacker")
+    return ground_root(blend_poses(sim, own, w), att.parts).replace(name="attacker")
 
 
 def _output_end(cfg: ResponseConfig, cont: Continuation, landed: float | None = None) -> float:
@@ -583,9 +584,10 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     fps = rec.motion.fps
     i_imp = int(np.ceil(naive.impact_time * fps - 1e-9))
     i_end = int(round(sim2.landed * fps))
-    # every piece with a dummy top joint on the ground under the pelvis (ground_root): the
-    # blend then moves the body, not meters of offset between the clips' dummy roots
-    grounded = lambda m: ground_root(m, rec.parts)  # noqa: E731
+    # every piece with a dummy top joint on the ground under the pelvis, unturned while blending
+    # (ground_root): the blend then moves the body, not meters of offset between the clips'
+    # dummy roots; the output is grounded and turned to the heading as a whole
+    grounded = lambda m: ground_root(m, rec.parts, turn=False)  # noqa: E731
     before = (grounded(rec.motion.sample(np.arange(0, i_imp) / fps + rec.clock0))
               if i_imp > 0 else None)  # fmt: skip
     times = np.arange(i_imp, i_end + 1) / fps
@@ -603,7 +605,7 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
         if cfg.foot_lock:
             blended = lock_feet(blended, rec.parts)
         pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]
-        recipient = Motion.concatenate(pieces, name="recipient")
+        recipient = ground_root(Motion.concatenate(pieces, name="recipient"), rec.parts)
         if cast.attacker is None or sim2.attacker is None:
             return Blend(recipient, None, blended, simulated, _seams(i_imp, i_end, before))
         # the blend moved the recipient off its simulation: the attacker's simulated part

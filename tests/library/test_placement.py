@@ -69,3 +69,39 @@ def test_place_faces_and_positions_the_clip(clips: dict[str, Motion]) -> None:
     pelvis = placed.global_positions()[frame, parts.joint_of("pelvis")]
     np.testing.assert_allclose(pelvis[:2], where, atol=1e-9)
     assert pelvis[2] == pytest.approx(m.global_positions()[frame, parts.joint_of("pelvis"), 2])
+
+
+def test_ground_root_keeps_the_body_and_unturned_form_holds_world_pelvis(
+    clips: dict[str, Motion],
+) -> None:
+    from reactmocap.library.placement import ground_root
+    from reactmocap.response.blend import blend_poses
+    from tests.fixtures.one_spine import dummy_root
+
+    m = dummy_root(clips["fall_backward"].transformed(2.0, (1, 2)))  # heading not 0
+    parts = map_body_parts(m.skeleton)
+    pel = parts.joint_of("pelvis")
+    pos, rot = m.forward_kinematics()
+    for turn in (True, False):
+        g = ground_root(m, parts, turn=turn)
+        gp, gr = g.forward_kinematics()
+        np.testing.assert_allclose(gp[:, 1:], pos[:, 1:], atol=1e-9)  # the body where it was
+        np.testing.assert_allclose(g.root_positions[:, 2], 0.0, atol=1e-12)  # on the ground
+        np.testing.assert_allclose(g.root_positions[:, :2], pos[:, pel, :2], atol=1e-9)
+    flat = ground_root(m, parts, turn=False)
+    np.testing.assert_allclose(np.abs(flat.rotations[:, 0, 0]), 1.0, atol=1e-12)
+    # blending a lying pose with an upright one in the unturned form slerps the pelvis's world
+    # rotation: halfway it is exactly halfway (grounded with the heading it need not be)
+    up, down = flat.slice(0, 1), flat.slice(flat.num_frames - 1, flat.num_frames)
+    mid = blend_poses(up, down, [0.5])
+    _, r_up = up.forward_kinematics()
+    _, r_down = down.forward_kinematics()
+    _, r_mid = mid.forward_kinematics()
+    from reactmocap.rotations import quat_conj, quat_log, quat_mul
+
+    def angle(a: np.ndarray, b: np.ndarray) -> float:
+        return float(np.linalg.norm(quat_log(quat_mul(quat_conj(a), b))))
+
+    total = angle(r_up[0, pel], r_down[0, pel])
+    assert total > 1.0  # the fall really turns the pelvis
+    assert angle(r_up[0, pel], r_mid[0, pel]) == pytest.approx(total / 2, abs=1e-6)
