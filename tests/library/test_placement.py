@@ -81,10 +81,10 @@ def test_ground_root_keeps_the_body_and_unturned_form_holds_world_pelvis(
     m = dummy_root(clips["fall_backward"].transformed(2.0, (1, 2)))  # heading not 0
     parts = map_body_parts(m.skeleton)
     pel = parts.joint_of("pelvis")
-    pos, rot = m.forward_kinematics()
+    pos, _ = m.forward_kinematics()
     for turn in (True, False):
         g = ground_root(m, parts, turn=turn)
-        gp, gr = g.forward_kinematics()
+        gp, _ = g.forward_kinematics()
         np.testing.assert_allclose(gp[:, 1:], pos[:, 1:], atol=1e-9)  # the body where it was
         np.testing.assert_allclose(g.root_positions[:, 2], 0.0, atol=1e-12)  # on the ground
         np.testing.assert_allclose(g.root_positions[:, :2], pos[:, pel, :2], atol=1e-9)
