@@ -155,7 +155,9 @@ def _report(
         ),
     }
     warnings = _warnings(scenario, cast, contact, naive, cont, quality)
-    if not sim2.on_clip:
+    if sim2.unstable is not None:
+        warnings.append(f"physical mode: Simulation 2 stopped early ({sim2.unstable})")
+    elif not sim2.on_clip:
         gap = sim2.landing_gap
         warnings.append(
             f"physical mode: the body did not reach the found clip within {cfg.land_within} s "

@@ -438,6 +438,9 @@ class TransitionSimulation:
     #: physical mode: the pelvis (m), root and largest joint (rad) gaps to the found clip at
     #: the landing (or the simulation's end)
     landing_gap: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    #: physical mode: why Simulation 2 stopped early (it went unstable), else None; it ends at
+    #: its last stable frame and the blend closes the rest
+    unstable: str | None = None
 
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
@@ -479,17 +482,20 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         world, seconds, controllers=ctrls, impacts=_impacts(scenario, rewind), record_fps=fps,
         references=[a.motion for a in cast.actors],
         reference_start=[rewind + a.clock0 for a in cast.actors], contact_every=CONTACT_EVERY,
-        stop=landing,
+        stop=landing, on_unstable="stop" if physical else "raise",
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
     assert res.contact_log is not None
     landed, on_clip, gap = cont.time, True, (0.0, 0.0, 0.0)
     if landing is not None:
         on_clip = landing.at is not None
-        landed = rewind + (landing.at if landing.at is not None else res.duration)
+        # a simulation that went unstable before the match still lands no earlier than it
+        landed = max(cont.time, rewind + (landing.at if on_clip else res.duration))
         gap = (float(landing.gap[0]), float(landing.gap[1]), float(landing.gap[2]))
+    unstable = res.reason if res.status == "unstable" else None
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
-                                res.contact_log, release, landed, on_clip, gap)  # fmt: skip
+                                res.contact_log, release, landed, on_clip, gap,
+                                unstable)  # fmt: skip
 
 
 def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
