@@ -601,6 +601,8 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     # the blend corrects the simulation toward what it was asked to do, which ends exactly on
     # the found clip: it then corrects only the tracking error, not the whole way to the clip
     found = desired_motion(cast, cfg, times, naive.impact_time, _yields(cfg, naive.impulse), cont)
+    if cfg.mode == "physical":  # close only the gap left at the landing, spread over the blend
+        found = _with_end_gap(simulated, found)
     on = cont.best.time + (sim2.landed - cont.time)  # the found clip's time at the landing
     tail_n = int(np.floor(max(0.0, min(cfg.tail, cont.found.duration - on)) * fps))
     tail = (grounded(cont.found.sample(on + np.arange(1, tail_n + 1) / fps))
@@ -608,7 +610,7 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     start = np.zeros(rec.motion.num_joints)
     for _ in range(6):  # limbs still touching the attacker keep their simulated pose longer
         blended = final_blend(simulated, found, start)
-        if cfg.foot_lock:
+        if cfg.foot_lock and cfg.mode == "blend":  # the physics holds the feet otherwise
             blended = lock_feet(blended, rec.parts)
         pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]
         recipient = ground_root(Motion.concatenate(pieces, name="recipient"), rec.parts)
@@ -626,6 +628,21 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
             break
         start = later
     return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
+
+
+def _with_end_gap(simulated: Motion, target: Motion) -> Motion:
+    """``simulated`` carrying the gap of its last frame to ``target``'s last frame on every
+    frame (each local rotation turned by the last frame's correction, the root moved by its
+    offset): a final blend toward it corrects nothing but that gap and still lands exactly."""
+    fix = quat_mul(quat_conj(simulated.rotations[-1]), target.rotations[-1])
+    offset = target.root_positions[-1] - simulated.root_positions[-1]
+    tr = None
+    if simulated.translations is not None or target.translations is not None:
+        ts = simulated.local_translations()
+        tr = ts + (target.local_translations()[-1] - ts[-1])[None]
+    return simulated.replace(rotations=quat_mul(simulated.rotations, fix[None]),
+                             root_positions=simulated.root_positions + offset,
+                             translations=tr)  # fmt: skip
 
 
 def _hit_body(contact: ContactEstimate) -> str:
