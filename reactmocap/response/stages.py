@@ -490,7 +490,7 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     if landing is not None:
         on_clip = landing.at is not None
         # a simulation that went unstable before the match still lands no earlier than it
-        landed = max(cont.time, rewind + (landing.at if on_clip else res.duration))
+        landed = max(cont.time, rewind + (res.duration if landing.at is None else landing.at))
         gap = (float(landing.gap[0]), float(landing.gap[1]), float(landing.gap[2]))
     unstable = res.reason if res.status == "unstable" else None
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
