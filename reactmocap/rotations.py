@@ -122,10 +122,19 @@ def quat_rotate(q: ArrayLike, v: ArrayLike) -> F64: ...
 def quat_rotate(q: ArrayLike, v: ArrayLike) -> Floats:
     """Rotate vectors ``v (..., 3)`` by unit quaternions ``q (..., 4)``."""
     qq, vv = _common(q, v)
-    w = qq[..., :1]
-    u = qq[..., 1:]
-    t = 2.0 * np.cross(u, vv)
-    return vv + w * t + np.cross(u, t)
+    # v + w t + u x t with t = 2 u x v, by components: np.cross's axis handling costs 3x more
+    # on the small arrays of forward kinematics (its hot path)
+    w, x, y, z = qq[..., 0], qq[..., 1], qq[..., 2], qq[..., 3]
+    vx, vy, vz = vv[..., 0], vv[..., 1], vv[..., 2]
+    tx, ty, tz = 2.0 * (y * vz - z * vy), 2.0 * (z * vx - x * vz), 2.0 * (x * vy - y * vx)
+    return np.stack(
+        [
+            vx + w * tx + (y * tz - z * ty),
+            vy + w * ty + (z * tx - x * tz),
+            vz + w * tz + (x * ty - y * tx),
+        ],
+        axis=-1,
+    )
 
 
 @overload

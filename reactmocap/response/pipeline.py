@@ -26,7 +26,6 @@ from reactmocap.search import SearchResult
 from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.character import Character
 from reactmocap.sim.impacts import overlap_depths
-from reactmocap.sim.world import World
 
 __all__ = ["LibraryCache", "ResponseResult", "prepare_library", "run_response", "run_scenario"]
 
@@ -130,7 +129,7 @@ def _report(
     overlap = 0.0
     if cast.attacker is not None and out.attacker is not None:
         att = out.attacker.sample(out.recipient.times).replace(fps=fps)
-        world = World([rec.character, cast.attacker.character])
+        world = cast.pair
         overlap = float(overlap_depths(world, [out.recipient, att]).max())
     quality = {
         "match_distance": qm.match_distance(best.distance),

@@ -6,6 +6,7 @@ the recipient clip at ``recipient.start``; outputs are at the recipient clip's f
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -96,6 +97,12 @@ class Cast:
     def actors(self) -> list[Actor]:
         return [self.recipient] + ([self.attacker] if self.attacker is not None else [])
 
+    @cached_property
+    def pair(self) -> World:
+        """Both characters in one World for kinematic contact and overlap checks (poses are
+        set, it is never stepped); built once, since building a World costs ~10 ms."""
+        return World([a.character for a in self.actors])
+
 
 def _clip(scenario: Scenario, spec: CharacterSpec, cache: LibraryCache) -> Motion:
     """A clip by file (``x.bvh``: the scenario's folder first, then the working folder) or by
@@ -152,8 +159,7 @@ def estimate_contact(scenario: Scenario, cast: Cast) -> ContactEstimate:
         horizon = min(rec.motion.duration - rec.clock0, att.motion.duration - att.clock0)
         shifted = [a.motion.sample(np.arange(0, horizon, 1 / a.motion.fps) + a.clock0)
                    .replace(fps=a.motion.fps) for a in (rec, att)]  # fmt: skip
-        world = World([rec.character, att.character])
-        kc = first_contact(world, shifted, fps=SCAN_FPS, end=horizon)
+        kc = first_contact(cast.pair, shifted, fps=SCAN_FPS, end=horizon)
         if kc is None:  # never touching: the scan runs to the end and the clip plays on
             return ContactEstimate(horizon, max(0.0, np.floor(horizon * fps - 1e-9) / fps),
                                    "contact")  # fmt: skip
@@ -509,7 +515,7 @@ def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
     if t.size == 0:
         return impact
     own = att.motion.sample(t + att.clock0).replace(fps=fps)
-    world = World([cast.recipient.character, att.character])
+    world = cast.pair
     depth = overlap_depths(world, [recipient.sample(t).replace(fps=fps), own])
     hit = np.flatnonzero(depth > 0.0)
     return float(t[hit[-1]] + 1.0 / fps) if hit.size else impact
@@ -517,10 +523,11 @@ def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
 
 def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
                      sim2: TransitionSimulation, duration: float, shift_times: F64,
-                     shift: F64, release: float) -> Motion:  # fmt: skip
+                     shift: F64, release: float, speed: float) -> Motion:  # fmt: skip
     """The attacker's output: its clip until the rewind, its simulation (moved by the
     recipient's blend ``shift`` at ``shift_times``, held after) until ``release``, then
-    blended back to its clip over ``attacker_blend``."""
+    blended back to its clip over ``attacker_blend`` or longer: no faster than half its
+    clip's fastest joint ``speed`` (m/s)."""
     assert sim2.attacker is not None
     afps = att.motion.fps
     t = np.arange(0, int(np.floor(duration * afps)) + 1) / afps
@@ -534,8 +541,9 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     # back to the clip no faster than the capture moves: the blend adds (gap / duration) to
     # the joints' speed, kept within half the clip's fastest joint speed
     i = min(int(np.searchsorted(t, release)), t.size - 1)
-    gap = float(np.linalg.norm(sim.global_positions()[i] - own.global_positions()[i], axis=1).max())
-    span = max(cfg.attacker_blend, gap / max(0.5 * joint_speed_max_m_s(att.motion), 1e-9))
+    gap = float(np.linalg.norm(sim.slice(i, i + 1).global_positions()[0]
+                               - own.slice(i, i + 1).global_positions()[0], axis=1).max())  # fmt: skip
+    span = max(cfg.attacker_blend, gap / max(0.5 * speed, 1e-9))
     w = np.where(t < contact.rewind, 1.0, np.clip((t - release) / span, 0, 1))
     return ground_root(blend_poses(sim, own, w), att.parts).replace(name="attacker")
 
@@ -561,7 +569,7 @@ def _attacker_clear(cast: Cast, cfg: ResponseConfig, naive: NaiveSimulation,
     planned = blend_poses(rec.motion.sample(t + rec.clock0),
                           cont.found.sample(cont.best.time + (t - cont.time)), w)  # fmt: skip
     own = att.motion.sample(t + att.clock0)
-    world = World([rec.character, att.character])
+    world = cast.pair
     depth = overlap_depths(world, [planned.replace(fps=SCAN_FPS), own.replace(fps=SCAN_FPS)])
     hit = np.flatnonzero(depth > 0.0)
     return float(t[hit[-1]] + 1.0 / SCAN_FPS) if hit.size else naive.impact_time
@@ -608,6 +616,7 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     tail = (grounded(cont.found.sample(on + np.arange(1, tail_n + 1) / fps))
             if tail_n > 0 else None)  # fmt: skip
     start = np.zeros(rec.motion.num_joints)
+    speed = joint_speed_max_m_s(cast.attacker.motion) if cast.attacker is not None else 0.0
     for _ in range(6):  # limbs still touching the attacker keep their simulated pose longer
         blended = final_blend(simulated, found, start)
         if cfg.foot_lock and cfg.mode == "blend":  # the physics holds the feet otherwise
@@ -622,7 +631,7 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
         shift = blended.global_positions()[:, hit] - simulated.global_positions()[:, hit]
         release = max(sim2.attacker_release, _clear_of(cast, recipient, naive.impact_time))
         attacker = _attacker_output(cfg, cast.attacker, contact, sim2, recipient.duration,
-                                    times, shift, release)  # fmt: skip
+                                    times, shift, release, speed)  # fmt: skip
         later = _blend_later(cast, blended, attacker, times, start)
         if later is None:
             break
@@ -675,7 +684,7 @@ def _blend_later(cast: Cast, blended: Motion, attacker: Motion, times: F64,
     rec = cast.recipient
     assert cast.attacker is not None
     att = attacker.sample(times).replace(fps=blended.fps)
-    world = World([rec.character, cast.attacker.character])
+    world = cast.pair
     depth = overlap_depths(world, [blended, att], per_body=True)  # (n, 16)
     hit = depth > 0.005
     if not hit.any():
