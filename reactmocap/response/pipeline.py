@@ -19,7 +19,7 @@ from reactmocap import __version__
 from reactmocap import metrics as qm
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
-from reactmocap.response import stages
+from reactmocap.response import final, stages
 from reactmocap.response.library_cache import LibraryCache, prepare_library
 from reactmocap.response.scenario import Scenario
 from reactmocap.search import SearchResult
@@ -81,7 +81,7 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     naive = timed("sim1", stages.naive_simulation, scenario, cast, contact)
     cont = timed("search", stages.search_continuation, scenario, cast, contact, naive)
     sim2 = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, cont)
-    out = timed("blend", stages.blend, scenario, cast, contact, naive, cont, sim2)
+    out = timed("blend", final.blend, scenario, cast, contact, naive, cont, sim2)
     timings["total"] = time.perf_counter() - t_all
     report = _report(scenario, cast, contact, naive, cont, sim2, out, timings)
     rec = cast.recipient
@@ -114,7 +114,7 @@ def _report(
     naive: stages.NaiveSimulation,
     cont: stages.Continuation,
     sim2: stages.TransitionSimulation,
-    out: stages.Blend,
+    out: final.Blend,
     timings: dict[str, float],
 ) -> dict[str, Any]:
     cfg = scenario.response
@@ -252,7 +252,7 @@ def _warnings(
 
 
 def _hit_marks(scenario: Scenario, cast: stages.Cast, contact: stages.ContactEstimate,
-               sim2: stages.TransitionSimulation, out: stages.Blend) -> tuple[F64, F64, F64]:  # fmt: skip
+               sim2: stages.TransitionSimulation, out: final.Blend) -> tuple[F64, F64, F64]:  # fmt: skip
     """Where and how hard the recipient was hit, over time (for the video)."""
     if scenario.impact is not None:
         imp = scenario.impact
