@@ -67,24 +67,30 @@ def blend_poses(a: Motion, b: Motion, weights: ArrayLike, joint_weights: ArrayLi
     return a.replace(root_positions=root, rotations=rot, translations=tr)
 
 
-def final_blend(simulated: Motion, target: Motion, joint_start: ArrayLike | None = None) -> Motion:
+def final_blend(simulated: Motion, target: Motion, joint_start: ArrayLike | None = None,
+                root_start: float = 0.0) -> Motion:  # fmt: skip
     """Land ``simulated`` exactly on ``target`` at the last frame.
 
     Both cover the same transition frames. The root error at the end is spread by a root offset
     growing linearly from 0 to the full error; every joint is slerped toward the target with the
     same linear weight, so the first frame is the simulation and the last is the target.
-    ``joint_start`` ``(J,)`` delays a joint's slerp: it starts at that frame and still ends on
-    the target (e.g. a limb still touching the other character keeps its simulated pose).
+    ``joint_start`` ``(J,)`` delays a joint's slerp and ``root_start`` the root offset: each
+    starts at that frame and still ends on the target (e.g. a body still touching the other
+    character keeps its simulated pose and place).
     """
     _check_pair(simulated, target)
     n = simulated.num_frames
+    i = np.arange(n, dtype=np.float64)
     w = np.linspace(0.0, 1.0, n) if n > 1 else np.ones(1)
     offset = target.root_positions[-1] - simulated.root_positions[-1]
     wj = None
     if joint_start is not None and n > 1:
         start = np.clip(np.asarray(joint_start, dtype=np.float64), 0.0, n - 2.0)
-        i = np.arange(n, dtype=np.float64)[:, None]
-        wj = np.clip((i - start[None]) / (n - 1.0 - start[None]), 0.0, 1.0)
+        wj = np.clip((i[:, None] - start[None]) / (n - 1.0 - start[None]), 0.0, 1.0)
     out = blend_poses(simulated, target, w, wj)
-    root = simulated.root_positions + w[:, None] * offset
+    wr = w
+    if root_start > 0 and n > 1:
+        r0 = min(float(root_start), n - 2.0)
+        wr = np.clip((i - r0) / (n - 1.0 - r0), 0.0, 1.0)
+    root = simulated.root_positions + wr[:, None] * offset
     return out.replace(root_positions=root)

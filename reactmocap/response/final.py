@@ -118,9 +118,11 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     tail = (grounded(cont.found.sample(on + np.arange(1, tail_n + 1) / fps))
             if tail_n > 0 else None)  # fmt: skip
     start = np.zeros(rec.motion.num_joints)
+    pelvis = rec.parts.joint_of("pelvis")  # its delayed start delays the root offset too
     speed = joint_speed_max_m_s(cast.attacker.motion) if cast.attacker is not None else 0.0
-    for _ in range(6):  # limbs still touching the attacker keep their simulated pose longer
-        blended = final_blend(simulated, found, start)
+    held = 0.0  # the attacker follows its simulation at least until then
+    for _ in range(8):  # limbs still touching the attacker keep their simulated pose longer
+        blended = final_blend(simulated, found, start, root_start=start[pelvis])
         if cfg.foot_lock and cfg.mode == "blend":  # the physics holds the feet otherwise
             blended = lock_feet(blended, rec.parts)
         pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]
@@ -131,13 +133,21 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
         # moves with the body it hit, so the two keep the spacing the physics gave them
         hit = int(rec.character.anchors[SIM_BODIES.index(_hit_body(contact))])
         shift = blended.global_positions()[:, hit] - simulated.global_positions()[:, hit]
-        release = max(sim2.attacker_release, _clear_of(cast, recipient, naive.impact_time))
+        release = max(sim2.attacker_release, _clear_of(cast, recipient, naive.impact_time), held)
         attacker = _attacker_output(cfg, cast.attacker, contact, sim2, recipient.duration,
                                     times, shift, release, speed)  # fmt: skip
-        later = _blend_later(cast, blended, attacker, times, start)
-        if later is None:
+        depth = overlap_depths(cast.pair, [blended, attacker.sample(times).replace(fps=fps)],
+                               per_body=True)  # fmt: skip
+        later = _blend_later(cast, depth > 0.005, start)
+        if later is not None:
+            start = later
+            continue
+        # nothing left to delay on the recipient's side: if the attacker, blending back to
+        # its clip, runs into it, the attacker follows its simulation past that
+        late = np.flatnonzero((depth.max(axis=1) > 0.005) & (times >= release))
+        if late.size == 0:
             break
-        start = later
+        held = float(times[late[-1]]) + 1.0 / fps
     return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
 
 
@@ -178,17 +188,11 @@ def _limb_root(body: int) -> int:
     return SIM_BODIES.index("waist")
 
 
-def _blend_later(cast: Cast, blended: Motion, attacker: Motion, times: F64,
-                 start: F64) -> F64 | None:  # fmt: skip
+def _blend_later(cast: Cast, hit: NDArray[np.bool_], start: F64) -> F64 | None:
     """New per-joint blend starts when limbs of the blended transition run into the attacker's
-    output: each such limb (its joints and the folded ones above it) keeps its simulated pose
+    output (``hit`` ``(n, 16)``: each recipient body overlapping it, per frame): each such limb (its joints and the folded ones above it) keeps its simulated pose
     until two frames after its last overlap. None when nothing overlaps (or nothing changes)."""
     rec = cast.recipient
-    assert cast.attacker is not None
-    att = attacker.sample(times).replace(fps=blended.fps)
-    world = cast.pair
-    depth = overlap_depths(world, [blended, att], per_body=True)  # (n, 16)
-    hit = depth > 0.005
     if not hit.any():
         return None
     out = start.copy()
