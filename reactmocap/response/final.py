@@ -143,11 +143,17 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
             start = later
             continue
         # nothing left to delay on the recipient's side: if the attacker, blending back to
-        # its clip, runs into it, the attacker follows its simulation past that
-        late = np.flatnonzero((depth.max(axis=1) > 0.005) & (times >= release))
+        # its clip, runs into the recipient's output, it follows its simulation past that
+        out_t = recipient.times
+        after = out_t >= release
+        if not after.any():
+            break
+        whole = overlap_depths(cast.pair, [recipient.slice(int(np.argmax(after))),
+                                           attacker.sample(out_t[after]).replace(fps=fps)])  # fmt: skip
+        late = np.flatnonzero(whole > 0.005)
         if late.size == 0:
             break
-        held = float(times[late[-1]]) + 1.0 / fps
+        held = float(out_t[after][late[-1]]) + 1.0 / fps
     return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
 
 

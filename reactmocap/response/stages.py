@@ -381,11 +381,30 @@ def search_continuation(
     if not results:
         raise SearchError("no library window continues the response (only the recipient's own "
                           "clip matched, and a real hit rules it out)")  # fmt: skip
-    best, best_start = min(results, key=lambda r: r[0].distance)
+    results.sort(key=lambda r: r[0].distance)
+    # a continuation that walks into the attacker (back on its own clip) is no continuation
+    best, best_start = next((r for r in results
+                             if not _runs_into(cast, cfg, r[0], contact.rewind + r[1] / q_fps)),
+                            results[0])  # fmt: skip
     candidates = index.top_k(query, best_start, n=cfg.top_k, parts=parts)
     found_clip = cast.library[best.clip]
     found = found_clip.transformed(best.yaw, best.translation).replace(name=best.clip)
     return Continuation(best, candidates, contact.rewind + best_start / q_fps, found, found_clip)
+
+
+def _runs_into(cast: Cast, cfg: ResponseConfig, r: SearchResult, at: float) -> bool:
+    """Whether window ``r``'s clip, matched at scenario time ``at`` and played for ``tail``
+    seconds, runs into the attacker's own clip (scanned at :data:`SCAN_FPS`)."""
+    att = cast.attacker
+    if att is None:
+        return False
+    clip = cast.library[r.clip]
+    t = np.arange(0.0, min(cfg.tail, clip.duration - r.time), 1.0 / SCAN_FPS)
+    if t.size == 0:
+        return False
+    found = clip.transformed(r.yaw, r.translation).sample(r.time + t).replace(fps=SCAN_FPS)
+    own = att.motion.sample(at + t + att.clock0).replace(fps=SCAN_FPS)
+    return bool(overlap_depths(cast.pair, [found, own]).max() > 0.02)
 
 
 #: Simulation 2's controllers in the physical mode: trackers that keep a free-rooted body
