@@ -25,6 +25,7 @@ __all__ = [
     "quat_normalize",
     "quat_rotate",
     "quat_slerp",
+    "quat_slerp_path",
     "quat_to_euler",
     "quat_to_matrix",
     "quat_yaw",
@@ -192,6 +193,23 @@ def quat_continuous(q: ArrayLike, axis: int = 0) -> Floats:
         sign = np.concatenate([np.ones_like(flips[:1]), 1 - 2 * flips], axis=0)
         arr = arr * sign[..., None].astype(arr.dtype)
     return np.moveaxis(arr, 0, axis)
+
+
+def quat_slerp_path(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F64:
+    """Slerp of two frame sequences ``(T, ..., 4)`` with weights ``t`` broadcasting against
+    ``(T, ...)``, along one arc per sequence: the first frame's short arc, followed over the
+    frames. Frame-wise short-arc slerp jumps to the other side when the turn between the two
+    passes half a turn (a spin); this follows it continuously and still ends exactly on ``b``
+    where ``t`` is 1."""
+    qa, qb = _common(a, b)
+    rel = quat_continuous(quat_mul(quat_conj(qa), qb), axis=0)
+    rel = rel * np.where(rel[:1, ..., :1] < 0.0, -1.0, 1.0)  # the first frame's short arc
+    v = rel[..., 1:]
+    s = np.linalg.norm(v, axis=-1, keepdims=True)
+    half = np.arctan2(s, rel[..., :1]) * np.asarray(t, dtype=np.float64)[..., None]
+    axis = np.where(s > 1e-12, v / np.maximum(s, 1e-12), 0.0)
+    step = np.concatenate([np.cos(half), axis * np.sin(half)], axis=-1)
+    return np.asarray(quat_normalize(quat_mul(qa, step)), dtype=np.float64)
 
 
 def quat_from_euler(angles_rad: ArrayLike, order: str) -> F64:

@@ -169,3 +169,24 @@ def test_other_input_is_computed_in_float64() -> None:
     assert mixed.dtype == np.float64
     assert quat_to_matrix(np.float16([1, 0, 0, 0])).dtype == np.float64
     assert quat_from_euler(np.float32([0.1, 0.2, 0.3]), "ZXY").dtype == np.float64  # scipy
+
+
+def test_slerp_path_follows_a_spin_past_half_a_turn_where_framewise_slerp_jumps() -> None:
+    from reactmocap.rotations import quat_from_yaw, quat_slerp, quat_slerp_path
+
+    n = 61
+    a = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+    b = quat_from_yaw(np.linspace(0.0, 1.5 * np.pi, n))  # b spins on past half a turn
+    w = np.full(n, 0.5)
+    path = quat_slerp_path(a, b, w)
+    yaw_path = np.unwrap(2 * np.arctan2(path[:, 3], path[:, 0]))
+    np.testing.assert_allclose(yaw_path, 0.5 * np.linspace(0.0, 1.5 * np.pi, n), atol=1e-9)
+    framewise = quat_slerp(a, b, w)
+    yaw_fw = np.unwrap(2 * np.arctan2(framewise[:, 3], framewise[:, 0]))
+    assert np.max(np.abs(np.diff(yaw_fw))) > 1.0  # the short arc flips sides: a jump
+    # ends exactly on b, starts on a, and agrees with slerp for small turns
+    np.testing.assert_allclose(np.abs(np.sum(quat_slerp_path(a, b, np.ones(n)) * b, axis=1)), 1.0,
+                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(quat_slerp_path(a, b, np.zeros(n)), a, atol=1e-12)
+    small = quat_from_yaw(np.linspace(0.0, 1.0, n))
+    np.testing.assert_allclose(quat_slerp_path(a, small, w), quat_slerp(a, small, w), atol=1e-12)

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from reactmocap.errors import MotionError
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_slerp
+from reactmocap.rotations import quat_slerp_path
 
 __all__ = ["blend_poses", "final_blend", "smoothstep", "transition_weights"]
 
@@ -49,7 +49,7 @@ def _check_pair(a: Motion, b: Motion) -> None:
 def blend_poses(a: Motion, b: Motion, weights: ArrayLike, joint_weights: ArrayLike | None = None
                 ) -> Motion:  # fmt: skip
     """Frame-wise blend from ``a`` (weight 0) to ``b`` (weight 1): slerp of every local rotation
-    (root orientation included), lerp of root positions and local translations. With
+    (root orientation included; one arc per joint over the frames), lerp of root positions and local translations. With
     ``joint_weights`` ``(T, J)`` the rotations take those instead of the frame weights."""
     _check_pair(a, b)
     w = np.asarray(weights, dtype=np.float64).reshape(-1)
@@ -58,7 +58,7 @@ def blend_poses(a: Motion, b: Motion, weights: ArrayLike, joint_weights: ArrayLi
     wj = w[:, None] if joint_weights is None else np.asarray(joint_weights, dtype=np.float64)
     if joint_weights is not None and wj.shape != (a.num_frames, a.num_joints):
         raise MotionError(f"joint weights must be {(a.num_frames, a.num_joints)}, got {wj.shape}")
-    rot = quat_slerp(a.rotations, b.rotations, wj)
+    rot = quat_slerp_path(a.rotations, b.rotations, wj)  # no jump when a spin passes half a turn
     root = a.root_positions + w[:, None] * (b.root_positions - a.root_positions)
     tr = None
     if a.translations is not None or b.translations is not None:
