@@ -1,0 +1,257 @@
+"""Landing (thesis ch. 6), a passive landing: in the air a foot-placement servo adds an offset to
+the hips (eq. 6.1) that puts the feet where the horizontal velocity will be gone when the COM
+is over them (the desired place: a velocity-proportional lead plus the foot-servo delta,
+interpolated over the horizontal velocity as in Table 6.1), the knees bend ready and the ankles
+keep the feet flat. At touchdown the knees' stiffness goes to zero and their damping up; once
+they have slowed to 20% of their touchdown speed the stiffness comes back, and the balance
+controller takes over when the COM passes over the feet, stops near them or starts to move
+away."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from reactmocap.athletics.balance import (
+    BALANCE_GAINS,
+    BalanceLaw,
+    Posture,
+    hold_pelvis_and_feet,
+)
+from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
+from reactmocap.athletics.rig import joint_index, per_joint
+from reactmocap.errors import ConfigError
+from reactmocap.sim.bodies import BALL_JOINTS
+from reactmocap.sim.controllers.machine import State, after
+from reactmocap.sim.world import World
+
+__all__ = ["LANDING_STIFFNESS", "Landing", "LandingParams"]
+
+NJ = len(BALL_JOINTS)
+_HIP = [joint_index(f"{s}_hip") for s in "lr"]
+_KNEE = [joint_index(f"{s}_knee") for s in "lr"]
+_ANKLE = [joint_index(f"{s}_ankle") for s in "lr"]
+#: stiffness while reaching for the ground (units of m g L N m/rad)
+LANDING_STIFFNESS = {
+    "waist": 3.0, "back": 3.0, "neck": 0.3, "shoulder": 0.3, "elbow": 0.15, "wrist": 0.05,
+    "hip": 1.5, "knee": 0.3, "ankle": 0.3,
+}  # fmt: skip
+#: joint damping while absorbing (units of m L sqrt(g L) N m s/rad; knees: see LandingParams)
+ABSORB_DAMPING = {"waist": 0.1, "back": 0.1, "hip": 0.05, "ankle": 0.05}
+#: lowest hip-to-ankle length (fraction of the leg) the absorption plans to stop by
+DEEPEST_LEG = 0.55
+#: most ground force (body weights) the absorption asks for
+MAX_SUPPORT = 6.0
+#: least deceleration per unit of sink speed during the absorption (1/s)
+SINK_DAMPING = 6.0
+#: a foot within this height (m) of the floor after touchdown carries weight
+STANCE_REACH = 0.02
+
+
+@dataclass(frozen=True)
+class LandingParams:
+    """Landing parameters.
+
+    Args:
+        knee: knee flexion held in the air (rad).
+        kp, kv: foot-placement servo gains (rad/m, rad s/m) on the hips.
+        lead: seconds of horizontal velocity the feet are placed ahead of the COM.
+        delta: foot-servo delta (m) added to the desired foot place (from the table).
+        damping: knee damping after touchdown as a vertical damper on the hips (units of
+            m sqrt(g / L) N s/m; turned into the knee's damping through the leg's lever,
+            ``d(hip-ankle length) / d(knee angle)``, each tick).
+        restore: fraction of the touchdown knee speed below which the knee stiffness returns.
+        arms: shoulder pitch held in the air (rad).
+        lean: torso pitch per radian of knee flexion while absorbing (see ``Posture``).
+        toes: ankle plantar flexion held in the air (rad): the forefoot lands first and the
+            foot rolls flat under load, as people land (the thesis lands flat-footed).
+    """
+
+    knee: float = 0.35
+    kp: float = 1.5
+    kv: float = 0.15
+    lead: float = 0.25
+    delta: float = -0.04
+    damping: float = 5.0
+    restore: float = 0.2
+    arms: float = -0.6
+    toes: float = 0.0
+    lean: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("knee", "kp", "kv", "lead", "delta", "damping", "restore", "arms", "toes", "lean"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
+
+
+class Landing(Basis):
+    """The landing basis controller; hands over to balance once the landing has settled."""
+
+    name = "land"
+    initial = "reach"
+
+    def __init__(self, params: LandingParams | None = None) -> None:
+        self.params = params or LandingParams()
+
+    def states(self, ctx: Context) -> list[State]:
+        p = self.params
+        every = ctx.control_every
+        rig = ctx.rig
+        bl = BalanceLaw(ctx, BALANCE_GAINS)
+        memo: dict[str, float] = {}
+
+        def reach_enter(world: World, t: float) -> None:
+            del world
+            rig.set_stiffness(per_joint(LANDING_STIFFNESS))
+            rig.set_damping(per_joint({"knee": 0.1, "hip": 0.1, "ankle": 0.05}))
+            rig.support[:] = 0.0
+            goal = np.full((NJ, 3), np.nan)
+            for s in "lr":
+                goal[joint_index(f"{s}_knee")] = (p.knee, 0.0, 0.0)
+                goal[joint_index(f"{s}_shoulder")] = (p.arms, 0.0, 0.0)
+            for j in ("waist", "back", "neck"):
+                goal[joint_index(j)] = 0.0
+            moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
+            rig.move(goal, 0.2, t, moving)
+
+        def reach(world: World, t: float) -> None:
+            s = ctx.sense(t)
+            h = s.heading()
+            hold_pelvis_and_feet(ctx, world.data, 0.0, h, t)
+            feet = s.sole_corners().mean(axis=(0, 1))  # the middle of the soles
+            fvel = _feet_velocity(world, s.feet)
+            v = s.local(s.com_vel, h)
+            want = np.array([p.lead * v[0] + p.delta, p.lead * v[1]])
+            x = s.local(feet - s.com, h)
+            xd = s.local(fvel - s.com_vel, h)
+            off = p.kp * (want - x) - p.kv * xd
+            off = np.clip(off, -0.8, 0.8)
+            rig.offset[:] = 0.0
+            for k in range(2):
+                rig.offset[_HIP[k], 0] = -off[0]
+                rig.offset[_HIP[k], 1] = off[1]
+                rig.offset[_ANKLE[k], 0] = p.toes
+
+        def absorb_enter(world: World, t: float) -> None:
+            rig.move(rig.desired(t) + rig.offset, 0.0, t, _HIP)
+            rig.offset[:] = 0.0
+            stiff = rig.stiffness.copy()
+            stiff[_KNEE] = 0.0
+            stiff[[joint_index(f"{s}_ankle") for s in "lr"]] = BALANCE_GAINS.stiffness_array()[
+                [joint_index(f"{s}_ankle") for s in "lr"]
+            ]
+            rig.set_stiffness(stiff)
+            # light damping: a joint damper is rigid at impact speeds (its torque grows with
+            # the joint rate), and a rigid leg makes the contact spring the body back up
+            rig.set_damping(per_joint(ABSORB_DAMPING))
+            memo["knee_peak"] = _knee_speed(world, ctx)
+            bl.posture = Posture(leg=_leg_fraction(ctx), lean=p.lean, settle=0.0)
+
+        def absorb(world: World, t: float) -> None:
+            s = ctx.sense(t)
+            bl.control(world, t)  # feet flat, COM servo, pelvis leaning with the knees
+            _stance_support(ctx)
+            damp = rig.damping.copy()
+            damp[_KNEE] = p.damping * _knee_lever(ctx) ** 2 / rig.athlete.leg_length**2
+            rig.set_damping(damp)
+            # the constant deceleration that stops the fall before the deepest crouch, and at
+            # least a damping of the sink rate (so the body stops rather than creeps)
+            room = (_leg_fraction(ctx) - DEEPEST_LEG) * ctx.athlete.leg_length
+            vz = min(float(s.com_vel @ s.floor_normal), 0.0)
+            decel = max(vz * vz / (2.0 * max(room, 0.03)), SINK_DAMPING * -vz)
+            g = float(np.linalg.norm(world.model.opt.gravity))
+            rig.support_scale = float(np.clip(1.0 + decel / g, 1.0, MAX_SUPPORT))
+            memo["knee_peak"] = max(memo["knee_peak"], _knee_speed(world, ctx))
+
+        def slowed(world: World, t: float, t_in: float) -> bool:
+            return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
+
+        def recover_enter(world: World, t: float) -> None:
+            del world
+            rig.support_scale = 1.0
+            rig.move(rig.current_angles(), 0.0, t, _KNEE)  # the knees stiffen where they are
+            leg = _leg_fraction(ctx)
+            bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
+            bl.set_posture(Posture(leg=max(leg, 0.5), lean=p.lean, settle=0.3), t)
+
+        def settled(world: World, t: float, t_in: float) -> bool:
+            del world
+            s = ctx.sense(t)
+            h = s.heading()
+            err = s.local(bl.com_target - s.com, h)
+            vel = s.local(s.com_vel, h)
+            passed = float(err @ vel) < 0.0  # moving away from the desired COM
+            still = float(np.linalg.norm(vel)) < 0.05 and float(np.linalg.norm(err)) < 0.05
+            return t_in > 0.05 and (passed or still)
+
+        def done(world: World, t: float) -> None:
+            del world
+            ctx.handover["posture"] = bl.posture
+            del t
+
+        return [
+            State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),
+            State("absorb", law(absorb, every), absorb_enter,
+                  ((slowed, "recover"), (after(0.6), "recover"))),
+            State("recover", law(bl.control, every), recover_enter,
+                  ((settled, "done"), (after(1.0), "done"))),
+            State("done", law(bl.control, every), done, ((after(0.0), NEXT),)),
+        ]  # fmt: skip
+
+
+def _stance_support(ctx: Context) -> None:
+    """Weight shares after touchdown: every foot whose sole is within :data:`STANCE_REACH`
+    of the floor (a landing foot bounces off its contacts for a moment now and then), split
+    by where the COM lies between the feet."""
+    s = ctx.senses
+    rel = s.sole_corners() - ctx.world.data.geom_xpos[s.floor]
+    near = (rel @ s.floor_normal).min(axis=1) < STANCE_REACH
+    rig = ctx.rig
+    rig.support[:] = 0.0
+    if not near.any():
+        return
+    if near.all():
+        pts = s.sole_corners().mean(axis=1)
+        a, b = pts[0, :2], pts[1, :2]
+        ab = b - a
+        w = float(np.clip(np.dot(s.com[:2] - a, ab) / max(float(ab @ ab), 1e-9), 0.0, 1.0))
+        rig.support[:] = (1.0 - w, w)
+    else:
+        rig.support[np.flatnonzero(near)[0]] = 1.0
+
+
+def _knee_lever(ctx: Context) -> float:
+    """Mean ``d(hip-ankle distance) / d(knee angle)`` of the legs (m/rad), law of cosines."""
+    a = ctx.athlete
+    knee = ctx.rig.current_angles()[_KNEE, 0]
+    ul, ll = a.thigh, a.shin
+    length = np.sqrt(ul**2 + ll**2 + 2 * ul * ll * np.cos(knee))
+    return float(np.mean(ul * ll * np.abs(np.sin(knee)) / length))
+
+
+def _knee_speed(world: World, ctx: Context) -> float:
+    wc = ctx.rig.wc
+    d = world.data
+    w = [d.qvel[wc.ball_dof_start + 3 * j : wc.ball_dof_start + 3 * j + 3] for j in _KNEE]
+    return float(max(np.linalg.norm(x) for x in w))
+
+
+def _feet_velocity(world: World, feet: np.ndarray) -> np.ndarray:
+    """Mean world velocity of the feet's centres of mass (``mj_subtreeVel`` has run)."""
+    return world.data.subtree_linvel[feet].mean(axis=0)
+
+
+def _leg_fraction(ctx: Context) -> float:
+    """Current mean hip-to-ankle distance as a fraction of the straight leg."""
+    d = ctx.world.data
+    wc = ctx.rig.wc
+    m = ctx.world.model
+    out = []
+    for s in "lr":
+        hip = d.xanchor[m.joint(wc.prefix + f"{s}_hip").id]
+        ankle = d.xanchor[m.joint(wc.prefix + f"{s}_ankle").id]
+        out.append(float(np.linalg.norm(hip - ankle)))
+    return float(np.clip(np.mean(out) / ctx.athlete.leg_length, 0.3, 1.0))

@@ -1,0 +1,170 @@
+"""The athletic state-machine base over the engine's :class:`~reactmocap.sim.controllers.
+StateMachine`: a shared context per run (the athlete's rig and senses, a per-tick log), exit
+events for athletes (touchdown, lift-off, apex, time, joint angle), and basis controllers as
+groups of states that hand over to the next one (:data:`NEXT`)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.athletics.bodies import Athlete
+from reactmocap.athletics.rig import Rig, joint_index
+from reactmocap.athletics.senses import Senses
+from reactmocap.errors import ConfigError
+from reactmocap.sim.controllers.machine import Event, State, after
+from reactmocap.sim.world import World
+
+__all__ = [
+    "NEXT",
+    "Basis",
+    "Context",
+    "Log",
+    "after",
+    "angle",
+    "apex",
+    "liftoff",
+    "touchdown",
+]
+
+F64 = NDArray[np.float64]
+#: an exit target meaning "hand over to the next basis controller of the sequence"
+NEXT = "<next>"
+
+
+@dataclass
+class Log:
+    """What every control tick saw: time, COM, COM velocity, ground reaction force, the feet
+    in contact, the state, and the servo torques and joint velocities (for the strength
+    check); turned into arrays by :meth:`arrays`."""
+
+    rows: list[tuple[float, F64, F64, F64, int, str]] = field(default_factory=list)
+    torques: list[F64] = field(default_factory=list)
+    powers: list[F64] = field(default_factory=list)
+
+    def arrays(self) -> dict[str, NDArray]:
+        if not self.rows:
+            z = np.zeros(0)
+            return {"t": z, "com": np.zeros((0, 3)), "com_vel": np.zeros((0, 3)),
+                    "grf": np.zeros((0, 3)), "feet": z.astype(int), "state": np.array([])}  # fmt: skip
+        t, com, vel, grf, feet, state = zip(*self.rows)
+        return {
+            "t": np.array(t), "com": np.array(com), "com_vel": np.array(vel),
+            "grf": np.array(grf), "feet": np.array(feet), "state": np.array(state),
+            "torque": np.array(self.torques), "power": np.array(self.powers),
+        }  # fmt: skip
+
+
+@dataclass(eq=False)
+class Context:
+    """One athlete in one world, shared by the basis controllers of a run."""
+
+    world: World
+    athlete: Athlete
+    character: int
+    rig: Rig
+    senses: Senses
+    #: physics steps between control ticks
+    control_every: int = 4
+    log: Log = field(default_factory=Log)
+    #: times of the latest lift-off and touchdown (None until they happen)
+    liftoff_time: float | None = None
+    touchdown_time: float | None = None
+    #: the standing COM height (m above the support), measured before any leap
+    standing_com: float | None = None
+    #: anything a basis controller hands to the next (e.g. the landing's balance posture)
+    handover: dict[str, object] = field(default_factory=dict)
+
+    @classmethod
+    def make(
+        cls, world: World, athlete: Athlete, character: int = 0, control_every: int = 4
+    ) -> Context:
+        if not (isinstance(control_every, int) and control_every >= 1):
+            raise ConfigError(f"control_every must be an int >= 1, got {control_every!r}")
+        return cls(world, athlete, character, Rig(world, athlete, character),
+                   Senses(world, athlete, character), control_every)  # fmt: skip
+
+    def sense(self, t: float) -> Senses:
+        self.senses.update(t)
+        return self.senses
+
+
+# ---------------------------------------------------------------------------------- events
+def touchdown(ctx: Context, both: bool = False) -> Event:
+    """Fires when a foot (``both``: both feet) touches the floor; records the time."""
+
+    def event(_w: World, t: float, _t_in: float) -> bool:
+        s = ctx.sense(t)
+        hit = bool(s.foot_contact.all() if both else s.foot_contact.any()) or bool(s.other_contact)
+        if hit:
+            ctx.touchdown_time = t
+        return hit
+
+    return event
+
+
+def liftoff(ctx: Context) -> Event:
+    """Fires when nothing of the athlete touches the floor; records the time."""
+
+    def event(_w: World, t: float, _t_in: float) -> bool:
+        s = ctx.sense(t)
+        if s.airborne:
+            ctx.liftoff_time = t
+            return True
+        return False
+
+    return event
+
+
+def apex(ctx: Context) -> Event:
+    """Fires when the centre of mass stops rising (vertical velocity <= 0)."""
+    return lambda _w, t, _t_in: bool(ctx.sense(t).com_vel[2] <= 0.0)
+
+
+def angle(ctx: Context, joint: str, axis: int, threshold: float, above: bool = True) -> Event:
+    """Fires when the anatomical angle of ``joint`` about ``axis`` (0 pitch, 1 roll, 2 yaw)
+    goes above (or below) ``threshold`` radians."""
+    j = joint_index(joint)
+    if axis not in (0, 1, 2):
+        raise ConfigError(f"angle axis must be 0 (pitch), 1 (roll) or 2 (yaw), got {axis!r}")
+
+    def event(_w: World, _t: float, _t_in: float) -> bool:
+        a = float(ctx.rig.current_angles()[j, axis])
+        return a > threshold if above else a < threshold
+
+    return event
+
+
+def timeout(seconds: float) -> Event:
+    """Fires once the state has lasted ``seconds`` (the engine's ``after``)."""
+    return after(seconds)
+
+
+# ---------------------------------------------------------------------------------- basis
+class Basis:
+    """A basis controller: a named group of states on a shared :class:`Context`. States exit to
+    each other by their local names, or to :data:`NEXT` to hand over to the next basis
+    controller of a sequence (the rig's targets carry on from where they are)."""
+
+    name: str = "basis"
+    initial: str = ""
+
+    def states(self, ctx: Context) -> list[State]:
+        raise NotImplementedError
+
+
+def law(fn: Callable[[World, float], None], control_every: int) -> object:
+    """A state's per-tick law from a function (a FunctionController)."""
+    from reactmocap.sim.controllers.base import FunctionController
+
+    return FunctionController(fn, control_every)
+
+
+def hold(ctx: Context) -> None:
+    """Entry action: keep every target where it is now (stops any transition)."""
+    rig = ctx.rig
+    t = ctx.senses.time
+    rig.move(rig.desired(t), 0.0, t)
