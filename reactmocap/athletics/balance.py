@@ -86,7 +86,7 @@ class Posture:
     com_offset: tuple[float, float] = (0.0, 0.0)
     arms: float = 0.0
     settle: float = 0.5
-    lean: float = 0.0
+    lean: float = 0.5
 
     def __post_init__(self) -> None:
         for name in ("pitch", "leg", "arms", "settle", "lean"):
@@ -160,8 +160,21 @@ class BalanceLaw:
             goal[joint_index(f"{s}_wrist")] = 0.0
         moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
         rig.move(goal, posture.settle, t, moving)
-        self._pitch0 = self._pitch_now(t)
+        # the commanded pitch starts from where the pelvis is (less the new posture's lean)
+        self._pitch0 = self.pelvis_pitch() - self._lean()
         self._t_pitch = t
+
+    def pelvis_pitch(self) -> float:
+        """Current anatomical pitch of the pelvis (rad, forward > 0)."""
+        d = self.ctx.world.data
+        q = quat_mul(d.xquat[self.ctx.senses.root], quat_conj(self.athlete.neutral[0]))
+        return float(quat_to_euler(q, EULER_ORDER)[0])
+
+    def _lean(self) -> float:
+        if not self.posture.lean:
+            return 0.0
+        knee = float(np.mean(self.ctx.rig.current_angles()[_KNEE, 0]))
+        return self.posture.lean * max(0.0, knee - self._knee_standing)
 
     def _pitch_now(self, t: float) -> float:
         if not hasattr(self, "_t_pitch"):
@@ -187,10 +200,7 @@ class BalanceLaw:
         err = s.local(target - s.com, h)
         vel = s.local(s.com_vel, h)
         delta = np.clip(g.kp * err - g.kv * vel, -g.max_offset, g.max_offset)
-        pitch = self._pitch_now(t)
-        if self.posture.lean:
-            knee = float(np.mean(rig.current_angles()[_KNEE, 0]))
-            pitch += self.posture.lean * max(0.0, knee - self._knee_standing)
+        pitch = self._pitch_now(t) + self._lean()
         hold_pelvis_and_feet(ctx, d, pitch, h, t)
         rig.offset[:] = 0.0
         for k in range(2):

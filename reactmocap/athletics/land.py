@@ -19,6 +19,7 @@ from reactmocap.athletics.balance import (
     BalanceLaw,
     Posture,
     hold_pelvis_and_feet,
+    knee_for_length,
 )
 from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
 from reactmocap.athletics.rig import joint_index, per_joint
@@ -44,8 +45,9 @@ ABSORB_DAMPING = {"waist": 0.1, "back": 0.1, "hip": 0.05, "ankle": 0.05}
 DEEPEST_LEG = 0.55
 #: most ground force (body weights) the absorption asks for
 MAX_SUPPORT = 6.0
-#: least deceleration per unit of sink speed during the absorption (1/s)
-SINK_DAMPING = 6.0
+#: fraction of the crouch left at touchdown that the planned stop uses
+PLAN_ROOM = 0.7
+
 #: a foot within this height (m) of the floor after touchdown carries weight
 STANCE_REACH = 0.02
 
@@ -57,31 +59,37 @@ class LandingParams:
     Args:
         knee: knee flexion held in the air (rad).
         kp, kv: foot-placement servo gains (rad/m, rad s/m) on the hips.
-        lead: seconds of horizontal velocity the feet are placed ahead of the COM.
+        lead: how far ahead of the COM the feet go, in units of the capture point's lead
+            (the horizontal velocity times ``sqrt(z / g)``).
         delta: foot-servo delta (m) added to the desired foot place (from the table).
         damping: knee damping after touchdown as a vertical damper on the hips (units of
             m sqrt(g / L) N s/m; turned into the knee's damping through the leg's lever,
             ``d(hip-ankle length) / d(knee angle)``, each tick).
         restore: fraction of the touchdown knee speed below which the knee stiffness returns.
         arms: shoulder pitch held in the air (rad).
+        knee_stiffness: knee stiffness while absorbing (units of m g L N m/rad); 0 is the
+            thesis's knee with its stiffness off; more makes the knees follow the planned
+            crouch.
         lean: torso pitch per radian of knee flexion while absorbing (see ``Posture``).
         toes: ankle plantar flexion held in the air (rad): the forefoot lands first and the
             foot rolls flat under load, as people land (the thesis lands flat-footed).
     """
 
-    knee: float = 0.35
+    knee: float = 0.6
     kp: float = 1.5
     kv: float = 0.15
-    lead: float = 0.25
+    lead: float = 1.0
     delta: float = -0.04
     damping: float = 5.0
     restore: float = 0.2
     arms: float = -0.6
     toes: float = 0.0
-    lean: float = 1.0
+    lean: float = 0.5
+    knee_stiffness: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("knee", "kp", "kv", "lead", "delta", "damping", "restore", "arms", "toes", "lean"):
+        for name in ("knee", "kp", "kv", "lead", "delta", "damping", "restore", "arms", "toes", "lean",
+                     "knee_stiffness"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
@@ -102,6 +110,10 @@ class Landing(Basis):
         rig = ctx.rig
         bl = BalanceLaw(ctx, BALANCE_GAINS)
         memo: dict[str, float] = {}
+        m = ctx.world.model
+        pre = rig.wc.prefix
+        _HIP_JOINTS = [m.joint(f"{pre}{s}_hip").id for s in "lr"]  # noqa: N806
+        _ANKLE_JOINTS = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]  # noqa: N806
 
         def reach_enter(world: World, t: float) -> None:
             del world
@@ -120,29 +132,44 @@ class Landing(Basis):
         def reach(world: World, t: float) -> None:
             s = ctx.sense(t)
             h = s.heading()
-            hold_pelvis_and_feet(ctx, world.data, 0.0, h, t)
+            d = world.data
+            hold_pelvis_and_feet(ctx, d, 0.0, h, t)  # ankles: feet flat (hips reset below)
             feet = s.sole_corners().mean(axis=(0, 1))  # the middle of the soles
             fvel = _feet_velocity(world, s.feet)
             v = s.local(s.com_vel, h)
-            want = np.array([p.lead * v[0] + p.delta, p.lead * v[1]])
+            # capture point: where the feet stop a pendulum of the COM's height (lead: its
+            # time constant sqrt(z / g)), plus the foot-servo delta
+            g = float(np.linalg.norm(world.model.opt.gravity))
+            lead = p.lead * math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
+            want = np.array([lead * v[0] + p.delta, lead * v[1]])
+            # eq. 6.1 as a correction on top of the geometric placement below
             x = s.local(feet - s.com, h)
             xd = s.local(fvel - s.com_vel, h)
-            off = p.kp * (want - x) - p.kv * xd
-            off = np.clip(off, -0.8, 0.8)
+            servo = np.clip(p.kp * (want - x) - p.kv * xd, -0.3, 0.3)
+            # each leg aimed in the world at its foot's place, whatever the pelvis's pitch
+            # (it turns freely in the air with the body's angular momentum)
+            pelvis = bl.pelvis_pitch()
+            goal = np.full((NJ, 3), np.nan)
+            for k in range(2):
+                hip = d.xanchor[_HIP_JOINTS[k]]
+                length = float(np.linalg.norm(hip - d.xanchor[_ANKLE_JOINTS[k]]))
+                ahead = float(s.local(s.com - hip, h)[0]) + want[0]
+                swing = math.asin(float(np.clip(ahead / max(length, 0.2), -0.9, 0.9)))
+                geom = float(knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k],
+                                             length)[1])  # fmt: skip
+                goal[_HIP[k]] = (-swing + geom - servo[0] - pelvis, servo[1], 0.0)
+            rig.move(goal, 0.0, t, _HIP)
             rig.offset[:] = 0.0
             for k in range(2):
-                rig.offset[_HIP[k], 0] = -off[0]
-                rig.offset[_HIP[k], 1] = off[1]
                 rig.offset[_ANKLE[k], 0] = p.toes
 
         def absorb_enter(world: World, t: float) -> None:
             rig.move(rig.desired(t) + rig.offset, 0.0, t, _HIP)
             rig.offset[:] = 0.0
             stiff = rig.stiffness.copy()
-            stiff[_KNEE] = 0.0
-            stiff[[joint_index(f"{s}_ankle") for s in "lr"]] = BALANCE_GAINS.stiffness_array()[
-                [joint_index(f"{s}_ankle") for s in "lr"]
-            ]
+            stiff[_KNEE] = p.knee_stiffness
+            stiff[_ANKLE] = BALANCE_GAINS.stiffness_array()[_ANKLE]
+            stiff[_HIP] = BALANCE_GAINS.stiffness_array()[_HIP]
             rig.set_stiffness(stiff)
             # light damping: a joint damper is rigid at impact speeds (its torque grows with
             # the joint rate), and a rigid leg makes the contact spring the body back up
@@ -157,16 +184,29 @@ class Landing(Basis):
             damp = rig.damping.copy()
             damp[_KNEE] = p.damping * _knee_lever(ctx) ** 2 / rig.athlete.leg_length**2
             rig.set_damping(damp)
-            # the constant deceleration that stops the fall before the deepest crouch, and at
-            # least a damping of the sink rate (so the body stops rather than creeps)
-            room = (_leg_fraction(ctx) - DEEPEST_LEG) * ctx.athlete.leg_length
-            vz = min(float(s.com_vel @ s.floor_normal), 0.0)
-            decel = max(vz * vz / (2.0 * max(room, 0.03)), SINK_DAMPING * -vz)
+            # the constant deceleration that stops the sink within the crouch left, planned
+            # afresh each tick (an impact may already have taken most of the speed), as a
+            # vertical ground force the stance legs make; never less than the body's weight
+            room = max((_leg_fraction(ctx) - DEEPEST_LEG) * ctx.athlete.leg_length, 0.03)
+            v = min(float(s.com_vel @ s.floor_normal), 0.0)
             g = float(np.linalg.norm(world.model.opt.gravity))
+            decel = v * v / (2.0 * PLAN_ROOM * room)
             rig.support_scale = float(np.clip(1.0 + decel / g, 1.0, MAX_SUPPORT))
+            z_d = float(s.com @ s.floor_normal) + v * ctx.control_every * world.timestep
+            z = float(s.com @ s.floor_normal)
+            if p.knee_stiffness > 0:  # the knees' targets follow the planned height
+                goal = np.full((NJ, 3), np.nan)
+                hips = _hip_heights(ctx)
+                for k in range(2):
+                    length = float(np.clip(hips[k] + z_d - z, 0.3 * ctx.athlete.leg_length,
+                                           ctx.athlete.leg_length))  # fmt: skip
+                    knee = knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k], length)
+                    goal[_KNEE[k]] = (float(knee[0]), 0.0, 0.0)
+                rig.move(goal, 0.0, t, _KNEE)
             memo["knee_peak"] = max(memo["knee_peak"], _knee_speed(world, ctx))
 
         def slowed(world: World, t: float, t_in: float) -> bool:
+            """The knees have slowed to ``restore`` of their peak speed."""
             return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
 
         def recover_enter(world: World, t: float) -> None:
@@ -195,7 +235,7 @@ class Landing(Basis):
         return [
             State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),
             State("absorb", law(absorb, every), absorb_enter,
-                  ((slowed, "recover"), (after(0.6), "recover"))),
+                  ((slowed, "recover"), (after(1.0), "recover"))),
             State("recover", law(bl.control, every), recover_enter,
                   ((settled, "done"), (after(1.0), "done"))),
             State("done", law(bl.control, every), done, ((after(0.0), NEXT),)),
@@ -221,6 +261,18 @@ def _stance_support(ctx: Context) -> None:
         rig.support[:] = (1.0 - w, w)
     else:
         rig.support[np.flatnonzero(near)[0]] = 1.0
+
+
+def _hip_heights(ctx: Context) -> np.ndarray:
+    """``(2,)`` current hip-to-ankle distance of each leg (m)."""
+    d = ctx.world.data
+    wc = ctx.rig.wc
+    m = ctx.world.model
+    return np.array([
+        float(np.linalg.norm(d.xanchor[m.joint(wc.prefix + f"{s}_hip").id]
+                             - d.xanchor[m.joint(wc.prefix + f"{s}_ankle").id]))
+        for s in "lr"
+    ])  # fmt: skip
 
 
 def _knee_lever(ctx: Context) -> float:

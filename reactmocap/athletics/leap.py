@@ -31,6 +31,12 @@ VERTICAL_TIMING = (0.10, 0.15, 0.22)
 BROAD_TIMING = (0.15, 0.20, 0.45)
 #: seconds after which a push that never left the ground hands over anyway
 THRUST_TIMEOUT = 1.0
+#: seconds over which the angular-momentum feedback comes in at the start of the push
+SPIN_RAMP = 0.05
+#: fraction of the friction cone the push may use
+FRICTION_USE = 0.8
+#: most ground force (body weights) the push asks for
+MAX_THRUST = 6.0
 #: joint stiffness during the push-off (units of m g L N m/rad), before the ankle multiplier
 LEAP_STIFFNESS = {
     "waist": 3.0, "back": 3.0, "neck": 0.3, "shoulder": 0.6, "elbow": 0.15, "wrist": 0.05,
@@ -59,16 +65,27 @@ class LeapParams:
     ankle_extension: float = 0.7
     liftoff_hip: float = 0.0
     broad: bool = False
+    speed: float = 0.0
+    angle: float = math.pi / 2
+    rise: float = 0.06
+    stiffness: float = 1.0
+    lean: float = 0.0
+    spin: float = 0.0
+    spin_gain: float = 0.0
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
-                self.hold, *self.timing, self.ankle_gain, self.ankle_extension, self.liftoff_hip]  # fmt: skip
+                self.hold, *self.timing, self.ankle_gain, self.ankle_extension, self.liftoff_hip,
+                self.speed, self.angle, self.rise, self.stiffness, self.lean,
+                self.spin, self.spin_gain]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.3 <= self.leg <= 1.0:
             raise ConfigError(f"leap crouch leg fraction must be in [0.3, 1.0], got {self.leg}")
         if min(self.timing) <= 0 or self.crouch <= 0 or self.hold < 0 or self.ankle_gain <= 0:
             raise ConfigError("leap timing, crouch and ankle gain must be > 0")
+        if self.speed < 0 or not 0.0 < self.angle <= math.pi / 2:
+            raise ConfigError("leap speed must be >= 0 and angle in (0, pi/2]")
 
 
 class Leap(Basis):
@@ -84,17 +101,23 @@ class Leap(Basis):
         p = self.params
         bl = BalanceLaw(ctx, BALANCE_GAINS)
         every = ctx.control_every
+        memo: dict[str, float] = {}
 
         def crouch(world: World, t: float) -> None:
             del world
+            s = ctx.sense(t)
+            memo["z_stand"] = float(s.com[2])
+            if ctx.standing_com is None:
+                ctx.standing_com = float(s.com[2])
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
-                        arms=p.arms_back, settle=p.crouch), t)  # fmt: skip
+                        arms=p.arms_back, settle=p.crouch, lean=p.lean), t)  # fmt: skip
 
         def thrust(world: World, t: float) -> None:
             del world
+            memo["t_thrust"] = t
             rig = ctx.rig
-            stiff = per_joint(LEAP_STIFFNESS)
+            stiff = per_joint(LEAP_STIFFNESS) * p.stiffness
             stiff[[joint_index(f"{s}_ankle") for s in "lr"]] *= p.ankle_gain
             rig.set_stiffness(stiff)
             rig.move(rig.desired(t) + rig.offset, 0.0, t)
@@ -118,14 +141,52 @@ class Leap(Basis):
             rig.move(goal, dur, t, moving)
 
         def push(world: World, t: float) -> None:
-            del world
             s = ctx.sense(t)
             bl._support(s)
+            if p.spin_gain > 0:
+                # whole-body angular momentum about the COM (mj_subtreeVel has run), pitch
+                # axis of the heading frame: the hips tilt the push ahead of or behind the COM
+                h = s.heading()
+                axis = np.array([-math.sin(h), math.cos(h), 0.0])
+                pitch_l = float(world.data.subtree_angmom[s.root] @ axis)
+                err = (pitch_l - p.spin) / (ctx.athlete.mass * ctx.athlete.leg_length**2)
+                ramp = min(1.0, (t - memo["t_thrust"]) / SPIN_RAMP)
+                off = float(np.clip(ramp * p.spin_gain * err, -0.6, 0.6))
+                for j in (joint_index("l_hip"), joint_index("r_hip")):
+                    ctx.rig.offset[j, 0] = off
+            if p.speed <= 0:
+                return
+            # the ground force that brings the COM velocity to the take-off velocity by the
+            # time the COM reaches its take-off height (constant acceleration), realised by the
+            # stance legs through their Jacobians
+            rig = ctx.rig
+            g = float(np.linalg.norm(world.model.opt.gravity))
+            up = s.floor_normal if s.floor_normal[2] > 0.99 else np.array([0.0, 0.0, 1.0])
+            h = s.heading()
+            fwd = np.array([math.cos(h), math.sin(h), 0.0])
+            target = p.speed * (math.cos(p.angle) * fwd + math.sin(p.angle) * up)
+            z_to = memo["z_stand"] + p.rise
+            z, vz = float(s.com @ up), float(s.com_vel @ up)
+            left = max(z_to - z, 0.02)
+            time_left = 2.0 * left / max(vz + target @ up, 0.2)
+            acc = (target - s.com_vel) / time_left
+            force = acc + g * up
+            fz = float(force @ up)
+            horiz = force - fz * up
+            lim = FRICTION_USE * world.config.friction * max(fz, 0.0)
+            if np.linalg.norm(horiz) > lim:
+                horiz *= lim / np.linalg.norm(horiz)
+            force = horiz + max(fz, 0.0) * up
+            size = float(np.linalg.norm(force))
+            rig.support_scale = float(np.clip(size / g, 0.0, MAX_THRUST))
+            rig.support_dir = force / max(size, 1e-9)
 
         def flight(world: World, t: float) -> None:
             del world
             ctx.rig.set_stiffness(per_joint(FLIGHT_STIFFNESS))
             ctx.rig.support[:] = 0.0
+            ctx.rig.support_scale = 1.0
+            ctx.rig.support_dir = None
 
         flight_exit: Event = apex(ctx) if not p.broad else after(0.0)
         return [

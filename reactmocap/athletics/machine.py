@@ -106,13 +106,23 @@ def touchdown(ctx: Context, both: bool = False) -> Event:
     return event
 
 
-def liftoff(ctx: Context) -> Event:
-    """Fires when nothing of the athlete touches the floor; records the time."""
+def liftoff(ctx: Context, ticks: int = 2, rising: float = 0.1) -> Event:
+    """Fires when nothing of the athlete has touched the floor for ``ticks`` control ticks in
+    a row while the COM rises faster than ``rising`` m/s (a jolt that lifts the feet for a
+    moment is not a take-off); records the time the feet left."""
+    seen = {"count": 0, "since": 0.0}
 
     def event(_w: World, t: float, _t_in: float) -> bool:
         s = ctx.sense(t)
-        if s.airborne:
-            ctx.liftoff_time = t
+        if s.airborne and float(s.com_vel @ s.floor_normal) > rising:
+            if seen["count"] == 0:
+                seen["since"] = t
+            seen["count"] += 1
+        else:
+            seen["count"] = 0
+        if seen["count"] >= ticks:
+            ctx.liftoff_time = seen["since"]
+            seen["count"] = 0
             return True
         return False
 

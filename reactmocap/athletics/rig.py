@@ -120,6 +120,8 @@ class Rig:
         #: the vertical ground force the supporting legs make, in body weights (1: hold the body
         #: up; more: decelerate a fall)
         self.support_scale = 1.0
+        #: direction (world, unit) of that ground force; None: against gravity
+        self.support_dir: F64 | None = None
         self._ankles = [self._balls[joint_index(f"{s}_ankle")] for s in "lr"]
         self.gravity_compensation = True
 
@@ -137,6 +139,7 @@ class Rig:
         self.offset[:] = 0.0
         self.support[:] = 0.0
         self.support_scale = 1.0
+        self.support_dir = None
 
     def release(self) -> None:
         """Give the model its joint damping back (call when the rig's rollout ends)."""
@@ -227,7 +230,8 @@ class Rig:
         self._ff[:] = np.einsum("nji,nj->ni", rot, tau)
         flat = self._ff.reshape(-1)
         for k in np.flatnonzero(self.support > 0):
-            force = self.support[k] * self.support_scale * self._weight_n * self._up
+            up = self._up if self.support_dir is None else self.support_dir
+            force = self.support[k] * self.support_scale * self._weight_n * up
             mujoco.mj_jac(m, d, self._jacp, None, d.xanchor[self._ankles[k]], self._feet[k])
             cols = self._leg_cols[k]
             flat[cols - self.wc.ball_dof_start] -= self._jacp[:, cols].T @ force
