@@ -18,6 +18,7 @@ import numpy as np
 from reactmocap.athletics.balance import BALANCE_GAINS, BalanceLaw, Posture
 from reactmocap.athletics.machine import NEXT, Basis, Context, apex, law, liftoff
 from reactmocap.athletics.rig import joint_index, per_joint
+from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
 from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import Event, State, after
@@ -88,6 +89,14 @@ class LeapParams:
             raise ConfigError("leap speed must be >= 0 and angle in (0, pi/2]")
 
 
+def pitch_momentum(world: World, s: Senses) -> float:
+    """Whole-body angular momentum about the COM (kg m^2/s) about the heading frame's pitch
+    axis (+Y turned by the heading; > 0 pitches forward). ``mj_subtreeVel`` has run."""
+    h = s.heading()
+    axis = np.array([-math.sin(h), math.cos(h), 0.0])
+    return float(world.data.subtree_angmom[s.root] @ axis)
+
+
 class Leap(Basis):
     """The leaping basis controller (vertical or broad, by ``params.broad``)."""
 
@@ -146,9 +155,7 @@ class Leap(Basis):
             if p.spin_gain > 0:
                 # whole-body angular momentum about the COM (mj_subtreeVel has run), pitch
                 # axis of the heading frame: the hips tilt the push ahead of or behind the COM
-                h = s.heading()
-                axis = np.array([-math.sin(h), math.cos(h), 0.0])
-                pitch_l = float(world.data.subtree_angmom[s.root] @ axis)
+                pitch_l = pitch_momentum(world, s)
                 err = (pitch_l - p.spin) / (ctx.athlete.mass * ctx.athlete.leg_length**2)
                 ramp = min(1.0, (t - memo["t_thrust"]) / SPIN_RAMP)
                 off = float(np.clip(ramp * p.spin_gain * err, -0.6, 0.6))
@@ -182,7 +189,8 @@ class Leap(Basis):
             rig.support_dir = force / max(size, 1e-9)
 
         def flight(world: World, t: float) -> None:
-            del world
+            s = ctx.sense(t)
+            ctx.handover["liftoff_pitch_momentum"] = pitch_momentum(world, s)
             ctx.rig.set_stiffness(per_joint(FLIGHT_STIFFNESS))
             ctx.rig.support[:] = 0.0
             ctx.rig.support_scale = 1.0

@@ -44,17 +44,26 @@ class Log:
     rows: list[tuple[float, F64, F64, F64, int, str]] = field(default_factory=list)
     torques: list[F64] = field(default_factory=list)
     powers: list[F64] = field(default_factory=list)
+    #: per tick: whether anything but the feet touched the floor, and the pelvis height
+    others: list[bool] = field(default_factory=list)
+    pelvis: list[float] = field(default_factory=list)
+    #: per tick: horizontal distance (m) of the COM from the support centre
+    offsets: list[float] = field(default_factory=list)
 
     def arrays(self) -> dict[str, NDArray]:
         if not self.rows:
             z = np.zeros(0)
             return {"t": z, "com": np.zeros((0, 3)), "com_vel": np.zeros((0, 3)),
-                    "grf": np.zeros((0, 3)), "feet": z.astype(int), "state": np.array([])}  # fmt: skip
+                    "grf": np.zeros((0, 3)), "feet": z.astype(int), "state": np.array([]),
+                    "torque": np.zeros((0, 15)), "power": np.zeros((0, 15)),
+                    "others": z.astype(bool), "pelvis": z, "offset": z}  # fmt: skip
         t, com, vel, grf, feet, state = zip(*self.rows)
         return {
             "t": np.array(t), "com": np.array(com), "com_vel": np.array(vel),
             "grf": np.array(grf), "feet": np.array(feet), "state": np.array(state),
             "torque": np.array(self.torques), "power": np.array(self.powers),
+            "others": np.array(self.others), "pelvis": np.array(self.pelvis),
+            "offset": np.array(self.offsets),
         }  # fmt: skip
 
 

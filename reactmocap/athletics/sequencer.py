@@ -76,3 +76,7 @@ class Sequencer:
                              int(s.foot_contact.sum()), self.machine.current.name))  # fmt: skip
         ctx.log.torques.append(np.linalg.norm(tau, axis=1))
         ctx.log.powers.append(np.einsum("ij,ij->i", tau, w))
+        ctx.log.others.append(bool(s.other_contact))
+        centre = s.support_center()
+        ctx.log.offsets.append(float(np.hypot(*(s.com[:2] - centre[:2]))))
+        ctx.log.pelvis.append(float(d.xpos[s.root][2]))
