@@ -112,7 +112,7 @@ class BalanceGains:
         ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
     )  # fmt: skip
     damping: tuple[tuple[str, float], ...] = (
-        ("waist", 0.3), ("back", 0.3), ("hip", 0.6), ("knee", 0.6), ("ankle", 0.8),
+        ("waist", 0.1), ("back", 0.1), ("hip", 0.15), ("knee", 0.15), ("ankle", 0.2),
     )  # fmt: skip
 
     def stiffness_array(self) -> F64:

@@ -38,6 +38,8 @@ __all__ = ["BEHAVIOURS", "AthleticsResult", "Behaviour", "Param", "run"]
 LANDED_AFTER = 2.0
 #: seconds of quiet standing before a leap
 LEAD_IN = 0.3
+#: the highest COM rise a run's length allows for when the height is not known beforehand
+MAX_APEX = 1.3
 #: physics steps per control tick (4 ms)
 CONTROL_EVERY = 8
 
@@ -111,9 +113,10 @@ def _simulate(
 ) -> tuple[Context, Sequencer, RolloutResult]:  # fmt: skip
     ctx = Context.make(world, ath, control_every=CONTROL_EVERY)
     seq = Sequencer(ctx, bases)
+    tick = None if on_tick is None else (lambda t: on_tick(min(t / duration, 1.0)))
     try:
         res = rollout(world, duration, controllers=[seq, *extra], impacts=impacts,
-                      record_fps=fps, on_unstable="stop", on_tick=on_tick)  # fmt: skip
+                      record_fps=fps, on_unstable="stop", on_tick=tick, tick_every=200)  # fmt: skip
     finally:
         ctx.rig.release()
     del behaviour
@@ -194,7 +197,8 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
         params = replace(params, spin=float(p["spin"]))
     world = athletics_world(ath, backpack=float(p.get("backpack") or 0.0))
     bases = [Balance(Posture(), seconds=LEAD_IN), Leap(params), Landing(), Balance()]
-    reach = target if not broad else 0.6
+    # the run lasts until well after touchdown: the flight time of the expected height
+    reach = target if table and p.get("effort") is None and not broad else MAX_APEX
     ctx, seq, res = _simulate(ath, world, bases, _leap_duration(reach, params),
                               behaviour="leap", on_tick=on_tick, fps=p["fps"])  # fmt: skip
     log = ctx.log.arrays()
@@ -416,7 +420,8 @@ def run(
 ) -> AthleticsResult:
     """Run behaviour ``name`` on ``body`` (``"male"``, ``"female"``, a BVH path or a Motion)
     with SI parameters (radians for angles), e.g. ``run("leap", body="male", height=0.6)``.
-    ``check_range=False`` runs outside the measured supported range (and reports honestly)."""
+    ``check_range=False`` runs outside the measured supported range (and reports honestly);
+    ``on_tick`` is called now and then with the fraction simulated (a progress bar)."""
     b = behaviour(name)
     ath = athlete(body)
     key = ath.name if ath.name in BODIES else "custom"

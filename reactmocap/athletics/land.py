@@ -78,7 +78,7 @@ class LandingParams:
     knee: float = 0.6
     kp: float = 1.5
     kv: float = 0.15
-    lead: float = 1.0
+    lead: float = 0.5
     delta: float = -0.04
     damping: float = 5.0
     restore: float = 0.2

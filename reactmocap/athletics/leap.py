@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -32,6 +33,8 @@ VERTICAL_TIMING = (0.10, 0.15, 0.22)
 BROAD_TIMING = (0.15, 0.20, 0.45)
 #: seconds after which a push that never left the ground hands over anyway
 THRUST_TIMEOUT = 1.0
+#: seconds over which the push's stiffness comes in (a step in stiffness jolts the feet)
+STIFFNESS_RAMP = 0.06
 #: seconds over which the angular-momentum feedback comes in at the start of the push
 SPIN_RAMP = 0.05
 #: fraction of the friction cone the push may use
@@ -73,6 +76,7 @@ class LeapParams:
     lean: float = 0.0
     spin: float = 0.0
     spin_gain: float = 0.0
+    accelerate: bool = False
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -110,7 +114,7 @@ class Leap(Basis):
         p = self.params
         bl = BalanceLaw(ctx, BALANCE_GAINS)
         every = ctx.control_every
-        memo: dict[str, float] = {}
+        memo: dict[str, Any] = {}
 
         def crouch(world: World, t: float) -> None:
             del world
@@ -125,10 +129,13 @@ class Leap(Basis):
         def thrust(world: World, t: float) -> None:
             del world
             memo["t_thrust"] = t
+            memo.pop("force", None)
+            memo.pop("ramp", None)
             rig = ctx.rig
             stiff = per_joint(LEAP_STIFFNESS) * p.stiffness
             stiff[[joint_index(f"{s}_ankle") for s in "lr"]] *= p.ankle_gain
-            rig.set_stiffness(stiff)
+            memo["stiff0"] = rig.stiffness.copy()
+            memo["stiff1"] = stiff
             rig.move(rig.desired(t) + rig.offset, 0.0, t)
             rig.offset[:] = 0.0
             hip_t, knee_t, ankle_t = p.timing
@@ -147,11 +154,15 @@ class Leap(Basis):
                 goal[joint_index(j)] = 0.0
                 dur[joint_index(j)] = hip_t
             moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
-            rig.move(goal, dur, t, moving)
+            rig.move(goal, dur, t, moving, accelerate=p.accelerate)
 
         def push(world: World, t: float) -> None:
             s = ctx.sense(t)
             bl._support(s)
+            ramp = min(1.0, (t - memo["t_thrust"]) / STIFFNESS_RAMP)
+            if memo.get("ramp", -1.0) < 1.0:  # the push's stiffness comes in smoothly
+                memo["ramp"] = ramp
+                ctx.rig.set_stiffness(memo["stiff0"] + ramp * (memo["stiff1"] - memo["stiff0"]))
             if p.spin_gain > 0:
                 # whole-body angular momentum about the COM (mj_subtreeVel has run), pitch
                 # axis of the heading frame: the hips tilt the push ahead of or behind the COM
@@ -163,30 +174,24 @@ class Leap(Basis):
                     ctx.rig.offset[j, 0] = off
             if p.speed <= 0:
                 return
-            # the ground force that brings the COM velocity to the take-off velocity by the
-            # time the COM reaches its take-off height (constant acceleration), realised by the
-            # stance legs through their Jacobians
             rig = ctx.rig
-            g = float(np.linalg.norm(world.model.opt.gravity))
-            up = s.floor_normal if s.floor_normal[2] > 0.99 else np.array([0.0, 0.0, 1.0])
-            h = s.heading()
-            fwd = np.array([math.cos(h), math.sin(h), 0.0])
-            target = p.speed * (math.cos(p.angle) * fwd + math.sin(p.angle) * up)
-            z_to = memo["z_stand"] + p.rise
-            z, vz = float(s.com @ up), float(s.com_vel @ up)
-            left = max(z_to - z, 0.02)
-            time_left = 2.0 * left / max(vz + target @ up, 0.2)
-            acc = (target - s.com_vel) / time_left
-            force = acc + g * up
-            fz = float(force @ up)
-            horiz = force - fz * up
-            lim = FRICTION_USE * world.config.friction * max(fz, 0.0)
-            if np.linalg.norm(horiz) > lim:
-                horiz *= lim / np.linalg.norm(horiz)
-            force = horiz + max(fz, 0.0) * up
-            size = float(np.linalg.norm(force))
-            rig.support_scale = float(np.clip(size / g, 0.0, MAX_THRUST))
-            rig.support_dir = force / max(size, 1e-9)
+            if "force" not in memo:
+                # a constant ground force that brings the COM from rest to the take-off
+                # velocity over the rise left to the take-off height (planned once, at the
+                # start of the push: v^2 = 2 a d), leaning along the take-off direction
+                g = float(np.linalg.norm(world.model.opt.gravity))
+                up = np.array([0.0, 0.0, 1.0])
+                h = s.heading()
+                fwd = np.array([math.cos(h), math.sin(h), 0.0])
+                rise = max(memo["z_stand"] + p.rise - float(s.com[2]), 0.05)
+                vz = p.speed * math.sin(p.angle)
+                duration = 2.0 * rise / max(vz, 1e-3)
+                acc = (p.speed * math.cos(p.angle) * fwd + vz * up) / duration
+                force = acc + g * up
+                memo["force"] = float(np.linalg.norm(force)) / g
+                memo["dir"] = force / np.linalg.norm(force)  # type: ignore[assignment]
+            rig.support_scale = min(memo["force"], MAX_THRUST)
+            rig.support_dir = memo["dir"]  # type: ignore[assignment]
 
         def flight(world: World, t: float) -> None:
             s = ctx.sense(t)

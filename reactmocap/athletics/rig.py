@@ -96,6 +96,7 @@ class Rig:
         self._start = np.zeros((NJ, 3))
         self._t0 = np.zeros(NJ)
         self._dur = np.ones(NJ)
+        self._accel = np.zeros(NJ, dtype=bool)  # joints on an accelerating (s^2) path
         self.offset = np.zeros((NJ, 3))
         self.stiffness = np.zeros(NJ)
         self.damping = np.zeros(NJ)
@@ -182,7 +183,8 @@ class Rig:
     # ------------------------------------------------------------------ targets
     def desired(self, t: float) -> F64:
         """``(15, 3)`` smoothed target angles at time ``t`` (without :attr:`offset`)."""
-        s = smoothstep((t - self._t0) / self._dur)[:, None]
+        x = np.clip((t - self._t0) / self._dur, 0.0, 1.0)
+        s = np.where(self._accel, x * x, smoothstep(x))[:, None]
         return self._start + (self._goal - self._start) * s
 
     def move(
@@ -191,10 +193,13 @@ class Rig:
         duration: float | F64,
         t: float,
         joints: Sequence[int] | NDArray[np.bool_] | None = None,
+        accelerate: bool = False,
     ) -> None:
         """Move the targets of ``joints`` (indices or a mask; default all) from where they are
         at ``t`` toward ``goal`` ``(15, 3)`` (NaN entries keep their goal) over ``duration``
-        seconds (scalar or per joint); 0 jumps."""
+        seconds (scalar or per joint); 0 jumps. The path is the Hermite curve (at rest at
+        both ends), or with ``accelerate`` a constant acceleration from rest that arrives at
+        full speed (a push)."""
         goal = np.asarray(goal, dtype=np.float64)
         sel = np.ones(NJ, dtype=bool) if joints is None else np.zeros(NJ, dtype=bool)
         if joints is not None:
@@ -208,6 +213,7 @@ class Rig:
         self._goal[sel] = new[sel]
         self._t0[sel] = t
         self._dur[sel] = np.maximum(dur[sel], 1e-9)
+        self._accel[sel] = accelerate
 
     def goal(self) -> F64:
         return self._goal.copy()

@@ -34,16 +34,16 @@ def leap_params(s: float) -> LeapParams:
     """The vertical leap at effort ``s``: a deeper crouch and stiffer push as ``s`` grows (the
     thesis's Table 4.1 walks crouch height and torso pitch the same way)."""
     s = float(np.clip(s, 0.0, 1.0))
-    return LeapParams(leg=0.9 - 0.3 * s, pitch=0.0, lean=0.5, stiffness=0.15 + 1.35 * s,
+    return LeapParams(leg=0.85 - 0.2 * s, pitch=0.0, lean=0.5, stiffness=0.1 + 0.9 * s,
                       spin_gain=20.0)  # fmt: skip
 
 
 def broad_params(s: float) -> LeapParams:
     """The standing broad jump at effort ``s``: crouch, COM ahead of the feet, arm swing."""
     s = float(np.clip(s, 0.0, 1.0))
-    return LeapParams(leg=0.8 - 0.2 * s, pitch=0.2, lean=0.5, com_offset=0.04 + 0.04 * s,
-                      stiffness=0.3 + 1.2 * s, timing=BROAD_TIMING, ankle_gain=3.6,
-                      arms=-1.8 - 1.4 * s, broad=True, spin_gain=20.0)  # fmt: skip
+    return LeapParams(leg=0.8 - 0.15 * s, pitch=0.2, lean=0.5, com_offset=0.12 + 0.1 * s,
+                      stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
+                      arms=-1.8 - 1.0 * s, broad=True, spin_gain=20.0, hold=0.1)  # fmt: skip
 
 
 # (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
