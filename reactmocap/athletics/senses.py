@@ -44,6 +44,7 @@ class Senses:
         self._own = world.geom_character == character
         self._body = world.geom_body
         self._f6 = np.zeros(6)
+        self._forward = _forward_in_body(athlete)
         self.time = -1.0
         self.com = np.zeros(3)
         self.com_vel = np.zeros(3)
@@ -120,7 +121,7 @@ class Senses:
     def heading(self) -> float:
         """Heading (rad about +Z) of the pelvis's anatomical forward axis."""
         d = self.world.data
-        fwd = d.xmat[self.root].reshape(3, 3) @ _forward_in_body(self.athlete)
+        fwd = d.xmat[self.root].reshape(3, 3) @ self._forward
         return float(np.arctan2(fwd[1], fwd[0]))
 
     def local(self, v: F64, heading: float | None = None) -> F64:
