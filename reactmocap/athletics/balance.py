@@ -252,6 +252,8 @@ def hold_pelvis_and_feet(ctx: Context, d, pitch: float, heading: float, t: float
 
 
 _LEG_NEUTRAL = [_BODY[b] for b in ("l_thigh", "r_thigh", "l_shin", "r_shin", "l_foot", "r_foot")]
+
+
 def _flat_feet(foot_now: F64, normal: F64) -> F64:
     """Each foot's anatomical frame turned so its sole lies flat on a floor of ``normal``,
     keeping its heading (MuJoCo's small-vector routines: this runs every tick)."""

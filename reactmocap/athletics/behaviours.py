@@ -220,10 +220,14 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     push = (t >= (thrust or 0.0)) & (t < (lift if lift is not None else -1.0))
     rep: dict[str, Any] = {"effort": s}
     if broad:
-        h0 = 0.0  # the athletes face +X
-        d = log["com"][-1] - log["com"][0]
+        # the jump's length: COM travel (ahead, +X) from standing to where the landing took
+        # the speed off (the landing's recovery starts), or 0.3 s after touchdown
+        settled = next((tr.time for tr in seq.transitions if tr.target == "land.recover"),
+                       (ctx.touchdown_time or t[-1]) + 0.3)  # fmt: skip
+        i = min(int(np.searchsorted(t, settled)), t.size - 1)
         rep["commanded_distance_m"] = target
-        rep["achieved_distance_m"] = float(d[0] * math.cos(h0) + d[1] * math.sin(h0))
+        rep["achieved_distance_m"] = float(log["com"][i, 0] - log["com"][0, 0])
+        rep["final_distance_m"] = float(log["com"][-1, 0] - log["com"][0, 0])
     else:
         rep["commanded_height_m"] = target
         rep["achieved_height_m"] = float(log["com"][:, 2].max() - com0) if lift is not None else 0.0
@@ -236,7 +240,9 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     return _result("broad-jump" if broad else "leap", ath, ctx, seq, res, rep)
 
 
-def _run_land(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None) -> AthleticsResult:
+def _run_land(
+    ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None
+) -> AthleticsResult:
     drop, vx = float(p["drop"]), float(p["vx"])
     world = athletics_world(ath)
     add_backpack(world, ath, float(p["backpack"]))
@@ -261,7 +267,9 @@ def _run_land(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
 LANDING_LEG = 0.92
 
 
-def _run_balance(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None) -> AthleticsResult:
+def _run_balance(
+    ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None
+) -> AthleticsResult:
     world = athletics_world(ath, backpack=float(p["backpack"]))
     leg = STANDING_LEG
     if p.get("pelvis_height") is not None:

@@ -88,8 +88,19 @@ class LandingParams:
     knee_stiffness: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("knee", "kp", "kv", "lead", "delta", "damping", "restore", "arms", "toes", "lean",
-                     "knee_stiffness"):
+        for name in (
+            "knee",
+            "kp",
+            "kv",
+            "lead",
+            "delta",
+            "damping",
+            "restore",
+            "arms",
+            "toes",
+            "lean",
+            "knee_stiffness",
+        ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
@@ -112,8 +123,8 @@ class Landing(Basis):
         memo: dict[str, float] = {}
         m = ctx.world.model
         pre = rig.wc.prefix
-        _HIP_JOINTS = [m.joint(f"{pre}{s}_hip").id for s in "lr"]  # noqa: N806
-        _ANKLE_JOINTS = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]  # noqa: N806
+        hip_joints = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
+        ankle_joints = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]
 
         def reach_enter(world: World, t: float) -> None:
             del world
@@ -151,8 +162,8 @@ class Landing(Basis):
             pelvis = bl.pelvis_pitch()
             goal = np.full((NJ, 3), np.nan)
             for k in range(2):
-                hip = d.xanchor[_HIP_JOINTS[k]]
-                length = float(np.linalg.norm(hip - d.xanchor[_ANKLE_JOINTS[k]]))
+                hip = d.xanchor[hip_joints[k]]
+                length = float(np.linalg.norm(hip - d.xanchor[ankle_joints[k]]))
                 ahead = float(s.local(s.com - hip, h)[0]) + want[0]
                 swing = math.asin(float(np.clip(ahead / max(length, 0.2), -0.9, 0.9)))
                 geom = float(knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k],

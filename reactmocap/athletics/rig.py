@@ -107,7 +107,7 @@ class Rig:
         self._child = np.asarray(wc.body_ids[1:])
         self._balls = np.array([m.joint(wc.prefix + j).id for j in BALL_JOINTS])
         up = -np.asarray(m.opt.gravity, dtype=np.float64)
-        self._up = up / max(np.linalg.norm(up), 1e-12)
+        self._up = up / max(float(np.linalg.norm(up)), 1e-12)
         self._weight = m.body_subtreemass[self._child] * g  # (15,) N
         self._weight_n = self.mass * g
         self._tau = np.zeros((NJ, 3))

@@ -14,6 +14,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from reactmocap.athletics import measured
 from reactmocap.athletics.land import LandingParams
 from reactmocap.athletics.leap import BROAD_TIMING, LeapParams
 from reactmocap.errors import ConfigError
@@ -49,17 +50,23 @@ def broad_params(s: float) -> LeapParams:
                       arms=-1.8 - 1.0 * s, broad=True, spin=-5.0, spin_gain=40.0, hold=0.1)  # fmt: skip
 
 
-# (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
-LEAP_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType({})
-# (effort s, achieved COM travel m)
-BROAD_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType({})
-# (horizontal velocity m/s, foot-servo delta m), thesis Table 6.1 rebuilt
-LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType({})
+#: (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
+LEAP_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(measured.LEAP_TABLES)
+#: (effort s, achieved COM travel m)
+BROAD_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    measured.BROAD_TABLES
+)
+#: (horizontal velocity m/s, foot-servo delta m), thesis Table 6.1 rebuilt
+LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    measured.LANDING_DELTAS
+)
 #: the landing's capture-point lead per body (tuned like the thesis's per-body deltas; a BVH
 #: body gets the landing's default)
 LANDING_LEADS: Mapping[str, float] = MappingProxyType({"male": 0.5, "female": 1.0})
 #: (behaviour, parameter) -> body -> (low, high): the measured supported range
-SUPPORTED: Mapping[tuple[str, str], Mapping[str, tuple[float, float]]] = MappingProxyType({})
+SUPPORTED: Mapping[tuple[str, str], Mapping[str, tuple[float, float]]] = MappingProxyType(
+    measured.SUPPORTED
+)
 
 
 def effort_for(table: tuple[tuple[float, float], ...], value: float, what: str) -> float:
