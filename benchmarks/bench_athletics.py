@@ -41,55 +41,67 @@ def _landed(r: dict[str, Any]) -> bool:
 
 
 # ---------------------------------------------------------------------------------- tables
-def build_tables(workers: int) -> dict[str, Any]:
-    leap_grid = [{"effort": round(s, 3)} for s in np.linspace(0.0, 1.0, 41)]
-    broad_grid = [{"effort": round(s, 3)} for s in np.linspace(0.0, 1.0, 41)]
-    out: dict[str, Any] = {"LEAP_TABLES": {}, "BROAD_TABLES": {}, "LANDING_DELTAS": {},
-                           "SUPPORTED": {}}  # fmt: skip
-    supported: dict[tuple[str, str], dict[str, tuple[float, float]]] = {}
+def build_tables(
+    workers: int, parts: tuple[str, ...] = ("leap", "broad", "land")
+) -> dict[str, Any]:
+    """Rebuild the measured tables and supported ranges (``parts``: which; the others are
+    kept as they are in measured.py)."""
+    from reactmocap.athletics import measured
+
+    grid = [{"effort": round(s, 3)} for s in np.linspace(0.0, 1.0, 41)]
+    out: dict[str, Any] = {
+        "LEAP_TABLES": dict(measured.LEAP_TABLES),
+        "BROAD_TABLES": dict(measured.BROAD_TABLES),
+        "LANDING_DELTAS": dict(measured.LANDING_DELTAS),
+    }
+    supported: dict[Any, dict[str, tuple[float, float]]] = {
+        k: dict(v) for k, v in measured.SUPPORTED.items()
+    }
+    lifted = lambda r: r["time_to_liftoff_s"] is not None  # noqa: E731
     for body in BODIES:
         t0 = time.time()
-        leaps = calibrate.sweep("leap", body, leap_grid, workers)
-        table = calibrate.effort_table(leaps, "achieved_height_m",
-                                       lambda r: r["time_to_liftoff_s"] is not None)  # fmt: skip
-        out["LEAP_TABLES"][body] = table
-        # supported: the heights over which the table's leaps land, contiguous from the lowest
-        ok = {round(float(r["achieved_height_m"]), 4): _landed(r) for r in leaps}
-        heights = [v for _, v in table]
-        good = [ok.get(v, False) for v in heights]
-        rng = _longest(heights, good)
-        if rng:
-            supported.setdefault(("leap", "height"), {})[body] = rng
-        broads = calibrate.sweep("broad-jump", body, broad_grid, workers)
-        btable = calibrate.effort_table(broads, "achieved_distance_m", _landed)
-        out["BROAD_TABLES"][body] = btable
-        if btable:
-            supported.setdefault(("broad-jump", "distance"), {})[body] = (
-                btable[0][1],
-                btable[-1][1],
+        if "leap" in parts:
+            leaps = calibrate.sweep("leap", body, grid, workers)
+            table = calibrate.effort_table(leaps, "achieved_height_m", lifted)
+            out["LEAP_TABLES"][body] = table
+            # supported: the longest stretch of the table's heights whose leaps land
+            ok = {round(float(r["achieved_height_m"]), 4): _landed(r) for r in leaps}
+            heights = [v for _, v in table]
+            rng = _longest(heights, [ok.get(v, False) for v in heights])
+            if rng:
+                supported.setdefault(("leap", "height"), {})[body] = rng
+        if "broad" in parts:
+            broads = calibrate.sweep("broad-jump", body, grid, workers)
+            btable = calibrate.effort_table(broads, "achieved_distance_m", lifted)
+            out["BROAD_TABLES"][body] = btable
+            if btable:
+                supported.setdefault(("broad-jump", "distance"), {})[body] = (
+                    btable[0][1],
+                    btable[-1][1],
+                )
+        if "land" in parts:
+            drops = np.round(np.arange(0.0, 2.51, 0.1), 2)
+            dr = calibrate.sweep("land", body, [{"drop": float(d)} for d in drops], workers)
+            rng = calibrate.contiguous_range(drops, [_landed(r) for r in dr], 0.0)
+            if rng:
+                supported.setdefault(("land", "drop"), {})[body] = rng
+            vxs = np.round(np.arange(-2.0, 4.01, 0.25), 2)
+            drop = _drop_for_com(body, 1.25)
+            grid_v = [{"drop": drop, "vx": float(v)} for v in vxs]
+            vr = calibrate.sweep("land", body, grid_v, workers)
+            rng = calibrate.contiguous_range(vxs, [_landed(r) for r in vr], 0.0)
+            if rng:
+                supported.setdefault(("land", "vx"), {})[body] = rng
+            slopes = _slope_limits(body, workers)
+            supported.setdefault(("balance", "slope"), {})[body] = (
+                0.0,
+                math.radians(min(slopes.values())),
             )
-        drops = np.round(np.arange(0.0, 2.51, 0.1), 2)
-        dr = calibrate.sweep("land", body, [{"drop": float(d)} for d in drops], workers)
-        rng = calibrate.contiguous_range(drops, [_landed(r) for r in dr], 0.0)
-        if rng:
-            supported.setdefault(("land", "drop"), {})[body] = rng
-        vxs = np.round(np.arange(-2.0, 4.01, 0.25), 2)
-        drop = _drop_for_com(body, 1.25)
-        vr = calibrate.sweep("land", body, [{"drop": drop, "vx": float(v)} for v in vxs], workers)
-        rng = calibrate.contiguous_range(vxs, [_landed(r) for r in vr], 0.0)
-        if rng:
-            supported.setdefault(("land", "vx"), {})[body] = rng
-        slopes = _slope_limits(body, workers)
-        supported.setdefault(("balance", "slope"), {})[body] = (
-            0.0,
-            math.radians(min(slopes.values())),
-        )
-        print(f"{body}: tables in {time.time() - t0:.0f} s; leap {len(table)} rows, broad "
-              f"{len(btable)} rows")  # fmt: skip
+        print(f"{body}: {','.join(parts)} tables in {time.time() - t0:.0f} s")
     out["SUPPORTED"] = supported
     out["MEASURED_ON"] = f"{datetime.date.today().isoformat()} (bench_athletics.py --tables)"
-    calibrate.write_measured(MEASURED, out, "Measured tables (written by "
-                             "``benchmarks/bench_athletics.py --tables``; do not edit).")  # fmt: skip
+    header = "Measured tables (written by ``benchmarks/bench_athletics.py --tables``; do not edit)."
+    calibrate.write_measured(MEASURED, out, header)
     return out
 
 
@@ -307,12 +319,14 @@ def main() -> int:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     ap.add_argument("--tables", action="store_true", help="rebuild tables and ranges")
+    ap.add_argument("--parts", default="leap,broad,land",
+                    help="with --tables: which of leap,broad,land to rebuild")  # fmt: skip
     ap.add_argument("--out", type=Path, help="folder for the plots")
     ap.add_argument("--json", type=Path, help="write every figure as JSON")
     ap.add_argument("--workers", type=int, default=1)
     args = ap.parse_args()
     if args.tables:
-        build_tables(args.workers)
+        build_tables(args.workers, tuple(args.parts.split(",")))
         return 0
     res = experiments(args.out, args.workers)
     print_table(res)

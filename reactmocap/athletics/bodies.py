@@ -36,6 +36,7 @@ __all__ = [
     "EULER_ORDER",
     "Athlete",
     "athlete",
+    "athlete_of",
     "thesis_character",
     "thesis_skeleton",
 ]
@@ -320,6 +321,11 @@ def _reference_heading(character: Character) -> float:
     rot = character.body_quat[0]
     left = quat_rotate(rot, p[SIM_BODIES.index("l_thigh")] - p[SIM_BODIES.index("r_thigh")])
     return float(np.arctan2(-left[0], left[1]))
+
+
+def athlete_of(character: Character, name: str = "character") -> Athlete:
+    """The athlete (anatomical frames, leg lengths) of an already built Character."""
+    return _athlete(name, character)
 
 
 _CACHE: dict[str, Athlete] = {}

@@ -40,19 +40,24 @@ def sweep(
 def effort_table(
     rows: Sequence[dict[str, Any]], key: str, ok: Callable[[dict[str, Any]], bool]
 ) -> tuple[tuple[float, float], ...]:
-    """``(effort, achieved)`` rows where ``ok`` holds, cut to the longest stretch over which the
-    achieved value grows with the effort (so the table can be inverted)."""
-    pts = [(float(r["effort"]), float(r[key])) for r in rows if ok(r)]
-    best: list[tuple[float, float]] = []
-    run: list[tuple[float, float]] = []
-    for p in sorted(pts):
-        if run and p[1] <= run[-1][1]:
-            best = max(best, run, key=len)
-            run = [p]
-        else:
-            run.append(p)
-    best = max(best, run, key=len)
-    return tuple((round(s, 4), round(v, 4)) for s, v in best)
+    """``(effort, achieved)`` rows where ``ok`` holds, thinned to the longest run over which
+    the achieved value strictly grows with the effort (a longest increasing subsequence), so
+    the table can be inverted."""
+    pts = sorted((float(r["effort"]), float(r[key])) for r in rows if ok(r))
+    if not pts:
+        return ()
+    best = [1] * len(pts)
+    prev = [-1] * len(pts)
+    for i in range(len(pts)):
+        for j in range(i):
+            if pts[j][1] < pts[i][1] and best[j] + 1 > best[i]:
+                best[i], prev[i] = best[j] + 1, j
+    i = int(np.argmax(best))
+    chain = []
+    while i >= 0:
+        chain.append(pts[i])
+        i = prev[i]
+    return tuple((round(s, 4), round(v, 4)) for s, v in reversed(chain))
 
 
 def contiguous_range(

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-LEAP_TABLES: dict[str, Any] = {}
-BROAD_TABLES: dict[str, Any] = {}
-LANDING_DELTAS: dict[str, Any] = {}
-SUPPORTED: dict[Any, Any] = {}
-MEASURED_ON = ""
+LEAP_TABLES: dict[Any, Any] = {'male': ((0.3, 0.3715), (0.325, 0.382), (0.35, 0.4077), (0.375, 0.4422), (0.4, 0.4668), (0.425, 0.5043), (0.45, 0.5403), (0.475, 0.563), (0.5, 0.5965), (0.525, 0.6237), (0.55, 0.6644), (0.575, 0.6942), (0.6, 0.7299), (0.625, 0.7448), (0.65, 0.778), (0.675, 0.8096), (0.7, 0.83), (0.725, 0.8583), (0.75, 0.8902), (0.775, 0.8966), (0.8, 0.9236), (0.825, 0.947), (0.85, 0.9993)), 'female': ((0.375, 0.3282), (0.4, 0.3666), (0.425, 0.4094), (0.45, 0.4363), (0.475, 0.4873), (0.5, 0.516), (0.525, 0.5502), (0.55, 0.5786), (0.575, 0.6026), (0.6, 1.2475))}
+BROAD_TABLES: dict[Any, Any] = {'male': ((0.775, 1.1435), (0.8, 1.2743)), 'female': ()}
+LANDING_DELTAS: dict[Any, Any] = {}
+SUPPORTED: dict[Any, Any] = {('leap', 'height'): {'male': (0.3715, 0.8583), 'female': (0.4873, 0.516)}, ('broad-jump', 'distance'): {'male': (1.1435, 1.2743)}, ('land', 'drop'): {'male': (0.0, 2.2), 'female': (0.0, 2.5)}, ('land', 'vx'): {'male': (-2.0, 0.0), 'female': (-0.5, 0.0)}, ('balance', 'slope'): {'male': (0.0, 0.7853981633974483), 'female': (0.0, 0.7853981633974483)}}
+MEASURED_ON = '2026-12-01 (bench_athletics.py --tables)'
