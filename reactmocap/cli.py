@@ -19,7 +19,7 @@ from reactmocap.errors import ReactMocapError
 __all__ = ["build_parser", "main"]
 
 # Modules under reactmocap.commands, each with register(subparsers). Order = help order.
-COMMAND_MODULES = ("library", "search", "sim", "response", "batch")
+COMMAND_MODULES = ("library", "search", "sim", "response", "batch", "athletics")
 
 
 def build_parser() -> argparse.ArgumentParser:

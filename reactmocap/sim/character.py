@@ -7,7 +7,7 @@ Geometry follows human proportions scaled by leg length; segment masses follow
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -27,6 +27,7 @@ from reactmocap.rotations import (
     quat_mul,
     quat_normalize,
     quat_rotate,
+    quat_to_matrix,
 )
 from reactmocap.sim.bodies import (
     BALL_JOINTS,
@@ -46,6 +47,7 @@ __all__ = [
     "SIM_PARENTS",
     "PATCH_GEOM_GROUP",
     "Character",
+    "SegmentInertia",
     "build_character",
     "qvel_between",
     "qvel_from_qpos",
@@ -92,6 +94,17 @@ def qvel_between(qa: F64, qb: F64, span: F64) -> F64:
     return np.concatenate([lin, ang.reshape(n, -1)], axis=1)
 
 
+@dataclass(frozen=True)
+class SegmentInertia:
+    """Explicit mass properties of one sim body, in the world frame of the reference pose (as
+    anthropometric tables and the thesis's SD/FAST listings print them): ``mass`` (kg), ``com``
+    ``(3,)`` (m) and ``inertia`` ``(3, 3)`` about the COM (kg m^2)."""
+
+    mass: float
+    com: tuple[float, float, float]
+    inertia: tuple[tuple[float, float, float], ...]
+
+
 @dataclass(eq=False)
 class Character:
     """A built character: its MuJoCo spec, the skeleton mapping and the reference pose.
@@ -124,6 +137,9 @@ class Character:
     geoms: tuple[GeomSpec, ...]
     density_scale: dict[str, float]
     _model: mujoco.MjModel | None = field(default=None, repr=False)
+    #: explicit mass, COM (body frame) and full inertia ``(ixx, iyy, izz, ixy, ixz, iyz)`` per
+    #: body (see :func:`build_character`'s ``inertials``); None: mass from the geoms
+    inertials: dict[str, tuple[float, tuple[float, ...], tuple[float, ...]]] | None = None
 
     # ------------------------------------------------------------------ model
     def make_spec(self) -> mujoco.MjSpec:
@@ -136,6 +152,12 @@ class Character:
             parent_body = spec.worldbody if parent is None else bodies[parent]
             body = parent_body.add_body(name=name, pos=self.body_pos[i], quat=self.body_quat[i])
             bodies[name] = body
+            if self.inertials is not None:
+                mass, ipos, full = self.inertials[name]
+                body.mass = mass
+                body.ipos = list(ipos)
+                body.fullinertia = list(full)
+                body.explicitinertial = True
             if joint is None:
                 body.add_freejoint(name="root")
             else:
@@ -438,6 +460,7 @@ def build_character(
     frame: int = 0,
     mass_model: MassModel = "table",
     joint_limits: bool = True,
+    inertials: Mapping[str, SegmentInertia] | None = None,
 ) -> Character:
     """Build the 51-DOF character of a skeleton.
 
@@ -450,6 +473,10 @@ def build_character(
             ball heights over the whole reference place the foot soles on the ground.
         mass_model: ``"table"`` or ``"geometry"`` (see the module docstring).
         joint_limits: MuJoCo cone limits around the reference pose (:data:`JOINT_RANGE`).
+        inertials: explicit mass properties for every sim body (e.g. the thesis's listing, see
+            ``reactmocap.athletics.bodies``), in the reference pose's world frame; they replace
+            the geoms' mass (``total_mass`` and ``mass_model`` are then unused) and the geoms
+            only collide.
     """
     if isinstance(skeleton, Motion):
         reference = skeleton if reference is None else reference
@@ -532,5 +559,29 @@ def build_character(
         k = total_mass / sum(geo.values())
         scale = dict.fromkeys(SIM_BODIES, k)
     char.density_scale = scale
+    if inertials is not None:
+        char.inertials = _body_inertials(inertials, P, G)
+        char.total_mass = float(sum(v.mass for v in inertials.values()))
     char._model = None
     return char
+
+
+def _body_inertials(
+    given: Mapping[str, SegmentInertia], P: F64, G: F64
+) -> dict[str, tuple[float, tuple[float, ...], tuple[float, ...]]]:
+    """World-frame segment inertials -> each body's frame (COM offset, full inertia)."""
+    missing = [b for b in SIM_BODIES if b not in given]
+    if missing:
+        raise SimulationError(f"inertials lack bodies {missing}")
+    out = {}
+    for i, b in enumerate(SIM_BODIES):
+        seg = given[b]
+        inertia = np.asarray(seg.inertia, dtype=np.float64)
+        if not (np.isfinite(seg.mass) and seg.mass > 0) or inertia.shape != (3, 3):
+            raise SimulationError(f"body {b!r}: mass must be > 0 and inertia 3x3")
+        rot = quat_to_matrix(G[i])  # body -> world
+        com = rot.T @ (np.asarray(seg.com, dtype=np.float64) - P[i])
+        local = rot.T @ inertia @ rot
+        full = (local[0, 0], local[1, 1], local[2, 2], local[0, 1], local[0, 2], local[1, 2])
+        out[b] = (float(seg.mass), tuple(float(x) for x in com), tuple(float(x) for x in full))
+    return out

@@ -1,0 +1,334 @@
+"""Balance (thesis ch. 7): keep the centre of mass over the centre of the support area.
+
+A PD servo on the horizontal COM error (heading frame) gives offsets ``delta`` that are added to
+the ankles' targets and, at half and with the opposite sign, to the hips' (eqs. 7.1-7.2); the
+ankles otherwise keep the feet flat on the floor (eqs. 7.3-7.4, on a slope: flat on the slope),
+the hips keep the pelvis at the commanded pitch, and the knees set the pelvis height through
+the law of cosines (eq. 7.5), leg by leg (so a leg on the uphill side of a slope bends more).
+User parameters: torso pitch, pelvis height and a COM offset (:class:`Posture`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.athletics.bodies import EULER_ORDER, Athlete
+from reactmocap.athletics.machine import NEXT, Basis, Context, law
+from reactmocap.athletics.rig import joint_index, per_joint
+from reactmocap.errors import ConfigError
+from reactmocap.rotations import (
+    quat_conj,
+    quat_from_euler,
+    quat_from_yaw,
+    quat_mul,
+    quat_to_euler,
+)
+from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
+from reactmocap.sim.controllers.machine import Event, State
+from reactmocap.sim.world import World
+
+__all__ = [
+    "ANKLE_LIMITS",
+    "BALANCE_GAINS",
+    "STANDING_LEG",
+    "Balance",
+    "BalanceGains",
+    "BalanceLaw",
+    "Posture",
+    "knee_for_length",
+]
+
+F64 = NDArray[np.float64]
+NJ = len(BALL_JOINTS)
+#: ankle pitch limits (rad): "joint limits prevent the ankles from extending beyond 90 degrees
+#: or flexing beyond -68 degrees" (section 7.1)
+ANKLE_LIMITS = (math.radians(-68.0), math.radians(90.0))
+#: standing hip-to-ankle length as a fraction of the straight leg (a knee slightly unlocked)
+STANDING_LEG = 0.985
+_HIP = [joint_index(f"{s}_hip") for s in "lr"]
+_KNEE = [joint_index(f"{s}_knee") for s in "lr"]
+_ANKLE = [joint_index(f"{s}_ankle") for s in "lr"]
+_SPINE = [joint_index(j) for j in ("waist", "back")]
+_BODY = {b: i for i, b in enumerate(SIM_BODIES)}
+
+
+def knee_for_length(thigh: F64 | float, shin: F64 | float, length: F64 | float) -> F64:
+    """Knee flexion (rad) that makes the hip-to-ankle distance ``length`` (eq. 7.5), and the
+    hip flexion that keeps the pelvis over the ankle with the hip-ankle line vertical (eq. 7.6,
+    returned negative: thigh forward)."""
+    ul, ll = np.asarray(thigh, dtype=np.float64), np.asarray(shin, dtype=np.float64)
+    lh = np.clip(np.asarray(length, dtype=np.float64), abs(ul - ll) + 1e-3, ul + ll - 1e-6)
+    knee = np.pi - np.arccos(np.clip((ul**2 + ll**2 - lh**2) / (2 * ul * ll), -1.0, 1.0))
+    hip = -np.arccos(np.clip((ul**2 - ll**2 + lh**2) / (2 * ul * lh), -1.0, 1.0))
+    return np.stack([knee, hip])
+
+
+@dataclass(frozen=True)
+class Posture:
+    """What the balance controller holds.
+
+    Args:
+        pitch: torso pitch (rad, forward > 0), made at the hips.
+        leg: hip-to-ankle length as a fraction of the straight leg (the pelvis height through
+            the law of cosines); :data:`STANDING_LEG` stands.
+        com_offset: desired COM ``(x, y)`` relative to the support centre (m, heading frame).
+        arms: shoulder pitch (rad; < 0 raises the arms forward).
+        settle: seconds the joints take to reach a new posture (Hermite).
+        lean: extra torso pitch per radian of knee flexion beyond standing (a squatting
+            person leans forward, which keeps the COM over the feet).
+    """
+
+    pitch: float = 0.0
+    leg: float = STANDING_LEG
+    com_offset: tuple[float, float] = (0.0, 0.0)
+    arms: float = 0.0
+    settle: float = 0.5
+    lean: float = 0.5
+
+    def __post_init__(self) -> None:
+        for name in ("pitch", "leg", "arms", "settle", "lean"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise ConfigError(f"posture {name} must be a finite number, got {v!r}")
+        if not 0.3 <= self.leg <= 1.0:
+            raise ConfigError(f"posture leg must be within [0.3, 1.0] of the leg, got {self.leg}")
+        if len(self.com_offset) != 2 or not all(math.isfinite(v) for v in self.com_offset):
+            raise ConfigError(f"posture com_offset must be 2 finite numbers, got {self.com_offset}")
+
+
+@dataclass(frozen=True)
+class BalanceGains:
+    """COM servo gains (rad/m and rad s/m) and the joint stiffness (units of ``m g L`` N m/rad)
+    and damping (``m L sqrt(g L)`` N m s/rad) while balancing."""
+
+    kp: float = 2.0
+    kv: float = 0.5
+    max_offset: float = 0.35
+    stiffness: tuple[tuple[str, float], ...] = (
+        ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
+        ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
+    )  # fmt: skip
+    damping: tuple[tuple[str, float], ...] = (
+        ("waist", 0.1), ("back", 0.1), ("hip", 0.15), ("knee", 0.15), ("ankle", 0.2),
+    )  # fmt: skip
+
+    def stiffness_array(self) -> F64:
+        return per_joint(dict(self.stiffness))
+
+    def damping_array(self) -> F64:
+        return per_joint(dict(self.damping))
+
+
+BALANCE_GAINS = BalanceGains()
+
+
+class BalanceLaw:
+    """The per-tick balance law on a context (used by :class:`Balance` and by the leap's crouch
+    and the landing's recovery). :meth:`set_posture` moves the posture targets smoothly."""
+
+    def __init__(self, ctx: Context, gains: BalanceGains = BALANCE_GAINS) -> None:
+        self.ctx = ctx
+        self.gains = gains
+        self.posture = Posture()
+        self.athlete: Athlete = ctx.athlete
+        a = self.athlete
+        self.heading = 0.0
+        self.com_target = np.zeros(3)
+        self._knee_standing = float(np.mean(knee_for_length(
+            a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
+
+    def set_posture(self, posture: Posture, t: float, gains: bool = True) -> None:
+        """Move the knees, spine and arms toward ``posture`` over ``posture.settle`` s."""
+        self.posture = posture
+        rig = self.ctx.rig
+        if gains:
+            rig.set_stiffness(self.gains.stiffness_array())
+            rig.set_damping(self.gains.damping_array())
+        goal = np.full((NJ, 3), np.nan)
+        knees = knee_for_length(self.athlete.thigh, self.athlete.shin,
+                                posture.leg * (self.athlete.thigh + self.athlete.shin))  # fmt: skip
+        for k in range(2):
+            goal[_KNEE[k]] = (knees[0, k], 0.0, 0.0)
+        for j in _SPINE + [joint_index("neck")]:
+            goal[j] = 0.0
+        for s in "lr":
+            goal[joint_index(f"{s}_shoulder")] = (posture.arms, 0.0, 0.0)
+            goal[joint_index(f"{s}_elbow")] = (0.0, 0.0, 0.0)
+            goal[joint_index(f"{s}_wrist")] = 0.0
+        moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
+        rig.move(goal, posture.settle, t, moving)
+        # the commanded pitch starts from where the pelvis is (less the new posture's lean)
+        self._pitch0 = self.pelvis_pitch() - self._lean()
+        self._t_pitch = t
+
+    def pelvis_pitch(self) -> float:
+        """Current anatomical pitch of the pelvis (rad, forward > 0)."""
+        d = self.ctx.world.data
+        q = quat_mul(d.xquat[self.ctx.senses.root], quat_conj(self.athlete.neutral[0]))
+        return float(quat_to_euler(q, EULER_ORDER)[0])
+
+    def _lean(self) -> float:
+        if not self.posture.lean:
+            return 0.0
+        knee = float(np.mean(self.ctx.rig.knee_flexion()))
+        return self.posture.lean * max(0.0, knee - self._knee_standing)
+
+    def _pitch_now(self, t: float) -> float:
+        if not hasattr(self, "_t_pitch"):
+            return self.posture.pitch
+        s = min(max((t - self._t_pitch) / max(self.posture.settle, 1e-9), 0.0), 1.0)
+        return self._pitch0 + (self.posture.pitch - self._pitch0) * s * s * (3 - 2 * s)
+
+    def control(self, world: World, t: float) -> None:
+        ctx = self.ctx
+        s = ctx.sense(t)
+        d = world.data
+        rig = ctx.rig
+        g = self.gains
+        h = s.heading()
+        self.heading = h
+        centre = s.support_center(h)
+        off = np.asarray(self.posture.com_offset)
+        c, sn = math.cos(h), math.sin(h)
+        target = centre.copy()
+        target[0] += c * off[0] - sn * off[1]
+        target[1] += sn * off[0] + c * off[1]
+        self.com_target = target
+        err = s.local(target - s.com, h)
+        vel = s.local(s.com_vel, h)
+        delta = np.clip(g.kp * err - g.kv * vel, -g.max_offset, g.max_offset)
+        pitch = self._pitch_now(t) + self._lean()
+        hold_pelvis_and_feet(ctx, d, pitch, h, t)
+        rig.offset[:] = 0.0
+        for k in range(2):
+            rig.offset[_ANKLE[k], 0] = -delta[0]
+            rig.offset[_ANKLE[k], 1] = delta[1]
+            rig.offset[_HIP[k], 0] = 0.5 * delta[0]
+            rig.offset[_HIP[k], 1] = -0.5 * delta[1]
+        lo, hi = ANKLE_LIMITS
+        desired = rig.desired(t)
+        for k in range(2):
+            total = desired[_ANKLE[k], 0] + rig.offset[_ANKLE[k], 0]
+            rig.offset[_ANKLE[k], 0] += float(np.clip(total, lo, hi)) - total
+        self._level_legs(d, desired)
+        self._support(s)
+
+    def _level_legs(self, d, desired: F64) -> None:  # type: ignore[no-untyped-def]
+        """Leg by leg (eq. 7.5 per leg): the leg whose ankle stands higher (uphill on a
+        sideways slope) is shortened by the height difference, so the pelvis stays level."""
+        a = self.athlete
+        z = d.xanchor[self.ctx.senses.ankle_joints, 2]
+        for k in range(2):
+            knee = float(desired[_KNEE[k], 0])
+            ul, ll = float(a.thigh[k]), float(a.shin[k])
+            length = math.sqrt(ul * ul + ll * ll + 2.0 * ul * ll * math.cos(knee))
+            level = length + 0.5 * float(z[1 - k] - z[k])
+            self.ctx.rig.offset[_KNEE[k], 0] = float(knee_for_length(ul, ll, level)[0]) - knee
+
+    def _support(self, s) -> None:  # type: ignore[no-untyped-def]
+        """Weight shares of the feet in contact (by where the COM lies between them)."""
+        rig = self.ctx.rig
+        rig.support[:] = 0.0
+        feet = np.flatnonzero(s.foot_contact)
+        if feet.size == 0:
+            return
+        if feet.size == 1:
+            rig.support[feet[0]] = 1.0
+            return
+        a, b = s.foot_point[0, :2], s.foot_point[1, :2]
+        ab = b - a
+        w = float(np.clip(np.dot(s.com[:2] - a, ab) / max(float(ab @ ab), 1e-9), 0.0, 1.0))
+        rig.support[:] = (1.0 - w, w)
+
+
+def hold_pelvis_and_feet(ctx: Context, d, pitch: float, heading: float, t: float) -> None:  # type: ignore[no-untyped-def]
+    """Set the hips' targets so the pelvis has ``pitch`` (forward > 0; upright otherwise, at
+    ``heading``) given where the thighs are, and the ankles' so the feet lie flat on the floor
+    given where the shins are (the thesis's eqs. 7.3-7.4 and "the hips keep the pelvis
+    vertical"). Yaw targets stay 0."""
+    a = ctx.athlete
+    rot = d.xquat[ctx.senses.leg_bodies]  # thighs, shins, feet (world)
+    anat = quat_mul(rot, quat_conj(a.neutral[_LEG_NEUTRAL]))
+    pelvis = quat_mul(quat_from_yaw(heading), quat_from_euler([pitch, 0.0, 0.0], EULER_ORDER))
+    flat = _flat_feet(anat[4:6], ctx.senses.floor_normal)
+    hips = quat_mul(quat_conj(pelvis)[None], anat[0:2])
+    ankles = quat_mul(quat_conj(anat[2:4]), flat)
+    eul = quat_to_euler(np.concatenate([hips, ankles]), EULER_ORDER)  # (4, 3) pitch, roll, yaw
+    goal = np.full((NJ, 3), np.nan)
+    for k in range(2):
+        goal[_HIP[k]] = (eul[k, 0], eul[k, 1], 0.0)
+        goal[_ANKLE[k]] = (eul[2 + k, 0], eul[2 + k, 1], 0.0)
+    ctx.rig.move(goal, 0.0, t, _HIP + _ANKLE)
+
+
+_LEG_NEUTRAL = [_BODY[b] for b in ("l_thigh", "r_thigh", "l_shin", "r_shin", "l_foot", "r_foot")]
+
+
+def _flat_feet(foot_now: F64, normal: F64) -> F64:
+    """Each foot's anatomical frame turned so its sole lies flat on a floor of ``normal``,
+    keeping its heading (MuJoCo's small-vector routines: this runs every tick)."""
+    out = np.empty_like(foot_now)
+    x = np.empty(3)
+    mat = np.empty(9)
+    for k in range(2):
+        mujoco.mju_rotVecQuat(x, _X, foot_now[k])
+        x -= normal * float(x @ normal)
+        x /= max(float(np.linalg.norm(x)), 1e-9)
+        y = np.array([normal[1] * x[2] - normal[2] * x[1], normal[2] * x[0] - normal[0] * x[2],
+                      normal[0] * x[1] - normal[1] * x[0]])  # fmt: skip
+        mat.reshape(3, 3)[:] = np.column_stack([x, y, normal])
+        mujoco.mju_mat2Quat(out[k], mat)
+    return out
+
+
+_X = np.array([1.0, 0.0, 0.0])
+
+
+class Balance(Basis):
+    """The balance basis controller: settle into ``posture`` and hold it, for ``seconds`` (then
+    hand over) or forever (``None``)."""
+
+    name = "balance"
+    initial = "hold"
+
+    def __init__(
+        self,
+        posture: Posture | None = None,
+        seconds: float | None = None,
+        gains: BalanceGains = BALANCE_GAINS,
+        until: Event | None = None,
+    ) -> None:
+        self.posture = posture or Posture()
+        if seconds is not None and not (math.isfinite(seconds) and seconds >= 0):
+            raise ConfigError(f"balance seconds must be >= 0, got {seconds!r}")
+        self.seconds = seconds
+        self.gains = gains
+        self.until = until
+        self.law: BalanceLaw | None = None
+
+    def states(self, ctx: Context) -> list[State]:
+        bl = BalanceLaw(ctx, self.gains)
+        self.law = bl
+
+        def enter(world: World, t: float) -> None:
+            del world
+            prev = ctx.handover.get("posture")
+            if isinstance(prev, Posture):
+                bl.posture = prev
+            bl.set_posture(self.posture, t)
+
+        exits: list[tuple[Event, str]] = []
+        if self.until is not None:
+            exits.append((self.until, NEXT))
+        if self.seconds is not None:
+            from reactmocap.sim.controllers.machine import after
+
+            exits.append((after(self.seconds), NEXT))
+        return [State("hold", law(bl.control, ctx.control_every), enter, tuple(exits))]
+
+    def with_posture(self, **changes: object) -> Balance:
+        return Balance(replace(self.posture, **changes), self.seconds, self.gains, self.until)  # type: ignore[arg-type]

@@ -1,0 +1,330 @@
+"""Landing (thesis ch. 6), a passive landing: in the air a foot-placement servo adds an offset to
+the hips (eq. 6.1) that puts the feet where the horizontal velocity will be gone when the COM
+is over them (the desired place: a velocity-proportional lead plus the foot-servo delta,
+interpolated over the horizontal velocity as in Table 6.1), the knees bend ready and the ankles
+keep the feet flat. At touchdown the knees' stiffness goes to zero and their damping up; once
+they have slowed to 20% of their touchdown speed the stiffness comes back, and the balance
+controller takes over when the COM passes over the feet, stops near them or starts to move
+away."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from reactmocap.athletics.balance import (
+    BALANCE_GAINS,
+    BalanceLaw,
+    Posture,
+    hold_pelvis_and_feet,
+    knee_for_length,
+)
+from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
+from reactmocap.athletics.rig import joint_index, per_joint
+from reactmocap.errors import ConfigError
+from reactmocap.sim.bodies import BALL_JOINTS
+from reactmocap.sim.controllers.machine import State, after
+from reactmocap.sim.world import World
+
+__all__ = ["LANDING_STIFFNESS", "Landing", "LandingParams"]
+
+NJ = len(BALL_JOINTS)
+_HIP = [joint_index(f"{s}_hip") for s in "lr"]
+_KNEE = [joint_index(f"{s}_knee") for s in "lr"]
+_ANKLE = [joint_index(f"{s}_ankle") for s in "lr"]
+#: stiffness while reaching for the ground (units of m g L N m/rad)
+LANDING_STIFFNESS = {
+    "waist": 3.0, "back": 3.0, "neck": 0.3, "shoulder": 0.3, "elbow": 0.15, "wrist": 0.05,
+    "hip": 1.5, "knee": 0.3, "ankle": 0.3,
+}  # fmt: skip
+#: joint damping while absorbing (units of m L sqrt(g L) N m s/rad; knees: see LandingParams)
+ABSORB_DAMPING = {"waist": 0.1, "back": 0.1, "hip": 0.05, "ankle": 0.05}
+#: lowest hip-to-ankle length (fraction of the leg) the absorption plans to stop by
+DEEPEST_LEG = 0.55
+#: most ground force (body weights) the absorption asks for
+MAX_SUPPORT = 6.0
+#: fraction of the crouch left at touchdown that the planned stop uses
+PLAN_ROOM = 0.7
+
+#: a foot within this height (m) of the floor after touchdown carries weight
+STANCE_REACH = 0.02
+
+
+@dataclass(frozen=True)
+class LandingParams:
+    """Landing parameters.
+
+    Args:
+        knee: knee flexion held in the air (rad).
+        kp, kv: foot-placement servo gains (rad/m, rad s/m) on the hips.
+        lead: how far ahead of the COM the feet go, in units of the capture point's lead
+            (the horizontal velocity times ``sqrt(z / g)``).
+        delta: foot-servo delta (m) added to the desired foot place (from the table).
+        damping: knee damping after touchdown as a vertical damper on the hips (units of
+            m sqrt(g / L) N s/m; turned into the knee's damping through the leg's lever,
+            ``d(hip-ankle length) / d(knee angle)``, each tick).
+        restore: fraction of the touchdown knee speed below which the knee stiffness returns.
+        arms: shoulder pitch held in the air (rad).
+        knee_stiffness: knee stiffness while absorbing (units of m g L N m/rad); 0 is the
+            thesis's knee with its stiffness off; more makes the knees follow the planned
+            crouch.
+        lean: torso pitch per radian of knee flexion while absorbing (see ``Posture``).
+        toes: ankle plantar flexion held in the air (rad): the forefoot lands first and the
+            foot rolls flat under load, as people land (the thesis lands flat-footed).
+    """
+
+    knee: float = 0.6
+    kp: float = 1.5
+    kv: float = 0.15
+    lead: float = 0.75
+    delta: float = -0.04
+    damping: float = 1.0
+    restore: float = 0.2
+    arms: float = -0.6
+    toes: float = 0.0
+    lean: float = 0.5
+    knee_stiffness: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in (
+            "knee",
+            "kp",
+            "kv",
+            "lead",
+            "delta",
+            "damping",
+            "restore",
+            "arms",
+            "toes",
+            "lean",
+            "knee_stiffness",
+        ):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
+
+
+class Landing(Basis):
+    """The landing basis controller; hands over to balance once the landing has settled."""
+
+    name = "land"
+    initial = "reach"
+
+    def __init__(self, params: LandingParams | None = None) -> None:
+        self.params = params or LandingParams()
+
+    def states(self, ctx: Context) -> list[State]:
+        p = self.params
+        every = ctx.control_every
+        rig = ctx.rig
+        bl = BalanceLaw(ctx, BALANCE_GAINS)
+        memo: dict[str, float] = {}
+        m = ctx.world.model
+        pre = rig.wc.prefix
+        hip_joints = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
+        ankle_joints = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]
+
+        def reach_enter(world: World, t: float) -> None:
+            del world
+            rig.set_stiffness(per_joint(LANDING_STIFFNESS))
+            rig.set_damping(per_joint({"knee": 0.1, "hip": 0.1, "ankle": 0.05}))
+            rig.support[:] = 0.0
+            goal = np.full((NJ, 3), np.nan)
+            for s in "lr":
+                goal[joint_index(f"{s}_knee")] = (p.knee, 0.0, 0.0)
+                goal[joint_index(f"{s}_shoulder")] = (p.arms, 0.0, 0.0)
+            for j in ("waist", "back", "neck"):
+                goal[joint_index(j)] = 0.0
+            moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
+            rig.move(goal, 0.2, t, moving)
+
+        def reach(world: World, t: float) -> None:
+            s = ctx.sense(t)
+            h = s.heading()
+            d = world.data
+            hold_pelvis_and_feet(ctx, d, 0.0, h, t)  # ankles: feet flat (hips reset below)
+            feet = s.sole_corners().mean(axis=(0, 1))  # the middle of the soles
+            fvel = _feet_velocity(world, s.feet)
+            v = s.local(s.com_vel, h)
+            # capture point: where the feet stop a pendulum of the COM's height (lead: its
+            # time constant sqrt(z / g)), plus the foot-servo delta
+            g = float(np.linalg.norm(world.model.opt.gravity))
+            lead = p.lead * math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
+            want = np.array([lead * v[0] + p.delta, lead * v[1]])
+            # eq. 6.1 as a correction on top of the geometric placement below
+            x = s.local(feet - s.com, h)
+            xd = s.local(fvel - s.com_vel, h)
+            servo = np.clip(p.kp * (want - x) - p.kv * xd, -0.3, 0.3)
+            # each leg aimed in the world at its foot's place, whatever the pelvis's pitch
+            # (it turns freely in the air with the body's angular momentum)
+            pelvis = bl.pelvis_pitch()
+            goal = np.full((NJ, 3), np.nan)
+            for k in range(2):
+                hip = d.xanchor[hip_joints[k]]
+                length = float(np.linalg.norm(hip - d.xanchor[ankle_joints[k]]))
+                ahead = float(s.local(s.com - hip, h)[0]) + want[0]
+                swing = math.asin(float(np.clip(ahead / max(length, 0.2), -0.9, 0.9)))
+                geom = float(knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k],
+                                             length)[1])  # fmt: skip
+                goal[_HIP[k]] = (-swing + geom - servo[0] - pelvis, servo[1], 0.0)
+            rig.move(goal, 0.0, t, _HIP)
+            rig.offset[:] = 0.0
+            for k in range(2):
+                rig.offset[_ANKLE[k], 0] = p.toes
+
+        def absorb_enter(world: World, t: float) -> None:
+            rig.move(rig.desired(t) + rig.offset, 0.0, t, _HIP)
+            rig.offset[:] = 0.0
+            stiff = rig.stiffness.copy()
+            stiff[_KNEE] = p.knee_stiffness
+            stiff[_ANKLE] = BALANCE_GAINS.stiffness_array()[_ANKLE]
+            stiff[_HIP] = BALANCE_GAINS.stiffness_array()[_HIP]
+            rig.set_stiffness(stiff)
+            # light damping: a joint damper is rigid at impact speeds (its torque grows with
+            # the joint rate), and a rigid leg makes the contact spring the body back up
+            rig.set_damping(per_joint(ABSORB_DAMPING))
+            memo["knee_peak"] = _knee_speed(world, ctx)
+            bl.posture = Posture(leg=_leg_fraction(ctx), lean=p.lean, settle=0.0)
+
+        def absorb(world: World, t: float) -> None:
+            s = ctx.sense(t)
+            # passive, as the thesis's: feet flat, pelvis upright (leaning as the knees bend),
+            # no COM servo (its ankle torques would push the body back off the ground)
+            hold_pelvis_and_feet(ctx, world.data, bl._lean(), s.heading(), t)
+            rig.offset[:] = 0.0
+            _stance_support(ctx)
+            damp = rig.damping.copy()
+            damp[_KNEE] = p.damping * _knee_lever(ctx) ** 2 / rig.athlete.leg_length**2
+            rig.set_damping(damp)
+            # the constant deceleration that stops the sink within the crouch left, planned
+            # afresh each tick (an impact may already have taken most of the speed), as a
+            # vertical ground force the stance legs make; never less than the body's weight
+            room = max((_leg_fraction(ctx) - DEEPEST_LEG) * ctx.athlete.leg_length, 0.03)
+            v = min(float(s.com_vel @ s.floor_normal), 0.0)
+            g = float(np.linalg.norm(world.model.opt.gravity))
+            decel = v * v / (2.0 * PLAN_ROOM * room)
+            vertical = float(np.clip(1.0 + decel / g, 1.0, MAX_SUPPORT))
+            # along the legs, from the feet to the COM, as a passive leg pushes: its
+            # horizontal part takes the horizontal speed off as the COM passes over the feet
+            line = s.com - s.sole_corners().mean(axis=(0, 1))
+            line /= max(float(line @ s.floor_normal), 0.2)
+            rig.support_scale = vertical * float(np.linalg.norm(line))
+            rig.support_dir = line / np.linalg.norm(line)
+            z_d = float(s.com @ s.floor_normal) + v * ctx.control_every * world.timestep
+            z = float(s.com @ s.floor_normal)
+            if p.knee_stiffness > 0:  # the knees' targets follow the planned height
+                goal = np.full((NJ, 3), np.nan)
+                hips = _hip_heights(ctx)
+                for k in range(2):
+                    length = float(np.clip(hips[k] + z_d - z, 0.3 * ctx.athlete.leg_length,
+                                           ctx.athlete.leg_length))  # fmt: skip
+                    knee = knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k], length)
+                    goal[_KNEE[k]] = (float(knee[0]), 0.0, 0.0)
+                rig.move(goal, 0.0, t, _KNEE)
+            memo["knee_peak"] = max(memo["knee_peak"], _knee_speed(world, ctx))
+
+        def slowed(world: World, t: float, t_in: float) -> bool:
+            """The knees have slowed to ``restore`` of their peak speed."""
+            return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
+
+        def recover_enter(world: World, t: float) -> None:
+            del world
+            rig.support_scale = 1.0
+            rig.support_dir = None
+            rig.move(rig.current_angles(), 0.0, t, _KNEE)  # the knees stiffen where they are
+            leg = _leg_fraction(ctx)
+            bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
+            bl.set_posture(Posture(leg=max(leg, 0.5), lean=p.lean, settle=0.3), t)
+
+        def settled(world: World, t: float, t_in: float) -> bool:
+            del world
+            s = ctx.sense(t)
+            h = s.heading()
+            err = s.local(bl.com_target - s.com, h)
+            vel = s.local(s.com_vel, h)
+            passed = float(err @ vel) < 0.0  # moving away from the desired COM
+            still = float(np.linalg.norm(vel)) < 0.05 and float(np.linalg.norm(err)) < 0.05
+            return t_in > 0.05 and (passed or still)
+
+        def done(world: World, t: float) -> None:
+            del world
+            ctx.handover["posture"] = bl.posture
+            del t
+
+        return [
+            State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),
+            State("absorb", law(absorb, every), absorb_enter,
+                  ((slowed, "recover"), (after(1.0), "recover"))),
+            State("recover", law(bl.control, every), recover_enter,
+                  ((settled, "done"), (after(1.0), "done"))),
+            State("done", law(bl.control, every), done, ((after(0.0), NEXT),)),
+        ]  # fmt: skip
+
+
+def _stance_support(ctx: Context) -> None:
+    """Weight shares after touchdown: every foot whose sole is within :data:`STANCE_REACH`
+    of the floor (a landing foot bounces off its contacts for a moment now and then), split
+    by where the COM lies between the feet."""
+    s = ctx.senses
+    rel = s.sole_corners() - ctx.world.data.geom_xpos[s.floor]
+    near = (rel @ s.floor_normal).min(axis=1) < STANCE_REACH
+    rig = ctx.rig
+    rig.support[:] = 0.0
+    if not near.any():
+        return
+    if near.all():
+        pts = s.sole_corners().mean(axis=1)
+        a, b = pts[0, :2], pts[1, :2]
+        ab = b - a
+        w = float(np.clip(np.dot(s.com[:2] - a, ab) / max(float(ab @ ab), 1e-9), 0.0, 1.0))
+        rig.support[:] = (1.0 - w, w)
+    else:
+        rig.support[np.flatnonzero(near)[0]] = 1.0
+
+
+def _hip_heights(ctx: Context) -> np.ndarray:
+    """``(2,)`` current hip-to-ankle distance of each leg (m)."""
+    d = ctx.world.data
+    wc = ctx.rig.wc
+    m = ctx.world.model
+    return np.array([
+        float(np.linalg.norm(d.xanchor[m.joint(wc.prefix + f"{s}_hip").id]
+                             - d.xanchor[m.joint(wc.prefix + f"{s}_ankle").id]))
+        for s in "lr"
+    ])  # fmt: skip
+
+
+def _knee_lever(ctx: Context) -> float:
+    """Mean ``d(hip-ankle distance) / d(knee angle)`` of the legs (m/rad), law of cosines."""
+    a = ctx.athlete
+    knee = ctx.rig.knee_flexion()
+    ul, ll = a.thigh, a.shin
+    length = np.sqrt(ul**2 + ll**2 + 2 * ul * ll * np.cos(knee))
+    return float(np.mean(ul * ll * np.abs(np.sin(knee)) / length))
+
+
+def _knee_speed(world: World, ctx: Context) -> float:
+    wc = ctx.rig.wc
+    d = world.data
+    w = [d.qvel[wc.ball_dof_start + 3 * j : wc.ball_dof_start + 3 * j + 3] for j in _KNEE]
+    return float(max(np.linalg.norm(x) for x in w))
+
+
+def _feet_velocity(world: World, feet: np.ndarray) -> np.ndarray:
+    """Mean world velocity of the feet's centres of mass (``mj_subtreeVel`` has run)."""
+    return world.data.subtree_linvel[feet].mean(axis=0)
+
+
+def _leg_fraction(ctx: Context) -> float:
+    """Current mean hip-to-ankle distance as a fraction of the straight leg."""
+    d = ctx.world.data
+    wc = ctx.rig.wc
+    m = ctx.world.model
+    out = []
+    for s in "lr":
+        hip = d.xanchor[m.joint(wc.prefix + f"{s}_hip").id]
+        ankle = d.xanchor[m.joint(wc.prefix + f"{s}_ankle").id]
+        out.append(float(np.linalg.norm(hip - ankle)))
+    return float(np.clip(np.mean(out) / ctx.athlete.leg_length, 0.3, 1.0))

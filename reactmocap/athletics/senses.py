@@ -1,0 +1,167 @@
+"""What the athletic controllers measure, once per control tick: the centre of mass and its
+velocity (``mj_subtreeVel``), which feet touch the floor and how hard, the ground reaction
+force, the floor's normal (slopes), the support area, and whether anything but the feet
+touches the ground."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.athletics.bodies import Athlete
+from reactmocap.rotations import quat_from_yaw
+from reactmocap.sim.bodies import SIM_BODIES
+from reactmocap.sim.feet import foot_soles, sole_corners_world
+from reactmocap.sim.world import World
+
+__all__ = ["LIFTOFF_CLEARANCE", "Senses"]
+
+F64 = NDArray[np.float64]
+#: how far (m) the lowest sole corner must be above the floor before the athlete counts as
+#: airborne
+LIFTOFF_CLEARANCE = 0.005
+
+
+class Senses:
+    """Measurements of one character, refreshed by :meth:`update` at most once per time."""
+
+    def __init__(self, world: World, athlete: Athlete, character: int = 0) -> None:
+        m = world.model
+        self.world = world
+        self.athlete = athlete
+        self.character = character
+        wc = world.characters[character]
+        self.wc = wc
+        self.root = int(wc.body_ids[0])
+        self.mass = float(m.body_subtreemass[self.root])
+        self.floor = int(m.geom("floor").id)
+        self.feet, self.soles, self._corners = foot_soles(world, character, "athletics")
+        self._ids = {b: int(i) for b, i in zip(SIM_BODIES, wc.body_ids)}
+        #: joint ids of the ankles (left, right)
+        self.ankle_joints = np.array([m.joint(f"{wc.prefix}{s}_ankle").id for s in "lr"])
+        #: body ids of the thighs, shins and feet (left, right each)
+        self.leg_bodies = np.array([self._ids[f"{s}_{p}"] for p in ("thigh", "shin", "foot")
+                                    for s in "lr"])  # fmt: skip
+        self._own = world.geom_character == character
+        self._body = world.geom_body
+        self._f6 = np.zeros(6)
+        self._forward = _forward_in_body(athlete)
+        self.time = -1.0
+        self.com = np.zeros(3)
+        self.com_vel = np.zeros(3)
+        self.foot_contact = np.zeros(2, dtype=bool)
+        self.foot_force = np.zeros(2)
+        self.foot_point = np.zeros((2, 3))
+        self.grf = np.zeros(3)
+        self.other_contact: tuple[str, ...] = ()
+        self.up = np.array([0.0, 0.0, 1.0])
+        self.floor_normal = np.array([0.0, 0.0, 1.0])
+        #: height (m) of the lowest sole corner above the floor
+        self.clearance = 0.0
+        #: ``(2, 4, 3)`` world sole corners at the last update
+        self.corners = np.zeros((2, 4, 3))
+
+    def body(self, name: str) -> int:
+        return self._ids[name]
+
+    def update(self, t: float) -> None:
+        """Measure at rollout time ``t`` (no-op if already done at ``t``)."""
+        if t == self.time:
+            return
+        self.time = t
+        m, d = self.world.model, self.world.data
+        mujoco.mj_subtreeVel(m, d)
+        self.com[:] = d.subtree_com[self.root]
+        self.com_vel[:] = d.subtree_linvel[self.root]
+        self.floor_normal[:] = d.geom_xmat[self.floor].reshape(3, 3)[:, 2]
+        self.foot_contact[:] = False
+        self.foot_force[:] = 0.0
+        self.foot_point[:] = 0.0
+        self.grf[:] = 0.0
+        others: set[str] = set()
+        n = d.ncon
+        if n:
+            geoms = d.contact.geom[:n]
+            hit = np.flatnonzero((geoms == self.floor).any(axis=1) & self._own[geoms].any(axis=1))
+            for i in hit:
+                g1, g2 = int(geoms[i, 0]), int(geoms[i, 1])
+                g = g2 if g1 == self.floor else g1
+                mujoco.mj_contactForce(m, d, int(i), self._f6)
+                frame = d.contact.frame[i].reshape(3, 3)
+                f = frame.T @ self._f6[:3]  # world force on geom2 from geom1
+                if g == g1:
+                    f = -f
+                self.grf += f
+                k = int(np.flatnonzero(self.soles == g)[0]) if g in self.soles else -1
+                if k >= 0:
+                    fn = abs(self._f6[0])
+                    self.foot_contact[k] = True
+                    self.foot_force[k] += fn
+                    self.foot_point[k] += fn * d.contact.pos[i]
+                else:
+                    others.add(SIM_BODIES[int(self._body[g])])
+        for k in range(2):
+            if self.foot_force[k] > 0:
+                self.foot_point[k] /= self.foot_force[k]
+            elif self.foot_contact[k]:
+                self.foot_point[k] = sole_corners_world(d, self.soles, self._corners)[k].mean(0)
+        self.other_contact = tuple(sorted(others))
+        self.corners = sole_corners_world(d, self.soles, self._corners)
+        rel = self.corners - d.geom_xpos[self.floor]
+        self.clearance = float((rel @ self.floor_normal).min())
+
+    # ------------------------------------------------------------------ derived
+    @property
+    def airborne(self) -> bool:
+        """Nothing touches the floor and the soles are clear of it by :data:`LIFTOFF_CLEARANCE`
+        (a sole resting on the floor loses its contacts for a step now and then)."""
+        return (not self.foot_contact.any() and not self.other_contact
+                and self.clearance > LIFTOFF_CLEARANCE)  # fmt: skip
+
+    def sole_corners(self) -> F64:
+        """``(2, 4, 3)`` world corners of the soles (left, right) at the last update."""
+        return self.corners
+
+    def heading(self) -> float:
+        """Heading (rad about +Z) of the pelvis's anatomical forward axis."""
+        d = self.world.data
+        fwd = d.xmat[self.root].reshape(3, 3) @ self._forward
+        return float(np.arctan2(fwd[1], fwd[0]))
+
+    def local(self, v: F64, heading: float | None = None) -> F64:
+        """Horizontal world vector(s) ``v (..., 3)`` in the heading frame (x forward, y left)."""
+        h = self.heading() if heading is None else heading
+        c, s = np.cos(h), np.sin(h)
+        v = np.asarray(v, dtype=np.float64)
+        return np.stack([c * v[..., 0] + s * v[..., 1], -s * v[..., 0] + c * v[..., 1]], -1)
+
+    def heading_quat(self, heading: float | None = None) -> F64:
+        return quat_from_yaw(self.heading() if heading is None else heading)
+
+    def support_center(self, heading: float | None = None) -> F64:
+        """World point (on the floor) at the middle of the support area's extents in the
+        heading frame: the feet in contact, or both feet when none is."""
+        corners = self.sole_corners()
+        use = self.foot_contact if self.foot_contact.any() else np.ones(2, dtype=bool)
+        pts = corners[use].reshape(-1, 3)
+        loc = self.local(pts, heading)
+        mid = 0.5 * (loc.min(axis=0) + loc.max(axis=0))
+        h = self.heading() if heading is None else heading
+        c, s = np.cos(h), np.sin(h)
+        z = float(pts[:, 2].mean())
+        return np.array([c * mid[0] - s * mid[1], s * mid[0] + c * mid[1], z])
+
+    def support_extent(self, heading: float | None = None) -> tuple[F64, F64]:
+        """Min and max ``(2,)`` of the supporting soles' corners in the heading frame."""
+        corners = self.sole_corners()
+        use = self.foot_contact if self.foot_contact.any() else np.ones(2, dtype=bool)
+        loc = self.local(corners[use].reshape(-1, 3), heading)
+        return loc.min(axis=0), loc.max(axis=0)
+
+
+def _forward_in_body(athlete: Athlete) -> F64:
+    """The pelvis's anatomical forward (+X of the neutral frame) in its body frame."""
+    from reactmocap.rotations import quat_conj, quat_rotate
+
+    return quat_rotate(quat_conj(athlete.neutral[0]), np.array([1.0, 0.0, 0.0]))

@@ -1,0 +1,109 @@
+"""The measured tables behind the commanded behaviours (thesis Tables 4.1, 4.2 and 6.1, rebuilt
+for our bodies): one parameter ``s`` in [0, 1] walks a path through the low-level leap
+parameters (:func:`leap_params`, :func:`broad_params`); the tables hold the height or distance
+each ``s`` achieved, and a command is interpolated back to its ``s``. The landing table holds
+the foot-servo delta per horizontal velocity. ``benchmarks/bench_athletics.py --tables``
+rebuilds them (``build_table``); the supported ranges are measured by the same script.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from types import MappingProxyType
+
+import numpy as np
+
+from reactmocap.athletics import measured
+from reactmocap.athletics.land import LandingParams
+from reactmocap.athletics.leap import BROAD_TIMING, LeapParams
+from reactmocap.errors import ConfigError
+
+__all__ = [
+    "BROAD_TABLES",
+    "LANDING_DELTAS",
+    "LANDING_LEADS",
+    "LEAP_TABLES",
+    "SUPPORTED",
+    "broad_params",
+    "effort_for",
+    "landing_delta",
+    "landing_params",
+    "leap_params",
+    "supported_range",
+]
+
+
+def leap_params(s: float) -> LeapParams:
+    """The vertical leap at effort ``s``: a deeper crouch and stiffer push as ``s`` grows (the
+    thesis's Table 4.1 walks crouch height and torso pitch the same way)."""
+    s = float(np.clip(s, 0.0, 1.0))
+    return LeapParams(leg=0.85 - 0.2 * s, pitch=0.0, lean=0.5, stiffness=0.1 + 0.9 * s,
+                      spin_gain=20.0)  # fmt: skip
+
+
+def broad_params(s: float) -> LeapParams:
+    """The standing broad jump at effort ``s``: crouch, COM ahead of the feet, arm swing."""
+    s = float(np.clip(s, 0.0, 1.0))
+    return LeapParams(leg=0.8 - 0.15 * s, pitch=0.3, lean=0.0, com_offset=0.12 + 0.1 * s,
+                      stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
+                      arms=-1.8 - 1.0 * s, broad=True, spin=-5.0, spin_gain=40.0, hold=0.1)  # fmt: skip
+
+
+#: (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
+LEAP_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(measured.LEAP_TABLES)
+#: (effort s, achieved COM travel m)
+BROAD_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    measured.BROAD_TABLES
+)
+#: (horizontal velocity m/s, foot-servo delta m), thesis Table 6.1 rebuilt
+LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    measured.LANDING_DELTAS
+)
+#: the landing's capture-point lead per body (tuned like the thesis's per-body deltas; a BVH
+#: body gets the landing's default)
+LANDING_LEADS: Mapping[str, float] = MappingProxyType({"male": 0.5, "female": 1.0})
+#: (behaviour, parameter) -> body -> (low, high): the measured supported range
+SUPPORTED: Mapping[tuple[str, str], Mapping[str, tuple[float, float]]] = MappingProxyType(
+    measured.SUPPORTED
+)
+
+
+def effort_for(table: tuple[tuple[float, float], ...], value: float, what: str) -> float:
+    """Interpolate a table back from an achieved value to its effort ``s`` (piecewise linear,
+    the table sorted by value)."""
+    if len(table) < 2:
+        raise ConfigError(f"no {what} table for this body; build one (build_table)")
+    s, v = np.array(sorted(table, key=lambda r: r[1])).T
+    return float(np.interp(value, v, s))
+
+
+def landing_delta(table: tuple[tuple[float, float], ...], velocity: float) -> float:
+    """The foot-servo delta (m) for a horizontal velocity (m/s), interpolated."""
+    if not table:
+        return -0.04
+    v, d = np.array(sorted(table)).T
+    return float(np.interp(velocity, v, d))
+
+
+def landing_params(body: str, velocity: float) -> LandingParams:
+    """The landing controller's parameters for a body and a horizontal velocity (m/s)."""
+    lead = LANDING_LEADS.get(body, LandingParams().lead)
+    return LandingParams(lead=lead, delta=landing_delta(LANDING_DELTAS.get(body, ()), velocity))
+
+
+def supported_range(behaviour: str, param: str, body: str) -> tuple[float, float] | None:
+    """The measured supported range of a behaviour's parameter for a body (a BVH body gets the
+    narrower of the two thesis bodies'); None if nothing was measured."""
+    ranges = SUPPORTED.get((behaviour, param))
+    if not ranges:
+        return None
+    if body in ranges:
+        return ranges[body]
+    lo = max(r[0] for r in ranges.values())
+    hi = min(r[1] for r in ranges.values())
+    return (lo, hi) if lo <= hi else None
+
+
+def _finite(value: float) -> bool:
+    return isinstance(value, (int, float)) and math.isfinite(value)

@@ -1,0 +1,148 @@
+"""``athletics leap|broad-jump|land|balance``: thin wrappers over
+:func:`reactmocap.athletics.run` that write a BVH, a report and optional plot and video."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import Any
+
+from reactmocap.errors import ConfigError
+from reactmocap.progress import Progress
+
+__all__ = ["register"]
+
+#: CLI flag -> (behaviour parameter, in degrees at the CLI)
+_FLAGS: dict[str, list[tuple[str, str, bool]]] = {
+    "leap": [("--height", "height", False), ("--effort", "effort", False),
+             ("--spin", "spin", False), ("--backpack", "backpack", False)],
+    "broad-jump": [("--distance", "distance", False), ("--effort", "effort", False),
+                   ("--spin", "spin", False), ("--backpack", "backpack", False)],
+    "land": [("--drop", "drop", False), ("--vx", "vx", False), ("--backpack", "backpack", False)],
+    "balance": [("--seconds", "seconds", False), ("--push", "push", False),
+                ("--push-dir", "push_dir", True), ("--push-duration", "push_duration", False),
+                ("--push-time", "push_time", False), ("--slope", "slope", True),
+                ("--slope-dir", "slope_dir", True), ("--pitch", "pitch", True),
+                ("--pelvis-height", "pelvis_height", False), ("--backpack", "backpack", False)],
+}  # fmt: skip
+_HELP = {
+    "leap": "vertical leap to a COM rise (m), land and balance",
+    "broad-jump": "standing broad jump over a COM distance (m), land and balance",
+    "land": "drop from a height (m), optionally moving, and land",
+    "balance": "stand balanced; optional push, slope, posture and backpack",
+}
+
+
+def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    from reactmocap.athletics.behaviours import BEHAVIOURS
+
+    ath = sub.add_parser("athletics", help="athletic controllers: leap, broad jump, land, balance")
+    inner = ath.add_subparsers(dest="behaviour", metavar="BEHAVIOUR", required=True)
+    for name, flags in _FLAGS.items():
+        b = BEHAVIOURS[name]
+        params = {p.name: p for p in b.params}
+        p = inner.add_parser(name, help=_HELP[name], description=b.description)
+        p.add_argument("--body", default="male", help="male, female or a BVH file (CLIP.bvh)")
+        for flag, key, deg in flags:
+            par = params[key]
+            unit = "deg" if deg else par.unit
+            default = par.default if par.default is None or not deg else math.degrees(par.default)
+            p.add_argument(flag, type=float, default=None,
+                           help=f"{par.help} ({unit}; default {default})")  # fmt: skip
+        if name == "balance":
+            p.add_argument("--com-offset", help="desired COM offset X,Y (m) from the support")
+        p.add_argument("--out", type=Path, help="BVH of the motion (default: NAME_BODY.bvh)")
+        p.add_argument("--report", type=Path, help="JSON report")
+        p.add_argument("--plot", type=Path, help="PNG of COM height and ground force")
+        p.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
+        p.add_argument("--fps", type=float, default=60.0, help="BVH frame rate")
+        p.add_argument("--any-range", action="store_true",
+                       help="run outside the measured supported range (reported honestly)")  # fmt: skip
+        p.set_defaults(func=_run, flags=flags)
+
+
+def _run(args: argparse.Namespace) -> int:
+    from reactmocap.athletics.behaviours import run
+    from reactmocap.io import atomic_write_text
+
+    params: dict[str, Any] = {"fps": args.fps}
+    for flag, key, deg in args.flags:
+        v = getattr(args, flag.lstrip("-").replace("-", "_"))
+        if v is not None:
+            params[key] = math.radians(v) if deg else v
+    if getattr(args, "com_offset", None):
+        try:
+            x, y = (float(v) for v in args.com_offset.split(","))
+        except ValueError:
+            raise ConfigError(
+                f"--com-offset must be X,Y in metres, got {args.com_offset!r}"
+            ) from None
+        params.update(com_offset_x=x, com_offset_y=y)
+    body = str(args.body)
+    bar = _Bar(args.behaviour)
+    with bar:
+        result = run(args.behaviour, body, on_tick=bar.tick, check_range=not args.any_range,
+                     **params)  # fmt: skip
+    out = args.out or Path(f"{args.behaviour}_{result.body}.bvh")
+    result.write_bvh(out)
+    if args.report is not None:
+        atomic_write_text(args.report, result.report_json())
+    if args.plot is not None:
+        from reactmocap.athletics.plots import run_plot
+
+        run_plot(result, args.plot)
+    if args.video is not None:
+        from reactmocap.athletics.plots import run_video
+
+        path, renderer = run_video(result, args.video)
+        print(f"video: {path} ({renderer})")
+    _summary(result.report, out)
+    return 0
+
+
+def _summary(r: dict[str, Any], out: Path) -> None:
+    name = r["behaviour"]
+    bits = [f"{name} ({r['body']})"]
+    if "achieved_height_m" in r:
+        bits.append(f"height {r['achieved_height_m']:.3f} m (asked {r['commanded_height_m']:.3f})")
+    if "achieved_distance_m" in r:
+        bits.append(f"distance {r['achieved_distance_m']:.3f} m "
+                    f"(asked {r['commanded_distance_m']:.3f})")  # fmt: skip
+    for key in ("landed", "balanced", "fell"):
+        if key in r:
+            bits.append(f"{key}={r[key]}")
+    if r.get("peak_grf_bw") is not None:
+        bits.append(f"push-off peak {r['peak_grf_bw']:.1f} BW")
+    if "max_com_offset_m" in r:
+        bits.append(f"max COM offset {r['max_com_offset_m']:.3f} m")
+    bits.append(f"{r['realtime_factor_cpu']:.1f}x real time ({r['realtime_factor']:.1f}x wall)")
+    print(", ".join(bits) + f" -> {out}")
+    if r.get("status") != "ok":
+        print(f"note: the simulation stopped early: {r.get('reason')}")
+    if r.get("human_plausible") is False:
+        over = ", ".join(f"{k} {v:.2f}x" for k, v in r.get("strength_exceeded", {}).items())
+        print(f"note: this needs more joint torque than the strength model allows ({over}); "
+              "a person could not do it (docs/athletics.md)")  # fmt: skip
+    if r.get("landed") is False or r.get("fell"):
+        print("note: the athlete did not end balanced on its feet")
+
+
+class _Bar:
+    """Progress over the simulated fraction (quiet unless stderr is a terminal)."""
+
+    def __init__(self, label: str) -> None:
+        self.label = label
+        self.bar: Progress | None = None
+
+    def tick(self, fraction: float) -> None:
+        if self.bar is None:
+            self.bar = Progress(100, f"{self.label} (% simulated)")
+        self.bar.update(round(100 * fraction) - self.bar.done)
+
+    def __enter__(self) -> _Bar:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(None, None, None)
