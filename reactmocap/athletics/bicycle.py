@@ -414,7 +414,7 @@ class Bicycle:
             _visual(crank, [-0.05, sign * off, z], [0.05, sign * off, z], 0.012, _TYRE_RGBA)
         spec.add_equality(
             name=pre + "chain", type=mujoco.mjtEq.mjEQ_JOINT, name1=pre + "rear_spin",
-            name2=pre + "crank", data=[0.0, dt.gear] + [0.0] * 9, solref=list(dt.chain),
+            name2=pre + "crank", data=[0.0, dt.gear] + [0.0] * 10, solref=list(dt.chain),
         )  # fmt: skip
 
     # --------------------------------------------------------------- binding
