@@ -340,7 +340,10 @@ class Bicycle:
         p, pre = self.params, self.prefix
         rr, rf = p.rear.radius, p.front.radius
         origin = np.array([0.0, 0.0, rr])  # the frame body sits at the rear wheel's centre
-        frame = spec.worldbody.add_body(name=pre + "frame", pos=origin.tolist())
+        pl = self.placement  # compiled where it starts: bicycles never overlap, even at qpos0
+        frame = spec.worldbody.add_body(
+            name=pre + "frame", pos=[pl.x, pl.y, rr], quat=_yaw_pitch_quat(pl.heading, 0.0).tolist()
+        )
         frame.add_freejoint(name=pre + "root")
         _inertial(frame, p.frame, origin)
         self._wheel(frame, "rear_wheel", "rear_spin", [0.0, 0.0, 0.0], p.rear)

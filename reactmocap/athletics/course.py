@@ -86,12 +86,15 @@ class Route:
         return s, near[rows, k]
 
     def point(self, s: F64) -> F64:
-        """Route points ``(k, 2)`` at distances ``s`` ``(k,)`` (clamped to the route)."""
+        """Route points ``(k, 2)`` at distances ``s`` ``(k,)``; past the end the route goes on
+        straight (riders ride on after the finish)."""
         lens = self.lengths
-        s = np.clip(s, 0.0, lens[-1])
-        x = np.interp(s, lens, self.points[:, 0])
-        y = np.interp(s, lens, self.points[:, 1])
-        return np.column_stack([x, y])
+        x = np.interp(np.clip(s, 0.0, lens[-1]), lens, self.points[:, 0])
+        y = np.interp(np.clip(s, 0.0, lens[-1]), lens, self.points[:, 1])
+        out = np.column_stack([x, y])
+        past = np.maximum(np.asarray(s, dtype=np.float64) - lens[-1], 0.0)
+        end = self.points[-1] - self.points[-2]
+        return out + past[:, None] * end / np.linalg.norm(end)
 
     def direction(self, s: F64) -> F64:
         """Unit directions ``(k, 2)`` of the route at distances ``s``."""

@@ -336,7 +336,10 @@ def _staging() -> Iterator[_Stage]:
             with contextlib.suppress(FileNotFoundError):
                 tmp.unlink()
         raise
+    mask = os.umask(0)
+    os.umask(mask)
     for target, tmp in st.files.items():
+        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600; honour the umask like open()
         os.replace(tmp, target)
 
 
@@ -565,11 +568,13 @@ def group_ride(
     body: str | Path | Motion = "male",
     gains: GroupGains | None = None,
     placements: Sequence[Placement] | None = None,
+    routes: Sequence[Route] | None = None,
     fps: float = 30.0,
     on_tick: Callable[[float], None] | None = None,
 ) -> CyclingResult:
     """``riders`` riders around ``course`` (a start grid behind the route's start unless
-    ``placements`` are given) for the course's seconds (or ``seconds``)."""
+    ``placements`` are given; the course's route for all unless each has its own in
+    ``routes``) for the course's seconds (or ``seconds``)."""
     if not (isinstance(riders, int) and 1 <= riders <= 26):
         raise ConfigError(f"riders must be 1-26, got {riders!r}")
     length = float(course.seconds if seconds is None else seconds)
@@ -581,7 +586,8 @@ def group_ride(
     for pl in pls:
         _check_speed(pl.speed, "a rider's start speed")
     team = setup(pls, body=body, terrain=course.terrain, obstacles=course.obstacles)
-    group = GroupRiding(team.riders, course.route, course.speed, obstacles=course.obstacles,
+    group = GroupRiding(team.riders, course.route if routes is None else routes, course.speed,
+                        obstacles=course.obstacles,
                         spacing=course.spacing, lookahead=course.lookahead, gains=gains,
                         control_every=team.riders[0].control_every * 2)  # fmt: skip
     mon = Monitor(team, course.route)

@@ -11,8 +11,8 @@ which we read as the change the rider makes to its current velocity ``v`` (with 
 command for :class:`~reactmocap.athletics.rider.Rider`. Riders know each other only by
 observation: a rider's desired position is its own, the others see where it goes.
 
-The desired position, relative to the rider's own: for each visible neighbour closer than the
-spacing, a point ``spacing`` from it on the rider's side (separation, as Reynolds); for each
+The desired position, relative to the rider's own: for each visible neighbour closer than
+1.25 spacings, a point ``spacing`` from it on the rider's side (separation, as Reynolds); for each
 visible neighbour or obstacle whose closest approach within :attr:`GroupGains.horizon` s, at the
 current velocities, passes nearer than the clearance, a sideways step to clear it (on the side
 the rider already passes, to the right when dead ahead). Design and figures:
@@ -43,17 +43,21 @@ class GroupGains:
     """Eq. 13's gains ``k_p`` (1/s) and ``k_v``; what a rider sees: ``view`` (m) and the field
     of view ``fov`` (rad, full angle); the time ``horizon`` (s) a rider looks ahead for close
     passes; the clearance kept from obstacles' surfaces (m); the speed command's range as
-    fractions of the global speed; the largest position correction (m)."""
+    fractions of the global speed; the largest position correction (m); the road's half width
+    (m) around the route, inside which nothing pulls a rider back to the route; neighbours
+    closer than ``separation`` times the spacing push the desired position away."""
 
-    kp: float = 0.6
+    kp: float = 0.5
     kv: float = 1.0
-    view: float = 15.0
+    view: float = 20.0
     fov: float = math.radians(240.0)
-    horizon: float = 3.0
+    horizon: float = 4.0
     clearance: float = 1.2
     min_speed: float = 0.6
     max_speed: float = 1.3
-    max_correction: float = 4.0
+    max_correction: float = 3.0
+    road: float = 4.0
+    separation: float = 1.25
 
     def __post_init__(self) -> None:
         if not (self.kp >= 0 and self.kv >= 0 and self.view > 0 and 0 < self.fov <= 2 * math.pi
@@ -89,8 +93,7 @@ def _pass_step(rel: F64, rel_vel: F64, clearance: F64, horizon: float, fallback:
     dist = np.linalg.norm(miss, axis=1)
     need = closing & (dist < clearance)
     away = np.where(dist[:, None] > 1e-3, -miss / np.maximum(dist, 1e-3)[:, None], fallback)
-    urgency = np.clip(1.0 - t / horizon, 0.0, 1.0)
-    return np.where(need[:, None], (clearance - dist)[:, None] * urgency[:, None] * away, 0.0)
+    return np.where(need[:, None], (clearance - dist)[:, None] * away, 0.0)
 
 
 class GroupRiding:
@@ -100,7 +103,7 @@ class GroupRiding:
     def __init__(
         self,
         riders: Sequence[Rider],
-        route: Route,
+        route: Route | Sequence[Route],
         speed: float,
         *,
         obstacles: Sequence[Obstacle] = (),
@@ -114,7 +117,11 @@ class GroupRiding:
         if not (math.isfinite(speed) and speed > 0 and spacing > 0 and lookahead > 0):
             raise ConfigError("group speed, spacing and lookahead must be > 0")
         self.riders = list(riders)
-        self.route = route
+        #: the route each rider's global velocity follows (one route for a group; a route per
+        #: rider lets riders meet, e.g. head on)
+        self.routes = [route] * len(self.riders) if isinstance(route, Route) else list(route)
+        if len(self.routes) != len(self.riders):
+            raise ConfigError(f"{len(self.riders)} riders need 1 or {len(self.riders)} routes")
         self.speed = float(speed)
         self.obstacles = np.array([[o.x, o.y, o.radius] for o in obstacles]).reshape(-1, 3)
         self.spacing = float(spacing)
@@ -128,15 +135,22 @@ class GroupRiding:
         del world
 
     def global_velocity(self, pos: F64) -> F64:
-        """``(n, 2)`` the group's global velocity at each rider: the course speed toward the
-        route point ``lookahead`` m further along than the rider's own."""
-        s, _ = self.route.project(pos)
-        target = self.route.point(s + self.lookahead)
-        d = target - pos
-        n = np.linalg.norm(d, axis=1, keepdims=True)
-        along = self.route.direction(s)
-        d = np.where(n > 1e-6, d / np.maximum(n, 1e-6), along)
-        return self.speed * d
+        """``(n, 2)`` the group's global velocity at each rider: the course speed along the
+        route (from the rider's nearest route point toward the one ``lookahead`` m further, so
+        corners are taken in time), plus a pull back toward the route for a rider more than
+        :attr:`GroupGains.road` m off it (the road's half width)."""
+        out = np.empty_like(pos)
+        for k, route in enumerate(self.routes):
+            p = pos[k : k + 1]
+            s, near = route.project(p)
+            ahead = route.point(s + self.lookahead) - near
+            n = float(np.linalg.norm(ahead))
+            along = ahead[0] / n if n > 1e-6 else route.direction(s)[0]
+            off = (near - p)[0]
+            dist = float(np.linalg.norm(off))
+            excess = max(dist - self.gains.road, 0.0)
+            out[k] = self.speed * along + self.gains.kp * excess * off / max(dist, 1e-6)
+        return out
 
     def commands(self, pos: F64, vel: F64, head: F64) -> tuple[F64, F64]:
         """Speed ``(n,)`` and heading ``(n,)`` commands from the observed state."""
@@ -155,7 +169,7 @@ class GroupRiding:
             seen = (dist < gn.view) & (np.abs(ang) <= gn.fov / 2)
             seen[i] = False
             e = np.zeros(2)
-            near = seen & (dist < self.spacing)
+            near = seen & (dist < gn.separation * self.spacing)
             if near.any():  # separation: a point `spacing` from each close neighbour
                 spots = pos[near] - rel[near] / np.maximum(dist[near], 1e-6)[:, None] * self.spacing
                 e += np.mean(spots, axis=0) - pos[i]

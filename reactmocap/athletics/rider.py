@@ -297,6 +297,10 @@ class RiderMount:
         neutral = ath.neutral
         rr = p.rear.radius
         pelvis = spec.body(pre + "pelvis")
+        # compiled beside its bicycle (the characters' reference poses all stand at the origin:
+        # many riders there would touch each other)
+        pl = self.bicycle.placement
+        pelvis.pos = [pelvis.pos[0] + pl.x, pelvis.pos[1] + pl.y, pelvis.pos[2]]
         frame = spec.body(bp + "frame")
         fork = spec.body(bp + "fork")
         head = p.steer_foot + p.steer_axis * (p.front.radius / p.steer_axis[2])
@@ -591,7 +595,11 @@ class Rider:
         lag = max(sg.lag, 2.0 * sg.zeta / wn)  # the lean servo's lag
         accel = max_rate / max(sg.turn_in, lag)
         left = _wrap(self.heading_cmd - self._ref)
-        want = math.copysign(min(max_rate, math.sqrt(2.0 * accel * abs(left))), left)
+        # as fast as allowed, braking in time (sqrt(2 a e)); near the target a first-order
+        # approach (the square root's gain is unbounded at zero: it would chatter)
+        want = math.copysign(
+            min(max_rate, math.sqrt(2.0 * accel * abs(left)), abs(left) / lag), left
+        )
         self._ref_rate += min(max(want - self._ref_rate, -accel * h), accel * h)
         self._ref = _wrap(self._ref + self._ref_rate * h)
         # the heading the bicycle can have by now: the reference through the lean's lag; the

@@ -312,7 +312,10 @@ class World:
         m, d, cfg = self.model, self.data, self.config
         for wc in self.characters:
             d.qpos[wc.qpos_slice] = wc.character.model.qpos0
-        mujoco.mj_forward(m, d)
+        # the mass matrix only: no collision pass (characters all at their origin would touch)
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_makeM(m, d)
         diag = np.empty(m.nv)
         diag[:] = d.M[m.M_rowadr + m.M_rownnz - 1]  # diagonal = last entry of each CSR row
         for wc in self.characters:
