@@ -463,9 +463,11 @@ class Rider:
         self._resist = p.rolling_resistance
         self._mass = float(m.body_subtreemass[wc.body_ids[0]]) + p.mass
         # leg Jacobian columns (hip and knee DOFs) and the ball sites
+        # leg Jacobian columns: hip, knee and ankle (the ankle passes the pedal force's moment
+        # about it on to the foot; its servo alone, scaled by a foot's inertia, would fold)
         self._leg_cols = [
-            np.concatenate([wc.ball_dof_start + 3 * BALL_JOINTS.index(f"{s}_hip") + np.arange(3),
-                            wc.ball_dof_start + 3 * BALL_JOINTS.index(f"{s}_knee") + np.arange(3)])
+            np.concatenate([wc.ball_dof_start + 3 * BALL_JOINTS.index(f"{s}_{j}") + np.arange(3)
+                            for j in ("hip", "knee", "ankle")])
             for s in "lr"
         ]  # fmt: skip
         self._feet = [int(wc.body_ids[_B[f"{s}_foot"]]) for s in "lr"]
@@ -592,7 +594,7 @@ class Rider:
             g * math.tan(sg.max_lean) / vv, vv * math.tan(0.5 * sg.max_fork) / self._wheelbase
         )
         wn = min(sg.wn, sg.wn_per_speed * vv)  # slower lean servo at low speed: gains ~ 1/v^2
-        lag = max(sg.lag, 2.0 * sg.zeta / wn)  # the lean servo's lag
+        lag = sg.lag * (sg.wn / wn) ** 1.5  # the lean servo's lag grows at low speed
         accel = max_rate / max(sg.turn_in, lag)
         left = _wrap(self.heading_cmd - self._ref)
         # as fast as allowed, braking in time (sqrt(2 a e)); near the target a first-order
