@@ -44,6 +44,7 @@ __all__ = [
     "Fit",
     "Part",
     "Placement",
+    "WHEEL_SHAPES",
     "Wheel",
     "benchmark_matrices",
     "linear_eigenvalues",
@@ -53,6 +54,8 @@ F64 = NDArray[np.float64]
 #: Meijaard et al. 2007, section 4: the benchmark's weave and capsize speeds (m/s)
 BENCHMARK_WEAVE_SPEED = 4.292382208689
 BENCHMARK_CAPSIZE_SPEED = 6.024262423973
+#: wheel collision shapes: the flat ellipsoid is the knife-edge wheel; the others for comparison
+WHEEL_SHAPES = ("ellipsoid", "cylinder", "sphere")
 #: a bicycle below this roll (rad) has fallen: its handlebar or pedal is on the ground
 FALLEN_ROLL = math.radians(60.0)
 
@@ -114,7 +117,9 @@ class BicycleParams:
             handlebar ``H``.
         rolling_resistance: total resistive force per unit speed (N s/m), half at each wheel.
         tyre: the wheel ellipsoid's half width (m); wheel_contact: its contact time constant
-            (s) and damping ratio; noslip: MuJoCo noslip iterations.
+            (s) and damping ratio; noslip: MuJoCo noslip iterations; wheel_shape: the wheel's
+            collision shape, ``"ellipsoid"`` (the knife edge) or, to show why not,
+            ``"cylinder"`` or ``"sphere"``.
         drivetrain, fit: for a rider (``None``: the bare benchmark).
     """
 
@@ -129,6 +134,7 @@ class BicycleParams:
     tyre: float = 0.002
     wheel_contact: tuple[float, float] = (0.004, 1.0)
     noslip: int = 10
+    wheel_shape: str = "ellipsoid"
     drivetrain: Drivetrain | None = None
     fit: Fit | None = None
 
@@ -155,6 +161,10 @@ class BicycleParams:
         if dt is not None and not (dt.gear > 0 and dt.crank_length > 0 and dt.crank_mass > 0
                                    and dt.crank_inertia > 0 and dt.chain[0] > 0):  # fmt: skip
             raise ConfigError("drivetrain gear, crank length, mass, inertia and chain must be > 0")
+        if self.wheel_shape not in WHEEL_SHAPES:
+            raise ConfigError(
+                f"wheel_shape must be one of {list(WHEEL_SHAPES)}, got {self.wheel_shape!r}"
+            )
         if self.noslip < 0:
             raise ConfigError(f"noslip iterations must be >= 0, got {self.noslip!r}")
 
@@ -387,8 +397,17 @@ class Bicycle:
         body.mass = w.mass
         body.ipos = [0.0, 0.0, 0.0]
         body.inertia = [w.ixx, w.iyy, w.ixx]
-        g = body.add_geom(name=pre + name, type=mujoco.mjtGeom.mjGEOM_ELLIPSOID,
-                          size=[w.radius, self.params.tyre, w.radius])  # fmt: skip
+        shape = self.params.wheel_shape
+        if shape == "ellipsoid":
+            g = body.add_geom(name=pre + name, type=mujoco.mjtGeom.mjGEOM_ELLIPSOID,
+                              size=[w.radius, self.params.tyre, w.radius])  # fmt: skip
+        elif shape == "cylinder":  # axis along the hinge (y)
+            g = body.add_geom(name=pre + name, type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                              size=[w.radius, self.params.tyre, 0.0],
+                              quat=[math.sqrt(0.5), math.sqrt(0.5), 0.0, 0.0])  # fmt: skip
+        else:
+            g = body.add_geom(name=pre + name, type=mujoco.mjtGeom.mjGEOM_SPHERE,
+                              size=[w.radius, 0.0, 0.0])  # fmt: skip
         g.density = 0.0
         g.mass = 0.0
         g.rgba = list(_TYRE_RGBA)
