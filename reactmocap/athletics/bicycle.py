@@ -448,7 +448,7 @@ class Bicycle:
         self.frame_id = int(m.body(pre + "frame").id)
         self.fork_id = int(m.body(pre + "fork").id)
         self.wheel_geoms = np.array([m.geom(pre + n).id for n in ("rear_wheel", "front_wheel")])
-        self.body_ids = np.flatnonzero(np.isin(np.arange(m.nbody), self._subtree(m)))
+        self.body_ids = np.array(self._subtree(m), dtype=np.int64)
         root = m.joint(pre + "root")
         self.qpos_adr = int(root.qposadr[0])
         self.dof_adr = int(root.dofadr[0])

@@ -18,7 +18,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
@@ -44,6 +43,7 @@ __all__ = [
     "group_ride",
     "ride",
     "setup",
+    "start_grid",
 ]
 
 F64 = NDArray[np.float64]
@@ -96,8 +96,7 @@ def setup(
     scene.place(world)
     riders = []
     for k, (b, mnt) in enumerate(zip(bikes, mounts)):
-        r = Rider(world, ath, b, k, speed=b.placement.speed, heading=b.placement.heading)
-        r.mount = mnt
+        r = Rider(world, ath, b, mnt, k, speed=b.placement.speed, heading=b.placement.heading)
         r.seat()
         riders.append(r)
     return Team(world, scene, ath, bikes, riders)
@@ -157,6 +156,7 @@ class Monitor:
         self.finish = np.full(n, np.nan)
         self.min_separation = math.inf
         self.separation_pair = (-1, -1)
+        self.separation_time = math.nan
         iu = np.triu_indices(n, 1)
         self._pairs = iu
 
@@ -169,15 +169,15 @@ class Monitor:
         if nc:
             g = d.contact.geom[:nc]
             o = self.owner[g]
-            for (a, b), (ga, gb) in zip(o, g):
-                if a == -3 or b == -3:
-                    continue
-                if a == -1 or b == -1:  # the floor: only a rider's body counts (a fall)
-                    k, geom = (b, gb) if a == -1 else (a, ga)
-                    if k >= 0 and not self.is_wheel[geom] and np.isnan(self.fell_at[k]):
+            floor = (o == -1).any(axis=1)
+            # wheels on the floor (nearly every contact) and looks-only geoms are not events
+            other = np.where(o[:, 0] == -1, g[:, 1], g[:, 0])
+            keep = ~(o == -3).any(axis=1) & ~(floor & self.is_wheel[other]) & (o[:, 0] != o[:, 1])
+            for (a, b), on_floor in zip(o[keep], floor[keep]):
+                if on_floor:  # a rider's body on the ground: a fall
+                    k = int(b if a == -1 else a)
+                    if k >= 0 and np.isnan(self.fell_at[k]):
                         self.fell_at[k] = t
-                    continue
-                if a == b:
                     continue
                 pair = (int(min(a, b)), int(max(a, b))) if min(a, b) >= 0 else (int(max(a, b)), -2)
                 last = self._last.get(pair)
@@ -195,6 +195,7 @@ class Monitor:
             if dist[k] < self.min_separation:
                 self.min_separation = float(dist[k])
                 self.separation_pair = (int(i[k]), int(j[k]))
+                self.separation_time = t
         if self.route is not None:
             a0, a1 = self._lines()
             s, _ = self.route.project(0.5 * (a0 + a1))
@@ -605,6 +606,7 @@ def group_ride(
                           for t, i, j in mon.collisions],
         "min_separation_m": None if not math.isfinite(mon.min_separation) else mon.min_separation,
         "min_separation_pair": list(mon.separation_pair),
+        "min_separation_at_s": mon.separation_time,
         "fell": int(fell.sum()),
         "finish_times_s": [None if np.isnan(f) else float(f) for f in mon.finish],
         "finished": int(np.sum(~np.isnan(mon.finish))),
@@ -618,9 +620,3 @@ def group_ride(
                             f"{length:g} s")  # fmt: skip
     return CyclingResult("group", team, res, rep, logs, course.route, course.obstacles, cpu,
                          {"group": group, "monitor": mon})  # fmt: skip
-
-
-def rendered_world(result: CyclingResult) -> tuple[mujoco.MjModel, F64]:
-    """The world's model and the recorded qpos rows (for rendering)."""
-    _, q = result.rollout.frames()
-    return result.team.world.model, q

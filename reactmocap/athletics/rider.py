@@ -390,7 +390,8 @@ def _wrap(a: float) -> float:
 
 
 class Rider:
-    """The rider's controller (module docstring) for character ``character`` on ``bicycle``.
+    """The rider's controller (module docstring) for character ``character`` on ``bicycle``,
+    tied to it by ``mount`` (bound in ``world``).
 
     Commands: :attr:`speed_cmd` (m/s) and :attr:`heading_cmd` (rad), settable at any time (a
     group behaviour sets them every tick). ``grade``: the terrain's rise along the bicycle's
@@ -401,6 +402,7 @@ class Rider:
         world: World,
         athlete: Athlete,
         bicycle: Bicycle,
+        mount: RiderMount,
         character: int = 0,
         *,
         speed: float = 5.0,
@@ -482,7 +484,9 @@ class Rider:
         self._integral = 0.0
         self._torque = 0.0
         self._fork_cmd = 0.0
-        self.mount: RiderMount | None = None
+        if mount.bicycle is not bicycle or mount.world is not world:
+            raise ConfigError("the rider's mount must tie it to this bicycle in this world")
+        self.mount = mount
 
     # ---------------------------------------------------------------- pose
     def _frame(self) -> tuple[F64, F64]:
@@ -546,8 +550,6 @@ class Rider:
         return out
 
     def _sites(self) -> dict[str, int]:
-        if self.mount is None:
-            raise ConfigError("the rider has no mount: pass the RiderMount to the Rider")
         return self.mount.sites
 
     def seat(self) -> None:
