@@ -72,12 +72,17 @@ class Route:
 
     def project(self, xy: F64) -> tuple[F64, F64]:
         """For points ``(k, 2)``: distance along the route of the nearest route point ``(k,)``
-        and that point ``(k, 2)``."""
+        (negative before the start, beyond the length after the end) and that point ``(k, 2)``."""
         p = self.points
         a, b = p[:-1], p[1:]
         ab = b - a
         t = np.einsum("kij,ij->ki", xy[:, None] - a[None], ab) / np.einsum("ij,ij->i", ab, ab)
-        t = np.clip(t, 0.0, 1.0)
+        # the route goes on straight before its start and after its end (riders start behind
+        # the start line and ride on after the finish)
+        lo = np.zeros(len(ab))
+        hi = np.ones(len(ab))
+        lo[0], hi[-1] = -np.inf, np.inf
+        t = np.clip(t, lo, hi)
         near = a[None] + t[..., None] * ab[None]
         d = np.linalg.norm(xy[:, None] - near, axis=2)
         k = np.argmin(d, axis=1)
@@ -86,15 +91,18 @@ class Route:
         return s, near[rows, k]
 
     def point(self, s: F64) -> F64:
-        """Route points ``(k, 2)`` at distances ``s`` ``(k,)``; past the end the route goes on
-        straight (riders ride on after the finish)."""
+        """Route points ``(k, 2)`` at distances ``s`` ``(k,)``; before the start and past the
+        end the route goes on straight."""
         lens = self.lengths
+        s = np.asarray(s, dtype=np.float64)
         x = np.interp(np.clip(s, 0.0, lens[-1]), lens, self.points[:, 0])
         y = np.interp(np.clip(s, 0.0, lens[-1]), lens, self.points[:, 1])
         out = np.column_stack([x, y])
-        past = np.maximum(np.asarray(s, dtype=np.float64) - lens[-1], 0.0)
-        end = self.points[-1] - self.points[-2]
-        return out + past[:, None] * end / np.linalg.norm(end)
+        p = self.points
+        first, last = p[1] - p[0], p[-1] - p[-2]
+        out += np.minimum(s, 0.0)[:, None] * first / np.linalg.norm(first)
+        out += np.maximum(s - lens[-1], 0.0)[:, None] * last / np.linalg.norm(last)
+        return out
 
     def direction(self, s: F64) -> F64:
         """Unit directions ``(k, 2)`` of the route at distances ``s``."""

@@ -394,8 +394,10 @@ class Rider:
     tied to it by ``mount`` (bound in ``world``).
 
     Commands: :attr:`speed_cmd` (m/s) and :attr:`heading_cmd` (rad), settable at any time (a
-    group behaviour sets them every tick). ``grade``: the terrain's rise along the bicycle's
-    heading, for the crank torque's feed-forward (0: flat)."""
+    group behaviour sets them every tick). Servo: stiffness ``kp`` (1/s^2, times each joint's
+    outboard inertia), scaled by ``arm_scale`` at the shoulders, elbows and wrists (the fork
+    follows the hands) and ``leg_scale`` at the hips, knees and ankles (the pedals lead the
+    legs); waist and back x3."""
 
     def __init__(
         self,
@@ -411,10 +413,16 @@ class Rider:
         speed_gains: SpeedGains | None = None,
         steer_gains: SteerGains | None = None,
         kp: float = 900.0,
+        arm_scale: float = 4.0,
+        leg_scale: float = 0.5,
         control_every: int = 4,
     ) -> None:
         if not (0 <= character < len(world.characters)):
             raise ConfigError(f"character {character} is not in the world")
+        if not (kp > 0 and arm_scale > 0 and leg_scale > 0 and control_every >= 1):
+            raise ConfigError("kp, arm_scale and leg_scale must be > 0, control_every >= 1")
+        if not (math.isfinite(speed) and math.isfinite(heading)):
+            raise ConfigError("speed and heading commands must be finite")
         self.world, self.athlete, self.bicycle, self.character = world, athlete, bicycle, character
         self.speed_cmd = float(speed)
         self.heading_cmd = float(heading)
@@ -422,17 +430,17 @@ class Rider:
         self.speed_gains = speed_gains or SpeedGains()
         self.steer_gains = steer_gains or SteerGains()
         self.kp = float(kp)
-        self.arm_scale = 4.0
-        self.leg_scale = 0.5
+        self.arm_scale = float(arm_scale)
+        self.leg_scale = float(leg_scale)
         self.control_every = int(control_every)
         self.log = RiderLog()
-        self.grade_normal = np.array([0.0, 0.0, 1.0])
         m = world.model
         wc = world.characters[character]
         self.wc = wc
         self.servo = world.servo
         p = bicycle.params
-        assert p.drivetrain is not None and p.fit is not None
+        if p.drivetrain is None or p.fit is None:
+            raise ConfigError("a rider's bicycle needs a drivetrain and a fit (fit_bicycle)")
         self.dt_params = p.drivetrain
         ch = athlete.character
         self._bq = ch.body_quat  # (16, 4)
@@ -464,7 +472,6 @@ class Rider:
         self._wheelbase = p.wheelbase / math.cos(p.steer_tilt)
         self._resist = p.rolling_resistance
         self._mass = float(m.body_subtreemass[wc.body_ids[0]]) + p.mass
-        # leg Jacobian columns (hip and knee DOFs) and the ball sites
         # leg Jacobian columns: hip, knee and ankle (the ankle passes the pedal force's moment
         # about it on to the foot; its servo alone, scaled by a foot's inertia, would fold)
         self._leg_cols = [
