@@ -177,14 +177,14 @@ def group(sizes: list[int], seconds: float | None) -> None:
     print("## 5. Group around the corner on a hill with five obstacles\n")
     course = load_course(COURSE)
     print(
-        "| riders | seconds | collisions | fell | min separation m | finished | finish s (median) | real time (wall) | real time (CPU) |"
+        "| riders | seconds | collisions | fell | min separation m (when) | finished | finish s (median) | real time (wall) | real time (CPU) |"
     )
     print("|---|---|---|---|---|---|---|---|---|")
     for n in sizes:
         res = group_ride(course, n, seconds=seconds)
         r = res.report
         done = [t for t in r["finish_times_s"] if t is not None]
-        print(f"| {n} | {r['seconds']:g} | {r['collisions']} | {r['fell']} | {_f(r['min_separation_m'])} | "
+        print(f"| {n} | {r['seconds']:g} | {r['collisions']} | {r['fell']} | {_f(r['min_separation_m'], '.3f')} at {_f(r['min_separation_at_s'], '.1f')} s | "
               f"{len(done)}/{n} | {_f(float(np.median(done)) if done else None, '.1f')} | "
               f"{r['realtime_factor']:.2f}x | {r['cpu_realtime_factor']:.2f}x |")  # fmt: skip
         if r["collisions"]:
