@@ -218,12 +218,8 @@ BENCHMARK = BicycleParams(
 #: rider), a fixed-gear drivetrain and a saddle and grips fitted later to the rider
 #: (:func:`reactmocap.athletics.rider.fit_bicycle`). Rolling resistance 3 N s/m lumps tyre
 #: losses and air drag: 15 N (75 W) at 5 m/s, 30 N (300 W) at 10 m/s.
-RIDER_BICYCLE = BicycleParams(
-    wheelbase=1.02,
-    trail=0.08,
-    steer_tilt=math.pi / 10,
-    rear=Wheel(0.3, 2.0, 0.0603, 0.12),
-    front=Wheel(0.35, 3.0, 0.1405, 0.28),
+RIDER_BICYCLE = replace(
+    BENCHMARK,
     frame=Part(8.0, (0.42, 0.62), (0.35, 0.6, 0.3, 0.05)),
     fork=Part(2.0, (0.85, 0.75), (0.08, 0.07, 0.03, 0.02)),
     rolling_resistance=3.0,

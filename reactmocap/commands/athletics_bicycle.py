@@ -10,8 +10,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+from reactmocap.commands.athletics import _Bar
 from reactmocap.errors import ConfigError
-from reactmocap.progress import Progress
 
 __all__ = ["register"]
 
@@ -119,23 +119,3 @@ def _print(bits: list[str], r: dict[str, Any], written: dict[str, str]) -> None:
         print(f"video: {written['video']} ({written.get('video_renderer')})")
     for note in r.get("notes", []):
         print(f"note: {note} (docs/athletics.md)")
-
-
-class _Bar:
-    """Progress over the simulated fraction (quiet unless stderr is a terminal)."""
-
-    def __init__(self, label: str) -> None:
-        self.label = label
-        self.bar: Progress | None = None
-
-    def tick(self, fraction: float) -> None:
-        if self.bar is None:
-            self.bar = Progress(100, f"{self.label} (% simulated)")
-        self.bar.update(round(100 * fraction) - self.bar.done)
-
-    def __enter__(self) -> _Bar:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if self.bar is not None:
-            self.bar.__exit__(None, None, None)
