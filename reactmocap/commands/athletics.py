@@ -60,6 +60,9 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         p.add_argument("--any-range", action="store_true",
                        help="run outside the measured supported range (reported honestly)")  # fmt: skip
         p.set_defaults(func=_run, flags=flags)
+    from reactmocap.commands.athletics_bicycle import register as register_bicycle
+
+    register_bicycle(inner)
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -1,13 +1,14 @@
-"""The simulated world: a floor, gravity, friction, one or two characters (each attached to one
-MjSpec under a prefix, ``a/`` and ``b/``), the servo actuators every ball joint carries, and
-which character and body each geom belongs to. Why the contact and solver settings are what
-they are: ``docs/design.md``."""
+"""The simulated world: a floor, gravity, friction, characters (each attached to one MjSpec under
+a prefix, ``a/``, ``b/``, ...), an optional :class:`Scene` (extra bodies such as bicycles and
+obstacles), the servo actuators every ball joint carries, and which character and body each geom
+belongs to. Why the contact and solver settings are what they are: ``docs/design.md``."""
 
 from __future__ import annotations
 
+import string
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Literal, Protocol
 
 import mujoco
 import numpy as np
@@ -20,10 +21,31 @@ from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, Character
 if TYPE_CHECKING:
     from reactmocap.sim.servo import PDServo
 
-__all__ = ["PATCH_ROLL", "PATCH_TORSION", "PREFIXES", "World", "WorldCharacter", "WorldConfig"]
+__all__ = [
+    "PATCH_ROLL",
+    "PATCH_TORSION",
+    "PREFIXES",
+    "Scene",
+    "World",
+    "WorldCharacter",
+    "WorldConfig",
+]
 
 F64 = NDArray[np.float64]
-PREFIXES = ("a/", "b/")
+#: name prefixes of a world's characters, in order (``a/`` and ``b/`` for the usual pair)
+PREFIXES = tuple(f"{c}/" for c in string.ascii_lowercase)
+
+
+class Scene(Protocol):
+    """Extra bodies in a World (bicycles, obstacles): :meth:`build` adds them to the MjSpec
+    after the characters are attached (so constraints may name character bodies) and before it
+    is compiled; :meth:`configure` runs once the World has applied its own contact settings to
+    every geom (a scene re-applies its own there)."""
+
+    def build(self, spec: mujoco.MjSpec) -> None: ...
+
+    def configure(self, world: World) -> None: ...
+
 
 _INTEGRATORS = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
@@ -151,17 +173,21 @@ PATCH_ROLL = 0.03
 
 
 class World:
-    """A MuJoCo model and data with a floor and one or two characters."""
+    """A MuJoCo model and data with a floor, characters (one or two for tracking and responses;
+    none or many with a :class:`Scene`) and the scene's bodies."""
 
     def __init__(
         self,
         characters: Character | Sequence[Character],
         config: WorldConfig | None = None,
+        *,
+        scene: Scene | None = None,
         **overrides: object,
     ) -> None:
         chars = [characters] if isinstance(characters, Character) else list(characters)
-        if not 1 <= len(chars) <= len(PREFIXES):
-            raise ConfigError(f"a World holds 1 or 2 characters, got {len(chars)}")
+        least = 0 if scene is not None else 1
+        if not least <= len(chars) <= len(PREFIXES):
+            raise ConfigError(f"a World holds {least}-{len(PREFIXES)} characters, got {len(chars)}")
         cfg = config or WorldConfig()
         if overrides:
             from dataclasses import replace
@@ -194,6 +220,8 @@ class World:
             spec.attach(ch.make_spec(), prefix=PREFIXES[k], frame=frame)
         for k in range(len(chars)):
             _add_servo_actuators(spec, PREFIXES[k])
+        if scene is not None:
+            scene.build(spec)
         try:
             self.model = spec.compile()
         except Exception as exc:  # mujoco raises ValueError with the compiler's message
@@ -261,6 +289,9 @@ class World:
         self._apply_contact_settings()
         self._apply_joint_settings()
         self.set_friction(cfg.friction)
+        self.scene = scene
+        if scene is not None:
+            scene.configure(self)
         mujoco.mj_forward(m, self.data)
 
     # ------------------------------------------------------------------ settings
@@ -293,7 +324,10 @@ class World:
         m, d, cfg = self.model, self.data, self.config
         for wc in self.characters:
             d.qpos[wc.qpos_slice] = wc.character.model.qpos0
-        mujoco.mj_forward(m, d)
+        # the mass matrix only: no collision pass (characters all at their origin would touch)
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_makeM(m, d)
         diag = np.empty(m.nv)
         diag[:] = d.M[m.M_rowadr + m.M_rownnz - 1]  # diagonal = last entry of each CSR row
         for wc in self.characters:
