@@ -51,8 +51,11 @@ F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
 _B = {b: i for i, b in enumerate(SIM_BODIES)}
 #: the rider's world: 2 ms steps (the mounts are 10-20 ms spring-dampers, the wheels 4 ms
-#: contacts), the athletics contact time constant for the body
-RIDER_WORLD = WorldConfig(timestep=0.002, contact_solref=(0.02, 1.0))
+#: contacts), the athletics contact time constant for the body, also between riders (the
+#: strike-stiff 2 ms of the response worlds needs 1 ms steps)
+RIDER_WORLD = WorldConfig(
+    timestep=0.002, contact_solref=(0.02, 1.0), body_contact_solref=(0.02, 1.0)
+)
 #: sit bones relative to the pelvis origin (anatomical frame: x forward, y left, z up; m)
 SIT_OFFSET = (-0.03, 0.06, -0.09)
 #: mount spring-dampers (time constant s, damping ratio): saddle, hands, feet
