@@ -16,7 +16,7 @@ from reactmocap.sim.character import BALL_JOINTS, qvel_from_qpos
 from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.world import World
 
-__all__ = ["ClipClock", "ReferencePath", "as_path", "reference_path"]
+__all__ = ["ClipClock", "ReferencePath", "as_path", "reference_path", "with_soles"]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
@@ -67,7 +67,10 @@ class ReferencePath:
     sign-continuous quaternions, ``v`` ``(T, 51)`` qvel and ``a`` ``(T, 51)`` qacc by central
     differences, ``planted`` ``(T, 2)`` the feet (left, right) whose sole is within ``reach`` of
     the floor, ``pivoting`` ``(T, 2)`` the planted feet turning faster than ``pivot_rate``;
-    ``fps`` the frame rate."""
+    ``fps`` the frame rate; ``sole`` ``(T, 2, 3)`` the centre of each sole's bottom face and
+    ``sole_yaw`` ``(T, 2)`` its heading (rad, unwrapped over time) in the world, ``corners``
+    ``(T, 2, 4, 3)`` its corners (world; heights above the floor) (``None`` when built by hand:
+    :func:`with_soles` adds them), ``com`` ``(T, 3)`` the centre of mass."""
 
     q: F64
     v: F64
@@ -75,6 +78,10 @@ class ReferencePath:
     planted: NDArray[np.bool_]
     pivoting: NDArray[np.bool_]
     fps: float
+    sole: F64 | None = None
+    sole_yaw: F64 | None = None
+    corners: F64 | None = None
+    com: F64 | None = None
 
     @property
     def num_frames(self) -> int:
@@ -103,6 +110,20 @@ class ReferencePath:
             acc[:] = 0.0
         return q, v, acc, self.planted[round(x)]
 
+    def sole_at(self, x: float) -> tuple[F64, F64]:
+        """The soles' centres ``(2, 3)`` and headings ``(2,)`` at fractional frame ``x``
+        (linear; clamped to the path)."""
+        if self.sole is None or self.sole_yaw is None:
+            raise ConfigError("this path has no sole tracks (build it with reference_path)")
+        x = min(max(x, 0.0), self.num_frames - 1.0)
+        i0 = int(x)
+        i1 = min(i0 + 1, self.num_frames - 1)
+        w = x - i0
+        return (
+            (1 - w) * self.sole[i0] + w * self.sole[i1],
+            (1 - w) * self.sole_yaw[i0] + w * self.sole_yaw[i1],
+        )
+
 
 def reference_path(
     world: World,
@@ -112,6 +133,7 @@ def reference_path(
     fps: float | None = None,
     reach: float = 0.05,
     pivot_rate: float | None = 2.0,
+    slide_speed: float | None = 0.5,
 ) -> ReferencePath:
     """``source`` on ``world``'s ``character`` as a :class:`ReferencePath`: a Motion on the
     character's skeleton, or a ``(T, 67)`` qpos path sampled at ``fps``. Foot stance is
@@ -119,6 +141,7 @@ def reference_path(
     for name, value in (
         ("reach", reach),
         ("pivot_rate", 0.0 if pivot_rate is None else pivot_rate),
+        ("slide_speed", 0.0 if slide_speed is None else slide_speed),
     ):
         if not (np.isfinite(value) and value >= 0):
             raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -137,27 +160,63 @@ def reference_path(
     q[:, 3:] = quat_continuous(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
     v = qvel_from_qpos(q, rate)
     a = np.gradient(v, 1.0 / rate, axis=0) if n > 2 else np.zeros_like(v)
+    corner_z, centre, yaw, com = _sole_tracks(world, character, q)
+    low = np.argmin(corner_z[..., 2], axis=2)[..., None, None]  # (T, 2, 1, 1)
+    planted = np.take_along_axis(corner_z[..., 2], low[..., 0], axis=2)[..., 0] < reach
+    rate_yaw = np.zeros((n, 2))
+    slide = np.zeros((n, 2))
+    if n > 1:
+        rate_yaw = np.abs(np.gradient(yaw, 1.0 / rate, axis=0))
+        vel = np.gradient(corner_z[..., :2], 1.0 / rate, axis=0)
+        slide = np.linalg.norm(np.take_along_axis(vel, low, axis=2)[:, :, 0], axis=-1)
+    turning = rate_yaw > (np.inf if pivot_rate is None else float(pivot_rate))
+    if slide_speed is not None:
+        # a foot skimming the floor (a low step, a slide in the capture) is not a support
+        planted &= (slide < slide_speed) | turning
+    pivoting = planted & turning
+    arrays = (q, v, a, planted, pivoting, centre, yaw, corner_z, com)
+    for arr in arrays:
+        arr.flags.writeable = False
+    return ReferencePath(q, v, a, planted, pivoting, rate, centre, yaw, corner_z, com)
+
+
+def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F64]:
+    """Per qpos row of ``character``: each sole's corners ``(T, 2, 4, 3)`` (heights above the
+    floor), the centre of its bottom face ``(T, 2, 3)`` and its heading ``(T, 2)``
+    (unwrapped), and the centre of mass ``(T, 3)``."""
     m = world.model
+    wc = world.characters[character]
     _, sole_ids, corners = foot_soles(world, character, "reference_path")
     floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
+    half = m.geom_size[sole_ids, 2][:, None]
     d = mujoco.MjData(m)
-    sole = np.empty((n, 2))
+    n = q.shape[0]
+    low = np.empty((n, 2, 4, 3))
+    centre = np.empty((n, 2, 3))
     yaw = np.empty((n, 2))
+    com = np.empty((n, 3))
+    bodies = wc.body_ids
+    mass = m.body_mass[bodies]
     for i in range(n):  # once per clip, not in the step loop
         d.qpos[wc.qpos_slice] = q[i]
         mujoco.mj_kinematics(m, d)
-        sole[i] = sole_corners_world(d, sole_ids, corners).min(axis=1)[:, 2] - floor_z
+        low[i] = sole_corners_world(d, sole_ids, corners)
         rot = d.geom_xmat[sole_ids].reshape(2, 3, 3)
+        centre[i] = d.geom_xpos[sole_ids] - rot[:, :, 2] * half
         yaw[i] = np.arctan2(rot[:, 1, 0], rot[:, 0, 0])
-    planted = sole < reach
-    rate_yaw = np.zeros((n, 2))
-    if n > 1:
-        rate_yaw = np.abs(np.gradient(np.unwrap(yaw, axis=0), 1.0 / rate, axis=0))
-    pivoting = planted & (rate_yaw > (np.inf if pivot_rate is None else float(pivot_rate)))
-    arrays = (q, v, a, planted, pivoting)
-    for arr in arrays:
+        com[i] = mass @ d.xipos[bodies] / mass.sum()
+    low[..., 2] -= floor_z
+    return low, centre, np.unwrap(yaw, axis=0), com
+
+
+def with_soles(world: World, character: int, path: ReferencePath) -> ReferencePath:
+    """``path`` with its sole tracks (:attr:`ReferencePath.sole`) on ``character``."""
+    if not any(a is None for a in (path.sole, path.sole_yaw, path.corners, path.com)):
+        return path
+    corner_z, centre, yaw, com = _sole_tracks(world, character, path.q)
+    for arr in (corner_z, centre, yaw, com):
         arr.flags.writeable = False
-    return ReferencePath(*arrays, fps=rate)
+    return replace(path, sole=centre, sole_yaw=yaw, corners=corner_z, com=com)
 
 
 def as_path(world: World, character: int, reference: Motion | ReferencePath) -> ReferencePath:

@@ -16,11 +16,11 @@ from scipy.optimize import nnls
 
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_conj, quat_log, quat_mul
+from reactmocap.rotations import quat_conj, quat_from_yaw, quat_log, quat_mul
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.feet import foot_soles, sole_corners_world
-from reactmocap.sim.reference import ReferencePath, reference_path
+from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
 
@@ -34,6 +34,60 @@ _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 _UP = np.array([[0.0], [0.0], [1.0]])
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
 _PATCH_CORNERS = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
+
+
+def clamp_to_support(p: F64, points: F64, margin: float) -> F64:
+    """``p`` (2,) moved into the convex hull of ``points`` (k, 2), at least ``margin`` inside
+    (or to its centroid when the hull is smaller)."""
+    hull = _hull(points)
+    centre = hull.mean(axis=0)
+    if len(hull) < 3:
+        if len(hull) == 1:
+            return hull[0].copy()
+        a, b = hull
+        u = b - a
+        s = float(np.clip((p - a) @ u / max(u @ u, 1e-12), 0.0, 1.0))
+        q = a + s * u
+    else:
+        edges = np.roll(hull, -1, axis=0) - hull
+        normal = np.column_stack([edges[:, 1], -edges[:, 0]])  # outward for a CCW hull
+        normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
+        dist = ((p - hull) * normal).sum(axis=1)
+        if dist.max() <= -margin:
+            return p
+        q = p
+        if dist.max() > 0:  # outside: the nearest point of the boundary
+            s = np.clip(((p - hull) * edges).sum(axis=1) / (edges * edges).sum(axis=1), 0, 1)
+            near = hull + s[:, None] * edges
+            q = near[np.argmin(np.linalg.norm(near - p, axis=1))]
+        else:
+            margin += float(dist.max())  # already that far inside
+    gap = centre - q
+    n = float(np.linalg.norm(gap))
+    return centre if n <= margin else q + gap * (margin / n)
+
+
+def _hull(points: F64) -> F64:
+    """The convex hull of a few 2-D points, counter-clockwise (Andrew's monotone chain)."""
+    pts = np.unique(np.round(points, 9), axis=0)
+    if len(pts) < 3:
+        return pts
+
+    def half(seq: F64) -> list[F64]:
+        out: list[F64] = []
+        for q in seq:  # a handful of sole corners per control tick
+            while len(out) >= 2 and np.cross(out[-1] - out[-2], q - out[-2]) <= 0:
+                out.pop()
+            out.append(q)
+        return out
+
+    lower, upper = half(pts), half(pts[::-1])
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def _rot2(yaw: float) -> F64:
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.array([[c, -s], [s, c]])
 
 
 @dataclass(frozen=True)
@@ -98,6 +152,22 @@ class WholeBodyTracker:
             foot's yaw rate is above this (rad/s); ``None``: feet never pivot. Measured on the
             benchmark windows: 80% tracked with 2.0 or 3.0, 74% without pivots. With a
             :class:`ReferencePath` given, its own ``planted`` and ``pivoting`` are used.
+        anchor_tau: re-anchoring time constant (s): the mocap's ground path (heading and
+            horizontal position) is moved toward where the character's supporting feet really
+            are, so the pelvis and the swing foot are tracked relative to the stance foot
+            (``None``: the mocap's world path, as captured).
+        slide_speed: a foot near the floor is planted only while its lowest corner moves
+            slower than this (m/s) or it pivots (``None``: any speed).
+        com_weight, kp_com: weight and stiffness (1/s^2, critically damped) of the
+            centre-of-mass rows: the ground forces are asked for the mocap's centre-of-mass
+            acceleration plus feedback (0: no such rows).
+        roll_band: a sole corner carries force only while the mocap holds it within this of
+            its foot's lowest corner (m): a heel the actor raises, or toes it lifts, are let
+            go (holding every touching corner still kept the heel down, and a straight stance
+            leg then could not lift the pelvis as the actor did); ``None``: every touching
+            corner.
+        anchor_touch: a foot anchors while planted in the mocap and its sole's lowest corner
+            is within this of the floor in the simulation (m).
         servo_kv: the servo's damping (1/s).
 
     Defaults were chosen on the shared walk, run and kick clips (``benchmarks/bench_sim.py``).
@@ -124,6 +194,15 @@ class WholeBodyTracker:
         touch: float = 0.0,
         force_reg: float = 1e-6,
         pivot_rate: float | None = 2.0,
+        slide_speed: float | None = 0.5,
+        roll_band: float | None = 0.01,
+        com_weight: float = 0.0,
+        dcm_gain: float = 5.0,
+        cop_margin: float = 0.02,
+        balance_margin: float | None = 0.03,
+        balance_tau: float = 0.1,
+        anchor_tau: float | None = 0.1,
+        anchor_touch: float = 0.01,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -134,6 +213,10 @@ class WholeBodyTracker:
                 "root_weight": root_weight, "contact_weight": contact_weight,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
+                "slide_speed": slide_speed,
+                "com_weight": com_weight, "dcm_gain": dcm_gain, "cop_margin": cop_margin,
+                "balance_margin": balance_margin, "balance_tau": balance_tau,
+                "anchor_tau": anchor_tau, "anchor_touch": anchor_touch, "roll_band": roll_band,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint,
             },
         )  # fmt: skip
@@ -185,19 +268,127 @@ class WholeBodyTracker:
         #: :class:`~reactmocap.sim.controllers.predictive.PredictiveTracker`, zero otherwise
         self.root_bias = np.zeros(6)
         #: the clip as this tracker follows it
-        self.path = (
+        self.path = with_soles(
+            world,
+            character,
             reference
             if isinstance(reference, ReferencePath)
-            else reference_path(world, character, reference, reach=reach, pivot_rate=pivot_rate)
+            else reference_path(world, character, reference, reach=reach, pivot_rate=pivot_rate,
+                                slide_speed=slide_speed),
         )
         self.clock = self.path.clock(start)
+        dt_tick = self.control_every * world.timestep
+        self._anchor_rate = 0.0 if anchor_tau is None else min(1.0, dt_tick / max(anchor_tau, 1e-9))
+        self.anchor_touch = float(anchor_touch)
+        self.roll_band = np.inf if roll_band is None else float(roll_band)
+        self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
+        assert self.path.com is not None
+        dt_f = 1.0 / self.path.fps
+        self._com = self.path.com
+        self._com_v = np.gradient(self._com, dt_f, axis=0) if self.path.num_frames > 1 else 0 * self._com
+        self._com_a = np.gradient(self._com_v, dt_f, axis=0) if self.path.num_frames > 2 else 0 * self._com
+        self.com_weight = float(com_weight)
+        self.dcm_gain = float(dcm_gain)
+        self.cop_margin = float(cop_margin)
+        self.balance_margin = None if balance_margin is None else float(balance_margin)
+        self._balance_rate = min(1.0, dt_tick / max(balance_tau, 1e-9))
+        #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
+        #: capture point inside the feet (see :meth:`rebalance`)
+        self.balance_shift = np.zeros(2)
+        self._mass = float(m.body_subtreemass[wc.body_ids[0]])
+        self._gravity = m.opt.gravity.copy()
+        #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
+        #: ``x -> Rz(yaw) x + shift``
+        self.anchor_yaw = 0.0
+        self.anchor_shift = np.zeros(2)
         self.release()
 
     # ------------------------------------------------------------------ reference
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
         the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
-        return self.path.sample(self.clock.frame(t), self.clock.coast(t))
+        q, v, a, planted = self.path.sample(self.clock.frame(t), self.clock.coast(t))
+        if self.anchor_yaw or self.anchor_shift.any():
+            rot = _rot2(self.anchor_yaw)
+            q[:2] = rot @ q[:2] + self.anchor_shift
+            q[3:7] = quat_mul(quat_from_yaw(self.anchor_yaw), q[3:7])
+            v[:2] = rot @ v[:2]  # free-joint angular velocity is local: unchanged
+            a[:2] = rot @ a[:2]
+        q[:2] += self.balance_shift
+        return q, v, a, planted
+
+    def com_reference(self, t: float) -> tuple[F64, F64, F64]:
+        """The mocap's centre of mass at ``t``: position, velocity, acceleration (world, as
+        re-anchored)."""
+        x = self.clock.frame(t)
+        i0 = int(x)
+        i1 = min(i0 + 1, self.path.num_frames - 1)
+        w = x - i0
+        c = (1 - w) * self._com[i0] + w * self._com[i1]
+        v = (1 - w) * self._com_v[i0] + w * self._com_v[i1]
+        a = (1 - w) * self._com_a[i0] + w * self._com_a[i1]
+        coast = self.clock.coast(t)
+        if coast > 0:
+            c = c + coast * v
+            a = np.zeros(3)
+        rot = _rot2(self.anchor_yaw)
+        c[:2] = rot @ c[:2] + self.anchor_shift + self.balance_shift
+        v[:2] = rot @ v[:2]
+        a[:2] = rot @ a[:2]
+        return c, v, a
+
+    def rebalance(self, t: float) -> None:
+        """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
+        capture point ``balance_margin`` inside both feet's soles on the floor (zero unless
+        both feet support: a walk's capture point leaves the stance foot on purpose)."""
+        if self.balance_margin is None:
+            return
+        d = self.world.data
+        corners = sole_corners_world(d, self.sole, self._corners)
+        down = (corners[:, :, 2] - self.floor_z < self.anchor_touch) & self.path.planted[
+            self.clock.nearest(t)
+        ][:, None]
+        target = np.zeros(2)
+        if down.any(axis=1).all():
+            c, v, _ = self.com_reference(t)
+            omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
+            xi = c[:2] - self.balance_shift + v[:2] / omega
+            target = clamp_to_support(xi, corners[down][:, :2], self.balance_margin) - xi
+        self.balance_shift += self._balance_rate * (target - self.balance_shift)
+
+    def _held(self, t: float) -> NDArray[np.bool_]:
+        """``(2, 4)`` the sole corners the mocap keeps on the ground at ``t`` (within
+        ``roll_band`` of its foot's lowest corner)."""
+        assert self.path.corners is not None
+        z = self.path.corners[self.clock.nearest(t), :, :, 2]
+        return z - z.min(axis=1, keepdims=True) < self.roll_band
+
+    def reanchor(self, t: float) -> None:
+        """Move the mocap's ground path a step (``anchor_tau``) toward the supporting feet:
+        their mean heading error is turned about their centre and their mean position error
+        shifted away. Without a foot both planted in the mocap and on the floor, no change."""
+        if not self._anchor_rate:
+            return
+        d = self.world.data
+        i = self.clock.nearest(t)
+        corners = sole_corners_world(d, self.sole, self._corners)
+        on = self.path.planted[i] & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
+        if not on.any():
+            return
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        sim = (d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half)[on, :2]
+        ref, ref_yaw = self.path.sole_at(self.clock.frame(t))
+        ref = ref[on, :2] @ _rot2(self.anchor_yaw).T + self.anchor_shift
+        centre = sim.mean(axis=0)
+        err = centre - ref.mean(axis=0)
+        turn = on & ~self.path.pivoting[i]  # a pivoting foot's heading is the clip's own turn
+        dyaw = 0.0
+        if turn.any():
+            yaw = np.arctan2(rot[turn, 1, 0], rot[turn, 0, 0]) - ref_yaw[turn] - self.anchor_yaw
+            dyaw = float(np.mean((yaw + np.pi) % (2 * np.pi) - np.pi))
+        k = self._anchor_rate
+        self.anchor_yaw += k * dyaw
+        self.anchor_shift = _rot2(k * dyaw) @ (self.anchor_shift + k * err - centre) + centre
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
@@ -206,9 +397,12 @@ class WholeBodyTracker:
         for f in range(2):
             self.world.set_foot_patch(self.character, f, False)
 
-    def _support(self, d: mujoco.MjData, planted: NDArray[np.bool_]) -> _Support:
-        """The contact model at the current state: the sole corners MuJoCo has in contact, or
-        the ball patch of a pivoting foot, of the feet planted in the mocap."""
+    def _support(
+        self, d: mujoco.MjData, planted: NDArray[np.bool_], held: NDArray[np.bool_]
+    ) -> _Support:
+        """The contact model at the current state: the sole corners MuJoCo has in contact that
+        the mocap holds down (``held`` ``(2, 4)``), or the ball patch of a pivoting foot, of
+        the feet planted in the mocap."""
         m = self.world.model
         corners = sole_corners_world(d, self.sole, self._corners)
         patch_on = self.world.foot_patch_on(self.character)
@@ -259,6 +453,8 @@ class WholeBodyTracker:
             touching = corners[f, :, 2] - self.floor_z < self.touch
             if not touching.any():
                 continue
+            if (touching & held[f]).any():
+                touching &= held[f]
             feet.append(f)
             for p in corners[f, touching]:
                 point(p, body, self._edges, True)
@@ -283,6 +479,7 @@ class WholeBodyTracker:
         quantities of the last step). Does not touch the simulation."""
         m, d = self.world.model, self.world.data
         qr, vr, ar, planted = self.reference(t)
+        held = self._held(t)
         sl = self._dofs
         q = d.qpos[self.wc.qpos_slice]
         v = d.qvel[sl]
@@ -301,7 +498,7 @@ class WholeBodyTracker:
         # purpose, so it acts as extra damping (compensating it, first version: 50% of the benchmark windows
         # tracked instead of 64%)
         h = d.qfrc_bias[sl]
-        sup = self._support(d, planted)
+        sup = self._support(d, planted, held)
         nc = len(sup.points)
         nb = sup.gen.shape[1]
         nj = 3 * NJ
@@ -328,6 +525,24 @@ class WholeBodyTracker:
             jt = sup.rows
             rows_a.append(self.sqrt_wc * (jt @ g))
             rows_b.append(-self.sqrt_wc * (jt @ g0 + sup.bias + self.contact_kv * (jt @ v)))
+        if nc and self.com_weight:
+            # the centre of mass moves by the ground forces alone: m (a_c - g) = sum f
+            c_ref, cv_ref, ca_ref = self.com_reference(t)
+            mujoco.mj_subtreeVel(m, d)
+            root = self.wc.body_ids[0]
+            c = d.subtree_com[root]
+            cv = d.subtree_linvel[root]
+            omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
+            xi = c[:2] + cv[:2] / omega
+            xi_ref = c_ref[:2] + cv_ref[:2] / omega
+            xi_ref_dot = cv_ref[:2] + ca_ref[:2] / omega
+            cop = xi - xi_ref_dot / omega + (self.dcm_gain / omega) * (xi - xi_ref)
+            cop = clamp_to_support(cop, sup.points[:, :2], self.cop_margin)
+            c_acc = omega * omega * (c[:2] - cop)
+            com_rows = np.zeros((2, nj + nb))
+            com_rows[:, nj:] = sup.basis[:, :2].T / self._mass
+            rows_a.append(self.com_weight * com_rows)
+            rows_b.append(self.com_weight * c_acc)
         a_mat = np.concatenate(rows_a)
         b_vec = np.concatenate(rows_b)
         ay, ab = a_mat[:, :nj], a_mat[:, nj:]
@@ -361,6 +576,9 @@ class WholeBodyTracker:
         self.clock = self.clock.held_from(t)
 
     def reset(self, world: World) -> None:
+        self.anchor_yaw = 0.0
+        self.anchor_shift = np.zeros(2)
+        self.balance_shift = np.zeros(2)
         servo = world.servo
         servo.enable(self.character, on=True)
         servo.set_gains(0.0, self.servo_kv, self.character)
@@ -370,6 +588,8 @@ class WholeBodyTracker:
         pivoting = self.path.pivoting[self.clock.nearest(t)]
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(pivoting[f]))
+        self.reanchor(t)
+        self.rebalance(t)
         plan = self.plan(t)
         self.last_plan = plan
         # the servo (damping only by default) keeps acting between ticks; at the tick the
