@@ -69,8 +69,8 @@ class ReferencePath:
     the floor, ``pivoting`` ``(T, 2)`` the planted feet turning faster than ``pivot_rate``;
     ``fps`` the frame rate; ``sole`` ``(T, 2, 3)`` the centre of each sole's bottom face and
     ``sole_yaw`` ``(T, 2)`` its heading (rad, unwrapped over time) in the world, ``corners``
-    ``(T, 2, 4, 3)`` its corners (world; heights above the floor) (``None`` when built by hand:
-    :func:`with_soles` adds them), ``com`` ``(T, 3)`` the centre of mass."""
+    ``(T, 2, 4, 3)`` its corners (world; heights above the floor) ``sole_up`` ``(T, 2, 3)`` its normal (``None``
+    when built by hand: :func:`with_soles` adds these), ``com`` ``(T, 3)`` the centre of mass."""
 
     q: F64
     v: F64
@@ -82,6 +82,7 @@ class ReferencePath:
     sole_yaw: F64 | None = None
     corners: F64 | None = None
     com: F64 | None = None
+    sole_up: F64 | None = None
 
     @property
     def num_frames(self) -> int:
@@ -160,7 +161,7 @@ def reference_path(
     q[:, 3:] = quat_continuous(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
     v = qvel_from_qpos(q, rate)
     a = np.gradient(v, 1.0 / rate, axis=0) if n > 2 else np.zeros_like(v)
-    corner_z, centre, yaw, com = _sole_tracks(world, character, q)
+    corner_z, centre, yaw, com, up = _sole_tracks(world, character, q)
     low = np.argmin(corner_z[..., 2], axis=2)[..., None, None]  # (T, 2, 1, 1)
     planted = np.take_along_axis(corner_z[..., 2], low[..., 0], axis=2)[..., 0] < reach
     rate_yaw = np.zeros((n, 2))
@@ -174,16 +175,16 @@ def reference_path(
         # a foot skimming the floor (a low step, a slide in the capture) is not a support
         planted &= (slide < slide_speed) | turning
     pivoting = planted & turning
-    arrays = (q, v, a, planted, pivoting, centre, yaw, corner_z, com)
+    arrays = (q, v, a, planted, pivoting, centre, yaw, corner_z, com, up)
     for arr in arrays:
         arr.flags.writeable = False
-    return ReferencePath(q, v, a, planted, pivoting, rate, centre, yaw, corner_z, com)
+    return ReferencePath(q, v, a, planted, pivoting, rate, centre, yaw, corner_z, com, up)
 
 
-def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F64]:
+def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F64, F64]:
     """Per qpos row of ``character``: each sole's corners ``(T, 2, 4, 3)`` (heights above the
     floor), the centre of its bottom face ``(T, 2, 3)`` and its heading ``(T, 2)``
-    (unwrapped), and the centre of mass ``(T, 3)``."""
+    (unwrapped), the centre of mass ``(T, 3)`` and each sole's normal ``(T, 2, 3)``."""
     m = world.model
     wc = world.characters[character]
     _, sole_ids, corners = foot_soles(world, character, "reference_path")
@@ -195,6 +196,7 @@ def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F
     centre = np.empty((n, 2, 3))
     yaw = np.empty((n, 2))
     com = np.empty((n, 3))
+    up = np.empty((n, 2, 3))
     bodies = wc.body_ids
     mass = m.body_mass[bodies]
     for i in range(n):  # once per clip, not in the step loop
@@ -205,18 +207,20 @@ def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F
         centre[i] = d.geom_xpos[sole_ids] - rot[:, :, 2] * half
         yaw[i] = np.arctan2(rot[:, 1, 0], rot[:, 0, 0])
         com[i] = mass @ d.xipos[bodies] / mass.sum()
+        up[i] = rot[:, :, 2]
     low[..., 2] -= floor_z
-    return low, centre, np.unwrap(yaw, axis=0), com
+    return low, centre, np.unwrap(yaw, axis=0), com, up
 
 
 def with_soles(world: World, character: int, path: ReferencePath) -> ReferencePath:
     """``path`` with its sole tracks (:attr:`ReferencePath.sole`) on ``character``."""
-    if not any(a is None for a in (path.sole, path.sole_yaw, path.corners, path.com)):
+    if not any(a is None for a in (path.sole, path.sole_yaw, path.corners, path.com,
+                                   path.sole_up)):  # fmt: skip
         return path
-    corner_z, centre, yaw, com = _sole_tracks(world, character, path.q)
-    for arr in (corner_z, centre, yaw, com):
+    corner_z, centre, yaw, com, up = _sole_tracks(world, character, path.q)
+    for arr in (corner_z, centre, yaw, com, up):
         arr.flags.writeable = False
-    return replace(path, sole=centre, sole_yaw=yaw, corners=corner_z, com=com)
+    return replace(path, sole=centre, sole_yaw=yaw, corners=corner_z, com=com, sole_up=up)
 
 
 def as_path(world: World, character: int, reference: Motion | ReferencePath) -> ReferencePath:

@@ -191,7 +191,7 @@ class WholeBodyTracker:
         contact_kv: float = 20.0,
         friction: float = 0.7,
         reach: float = 0.05,
-        touch: float = 0.0,
+        touch: float = 0.003,
         force_reg: float = 1e-6,
         pivot_rate: float | None = 2.0,
         slide_speed: float | None = 0.5,
@@ -200,6 +200,9 @@ class WholeBodyTracker:
         dcm_gain: float = 5.0,
         cop_margin: float = 0.02,
         balance_margin: float | None = 0.03,
+        foot_weight: float = 0.0,
+        com_feedback: float = 0.0,
+        kp_foot: float = 100.0,
         balance_tau: float = 0.1,
         anchor_tau: float | None = 0.1,
         anchor_touch: float = 0.01,
@@ -216,6 +219,7 @@ class WholeBodyTracker:
                 "slide_speed": slide_speed,
                 "com_weight": com_weight, "dcm_gain": dcm_gain, "cop_margin": cop_margin,
                 "balance_margin": balance_margin, "balance_tau": balance_tau,
+                "foot_weight": foot_weight, "kp_foot": kp_foot, "com_feedback": com_feedback,
                 "anchor_tau": anchor_tau, "anchor_touch": anchor_touch, "roll_band": roll_band,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint,
             },
@@ -240,6 +244,8 @@ class WholeBodyTracker:
         ]
         self._kp0, self._kv0 = self.kp.copy(), self.kv.copy()
         self.w = np.r_[np.full(6, root_weight), np.ones(3 * NJ)]
+        import os
+        self.w[:2] *= float(os.environ.get("RPW", "1"))
         self._w_air = np.r_[np.zeros(6), np.ones(3 * NJ)]
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
@@ -295,6 +301,17 @@ class WholeBodyTracker:
         #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
         #: capture point inside the feet (see :meth:`rebalance`)
         self.balance_shift = np.zeros(2)
+        self.foot_weight = float(foot_weight)
+        assert self.path.corners is not None
+        cz = self.path.corners[..., 2]
+        held = cz - cz.min(axis=2, keepdims=True) < self.roll_band
+        #: ``(T, 2)`` planted feet the actor stands on the ball of (heel raised): they touch
+        #: through their ball patch, whose centre of pressure can roll as a forefoot's does (on
+        #: the box's two toe corners the character stood on an edge)
+        self.on_ball = self.path.planted & held[..., :2].all(axis=2) & ~held[..., 2:].any(axis=2)
+        self.com_feedback = float(com_feedback)
+        self.kp_foot = float(kp_foot)
+        self.kv_foot = critical_kv(kp_foot)
         self._mass = float(m.body_subtreemass[wc.body_ids[0]])
         self._gravity = m.opt.gravity.copy()
         #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
@@ -337,23 +354,44 @@ class WholeBodyTracker:
         a[:2] = rot @ a[:2]
         return c, v, a
 
+    def _footprint(self, t: float) -> list[F64]:
+        """Per foot planted in the mocap, the ground points ``(k, 2)`` it can push through now:
+        its sole corners within ``anchor_touch`` of the floor, or its ball patch's
+        centre-of-pressure range; empty for a foot in the air."""
+        d = self.world.data
+        planted = self.path.planted[self.clock.nearest(t)]
+        corners = sole_corners_world(d, self.sole, self._corners)
+        patch_on = self.world.foot_patch_on(self.character)
+        out: list[F64] = []
+        for f in range(2):  # two feet
+            if not planted[f]:
+                out.append(np.zeros((0, 2)))
+            elif patch_on[f]:
+                rot = d.geom_xmat[self.patch[f]].reshape(3, 3)
+                p = d.geom_xpos[self.patch[f]] - rot[:, 2] * self.patch_half[f]
+                if p[2] - self.floor_z >= self.anchor_touch:
+                    out.append(np.zeros((0, 2)))
+                    continue
+                axes = rot[:2, :2].T * self.patch_arm[f]
+                out.append(p[:2] + np.array([axes[0], -axes[0], axes[1], -axes[1]]))
+            else:
+                down = corners[f, :, 2] - self.floor_z < self.anchor_touch
+                out.append(corners[f, down, :2])
+        return out
+
     def rebalance(self, t: float) -> None:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
         capture point ``balance_margin`` inside both feet's soles on the floor (zero unless
         both feet support: a walk's capture point leaves the stance foot on purpose)."""
         if self.balance_margin is None:
             return
-        d = self.world.data
-        corners = sole_corners_world(d, self.sole, self._corners)
-        down = (corners[:, :, 2] - self.floor_z < self.anchor_touch) & self.path.planted[
-            self.clock.nearest(t)
-        ][:, None]
         target = np.zeros(2)
-        if down.any(axis=1).all():
+        feet = self._footprint(t)
+        if all(len(f) for f in feet):
             c, v, _ = self.com_reference(t)
             omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
             xi = c[:2] - self.balance_shift + v[:2] / omega
-            target = clamp_to_support(xi, corners[down][:, :2], self.balance_margin) - xi
+            target = clamp_to_support(xi, np.concatenate(feet), self.balance_margin) - xi
         self.balance_shift += self._balance_rate * (target - self.balance_shift)
 
     def _held(self, t: float) -> NDArray[np.bool_]:
@@ -489,7 +527,17 @@ class WholeBodyTracker:
         rel = quat_mul(quat_conj(q[3:].reshape(NJ + 1, 4)), qr[3:].reshape(NJ + 1, 4))
         rel *= np.where(rel[:, :1] < 0, -1.0, 1.0)
         err = np.r_[qr[:3] - q[:3], quat_log(rel).reshape(-1)]
-        acc_des = ar + self.kp * err + self.kv * (vr - v)
+        verr = vr - v
+        if self.com_feedback:
+            # the pelvis rows steer the centre of mass: what balance needs is where the whole
+            # body's mass is, and the trunk and arms lagging the mocap moves it off the pelvis
+            c_ref, cv_ref, _ = self.com_reference(t)
+            mujoco.mj_subtreeVel(m, d)
+            root = self.wc.body_ids[0]
+            b = self.com_feedback
+            err[:2] += b * ((c_ref[:2] - d.subtree_com[root][:2]) - err[:2])
+            verr[:2] += b * ((cv_ref[:2] - d.subtree_linvel[root][:2]) - verr[:2])
+        acc_des = ar + self.kp * err + self.kv * verr
         acc_des[:6] += self.root_bias
 
         mujoco.mj_fullM(m, d, self._full)
@@ -525,6 +573,29 @@ class WholeBodyTracker:
             jt = sup.rows
             rows_a.append(self.sqrt_wc * (jt @ g))
             rows_b.append(-self.sqrt_wc * (jt @ g0 + sup.bias + self.contact_kv * (jt @ v)))
+        if self.foot_weight:
+            # a planted foot on the floor takes the mocap's tilt (flat where the actor's foot
+            # is flat), so it stands on its whole sole, not on an edge the legs rolled it to
+            assert self.path.sole_up is not None
+            ups = self.path.sole_up[self.clock.nearest(t)]
+            rot_z = _rot2(self.anchor_yaw)
+            corners = sole_corners_world(d, self.sole, self._corners)
+            near = corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch
+            patch_on = self.world.foot_patch_on(self.character)
+            for f in range(2):  # two feet
+                if not (planted[f] and near[f] and held[f].all()) or patch_on[f]:
+                    continue
+                up_sim = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, 2]
+                up_ref = np.r_[rot_z @ ups[f, :2], ups[f, 2]]
+                body = int(self.feet[f])
+                point = d.xpos[body]
+                mujoco.mj_jac(m, d, None, self._jacr, point, body)
+                mujoco.mj_jacDot(m, d, None, self._jacrd, point, body)
+                jr = self._jacr[:2, sl]
+                omega_f = jr @ v
+                want = self.kp_foot * np.cross(up_sim, up_ref)[:2] - self.kv_foot * omega_f
+                rows_a.append(self.foot_weight * (jr @ g))
+                rows_b.append(self.foot_weight * (want - jr @ g0 - self._jacrd[:2, sl] @ v))
         if nc and self.com_weight:
             # the centre of mass moves by the ground forces alone: m (a_c - g) = sum f
             c_ref, cv_ref, ca_ref = self.com_reference(t)
@@ -585,9 +656,10 @@ class WholeBodyTracker:
         servo.refresh_every = self.control_every
 
     def control(self, world: World, t: float) -> None:
-        pivoting = self.path.pivoting[self.clock.nearest(t)]
+        i = self.clock.nearest(t)
+        patch = self.path.pivoting[i]
         for f in range(2):
-            world.set_foot_patch(self.character, f, bool(pivoting[f]))
+            world.set_foot_patch(self.character, f, bool(patch[f]))
         self.reanchor(t)
         self.rebalance(t)
         plan = self.plan(t)
