@@ -19,6 +19,13 @@ from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_from_yaw, quat_log, quat_mul
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.controllers.base import check_character, check_params
+from reactmocap.sim.controllers.stepping import (
+    Step,
+    clamp_to_support,
+    convex_hull,
+    outside_distance,
+    step_target,
+)
 from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
@@ -34,55 +41,6 @@ _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 _UP = np.array([[0.0], [0.0], [1.0]])
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
 _PATCH_CORNERS = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
-
-
-def clamp_to_support(p: F64, points: F64, margin: float) -> F64:
-    """``p`` (2,) moved into the convex hull of ``points`` (k, 2), at least ``margin`` inside
-    (or to its centroid when the hull is smaller)."""
-    hull = _hull(points)
-    centre = hull.mean(axis=0)
-    if len(hull) < 3:
-        if len(hull) == 1:
-            return hull[0].copy()
-        a, b = hull
-        u = b - a
-        s = float(np.clip((p - a) @ u / max(u @ u, 1e-12), 0.0, 1.0))
-        q = a + s * u
-    else:
-        edges = np.roll(hull, -1, axis=0) - hull
-        normal = np.column_stack([edges[:, 1], -edges[:, 0]])  # outward for a CCW hull
-        normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
-        dist = ((p - hull) * normal).sum(axis=1)
-        if dist.max() <= -margin:
-            return p
-        q = p
-        if dist.max() > 0:  # outside: the nearest point of the boundary
-            s = np.clip(((p - hull) * edges).sum(axis=1) / (edges * edges).sum(axis=1), 0, 1)
-            near = hull + s[:, None] * edges
-            q = near[np.argmin(np.linalg.norm(near - p, axis=1))]
-        else:
-            margin += float(dist.max())  # already that far inside
-    gap = centre - q
-    n = float(np.linalg.norm(gap))
-    return centre if n <= margin else q + gap * (margin / n)
-
-
-def _hull(points: F64) -> F64:
-    """The convex hull of a few 2-D points, counter-clockwise (Andrew's monotone chain)."""
-    pts = np.unique(np.round(points, 9), axis=0)
-    if len(pts) < 3:
-        return pts
-
-    def half(seq: F64) -> list[F64]:
-        out: list[F64] = []
-        for q in seq:  # a handful of sole corners per control tick
-            while len(out) >= 2 and np.cross(out[-1] - out[-2], q - out[-2]) <= 0:
-                out.pop()
-            out.append(q)
-        return out
-
-    lower, upper = half(pts), half(pts[::-1])
-    return np.array(lower[:-1] + upper[:-1])
 
 
 def _rot2(yaw: float) -> F64:
@@ -158,9 +116,6 @@ class WholeBodyTracker:
             (``None``: the mocap's world path, as captured).
         slide_speed: a foot near the floor is planted only while its lowest corner moves
             slower than this (m/s) or it pivots (``None``: any speed).
-        com_weight, kp_com: weight and stiffness (1/s^2, critically damped) of the
-            centre-of-mass rows: the ground forces are asked for the mocap's centre-of-mass
-            acceleration plus feedback (0: no such rows).
         roll_band: a sole corner carries force only while the mocap holds it within this of
             its foot's lowest corner (m): a heel the actor raises, or toes it lifts, are let
             go (holding every touching corner still kept the heel down, and a straight stance
@@ -168,6 +123,14 @@ class WholeBodyTracker:
             corner.
         anchor_touch: a foot anchors while planted in the mocap and its sole's lowest corner
             is within this of the floor in the simulation (m).
+        balance_margin, balance_tau: while both feet support, the pelvis and centre-of-mass
+            targets shift (time constant ``balance_tau``) so the mocap's capture point stays
+            ``balance_margin`` m inside the soles on the floor (``None``: never).
+        step_margin: the tracker takes a balance step when the simulated capture point is
+            this far outside both feet's support while the mocap stands (``None``: never).
+        step_time, step_height: a balance step's duration (s) and lift (m).
+        swing_weight, kp_swing: weight and stiffness (critically damped) of a balance step's
+            foot position and tilt rows.
         servo_kv: the servo's damping (1/s).
 
     Defaults were chosen on the shared walk, run and kick clips (``benchmarks/bench_sim.py``).
@@ -195,17 +158,16 @@ class WholeBodyTracker:
         force_reg: float = 1e-6,
         pivot_rate: float | None = 2.0,
         slide_speed: float | None = 0.5,
-        roll_band: float | None = 0.01,
-        com_weight: float = 0.0,
-        dcm_gain: float = 5.0,
-        cop_margin: float = 0.02,
-        balance_margin: float | None = 0.03,
-        foot_weight: float = 0.0,
-        com_feedback: float = 0.0,
-        kp_foot: float = 100.0,
-        balance_tau: float = 0.1,
+        roll_band: float | None = 0.02,
         anchor_tau: float | None = 0.1,
         anchor_touch: float = 0.01,
+        balance_margin: float | None = 0.03,
+        balance_tau: float = 0.1,
+        step_margin: float | None = 0.02,
+        step_time: float = 0.35,
+        step_height: float = 0.06,
+        swing_weight: float = 10.0,
+        kp_swing: float = 400.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -216,11 +178,10 @@ class WholeBodyTracker:
                 "root_weight": root_weight, "contact_weight": contact_weight,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
-                "slide_speed": slide_speed,
-                "com_weight": com_weight, "dcm_gain": dcm_gain, "cop_margin": cop_margin,
-                "balance_margin": balance_margin, "balance_tau": balance_tau,
-                "foot_weight": foot_weight, "kp_foot": kp_foot, "com_feedback": com_feedback,
-                "anchor_tau": anchor_tau, "anchor_touch": anchor_touch, "roll_band": roll_band,
+                "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
+                "anchor_touch": anchor_touch, "balance_margin": balance_margin,
+                "balance_tau": balance_tau, "step_margin": step_margin, "step_time": step_time,
+                "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint,
             },
         )  # fmt: skip
@@ -244,8 +205,6 @@ class WholeBodyTracker:
         ]
         self._kp0, self._kv0 = self.kp.copy(), self.kv.copy()
         self.w = np.r_[np.full(6, root_weight), np.ones(3 * NJ)]
-        import os
-        self.w[:2] *= float(os.environ.get("RPW", "1"))
         self._w_air = np.r_[np.zeros(6), np.ones(3 * NJ)]
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
@@ -288,32 +247,31 @@ class WholeBodyTracker:
         self.anchor_touch = float(anchor_touch)
         self.roll_band = np.inf if roll_band is None else float(roll_band)
         self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
-        assert self.path.com is not None
-        dt_f = 1.0 / self.path.fps
         self._com = self.path.com
-        self._com_v = np.gradient(self._com, dt_f, axis=0) if self.path.num_frames > 1 else 0 * self._com
-        self._com_a = np.gradient(self._com_v, dt_f, axis=0) if self.path.num_frames > 2 else 0 * self._com
-        self.com_weight = float(com_weight)
-        self.dcm_gain = float(dcm_gain)
-        self.cop_margin = float(cop_margin)
+        assert self._com is not None and self.path.sole is not None
+        dt_f = 1.0 / self.path.fps
+        n = self.path.num_frames
+        self._com_v = np.gradient(self._com, dt_f, axis=0) if n > 1 else 0 * self._com
+        self._com_a = np.gradient(self._com_v, dt_f, axis=0) if n > 2 else 0 * self._com
+        self._sole_v = np.gradient(self.path.sole, dt_f, axis=0) if n > 1 else 0 * self.path.sole
         self.balance_margin = None if balance_margin is None else float(balance_margin)
         self._balance_rate = min(1.0, dt_tick / max(balance_tau, 1e-9))
         #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
         #: capture point inside the feet (see :meth:`rebalance`)
         self.balance_shift = np.zeros(2)
-        self.foot_weight = float(foot_weight)
-        assert self.path.corners is not None
-        cz = self.path.corners[..., 2]
-        held = cz - cz.min(axis=2, keepdims=True) < self.roll_band
-        #: ``(T, 2)`` planted feet the actor stands on the ball of (heel raised): they touch
-        #: through their ball patch, whose centre of pressure can roll as a forefoot's does (on
-        #: the box's two toe corners the character stood on an edge)
-        self.on_ball = self.path.planted & held[..., :2].all(axis=2) & ~held[..., 2:].any(axis=2)
-        self.com_feedback = float(com_feedback)
-        self.kp_foot = float(kp_foot)
-        self.kv_foot = critical_kv(kp_foot)
-        self._mass = float(m.body_subtreemass[wc.body_ids[0]])
+        self.step_margin = None if step_margin is None else float(step_margin)
+        self.step_time = float(step_time)
+        self.step_height = float(step_height)
+        self.sqrt_ws = float(np.sqrt(swing_weight))
+        self.kp_swing = float(kp_swing)
+        self.kv_swing = critical_kv(kp_swing)
+        #: the balance step under way (None: none)
+        self.step: Step | None = None
+        #: rollout times of the balance steps taken
+        self.steps_taken: list[float] = []
+        self._step_ready = 0.0
         self._gravity = m.opt.gravity.copy()
+        self._root = int(wc.body_ids[0])
         #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
         #: ``x -> Rz(yaw) x + shift``
         self.anchor_yaw = 0.0
@@ -324,7 +282,8 @@ class WholeBodyTracker:
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
         the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
-        q, v, a, planted = self.path.sample(self.clock.frame(t), self.clock.coast(t))
+        q, v, a, _ = self.path.sample(self.clock.frame(t), self.clock.coast(t))
+        planted = self.planted_now(t)
         if self.anchor_yaw or self.anchor_shift.any():
             rot = _rot2(self.anchor_yaw)
             q[:2] = rot @ q[:2] + self.anchor_shift
@@ -333,6 +292,14 @@ class WholeBodyTracker:
             a[:2] = rot @ a[:2]
         q[:2] += self.balance_shift
         return q, v, a, planted
+
+    def planted_now(self, t: float) -> NDArray[np.bool_]:
+        """``(2,)`` the feet the tracker stands on at ``t``: those planted in the mocap, but
+        for the foot of a balance step under way."""
+        planted = self.path.planted[self.clock.nearest(t)].copy()
+        if self.step is not None:
+            planted[self.step.foot] = False
+        return planted
 
     def com_reference(self, t: float) -> tuple[F64, F64, F64]:
         """The mocap's centre of mass at ``t``: position, velocity, acceleration (world, as
@@ -359,7 +326,7 @@ class WholeBodyTracker:
         its sole corners within ``anchor_touch`` of the floor, or its ball patch's
         centre-of-pressure range; empty for a foot in the air."""
         d = self.world.data
-        planted = self.path.planted[self.clock.nearest(t)]
+        planted = self.planted_now(t)
         corners = sole_corners_world(d, self.sole, self._corners)
         patch_on = self.world.foot_patch_on(self.character)
         out: list[F64] = []
@@ -378,6 +345,65 @@ class WholeBodyTracker:
                 down = corners[f, :, 2] - self.floor_z < self.anchor_touch
                 out.append(corners[f, down, :2])
         return out
+
+    def capture_point(self) -> tuple[F64, float]:
+        """The simulated body's capture point ``c + v / omega`` (2,) and ``omega`` (1/s), the
+        natural frequency of its centre of mass as an inverted pendulum."""
+        d = self.world.data
+        mujoco.mj_subtreeVel(self.world.model, d)
+        c = d.subtree_com[self._root]
+        omega = float(np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3)))
+        return c[:2] + d.subtree_linvel[self._root][:2] / omega, omega
+
+    def _swing_targets(self, t: float) -> dict[int, tuple[F64, F64, F64, F64]]:
+        """Per foot on a balance step: its sole centre's target position, velocity and
+        acceleration, and its sole's target normal (level)."""
+        if self.step is None:
+            return {}
+        p, v, a = self.step.at(t)
+        return {self.step.foot: (p, v, a, np.array([0.0, 0.0, 1.0]))}
+
+    def _update_step(self, t: float) -> None:
+        """End a balance step that has landed; start one when the capture point has left both
+        feet's support by ``step_margin`` while the mocap keeps both feet planted; update
+        nothing else."""
+        d = self.world.data
+        if self.step is not None:
+            s = self.step
+            corners = sole_corners_world(d, self.sole, self._corners)
+            down = corners[s.foot, :, 2].min() - self.floor_z < self.anchor_touch
+            if (s.phase(t) >= 1.0 and down) or t > s.t0 + 1.5 * s.duration:
+                self.step = None
+                self._step_ready = t + 0.05
+        if self.step is not None or self.step_margin is None or t < self._step_ready:
+            return
+        i = self.clock.nearest(t)
+        ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
+        feet = self._footprint(t)
+        if not (ahead.all() and all(len(f) for f in feet)):
+            return
+        xi, omega = self.capture_point()
+        if outside_distance(xi, np.concatenate(feet)) <= self.step_margin:
+            return
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
+        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
+        left = np.array([-np.sin(heading), np.cos(heading)])
+        fall = xi - convex_hull(np.concatenate(feet)).mean(axis=0)
+        side = float(fall @ left)
+        if abs(side) > abs(float(fall @ np.array([left[1], -left[0]]))):
+            foot = 0 if side > 0 else 1  # a side step with the foot on that side
+        else:  # the trailing foot
+            foot = int(np.argmax(np.linalg.norm(centre[:, :2] - xi, axis=1)))
+        stance = centre[1 - foot, :2]
+        lateral = left if foot == 0 else -left
+        target = step_target(
+            xi, stance, centre[foot, :2], omega, self.step_time, beyond=0.05, max_length=0.6,
+            min_width=0.12, lateral=lateral,
+        )  # fmt: skip
+        self.step = Step(foot, t, self.step_time, centre[foot].copy(),
+                         np.r_[target, self.floor_z], self.step_height)  # fmt: skip
+        self.steps_taken.append(t)
 
     def rebalance(self, t: float) -> None:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
@@ -410,7 +436,7 @@ class WholeBodyTracker:
         d = self.world.data
         i = self.clock.nearest(t)
         corners = sole_corners_world(d, self.sole, self._corners)
-        on = self.path.planted[i] & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
+        on = self.planted_now(t) & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
         if not on.any():
             return
         rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
@@ -527,17 +553,7 @@ class WholeBodyTracker:
         rel = quat_mul(quat_conj(q[3:].reshape(NJ + 1, 4)), qr[3:].reshape(NJ + 1, 4))
         rel *= np.where(rel[:, :1] < 0, -1.0, 1.0)
         err = np.r_[qr[:3] - q[:3], quat_log(rel).reshape(-1)]
-        verr = vr - v
-        if self.com_feedback:
-            # the pelvis rows steer the centre of mass: what balance needs is where the whole
-            # body's mass is, and the trunk and arms lagging the mocap moves it off the pelvis
-            c_ref, cv_ref, _ = self.com_reference(t)
-            mujoco.mj_subtreeVel(m, d)
-            root = self.wc.body_ids[0]
-            b = self.com_feedback
-            err[:2] += b * ((c_ref[:2] - d.subtree_com[root][:2]) - err[:2])
-            verr[:2] += b * ((cv_ref[:2] - d.subtree_linvel[root][:2]) - verr[:2])
-        acc_des = ar + self.kp * err + self.kv * verr
+        acc_des = ar + self.kp * err + self.kv * (vr - v)
         acc_des[:6] += self.root_bias
 
         mujoco.mj_fullM(m, d, self._full)
@@ -573,47 +589,23 @@ class WholeBodyTracker:
             jt = sup.rows
             rows_a.append(self.sqrt_wc * (jt @ g))
             rows_b.append(-self.sqrt_wc * (jt @ g0 + sup.bias + self.contact_kv * (jt @ v)))
-        if self.foot_weight:
-            # a planted foot on the floor takes the mocap's tilt (flat where the actor's foot
-            # is flat), so it stands on its whole sole, not on an edge the legs rolled it to
-            assert self.path.sole_up is not None
-            ups = self.path.sole_up[self.clock.nearest(t)]
-            rot_z = _rot2(self.anchor_yaw)
-            corners = sole_corners_world(d, self.sole, self._corners)
-            near = corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch
-            patch_on = self.world.foot_patch_on(self.character)
-            for f in range(2):  # two feet
-                if not (planted[f] and near[f] and held[f].all()) or patch_on[f]:
-                    continue
-                up_sim = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, 2]
-                up_ref = np.r_[rot_z @ ups[f, :2], ups[f, 2]]
-                body = int(self.feet[f])
-                point = d.xpos[body]
-                mujoco.mj_jac(m, d, None, self._jacr, point, body)
-                mujoco.mj_jacDot(m, d, None, self._jacrd, point, body)
-                jr = self._jacr[:2, sl]
-                omega_f = jr @ v
-                want = self.kp_foot * np.cross(up_sim, up_ref)[:2] - self.kv_foot * omega_f
-                rows_a.append(self.foot_weight * (jr @ g))
-                rows_b.append(self.foot_weight * (want - jr @ g0 - self._jacrd[:2, sl] @ v))
-        if nc and self.com_weight:
-            # the centre of mass moves by the ground forces alone: m (a_c - g) = sum f
-            c_ref, cv_ref, ca_ref = self.com_reference(t)
-            mujoco.mj_subtreeVel(m, d)
-            root = self.wc.body_ids[0]
-            c = d.subtree_com[root]
-            cv = d.subtree_linvel[root]
-            omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
-            xi = c[:2] + cv[:2] / omega
-            xi_ref = c_ref[:2] + cv_ref[:2] / omega
-            xi_ref_dot = cv_ref[:2] + ca_ref[:2] / omega
-            cop = xi - xi_ref_dot / omega + (self.dcm_gain / omega) * (xi - xi_ref)
-            cop = clamp_to_support(cop, sup.points[:, :2], self.cop_margin)
-            c_acc = omega * omega * (c[:2] - cop)
-            com_rows = np.zeros((2, nj + nb))
-            com_rows[:, nj:] = sup.basis[:, :2].T / self._mass
-            rows_a.append(self.com_weight * com_rows)
-            rows_b.append(self.com_weight * c_acc)
+        for f, (p_d, v_d, a_d, up_d) in self._swing_targets(t).items():
+            # a swinging foot goes where balance needs it (the mocap's landing moved by the
+            # capture point's error, or a balance step), level with the floor
+            body = int(self.feet[f])
+            rot = d.geom_xmat[self.sole[f]].reshape(3, 3)
+            point = d.geom_xpos[self.sole[f]] - rot[:, 2] * self._sole_half[f]
+            mujoco.mj_jac(m, d, self._jacp, self._jacr, point, body)
+            mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, point, body)
+            jf = np.concatenate([self._jacp[:, sl], self._jacr[:2, sl]])
+            jdv = np.concatenate([self._jacd[:, sl] @ v, self._jacrd[:2, sl] @ v])
+            vel = jf @ v
+            want = np.r_[
+                a_d + self.kp_swing * (p_d - point) + self.kv_swing * (v_d - vel[:3]),
+                self.kp_swing * np.cross(rot[:, 2], up_d)[:2] - self.kv_swing * vel[3:],
+            ]
+            rows_a.append(self.sqrt_ws * (jf @ g))
+            rows_b.append(self.sqrt_ws * (want - jf @ g0 - jdv))
         a_mat = np.concatenate(rows_a)
         b_vec = np.concatenate(rows_b)
         ay, ab = a_mat[:, :nj], a_mat[:, nj:]
@@ -650,6 +642,9 @@ class WholeBodyTracker:
         self.anchor_yaw = 0.0
         self.anchor_shift = np.zeros(2)
         self.balance_shift = np.zeros(2)
+        self.step = None
+        self.steps_taken = []
+        self._step_ready = 0.0
         servo = world.servo
         servo.enable(self.character, on=True)
         servo.set_gains(0.0, self.servo_kv, self.character)
@@ -660,6 +655,7 @@ class WholeBodyTracker:
         patch = self.path.pivoting[i]
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(patch[f]))
+        self._update_step(t)
         self.reanchor(t)
         self.rebalance(t)
         plan = self.plan(t)
