@@ -17,24 +17,23 @@ F64 = NDArray[np.float64]
 def convex_hull(points: F64) -> F64:
     """The convex hull of a few 2-D points ``(k, 2)``, counter-clockwise (Andrew's monotone
     chain); fewer than 3 distinct points come back as they are."""
-    pts = np.unique(np.round(points, 9), axis=0)
+    pts = sorted(set(map(tuple, np.round(points, 9).tolist())))
     if len(pts) < 3:
-        return pts
+        return np.array(pts, dtype=np.float64).reshape(-1, 2)
 
-    def half(seq: F64) -> list[F64]:
-        out: list[F64] = []
+    def half(seq: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        out: list[tuple[float, float]] = []
         for q in seq:  # a handful of sole corners per control tick
-            while len(out) >= 2 and _cross(out[-1] - out[-2], q - out[-2]) <= 0:
+            while len(out) >= 2 and (
+                (out[-1][0] - out[-2][0]) * (q[1] - out[-2][1])
+                - (out[-1][1] - out[-2][1]) * (q[0] - out[-2][0])
+            ) <= 0:
                 out.pop()
             out.append(q)
         return out
 
     lower, upper = half(pts), half(pts[::-1])
     return np.array(lower[:-1] + upper[:-1])
-
-
-def _cross(a: F64, b: F64) -> float:
-    return float(a[0] * b[1] - a[1] * b[0])
 
 
 def _edges(hull: F64) -> tuple[F64, F64]:

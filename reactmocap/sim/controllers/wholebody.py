@@ -2,8 +2,10 @@
 2009, Lee et al. 2010, Muico et al. 2009): each tick a small least-squares program for every
 DOF's acceleration (the pelvis moved only by ground forces at the sole corners in contact,
 inside friction pyramids), realised as joint torques. Only joint torques act: the result is
-physical. A foot pivoting in the mocap touches through its ball-of-foot patch. The program,
-and why: ``docs/design.md``."""
+physical. A foot pivoting in the mocap touches through its ball-of-foot patch. For whole clips
+the mocap's ground path is re-anchored to the feet, the targets keep its capture point inside
+them, and a capture-point step catches the body when it leaves them. The program, and why:
+``docs/design.md`` and ``docs/tracking.md``."""
 
 from __future__ import annotations
 
@@ -101,39 +103,39 @@ class WholeBodyTracker:
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
-            floor (no speed test: a pivoting or rolling foot still carries weight); a sole
-            corner supports when it is below ``floor + touch`` in the simulation (0: exactly
-            MuJoCo's contact set; a 1 cm band put forces on hovering corners, which the
-            simulation then did not produce).
+            floor; a sole corner supports when it is below ``floor + touch`` in the
+            simulation (0: exactly MuJoCo's contact set; 3 mm keeps a foot that rests on
+            two corners from standing on a line).
         force_reg: ``lam``, the regulariser on the pyramid coefficients (relative).
         pivot_rate: a planted foot pivots (touches through its ball patch) while the mocap
-            foot's yaw rate is above this (rad/s); ``None``: feet never pivot. Measured on the
-            benchmark windows: 80% tracked with 2.0 or 3.0, 74% without pivots. With a
+            foot's yaw rate is above this (rad/s); ``None``: feet never pivot. With a
             :class:`ReferencePath` given, its own ``planted`` and ``pivoting`` are used.
-        anchor_tau: re-anchoring time constant (s): the mocap's ground path (heading and
-            horizontal position) is moved toward where the character's supporting feet really
-            are, so the pelvis and the swing foot are tracked relative to the stance foot
-            (``None``: the mocap's world path, as captured).
         slide_speed: a foot near the floor is planted only while its lowest corner moves
-            slower than this (m/s) or it pivots (``None``: any speed).
+            slower than this (m/s) or it pivots (0: any speed).
         roll_band: a sole corner carries force only while the mocap holds it within this of
-            its foot's lowest corner (m): a heel the actor raises, or toes it lifts, are let
-            go (holding every touching corner still kept the heel down, and a straight stance
-            leg then could not lift the pelvis as the actor did); ``None``: every touching
-            corner.
-        anchor_touch: a foot anchors while planted in the mocap and its sole's lowest corner
-            is within this of the floor in the simulation (m).
+            its foot's lowest corner (m): a heel the actor raises is let go (0: every
+            touching corner).
+        anchor_tau, anchor_touch, anchor_return: the mocap's ground path (heading and
+            horizontal position) is moved, with time constant ``anchor_tau`` (s; 0: never),
+            toward where the feet that are planted and within ``anchor_touch`` m of the floor
+            really are, and back toward the captured path with ``anchor_return`` (s; 0:
+            never).
         balance_margin, balance_tau: while both feet support, the pelvis and centre-of-mass
-            targets shift (time constant ``balance_tau``) so the mocap's capture point stays
-            ``balance_margin`` m inside the soles on the floor (``None``: never).
-        step_margin: the tracker takes a balance step when the simulated capture point is
-            this far outside both feet's support while the mocap stands (``None``: never).
-        step_time, step_height: a balance step's duration (s) and lift (m).
-        swing_weight, kp_swing: weight and stiffness (critically damped) of a balance step's
-            foot position and tilt rows.
+            targets shift (time constant ``balance_tau``, 0: never) so the mocap's capture
+            point stays ``balance_margin`` m inside the feet on the floor.
+        step_margin, step_time, step_height: a balance step (lasting ``step_time`` s, 0:
+            never; lifting ``step_height`` m) starts when the simulated capture point is
+            ``step_margin`` m outside both feet while the mocap stands.
+        swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
+            foot's position and tilt rows.
+        place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
+            above ``place_height``) and the simulated capture point is more than
+            ``place_deadband`` m from the mocap's, the foot lands ``place_gain`` times that
+            error (at most 0.4 m) from the mocap's landing (0: off; see ``docs/tracking.md``).
         servo_kv: the servo's damping (1/s).
 
-    Defaults were chosen on the shared walk, run and kick clips (``benchmarks/bench_sim.py``).
+    Defaults were chosen on the shared walk, run and kick windows and whole shared clips
+    (``benchmarks/bench_sim.py``, ``docs/tracking.md``).
     """
 
     def __init__(
@@ -157,17 +159,21 @@ class WholeBodyTracker:
         touch: float = 0.003,
         force_reg: float = 1e-6,
         pivot_rate: float | None = 2.0,
-        slide_speed: float | None = 0.5,
-        roll_band: float | None = 0.02,
-        anchor_tau: float | None = 0.1,
+        slide_speed: float = 0.5,
+        roll_band: float = 0.02,
+        anchor_tau: float = 0.1,
         anchor_touch: float = 0.01,
-        balance_margin: float | None = 0.03,
+        anchor_return: float = 5.0,
+        balance_margin: float = 0.03,
         balance_tau: float = 0.1,
-        step_margin: float | None = 0.02,
+        step_margin: float = 0.02,
         step_time: float = 0.35,
         step_height: float = 0.06,
         swing_weight: float = 10.0,
         kp_swing: float = 400.0,
+        place_gain: float = 0.0,
+        place_deadband: float = 0.15,
+        place_height: float = 0.03,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -179,9 +185,12 @@ class WholeBodyTracker:
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
-                "anchor_touch": anchor_touch, "balance_margin": balance_margin,
+                "anchor_touch": anchor_touch,
+                "anchor_return": anchor_return, "balance_margin": balance_margin,
                 "balance_tau": balance_tau, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
+                "place_gain": place_gain, "place_deadband": place_deadband,
+                "place_height": place_height,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint,
             },
         )  # fmt: skip
@@ -239,13 +248,14 @@ class WholeBodyTracker:
             reference
             if isinstance(reference, ReferencePath)
             else reference_path(world, character, reference, reach=reach, pivot_rate=pivot_rate,
-                                slide_speed=slide_speed),
+                                slide_speed=slide_speed or None),
         )
         self.clock = self.path.clock(start)
         dt_tick = self.control_every * world.timestep
-        self._anchor_rate = 0.0 if anchor_tau is None else min(1.0, dt_tick / max(anchor_tau, 1e-9))
+        self._anchor_rate = min(1.0, dt_tick / anchor_tau) if anchor_tau > 0 else 0.0
         self.anchor_touch = float(anchor_touch)
-        self.roll_band = np.inf if roll_band is None else float(roll_band)
+        self._return_rate = min(1.0, dt_tick / anchor_return) if anchor_return > 0 else 0.0
+        self.roll_band = float(roll_band) if roll_band > 0 else np.inf
         self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
         self._com = self.path.com
         assert self._com is not None and self.path.sole is not None
@@ -254,17 +264,23 @@ class WholeBodyTracker:
         self._com_v = np.gradient(self._com, dt_f, axis=0) if n > 1 else 0 * self._com
         self._com_a = np.gradient(self._com_v, dt_f, axis=0) if n > 2 else 0 * self._com
         self._sole_v = np.gradient(self.path.sole, dt_f, axis=0) if n > 1 else 0 * self.path.sole
-        self.balance_margin = None if balance_margin is None else float(balance_margin)
-        self._balance_rate = min(1.0, dt_tick / max(balance_tau, 1e-9))
+        self.balance_margin = float(balance_margin)
+        self._balance_rate = min(1.0, dt_tick / balance_tau) if balance_tau > 0 else 0.0
         #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
         #: capture point inside the feet (see :meth:`rebalance`)
         self.balance_shift = np.zeros(2)
-        self.step_margin = None if step_margin is None else float(step_margin)
+        self.step_margin = float(step_margin)
         self.step_time = float(step_time)
         self.step_height = float(step_height)
         self.sqrt_ws = float(np.sqrt(swing_weight))
         self.kp_swing = float(kp_swing)
         self.kv_swing = critical_kv(kp_swing)
+        self.place_gain = float(place_gain)
+        self.place_deadband = float(place_deadband)
+        self.place_height = float(place_height)
+        #: horizontal shift of a mocap swing foot's landing (m): the capture point's error
+        #: against the mocap's beyond ``place_deadband``
+        self.place_shift = np.zeros(2)
         #: the balance step under way (None: none)
         self.step: Step | None = None
         #: rollout times of the balance steps taken
@@ -272,6 +288,10 @@ class WholeBodyTracker:
         self._step_ready = 0.0
         self._gravity = m.opt.gravity.copy()
         self._root = int(wc.body_ids[0])
+        self._corners_at: tuple[float, bytes] = (float("nan"), b"")
+        self._corners_now = np.zeros((2, 4, 3))
+        legs = [[BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"]
+        self._leg_rows = [np.concatenate([6 + 3 * k + np.arange(3) for k in leg]) for leg in legs]
         #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
         #: ``x -> Rz(yaw) x + shift``
         self.anchor_yaw = 0.0
@@ -292,6 +312,15 @@ class WholeBodyTracker:
             a[:2] = rot @ a[:2]
         q[:2] += self.balance_shift
         return q, v, a, planted
+
+    def _sole_corners(self) -> F64:
+        """``(2, 4, 3)`` the sole corners now (computed once per simulation time)."""
+        d = self.world.data
+        key = (float(d.time), d.geom_xpos[self.sole].tobytes())
+        if self._corners_at != key:
+            self._corners_now = sole_corners_world(d, self.sole, self._corners)
+            self._corners_at = key
+        return self._corners_now
 
     def planted_now(self, t: float) -> NDArray[np.bool_]:
         """``(2,)`` the feet the tracker stands on at ``t``: those planted in the mocap, but
@@ -327,7 +356,7 @@ class WholeBodyTracker:
         centre-of-pressure range; empty for a foot in the air."""
         d = self.world.data
         planted = self.planted_now(t)
-        corners = sole_corners_world(d, self.sole, self._corners)
+        corners = self._sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
         out: list[F64] = []
         for f in range(2):  # two feet
@@ -355,27 +384,58 @@ class WholeBodyTracker:
         omega = float(np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3)))
         return c[:2] + d.subtree_linvel[self._root][:2] / omega, omega
 
-    def _swing_targets(self, t: float) -> dict[int, tuple[F64, F64, F64, F64]]:
-        """Per foot on a balance step: its sole centre's target position, velocity and
-        acceleration, and its sole's target normal (level)."""
-        if self.step is None:
-            return {}
-        p, v, a = self.step.at(t)
-        return {self.step.foot: (p, v, a, np.array([0.0, 0.0, 1.0]))}
+    def _swing_targets(self, t: float) -> dict[int, tuple[F64, F64, F64, F64 | None]]:
+        """Per foot stepping for balance: its sole centre's target position, velocity and
+        acceleration, and its sole's target normal (``None``: free; a placement moves only
+        the foot's horizontal position): a balance step's path, or a mocap swing foot whose
+        landing the capture point's error moves (see :attr:`place_shift`)."""
+        out: dict[int, tuple[F64, F64, F64, F64 | None]] = {}
+        if self.step is not None:
+            p, v, a = self.step.at(t)
+            out[self.step.foot] = (p, v, a, np.array([0.0, 0.0, 1.0]))
+        if not self.place_shift.any():
+            return out
+        assert self.path.sole is not None
+        x = self.clock.frame(t)
+        i = self.clock.nearest(t)
+        i0 = int(x)
+        i1 = min(i0 + 1, self.path.num_frames - 1)
+        w = x - i0
+        rot = _rot2(self.anchor_yaw)
+        for f in range(2):  # two feet
+            if self.path.planted[i, f] or f in out:
+                continue
+            p = (1 - w) * self.path.sole[i0, f] + w * self.path.sole[i1, f]
+            if p[2] - self.floor_z < self.place_height:
+                continue
+            v = (1 - w) * self._sole_v[i0, f] + w * self._sole_v[i1, f]
+            p[:2] = rot @ p[:2] + self.anchor_shift + self.place_shift
+            v[:2] = rot @ v[:2]
+            out[f] = (p, v, np.zeros(3), None)
+        return out
 
     def _update_step(self, t: float) -> None:
         """End a balance step that has landed; start one when the capture point has left both
         feet's support by ``step_margin`` while the mocap keeps both feet planted; update
         nothing else."""
         d = self.world.data
+        self.place_shift = np.zeros(2)
+        if self.place_gain and not self.path.planted[self.clock.nearest(t)].all():
+            xi, omega = self.capture_point()
+            c_ref, cv_ref, _ = self.com_reference(t)
+            miss = xi - c_ref[:2] - cv_ref[:2] / omega
+            n = float(np.linalg.norm(miss))
+            if n > self.place_deadband:
+                # beyond the dead band a walk's own capture-point error never reaches
+                self.place_shift = self.place_gain * miss * min(1.0, 0.4 / n)
         if self.step is not None:
             s = self.step
-            corners = sole_corners_world(d, self.sole, self._corners)
+            corners = self._sole_corners()
             down = corners[s.foot, :, 2].min() - self.floor_z < self.anchor_touch
             if (s.phase(t) >= 1.0 and down) or t > s.t0 + 1.5 * s.duration:
                 self.step = None
                 self._step_ready = t + 0.05
-        if self.step is not None or self.step_margin is None or t < self._step_ready:
+        if self.step is not None or not self.step_time or t < self._step_ready:
             return
         i = self.clock.nearest(t)
         ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
@@ -409,7 +469,7 @@ class WholeBodyTracker:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
         capture point ``balance_margin`` inside both feet's soles on the floor (zero unless
         both feet support: a walk's capture point leaves the stance foot on purpose)."""
-        if self.balance_margin is None:
+        if not self._balance_rate:
             return
         target = np.zeros(2)
         feet = self._footprint(t)
@@ -435,7 +495,7 @@ class WholeBodyTracker:
             return
         d = self.world.data
         i = self.clock.nearest(t)
-        corners = sole_corners_world(d, self.sole, self._corners)
+        corners = self._sole_corners()
         on = self.planted_now(t) & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
         if not on.any():
             return
@@ -453,6 +513,9 @@ class WholeBodyTracker:
         k = self._anchor_rate
         self.anchor_yaw += k * dyaw
         self.anchor_shift = _rot2(k * dyaw) @ (self.anchor_shift + k * err - centre) + centre
+        # and slowly back toward the captured path, which the gait then follows step by step
+        self.anchor_yaw -= self._return_rate * self.anchor_yaw
+        self.anchor_shift -= self._return_rate * self.anchor_shift
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
@@ -468,7 +531,7 @@ class WholeBodyTracker:
         the mocap holds down (``held`` ``(2, 4)``), or the ball patch of a pivoting foot, of
         the feet planted in the mocap."""
         m = self.world.model
-        corners = sole_corners_world(d, self.sole, self._corners)
+        corners = self._sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
         qdot = d.qvel[self._dofs]
         sl = self._dofs
@@ -552,7 +615,7 @@ class WholeBodyTracker:
         # position error in qvel coordinates: world translation, local rotation vectors
         rel = quat_mul(quat_conj(q[3:].reshape(NJ + 1, 4)), qr[3:].reshape(NJ + 1, 4))
         rel *= np.where(rel[:, :1] < 0, -1.0, 1.0)
-        err = np.r_[qr[:3] - q[:3], quat_log(rel).reshape(-1)]
+        err = np.concatenate([qr[:3] - q[:3], quat_log(rel).reshape(-1)])
         acc_des = ar + self.kp * err + self.kv * (vr - v)
         acc_des[:6] += self.root_bias
 
@@ -579,6 +642,12 @@ class WholeBodyTracker:
         # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
         # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
         w = self.w if nc else self._w_air
+        swing = self._swing_targets(t)
+        if swing:
+            # a stepping leg follows its foot's target, not the mocap's leg
+            w = w.copy()
+            for f in swing:
+                w[self._leg_rows[f]] = 0.1
         rows_a = [w[:, None] * g]
         rows_b = [w * (acc_des - g0)]
         if nc:
@@ -589,7 +658,7 @@ class WholeBodyTracker:
             jt = sup.rows
             rows_a.append(self.sqrt_wc * (jt @ g))
             rows_b.append(-self.sqrt_wc * (jt @ g0 + sup.bias + self.contact_kv * (jt @ v)))
-        for f, (p_d, v_d, a_d, up_d) in self._swing_targets(t).items():
+        for f, (p_d, v_d, a_d, up_d) in swing.items():
             # a swinging foot goes where balance needs it (the mocap's landing moved by the
             # capture point's error, or a balance step), level with the floor
             body = int(self.feet[f])
@@ -602,8 +671,11 @@ class WholeBodyTracker:
             vel = jf @ v
             want = np.r_[
                 a_d + self.kp_swing * (p_d - point) + self.kv_swing * (v_d - vel[:3]),
-                self.kp_swing * np.cross(rot[:, 2], up_d)[:2] - self.kv_swing * vel[3:],
+                self.kp_swing * np.cross(rot[:, 2], up_d if up_d is not None else rot[:, 2])[:2]
+                - self.kv_swing * vel[3:],
             ]
+            if up_d is None:  # a placement: where the foot lands, not how it swings
+                jf, jdv, want = jf[:2], jdv[:2], want[:2]
             rows_a.append(self.sqrt_ws * (jf @ g))
             rows_b.append(self.sqrt_ws * (want - jf @ g0 - jdv))
         a_mat = np.concatenate(rows_a)
@@ -616,11 +688,11 @@ class WholeBodyTracker:
             pb = b_vec - qmat @ (qmat.T @ b_vec)
             scale = float(np.linalg.norm(pab, axis=0).max()) or 1.0
             lhs = np.concatenate([pab, self.sqrt_reg * scale * np.eye(nb)])
-            beta, _ = nnls(lhs, np.r_[pb, np.zeros(nb)], maxiter=50 * nb)
+            beta, _ = nnls(lhs, np.concatenate([pb, np.zeros(nb)]), maxiter=50 * nb)
         else:
             beta = np.zeros(0)
         y = np.linalg.solve(rmat, qmat.T @ (b_vec - ab @ beta))
-        qdd = g @ np.r_[y, beta] + g0
+        qdd = g @ np.concatenate([y, beta]) + g0
         tau = big_m[6:] @ qdd + h[6:] - qb[6:] @ beta
         forces = np.zeros((nc, 3))
         np.add.at(forces, sup.owner, sup.basis * beta[:, None])
@@ -642,6 +714,7 @@ class WholeBodyTracker:
         self.anchor_yaw = 0.0
         self.anchor_shift = np.zeros(2)
         self.balance_shift = np.zeros(2)
+        self.place_shift = np.zeros(2)
         self.step = None
         self.steps_taken = []
         self._step_ready = 0.0
