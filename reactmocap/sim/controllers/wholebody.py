@@ -41,6 +41,8 @@ NV = 6 + 3 * NJ
 # friction pyramid edge directions per unit of mu (world x+, x-, y+, y-)
 _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 _UP = np.array([[0.0], [0.0], [1.0]])
+# a heading error's dead band is the position dead band over this lever (m)
+_DEADBAND_ARM = 0.5
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
 _PATCH_CORNERS = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
 
@@ -119,7 +121,8 @@ class WholeBodyTracker:
             horizontal position) is moved, with time constant ``anchor_tau`` (s; 0: never),
             toward where the feet that are planted and within ``anchor_touch`` m of the floor
             really are, and back toward the captured path with ``anchor_return`` (s; 0:
-            never).
+            never). Only the feet's error beyond ``anchor_deadband`` m (heading: that over
+            0.5 m, in rad) moves it.
         balance_margin, balance_tau: while both feet support, the pelvis and centre-of-mass
             targets shift (time constant ``balance_tau``, 0: never) so the mocap's capture
             point stays ``balance_margin`` m inside the feet on the floor.
@@ -164,6 +167,7 @@ class WholeBodyTracker:
         anchor_tau: float = 0.1,
         anchor_touch: float = 0.01,
         anchor_return: float = 5.0,
+        anchor_deadband: float = 0.1,
         balance_margin: float = 0.03,
         balance_tau: float = 0.1,
         step_margin: float = 0.02,
@@ -186,7 +190,7 @@ class WholeBodyTracker:
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
                 "anchor_touch": anchor_touch,
-                "anchor_return": anchor_return, "balance_margin": balance_margin,
+                "anchor_return": anchor_return, "anchor_deadband": anchor_deadband, "balance_margin": balance_margin,
                 "balance_tau": balance_tau, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
@@ -254,6 +258,7 @@ class WholeBodyTracker:
         dt_tick = self.control_every * world.timestep
         self._anchor_rate = min(1.0, dt_tick / anchor_tau) if anchor_tau > 0 else 0.0
         self.anchor_touch = float(anchor_touch)
+        self.anchor_deadband = float(anchor_deadband)
         self._return_rate = min(1.0, dt_tick / anchor_return) if anchor_return > 0 else 0.0
         self.roll_band = float(roll_band) if roll_band > 0 else np.inf
         self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
@@ -510,6 +515,11 @@ class WholeBodyTracker:
         if turn.any():
             yaw = np.arctan2(rot[turn, 1, 0], rot[turn, 0, 0]) - ref_yaw[turn] - self.anchor_yaw
             dyaw = float(np.mean((yaw + np.pi) % (2 * np.pi) - np.pi))
+        # only what is beyond the dead band: a small offset is the tracking's own to correct
+        db = self.anchor_deadband
+        n = float(np.linalg.norm(err))
+        err = err * max(0.0, 1.0 - db / n) if n > 0 else err
+        dyaw = float(np.sign(dyaw) * max(0.0, abs(dyaw) - db / _DEADBAND_ARM))
         k = self._anchor_rate
         self.anchor_yaw += k * dyaw
         self.anchor_shift = _rot2(k * dyaw) @ (self.anchor_shift + k * err - centre) + centre
