@@ -109,7 +109,8 @@ def support_feasibility(
             f"{motion.name!r} has {motion.num_frames}"
         )
     world = World(build_character(motion, total_mass=total_mass, frame=0))
-    ref = reference_path(world, 0, motion, reach=reach)
+    # a foot dragged along the floor still carries weight: every foot near it supports
+    ref = reference_path(world, 0, motion, reach=reach, slide_speed=None)
     m = world.model
     d = mujoco.MjData(m)
     wc = world.characters[0]

@@ -173,9 +173,10 @@ def track_clip(
     cfg = config or WorldConfig(friction=friction)
     world = World(character, cfg)
     world.set_from_motion(0, motion, frame)
-    path = reference_path(world, 0, motion)
-    ctrls = [build(controller, world, path, given, start=start)]
+    # the controller builds its path from the clip: stance detection is its own option
+    ctrls = [build(controller, world, motion, given, start=start)]
     if root_assist > 0:
+        path = reference_path(world, 0, motion)
         ctrls.append(build("root_assist", world, path, {"kp": root_assist}, start=start))
     pelvis = world.characters[0].qpos_adr + 2
     low = FALL_FRACTION * float(world.data.qpos[pelvis])

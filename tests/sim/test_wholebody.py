@@ -38,11 +38,13 @@ def _tracker(world: World, motion: Motion, start: float, **kw: float | None) -> 
     return wb
 
 
-def _standing(motion: Motion, frame: int) -> tuple[World, PDServo, WholeBodyTracker]:
+def _standing(
+    motion: Motion, frame: int, **kw: float | None
+) -> tuple[World, PDServo, WholeBodyTracker]:
     world = World(build_character(motion, frame=frame))
     world.set_from_motion(0, motion, frame)
     mujoco.mj_forward(world.model, world.data)
-    wb = _tracker(world, motion, frame / motion.fps)
+    wb = _tracker(world, motion, frame / motion.fps, **kw)
     return world, world.servo, wb
 
 
@@ -117,7 +119,8 @@ def test_planned_forces_are_the_simulated_ones(request: pytest.FixtureRequest, c
     planned torques (within 15% at the 90th percentile of control ticks). Planning on corners
     hovering within 1 cm with a soft tangential-only no-slip term gave 26-34% here."""
     motion: Motion = request.getfixturevalue(clip)
-    world, _servo, wb = _standing(motion, 0)
+    # exactly MuJoCo's contact set (the default 3 mm band plans on corners about to touch)
+    world, _servo, wb = _standing(motion, 0, touch=0.0)
     m = world.model
     probe = mujoco.MjData(m)
     f6 = np.zeros(6)
@@ -252,6 +255,8 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("friction", -0.5),
         ("reach", float("inf")),
         ("pivot_rate", -2.0),
+        ("anchor_tau", -0.1),
+        ("step_time", float("nan")),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

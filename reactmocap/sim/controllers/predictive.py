@@ -154,6 +154,7 @@ class PredictiveTracker:
         it found it."""
         world = self.world
         state = world.get_state()
+        memory = self.tracker.memory()
         d = world.data
         self._warnings = _diverged_count(d)
         noise = self.sigma * self._rng.standard_normal((self.samples - 2, 6))
@@ -166,10 +167,12 @@ class PredictiveTracker:
         try:
             for i, bias in enumerate(candidates):
                 world.set_state(state)
+                self.tracker.restore(memory)
                 costs[i] = self._predict(bias, t)
         finally:
             mujoco.set_mju_user_warning(handler)
             world.set_state(state)
+            self.tracker.restore(memory)
             for w, n in zip(_DIVERGED, self._warnings):
                 d.warning[w].number = n
         self.last_costs = costs

@@ -107,20 +107,20 @@ class Step:
         return float(np.clip((t - self.t0) / self.duration, 0.0, 1.0))
 
     def at(self, t: float) -> tuple[F64, F64, F64]:
-        """Position, velocity and acceleration of the sole centre at ``t`` (a smoothstep
-        across, a half sine up)."""
+        """Position, velocity and acceleration of the sole centre at ``t``: a smoothstep
+        across, a bump ``16 h s^2 (1 - s)^2`` up (both at rest at the ends)."""
         s = self.phase(t)
         T = self.duration
         moving = 0.0 < (t - self.t0) < T
-        ease, dease, ddease = 3 * s**2 - 2 * s**3, 6 * s * (1 - s), 6 - 12 * s
         span = self.target - self.start
-        p = self.start + ease * span
-        v = (dease / T) * span if moving else np.zeros(3)
-        a = (ddease / T**2) * span if moving else np.zeros(3)
-        p[2] += self.height * np.sin(np.pi * s)
-        if moving:
-            v[2] += self.height * np.pi / T * np.cos(np.pi * s)
-            a[2] -= self.height * (np.pi / T) ** 2 * np.sin(np.pi * s)
+        p = self.start + (3 * s**2 - 2 * s**3) * span
+        p[2] += 16.0 * self.height * s**2 * (1 - s) ** 2
+        if not moving:
+            return p, np.zeros(3), np.zeros(3)
+        v = (6 * s * (1 - s) / T) * span
+        a = ((6 - 12 * s) / T**2) * span
+        v[2] += 32.0 * self.height * s * (1 - s) * (1 - 2 * s) / T
+        a[2] += 32.0 * self.height * (1 - 6 * s + 6 * s**2) / T**2
         return p, v, a
 
 

@@ -41,6 +41,12 @@ NV = 6 + 3 * NJ
 # friction pyramid edge directions per unit of mu (world x+, x-, y+, y-)
 _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 _UP = np.array([[0.0], [0.0], [1.0]])
+# largest acceleration a swinging foot's rows ask for (m/s^2, and rad/s^2 for its tilt)
+_SWING_ACC = 100.0
+# no balance step once the pelvis has tilted this far from its start (cos 35 deg)
+_STEP_TILT_COS = float(np.cos(np.radians(35.0)))
+# seconds between updates of the ground path, the balance shift and the step decision
+_SLOW_PERIOD = 0.008
 # a heading error's dead band is the position dead band over this lever (m)
 _DEADBAND_ARM = 0.5
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
@@ -126,9 +132,11 @@ class WholeBodyTracker:
         balance_margin, balance_tau: while both feet support, the pelvis and centre-of-mass
             targets shift (time constant ``balance_tau``, 0: never) so the mocap's capture
             point stays ``balance_margin`` m inside the feet on the floor.
-        step_margin, step_time, step_height: a balance step (lasting ``step_time`` s, 0:
-            never; lifting ``step_height`` m) starts when the simulated capture point is
-            ``step_margin`` m outside both feet while the mocap stands.
+        stepping, step_margin, step_time, step_height: with ``stepping``, a balance step
+            (lasting ``step_time`` s, lifting ``step_height`` m) starts when the simulated
+            capture point is ``step_margin`` m outside both feet while the mocap stands and
+            the body is still up. Off by default: ``push`` turns it on (tracking a whole clip,
+            the steps it took in fighting stances sometimes ended in a blow-up).
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -170,6 +178,7 @@ class WholeBodyTracker:
         anchor_deadband: float = 0.1,
         balance_margin: float = 0.03,
         balance_tau: float = 0.1,
+        stepping: bool = False,
         step_margin: float = 0.02,
         step_time: float = 0.35,
         step_height: float = 0.06,
@@ -182,6 +191,8 @@ class WholeBodyTracker:
         control_every: int,
     ) -> None:
         check_character(world, character)
+        if not (isinstance(control_every, int) and control_every >= 1):
+            raise ConfigError(f"control_every must be an int >= 1, got {control_every!r}")
         check_params(
             {
                 "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint,
@@ -191,7 +202,7 @@ class WholeBodyTracker:
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
                 "anchor_touch": anchor_touch,
                 "anchor_return": anchor_return, "anchor_deadband": anchor_deadband, "balance_margin": balance_margin,
-                "balance_tau": balance_tau, "step_margin": step_margin, "step_time": step_time,
+                "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height,
@@ -256,10 +267,11 @@ class WholeBodyTracker:
         )
         self.clock = self.path.clock(start)
         dt_tick = self.control_every * world.timestep
-        self._anchor_rate = min(1.0, dt_tick / anchor_tau) if anchor_tau > 0 else 0.0
+        dt_slow = np.ceil(_SLOW_PERIOD / dt_tick - 1e-9) * dt_tick  # see control()
+        self._anchor_rate = min(1.0, dt_slow / anchor_tau) if anchor_tau > 0 else 0.0
         self.anchor_touch = float(anchor_touch)
         self.anchor_deadband = float(anchor_deadband)
-        self._return_rate = min(1.0, dt_tick / anchor_return) if anchor_return > 0 else 0.0
+        self._return_rate = min(1.0, dt_slow / anchor_return) if anchor_return > 0 else 0.0
         self.roll_band = float(roll_band) if roll_band > 0 else np.inf
         self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
         self._com = self.path.com
@@ -270,10 +282,11 @@ class WholeBodyTracker:
         self._com_a = np.gradient(self._com_v, dt_f, axis=0) if n > 2 else 0 * self._com
         self._sole_v = np.gradient(self.path.sole, dt_f, axis=0) if n > 1 else 0 * self.path.sole
         self.balance_margin = float(balance_margin)
-        self._balance_rate = min(1.0, dt_tick / balance_tau) if balance_tau > 0 else 0.0
+        self._balance_rate = min(1.0, dt_slow / balance_tau) if balance_tau > 0 else 0.0
         #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
         #: capture point inside the feet (see :meth:`rebalance`)
         self.balance_shift = np.zeros(2)
+        self.stepping = bool(stepping)
         self.step_margin = float(step_margin)
         self.step_time = float(step_time)
         self.step_height = float(step_height)
@@ -293,6 +306,10 @@ class WholeBodyTracker:
         self._step_ready = 0.0
         self._gravity = m.opt.gravity.copy()
         self._root = int(wc.body_ids[0])
+        self._slow_next = 0.0
+        self._z_adr = wc.qpos_slice.start + 2
+        self._z0 = float(world.data.qpos[self._z_adr])
+        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
         self._corners_at: tuple[float, bytes] = (float("nan"), b"")
         self._corners_now = np.zeros((2, 4, 3))
         legs = [[BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"]
@@ -437,12 +454,15 @@ class WholeBodyTracker:
             s = self.step
             corners = self._sole_corners()
             down = corners[s.foot, :, 2].min() - self.floor_z < self.anchor_touch
-            if (s.phase(t) >= 1.0 and down) or t > s.t0 + 1.5 * s.duration:
+            if (s.phase(t) >= 0.6 and down) or t > s.t0 + 1.5 * s.duration:
                 self.step = None
                 self._step_ready = t + 0.05
-        if self.step is not None or not self.step_time or t < self._step_ready:
+        if self.step is not None or not self.stepping or t < self._step_ready:
             return
         i = self.clock.nearest(t)
+        up = d.xmat[self._root].reshape(3, 3)[:, 2]
+        if up @ self._root_up0 < _STEP_TILT_COS or d.qpos[self._z_adr] < 0.75 * self._z0:
+            return  # already going down: a step would only flail
         ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
         feet = self._footprint(t)
         if not (ahead.all() and all(len(f) for f in feet)):
@@ -684,6 +704,9 @@ class WholeBodyTracker:
                 self.kp_swing * np.cross(rot[:, 2], up_d if up_d is not None else rot[:, 2])[:2]
                 - self.kv_swing * vel[3:],
             ]
+            # bounded: an out-of-reach target must not whip the leg
+            want[:3] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[:3])), 1e-9))
+            want[3:] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[3:])), 1e-9))
             if up_d is None:  # a placement: where the foot lands, not how it swings
                 jf, jdv, want = jf[:2], jdv[:2], want[:2]
             rows_a.append(self.sqrt_ws * (jf @ g))
@@ -720,6 +743,25 @@ class WholeBodyTracker:
         """From rollout time ``t`` on, follow the reference's pose at ``t``."""
         self.clock = self.clock.held_from(t)
 
+    def memory(self) -> tuple[object, ...]:
+        """What the tracker carries from tick to tick (the ground path's anchoring, the
+        balance shift, a step under way), for :meth:`restore` after a look ahead."""
+        return (self.anchor_yaw, self.anchor_shift.copy(), self.balance_shift.copy(),
+                self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
+                self._slow_next)  # fmt: skip
+
+    def restore(self, memory: tuple[object, ...]) -> None:
+        """Back to a :meth:`memory`."""
+        yaw, shift, bal, place, step, taken, ready, slow = memory
+        self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
+        self.anchor_shift = np.array(shift)
+        self.balance_shift = np.array(bal)
+        self.place_shift = np.array(place)
+        self.step = step  # type: ignore[assignment]
+        del self.steps_taken[int(taken) :]  # type: ignore[call-overload]
+        self._step_ready = float(ready)  # type: ignore[arg-type]
+        self._slow_next = float(slow)  # type: ignore[arg-type]
+
     def reset(self, world: World) -> None:
         self.anchor_yaw = 0.0
         self.anchor_shift = np.zeros(2)
@@ -728,19 +770,31 @@ class WholeBodyTracker:
         self.step = None
         self.steps_taken = []
         self._step_ready = 0.0
+        self._slow_next = 0.0
+        self._z0 = float(world.data.qpos[self._z_adr])
+        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
         servo = world.servo
         servo.enable(self.character, on=True)
         servo.set_gains(0.0, self.servo_kv, self.character)
         servo.refresh_every = self.control_every
 
     def control(self, world: World, t: float) -> None:
+        d = world.data
+        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
+            # diverged between the engine's checks: it reports that at its next check (a
+            # result, not an exception)
+            self._ff[:] = 0.0
+            return
         i = self.clock.nearest(t)
         patch = self.path.pivoting[i]
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(patch[f]))
-        self._update_step(t)
-        self.reanchor(t)
-        self.rebalance(t)
+        if t >= self._slow_next - 1e-9:
+            # the ground path and the balance targets move slowly: every few ticks is enough
+            self._slow_next = t + _SLOW_PERIOD
+            self._update_step(t)
+            self.reanchor(t)
+            self.rebalance(t)
         plan = self.plan(t)
         self.last_plan = plan
         # the servo (damping only by default) keeps acting between ticks; at the tick the

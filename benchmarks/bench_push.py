@@ -1,0 +1,151 @@
+"""Push recovery while tracking (prints figures; run ``.venv/bin/python benchmarks/bench_push.py``).
+
+The largest chest push (``--duration`` s, 8 directions relative to the character's heading) that
+a standing and a walking shared clip survive, by bisection on the force: upright (pelvis above
+half its start height) until ``--after`` s past the push. Writes the figures as JSON and a polar
+plot beside Wooten's standing figure (thesis Fig. 7.7, as far as the text gives it) and
+SIMBICON's 350 N diagonal push while walking (Yin et al. 2007).
+
+Survival is not monotonic in the force once the tracker steps (a harder push can land a better
+step), so a bisection's answer is a value that was survived with every tested force below it
+that the search probed, not a guaranteed threshold.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from reactmocap.library.motion import Motion
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT / ".." / "shared" / "mocap" / "bandai-namco-1"
+LABELS = ("front", "front-left", "left", "back-left", "back", "back-right", "right", "front-right")
+#: Wooten's standing figure as the brief summarises thesis Fig. 7.7 (the plotted values are not
+#: in the text): about 200 N front and back, 100 N sideways, 0.25 s at the sternum
+WOOTEN_STANDING_N = (200.0, 141.0, 100.0, 141.0, 200.0, 141.0, 100.0, 141.0)
+#: SIMBICON's walking figure (Yin et al. 2007): 350 N for 0.2 s, diagonal, survived
+SIMBICON_WALKING_N = 350.0
+
+
+def _clip(name: str) -> Motion:
+    from reactmocap.library.bvh import read_bvh
+
+    return read_bvh(SHARED / f"dataset-1_{name}.bvh")
+
+
+def heading(motion: Motion, time_s: float) -> float:
+    """The character's heading at clip time ``time_s``: the mean of its soles' yaw (rad)."""
+    from reactmocap.sim import World, build_character
+    from reactmocap.sim.reference import reference_path
+
+    world = World(build_character(motion, frame=0))
+    path = reference_path(world, 0, motion)
+    assert path.sole_yaw is not None
+    yaw = path.sole_yaw[min(round(time_s * path.fps), path.num_frames - 1)]
+    return float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum()))
+
+
+def survives(job: tuple[str, float, float, float, float, float, dict[str, Any]]) -> bool:
+    name, at, angle, force, duration, after, params = job
+    from reactmocap.sim import push_clip
+
+    motion = _clip(name)
+    start = max(0.0, at - 0.5)
+    seconds = min(motion.duration - start, at - start + duration + after)
+    res = push_clip(
+        motion, time=at, body="chest", force=[force * np.cos(angle), force * np.sin(angle), 0.0],
+        duration=duration, start=start, seconds=seconds, params=params,
+    )  # fmt: skip
+    return res.report.status == "ok"
+
+
+def largest(job: tuple[str, float, float, float, float, dict[str, Any], float, int]) -> float:
+    """Bisection on the force in ``[0, hi]`` (``steps`` halvings)."""
+    name, at, angle, duration, after, params, hi, steps = job
+    if survives((name, at, angle, hi, duration, after, params)):
+        return hi
+    lo = 0.0
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        if survives((name, at, angle, mid, duration, after, params)):
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> list[float]:
+    motion = _clip(name)
+    yaw = heading(motion, at)
+    params = json.loads(args.params)
+    jobs = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.max_force,
+             args.steps) for k in range(8)]  # fmt: skip
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        return list(pool.map(largest, jobs))
+
+
+def plot(out: Path, standing: list[float], walking: list[float], meta: dict[str, Any]) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ang = np.arange(9) * np.pi / 4
+    ring = lambda v: np.r_[v, v[:1]]  # noqa: E731
+    fig, axes = plt.subplots(1, 2, subplot_kw={"projection": "polar"}, figsize=(11, 5.2))
+    for ax, title in zip(axes, ("standing (push 0.25 s)", "walking (push 0.2 s)")):
+        ax.set_theta_zero_location("N")
+        ax.set_xticks(ang[:8], ["front", "", "left", "", "back", "", "right", ""])
+        ax.set_title(title, pad=14)
+    axes[0].plot(ang, ring(np.array(standing)), "o-", label=f"reactmocap ({meta['standing']})")
+    axes[0].plot(ang, ring(np.array(WOOTEN_STANDING_N)), "--",
+                 label="Wooten Fig. 7.7, approx. (no stepping)")  # fmt: skip
+    axes[1].plot(ang, ring(np.array(walking)), "o-", label=f"reactmocap ({meta['walking']})")
+    axes[1].plot(ang, np.full(9, SIMBICON_WALKING_N), "--", label="SIMBICON goal 350 N")
+    for ax in axes:
+        ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.28), fontsize=8)
+    fig.suptitle("Largest survived chest push (N), directions relative to the heading")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--standing", default="bye_normal_001:1.0", help="clip:push time (s)")
+    ap.add_argument("--walking", default="walk_normal_001:2.0", help="clip:push time (s)")
+    ap.add_argument("--after", type=float, default=2.0, help="seconds tracked after the push")
+    ap.add_argument("--max-force", type=float, default=800.0)
+    ap.add_argument("--steps", type=int, default=6, help="bisection halvings")
+    ap.add_argument("--params", default="{}", help="controller parameters (JSON)")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--json", type=Path, help="write the figures here")
+    ap.add_argument("--plot", type=Path, help="write the polar plot (PNG) here")
+    args = ap.parse_args(argv)
+    if not SHARED.is_dir():
+        print(f"(no shared clips under {SHARED.resolve()}: nothing to measure)")
+        return 0
+    out: dict[str, Any] = {"labels": LABELS, "params": json.loads(args.params)}
+    for key, dur in (("standing", 0.25), ("walking", 0.2)):
+        name, at = getattr(args, key).split(":")
+        t0 = time.perf_counter()
+        forces = measure(name, float(at), dur, args)
+        out[key] = {"clip": name, "time_s": float(at), "duration_s": dur, "max_force_n": forces}
+        print(f"{key} {name} @ {at} s, {dur} s pushes ({time.perf_counter() - t0:.0f} s): "
+              + ", ".join(f"{lab} {f:.0f} N" for lab, f in zip(LABELS, forces)))  # fmt: skip
+    if args.json:
+        args.json.write_text(json.dumps(out, indent=2) + "\n")
+    if args.plot:
+        plot(args.plot, out["standing"]["max_force_n"], out["walking"]["max_force_n"],
+             {k: out[k]["clip"] for k in ("standing", "walking")})  # fmt: skip
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

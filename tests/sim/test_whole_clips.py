@@ -1,0 +1,139 @@
+"""Whole clips and pushes while tracking: the default tracker keeps a whole real walk up (before
+the ground path was re-anchored to the feet it fell after 1.5-2.8 s), a standing clip recovers
+from moderate chest pushes in four directions and falls under a huge one; the balance geometry
+(hull, clamp, step target) and the re-anchoring on their own."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reactmocap.library.motion import Motion
+from reactmocap.sim import World, build_character, push_clip, track_clip
+from reactmocap.sim.controllers.registry import controller_spec
+from reactmocap.sim.controllers.stepping import (
+    Step,
+    clamp_to_support,
+    convex_hull,
+    outside_distance,
+    step_target,
+)
+from reactmocap.sim.controllers.wholebody import WholeBodyTracker
+from reactmocap.sim.reference import reference_path
+
+SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]])
+
+
+def test_a_whole_shared_walk_stays_up(shared_mocap_dir: Path) -> None:
+    from reactmocap.library.bvh import read_bvh
+
+    clip = shared_mocap_dir / "dataset-1_walk-left_normal_001.bvh"
+    if not clip.is_file():
+        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
+    walk = read_bvh(clip)
+    rep = track_clip(walk).report
+    assert rep.status == "ok" and not rep.fell, rep.reason
+    assert rep.seconds == pytest.approx(walk.duration)
+    assert rep.mean_joint_error_rad < 0.15
+
+
+@pytest.fixture(scope="module")
+def standing(guard: Motion) -> Motion:
+    return Motion.concatenate([guard, guard.slice(1), guard.slice(1)], name="guard_x3")
+
+
+def _push(standing: Motion, angle_deg: float, force: float) -> str:
+    a = np.radians(angle_deg)
+    res = push_clip(standing, time=1.0, body="chest", force=[force * np.cos(a),
+                    force * np.sin(a), 0.0], duration=0.25, seconds=2.5)  # fmt: skip
+    return res.report.status
+
+
+@pytest.mark.parametrize("angle", [0.0, 90.0, 180.0, 270.0])
+def test_a_standing_clip_recovers_from_a_moderate_push(standing: Motion, angle: float) -> None:
+    assert _push(standing, angle, 150.0) == "ok"
+
+
+def test_a_standing_clip_falls_under_a_huge_push(standing: Motion) -> None:
+    assert _push(standing, 0.0, 2000.0) == "fell"
+
+
+def test_convex_hull_and_distances() -> None:
+    hull = convex_hull(SQUARE)
+    assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}
+    assert outside_distance(np.array([0.5, 0.5]), SQUARE) == pytest.approx(-0.5)
+    assert outside_distance(np.array([1.25, 0.5]), SQUARE) == pytest.approx(0.25)
+    # a segment (one foot on an edge) and a point
+    assert outside_distance(np.array([0.5, 0.3]), SQUARE[:2]) == pytest.approx(0.3)
+    assert outside_distance(np.array([0.0, 2.0]), SQUARE[:1]) == pytest.approx(2.0)
+
+
+def test_clamp_to_support_keeps_a_margin() -> None:
+    inside = np.array([0.5, 0.5])
+    assert np.array_equal(clamp_to_support(inside, SQUARE, 0.1), inside)
+    out = clamp_to_support(np.array([2.0, 0.5]), SQUARE, 0.1)
+    assert outside_distance(out, SQUARE) == pytest.approx(-0.1)
+    near = clamp_to_support(np.array([0.95, 0.5]), SQUARE, 0.1)
+    assert outside_distance(near, SQUARE) == pytest.approx(-0.1)
+
+
+def test_step_target_catches_the_fall_without_crossing() -> None:
+    stance, swing, left = np.zeros(2), np.array([0.0, 0.2]), np.array([0.0, 1.0])
+    forward = step_target(np.array([0.1, 0.1]), stance, swing, 3.0, 0.3, beyond=0.05,
+                          max_length=0.6, min_width=0.12, lateral=left)  # fmt: skip
+    assert forward[0] > 0.1 and forward[1] >= 0.12 - 1e-9
+    crossing = step_target(np.array([0.0, -0.1]), stance, swing, 3.0, 0.3, beyond=0.05,
+                           max_length=0.6, min_width=0.12, lateral=left)  # fmt: skip
+    assert crossing[1] >= 0.12 - 1e-9  # the left foot does not cross to the right
+    far = step_target(np.array([2.0, 0.0]), stance, swing, 3.0, 0.3, beyond=0.05,
+                      max_length=0.6, min_width=0.12, lateral=left)  # fmt: skip
+    assert np.linalg.norm(far) == pytest.approx(0.6)
+
+
+def test_a_step_starts_and_lands_at_rest() -> None:
+    s = Step(0, 1.0, 0.4, np.array([0.0, 0.0, 0.0]), np.array([0.3, 0.1, 0.0]), 0.05)
+    p0, v0, _ = s.at(1.0)
+    p1, v1, _ = s.at(1.4)
+    mid, _, _ = s.at(1.2)
+    np.testing.assert_allclose(p0, s.start)
+    np.testing.assert_allclose(p1, s.target, atol=1e-12)
+    assert np.allclose(v0, 0.0) and np.allclose(v1, 0.0)
+    assert mid[2] == pytest.approx(0.05)
+
+
+def test_the_ground_path_follows_displaced_feet(guard: Motion) -> None:
+    """A character standing 0.3 m beside its mocap: the re-anchored path moves over to it, up
+    to the dead band, and only while the feet touch the floor."""
+    world = World(build_character(guard, frame=0))
+    world.set_from_motion(0, guard, 0)
+    wc = world.characters[0]
+    world.data.qpos[wc.qpos_slice.start] += 0.3
+    import mujoco
+
+    mujoco.mj_forward(world.model, world.data)
+    spec = controller_spec("wholebody")
+    wb = WholeBodyTracker(world, 0, guard, 0.0, kp_joint=1000.0,
+                          servo_kv=float(spec.defaults["servo_kv"]), control_every=4)  # fmt: skip
+    for _ in range(400):
+        wb.reanchor(0.0)
+    assert wb.anchor_shift[0] == pytest.approx(0.3 - wb.anchor_deadband, abs=0.02)
+    assert abs(wb.anchor_shift[1]) < 0.01 and abs(wb.anchor_yaw) < 0.01
+    off = WholeBodyTracker(world, 0, guard, 0.0, kp_joint=1000.0, anchor_tau=0.0,
+                           servo_kv=20.0, control_every=4)  # fmt: skip
+    off.reanchor(0.0)
+    assert not off.anchor_shift.any()
+
+
+def test_a_sliding_foot_is_not_planted(guard: Motion) -> None:
+    """A foot skimming the floor faster than ``slide_speed`` is not a support."""
+    world = World(build_character(guard, frame=0))
+    path = reference_path(world, 0, guard)
+    q = np.repeat(path.q[:1], 20, axis=0)
+    q[:, 0] += np.linspace(0.0, 0.5, 20)  # the whole body glides 0.5 m in 20 frames at 30 fps
+    glide = reference_path(world, 0, q, fps=30.0)
+    still = reference_path(world, 0, q, fps=30.0, slide_speed=None)
+    assert path.planted[0].all() and still.planted.all()
+    assert not glide.planted[2:-2].any()
+    assert glide.sole is not None and glide.sole.shape == (20, 2, 3)
