@@ -103,6 +103,9 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fps", type=float, default=60.0, help="output frame rate")
     p.add_argument("--parts", type=Path, help="body-part rules TOML ([parts], [aliases])")
     p.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
+    p.add_argument("--stepping", action="store_true",
+                   help="let the whole-body tracker take capture-point balance steps "
+                   "(experimental: off by default, see docs/tracking.md)")  # fmt: skip
     p.add_argument("--strict", action="store_true",
                    help="exit 3 unless the character stayed up and stable (status ok)")  # fmt: skip
     p.add_argument(
@@ -178,6 +181,7 @@ def _kwargs(args: argparse.Namespace) -> dict[str, object]:
         "total_mass": args.mass,
         "root_assist": args.root_assist,
         "controller": args.controller,
+        "params": {"stepping": True} if args.stepping else None,
     }
 
 

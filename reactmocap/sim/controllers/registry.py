@@ -135,7 +135,7 @@ _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: the tracker under predictive sampling is the short-window one (world path, every touching
 #: corner, any foot near the floor): its samples are scored by the pelvis's distance from the
 #: captured path; with the whole-clip options a real run ended 15 cm and 57 deg off it
-_PREDICTIVE_TRACKER = {"anchor_tau": 0.0, "balance_tau": 0.0, "touch": 0.0, "roll_band": 0.0,
+_PREDICTIVE_TRACKER: dict[str, Any] = {"anchor_tau": 0.0, "balance_tau": 0.0, "touch": 0.0, "roll_band": 0.0,
                        "slide_speed": 0.0}  # fmt: skip
 
 _REGISTRY: dict[str, ControllerSpec] = {

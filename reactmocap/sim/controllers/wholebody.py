@@ -262,8 +262,14 @@ class WholeBodyTracker:
             character,
             reference
             if isinstance(reference, ReferencePath)
-            else reference_path(world, character, reference, reach=reach, pivot_rate=pivot_rate,
-                                slide_speed=slide_speed or None),
+            else reference_path(
+                world,
+                character,
+                reference,
+                reach=reach,
+                pivot_rate=pivot_rate,
+                slide_speed=slide_speed or None,
+            ),
         )
         self.clock = self.path.clock(start)
         dt_tick = self.control_every * world.timestep
@@ -274,8 +280,8 @@ class WholeBodyTracker:
         self._return_rate = min(1.0, dt_slow / anchor_return) if anchor_return > 0 else 0.0
         self.roll_band = float(roll_band) if roll_band > 0 else np.inf
         self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
-        self._com = self.path.com
-        assert self._com is not None and self.path.sole is not None
+        assert self.path.com is not None and self.path.sole is not None
+        self._com: F64 = self.path.com
         dt_f = 1.0 / self.path.fps
         n = self.path.num_frames
         self._com_v = np.gradient(self._com, dt_f, axis=0) if n > 1 else 0 * self._com
@@ -312,7 +318,9 @@ class WholeBodyTracker:
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
         self._corners_at: tuple[float, bytes] = (float("nan"), b"")
         self._corners_now = np.zeros((2, 4, 3))
-        legs = [[BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"]
+        legs = [
+            [BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"
+        ]
         self._leg_rows = [np.concatenate([6 + 3 * k + np.arange(3) for k in leg]) for leg in legs]
         #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
         #: ``x -> Rz(yaw) x + shift``
