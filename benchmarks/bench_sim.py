@@ -39,6 +39,7 @@ from reactmocap.sim import (
     support_feasibility,
     track_clip,
 )
+from reactmocap.sim.controllers.registry import WHOLE_CLIP
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT / ".." / "shared" / "mocap"
@@ -164,17 +165,18 @@ def _infeasible_seconds(motion: Motion, check: SupportFeasibility | None = None)
 
 
 def _track_window(
-    job: tuple[Path, float, str, float],
+    job: tuple[Path, float, str, float, dict[str, float]],
 ) -> tuple[bool, bool, float, float, float, float] | str:
     """One window: (ok, upright, max root error m, max angle rad, mean joint error rad,
     wall seconds per simulated second), or the error message."""
-    path, s, controller, assist = job
+    path, s, controller, assist, params = job
     motion = _read_bvh(path)
     secs = min(1.0, motion.duration - s)
     try:
         res = track_clip(
-            motion, start=float(s), seconds=secs, root_assist=assist, controller=controller
-        )
+            motion, start=float(s), seconds=secs, root_assist=assist, controller=controller,
+            params=params,
+        )  # fmt: skip
     except Exception as exc:
         return f"{path.name} @ {s:.1f}s failed: {exc}"
     rep = res.report
@@ -191,10 +193,13 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
         print(f"\n(no shared clips under {SHARED.resolve()}: tracking robustness skipped)")
         return
     labels = {"pd": "PD only", "balance": "PD + stance balance (physical)",
-              "wholebody": "whole-body inverse dynamics (physical, default)",
+              "wholebody": "whole-body inverse dynamics (physical, default, WHOLE_CLIP)",
               "predictive": "whole-body + predictive sampling (physical)"}  # fmt: skip
-    modes = [(c, 0.0, labels.get(c, c)) for c in controllers]
-    modes.append(("pd", assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}"))
+    modes = [(c, 0.0, labels.get(c, c), {}) for c in controllers]
+    if "wholebody" in controllers:  # the tracker without the whole-clip options
+        window = {k: 0.0 for k in WHOLE_CLIP}
+        modes.append(("wholebody", 0.0, "whole-body, window settings (no WHOLE_CLIP)", window))
+    modes.append(("pd", assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}", {}))
     motions = {p: _read_bvh(p) for p in clips}
     windows = {p: _windows(m) for p, m in motions.items()}
     feasible = {
@@ -202,19 +207,19 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
     }
     print(f"\n(windows run in {jobs} processes: real-time factors are per process)")
     with ProcessPoolExecutor(max_workers=jobs) as pool:
-        for controller, assist, label in modes:
+        for controller, assist, label, params in modes:
             print(f"\n## tracking robustness, {label} (controller's default gains)")
             print(
                 f"{'clip':<28} {'windows':>7} {'ok %':>6} {'upright %':>9} {'med root cm':>11} "
                 f"{'med ang deg':>11} {'med joint rad':>13}"
             )
             t0 = time.perf_counter()
-            work = [(p, s, controller, assist) for p in clips for s in windows[p]]
+            work = [(p, s, controller, assist, params) for p in clips for s in windows[p]]
             results = list(pool.map(_track_window, work))
             tot_ok = tot = feas_ok = feas = 0
             walls: list[float] = []
             for path in clips:
-                rows = [r for (p, _, _, _), r in zip(work, results) if p == path]
+                rows = [r for (p, *_), r in zip(work, results) if p == path]
                 for r in rows:
                     if isinstance(r, str):
                         print(f"  {r}")

@@ -23,6 +23,7 @@ from reactmocap.sim.world import World
 
 __all__ = [
     "CONTROLLERS",
+    "WHOLE_CLIP",
     "ControllerSpec",
     "Factory",
     "build",
@@ -105,7 +106,7 @@ def _predictive(
     wb = {k: p.pop(k) for k in ("kp", "kv", "servo_kv", "control_every")}
     tracker = WholeBodyTracker(
         world, c, ref, start, kp_joint=wb["kp"], kv_joint=wb["kv"],
-        servo_kv=wb["servo_kv"], control_every=wb["control_every"], **_PREDICTIVE_TRACKER,
+        servo_kv=wb["servo_kv"], control_every=wb["control_every"],
     )  # fmt: skip
     return PredictiveTracker(tracker, **p)
 
@@ -132,11 +133,15 @@ def _athletic_balance(
 
 _PD = {"kp": 4000.0, "kv": None, "control_every": 10, "refresh_every": 10}
 _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
-#: the tracker under predictive sampling is the short-window one (world path, every touching
-#: corner, any foot near the floor): its samples are scored by the pelvis's distance from the
-#: captured path; with the whole-clip options a real run ended 15 cm and 57 deg off it
-_PREDICTIVE_TRACKER: dict[str, Any] = {"anchor_tau": 0.0, "balance_tau": 0.0, "touch": 0.0, "roll_band": 0.0,
-                       "slide_speed": 0.0}  # fmt: skip
+#: the whole-body tracker's options for whole clips (``track``, ``push``; see
+#: ``docs/tracking.md``): corners within 3 mm support, a foot skimming the floor faster than
+#: 0.5 m/s is not planted, a heel raised 2 cm is let go, the ground path re-anchored to the
+#: feet (0.1 s) and the targets keeping the capture point inside them (0.1 s). Without them
+#: the tracker follows the captured world path, as the 1 s benchmark windows, predictive
+#: sampling and the response pipeline's physical mode expect.
+WHOLE_CLIP: Mapping[str, Param] = MappingProxyType(
+    {"touch": 0.003, "slide_speed": 0.5, "roll_band": 0.02, "anchor_tau": 0.1, "balance_tau": 0.1}
+)
 
 _REGISTRY: dict[str, ControllerSpec] = {
     "pd": ControllerSpec(

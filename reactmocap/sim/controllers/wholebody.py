@@ -145,8 +145,10 @@ class WholeBodyTracker:
             error (at most 0.4 m) from the mocap's landing (0: off; see ``docs/tracking.md``).
         servo_kv: the servo's damping (1/s).
 
-    Defaults were chosen on the shared walk, run and kick windows and whole shared clips
-    (``benchmarks/bench_sim.py``, ``docs/tracking.md``).
+    The constructor's defaults are the short-window tracker (the captured world path, every
+    touching corner, any foot near the floor; chosen on the benchmark's 1 s windows);
+    :data:`~reactmocap.sim.controllers.registry.WHOLE_CLIP` holds the options ``track`` and
+    ``push`` add for whole clips (``docs/tracking.md``).
     """
 
     def __init__(
@@ -167,17 +169,17 @@ class WholeBodyTracker:
         contact_kv: float = 20.0,
         friction: float = 0.7,
         reach: float = 0.05,
-        touch: float = 0.003,
+        touch: float = 0.0,
         force_reg: float = 1e-6,
         pivot_rate: float | None = 2.0,
-        slide_speed: float = 0.5,
-        roll_band: float = 0.02,
-        anchor_tau: float = 0.1,
+        slide_speed: float = 0.0,
+        roll_band: float = 0.0,
+        anchor_tau: float = 0.0,
         anchor_touch: float = 0.01,
         anchor_return: float = 5.0,
         anchor_deadband: float = 0.1,
         balance_margin: float = 0.03,
-        balance_tau: float = 0.1,
+        balance_tau: float = 0.0,
         stepping: bool = False,
         step_margin: float = 0.02,
         step_time: float = 0.35,
