@@ -91,7 +91,12 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
         return list(pool.map(largest, jobs))
 
 
-def plot(out: Path, standing: list[float], walking: list[float], meta: dict[str, Any]) -> None:
+def _label(params: dict[str, Any]) -> str:
+    return "with balance steps" if params.get("stepping") else "no balance steps"
+
+
+def plot(out: Path, runs: list[dict[str, Any]]) -> None:
+    """``runs``: this script's JSON outputs, one line each per panel."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -104,10 +109,12 @@ def plot(out: Path, standing: list[float], walking: list[float], meta: dict[str,
         ax.set_theta_zero_location("N")
         ax.set_xticks(ang[:8], ["front", "", "left", "", "back", "", "right", ""])
         ax.set_title(title, pad=14)
-    axes[0].plot(ang, ring(np.array(standing)), "o-", label=f"reactmocap ({meta['standing']})")
+    for run in runs:
+        for ax, key in zip(axes, ("standing", "walking")):
+            forces = np.array(run[key]["max_force_n"])
+            ax.plot(ang, ring(forces), "o-", label=f"{run[key]['clip']}, {_label(run['params'])}")
     axes[0].plot(ang, ring(np.array(WOOTEN_STANDING_N)), "--",
                  label="Wooten Fig. 7.7, approx. (no stepping)")  # fmt: skip
-    axes[1].plot(ang, ring(np.array(walking)), "o-", label=f"reactmocap ({meta['walking']})")
     axes[1].plot(ang, np.full(9, SIMBICON_WALKING_N), "--", label="SIMBICON goal 350 N")
     for ax in axes:
         ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.28), fontsize=8)
@@ -127,9 +134,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", type=Path, help="write the figures here")
     ap.add_argument("--plot", type=Path, help="write the polar plot (PNG) here")
+    ap.add_argument("--overlay", type=Path, nargs="*", default=[],
+                    help="earlier --json outputs drawn in the same plot")  # fmt: skip
+    ap.add_argument("--plot-only", action="store_true", help="plot --overlay files only")
     args = ap.parse_args(argv)
     if not SHARED.is_dir():
         print(f"(no shared clips under {SHARED.resolve()}: nothing to measure)")
+        return 0
+    earlier = [json.loads(p.read_text()) for p in args.overlay]
+    if args.plot_only:
+        if args.plot:
+            plot(args.plot, earlier)
         return 0
     out: dict[str, Any] = {"labels": LABELS, "params": json.loads(args.params)}
     for key, dur in (("standing", 0.25), ("walking", 0.2)):
@@ -142,8 +157,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         args.json.write_text(json.dumps(out, indent=2) + "\n")
     if args.plot:
-        plot(args.plot, out["standing"]["max_force_n"], out["walking"]["max_force_n"],
-             {k: out[k]["clip"] for k in ("standing", "walking")})  # fmt: skip
+        plot(args.plot, [*earlier, out])
     return 0
 
 
