@@ -167,7 +167,7 @@ class Polyline:
 def Straight(heading: float = 0.0, start: ArrayLike = (0.0, 0.0)) -> Polyline:
     """A straight line from ``start`` along ``heading`` (rad), 10 km long."""
     p0 = np.asarray(start, dtype=np.float64)[:2]
-    return Polyline([p0, p0 + 1e4 * np.array([math.cos(heading), math.sin(heading)])])
+    return Polyline(np.stack([p0, p0 + 1e4 * np.array([math.cos(heading), math.sin(heading)])]))
 
 
 def figure_eight(radius: float, start: ArrayLike = (0.0, 0.0), heading: float = 0.0,

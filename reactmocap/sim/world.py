@@ -5,7 +5,7 @@ they are: ``docs/design.md``."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
@@ -145,12 +145,15 @@ PATCH_ROLL = 0.03
 
 
 class World:
-    """A MuJoCo model and data with a floor and one or two characters."""
+    """A MuJoCo model and data with a floor and one or two characters; ``extras(spec)``, if
+    given, adds apparatus (bodies, geoms, joints) to the spec after the characters."""
 
     def __init__(
         self,
         characters: Character | Sequence[Character],
         config: WorldConfig | None = None,
+        *,
+        extras: Callable[[mujoco.MjSpec], None] | None = None,
         **overrides: object,
     ) -> None:
         chars = [characters] if isinstance(characters, Character) else list(characters)
@@ -186,6 +189,10 @@ class World:
         for k, ch in enumerate(chars):
             frame = spec.worldbody.add_frame()
             spec.attach(ch.make_spec(), prefix=PREFIXES[k], frame=frame)
+        if extras is not None:
+            # apparatus (a springboard, a horse): bodies added after the characters', so the
+            # characters' ids, qpos and dofs come first and keep their addresses
+            extras(spec)
         for k in range(len(chars)):
             _add_servo_actuators(spec, PREFIXES[k])
         try:
