@@ -19,6 +19,7 @@ from reactmocap.errors import ConfigError
 
 __all__ = [
     "LOOKAHEAD",
+    "TURN_RATE",
     "Circle",
     "Course",
     "Facing",
@@ -31,6 +32,8 @@ __all__ = [
 F64 = NDArray[np.float64]
 #: pure-pursuit look-ahead distance (m)
 LOOKAHEAD = 3.0
+#: how fast a commanded facing is turned toward (rad/s)
+TURN_RATE = 0.5
 
 
 class Course(Protocol):
@@ -40,22 +43,40 @@ class Course(Protocol):
 
 
 class Facing:
-    """A facing direction without a path: ``schedule`` is ``(time, heading)`` pairs; the
-    heading in force is the last one whose time has come."""
+    """A facing direction without a path: ``schedule`` is ``(time, heading)`` pairs, the
+    heading in force being the last one whose time has come. The desired facing turns toward
+    it at no more than ``rate`` rad/s (an abrupt change of facing throws a runner down, as
+    Hodgins et al. note); its curvature for the lean is the turn rate over ``speed``."""
 
-    def __init__(self, schedule: Sequence[tuple[float, float]] | float = 0.0) -> None:
+    def __init__(self, schedule: Sequence[tuple[float, float]] | float = 0.0,
+                 rate: float = TURN_RATE) -> None:  # fmt: skip
         sched = [(0.0, float(schedule))] if isinstance(schedule, (int, float)) else list(schedule)
         if not sched or not all(math.isfinite(a) and math.isfinite(b) for a, b in sched):
             raise ConfigError(f"facing schedule must be finite (time, heading) pairs: {sched}")
+        if not (math.isfinite(rate) and rate > 0):
+            raise ConfigError(f"turn rate must be > 0 rad/s, got {rate!r}")
         self.schedule = sorted((float(a), float(b)) for a, b in sched)
+        self.rate = float(rate)
+        self.speed = 1.0
+        self.reset()
+
+    def reset(self) -> None:
+        self.heading = self.schedule[0][1]
+        self.time = self.schedule[0][0]
 
     def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
         del pos
-        h = self.schedule[0][1]
+        goal = self.schedule[0][1]
         for when, heading in self.schedule:
             if t >= when:
-                h = heading
-        return h, 0.0, math.nan
+                goal = heading
+        dt = max(t - self.time, 0.0)
+        self.time = t
+        step = float(np.clip(goal - self.heading, -self.rate * dt, self.rate * dt))
+        self.heading += step
+        turning = dt > 0 and abs(step) > 1e-9
+        curvature = (step / dt) / max(self.speed, 0.1) if turning else 0.0
+        return self.heading, curvature, math.nan
 
 
 class Circle:

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import athlete as make_athlete
-from reactmocap.athletics.course import Course, Polyline, parse_course
+from reactmocap.athletics.course import Course, Facing, Polyline, parse_course
 from reactmocap.athletics.report import FALL_HEIGHT
 from reactmocap.athletics.running import Runner, RunParams, check_speed, running_start
 from reactmocap.athletics.scene import athletics_world, stand_angles
@@ -109,8 +109,10 @@ def run_course(
     world.set_pose(0, qpos, qvel)
     start = world.com(0)[:2]
     course = parse_course(path, start, 0.0) if isinstance(path, str) else path
-    if isinstance(course, Polyline):
+    if isinstance(course, (Polyline, Facing)):
         course.reset()
+    if isinstance(course, Facing):
+        course.speed = speed
     runner = Runner(world, ath, speed, course, params, control_every=CONTROL_EVERY)
     controllers: list[Controller] = [runner]
     dress = None

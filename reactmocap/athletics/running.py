@@ -44,6 +44,7 @@ from reactmocap.sim.world import World
 __all__ = [
     "RUN_STATES",
     "SPEED_RANGE",
+    "TUNED_SPEEDS",
     "RunLog",
     "RunParams",
     "Runner",
@@ -82,14 +83,16 @@ def check_speed(speed: float) -> float:
     return float(speed)
 
 
-#: a tuning value at the slowest and the fastest supported speed, interpolated linearly
-Pair = tuple[float, float]
+#: a tuning value at 2.5, 3.5 and 5 m/s (:data:`TUNED_SPEEDS`), interpolated piecewise linearly
+Speeds = tuple[float, float, float]
+#: the speeds the tuning triples are given at (m/s)
+TUNED_SPEEDS = (2.5, 3.5, 5.0)
 
 
 @dataclass(frozen=True)
 class RunParams:
-    """The runner's tuning. Values given as a pair are at 2.5 and 5 m/s, interpolated
-    linearly by speed (a single number is used at every speed). Angles in radians, joint
+    """The runner's tuning. Values given as three numbers are at 2.5, 3.5 and 5 m/s,
+    interpolated piecewise linearly by speed (a single number is used at every speed). Angles in radians, joint
     stiffness in units of ``m g L`` N m/rad (body mass, leg length), leg stiffness in
     ``m g / L`` N/m, times in seconds. The defaults were found by a search over these
     parameters (``benchmarks/bench_athletics_running.py --tune``), see ``docs/athletics.md``.
@@ -127,32 +130,32 @@ class RunParams:
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
 
-    stance_time: float | Pair = 0.177
-    speed_gain: float | Pair = 0.0835
-    speed_integral: float | Pair = 0.0
-    touchdown_leg: float | Pair = 0.948
-    speed_matching: float | Pair = 0.009
-    retract_time: float | Pair = 0.06
-    heel_up: float | Pair = 0.2
-    step_width: float | Pair = 0.065
-    leg_stiffness: float | Pair = 21.6
-    leg_damping: float | Pair = 0.04
-    thrust: float | Pair = 1.71
-    takeoff_vz: float | Pair = (0.365, 0.745)
-    toe_fraction: float | Pair = (0.488, 0.319)
-    pitch: float | Pair = 0.013
+    stance_time: float | Speeds = (0.177, 0.177, 0.1825)
+    speed_gain: float | Speeds = (0.0835, 0.0835, 0.08567)
+    speed_integral: float | Speeds = (0, 0, 0.001824)
+    touchdown_leg: float | Speeds = 0.948
+    speed_matching: float | Speeds = 0.009
+    retract_time: float | Speeds = 0.06
+    heel_up: float | Speeds = 0.2
+    step_width: float | Speeds = 0.065
+    leg_stiffness: float | Speeds = (21.6, 21.6, 20.68)
+    leg_damping: float | Speeds = (0.04, 0.04, 0.05479)
+    thrust: float | Speeds = (1.71, 1.71, 1.361)
+    takeoff_vz: float | Speeds = (0.365, 0.517, 0.745)
+    toe_fraction: float | Speeds = (0.488, 0.420, 0.319)
+    pitch: float | Speeds = (0.013, 0.013, -0.0141)
     attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
     attitude_kv: tuple[float, float, float] = (14.0, 14.0, 5.42)
-    yaw_grip: float | Pair = 0.181
-    knee_hold: float | Pair = 3.0
-    ankle_hold: float | Pair = 1.0
-    idle_knee: float | Pair = 1.813
-    reach_knee: float | Pair = 1.066
-    swing_ready: float | Pair = -0.369
-    arm_gain: float | Pair = 1.273
-    arm_offset: float | Pair = 0.05
-    elbow: float | Pair = 1.4
-    smoothing: float | Pair = 0.0202
+    yaw_grip: float | Speeds = 0.181
+    knee_hold: float | Speeds = 3.0
+    ankle_hold: float | Speeds = 1.0
+    idle_knee: float | Speeds = (1.813, 1.813, 1.703)
+    reach_knee: float | Speeds = (1.066, 1.066, 1.102)
+    swing_ready: float | Speeds = (-0.369, -0.369, -0.407)
+    arm_gain: float | Speeds = (1.273, 1.273, 1.297)
+    arm_offset: float | Speeds = 0.05
+    elbow: float | Speeds = 1.4
+    smoothing: float | Speeds = (0.0202, 0.0202, 0.009708)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
             "waist": 4.0, "back": 4.0, "neck": 0.3, "shoulder": 0.4, "elbow": 0.2,
@@ -166,8 +169,10 @@ class RunParams:
             vals = v.values() if isinstance(v, dict) else v if isinstance(v, tuple) else (v,)
             if not all(isinstance(x, (int, float)) and math.isfinite(x) for x in vals):
                 raise ConfigError(f"running parameter {f.name} must be finite, got {v!r}")
-            if isinstance(v, tuple) and f.name not in _TRIPLES and len(v) != 2:
-                raise ConfigError(f"running parameter {f.name} takes a number or a pair")
+            if isinstance(v, tuple) and f.name not in _AXES and len(v) != 3:
+                raise ConfigError(
+                    f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
+                )
         per_joint(self.stiffness)  # unknown joint kinds are named there
         lo, hi = SPEED_RANGE
         for speed in (lo, hi):
@@ -178,19 +183,21 @@ class RunParams:
                 raise ConfigError("stance_time and leg_stiffness must be > 0, smoothing >= 0")
 
     def at(self, speed: float) -> dict[str, float]:
-        """Every scalar tuning value at ``speed`` (pairs interpolated, clamped to the range)."""
-        lo, hi = SPEED_RANGE
-        s = min(max((speed - lo) / (hi - lo), 0.0), 1.0)
+        """Every scalar tuning value at ``speed`` (triples interpolated, clamped to the
+        range)."""
         out = {}
         for f in fields(self):
-            if f.name in _TRIPLES or f.name == "stiffness":
+            if f.name in _AXES or f.name == "stiffness":
                 continue
             v = getattr(self, f.name)
-            out[f.name] = float(v[0] + (v[1] - v[0]) * s) if isinstance(v, tuple) else float(v)
+            out[f.name] = (
+                float(np.interp(speed, TUNED_SPEEDS, v)) if isinstance(v, tuple) else float(v)
+            )
         return out
 
 
-_TRIPLES = ("attitude_kp", "attitude_kv")
+#: per-axis (roll, pitch, yaw) values, not per-speed
+_AXES = ("attitude_kp", "attitude_kv")
 
 
 @dataclass
@@ -245,6 +252,7 @@ class Runner:
         self.k = self.params.at(self.speed)
         self.character = character
         self.control_every = control_every
+        self.p_frame = True
         self.rig = Rig(world, athlete, character)
         self.senses = Senses(world, athlete, character)
         self.log = RunLog()
@@ -609,7 +617,7 @@ class Runner:
 
     def _flight(self, world: World, t: float) -> None:
         del world, t
-        self._placement(self.active, self.heading())
+        self._placement(self.active, self.heading_d if self.p_frame else self.heading())
 
     def _stance(self, world: World, t: float) -> None:
         del world, t
@@ -624,7 +632,9 @@ class Runner:
         self._contacts()
         self.heading_d, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
         self.machine.control(world, t)
-        heading = self.heading()
+        # the frame the legs are placed and swung in: the desired facing, not the pelvis's
+        # (which yaws back and forth with every stride)
+        heading = self.heading_d if self.p_frame else self.heading()
         angles = self.rig.current_angles()
         self._idle(t, heading)
         self._upper(angles[list(_HIP), 0])
@@ -643,13 +653,13 @@ class Runner:
             rot = world.data.xmat[self._thighs[self.active]].reshape(3, 3)
             rig._ff[_HIP[self.active]] = -rot.T @ self._attitude_torque(heading)
             self._leg_spring(t, dt, angles)
-        self._log(t, heading, angles)
+        self._log(t, angles)
 
-    def _log(self, t: float, heading: float, angles: F64) -> None:
+    def _log(self, t: float, angles: F64) -> None:
         s = self.senses
         feet = int(s.foot_contact[0]) | (int(s.foot_contact[1]) << 1)
         self.log.rows.append((
-            t, s.com.copy(), s.com_vel.copy(), heading,
+            t, s.com.copy(), s.com_vel.copy(), s.heading(),
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
             angles[list(_HIP), 0], angles[list(_KNEE), 0], self.heading_d, self.cross_track,
