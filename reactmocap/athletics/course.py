@@ -33,7 +33,7 @@ F64 = NDArray[np.float64]
 #: pure-pursuit look-ahead distance (m)
 LOOKAHEAD = 3.0
 #: how fast a commanded facing is turned toward (rad/s)
-TURN_RATE = 0.5
+TURN_RATE = 0.2
 
 
 class Course(Protocol):
