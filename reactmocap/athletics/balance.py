@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
@@ -251,29 +252,26 @@ def hold_pelvis_and_feet(ctx: Context, d, pitch: float, heading: float, t: float
 
 
 _LEG_NEUTRAL = [_BODY[b] for b in ("l_thigh", "r_thigh", "l_shin", "r_shin", "l_foot", "r_foot")]
+
+
 def _flat_feet(foot_now: F64, normal: F64) -> F64:
     """Each foot's anatomical frame turned so its sole lies flat on a floor of ``normal``,
-    keeping its heading."""
+    keeping its heading (MuJoCo's small-vector routines: this runs every tick)."""
     out = np.empty_like(foot_now)
+    x = np.empty(3)
+    mat = np.empty(9)
     for k in range(2):
-        x = _rotate(foot_now[k], np.array([1.0, 0.0, 0.0]))
-        x = x - normal * float(x @ normal)
-        x /= max(np.linalg.norm(x), 1e-9)
-        y = np.cross(normal, x)
-        out[k] = _quat_from_axes(x, y, normal)
+        mujoco.mju_rotVecQuat(x, _X, foot_now[k])
+        x -= normal * float(x @ normal)
+        x /= max(float(np.linalg.norm(x)), 1e-9)
+        y = np.array([normal[1] * x[2] - normal[2] * x[1], normal[2] * x[0] - normal[0] * x[2],
+                      normal[0] * x[1] - normal[1] * x[0]])  # fmt: skip
+        mat.reshape(3, 3)[:] = np.column_stack([x, y, normal])
+        mujoco.mju_mat2Quat(out[k], mat)
     return out
 
 
-def _rotate(q: F64, v: F64) -> F64:
-    from reactmocap.rotations import quat_rotate
-
-    return quat_rotate(q, v)
-
-
-def _quat_from_axes(x: F64, y: F64, z: F64) -> F64:
-    from reactmocap.rotations import quat_from_matrix
-
-    return quat_from_matrix(np.stack([x, y, z], axis=1))
+_X = np.array([1.0, 0.0, 0.0])
 
 
 class Balance(Basis):

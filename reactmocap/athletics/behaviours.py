@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,7 +20,7 @@ import numpy as np
 from reactmocap.athletics import tables
 from reactmocap.athletics.balance import STANDING_LEG, Balance, Posture
 from reactmocap.athletics.bodies import BODIES, Athlete, athlete
-from reactmocap.athletics.land import Landing, LandingParams
+from reactmocap.athletics.land import Landing
 from reactmocap.athletics.leap import Leap, LeapParams
 from reactmocap.athletics.machine import Context
 from reactmocap.athletics.report import fell, joint_peaks, plausibility, standing_balanced
@@ -36,6 +37,9 @@ __all__ = ["BEHAVIOURS", "AthleticsResult", "Behaviour", "Param", "run"]
 
 #: seconds the athlete must stay balanced after touching down for ``landed``
 LANDED_AFTER = 2.0
+#: the posture a landing stands up into, slowly (a quick stand-up from a deep crouch pushes
+#: the COM off the feet)
+STAND_UP = Posture(settle=0.5)
 #: seconds of quiet standing before a leap
 LEAD_IN = 0.3
 #: the highest COM rise a run's length allows for when the height is not known beforehand
@@ -114,11 +118,13 @@ def _simulate(
     ctx = Context.make(world, ath, control_every=CONTROL_EVERY)
     seq = Sequencer(ctx, bases)
     tick = None if on_tick is None else (lambda t: on_tick(min(t / duration, 1.0)))
+    cpu = time.process_time()
     try:
         res = rollout(world, duration, controllers=[seq, *extra], impacts=impacts,
                       record_fps=fps, on_unstable="stop", on_tick=tick, tick_every=200)  # fmt: skip
     finally:
         ctx.rig.release()
+    ctx.handover["cpu_s"] = time.process_time() - cpu
     del behaviour
     return ctx, seq, res
 
@@ -130,6 +136,8 @@ def _result(
     report = {"behaviour": name, "body": ath.name, "mass_kg": round(ath.mass, 2), **report,
               "simulated_s": round(res.seconds, 3), "wall_s": round(res.wall_s, 3),
               "realtime_factor": round(res.seconds / max(res.wall_s, 1e-9), 2),
+              "realtime_factor_cpu": round(res.seconds / max(float(ctx.handover["cpu_s"]),  # type: ignore[arg-type]
+                                                              1e-9), 2),
               "status": res.status}  # fmt: skip
     if res.status != "ok":
         report["reason"] = res.reason
@@ -196,7 +204,9 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
 
         params = replace(params, spin=float(p["spin"]))
     world = athletics_world(ath, backpack=float(p.get("backpack") or 0.0))
-    bases = [Balance(Posture(), seconds=LEAD_IN), Leap(params), Landing(), Balance()]
+    landing = tables.landing_params(ath.name, 0.0)
+    bases = [Balance(Posture(), seconds=LEAD_IN), Leap(params), Landing(landing),
+             Balance(STAND_UP)]  # fmt: skip
     # the run lasts until well after touchdown: the flight time of the expected height
     reach = target if table and p.get("effort") is None and not broad else MAX_APEX
     ctx, seq, res = _simulate(ath, world, bases, _leap_duration(reach, params),
@@ -210,10 +220,14 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     push = (t >= (thrust or 0.0)) & (t < (lift if lift is not None else -1.0))
     rep: dict[str, Any] = {"effort": s}
     if broad:
-        h0 = 0.0  # the athletes face +X
-        d = log["com"][-1] - log["com"][0]
+        # the jump's length: COM travel (ahead, +X) from standing to where the landing took
+        # the speed off (the landing's recovery starts), or 0.3 s after touchdown
+        settled = next((tr.time for tr in seq.transitions if tr.target == "land.recover"),
+                       (ctx.touchdown_time or t[-1]) + 0.3)  # fmt: skip
+        i = min(int(np.searchsorted(t, settled)), t.size - 1)
         rep["commanded_distance_m"] = target
-        rep["achieved_distance_m"] = float(d[0] * math.cos(h0) + d[1] * math.sin(h0))
+        rep["achieved_distance_m"] = float(log["com"][i, 0] - log["com"][0, 0])
+        rep["final_distance_m"] = float(log["com"][-1, 0] - log["com"][0, 0])
     else:
         rep["commanded_height_m"] = target
         rep["achieved_height_m"] = float(log["com"][:, 2].max() - com0) if lift is not None else 0.0
@@ -226,7 +240,9 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     return _result("broad-jump" if broad else "leap", ath, ctx, seq, res, rep)
 
 
-def _run_land(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None) -> AthleticsResult:
+def _run_land(
+    ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None
+) -> AthleticsResult:
     drop, vx = float(p["drop"]), float(p["vx"])
     world = athletics_world(ath)
     add_backpack(world, ath, float(p["backpack"]))
@@ -234,10 +250,9 @@ def _run_land(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     v = np.zeros(world.model.nv)
     v[0] = vx
     world.set_pose(0, q, v[world.characters[0].qvel_slice])
-    table = tables.LANDING_DELTAS.get(ath.name, ())
-    lp = LandingParams(delta=tables.landing_delta(table, vx))
+    lp = tables.landing_params(ath.name, vx)
     fall = math.sqrt(2.0 * max(drop, 0.0) / 9.81)
-    ctx, seq, res = _simulate(ath, world, [Landing(lp), Balance()], fall + LANDED_AFTER + 0.3,
+    ctx, seq, res = _simulate(ath, world, [Landing(lp), Balance(STAND_UP)], fall + LANDED_AFTER + 0.3,
                               behaviour="land", on_tick=on_tick, fps=p["fps"])  # fmt: skip
     log = ctx.log.arrays()
     standing_pelvis = float(ath.standing_qpos(stand_angles(ath))[2])
@@ -252,7 +267,9 @@ def _run_land(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
 LANDING_LEG = 0.92
 
 
-def _run_balance(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None) -> AthleticsResult:
+def _run_balance(
+    ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None
+) -> AthleticsResult:
     world = athletics_world(ath, backpack=float(p["backpack"]))
     leg = STANDING_LEG
     if p.get("pelvis_height") is not None:

@@ -29,15 +29,14 @@ from reactmocap.rotations import (
 )
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.character import Character, SegmentInertia, build_character
-from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.reference_bodies import inertia_matrix, reference_listing
-from reactmocap.sim.world import World
 
 __all__ = [
     "BODIES",
     "EULER_ORDER",
     "Athlete",
     "athlete",
+    "athlete_of",
     "thesis_character",
     "thesis_skeleton",
 ]
@@ -119,9 +118,7 @@ def thesis_skeleton(sex: str) -> tuple[Skeleton, BodyPartMap]:
         ends[toe] = (0.06 * height / 1.84, 0.0, 0.0)
     rot = ("Zrotation", "Xrotation", "Yrotation")
     chans = (("Xposition", "Yposition", "Zposition", *rot),) + (rot,) * (len(names) - 1)
-    skel = Skeleton(
-        tuple(names), np.array(parents), offsets, BVHLayout(chans, "m", "y", ends)
-    )
+    skel = Skeleton(tuple(names), np.array(parents), offsets, BVHLayout(chans, "m", "y", ends))
     parts = BodyPartMap(skel, {p: names.index(j) for p, j in _PARTS.items()})
     return skel, parts
 
@@ -140,9 +137,9 @@ def _inertials(sex: str) -> dict[str, SegmentInertia]:
         for b in bodies:
             d = np.asarray(b.com) - com
             inertia += inertia_matrix(b) + b.mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
-        out[part] = SegmentInertia(
-            float(mass), tuple(float(x) for x in com), tuple(tuple(r) for r in inertia.tolist())  # type: ignore[arg-type]
-        )
+        c = (float(com[0]), float(com[1]), float(com[2]))
+        rows = tuple((float(r[0]), float(r[1]), float(r[2])) for r in inertia)
+        out[part] = SegmentInertia(float(mass), c, rows)
     return out
 
 
@@ -326,6 +323,11 @@ def _reference_heading(character: Character) -> float:
     return float(np.arctan2(-left[0], left[1]))
 
 
+def athlete_of(character: Character, name: str = "character") -> Athlete:
+    """The athlete (anatomical frames, leg lengths) of an already built Character."""
+    return _athlete(name, character)
+
+
 _CACHE: dict[str, Athlete] = {}
 
 
@@ -351,9 +353,3 @@ def athlete(body: str | Path | Motion) -> Athlete:
 
     clip = read_bvh(path)
     return _athlete(path.stem, build_character(clip, map_body_parts(clip.skeleton)))
-
-
-def sole_corners(world: World, character: int = 0) -> F64:
-    """``(2, 4, 3)`` world sole corners of a character's feet (left, right)."""
-    _, sole, corners = foot_soles(world, character, "athletics")
-    return sole_corners_world(world.data, sole, corners)

@@ -78,9 +78,9 @@ class LandingParams:
     knee: float = 0.6
     kp: float = 1.5
     kv: float = 0.15
-    lead: float = 0.5
+    lead: float = 0.75
     delta: float = -0.04
-    damping: float = 5.0
+    damping: float = 1.0
     restore: float = 0.2
     arms: float = -0.6
     toes: float = 0.0
@@ -88,8 +88,19 @@ class LandingParams:
     knee_stiffness: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("knee", "kp", "kv", "lead", "delta", "damping", "restore", "arms", "toes", "lean",
-                     "knee_stiffness"):
+        for name in (
+            "knee",
+            "kp",
+            "kv",
+            "lead",
+            "delta",
+            "damping",
+            "restore",
+            "arms",
+            "toes",
+            "lean",
+            "knee_stiffness",
+        ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
@@ -112,8 +123,8 @@ class Landing(Basis):
         memo: dict[str, float] = {}
         m = ctx.world.model
         pre = rig.wc.prefix
-        _HIP_JOINTS = [m.joint(f"{pre}{s}_hip").id for s in "lr"]  # noqa: N806
-        _ANKLE_JOINTS = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]  # noqa: N806
+        hip_joints = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
+        ankle_joints = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]
 
         def reach_enter(world: World, t: float) -> None:
             del world
@@ -151,8 +162,8 @@ class Landing(Basis):
             pelvis = bl.pelvis_pitch()
             goal = np.full((NJ, 3), np.nan)
             for k in range(2):
-                hip = d.xanchor[_HIP_JOINTS[k]]
-                length = float(np.linalg.norm(hip - d.xanchor[_ANKLE_JOINTS[k]]))
+                hip = d.xanchor[hip_joints[k]]
+                length = float(np.linalg.norm(hip - d.xanchor[ankle_joints[k]]))
                 ahead = float(s.local(s.com - hip, h)[0]) + want[0]
                 swing = math.asin(float(np.clip(ahead / max(length, 0.2), -0.9, 0.9)))
                 geom = float(knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k],
@@ -179,7 +190,10 @@ class Landing(Basis):
 
         def absorb(world: World, t: float) -> None:
             s = ctx.sense(t)
-            bl.control(world, t)  # feet flat, COM servo, pelvis leaning with the knees
+            # passive, as the thesis's: feet flat, pelvis upright (leaning as the knees bend),
+            # no COM servo (its ankle torques would push the body back off the ground)
+            hold_pelvis_and_feet(ctx, world.data, bl._lean(), s.heading(), t)
+            rig.offset[:] = 0.0
             _stance_support(ctx)
             damp = rig.damping.copy()
             damp[_KNEE] = p.damping * _knee_lever(ctx) ** 2 / rig.athlete.leg_length**2
@@ -191,7 +205,13 @@ class Landing(Basis):
             v = min(float(s.com_vel @ s.floor_normal), 0.0)
             g = float(np.linalg.norm(world.model.opt.gravity))
             decel = v * v / (2.0 * PLAN_ROOM * room)
-            rig.support_scale = float(np.clip(1.0 + decel / g, 1.0, MAX_SUPPORT))
+            vertical = float(np.clip(1.0 + decel / g, 1.0, MAX_SUPPORT))
+            # along the legs, from the feet to the COM, as a passive leg pushes: its
+            # horizontal part takes the horizontal speed off as the COM passes over the feet
+            line = s.com - s.sole_corners().mean(axis=(0, 1))
+            line /= max(float(line @ s.floor_normal), 0.2)
+            rig.support_scale = vertical * float(np.linalg.norm(line))
+            rig.support_dir = line / np.linalg.norm(line)
             z_d = float(s.com @ s.floor_normal) + v * ctx.control_every * world.timestep
             z = float(s.com @ s.floor_normal)
             if p.knee_stiffness > 0:  # the knees' targets follow the planned height
@@ -212,6 +232,7 @@ class Landing(Basis):
         def recover_enter(world: World, t: float) -> None:
             del world
             rig.support_scale = 1.0
+            rig.support_dir = None
             rig.move(rig.current_angles(), 0.0, t, _KNEE)  # the knees stiffen where they are
             leg = _leg_fraction(ctx)
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)

@@ -203,8 +203,14 @@ class Leap(Basis):
 
         flight_exit: Event = apex(ctx) if not p.broad else after(0.0)
         return [
-            State("crouch", law(bl.control, every), crouch, ((after(p.crouch + p.hold), "thrust"),)),
-            State("thrust", law(push, every), thrust,
-                  ((liftoff(ctx), "flight"), (after(THRUST_TIMEOUT), "flight"))),
+            State(
+                "crouch", law(bl.control, every), crouch, ((after(p.crouch + p.hold), "thrust"),)
+            ),
+            State(
+                "thrust",
+                law(push, every),
+                thrust,
+                ((liftoff(ctx), "flight"), (after(THRUST_TIMEOUT), "flight")),
+            ),
             State("flight", None, flight, ((flight_exit, NEXT),)),
         ]

@@ -15,6 +15,7 @@ from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.rig import Rig, joint_index
 from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
+from reactmocap.sim.controllers.base import FunctionController
 from reactmocap.sim.controllers.machine import Event, State, after
 from reactmocap.sim.world import World
 
@@ -49,6 +50,8 @@ class Log:
     pelvis: list[float] = field(default_factory=list)
     #: per tick: horizontal distance (m) of the COM from the support centre
     offsets: list[float] = field(default_factory=list)
+    #: per tick: whole-body angular momentum about the COM (kg m^2/s, world)
+    momentum: list[F64] = field(default_factory=list)
 
     def arrays(self) -> dict[str, NDArray]:
         if not self.rows:
@@ -56,14 +59,15 @@ class Log:
             return {"t": z, "com": np.zeros((0, 3)), "com_vel": np.zeros((0, 3)),
                     "grf": np.zeros((0, 3)), "feet": z.astype(int), "state": np.array([]),
                     "torque": np.zeros((0, 15)), "power": np.zeros((0, 15)),
-                    "others": z.astype(bool), "pelvis": z, "offset": z}  # fmt: skip
+                    "others": z.astype(bool), "pelvis": z, "offset": z,
+                    "momentum": np.zeros((0, 3))}  # fmt: skip
         t, com, vel, grf, feet, state = zip(*self.rows)
         return {
             "t": np.array(t), "com": np.array(com), "com_vel": np.array(vel),
             "grf": np.array(grf), "feet": np.array(feet), "state": np.array(state),
             "torque": np.array(self.torques), "power": np.array(self.powers),
             "others": np.array(self.others), "pelvis": np.array(self.pelvis),
-            "offset": np.array(self.offsets),
+            "offset": np.array(self.offsets), "momentum": np.array(self.momentum),
         }  # fmt: skip
 
 
@@ -175,10 +179,8 @@ class Basis:
         raise NotImplementedError
 
 
-def law(fn: Callable[[World, float], None], control_every: int) -> object:
-    """A state's per-tick law from a function (a FunctionController)."""
-    from reactmocap.sim.controllers.base import FunctionController
-
+def law(fn: Callable[[World, float], None], control_every: int) -> FunctionController:
+    """A state's per-tick law from a function."""
     return FunctionController(fn, control_every)
 
 

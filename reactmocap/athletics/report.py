@@ -26,10 +26,11 @@ F64 = NDArray[np.float64]
 #: the strength model: peak voluntary joint torque (N m per kg of body mass) a strong young man
 #: can make, per joint kind and leg or arm (docs/athletics.md: Anderson, Madigan & Nussbaum
 #: 2007; values at the upper end of their young men's isometric peaks)
-STRENGTH: Mapping[str, float] = MappingProxyType(
-    {"hip": 4.0, "knee": 3.5, "ankle": 3.0, "waist": 4.0, "back": 4.0, "shoulder": 1.5,
-     "elbow": 1.0, "neck": 0.6, "wrist": 0.3}  # fmt: skip
-)
+_STRENGTH = {
+    "hip": 4.0, "knee": 3.5, "ankle": 3.0, "waist": 4.0, "back": 4.0, "shoulder": 1.5,
+    "elbow": 1.0, "neck": 0.6, "wrist": 0.3,
+}  # fmt: skip
+STRENGTH: Mapping[str, float] = MappingProxyType(_STRENGTH)
 #: women's peak torques per kg are about 80% of men's in the same studies
 FEMALE_STRENGTH: Mapping[str, float] = MappingProxyType({k: 0.8 * v for k, v in STRENGTH.items()})
 #: a pelvis lower than this fraction of its standing height means a fall
@@ -42,7 +43,9 @@ def _kind(joint: str) -> str:
     return joint[2:] if joint[:2] in ("l_", "r_") else joint
 
 
-def joint_peaks(ctx: Context, start: float = 0.0, end: float = np.inf) -> dict[str, dict[str, float]]:
+def joint_peaks(
+    ctx: Context, start: float = 0.0, end: float = np.inf
+) -> dict[str, dict[str, float]]:
     """Peak torque (N m) and positive power (W) of each joint kind (both sides together) over
     the log's ticks in ``[start, end)``."""
     log = ctx.log.arrays()

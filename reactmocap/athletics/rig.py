@@ -26,6 +26,8 @@ JOINT_KINDS = ("waist", "back", "neck", "shoulder", "elbow", "wrist", "hip", "kn
 _KIND = np.array([JOINT_KINDS.index(j[2:] if j[:2] in ("l_", "r_") else j) for j in BALL_JOINTS])
 #: the servo's base stiffness (1/s^2); the rig's per-joint scales make the absolute stiffness
 SERVO_KP = 1000.0
+#: physics steps between the servo's re-linearisations (the controllers' tick, 4 ms)
+SERVO_REFRESH = 8
 
 
 def joint_index(name: str) -> int:
@@ -105,7 +107,7 @@ class Rig:
         self._child = np.asarray(wc.body_ids[1:])
         self._balls = np.array([m.joint(wc.prefix + j).id for j in BALL_JOINTS])
         up = -np.asarray(m.opt.gravity, dtype=np.float64)
-        self._up = up / max(np.linalg.norm(up), 1e-12)
+        self._up = up / max(float(np.linalg.norm(up)), 1e-12)
         self._weight = m.body_subtreemass[self._child] * g  # (15,) N
         self._weight_n = self.mass * g
         self._tau = np.zeros((NJ, 3))
@@ -132,6 +134,7 @@ class Rig:
         servo = self.servo
         servo.enable(self.character, on=True)
         servo.set_gains(SERVO_KP, None, self.character)
+        servo.refresh_every = SERVO_REFRESH
         now = self.current_angles() if angles is None else np.array(angles, dtype=np.float64)
         self._start[:] = now
         self._goal[:] = now
@@ -231,7 +234,8 @@ class Rig:
         m, d = self.world.model, self.world.data
         # each joint holds its subtree up: (subtree com - anchor) x (weight up), child frame
         r = d.subtree_com[self._child] - d.xanchor[self._balls]
-        tau = np.cross(r, self._weight[:, None] * self._up)
+        w = self._weight[:, None] * self._up
+        tau = r[:, [1, 2, 0]] * w[:, [2, 0, 1]] - r[:, [2, 0, 1]] * w[:, [1, 2, 0]]  # r x w
         rot = d.xmat[self._child].reshape(NJ, 3, 3)
         self._ff[:] = np.einsum("nji,nj->ni", rot, tau)
         flat = self._ff.reshape(-1)

@@ -61,9 +61,9 @@ def add_backpack(world: World, athlete: Athlete, mass: float, character: int = 0
     body = world.characters[character].body_id("chest")
     m0 = float(m.body_mass[body])
     c0 = m.body_ipos[body].copy()
-    rot = np.zeros(9)
-    mujoco.mju_quat2Mat(rot, m.body_iquat[body])
-    rot = rot.reshape(3, 3)
+    flat = np.zeros(9)
+    mujoco.mju_quat2Mat(flat, m.body_iquat[body])
+    rot = flat.reshape(3, 3)
     chest = SIM_BODIES.index("chest")
     p = c0 + quat_rotate(quat_conj(athlete.neutral[chest]), np.asarray(BACKPACK_OFFSET))
     c = (m0 * c0 + mass * p) / (m0 + mass)
@@ -102,6 +102,7 @@ class Slope:
         self.pivot = np.zeros(3) if pivot is None else np.asarray(pivot, dtype=np.float64)
         self.control_every = control_every
         self.floor = int(world.model.geom("floor").id)
+        self._scratch: mujoco.MjData | None = None
 
     def tilt(self, angle: float) -> None:
         """Turn the floor to ``angle`` now."""
@@ -110,10 +111,16 @@ class Slope:
         yaw = quat_from_yaw(self.direction)
         q = quat_mul(yaw, quat_mul(quat_from_euler([-angle, 0.0, 0.0], "YXZ"),
                                    quat_from_yaw(-self.direction)))  # fmt: skip
-        m = self.world.model
+        m, d = self.world.model, self.world.data
         m.geom_quat[self.floor] = q
         m.geom_pos[self.floor] = self.pivot
-        mujoco.mj_kinematics(m, self.world.data)
+        # MuJoCo places the world body's geoms in mj_setConst (at qpos0, in the data it is
+        # given): run it on a scratch copy, then copy the floor's new pose over
+        scratch = mujoco.MjData(m) if self._scratch is None else self._scratch
+        self._scratch = scratch
+        mujoco.mj_setConst(m, scratch)
+        d.geom_xmat[self.floor] = scratch.geom_xmat[self.floor]
+        d.geom_xpos[self.floor] = scratch.geom_xpos[self.floor]
 
     def reset(self, world: World) -> None:
         del world

@@ -44,6 +44,7 @@ class Senses:
         self._own = world.geom_character == character
         self._body = world.geom_body
         self._f6 = np.zeros(6)
+        self._forward = _forward_in_body(athlete)
         self.time = -1.0
         self.com = np.zeros(3)
         self.com_vel = np.zeros(3)
@@ -56,6 +57,8 @@ class Senses:
         self.floor_normal = np.array([0.0, 0.0, 1.0])
         #: height (m) of the lowest sole corner above the floor
         self.clearance = 0.0
+        #: ``(2, 4, 3)`` world sole corners at the last update
+        self.corners = np.zeros((2, 4, 3))
 
     def body(self, name: str) -> int:
         return self._ids[name]
@@ -100,9 +103,10 @@ class Senses:
             if self.foot_force[k] > 0:
                 self.foot_point[k] /= self.foot_force[k]
             elif self.foot_contact[k]:
-                self.foot_point[k] = self.sole_corners()[k].mean(axis=0)
+                self.foot_point[k] = sole_corners_world(d, self.soles, self._corners)[k].mean(0)
         self.other_contact = tuple(sorted(others))
-        rel = self.sole_corners() - d.geom_xpos[self.floor]
+        self.corners = sole_corners_world(d, self.soles, self._corners)
+        rel = self.corners - d.geom_xpos[self.floor]
         self.clearance = float((rel @ self.floor_normal).min())
 
     # ------------------------------------------------------------------ derived
@@ -114,13 +118,13 @@ class Senses:
                 and self.clearance > LIFTOFF_CLEARANCE)  # fmt: skip
 
     def sole_corners(self) -> F64:
-        """``(2, 4, 3)`` world corners of the soles (left, right)."""
-        return sole_corners_world(self.world.data, self.soles, self._corners)
+        """``(2, 4, 3)`` world corners of the soles (left, right) at the last update."""
+        return self.corners
 
     def heading(self) -> float:
         """Heading (rad about +Z) of the pelvis's anatomical forward axis."""
         d = self.world.data
-        fwd = d.xmat[self.root].reshape(3, 3) @ _forward_in_body(self.athlete)
+        fwd = d.xmat[self.root].reshape(3, 3) @ self._forward
         return float(np.arctan2(fwd[1], fwd[0]))
 
     def local(self, v: F64, heading: float | None = None) -> F64:

@@ -77,6 +77,7 @@ class Sequencer:
         ctx.log.torques.append(np.linalg.norm(tau, axis=1))
         ctx.log.powers.append(np.einsum("ij,ij->i", tau, w))
         ctx.log.others.append(bool(s.other_contact))
+        ctx.log.momentum.append(d.subtree_angmom[s.root].copy())
         centre = s.support_center()
         ctx.log.offsets.append(float(np.hypot(*(s.com[:2] - centre[:2]))))
         ctx.log.pelvis.append(float(d.xpos[s.root][2]))

@@ -14,17 +14,21 @@ from types import MappingProxyType
 
 import numpy as np
 
+from reactmocap.athletics import measured
+from reactmocap.athletics.land import LandingParams
 from reactmocap.athletics.leap import BROAD_TIMING, LeapParams
 from reactmocap.errors import ConfigError
 
 __all__ = [
     "BROAD_TABLES",
     "LANDING_DELTAS",
+    "LANDING_LEADS",
     "LEAP_TABLES",
     "SUPPORTED",
     "broad_params",
     "effort_for",
     "landing_delta",
+    "landing_params",
     "leap_params",
     "supported_range",
 ]
@@ -41,19 +45,28 @@ def leap_params(s: float) -> LeapParams:
 def broad_params(s: float) -> LeapParams:
     """The standing broad jump at effort ``s``: crouch, COM ahead of the feet, arm swing."""
     s = float(np.clip(s, 0.0, 1.0))
-    return LeapParams(leg=0.8 - 0.15 * s, pitch=0.2, lean=0.5, com_offset=0.12 + 0.1 * s,
+    return LeapParams(leg=0.8 - 0.15 * s, pitch=0.3, lean=0.0, com_offset=0.12 + 0.1 * s,
                       stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
-                      arms=-1.8 - 1.0 * s, broad=True, spin_gain=20.0, hold=0.1)  # fmt: skip
+                      arms=-1.8 - 1.0 * s, broad=True, spin=-5.0, spin_gain=40.0, hold=0.1)  # fmt: skip
 
 
-# (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
-LEAP_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType({})
-# (effort s, achieved COM travel m)
-BROAD_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType({})
-# (horizontal velocity m/s, foot-servo delta m), thesis Table 6.1 rebuilt
-LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType({})
+#: (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
+LEAP_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(measured.LEAP_TABLES)
+#: (effort s, achieved COM travel m)
+BROAD_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    measured.BROAD_TABLES
+)
+#: (horizontal velocity m/s, foot-servo delta m), thesis Table 6.1 rebuilt
+LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    measured.LANDING_DELTAS
+)
+#: the landing's capture-point lead per body (tuned like the thesis's per-body deltas; a BVH
+#: body gets the landing's default)
+LANDING_LEADS: Mapping[str, float] = MappingProxyType({"male": 0.5, "female": 1.0})
 #: (behaviour, parameter) -> body -> (low, high): the measured supported range
-SUPPORTED: Mapping[tuple[str, str], Mapping[str, tuple[float, float]]] = MappingProxyType({})
+SUPPORTED: Mapping[tuple[str, str], Mapping[str, tuple[float, float]]] = MappingProxyType(
+    measured.SUPPORTED
+)
 
 
 def effort_for(table: tuple[tuple[float, float], ...], value: float, what: str) -> float:
@@ -71,6 +84,12 @@ def landing_delta(table: tuple[tuple[float, float], ...], velocity: float) -> fl
         return -0.04
     v, d = np.array(sorted(table)).T
     return float(np.interp(velocity, v, d))
+
+
+def landing_params(body: str, velocity: float) -> LandingParams:
+    """The landing controller's parameters for a body and a horizontal velocity (m/s)."""
+    lead = LANDING_LEADS.get(body, LandingParams().lead)
+    return LandingParams(lead=lead, delta=landing_delta(LANDING_DELTAS.get(body, ()), velocity))
 
 
 def supported_range(behaviour: str, param: str, body: str) -> tuple[float, float] | None:

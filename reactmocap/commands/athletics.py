@@ -80,7 +80,9 @@ def _run(args: argparse.Namespace) -> int:
         try:
             x, y = (float(v) for v in args.com_offset.split(","))
         except ValueError:
-            raise ConfigError(f"--com-offset must be X,Y in metres, got {args.com_offset!r}") from None
+            raise ConfigError(
+                f"--com-offset must be X,Y in metres, got {args.com_offset!r}"
+            ) from None
         params.update(com_offset_x=x, com_offset_y=y)
     body = str(args.body)
     bar = _Bar(args.behaviour)

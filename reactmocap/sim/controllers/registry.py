@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
+from reactmocap.athletics.controller import ATHLETIC_BALANCE_DEFAULTS, athletic_balance
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.controllers.balance import StanceBalance
@@ -144,6 +145,10 @@ _REGISTRY: dict[str, ControllerSpec] = {
         "root_assist", "NON-PHYSICAL external pelvis wrench toward the reference (an add-on "
         "to another controller)", {"kp": 100.0, "kv": None, "control_every": 1}, _root_assist,
         physical=False),
+    "athletic_balance": ControllerSpec(
+        "athletic_balance", "the thesis's balance (athletics, ch. 7): COM over the feet by ankle "
+        "and hip offsets; does not follow the clip", ATHLETIC_BALANCE_DEFAULTS,
+        athletic_balance, ("pitch", "leg", "com_offset_x", "com_offset_y")),
 }  # fmt: skip
 #: every registered controller (read-only view; :func:`register` adds); the gains and rates
 #: here are the only defaults (the CLI help and the scenario docs print them from this table)

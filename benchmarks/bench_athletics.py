@@ -1,0 +1,341 @@
+"""The athletics experiments (issue 18; Wooten's thesis, ch. 4, 6 and 7) on the thesis's male and
+female bodies. Prints one line per experiment row with the thesis's figure beside ours, writes
+the thesis-style plots and a JSON of every figure.
+
+    python benchmarks/bench_athletics.py --tables      # rebuild the tables and supported ranges
+    python benchmarks/bench_athletics.py --out docs/athletics   # the experiments and plots
+
+``--workers N`` runs simulations in N processes (the figures do not depend on it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from reactmocap.athletics import calibrate, run, tables
+from reactmocap.athletics.plots import commanded_plot, series_plot
+
+BODIES = ("male", "female")
+ROOT = Path(__file__).resolve().parents[1]
+MEASURED = ROOT / "reactmocap" / "athletics" / "measured.py"
+#: thesis figures (Wooten, ch. 4, 6, 7); Table 4.1 and 4.2 rows as (command, achieved)
+THESIS = {
+    "broad_max": {"male": 2.12, "female": 1.57},
+    "broad_table": {"male": ([0.376, 1.155, 2.120], [0.376, 1.155, 2.120]),
+                    "female": ([0.31, 0.69, 1.57], [0.31, 0.69, 1.57])},
+    "drop_max": {"male": 1.15, "female": 0.92},
+    "slope": {"+X": 33.7, "-X": 38.6, "Y": 25.7},
+}  # fmt: skip
+
+
+def _landed(r: dict[str, Any]) -> bool:
+    return bool(r.get("landed")) and r.get("status") == "ok"
+
+
+# ---------------------------------------------------------------------------------- tables
+def build_tables(
+    workers: int, parts: tuple[str, ...] = ("leap", "broad", "land")
+) -> dict[str, Any]:
+    """Rebuild the measured tables and supported ranges (``parts``: which; the others are
+    kept as they are in measured.py)."""
+    from reactmocap.athletics import measured
+
+    grid = [{"effort": round(s, 3)} for s in np.linspace(0.0, 1.0, 41)]
+    out: dict[str, Any] = {
+        "LEAP_TABLES": dict(measured.LEAP_TABLES),
+        "BROAD_TABLES": dict(measured.BROAD_TABLES),
+        "LANDING_DELTAS": dict(measured.LANDING_DELTAS),
+    }
+    supported: dict[Any, dict[str, tuple[float, float]]] = {
+        k: dict(v) for k, v in measured.SUPPORTED.items()
+    }
+    lifted = lambda r: r["time_to_liftoff_s"] is not None  # noqa: E731
+    for body in BODIES:
+        t0 = time.time()
+        if "leap" in parts:
+            leaps = calibrate.sweep("leap", body, grid, workers)
+            table = calibrate.effort_table(leaps, "achieved_height_m", lifted)
+            out["LEAP_TABLES"][body] = table
+            # supported: the longest stretch of the table's heights whose leaps land
+            ok = {round(float(r["achieved_height_m"]), 4): _landed(r) for r in leaps}
+            heights = [v for _, v in table]
+            rng = _longest(heights, [ok.get(v, False) for v in heights])
+            if rng:
+                supported.setdefault(("leap", "height"), {})[body] = rng
+        if "broad" in parts:
+            broads = calibrate.sweep("broad-jump", body, grid, workers)
+            btable = calibrate.effort_table(broads, "achieved_distance_m", lifted)
+            out["BROAD_TABLES"][body] = btable
+            if btable:
+                supported.setdefault(("broad-jump", "distance"), {})[body] = (
+                    btable[0][1],
+                    btable[-1][1],
+                )
+        if "land" in parts:
+            drops = np.round(np.arange(0.0, 2.51, 0.1), 2)
+            dr = calibrate.sweep("land", body, [{"drop": float(d)} for d in drops], workers)
+            rng = calibrate.contiguous_range(drops, [_landed(r) for r in dr], 0.0)
+            if rng:
+                supported.setdefault(("land", "drop"), {})[body] = rng
+            vxs = np.round(np.arange(-2.0, 4.01, 0.25), 2)
+            drop = _drop_for_com(body, 1.25)
+            grid_v = [{"drop": drop, "vx": float(v)} for v in vxs]
+            vr = calibrate.sweep("land", body, grid_v, workers)
+            rng = calibrate.contiguous_range(vxs, [_landed(r) for r in vr], 0.0)
+            if rng:
+                supported.setdefault(("land", "vx"), {})[body] = rng
+            slopes = _slope_limits(body, workers)
+            supported.setdefault(("balance", "slope"), {})[body] = (
+                0.0,
+                math.radians(min(slopes.values())),
+            )
+        print(f"{body}: {','.join(parts)} tables in {time.time() - t0:.0f} s")
+    out["SUPPORTED"] = supported
+    out["MEASURED_ON"] = f"{datetime.date.today().isoformat()} (bench_athletics.py --tables)"
+    header = "Measured tables (written by ``benchmarks/bench_athletics.py --tables``; do not edit)."
+    calibrate.write_measured(MEASURED, out, header)
+    return out
+
+
+def _longest(values: list[float], ok: list[bool]) -> tuple[float, float] | None:
+    best: tuple[int, int] | None = None
+    i = 0
+    while i < len(values):
+        if ok[i]:
+            j = i
+            while j + 1 < len(values) and ok[j + 1]:
+                j += 1
+            if best is None or j - i > best[1] - best[0]:
+                best = (i, j)
+            i = j + 1
+        else:
+            i += 1
+    return None if best is None else (values[best[0]], values[best[1]])
+
+
+def _drop_for_com(body: str, com_height: float) -> float:
+    """Sole clearance that puts the landing pose's COM at ``com_height`` m (thesis ch. 6)."""
+    import mujoco
+
+    from reactmocap.athletics.behaviours import LANDING_LEG
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import stand_angles
+
+    ath = athlete(body)
+    q = ath.standing_qpos(stand_angles(ath, LANDING_LEG), clearance=0.0)
+    data = mujoco.MjData(ath.character.model)
+    data.qpos[:] = q
+    mujoco.mj_forward(ath.character.model, data)
+    return round(com_height - float(data.subtree_com[1][2]), 3)
+
+
+# ---------------------------------------------------------------------------------- searches
+def _largest(ok: Any, lo: float, hi: float, step: float) -> float:
+    """Largest value in [lo, hi] on a ``step`` grid for which ``ok`` holds, assuming it holds
+    below and fails above (bisection)."""
+    if not ok(lo):
+        return float("nan")
+    if ok(hi):
+        return hi
+    a, b = lo, hi
+    while b - a > step + 1e-9:
+        mid = round((a + b) / 2 / step) * step
+        if mid in (a, b):
+            break
+        if ok(mid):
+            a = mid
+        else:
+            b = mid
+    return a
+
+
+def _slope_limits(body: str, workers: int) -> dict[str, float]:
+    dirs = {"+X": 0.0, "-X": 180.0, "Y": 90.0}
+
+    def limit(d: float) -> float:
+        return _largest(lambda deg: bool(run("balance", body, check_range=False, seconds=3.0,
+                                             slope=math.radians(deg), slope_dir=math.radians(d)
+                                             ).report["balanced"]), 0.0, 45.0, 0.5)  # fmt: skip
+
+    return {k: limit(v) for k, v in dirs.items()}
+
+
+def _push_limit(body: str, direction: float) -> float:
+    return _largest(lambda f: bool(run("balance", body, check_range=False, seconds=3.0, push=f,
+                                       push_dir=math.radians(direction)).report["balanced"]),
+                    0.0, 600.0, 5.0)  # fmt: skip
+
+
+def _offset_limit(body: str, direction: float) -> float:
+    a = math.radians(direction)
+    return _largest(lambda m: bool(run("balance", body, check_range=False, seconds=3.0,
+                                       com_offset_x=m * math.cos(a), com_offset_y=m * math.sin(a)
+                                       ).report["balanced"]), 0.0, 0.3, 0.005)  # fmt: skip
+
+
+# ---------------------------------------------------------------------------------- experiments
+def experiments(out: Path | None, workers: int) -> dict[str, Any]:
+    res: dict[str, Any] = {"date": datetime.date.today().isoformat()}
+    speeds: list[tuple[float, float]] = []
+    commands = [round(x, 2) for x in np.linspace(0.1, 1.0, 10)]
+    panels, grf_curves = {}, {}
+    for body in BODIES:
+        rows = calibrate.sweep("leap", body, [{"height": h} for h in commands], workers)
+        speeds += [(r["realtime_factor"], r["realtime_factor_cpu"]) for r in rows]
+        got = [r["achieved_height_m"] for r in rows]
+        err = [abs(g - c) for g, c in zip(got, commands)]
+        res[f"leap_{body}"] = {
+            "commanded": commands, "achieved": got, "abs_error": err,
+            "landed": [_landed(r) for r in rows], "max_abs_error": max(err),
+            "human_plausible": [r["human_plausible"] for r in rows],
+            "peak_joint_torque_nm": [r["peak_joint_torque_nm"] for r in rows],
+            "peak_joint_power_w": [r["peak_joint_power_w"] for r in rows],
+        }  # fmt: skip
+        panels[body] = (commands, got)
+        half = calibrate.sweep("leap", body, [{"height": 0.5}], 1)[0]
+        res[f"leap05_{body}"] = {k: half[k] for k in ("time_to_liftoff_s", "peak_grf_bw",
+                                                       "achieved_height_m", "landed")}  # fmt: skip
+        for h in (0.2, 0.5, 0.8):
+            r = run("leap", body, height=h, check_range=False)
+            t = r.log["t"]
+            grf_curves[f"{body} {h} m"] = (t, r.log["grf"][:, 2] / (r.report["mass_kg"] * 9.81))
+        # broad jump: commanded over the table's span, and the longest landed jump
+        btable = tables.BROAD_TABLES.get(body, ())
+        if btable:
+            span = np.linspace(btable[0][1], btable[-1][1], 6)
+            brows = calibrate.sweep("broad-jump", body, [{"distance": float(d)} for d in span],
+                                    workers)  # fmt: skip
+            bgot = [r["achieved_distance_m"] for r in brows]
+            res[f"broad_{body}"] = {"commanded": span.tolist(), "achieved": bgot,
+                                    "abs_error": [abs(a - b) for a, b in zip(bgot, span)],
+                                    "landed": [_landed(r) for r in brows],
+                                    "max_landed": btable[-1][1]}  # fmt: skip
+        # landing
+        drops = np.round(np.arange(0.1, 2.51, 0.1), 2)
+        dr = calibrate.sweep("land", body, [{"drop": float(d)} for d in drops], workers)
+        rng = calibrate.contiguous_range(drops, [_landed(r) for r in dr], 0.1)
+        res[f"drop_{body}"] = {"max_landed": rng[1] if rng else None,
+                               "landed": {float(d): _landed(r) for d, r in zip(drops, dr)}}  # fmt: skip
+        drop = _drop_for_com(body, 1.25)
+        vxs = np.round(np.arange(-2.0, 4.01, 0.25), 2)
+        vr = calibrate.sweep("land", body, [{"drop": drop, "vx": float(v)} for v in vxs],
+                             workers)  # fmt: skip
+        rng = calibrate.contiguous_range(vxs, [_landed(r) for r in vr], 0.0)
+        res[f"vx_{body}"] = {"range": rng, "drop_m": drop,
+                             "landed": {float(v): _landed(r) for v, r in zip(vxs, vr)}}  # fmt: skip
+        # balance
+        dirs = [0, 45, 90, 135, 180, 225, 270, 315]
+        res[f"push_{body}"] = {d: _push_limit(body, d) for d in dirs}
+        res[f"offset_{body}"] = {d: _offset_limit(body, d) for d in dirs}
+        res[f"slope_{body}"] = _slope_limits(body, workers)
+    # backpack (female, no re-tuning): horizontal-velocity landings with 2 and 4 kg
+    drop = _drop_for_com("female", 1.25)
+    for kg in (2.0, 4.0):
+        rows = calibrate.sweep("land", "female", [{"drop": drop, "vx": v, "backpack": kg}
+                                                  for v in (-1.0, 0.0, 1.0, 2.0, 3.0)], workers)  # fmt: skip
+        res[f"backpack_{int(kg)}kg"] = {v: _landed(r) for v, r in
+                                        zip((-1.0, 0.0, 1.0, 2.0, 3.0), rows)}  # fmt: skip
+    res["speed"] = {"wall_median": float(np.median([s[0] for s in speeds])),
+                    "cpu_median": float(np.median([s[1] for s in speeds]))}  # fmt: skip
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        commanded_plot(panels, out / "fig4_1_vertical_leap.png", quantity="height")
+        series_plot(grf_curves, out / "fig4_2_ground_force.png", xlabel="time (s)",
+                    ylabel="vertical GRF (body weights)", title="Leaps, ground reaction force")  # fmt: skip
+        bpanels = {b: (res[f"broad_{b}"]["commanded"], res[f"broad_{b}"]["achieved"])
+                   for b in BODIES if f"broad_{b}" in res}  # fmt: skip
+        if bpanels:
+            commanded_plot(bpanels, out / "fig4_4_broad_jump.png", quantity="distance",
+                           thesis={b: THESIS["broad_table"][b] for b in bpanels})  # fmt: skip
+        _polar_plot(res, out)
+    return res
+
+
+def _polar_plot(res: dict[str, Any], out: Path) -> None:
+    from reactmocap.response.plots import _pyplot
+
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 2, figsize=(9, 8), dpi=100)
+    for row, body in enumerate(BODIES):
+        for col, (key, unit) in enumerate((("offset", "m"), ("push", "N"))):
+            ax = axes[row, col]
+            data = res[f"{key}_{body}"]
+            ang = np.radians(list(data)) if data else np.zeros(0)
+            mag = np.array(list(data.values()), dtype=float)
+            ax.plot(np.append(mag * np.cos(ang), mag[:1] * np.cos(ang[:1])),
+                    np.append(mag * np.sin(ang), mag[:1] * np.sin(ang[:1])), "o-")  # fmt: skip
+            ax.axhline(0, color="0.8")
+            ax.axvline(0, color="0.8")
+            ax.set_aspect("equal")
+            ax.set_title(f"{body}: largest {'COM offset' if key == 'offset' else 'push'} ({unit})")
+            ax.set_xlabel(f"X ({unit})")
+            ax.set_ylabel(f"Y ({unit})")
+    fig.tight_layout()
+    from reactmocap.io import atomic_write
+
+    with atomic_write(out / "fig7_5_7_7_balance.png", "wb") as fh:
+        fig.savefig(fh, format="png")
+    plt.close(fig)
+
+
+def print_table(res: dict[str, Any]) -> None:
+    def fmt(x: Any) -> str:
+        return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.3g}"
+
+    print(f"athletics experiments, {res['date']}")
+    for b in BODIES:
+        lp = res[f"leap_{b}"]
+        print(f"Fig 4.1 {b}: max |error| {fmt(lp['max_abs_error'])} m over 0.1-1.0 m; landed "
+              f"{sum(lp['landed'])}/10; human-plausible {sum(lp['human_plausible'])}/10")  # fmt: skip
+        h = res[f"leap05_{b}"]
+        print(f"Fig 4.2 {b} 0.5 m: lift-off {fmt(h['time_to_liftoff_s'])} s, push-off peak "
+              f"{fmt(h['peak_grf_bw'])} BW (thesis male 1.1 s, 5.8 BW; human 1.1 s, 2.5 BW)")  # fmt: skip
+        if f"broad_{b}" in res:
+            br = res[f"broad_{b}"]
+            print(f"Fig 4.4 {b}: max |error| {fmt(max(br['abs_error']))} m; longest landed "
+                  f"{fmt(br['max_landed'])} m (thesis {THESIS['broad_max'][b]} m)")  # fmt: skip
+        print(f"Ch 6 drop {b}: highest landed {fmt(res[f'drop_{b}']['max_landed'])} m "
+              f"(thesis {THESIS['drop_max'][b]} m)")  # fmt: skip
+        print(f"Ch 6 vx {b}: landed range {res[f'vx_{b}']['range']} m/s (thesis -1.0 to 3.0)")
+        print(f"Fig 7.5 {b}: largest COM offset by direction {res[f'offset_{b}']}")
+        print(f"Fig 7.7 {b}: largest push by direction {res[f'push_{b}']}")
+        print(f"Ch 7 slope {b}: {res[f'slope_{b}']} (thesis male {THESIS['slope']})")
+    for kg in (2, 4):
+        print(f"Table 6.2 female {kg} kg: landed by vx {res[f'backpack_{kg}kg']}")
+    print(f"speed: median {res['speed']['wall_median']:.2f}x real time (wall, shared machine), "
+          f"{res['speed']['cpu_median']:.2f}x (CPU time); thesis 70x slower")  # fmt: skip
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument("--tables", action="store_true", help="rebuild tables and ranges")
+    ap.add_argument("--parts", default="leap,broad,land",
+                    help="with --tables: which of leap,broad,land to rebuild")  # fmt: skip
+    ap.add_argument("--out", type=Path, help="folder for the plots")
+    ap.add_argument("--json", type=Path, help="write every figure as JSON")
+    ap.add_argument("--workers", type=int, default=1)
+    args = ap.parse_args()
+    if args.tables:
+        build_tables(args.workers, tuple(args.parts.split(",")))
+        return 0
+    res = experiments(args.out, args.workers)
+    print_table(res)
+    if args.json is not None:
+        from reactmocap.io import atomic_write_text
+
+        atomic_write_text(args.json, json.dumps(res, indent=1, default=str) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

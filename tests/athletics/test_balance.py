@@ -1,0 +1,43 @@
+"""Balance (thesis ch. 7): standing, pushes on the chest, posture, slopes and a backpack."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from reactmocap.athletics import run
+
+
+def test_a_50_newton_push_is_recovered() -> None:
+    r = run("balance", "male", seconds=2.5, push=50.0, push_dir=0.0)
+    assert r.report["balanced"] and not r.report["fell"]
+    assert r.report["max_com_offset_m"] < 0.1
+
+
+def test_a_2000_newton_push_falls() -> None:
+    r = run("balance", "male", seconds=2.5, push=2000.0, push_dir=0.0)
+    assert r.report["fell"]
+    assert not r.report["balanced"]
+
+
+def test_pelvis_height_and_torso_pitch_are_held() -> None:
+    r = run("balance", "female", seconds=2.5, pelvis_height=0.72, pitch=math.radians(20))
+    assert r.report["balanced"]
+    world = r.rollout.world
+    data = world.data
+    m = world.model
+    hips = [data.xanchor[m.joint(f"a/{s}_hip").id][2] for s in "lr"]
+    assert float(np.mean(hips)) == pytest.approx(0.72, abs=0.04)
+    # the pelvis leans forward about as asked (plus the squat's lean)
+    pelvis = data.xmat[world.characters[0].body_ids[0]].reshape(3, 3)
+    pitch = math.degrees(math.atan2(-pelvis[2, 0], pelvis[0, 0]))
+    assert 15.0 < pitch < 45.0
+
+
+def test_balance_on_a_slope_and_with_a_backpack() -> None:
+    r = run("balance", "male", seconds=1.0, slope=math.radians(12.0))
+    assert r.report["balanced"]
+    r = run("balance", "female", seconds=2.0, backpack=4.0)
+    assert r.report["balanced"] and r.report["mass_kg"] == pytest.approx(53.3, abs=0.01)

@@ -1,0 +1,45 @@
+"""``reactmocap athletics ...``: one smoke test per command, and one-line errors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from reactmocap.cli import main
+from reactmocap.library.bvh import read_bvh
+
+
+@pytest.mark.parametrize(
+    ("args", "keys"),
+    [
+        (["balance", "--seconds", "0.5", "--push", "30"], ["fell", "max_com_offset_m"]),
+        (["land", "--drop", "0.2", "--body", "female"], ["landed", "fell"]),
+        (["leap", "--effort", "0.3"],
+         ["achieved_height_m", "fell", "landed", "peak_grf_bw", "time_to_liftoff_s",
+          "human_plausible"]),
+        (["broad-jump", "--effort", "0.2"], ["achieved_distance_m", "fell", "landed"]),
+    ],
+)  # fmt: skip
+def test_each_command_writes_bvh_and_report(
+    args: list[str], keys: list[str], tmp_path: Path
+) -> None:
+    out, rep = tmp_path / "m.bvh", tmp_path / "r.json"
+    assert main(["athletics", *args, "--out", str(out), "--report", str(rep)]) == 0
+    report = json.loads(rep.read_text())
+    assert all(k in report for k in keys)
+    motion = read_bvh(out)
+    assert motion.num_frames > 10 and "LeftUpLeg" in motion.skeleton.names
+
+
+def test_bad_input_is_one_line_and_nothing_is_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "m.bvh"
+    for args in (["leap", "--height", "5"], ["leap", "--body", "robot", "--height", "0.3"],
+                 ["land", "--drop", "nan"]):  # fmt: skip
+        assert main(["athletics", *args, "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("reactmocap: error:")
+    assert not out.exists()

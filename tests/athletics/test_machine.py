@@ -1,0 +1,103 @@
+"""The athletic state machines: events, the sequencer's hand-over, the rig's targets."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from reactmocap.athletics import Balance, Landing, Posture, Sequencer, athlete
+from reactmocap.athletics.machine import NEXT, Basis, Context, angle, apex, touchdown
+from reactmocap.athletics.rig import Rig, per_joint
+from reactmocap.athletics.scene import athletics_world, stand_angles
+from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.sim.controllers.machine import State, after
+from reactmocap.sim.rollout import rollout
+
+
+def test_a_drop_runs_the_landing_states_in_order_and_hands_over_to_balance() -> None:
+    ath = athlete("male")
+    world = athletics_world(ath)
+    drop = 0.3
+    world.set_pose(0, ath.standing_qpos(stand_angles(ath, 0.92), clearance=drop))
+    ctx = Context.make(world, ath, control_every=8)
+    seq = Sequencer(ctx, [Landing(), Balance(Posture(settle=1.0))])
+    rollout(world, 1.6, controllers=[seq])
+    states = [tr.target for tr in seq.transitions]
+    assert states[:4] == ["land.absorb", "land.recover", "land.done", "balance.hold"]
+    # touchdown when the soles reach the floor: free fall of the drop height (to a tick)
+    assert ctx.touchdown_time == pytest.approx(math.sqrt(2 * drop / 9.81), abs=0.012)
+    # the hand-over moves no target: the knees' targets are continuous across it
+    log = ctx.log.arrays()
+    assert not log["others"].any()
+
+
+def test_events_fire_on_what_they_measure() -> None:
+    ath = athlete("female")
+    world = athletics_world(ath)
+    ctx = Context.make(world, ath)
+    ctx.rig.reset()
+    ctx.sense(0.0)
+    assert touchdown(ctx)(world, 0.0, 0.0)  # standing: the feet touch
+    assert not apex(ctx)(world, 0.0, 0.0) or ctx.senses.com_vel[2] <= 0.0
+    knee = float(stand_angles(ath)[10, 0])
+    assert angle(ctx, "l_knee", 0, knee - 0.05)(world, 0.0, 0.0)
+    assert not angle(ctx, "l_knee", 0, knee + 0.05)(world, 0.0, 0.0)
+    with pytest.raises(UnknownKeyError, match="l_knee"):
+        angle(ctx, "knee_l", 0, 0.1)
+    with pytest.raises(ConfigError, match="axis"):
+        angle(ctx, "l_knee", 3, 0.1)
+
+
+def test_sequencer_chains_bases_and_drops_the_last_next() -> None:
+    class Wait(Basis):
+        name = "wait"
+        initial = "w"
+
+        def states(self, ctx: Context) -> list[State]:
+            return [State("w", None, None, ((after(0.05), NEXT),))]
+
+    ath = athlete("male")
+    world = athletics_world(ath)
+    ctx = Context.make(world, ath)
+    seq = Sequencer(ctx, [Wait(), Wait(), Balance(seconds=0.05)])
+    rollout(world, 0.3, controllers=[seq])
+    assert [tr.target for tr in seq.transitions] == ["wait1.w", "balance.hold"]
+    assert seq.state == "balance.hold"  # the last NEXT has nowhere to go: final state
+    with pytest.raises(ConfigError, match="at least one"):
+        Sequencer(ctx, [])
+
+
+def test_rig_moves_targets_on_hermite_and_accelerating_paths() -> None:
+    ath = athlete("male")
+    world = athletics_world(ath)
+    rig = Rig(world, ath)
+    rig.reset(np.zeros((15, 3)))
+    goal = np.ones((15, 3))
+    rig.move(goal, 1.0, 0.0, [0])
+    rig.move(goal, 1.0, 0.0, [1], accelerate=True)
+    mid = rig.desired(0.5)
+    assert mid[0, 0] == pytest.approx(0.5)  # Hermite: half way at half time
+    assert mid[1, 0] == pytest.approx(0.25)  # constant acceleration: a quarter
+    assert np.allclose(rig.desired(1.0)[:2], 1.0)
+    assert np.allclose(rig.desired(0.5)[2:], 0.0)  # the others stay
+    rig.move(goal * 2, 0.0, 0.5, [2])
+    assert rig.desired(0.5)[2, 0] == pytest.approx(2.0)  # duration 0 jumps at once
+    assert per_joint({"knee": 2.0, "l_knee": 3.0})[[10, 13]].tolist() == [3.0, 2.0]
+    with pytest.raises(ConfigError):
+        rig.set_stiffness(np.full(15, -1.0))
+
+
+def test_the_registry_row_balances_any_character(guard) -> None:  # type: ignore[no-untyped-def]
+    from reactmocap.athletics.bodies import athlete_of
+    from reactmocap.sim.controllers import build
+    from reactmocap.sim.world import World
+
+    ath = athlete(guard)
+    world = World(ath.character)
+    world.set_pose(0, athlete_of(ath.character).standing_qpos(stand_angles(ath), 0.0005))
+    ctl = build("athletic_balance", world, guard)
+    res = rollout(world, 1.5, controllers=[ctl])
+    pelvis = res.body_transforms(0)[0][:, 0, 2]
+    assert pelvis.min() > 0.8 * pelvis[0]  # still standing
