@@ -23,20 +23,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.athletics.balance import knee_for_length
-from reactmocap.athletics.bodies import EULER_ORDER, Athlete
+from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.course import Course, Straight
 from reactmocap.athletics.rig import Rig, joint_index, per_joint
 from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
 from reactmocap.rotations import (
     quat_conj,
-    quat_from_euler,
     quat_from_yaw,
-    quat_log,
     quat_mul,
-    quat_to_euler,
 )
-from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
+from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.controllers.base import FunctionController
 from reactmocap.sim.controllers.machine import State, StateMachine, after
 from reactmocap.sim.world import World
@@ -65,12 +62,54 @@ _SHOULDER = (joint_index("l_shoulder"), joint_index("r_shoulder"))
 _ELBOW = (joint_index("l_elbow"), joint_index("r_elbow"))
 _SPINE = (joint_index("waist"), joint_index("back"))
 _NECK = joint_index("neck")
+_LEG_JOINTS = (*_HIP, *_KNEE, *_ANKLE)
 _BODY = {b: i for i, b in enumerate(SIM_BODIES)}
 _THIGH = (_BODY["l_thigh"], _BODY["r_thigh"])
 _SHIN = (_BODY["l_shin"], _BODY["r_shin"])
 _FOOT = (_BODY["l_foot"], _BODY["r_foot"])
 #: a sole corner closer than this to the floor (m) counts as touching
 CORNER_TOUCH = 0.004
+
+
+# ---------------------------------------------------------------------------------- small math
+# single quaternions at every tick: MuJoCo's C routines and closed forms instead of the
+# vectorised helpers (scipy), which cost 100-400 us a call and dominated the tick
+def _qmul(a: F64, b: F64) -> F64:
+    out = np.empty(4)
+    mujoco.mju_mulQuat(out, a, b)
+    return out
+
+
+def _clamp(x: float, lo: float, hi: float) -> float:
+    return float(min(max(x, lo), hi))
+
+
+def _qconj(q: F64) -> F64:
+    return np.array([q[0], -q[1], -q[2], -q[3]])
+
+
+def _qyaw(yaw: float) -> F64:
+    return np.array([math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw)])
+
+
+def _quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
+    """Quaternion of intrinsic Y-X-Z Euler angles (:data:`~reactmocap.athletics.bodies.
+    EULER_ORDER`)."""
+    qy = np.array([math.cos(0.5 * pitch), 0.0, math.sin(0.5 * pitch), 0.0])
+    qx = np.array([math.cos(0.5 * roll), math.sin(0.5 * roll), 0.0, 0.0])
+    return _qmul(_qmul(qy, qx), _qyaw(yaw))
+
+
+def _euler_yxz(q: F64) -> tuple[float, float, float]:
+    """Intrinsic Y-X-Z Euler angles (pitch, roll, yaw) of a quaternion: with
+    ``R = Ry Rx Rz``, pitch = atan2(R02, R22), roll = asin(-R12), yaw = atan2(R10, R11)."""
+    w, x, y, z = q
+    r02 = 2.0 * (x * z + w * y)
+    r22 = 1.0 - 2.0 * (x * x + y * y)
+    r12 = 2.0 * (y * z - w * x)
+    r10 = 2.0 * (x * y + w * z)
+    r11 = 1.0 - 2.0 * (x * x + z * z)
+    return (math.atan2(r02, r22), math.asin(max(-1.0, min(1.0, -r12))), math.atan2(r10, r11))
 
 
 def check_speed(speed: float) -> float:
@@ -271,7 +310,8 @@ class Runner:
         self._shins = wc.body_ids[list(_SHIN)]
         self._feet = wc.body_ids[list(_FOOT)]
         self._neutral = athlete.neutral
-        self._chest_neutral = quat_conj(athlete.neutral[_BODY["chest"]])
+        self._neutral_conj = quat_conj(athlete.neutral)
+        self._bodies = np.asarray(wc.body_ids)
         self._jacp = np.zeros((3, m.nv))
         b = wc.ball_dof_start
         # the knee's and ankle's dofs of each leg
@@ -318,7 +358,10 @@ class Runner:
         self._reset_state()
         self.rig.reset()
         self.senses.time = -1.0
-        angles = self.rig.current_angles()
+        # the pitch of the legs' joints (the only joint angles the laws read)
+        angles = np.zeros((NJ, 3))
+        for j in _LEG_JOINTS:
+            angles[j, 0] = self._joint_pitch(j)
         self.targets[:] = angles
         self.goal[:] = angles
         self.machine.reset(self.world)
@@ -330,16 +373,27 @@ class Runner:
         """The pelvis's heading (rad about +Z)."""
         return self.senses.heading()
 
+    def _anat(self, body: int, neutral: int) -> F64:
+        """A body's anatomical world rotation."""
+        return _qmul(self.world.data.xquat[body], self._neutral_conj[neutral])
+
     def _pitch(self, body: int, neutral: int, heading: float) -> float:
         """Anatomical pitch (rad) of a body in the heading frame (thigh forward < 0)."""
-        q = quat_mul(self.world.data.xquat[body], quat_conj(self._neutral[neutral]))
-        q = quat_mul(quat_from_yaw(-heading), q)
-        return float(quat_to_euler(q, EULER_ORDER)[0])
+        return _euler_yxz(_qmul(_qyaw(-heading), self._anat(body, neutral)))[0]
 
-    def trunk_euler(self) -> F64:
+    def _joint_pitch(self, joint: int) -> float:
+        """Anatomical pitch (rad) of a ball joint: its child's rotation relative to its
+        parent's, both in their anatomical frames (as ``Athlete.joint_angles``)."""
+        child = joint + 1
+        parent = int(SIM_PARENTS[child])
+        rel = _qmul(_qconj(self._anat(self._bodies[parent], parent)),
+                    self._anat(self._bodies[child], child))  # fmt: skip
+        return _euler_yxz(rel)[0]
+
+    def trunk_euler(self) -> tuple[float, float, float]:
         """Chest pitch, roll and yaw (anatomical, heading frame, rad)."""
-        now = quat_mul(self.world.data.xquat[self._chest], self._chest_neutral)
-        return quat_to_euler(quat_mul(quat_from_yaw(-self.heading()), now), EULER_ORDER)
+        chest = _BODY["chest"]
+        return _euler_yxz(_qmul(_qyaw(-self.heading()), self._anat(self._chest, chest)))
 
     def _contacts(self) -> None:
         """Which feet touch with their heel (rear corners) and toe (front corners)."""
@@ -383,25 +437,23 @@ class Runner:
         vz = float(s.com_vel[2])
         low = float(s.sole_corners()[leg, :, 2].min())
         to_go = low / -vz if vz < -1e-3 else np.inf
-        fwd += k["speed_matching"] * float(np.clip(to_go / k["retract_time"], 0.0, 1.0))
+        fwd += k["speed_matching"] * _clamp(to_go / k["retract_time"], 0.0, 1.0)
         fwd += 0.3 * lf  # the heel sits behind the ankle
         length = k["touchdown_leg"] * (self.athlete.thigh[leg] + self.athlete.shin[leg])
-        fwd = float(np.clip(fwd, -0.5 * length, 0.75 * length))
-        lat = float(np.clip(lat, -0.3 * length, 0.3 * length))
+        fwd = _clamp(fwd, -0.5 * length, 0.75 * length)
+        lat = _clamp(lat, -0.3 * length, 0.3 * length)
         down = math.sqrt(max(length * length - fwd * fwd - lat * lat, 0.04))
         swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
         roll = math.atan2(lat, math.hypot(fwd, down))
         knee, geom = knee_for_length(self.athlete.thigh[leg], self.athlete.shin[leg], length)
-        thigh = quat_mul(
-            quat_from_yaw(heading), quat_from_euler([-swing + float(geom), roll, 0.0], EULER_ORDER)
-        )
-        pelvis = quat_mul(d.xquat[self._root], quat_conj(self._neutral[0]))
-        hip_angles = quat_to_euler(quat_mul(quat_conj(pelvis), thigh), EULER_ORDER)
-        self.goal[_HIP[leg]] = (hip_angles[0], hip_angles[1], 0.0)
+        thigh = _qmul(_qyaw(heading), _quat_yxz(-swing + float(geom), roll, 0.0))
+        pelvis = self._anat(self._root, 0)
+        hip_pitch, hip_roll, _ = _euler_yxz(_qmul(_qconj(pelvis), thigh))
+        self.goal[_HIP[leg]] = (hip_pitch, hip_roll, 0.0)
         self.goal[_KNEE[leg]] = (float(knee), 0.0, 0.0)
         self.knee_td = float(knee)
         shin = self._pitch(self._shins[leg], _SHIN[leg], heading)
-        self.goal[_ANKLE[leg]] = (float(np.clip(-k["heel_up"] - shin, -0.5, 0.9)), 0.0, 0.0)
+        self.goal[_ANKLE[leg]] = (_clamp(-k["heel_up"] - shin, -0.5, 0.9), 0.0, 0.0)
 
     def _idle(self, t: float, heading: float) -> None:
         """The idle leg. In flight, eqs. 3-4: the idle thigh mirrors the active one's travel
@@ -418,11 +470,11 @@ class Runner:
             want = self.lo_pitch[i] - (act - self.lo_pitch[a])
         else:
             prog = (t - self.t_touchdown) / max(self.stance_estimate, 0.05)
-            sm = float(np.clip(prog, 0.0, 1.0))
+            sm = _clamp(prog, 0.0, 1.0)
             want = self.td_pitch + (k["swing_ready"] - self.td_pitch) * sm * sm * (3.0 - 2.0 * sm)
-            late = float(np.clip(2.0 * prog - 1.0, 0.0, 1.0))
+            late = _clamp(2.0 * prog - 1.0, 0.0, 1.0)
             knee += (k["reach_knee"] - k["idle_knee"]) * late * late * (3.0 - 2.0 * late)
-        hip = float(np.clip(want, -1.1, 0.7)) - self._pitch(self._root, 0, heading)
+        hip = _clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
         self.goal[_HIP[i]] = (hip, 0.03 * (1 - 2 * i), 0.0)
         self.goal[_KNEE[i]] = (knee, 0.0, 0.0)
         self.goal[_ANKLE[i]] = (-0.15, 0.0, 0.0)
@@ -443,13 +495,13 @@ class Runner:
         lean into the curve), pitch (slightly forward) and yaw (the desired facing)."""
         k = self.k
         lean = math.atan(self.speed**2 * self.curvature / self.g)
-        want = quat_mul(quat_from_yaw(self.heading_d),
-                        quat_from_euler([k["pitch"], -lean, 0.0], EULER_ORDER))  # fmt: skip
+        want = _qmul(_qyaw(self.heading_d), _quat_yxz(k["pitch"], -lean, 0.0))
         # the chest's attitude and rate: the pelvis alone is light and sits between two
         # servoed joints, and damping its rate explicitly at the control rate rings
         d = self.world.data
-        now = quat_mul(d.xquat[self._chest], self._chest_neutral)
-        err = quat_log(quat_mul(want, quat_conj(now)))  # world rotation vector
+        now = self._anat(self._chest, _BODY["chest"])
+        err = np.empty(3)
+        mujoco.mju_quat2Vel(err, _qmul(want, _qconj(now)), 1.0)  # world rotation vector
         c, s = math.cos(heading), math.sin(heading)
         axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
         gain = self.inertia_unit * (
@@ -464,7 +516,7 @@ class Runner:
         axis /= max(float(np.linalg.norm(axis)), 1e-9)
         along = float(torque @ axis)
         limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
-        return torque - (along - float(np.clip(along, -limit, limit))) * axis
+        return torque - (along - _clamp(along, -limit, limit)) * axis
 
     def _support_point(self, t: float) -> F64:
         """Where the stance foot bears on the ground (world): the heel until the ball is
@@ -479,7 +531,7 @@ class Runner:
         if state == "heel_toe":
             end = self.t_touchdown + self.k["toe_fraction"] * self.stance_estimate
             span = max(end - self.t_heel_toe, 1e-3)
-            frac = float(np.clip((t - self.t_heel_toe) / span, 0.0, 1.0))
+            frac = _clamp((t - self.t_heel_toe) / span, 0.0, 1.0)
             return heel + frac * (ball - heel)
         return ball
 
@@ -541,7 +593,7 @@ class Runner:
             return t - self.t_touchdown >= self.k["toe_fraction"] * self.stance_estimate
 
         def knee_extended(_w: World, _t: float, t_in: float) -> bool:
-            knee = self.rig.current_angles()[_KNEE[self.active], 0]
+            knee = self._joint_pitch(_KNEE[self.active])
             return t_in > 0.02 and knee <= self.knee_td + 0.05
 
         def left_ground(_w: World, _t: float, _ti: float) -> bool:
@@ -576,7 +628,7 @@ class Runner:
     def _enter_flight(self, world: World, t: float) -> None:
         del world
         if self.machine.transitions:  # lift-off (not the first tick): swap the legs
-            self.stance_estimate = float(np.clip(t - self.t_touchdown, 0.12, 0.4))
+            self.stance_estimate = _clamp(t - self.t_touchdown, 0.12, 0.4)
             self.log.liftoffs.append((t, self.active))
             self.active = 1 - self.active
         h = self.heading()
@@ -601,7 +653,7 @@ class Runner:
             dist = float((com - self.step_start[1]) @ np.array([math.cos(h), math.sin(h)]))
             err = dist / (t - self.step_start[0]) - self.speed
             bias = self.speed_bias + self.k["speed_integral"] * err
-            self.speed_bias = float(np.clip(bias, -0.3, 0.3))
+            self.speed_bias = _clamp(bias, -0.3, 0.3)
         self.step_start = (t, com)
         # the spring's rest length: the hip-to-ankle length at touchdown as planned, or as
         # it landed if longer
@@ -635,7 +687,10 @@ class Runner:
         # the frame the legs are placed and swung in: the desired facing, not the pelvis's
         # (which yaws back and forth with every stride)
         heading = self.heading_d if self.p_frame else self.heading()
-        angles = self.rig.current_angles()
+        # the pitch of the legs' joints (the only joint angles the laws read)
+        angles = np.zeros((NJ, 3))
+        for j in _LEG_JOINTS:
+            angles[j, 0] = self._joint_pitch(j)
         self._idle(t, heading)
         self._upper(angles[list(_HIP), 0])
         # eq. 6: the targets move smoothly toward the goals (first order, time constant)

@@ -192,7 +192,12 @@ def vault_athlete(height: float = GYMNAST_HEIGHT, mass: float = GYMNAST_MASS) ->
         raise ConfigError(f"height and mass must be > 0, got {height!r}, {mass!r}")
     key = (round(height, 4), round(mass, 4))
     if key not in _ATHLETE:
-        from reactmocap.athletics.bodies import _athlete, _inertials, _joint_points, thesis_skeleton
+        from reactmocap.athletics.bodies import (
+            _inertials,
+            _joint_points,
+            athlete_of,
+            thesis_skeleton,
+        )
         from reactmocap.library.bodyparts import BodyPartMap
         from reactmocap.library.skeleton import Skeleton
         from reactmocap.sim.character import SegmentInertia, build_character
@@ -220,7 +225,7 @@ def vault_athlete(height: float = GYMNAST_HEIGHT, mass: float = GYMNAST_MASS) ->
                 tuple((float(a), float(b), float(c)) for a, b, c in inertia),
             )
         ch = build_character(scaled, parts_s, reference=ref, inertials=inertials)
-        _ATHLETE[key] = _athlete("female", ch)
+        _ATHLETE[key] = athlete_of(ch, "female")
     return _ATHLETE[key]
 
 
@@ -310,16 +315,15 @@ class Vault(Basis):
         hands = {SIM_BODIES.index(b) for b in ("l_hand", "r_hand", "l_forearm", "r_forearm")}
         f6 = np.zeros(6)
         seen = {"board": 0, "horse": 0, "deepest": False}
-        body_geoms = [np.flatnonzero((part == b) & own) for b in range(len(SIM_BODIES))]
-        # how far below its centre a geom reaches (a bound: its half-diagonal or radius)
-        reach = np.where(m.geom_type == int(mujoco.mjtGeom.mjGEOM_SPHERE), m.geom_size[:, 0],
-                         np.linalg.norm(m.geom_size, axis=1))  # fmt: skip
+        # the geoms that must stay above the horse's top while over it: all but the arms'
+        check = np.flatnonzero(own & ~np.isin(part, list(hands)))
+        is_box = m.geom_type == int(mujoco.mjtGeom.mjGEOM_BOX)
+        is_capsule = m.geom_type == int(mujoco.mjtGeom.mjGEOM_CAPSULE)
         chest = int(wc.body_ids[SIM_BODIES.index("chest")])
         sh_j = [m.joint(wc.prefix + f"{s}_shoulder").id for s in "lr"]
         horse_top = HORSE.top
         hx0 = p.horse_distance - 0.5 * HORSE.size[0]
         hx1 = p.horse_distance + 0.5 * HORSE.size[0]
-        ids = wc.body_ids
 
         def sense(t: float) -> tuple[bool, bool, bool]:
             """Contacts with the board (feet), the horse (hands) and the floor; logs a row."""
@@ -344,15 +348,18 @@ class Vault(Basis):
                     on_f = True
             s = ctx.sense(t)
             # the body's lowest point while over the horse (only the hands may touch)
-            clear = math.inf
-            xs = d.xpos[ids, 0]
+            xs = d.geom_xpos[check, 0]
             over = (xs > hx0) & (xs < hx1)
-            for b in np.flatnonzero(over):
-                if b in hands:
-                    continue
-                for g in body_geoms[b]:
-                    low = float(d.geom_xpos[g, 2]) - float(reach[g])
-                    clear = min(clear, low - horse_top)
+            clear = math.inf
+            if over.any():
+                g = check[over]
+                rz = np.abs(d.geom_xmat[g].reshape(-1, 3, 3)[:, 2, :])  # |R[z, j]|
+                size = m.geom_size[g]
+                # each geom's lowest point: a box's corners, a capsule's end cap, a sphere
+                low = np.where(is_box[g], (rz * size).sum(axis=1),
+                               np.where(is_capsule[g], rz[:, 2] * size[:, 1] + size[:, 0],
+                                        size[:, 0]))  # fmt: skip
+                clear = float((d.geom_xpos[g, 2] - low).min()) - horse_top
             pitch = _body_pitch(d, chest, ctx.athlete)
             self.log.rows.append((t, s.com.copy(), s.com_vel.copy(), fb, fh, on_b, on_h, on_f,
                                   clear, pitch))  # fmt: skip
@@ -613,8 +620,8 @@ def _com_of(ath: Athlete, q: F64) -> F64:
 
 #: seconds the gymnast must stay up after landing for ``landed``
 LANDED_AFTER = 1.0
-#: physics steps per control tick (2 ms: the board contact lasts about 0.14 s)
-CONTROL_EVERY = 4
+#: physics steps per control tick (4 ms; the board contact lasts about 0.14 s)
+CONTROL_EVERY = 8
 
 
 def vault(
