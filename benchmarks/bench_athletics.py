@@ -157,15 +157,28 @@ def _largest(ok: Any, lo: float, hi: float, step: float) -> float:
     return a
 
 
+def _pool(fn: Any, body: str, dirs: list[float], workers: int) -> list[float]:
+    """``fn(body, direction)`` for each direction, in ``workers`` processes."""
+    if workers <= 1:
+        return [fn(body, d) for d in dirs]
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(workers) as ex:
+        return list(ex.map(fn, [body] * len(dirs), dirs))
+
+
+def _slope_limit(body: str, direction: float) -> float:
+    def ok(deg: float) -> bool:
+        r = run("balance", body, check_range=False, seconds=3.0, slope=math.radians(deg),
+                slope_dir=math.radians(direction))  # fmt: skip
+        return bool(r.report["balanced"])
+
+    return _largest(ok, 0.0, 45.0, 0.5)
+
+
 def _slope_limits(body: str, workers: int) -> dict[str, float]:
     dirs = {"+X": 0.0, "-X": 180.0, "Y": 90.0}
-
-    def limit(d: float) -> float:
-        return _largest(lambda deg: bool(run("balance", body, check_range=False, seconds=3.0,
-                                             slope=math.radians(deg), slope_dir=math.radians(d)
-                                             ).report["balanced"]), 0.0, 45.0, 0.5)  # fmt: skip
-
-    return {k: limit(v) for k, v in dirs.items()}
+    return dict(zip(dirs, _pool(_slope_limit, body, list(dirs.values()), workers)))
 
 
 def _push_limit(body: str, direction: float) -> float:
@@ -233,8 +246,8 @@ def experiments(out: Path | None, workers: int) -> dict[str, Any]:
                              "landed": {float(v): _landed(r) for v, r in zip(vxs, vr)}}  # fmt: skip
         # balance
         dirs = [0, 45, 90, 135, 180, 225, 270, 315]
-        res[f"push_{body}"] = {d: _push_limit(body, d) for d in dirs}
-        res[f"offset_{body}"] = {d: _offset_limit(body, d) for d in dirs}
+        res[f"push_{body}"] = dict(zip(dirs, _pool(_push_limit, body, dirs, workers)))
+        res[f"offset_{body}"] = dict(zip(dirs, _pool(_offset_limit, body, dirs, workers)))
         res[f"slope_{body}"] = _slope_limits(body, workers)
     # backpack (female, no re-tuning): horizontal-velocity landings with 2 and 4 kg
     drop = _drop_for_com("female", 1.25)
@@ -278,12 +291,9 @@ def _polar_plot(res: dict[str, Any], out: Path) -> None:
             ax.set_title(f"{body}: largest {'COM offset' if key == 'offset' else 'push'} ({unit})")
             ax.set_xlabel(f"X ({unit})")
             ax.set_ylabel(f"Y ({unit})")
-    fig.tight_layout()
-    from reactmocap.io import atomic_write
+    from reactmocap.athletics.plots import _save
 
-    with atomic_write(out / "fig7_5_7_7_balance.png", "wb") as fh:
-        fig.savefig(fh, format="png")
-    plt.close(fig)
+    _save(plt, fig, out / "fig7_5_7_7_balance.png")
 
 
 def print_table(res: dict[str, Any]) -> None:

@@ -210,10 +210,24 @@ class BalanceLaw:
             rig.offset[_HIP[k], 0] = 0.5 * delta[0]
             rig.offset[_HIP[k], 1] = -0.5 * delta[1]
         lo, hi = ANKLE_LIMITS
+        desired = rig.desired(t)
         for k in range(2):
-            total = rig.desired(t)[_ANKLE[k], 0] + rig.offset[_ANKLE[k], 0]
+            total = desired[_ANKLE[k], 0] + rig.offset[_ANKLE[k], 0]
             rig.offset[_ANKLE[k], 0] += float(np.clip(total, lo, hi)) - total
+        self._level_legs(d, desired)
         self._support(s)
+
+    def _level_legs(self, d, desired: F64) -> None:  # type: ignore[no-untyped-def]
+        """Leg by leg (eq. 7.5 per leg): the leg whose ankle stands higher (uphill on a
+        sideways slope) is shortened by the height difference, so the pelvis stays level."""
+        a = self.athlete
+        z = d.xanchor[self.ctx.senses.ankle_joints, 2]
+        for k in range(2):
+            knee = float(desired[_KNEE[k], 0])
+            ul, ll = float(a.thigh[k]), float(a.shin[k])
+            length = math.sqrt(ul * ul + ll * ll + 2.0 * ul * ll * math.cos(knee))
+            level = length + 0.5 * float(z[1 - k] - z[k])
+            self.ctx.rig.offset[_KNEE[k], 0] = float(knee_for_length(ul, ll, level)[0]) - knee
 
     def _support(self, s) -> None:  # type: ignore[no-untyped-def]
         """Weight shares of the feet in contact (by where the COM lies between them)."""

@@ -15,10 +15,13 @@ from reactmocap.response.plots import _pyplot
 __all__ = ["commanded_plot", "run_plot", "run_video", "series_plot"]
 
 
-def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
+def _save(plt, fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
+    """Lay the figure out, write it as PNG (atomically) and close it."""
+    fig.tight_layout()
     out = Path(path)
     with atomic_write(out, "wb") as fh:
         fig.savefig(fh, format="png")
+    plt.close(fig)
     return out
 
 
@@ -40,10 +43,7 @@ def run_plot(result, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
             ax.axvline(time, color="0.7", lw=0.8)
         a1.text(time, a1.get_ylim()[1], dst, rotation=90, va="top", fontsize=7)
     a1.set_title(f"{result.behaviour} ({result.body})")
-    fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return _save(plt, fig, path)
 
 
 def commanded_plot(
@@ -70,10 +70,7 @@ def commanded_plot(
         ax.set_xlabel(f"desired {quantity} (m)")
         ax.set_ylabel(f"actual {quantity} (m)")
         ax.legend(fontsize=8)
-    fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return _save(plt, fig, path)
 
 
 def series_plot(
@@ -97,10 +94,7 @@ def series_plot(
     if title:
         ax.set_title(title)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return _save(plt, fig, path)
 
 
 def run_video(result, path: str | Path, fps: float = 30.0) -> tuple[Path, str]:  # type: ignore[no-untyped-def]

@@ -38,6 +38,8 @@ class Senses:
         self.floor = int(m.geom("floor").id)
         self.feet, self.soles, self._corners = foot_soles(world, character, "athletics")
         self._ids = {b: int(i) for b, i in zip(SIM_BODIES, wc.body_ids)}
+        #: joint ids of the ankles (left, right)
+        self.ankle_joints = np.array([m.joint(f"{wc.prefix}{s}_ankle").id for s in "lr"])
         #: body ids of the thighs, shins and feet (left, right each)
         self.leg_bodies = np.array([self._ids[f"{s}_{p}"] for p in ("thigh", "shin", "foot")
                                     for s in "lr"])  # fmt: skip

@@ -121,7 +121,7 @@ def _summary(r: dict[str, Any], out: Path) -> None:
         bits.append(f"push-off peak {r['peak_grf_bw']:.1f} BW")
     if "max_com_offset_m" in r:
         bits.append(f"max COM offset {r['max_com_offset_m']:.3f} m")
-    bits.append(f"{r['realtime_factor']:.1f}x real time")
+    bits.append(f"{r['realtime_factor_cpu']:.1f}x real time ({r['realtime_factor']:.1f}x wall)")
     print(", ".join(bits) + f" -> {out}")
     if r.get("status") != "ok":
         print(f"note: the simulation stopped early: {r.get('reason')}")

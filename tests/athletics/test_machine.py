@@ -38,9 +38,11 @@ def test_events_fire_on_what_they_measure() -> None:
     world = athletics_world(ath)
     ctx = Context.make(world, ath)
     ctx.rig.reset()
-    ctx.sense(0.0)
-    assert touchdown(ctx)(world, 0.0, 0.0)  # standing: the feet touch
-    assert not apex(ctx)(world, 0.0, 0.0) or ctx.senses.com_vel[2] <= 0.0
+    world.step(40)  # settle onto the floor (the pose starts 0.5 mm above it)
+    ctx.sense(0.02)
+    assert touchdown(ctx)(world, 0.02, 0.0)  # standing: the feet touch
+    assert ctx.touchdown_time == 0.02
+    assert apex(ctx)(world, 0.02, 0.0) == (ctx.senses.com_vel[2] <= 0.0)
     knee = float(stand_angles(ath)[10, 0])
     assert angle(ctx, "l_knee", 0, knee - 0.05)(world, 0.0, 0.0)
     assert not angle(ctx, "l_knee", 0, knee + 0.05)(world, 0.0, 0.0)
