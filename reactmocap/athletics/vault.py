@@ -137,6 +137,11 @@ class VaultParams:
         knee_touchdown: knee flexion at board touchdown (rad).
         knee_stiffness: knee and hip stiffness on the board (units of m g L).
         push_stiffness: stiffness of the extension at the board's deepest (units of m g L).
+        push_hip: hip flexion the extension drives to (rad; < 0 brings the trunk forward).
+        arms_push: shoulder pitch the arms swing to during the extension (rad).
+        approach_spin: forward angular velocity of the body at the start (rad/s), estimated
+            like the paper's other initial conditions.
+        arms_flight2: shoulder pitch in the second flight (rad).
         arms_board: shoulder pitch the arms swing to on the board (rad, < 0 forward/up).
         hand_target: where on the horse's top the hands aim, from its centre along the run (m).
         pike: hip flexion held in the first flight (rad).
@@ -161,6 +166,10 @@ class VaultParams:
     knee_touchdown: float = 0.25
     knee_stiffness: float = 4.0
     push_stiffness: float = 8.0
+    push_hip: float = 0.0
+    arms_push: float = -2.6
+    approach_spin: float = 0.0
+    arms_flight2: float = -2.6
     arms_board: float = -2.6
     hand_target: float = 0.0
     pike: float = 0.0
@@ -407,8 +416,10 @@ class Vault(Basis):
                 seen["deepest"] = True
                 stiff(flight | {"hip": p.push_stiffness, "knee": p.push_stiffness,
                                 "ankle": p.push_stiffness})  # fmt: skip
-                goal = {_J[f"{s}_{j}"]: (0.0, 0.0, 0.0) for s in "lr" for j in ("hip", "knee")}
+                goal = {_J[f"{s}_knee"]: (0.0, 0.0, 0.0) for s in "lr"}
+                goal |= {_J[f"{s}_hip"]: (p.push_hip, 0.0, 0.0) for s in "lr"}
                 goal |= {_J[f"{s}_ankle"]: (0.3, 0.0, 0.0) for s in "lr"}
+                goal |= {_J[f"{s}_shoulder"]: (p.arms_push, 0.0, 0.0) for s in "lr"}
                 pose(goal, 0.05, t)
 
         t_in = {"board": 0.0}
@@ -474,7 +485,9 @@ class Vault(Basis):
             goal = {_J[f"{s}_{j}"]: (0.0, (0.08 if s == "l" else -0.08) if j == "hip" else 0.0,
                                      0.0) for s in "lr" for j in ("hip", "knee")}  # fmt: skip
             goal |= {_J[j]: (0.0, 0.0, 0.0) for j in ("waist", "back")}
-            pose(goal, 0.1, t)
+            goal |= {_J[f"{s}_shoulder"]: (p.arms_flight2, 0.0, 0.0) for s in "lr"}
+            goal |= {_J[f"{s}_wrist"]: (0.0, 0.0, 0.0) for s in "lr"}
+            pose(goal, 0.15, t)
 
         def flight2(_w: World, t: float) -> None:
             sense(t)
@@ -606,6 +619,10 @@ def vault_start(ath: Athlete, p: VaultParams) -> tuple[F64, F64]:
     v = np.zeros(6 + 3 * NJ)
     v[0] = p.approach_vx
     v[2] = p.approach_vz
+    # the forward rotation the hurdle step brings (body frame of the free joint)
+    rot = np.empty(9)
+    mujoco.mju_quat2Mat(rot, q[3:7])
+    v[3:6] = rot.reshape(3, 3).T @ np.array([0.0, p.approach_spin, 0.0])
     return q, v
 
 
@@ -746,6 +763,8 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
     )
     pitch = np.unwrap(log["pitch"]) if log["pitch"].size else np.zeros(0)
     rotation = float(np.degrees(pitch[-1] - pitch[0])) if pitch.size else 0.0
+    td_i = int(np.flatnonzero(log["on_floor"].astype(bool))[0]) if log["on_floor"].any() else -1
+    rotation_td = float(np.degrees(pitch[td_i] - pitch[0])) if pitch.size else 0.0
     t = log["t"]
     floor = log["on_floor"].astype(bool)
     td = float(t[np.flatnonzero(floor)[0]]) if floor.any() else None
@@ -771,6 +790,7 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
         "landed": landed,
         "touchdown_s": td,
         "rotation_deg": rotation,
+        "rotation_at_touchdown_deg": rotation_td,
         "board_stiffness_n_m": p.board_stiffness,
         "board_damping_n_s_m": p.board_damping,
         "horse_height_m": HORSE.top,
