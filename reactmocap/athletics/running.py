@@ -170,31 +170,31 @@ class RunParams:
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1825)
-    speed_gain: float | Speeds = (0.1527, 0.0835, 0.08567)
-    speed_integral: float | Speeds = (0.006476, 0, 0.001824)
-    touchdown_leg: float | Speeds = (0.9401, 0.948, 0.9536)
-    speed_matching: float | Speeds = (0.0155, 0.009, 0.03712)
+    speed_gain: float | Speeds = (0.1914, 0.0835, 0.08567)
+    speed_integral: float | Speeds = (0, 0, 0.001824)
+    touchdown_leg: float | Speeds = (0.93, 0.948, 0.9536)
+    speed_matching: float | Speeds = (0, 0.009, 0.03712)
     retract_time: float | Speeds = 0.06
     heel_up: float | Speeds = 0.2
-    step_width: float | Speeds = (0.0676, 0.065, 0.05902)
-    leg_stiffness: float | Speeds = (27.27, 21.6, 21.19)
+    step_width: float | Speeds = (0.06929, 0.065, 0.05902)
+    leg_stiffness: float | Speeds = (32.11, 21.6, 21.19)
     leg_damping: float | Speeds = (0.08527, 0.04, 0.05531)
-    thrust: float | Speeds = (1.353, 1.71, 1.224)
-    takeoff_vz: float | Speeds = (0.5013, 0.517, 0.6449)
+    thrust: float | Speeds = (1.683, 1.71, 1.224)
+    takeoff_vz: float | Speeds = (0.5575, 0.517, 0.6449)
     toe_fraction: float | Speeds = (0.3849, 0.42, 0.3199)
-    pitch: float | Speeds = (0.07481, 0.013, -0.01578)
+    pitch: float | Speeds = (0.1207, 0.013, -0.01578)
     attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
     attitude_kv: tuple[float, float, float] = (14.0, 14.0, 5.42)
     yaw_grip: float | Speeds = 0.181
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
-    idle_knee: float | Speeds = (1.894, 1.813, 1.692)
-    reach_knee: float | Speeds = (1.331, 1.066, 1.102)
-    swing_ready: float | Speeds = (-0.3277, -0.369, -0.407)
-    arm_gain: float | Speeds = (1.273, 1.273, 1.336)
+    idle_knee: float | Speeds = (2.182, 1.813, 1.692)
+    reach_knee: float | Speeds = (1.192, 1.066, 1.102)
+    swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
+    arm_gain: float | Speeds = (0.7815, 1.273, 1.336)
     arm_offset: float | Speeds = 0.05
     elbow: float | Speeds = 1.4
-    smoothing: float | Speeds = (0.01297, 0.0202, 0.0157)
+    smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
             "waist": 4.0, "back": 4.0, "neck": 0.3, "shoulder": 0.4, "elbow": 0.2,
