@@ -405,4 +405,4 @@ def _set_vertices(m: mujoco.MjModel, d: mujoco.MjData, verts: F64) -> None:
         local = rot.T @ (verts[v] - d.xpos[parent]) - m.body_pos[body]
         adr = int(m.jnt_qposadr[jnt])
         d.qpos[adr : adr + 3] = local
-    mujoco.mj_kinematics(m, d)
+    mujoco.mj_fwdPosition(m, d)  # the flex's vertex positions are made here
