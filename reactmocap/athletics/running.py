@@ -165,6 +165,7 @@ class RunParams:
         swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
         arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
         elbow: elbow flexion (rad).
+        turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -194,6 +195,7 @@ class RunParams:
     arm_gain: float | Speeds = (0.7815, 1.273, 1.336)
     arm_offset: float | Speeds = 0.05
     elbow: float | Speeds = 1.4
+    turn_rate: float | Speeds = 0.35
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
@@ -339,6 +341,7 @@ class Runner:
         self.heel = np.zeros(2, dtype=bool)
         self.toe = np.zeros(2, dtype=bool)
         self.heading_d = 0.0
+        self._steered = False
         self.curvature = 0.0
         self.cross_track = math.nan
         self.knee_td = 0.3
@@ -682,7 +685,15 @@ class Runner:
         s = self.senses
         s.update(t)
         self._contacts()
-        self.heading_d, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
+        want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
+        # the facing turns at a limited rate whatever the course asks (an abrupt change of
+        # facing throws the runner down)
+        if self._steered:
+            step = (want - self.heading_d + math.pi) % (2 * math.pi) - math.pi
+            limit = self.k["turn_rate"] * self.control_every * world.timestep
+            self.heading_d += _clamp(step, -limit, limit)
+        else:
+            self.heading_d, self._steered = want, True
         self.machine.control(world, t)
         # the frame the legs are placed and swung in: the desired facing, not the pelvis's
         # (which yaws back and forth with every stride)
