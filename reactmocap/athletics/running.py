@@ -170,18 +170,18 @@ class RunParams:
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
 
-    stance_time: float | Speeds = (0.2299, 0.177, 0.1825)
+    stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
     speed_gain: float | Speeds = (0.1914, 0.0835, 0.08567)
     speed_integral: float | Speeds = (0, 0, 0.001824)
-    touchdown_leg: float | Speeds = (0.93, 0.948, 0.9536)
+    touchdown_leg: float | Speeds = (0.93, 0.948, 0.9475)
     speed_matching: float | Speeds = (0, 0.009, 0.03712)
     retract_time: float | Speeds = 0.06
     heel_up: float | Speeds = 0.2
     step_width: float | Speeds = (0.06929, 0.065, 0.05902)
     leg_stiffness: float | Speeds = (32.11, 21.6, 21.19)
-    leg_damping: float | Speeds = (0.08527, 0.04, 0.05531)
-    thrust: float | Speeds = (1.683, 1.71, 1.224)
-    takeoff_vz: float | Speeds = (0.5575, 0.517, 0.6449)
+    leg_damping: float | Speeds = (0.08527, 0.04, 0.06971)
+    thrust: float | Speeds = (1.683, 1.71, 1.716)
+    takeoff_vz: float | Speeds = (0.5575, 0.517, 0.5806)
     toe_fraction: float | Speeds = (0.3849, 0.42, 0.3199)
     pitch: float | Speeds = (0.1207, 0.013, -0.01578)
     attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
