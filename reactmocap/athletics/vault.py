@@ -142,6 +142,7 @@ class VaultParams:
         approach_spin: forward angular velocity of the body at the start (rad/s), estimated
             like the paper's other initial conditions.
         arms_flight2: shoulder pitch in the second flight (rad).
+        pike2: hip flexion in the second flight (rad; a pike turns the somersault faster).
         arms_board: shoulder pitch the arms swing to on the board (rad, < 0 forward/up).
         hand_target: where on the horse's top the hands aim, from its centre along the run (m).
         pike: hip flexion held in the first flight (rad).
@@ -154,28 +155,29 @@ class VaultParams:
             ground (the paper: "reducing the stiffness of the ground").
     """
 
-    board_stiffness: float = 45000.0
-    board_damping: float = 300.0
+    board_stiffness: float = 36849.0
+    board_damping: float = 242.8
     board_mass: float = 5.0
-    horse_distance: float = 1.75
+    horse_distance: float = 1.621
     approach_vx: float = 6.75
     approach_vz: float = -1.10
     start_clearance: float = 0.02
-    start_x: float = -0.35
-    block: float = -0.35
-    knee_touchdown: float = 0.25
-    knee_stiffness: float = 4.0
-    push_stiffness: float = 8.0
-    push_hip: float = 0.0
-    arms_push: float = -2.6
+    start_x: float = -0.3523
+    block: float = -0.6745
+    knee_touchdown: float = 0.2449
+    knee_stiffness: float = 12.0
+    push_stiffness: float = 20.0
+    push_hip: float = -0.1641
+    arms_push: float = -2.468
     approach_spin: float = 0.0
-    arms_flight2: float = -2.6
-    arms_board: float = -2.6
-    hand_target: float = 0.0
-    pike: float = 0.0
-    flight_stiffness: float = 3.0
+    pike2: float = 0.0
+    arms_flight2: float = -2.388
+    arms_board: float = -2.65
+    hand_target: float = -0.05048
+    pike: float = -0.06506
+    flight_stiffness: float = 4.145
     horse_push: float = 0.0
-    landing_height: float = 1.3
+    landing_height: float = 1.039
     mat_solref: float = 0.03
 
     def __post_init__(self) -> None:
@@ -482,8 +484,8 @@ class Vault(Basis):
         # -------------------------------------------------------------- second flight
         def flight2_enter(_w: World, t: float) -> None:
             stiff(flight)
-            goal = {_J[f"{s}_{j}"]: (0.0, (0.08 if s == "l" else -0.08) if j == "hip" else 0.0,
-                                     0.0) for s in "lr" for j in ("hip", "knee")}  # fmt: skip
+            goal = {_J[f"{s}_hip"]: (-p.pike2, 0.08 if s == "l" else -0.08, 0.0) for s in "lr"}
+            goal |= {_J[f"{s}_knee"]: (0.0, 0.0, 0.0) for s in "lr"}
             goal |= {_J[j]: (0.0, 0.0, 0.0) for j in ("waist", "back")}
             goal |= {_J[f"{s}_shoulder"]: (p.arms_flight2, 0.0, 0.0) for s in "lr"}
             goal |= {_J[f"{s}_wrist"]: (0.0, 0.0, 0.0) for s in "lr"}
