@@ -50,8 +50,10 @@ def test_cloth_options_are_checked() -> None:
     from reactmocap.athletics.scene import athletics_world
 
     world = athletics_world(athlete("male"))
-    with pytest.raises(ConfigError, match=r"valid clothes are \['pants', 'shorts'\]"):
+    with pytest.raises(
+        ConfigError, match=r"valid clothes are \['pants', 'pants-light', 'shorts'\]"
+    ):
         Cloth(world, "kilt")
     with pytest.raises(ConfigError, match="slack"):
         ClothSpec(slack=-1.0)
-    assert set(CLOTHES) == {"pants", "shorts"}
+    assert set(CLOTHES) == {"pants", "pants-light", "shorts"}
