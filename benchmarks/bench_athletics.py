@@ -29,8 +29,6 @@ MEASURED = ROOT / "reactmocap" / "athletics" / "measured.py"
 #: thesis figures (Wooten, ch. 4, 6, 7); Table 4.1 and 4.2 rows as (command, achieved)
 THESIS = {
     "broad_max": {"male": 2.12, "female": 1.57},
-    "broad_table": {"male": ([0.376, 1.155, 2.120], [0.376, 1.155, 2.120]),
-                    "female": ([0.31, 0.69, 1.57], [0.31, 0.69, 1.57])},
     "drop_max": {"male": 1.15, "female": 0.92},
     "slope": {"+X": 33.7, "-X": 38.6, "Y": 25.7},
 }  # fmt: skip
@@ -259,17 +257,24 @@ def experiments(out: Path | None, workers: int) -> dict[str, Any]:
     res["speed"] = {"wall_median": float(np.median([s[0] for s in speeds])),
                     "cpu_median": float(np.median([s[1] for s in speeds]))}  # fmt: skip
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        commanded_plot(panels, out / "fig4_1_vertical_leap.png", quantity="height")
+        plots(res, grf_curves, out)
+    return res
+
+
+def plots(res: dict[str, Any], grf_curves: dict[str, Any] | None, out: Path) -> None:
+    """The thesis-style figures from the experiments' results (``--replot`` redraws them
+    from the JSON, without the ground-force curves)."""
+    out.mkdir(parents=True, exist_ok=True)
+    panels = {b: (res[f"leap_{b}"]["commanded"], res[f"leap_{b}"]["achieved"]) for b in BODIES}
+    commanded_plot(panels, out / "fig4_1_vertical_leap.png", quantity="height")
+    if grf_curves:
         series_plot(grf_curves, out / "fig4_2_ground_force.png", xlabel="time (s)",
                     ylabel="vertical GRF (body weights)", title="Leaps, ground reaction force")  # fmt: skip
-        bpanels = {b: (res[f"broad_{b}"]["commanded"], res[f"broad_{b}"]["achieved"])
-                   for b in BODIES if f"broad_{b}" in res}  # fmt: skip
-        if bpanels:
-            commanded_plot(bpanels, out / "fig4_4_broad_jump.png", quantity="distance",
-                           thesis={b: THESIS["broad_table"][b] for b in bpanels})  # fmt: skip
-        _polar_plot(res, out)
-    return res
+    bpanels = {b: (res[f"broad_{b}"]["commanded"], res[f"broad_{b}"]["achieved"])
+               for b in BODIES if f"broad_{b}" in res}  # fmt: skip
+    if bpanels:
+        commanded_plot(bpanels, out / "fig4_4_broad_jump.png", quantity="distance")
+    _polar_plot(res, out)
 
 
 def _polar_plot(res: dict[str, Any], out: Path) -> None:
@@ -334,9 +339,18 @@ def main() -> int:
     ap.add_argument("--out", type=Path, help="folder for the plots")
     ap.add_argument("--json", type=Path, help="write every figure as JSON")
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--replot", type=Path, help="redraw the plots from a --json file into --out")
     args = ap.parse_args()
     if args.tables:
         build_tables(args.workers, tuple(args.parts.split(",")))
+        return 0
+    if args.replot is not None:
+        res = json.loads(args.replot.read_text())
+        for key in list(res):  # JSON keys of the direction tables are strings
+            if key.startswith(("push_", "offset_")):
+                res[key] = {float(k): v for k, v in res[key].items()}
+        plots(res, None, args.out or args.replot.parent)
+        print_table(res)
         return 0
     res = experiments(args.out, args.workers)
     print_table(res)

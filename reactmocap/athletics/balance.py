@@ -174,7 +174,7 @@ class BalanceLaw:
     def _lean(self) -> float:
         if not self.posture.lean:
             return 0.0
-        knee = float(np.mean(self.ctx.rig.current_angles()[_KNEE, 0]))
+        knee = float(np.mean(self.ctx.rig.knee_flexion()))
         return self.posture.lean * max(0.0, knee - self._knee_standing)
 
     def _pitch_now(self, t: float) -> float:

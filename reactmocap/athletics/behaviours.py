@@ -414,7 +414,8 @@ def _params(b: Behaviour, given: Mapping[str, Any], check_range: bool, body: str
         for name in b.ranged:
             rng = tables.supported_range(b.name, name, body)
             v = out[name]
-            if rng is None or v is None or (name == "height" and out.get("effort") is not None):
+            effort = name in ("height", "distance") and out.get("effort") is not None
+            if rng is None or v is None or effort:
                 continue
             if not rng[0] - 1e-9 <= v <= rng[1] + 1e-9:
                 unit = next(p.unit for p in b.params if p.name == name)

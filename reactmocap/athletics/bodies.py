@@ -333,10 +333,10 @@ _CACHE: dict[str, Athlete] = {}
 
 def athlete(body: str | Path | Motion) -> Athlete:
     """The athlete for ``body``: ``"male"`` or ``"female"`` (the thesis bodies), a BVH file or
-    a Motion of any mapped skeleton (its first frame fixes the body frames; 75 kg, the project's
+    a Motion of any mapped skeleton (built on the skeleton's rest pose; 75 kg, the project's
     mass fractions)."""
     if isinstance(body, Motion):
-        return _athlete(body.name or "clip", build_character(body, map_body_parts(body.skeleton)))
+        return _mocap_athlete(body.name or "clip", body.skeleton)
     key = str(body)
     if key in BODIES:
         if key not in _CACHE:
@@ -352,4 +352,10 @@ def athlete(body: str | Path | Motion) -> Athlete:
     from reactmocap.library.bvh import read_bvh
 
     clip = read_bvh(path)
-    return _athlete(path.stem, build_character(clip, map_body_parts(clip.skeleton)))
+    return _mocap_athlete(path.stem, clip.skeleton)
+
+
+def _mocap_athlete(name: str, skeleton: Skeleton) -> Athlete:
+    """A mocap skeleton's athlete, built on its rest pose (a BVH rest pose stands with the legs
+    straight down and the feet forward; a clip's frames are in a stance of their own)."""
+    return _athlete(name, build_character(skeleton, map_body_parts(skeleton)))

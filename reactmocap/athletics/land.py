@@ -299,7 +299,7 @@ def _hip_heights(ctx: Context) -> np.ndarray:
 def _knee_lever(ctx: Context) -> float:
     """Mean ``d(hip-ankle distance) / d(knee angle)`` of the legs (m/rad), law of cosines."""
     a = ctx.athlete
-    knee = ctx.rig.current_angles()[_KNEE, 0]
+    knee = ctx.rig.knee_flexion()
     ul, ll = a.thigh, a.shin
     length = np.sqrt(ul**2 + ll**2 + 2 * ul * ll * np.cos(knee))
     return float(np.mean(ul * ll * np.abs(np.sin(knee)) / length))

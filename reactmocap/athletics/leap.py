@@ -37,10 +37,6 @@ THRUST_TIMEOUT = 1.0
 STIFFNESS_RAMP = 0.06
 #: seconds over which the angular-momentum feedback comes in at the start of the push
 SPIN_RAMP = 0.05
-#: fraction of the friction cone the push may use
-FRICTION_USE = 0.8
-#: most ground force (body weights) the push asks for
-MAX_THRUST = 6.0
 #: joint stiffness during the push-off (units of m g L N m/rad), before the ankle multiplier
 LEAP_STIFFNESS = {
     "waist": 3.0, "back": 3.0, "neck": 0.3, "shoulder": 0.6, "elbow": 0.15, "wrist": 0.05,
@@ -69,9 +65,6 @@ class LeapParams:
     ankle_extension: float = 0.7
     liftoff_hip: float = 0.0
     broad: bool = False
-    speed: float = 0.0
-    angle: float = math.pi / 2
-    rise: float = 0.06
     stiffness: float = 1.0
     lean: float = 0.0
     spin: float = 0.0
@@ -81,7 +74,7 @@ class LeapParams:
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
                 self.hold, *self.timing, self.ankle_gain, self.ankle_extension, self.liftoff_hip,
-                self.speed, self.angle, self.rise, self.stiffness, self.lean,
+                self.stiffness, self.lean,
                 self.spin, self.spin_gain]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
@@ -89,8 +82,6 @@ class LeapParams:
             raise ConfigError(f"leap crouch leg fraction must be in [0.3, 1.0], got {self.leg}")
         if min(self.timing) <= 0 or self.crouch <= 0 or self.hold < 0 or self.ankle_gain <= 0:
             raise ConfigError("leap timing, crouch and ankle gain must be > 0")
-        if self.speed < 0 or not 0.0 < self.angle <= math.pi / 2:
-            raise ConfigError("leap speed must be >= 0 and angle in (0, pi/2]")
 
 
 def pitch_momentum(world: World, s: Senses) -> float:
@@ -129,7 +120,6 @@ class Leap(Basis):
         def thrust(world: World, t: float) -> None:
             del world
             memo["t_thrust"] = t
-            memo.pop("force", None)
             memo.pop("ramp", None)
             rig = ctx.rig
             stiff = per_joint(LEAP_STIFFNESS) * p.stiffness
@@ -172,26 +162,6 @@ class Leap(Basis):
                 off = float(np.clip(ramp * p.spin_gain * err, -0.6, 0.6))
                 for j in (joint_index("l_hip"), joint_index("r_hip")):
                     ctx.rig.offset[j, 0] = off
-            if p.speed <= 0:
-                return
-            rig = ctx.rig
-            if "force" not in memo:
-                # a constant ground force that brings the COM from rest to the take-off
-                # velocity over the rise left to the take-off height (planned once, at the
-                # start of the push: v^2 = 2 a d), leaning along the take-off direction
-                g = float(np.linalg.norm(world.model.opt.gravity))
-                up = np.array([0.0, 0.0, 1.0])
-                h = s.heading()
-                fwd = np.array([math.cos(h), math.sin(h), 0.0])
-                rise = max(memo["z_stand"] + p.rise - float(s.com[2]), 0.05)
-                vz = p.speed * math.sin(p.angle)
-                duration = 2.0 * rise / max(vz, 1e-3)
-                acc = (p.speed * math.cos(p.angle) * fwd + vz * up) / duration
-                force = acc + g * up
-                memo["force"] = float(np.linalg.norm(force)) / g
-                memo["dir"] = force / np.linalg.norm(force)  # type: ignore[assignment]
-            rig.support_scale = min(memo["force"], MAX_THRUST)
-            rig.support_dir = memo["dir"]  # type: ignore[assignment]
 
         def flight(world: World, t: float) -> None:
             s = ctx.sense(t)

@@ -27,6 +27,7 @@ __all__ = [
     "after",
     "angle",
     "apex",
+    "law",
     "liftoff",
     "touchdown",
 ]
@@ -161,11 +162,6 @@ def angle(ctx: Context, joint: str, axis: int, threshold: float, above: bool = T
     return event
 
 
-def timeout(seconds: float) -> Event:
-    """Fires once the state has lasted ``seconds`` (the engine's ``after``)."""
-    return after(seconds)
-
-
 # ---------------------------------------------------------------------------------- basis
 class Basis:
     """A basis controller: a named group of states on a shared :class:`Context`. States exit to
@@ -182,10 +178,3 @@ class Basis:
 def law(fn: Callable[[World, float], None], control_every: int) -> FunctionController:
     """A state's per-tick law from a function."""
     return FunctionController(fn, control_every)
-
-
-def hold(ctx: Context) -> None:
-    """Entry action: keep every target where it is now (stops any transition)."""
-    rig = ctx.rig
-    t = ctx.senses.time
-    rig.move(rig.desired(t), 0.0, t)

@@ -59,9 +59,14 @@ def commanded_plot(
     fig, axes = plt.subplots(len(panels), 1, figsize=(5, 4 * len(panels)), dpi=100)
     axes = np.atleast_1d(axes)
     for ax, (name, (cmd, got)) in zip(axes, panels.items()):
-        hi = max(max(cmd, default=1.0), max(got, default=1.0)) * 1.1
+        hi = max(cmd, default=1.0) * 1.25
         ax.plot([0, hi], [0, hi], "k--", lw=1, label="perfect")
-        ax.plot(cmd, got, "o-", color="C0", label="ours")
+        shown = np.minimum(np.asarray(got, dtype=float), hi)
+        ax.plot(cmd, shown, "o-", color="C0", label="ours")
+        for c, g in zip(cmd, got):
+            if g > hi:  # off the chart: drawn at its top edge, labelled with its value
+                ax.annotate(f"{g:.2f}", (c, hi), textcoords="offset points", xytext=(4, -10),
+                            fontsize=7)  # fmt: skip
         if thesis and name in thesis:
             ax.plot(*thesis[name], "x", color="C3", label="thesis")
         ax.set_xlim(0, hi)

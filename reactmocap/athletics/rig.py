@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.world import World
 
@@ -126,6 +127,10 @@ class Rig:
         #: direction (world, unit) of that ground force; None: against gravity
         self.support_dir: F64 | None = None
         self._ankles = [self._balls[joint_index(f"{s}_ankle")] for s in "lr"]
+        self._knees = [joint_index(f"{s}_knee") for s in "lr"]
+        self._knee_qpos = np.concatenate(
+            [wc.ball_qpos_start + 4 * k + np.arange(4) for k in self._knees]
+        )
         self.gravity_compensation = True
 
     # ------------------------------------------------------------------ setup
@@ -153,6 +158,15 @@ class Rig:
         """``(15, 3)`` anatomical angles of the character's current pose."""
         q = self.world.data.qpos[self.wc.ball_qpos_start : self.wc.ball_qpos_start + 4 * NJ]
         return self.athlete.joint_angles(q.reshape(NJ, 4))
+
+    def knee_flexion(self) -> F64:
+        """``(2,)`` current knee flexion (rad; left, right): the pitch part of each knee's
+        anatomical rotation vector (a knee turns almost only about its pitch axis). Cheaper
+        than :meth:`current_angles`, for the per-tick laws."""
+        q = self.world.data.qpos[self._knee_qpos].reshape(2, 4)
+        a = self.athlete
+        r = quat_mul(quat_conj(a._left[self._knees]), quat_mul(q, quat_conj(a._right[self._knees])))
+        return quat_log(r)[:, 1]
 
     def set_stiffness(self, values: F64) -> None:
         """Per-joint stiffness ``(15,)`` in units of ``m g L`` (N m/rad); 0 switches a joint's
