@@ -166,6 +166,7 @@ class RunParams:
         arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
         elbow: elbow flexion (rad).
         turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
+        lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -196,6 +197,7 @@ class RunParams:
     arm_offset: float | Speeds = 0.05
     elbow: float | Speeds = 1.4
     turn_rate: float | Speeds = 0.35
+    lean: float | Speeds = 1.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
@@ -497,7 +499,7 @@ class Runner:
         """World torque on the trunk that servos its attitude toward the desired roll (a
         lean into the curve), pitch (slightly forward) and yaw (the desired facing)."""
         k = self.k
-        lean = math.atan(self.speed**2 * self.curvature / self.g)
+        lean = k["lean"] * math.atan(self.speed**2 * self.curvature / self.g)
         want = _qmul(_qyaw(self.heading_d), _quat_yxz(k["pitch"], -lean, 0.0))
         # the chest's attitude and rate: the pelvis alone is light and sits between two
         # servoed joints, and damping its rate explicitly at the control rate rings
