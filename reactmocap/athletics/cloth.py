@@ -10,7 +10,6 @@ Why a model of its own: ``docs/athletics.md``."""
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 
 import mujoco
@@ -361,20 +360,14 @@ def render_cloth_video(cloth: Cloth, path: str | Path, size: tuple[int, int] = (
     geoms, the cloth as its flex). Raises :class:`~reactmocap.response.render.RenderUnavailable`
     where no GL context exists."""
     from reactmocap.response.plots import write_video
-    from reactmocap.response.render import RenderUnavailable
+    from reactmocap.response.render import offscreen_renderer
 
     if cloth.model is None or not cloth.frames:
         raise ReactMocapError("the cloth has no recorded frames (run it first)")
     m = cloth.model
     d = mujoco.MjData(m)
     width, height = size
-    try:
-        renderer = mujoco.Renderer(m, height=height, width=width)
-    except Exception as exc:  # each GL backend fails in its own way
-        raise RenderUnavailable(
-            f"MuJoCo offscreen rendering unavailable (MUJOCO_GL="
-            f"{os.environ.get('MUJOCO_GL', 'unset')!r}): {exc}"
-        ) from exc
+    renderer = offscreen_renderer(m, size)
     cam = mujoco.MjvCamera()
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
     cam.distance, cam.elevation, cam.azimuth = 3.2, -12.0, 120.0

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from reactmocap.athletics.behaviours import _clean
 from reactmocap.athletics.bodies import athlete as make_athlete
 from reactmocap.athletics.course import Course, Facing, Polyline, parse_course
 from reactmocap.athletics.report import FALL_HEIGHT
@@ -63,20 +64,6 @@ class RunResult:
 
     def report_json(self) -> str:
         return json.dumps(_clean(self.report), indent=2) + "\n"
-
-
-def _clean(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_clean(v) for v in value]
-    if isinstance(value, (float, np.floating)):
-        return None if not math.isfinite(float(value)) else round(float(value), 4)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    return value
 
 
 def run_course(

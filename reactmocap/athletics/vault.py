@@ -556,7 +556,7 @@ class VaultResult:
     params: VaultParams
 
     def report_json(self) -> str:
-        from reactmocap.athletics.run_course import _clean
+        from reactmocap.athletics.behaviours import _clean
 
         return json.dumps(_clean(self.report), indent=2) + "\n"
 
@@ -569,10 +569,9 @@ def render_world_video(res: RolloutResult, path: str | Path, fps: float = 30.0,
                        size: tuple[int, int] = (512, 384)) -> Path:  # fmt: skip
     """A rollout's recorded states rendered in its own world (its apparatus included), the
     camera following character 0 from the side. Raises RenderUnavailable without GL."""
-    import os
 
     from reactmocap.response.plots import write_video
-    from reactmocap.response.render import RenderUnavailable
+    from reactmocap.response.render import offscreen_renderer
 
     world = res.world
     m = world.model
@@ -581,13 +580,7 @@ def render_world_video(res: RolloutResult, path: str | Path, fps: float = 30.0,
     step = max(1, round(res.fps[0] / fps))
     qpos = qpos[::step]
     width, height = size
-    try:
-        renderer = mujoco.Renderer(m, height=height, width=width)
-    except Exception as exc:  # each GL backend fails in its own way
-        raise RenderUnavailable(
-            f"MuJoCo offscreen rendering unavailable (MUJOCO_GL="
-            f"{os.environ.get('MUJOCO_GL', 'unset')!r}): {exc}"
-        ) from exc
+    renderer = offscreen_renderer(m, size)
     cam = mujoco.MjvCamera()
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
     cam.distance, cam.elevation, cam.azimuth = 5.0, -10.0, 90.0
@@ -815,7 +808,7 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
 
 def vault_plot(result: VaultResult, path: str | Path) -> Path:
     """COM path with the apparatus, and Table 1: ours against the human range and mean."""
-    from reactmocap.io import atomic_write
+    from reactmocap.athletics.running_plots import _save
     from reactmocap.response.plots import _pyplot
 
     plt = _pyplot()
@@ -849,8 +842,6 @@ def vault_plot(result: VaultResult, path: str | Path) -> Path:
     a2.invert_yaxis()
     a2.set_title(f"Table 1: {result.report['table1_inside']}/16 rows inside the human range")
     fig.tight_layout()
-    out = Path(path)
-    with atomic_write(out, "wb") as fh:
-        fig.savefig(fh, format="png")
+    out = _save(fig, path)
     plt.close(fig)
     return out
