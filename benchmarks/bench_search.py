@@ -27,7 +27,14 @@ sys.path.insert(0, str(REPO))
 
 from reactmocap.library.motion import Motion  # noqa: E402
 from reactmocap.rotations import quat_exp, quat_mul  # noqa: E402
-from reactmocap.search import MotionIndex, SearchWeights, WindowConfig, brute_force  # noqa: E402
+from reactmocap.search import (  # noqa: E402
+    MotionIndex,
+    SearchWeights,
+    WindowConfig,
+    brute_force,
+    prepare_query,
+    search_window,
+)
 
 SHARED = REPO.parent / "shared" / "mocap"
 
@@ -145,15 +152,18 @@ def run_size(
     gc.collect()
     # warm-up
     index.query(queries[0][2], 0, k=args.k, refine=args.refine)
-    q_ms, prep_ms, search_ms, cpu_ms = [], [], [], []
+    q_ms, prep_ms, search_ms, cpu_ms, refined, exact_d = [], [], [], [], [], []
     found = []
     for _, _, seg in queries:
         c0 = time.process_time()
         t0 = time.perf_counter()
-        qw = index.prepare_query(seg, 0)
+        qw = prepare_query(index, seg, 0)
         t1 = time.perf_counter()
-        r = index.search_window(qw, k=args.k, refine=args.refine, exact=args.exact)[0]
+        res, stats = search_window(index, qw, k=args.k, refine=args.refine, exact=args.exact)
         t2 = time.perf_counter()
+        r = res[0]
+        refined.append(stats.refined_windows)
+        exact_d.append(stats.exact_windows)
         cpu_ms.append((time.process_time() - c0) * 1e3)
         q_ms.append((t2 - t0) * 1e3)
         prep_ms.append((t1 - t0) * 1e3)
@@ -180,6 +190,8 @@ def run_size(
         "prepare_median_ms": pct(prep_ms, 50),
         "search_median_ms": pct(search_ms, 50),
         "search_p95_ms": pct(search_ms, 95),
+        "refined_median": pct(refined, 50),
+        "exact_median": pct(exact_d, 50),
         "recall_at_1": float(np.mean(exact)),
         "d_ratio_p95": pct(ratios, 95),
         "d_ratio_max": float(np.max(ratios)),
@@ -284,7 +296,8 @@ def main() -> None:
         print(f"  features         median {r['prepare_median_ms']:.2f} ms")
         print(
             f"  search+refine    median {r['search_median_ms']:.2f} ms, "
-            f"p95 {r['search_p95_ms']:.2f} ms"
+            f"p95 {r['search_p95_ms']:.2f} ms; "
+            f"median {r['refined_median']:.0f} refinement windows, exact D on {r['exact_median']:.0f}"
         )
         print(
             f"brute force        median {r['brute_median_ms']:.1f} ms  "

@@ -251,7 +251,7 @@ def bench_guard(kp: float, assist_gain: float) -> None:
         ).report  # fmt: skip
         label = f"root assist kp={assist:g}" if assist else controller
         print(
-            f"\n## guard 10 s ({label}): fell={rep.fell} (at {rep.fall_time}), "
+            f"\n## guard 10 s ({label}): fell={rep.fell} (at {rep.fell_at_s}), "
             f"mean joint err {rep.mean_joint_error_rad:.3f} rad, root err "
             f"{100 * rep.root_error_m:.1f} cm, RT factor {rep.realtime_factor:.2f}x"
         )

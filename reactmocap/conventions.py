@@ -5,7 +5,10 @@
 * Quaternions are ``(w, x, y, z)`` like MuJoCo. scipy uses ``(x, y, z, w)``: convert with
   :func:`reactmocap.rotations.rotation_from_wxyz` / :func:`reactmocap.rotations.wxyz_from_rotation`.
 * Arrays: a motion is ``(T, J, 4)`` local rotations and ``(T, 3)`` root positions.
-* Facing: a character's heading is the yaw of its root's forward axis around +Z.
+* Facing: a character's heading is the twist about +Z (radians from +X, counter-clockwise) of its
+  anatomical body frame, fixed to the pelvis: up = pelvis to chest, left = right to left thigh
+  joint, forward = left x up (:func:`reactmocap.library.placement.heading`; the search uses the
+  same). Unlike a projected forward axis it stays defined when the character lies down.
 """
 
 from __future__ import annotations

@@ -1,9 +1,13 @@
-"""Quaternion helpers in the glossary's ``(w, x, y, z)`` order, broadcasting over any leading
-shape. scipy's Rotation is used for Euler angles and conversions; the few products below are
-written by hand because Rotation only stacks 1-D and allocates objects, and these run on
-``(T, J, 4)`` arrays in feature extraction, FK and blending."""
+"""Quaternion helpers in the glossary's ``(w, x, y, z)`` order, for unit quaternions, broadcasting
+over any leading shape. float32 input gives float32 output (the search keeps its features in
+float32); anything else is computed in float64. Products and conversions are plain numpy because
+scipy's Rotation only stacks 1-D, allocates objects and works in float64; scipy does the Euler
+angles."""
 
 from __future__ import annotations
+
+import warnings
+from typing import Any, TypeVar, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -16,12 +20,12 @@ __all__ = [
     "quat_exp",
     "quat_from_matrix",
     "quat_from_euler",
-    "quat_identity",
     "quat_log",
     "quat_mul",
     "quat_normalize",
     "quat_rotate",
     "quat_slerp",
+    "quat_slerp_path",
     "quat_to_euler",
     "quat_to_matrix",
     "quat_yaw",
@@ -31,6 +35,25 @@ __all__ = [
 ]
 
 F64 = NDArray[np.float64]
+Floats = NDArray[np.floating[Any]]
+#: the dtypes kept as they are (overloads: float32 or float64 in, the same out)
+_F = TypeVar("_F", np.float32, np.float64)
+
+
+def _floats(a: ArrayLike, copy: bool = False) -> Floats:
+    """``a`` as float32 when it is float32, else as float64 (a copy when ``copy``)."""
+    arr = np.asarray(a)
+    if arr.dtype != np.float32:
+        arr = arr.astype(np.float64, copy=False)
+    return arr.copy() if copy else arr
+
+
+def _common(*arrays: ArrayLike) -> tuple[Floats, ...]:
+    """The arrays in one dtype: float32 only when all of them are float32."""
+    out = tuple(_floats(a) for a in arrays)
+    if any(a.dtype != np.float32 for a in out):
+        out = tuple(a.astype(np.float64, copy=False) for a in out)
+    return out
 
 
 def rotation_from_wxyz(q: ArrayLike) -> Rotation:
@@ -44,35 +67,44 @@ def wxyz_from_rotation(r: Rotation) -> F64:
     return np.asarray(r.as_quat(scalar_first=True), dtype=np.float64).reshape(-1, 4)
 
 
-def quat_identity(shape: tuple[int, ...] = ()) -> F64:
-    q = np.zeros((*shape, 4))
-    q[..., 0] = 1.0
-    return q
-
-
-def quat_normalize(q: ArrayLike) -> F64:
-    arr = np.asarray(q, dtype=np.float64)
+@overload
+def quat_normalize(q: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_normalize(q: ArrayLike) -> F64: ...
+def quat_normalize(q: ArrayLike) -> Floats:
+    arr = _floats(q)
     return arr / np.linalg.norm(arr, axis=-1, keepdims=True)
 
 
-def quat_canonical(q: ArrayLike) -> F64:
+@overload
+def quat_canonical(q: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_canonical(q: ArrayLike) -> F64: ...
+def quat_canonical(q: ArrayLike) -> Floats:
     """Same rotation with ``w >= 0``."""
-    arr = np.array(q, dtype=np.float64)
+    arr = _floats(q)
     return np.where(arr[..., :1] < 0.0, -arr, arr)
 
 
-def quat_conj(q: ArrayLike) -> F64:
-    arr = np.array(q, dtype=np.float64)
+@overload
+def quat_conj(q: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_conj(q: ArrayLike) -> F64: ...
+def quat_conj(q: ArrayLike) -> Floats:
+    arr = _floats(q, copy=True)
     arr[..., 1:] *= -1.0
     return arr
 
 
-def quat_mul(a: ArrayLike, b: ArrayLike) -> F64:
+@overload
+def quat_mul(a: NDArray[_F], b: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_mul(a: ArrayLike, b: ArrayLike) -> F64: ...
+def quat_mul(a: ArrayLike, b: ArrayLike) -> Floats:
     """Hamilton product ``a * b`` (apply ``b`` first, then ``a``)."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
-    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
+    qa, qb = _common(a, b)
+    aw, ax, ay, az = qa[..., 0], qa[..., 1], qa[..., 2], qa[..., 3]
+    bw, bx, by, bz = qb[..., 0], qb[..., 1], qb[..., 2], qb[..., 3]
     return np.stack(
         [
             aw * bw - ax * bx - ay * by - az * bz,
@@ -84,100 +116,196 @@ def quat_mul(a: ArrayLike, b: ArrayLike) -> F64:
     )
 
 
-def quat_rotate(q: ArrayLike, v: ArrayLike) -> F64:
+@overload
+def quat_rotate(q: NDArray[_F], v: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_rotate(q: ArrayLike, v: ArrayLike) -> F64: ...
+def quat_rotate(q: ArrayLike, v: ArrayLike) -> Floats:
     """Rotate vectors ``v (..., 3)`` by unit quaternions ``q (..., 4)``."""
-    q = np.asarray(q, dtype=np.float64)
-    v = np.asarray(v, dtype=np.float64)
-    w = q[..., :1]
-    u = q[..., 1:]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    qq, vv = _common(q, v)
+    # v + w t + u x t with t = 2 u x v, by components: np.cross's axis handling costs 3x more
+    # on the small arrays of forward kinematics (its hot path)
+    w, x, y, z = qq[..., 0], qq[..., 1], qq[..., 2], qq[..., 3]
+    vx, vy, vz = vv[..., 0], vv[..., 1], vv[..., 2]
+    tx, ty, tz = 2.0 * (y * vz - z * vy), 2.0 * (z * vx - x * vz), 2.0 * (x * vy - y * vx)
+    return np.stack(
+        [
+            vx + w * tx + (y * tz - z * ty),
+            vy + w * ty + (z * tx - x * tz),
+            vz + w * tz + (x * ty - y * tx),
+        ],
+        axis=-1,
+    )
 
 
-def quat_log(q: ArrayLike) -> F64:
+@overload
+def quat_log(q: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_log(q: ArrayLike) -> F64: ...
+def quat_log(q: ArrayLike) -> Floats:
     """Rotation vector (axis * angle, radians) of unit quaternions; sign-safe (angle <= pi)."""
-    q = quat_canonical(q)
-    v = q[..., 1:]
+    qc = quat_canonical(_floats(q))
+    v = qc[..., 1:]
     s = np.linalg.norm(v, axis=-1, keepdims=True)
-    angle = 2.0 * np.arctan2(s, q[..., :1])
+    angle = 2.0 * np.arctan2(s, qc[..., :1])
     # angle/s -> 2 as s -> 0 (first-order Taylor term)
     scale = np.where(s > 1e-12, angle / np.maximum(s, 1e-12), 2.0)
     return v * scale
 
 
-def quat_exp(r: ArrayLike) -> F64:
+@overload
+def quat_exp(r: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_exp(r: ArrayLike) -> F64: ...
+def quat_exp(r: ArrayLike) -> Floats:
     """Unit quaternion of a rotation vector."""
-    r = np.asarray(r, dtype=np.float64)
-    angle = np.linalg.norm(r, axis=-1, keepdims=True)
+    rv = _floats(r)
+    angle = np.linalg.norm(rv, axis=-1, keepdims=True)
     half = 0.5 * angle
     k = np.where(angle > 1e-12, np.sin(half) / np.maximum(angle, 1e-12), 0.5)
-    return np.concatenate([np.cos(half), r * k], axis=-1)
+    return np.concatenate([np.cos(half), rv * k], axis=-1)
 
 
-def quat_slerp(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F64:
+@overload
+def quat_slerp(a: NDArray[_F], b: NDArray[_F], t: ArrayLike) -> NDArray[_F]: ...
+@overload
+def quat_slerp(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F64: ...
+def quat_slerp(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> Floats:
     """Spherical interpolation along the short arc; ``t`` broadcasts against ``(...,)``."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    t = np.asarray(t, dtype=np.float64)[..., None]
-    dot = np.sum(a * b, axis=-1, keepdims=True)
-    b = np.where(dot < 0.0, -b, b)
-    dot = np.abs(dot)
-    rel = quat_mul(quat_conj(a), b)
-    return quat_normalize(quat_mul(a, quat_exp(quat_log(rel) * t)))
+    qa, qb = _common(a, b)
+    tt = np.asarray(t, dtype=qa.dtype)[..., None]
+    dot = np.sum(qa * qb, axis=-1, keepdims=True)
+    qb = np.where(dot < 0.0, -qb, qb)
+    rel = quat_mul(quat_conj(qa), qb)
+    return quat_normalize(quat_mul(qa, quat_exp(quat_log(rel) * tt)))
 
 
-def quat_continuous(q: ArrayLike, axis: int = 0) -> F64:
+@overload
+def quat_continuous(q: NDArray[_F], axis: int = 0) -> NDArray[_F]: ...
+@overload
+def quat_continuous(q: ArrayLike, axis: int = 0) -> F64: ...
+def quat_continuous(q: ArrayLike, axis: int = 0) -> Floats:
     """Flip signs along ``axis`` so consecutive quaternions lie in the same hemisphere."""
-    arr = np.array(q, dtype=np.float64)
-    arr = np.moveaxis(arr, axis, 0)
+    arr = np.moveaxis(_floats(q, copy=True), axis, 0)
     if arr.shape[0] > 1:
         dots = np.sum(arr[1:] * arr[:-1], axis=-1)
         flips = np.cumsum(dots < 0.0, axis=0) % 2
         sign = np.concatenate([np.ones_like(flips[:1]), 1 - 2 * flips], axis=0)
-        arr = arr * sign[..., None]
+        arr = arr * sign[..., None].astype(arr.dtype)
     return np.moveaxis(arr, 0, axis)
+
+
+def quat_slerp_path(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F64:
+    """Slerp of two frame sequences ``(T, ..., 4)`` with weights ``t`` broadcasting against
+    ``(T, ...)``, along one arc per sequence: the first frame's short arc, followed over the
+    frames. Frame-wise short-arc slerp jumps to the other side when the turn between the two
+    passes half a turn (a spin); this follows it continuously and still ends exactly on ``b``
+    where ``t`` is 1."""
+    qa, qb = _common(a, b)
+    rel = quat_continuous(quat_mul(quat_conj(qa), qb), axis=0)
+    rel = rel * np.where(rel[:1, ..., :1] < 0.0, -1.0, 1.0)  # the first frame's short arc
+    v = rel[..., 1:]
+    s = np.linalg.norm(v, axis=-1, keepdims=True)
+    half = np.arctan2(s, rel[..., :1]) * np.asarray(t, dtype=np.float64)[..., None]
+    axis = np.where(s > 1e-12, v / np.maximum(s, 1e-12), 0.0)
+    step = np.concatenate([np.cos(half), axis * np.sin(half)], axis=-1)
+    return np.asarray(quat_normalize(quat_mul(qa, step)), dtype=np.float64)
 
 
 def quat_from_euler(angles_rad: ArrayLike, order: str) -> F64:
     """Quaternions from intrinsic Euler angles ``(..., 3)``; ``order`` like ``"ZXY"`` means
-    ``R = Rz @ Rx @ Ry`` (the BVH channel order)."""
+    ``R = Rz @ Rx @ Ry`` (the BVH channel order). Always float64 (scipy)."""
     a = np.asarray(angles_rad, dtype=np.float64)
     r = Rotation.from_euler(order.upper(), a.reshape(-1, 3))
     return wxyz_from_rotation(r).reshape(*a.shape[:-1], 4)
 
 
 def quat_to_euler(q: ArrayLike, order: str) -> F64:
-    """Intrinsic Euler angles (radians) in ``order``; inverse of :func:`quat_from_euler`."""
+    """Intrinsic Euler angles (radians) in ``order``; inverse of :func:`quat_from_euler`.
+    Always float64 (scipy)."""
     arr = np.asarray(q, dtype=np.float64)
-    import warnings
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # gimbal lock: still a valid decomposition
         e = rotation_from_wxyz(arr).as_euler(order.upper())
     return np.asarray(e).reshape(*arr.shape[:-1], 3)
 
 
-def quat_to_matrix(q: ArrayLike) -> F64:
-    arr = np.asarray(q, dtype=np.float64)
-    return rotation_from_wxyz(arr).as_matrix().reshape(*arr.shape[:-1], 3, 3)
+@overload
+def quat_to_matrix(q: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_to_matrix(q: ArrayLike) -> F64: ...
+def quat_to_matrix(q: ArrayLike) -> Floats:
+    """``(..., 3, 3)`` rotation matrices of unit quaternions (not normalised here)."""
+    arr = _floats(q)
+    w, x, y, z = arr[..., 0], arr[..., 1], arr[..., 2], arr[..., 3]
+    xx, yy, zz = x * x, y * y, z * z
+    xy, xz, yz = x * y, x * z, y * z
+    wx, wy, wz = w * x, w * y, w * z
+    m = np.empty((*arr.shape[:-1], 3, 3), dtype=arr.dtype)
+    m[..., 0, 0] = 1 - 2 * (yy + zz)
+    m[..., 0, 1] = 2 * (xy - wz)
+    m[..., 0, 2] = 2 * (xz + wy)
+    m[..., 1, 0] = 2 * (xy + wz)
+    m[..., 1, 1] = 1 - 2 * (xx + zz)
+    m[..., 1, 2] = 2 * (yz - wx)
+    m[..., 2, 0] = 2 * (xz - wy)
+    m[..., 2, 1] = 2 * (yz + wx)
+    m[..., 2, 2] = 1 - 2 * (xx + yy)
+    return m
 
 
-def quat_from_matrix(m: ArrayLike) -> F64:
-    arr = np.asarray(m, dtype=np.float64)
-    r = Rotation.from_matrix(arr.reshape(-1, 3, 3))
-    return wxyz_from_rotation(r).reshape(*arr.shape[:-2], 4)
+@overload
+def quat_from_matrix(m: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_from_matrix(m: ArrayLike) -> F64: ...
+def quat_from_matrix(m: ArrayLike) -> Floats:
+    """Unit quaternions (``w >= 0``) of rotation matrices ``(..., 3, 3)`` (Shepperd's method:
+    the largest of the four candidate components sets the others, so no cancellation)."""
+    a = _floats(m)
+    m00, m11, m22 = a[..., 0, 0], a[..., 1, 1], a[..., 2, 2]
+    tr = m00 + m11 + m22
+    s21, d21 = a[..., 2, 1] + a[..., 1, 2], a[..., 2, 1] - a[..., 1, 2]
+    s02, d02 = a[..., 0, 2] + a[..., 2, 0], a[..., 0, 2] - a[..., 2, 0]
+    s10, d10 = a[..., 1, 0] + a[..., 0, 1], a[..., 1, 0] - a[..., 0, 1]
+    # row c: the quaternion scaled by 4 q_c, computed from the diagonal entry of component c
+    cands = np.empty((*a.shape[:-2], 4, 4), dtype=a.dtype)
+    rows = (
+        (1 + tr, d21, d02, d10),
+        (d21, 1 + m00 - m11 - m22, s10, s02),
+        (d02, s10, 1 - m00 + m11 - m22, s21),
+        (d10, s02, s21, 1 - m00 - m11 + m22),
+    )
+    for c, row in enumerate(rows):
+        for k, value in enumerate(row):
+            cands[..., c, k] = value
+    choice = np.argmax(np.stack([tr, m00, m11, m22], -1), axis=-1)
+    q = np.take_along_axis(cands, choice[..., None, None], axis=-2)[..., 0, :]
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return np.where(q[..., :1] < 0, -q, q)
 
 
-def quat_yaw(q: ArrayLike, forward: ArrayLike = (1.0, 0.0, 0.0)) -> F64:
-    """Heading (radians about +Z) of the body axis ``forward`` rotated by ``q``."""
-    f = quat_rotate(q, np.broadcast_to(np.asarray(forward, float), np.shape(q)[:-1] + (3,)))
-    return np.arctan2(f[..., 1], f[..., 0])
+@overload
+def quat_yaw(q: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_yaw(q: ArrayLike) -> F64: ...
+def quat_yaw(q: ArrayLike) -> Floats:
+    """Twist angle about world +Z (radians, in ``[-pi, pi)``) of ``q = twist_z * swing``, the
+    swing about a horizontal axis. Inverse of :func:`quat_from_yaw`; unlike the projection of a
+    body axis onto the ground it stays defined when that axis is vertical (singular only for a
+    half turn about a horizontal axis)."""
+    arr = _floats(q)
+    yaw = 2.0 * np.arctan2(arr[..., 3], arr[..., 0])
+    return (yaw + np.pi) % (2 * np.pi) - np.pi
 
 
-def quat_from_yaw(yaw: ArrayLike) -> F64:
+@overload
+def quat_from_yaw(yaw: NDArray[_F]) -> NDArray[_F]: ...
+@overload
+def quat_from_yaw(yaw: ArrayLike) -> F64: ...
+def quat_from_yaw(yaw: ArrayLike) -> Floats:
     """Rotation about +Z by ``yaw`` radians."""
-    y = np.asarray(yaw, dtype=np.float64)
-    q = np.zeros((*y.shape, 4))
+    y = _floats(yaw)
+    q = np.zeros((*y.shape, 4), dtype=y.dtype)
     q[..., 0] = np.cos(0.5 * y)
     q[..., 3] = np.sin(0.5 * y)
     return q

@@ -1,8 +1,9 @@
-"""Property tests for the wxyz quaternion helpers against scipy."""
+"""Property tests for the wxyz quaternion helpers against scipy, and their float32 path."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
@@ -14,12 +15,15 @@ from reactmocap.rotations import (
     quat_continuous,
     quat_exp,
     quat_from_euler,
+    quat_from_matrix,
     quat_from_yaw,
     quat_log,
     quat_mul,
+    quat_normalize,
     quat_rotate,
     quat_slerp,
     quat_to_euler,
+    quat_to_matrix,
     quat_yaw,
     rotation_from_wxyz,
     wxyz_from_rotation,
@@ -97,6 +101,92 @@ def test_continuous_and_canonical(seq: np.ndarray) -> None:
     assert np.all(quat_canonical(seq)[:, 0] >= 0)
 
 
-@given(st.floats(-3.0, 3.0))
-def test_yaw_round_trip(yaw: float) -> None:
+@given(quats)
+def test_matrix_round_trip_matches_scipy(q: np.ndarray) -> None:
+    m = quat_to_matrix(q)
+    np.testing.assert_allclose(m, rotation_from_wxyz(q).as_matrix()[0], atol=1e-12)
+    back = quat_from_matrix(m)
+    assert back[0] >= 0.0 and same_rotation(back, q, tol=1e-12)
+
+
+@given(st.floats(-3.0, 3.0), quats)
+def test_yaw_is_the_twist_about_z(yaw: float, q: np.ndarray) -> None:
     assert abs(quat_yaw(quat_from_yaw(yaw)) - yaw) < 1e-9
+    assert abs(quat_yaw(-quat_from_yaw(yaw)) - yaw) < 1e-9  # sign-safe
+    # a swing about any horizontal axis does not change it, whichever side it is applied on
+    axis = np.array([q[1], q[2], 0.0])
+    if np.linalg.norm(axis) > 0.1 and abs(yaw) < 3.0:
+        swing = quat_exp(0.6 * axis / np.linalg.norm(axis))
+        for turned in (quat_mul(quat_from_yaw(yaw), swing), quat_mul(swing, quat_from_yaw(yaw))):
+            assert abs(quat_yaw(turned) - yaw) < 1e-9
+
+
+def test_yaw_stays_defined_with_the_body_axis_vertical() -> None:
+    # facing +Y, then pitched 90 degrees nose down: forward points at the floor, the twist is +90
+    pitched = quat_mul(quat_from_yaw(np.pi / 2), quat_exp(np.array([0.0, np.pi / 2, 0.0])))
+    np.testing.assert_allclose(quat_rotate(pitched, [1.0, 0.0, 0.0]), [0, 0, -1], atol=1e-12)
+    assert quat_yaw(pitched) == pytest.approx(np.pi / 2)
+
+
+def _random_quats(n: int, seed: int = 0) -> np.ndarray:
+    q = np.random.default_rng(seed).normal(size=(n, 4))
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+@pytest.mark.parametrize(
+    ("name", "call"),
+    [
+        ("mul", lambda a, b: quat_mul(a, b)),
+        ("conj", lambda a, b: quat_conj(a)),
+        ("normalize", lambda a, b: quat_normalize(2 * a)),
+        ("canonical", lambda a, b: quat_canonical(a)),
+        ("rotate", lambda a, b: quat_rotate(a, b[:, 1:])),
+        ("log", lambda a, b: quat_log(a)),
+        ("exp", lambda a, b: quat_exp(b[:, 1:])),
+        ("slerp", lambda a, b: quat_slerp(a, b, 0.3)),
+        ("continuous", lambda a, b: quat_continuous(a)),
+        ("to_matrix", lambda a, b: quat_to_matrix(a)),
+        ("from_matrix", lambda a, b: quat_from_matrix(quat_to_matrix(a))),
+        ("yaw", lambda a, b: quat_yaw(a)),
+        ("from_yaw", lambda a, b: quat_from_yaw(b[:, 0])),
+    ],
+)
+def test_float32_in_float32_out(name: str, call) -> None:  # type: ignore[no-untyped-def]
+    a, b = _random_quats(500, 1), _random_quats(500, 2)
+    a[:, 0] = np.abs(a[:, 0]) + 0.05  # keep yaw and sign choices away from their +-pi / w=0 ties
+    b[:, 0] = np.abs(b[:, 0]) + 0.05
+    a, b = quat_normalize(a), quat_normalize(b)
+    exact = call(a, b)
+    single = call(a.astype(np.float32), b.astype(np.float32))
+    assert exact.dtype == np.float64, name
+    assert single.dtype == np.float32, name
+    np.testing.assert_allclose(single, exact, atol=2e-6, err_msg=name)
+
+
+def test_other_input_is_computed_in_float64() -> None:
+    assert quat_mul([1, 0, 0, 0], [0, 1, 0, 0]).dtype == np.float64  # ints and lists
+    mixed = quat_mul(np.float32([1, 0, 0, 0]), np.array([0.0, 1.0, 0.0, 0.0]))
+    assert mixed.dtype == np.float64
+    assert quat_to_matrix(np.float16([1, 0, 0, 0])).dtype == np.float64
+    assert quat_from_euler(np.float32([0.1, 0.2, 0.3]), "ZXY").dtype == np.float64  # scipy
+
+
+def test_slerp_path_follows_a_spin_past_half_a_turn_where_framewise_slerp_jumps() -> None:
+    from reactmocap.rotations import quat_from_yaw, quat_slerp, quat_slerp_path
+
+    n = 61
+    a = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+    b = quat_from_yaw(np.linspace(0.0, 1.5 * np.pi, n))  # b spins on past half a turn
+    w = np.full(n, 0.5)
+    path = quat_slerp_path(a, b, w)
+    yaw_path = np.unwrap(2 * np.arctan2(path[:, 3], path[:, 0]))
+    np.testing.assert_allclose(yaw_path, 0.5 * np.linspace(0.0, 1.5 * np.pi, n), atol=1e-9)
+    framewise = quat_slerp(a, b, w)
+    yaw_fw = np.unwrap(2 * np.arctan2(framewise[:, 3], framewise[:, 0]))
+    assert np.max(np.abs(np.diff(yaw_fw))) > 1.0  # the short arc flips sides: a jump
+    # ends exactly on b, starts on a, and agrees with slerp for small turns
+    np.testing.assert_allclose(np.abs(np.sum(quat_slerp_path(a, b, np.ones(n)) * b, axis=1)), 1.0,
+                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(quat_slerp_path(a, b, np.zeros(n)), a, atol=1e-12)
+    small = quat_from_yaw(np.linspace(0.0, 1.0, n))
+    np.testing.assert_allclose(quat_slerp_path(a, small, w), quat_slerp(a, small, w), atol=1e-12)

@@ -9,10 +9,7 @@ from typing import Any
 from reactmocap.sim.controllers.base import Controller
 from reactmocap.sim.world import World
 
-__all__ = ["ATHLETIC_BALANCE_DEFAULTS", "athletic_balance"]
-
-#: the registry row's defaults: control every 8 steps (4 ms at the default timestep)
-ATHLETIC_BALANCE_DEFAULTS: dict[str, float | int | None] = {"control_every": 8}
+__all__ = ["athletic_balance"]
 
 
 def athletic_balance(

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from reactmocap.athletics.behaviours import _clean
 from reactmocap.athletics.bodies import athlete as make_athlete
-from reactmocap.athletics.course import Course, Facing, Polyline, parse_course
+from reactmocap.athletics.paths import Course, Facing, Polyline, parse_course
 from reactmocap.athletics.report import FALL_HEIGHT
 from reactmocap.athletics.running import Runner, RunParams, check_speed, running_start
 from reactmocap.athletics.scene import athletics_world, stand_angles

@@ -5,7 +5,7 @@ spring in stance and an ankle that gives the thrust, the stance hip servoing the
 attitude (roll, pitch, yaw, with a lean into curves), the idle leg mirroring the active one
 (eqs. 3-4) and shortened, the arms swinging with the opposite hip (eq. 5), and every joint
 following a smooth trajectory toward its desired angle (eq. 6). The user gives a speed
-(2.5-5 m/s) and a facing direction or a path (:mod:`reactmocap.athletics.course`).
+(2.5-5 m/s) and a facing direction or a path (:mod:`reactmocap.athletics.paths`).
 
 The feet: the thesis bodies' toes are merged into the feet (the engine's characters have 15
 ball joints), so the paper's two-part foot is a rigid sole box here. Heel and toe contact are
@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from reactmocap.athletics.balance import knee_for_length
 from reactmocap.athletics.bodies import Athlete
-from reactmocap.athletics.course import Course, Straight
+from reactmocap.athletics.paths import Course, Straight
 from reactmocap.athletics.rig import Rig, joint_index, per_joint
 from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError

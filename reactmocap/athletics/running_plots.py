@@ -123,7 +123,7 @@ def phase_plot(curves: Mapping[str, tuple[F64, F64]], path: str | Path, title: s
 def run_plot(result: Any, path: str | Path) -> Path:
     """A run's figure: the ground track with the course, the speed over time (per stride and
     desired), and the hip-knee phase plot of its last strides."""
-    from reactmocap.athletics.course import Circle, Polyline
+    from reactmocap.athletics.paths import Circle, Polyline
     from reactmocap.response.plots import _pyplot
 
     plt = _pyplot()

@@ -240,14 +240,16 @@ def vault_athlete(height: float = GYMNAST_HEIGHT, mass: float = GYMNAST_MASS) ->
     return _ATHLETE[key]
 
 
-def vault_world(ath: Athlete, params: VaultParams) -> World:
-    """A World with the athlete, the springboard (a plate on a vertical slide joint with the
-    board's stiffness and damping, resting with its top at its height) and the horse; the
-    floor is the landing mat. The shins do not touch the floor (as in the athletics world)."""
-    p = params
-    horse_x = p.horse_distance
+@dataclass(frozen=True)
+class _Apparatus:
+    """The vault's :class:`~reactmocap.sim.world.Scene`: the springboard (a plate on a vertical
+    slide joint with the board's stiffness and damping, resting with its top at its height) and
+    the horse; the floor is the landing mat."""
 
-    def extras(spec: mujoco.MjSpec) -> None:
+    params: VaultParams
+
+    def build(self, spec: mujoco.MjSpec) -> None:
+        p = self.params
         plate = spec.worldbody.add_body(name="board", pos=list(BOARD.centre))
         j = plate.add_joint(name="board_spring", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 0, 1])
         j.stiffness = [p.board_stiffness, 0.0, 0.0]
@@ -260,21 +262,31 @@ def vault_world(ath: Athlete, params: VaultParams) -> World:
                            size=[0.5 * x for x in BOARD.size], rgba=[0.75, 0.55, 0.35, 1.0])  # fmt: skip
         g.mass = p.board_mass
         horse = spec.worldbody.add_body(
-            name="horse", pos=[horse_x, HORSE.centre[1], HORSE.centre[2]]
+            name="horse", pos=[p.horse_distance, HORSE.centre[1], HORSE.centre[2]]
         )
         horse.add_geom(name="horse_box", type=mujoco.mjtGeom.mjGEOM_BOX,
                        size=[0.5 * x for x in HORSE.size], rgba=[0.45, 0.3, 0.2, 1.0])  # fmt: skip
 
-    world = World(ath.character, ATHLETICS_WORLD, extras=extras)
-    m = world.model
-    for side in "lr":
-        body = world.characters[0].body_id(f"{side}_shin")
-        geoms = np.flatnonzero(m.geom_bodyid == body)
-        m.geom_contype[geoms] = 0
-        m.geom_conaffinity[geoms] = 0
-    floor = m.geom("floor").id
-    m.geom_solref[floor] = (p.mat_solref, 1.0)
-    return world
+    def configure(self, world: World) -> None:
+        # the shins do not touch the floor (as in the athletics world); the mat is softer
+        m = world.model
+        for side in "lr":
+            body = world.characters[0].body_id(f"{side}_shin")
+            geoms = np.flatnonzero(m.geom_bodyid == body)
+            m.geom_contype[geoms] = 0
+            m.geom_conaffinity[geoms] = 0
+        # the apparatus is as soft as the floor (the values were found with it so) and, like
+        # the floor, dominates the solref of its contacts with the gymnast
+        for name in ("board_plate", "horse_box"):
+            g = m.geom(name).id
+            m.geom_solref[g] = world.config.contact_solref
+            m.geom_solmix[g] = 1e9
+        m.geom_solref[m.geom("floor").id] = (self.params.mat_solref, 1.0)
+
+
+def vault_world(ath: Athlete, params: VaultParams) -> World:
+    """A World with the athlete and the vault's apparatus (:class:`_Apparatus`)."""
+    return World(ath.character, ATHLETICS_WORLD, scene=_Apparatus(params))
 
 
 # ---------------------------------------------------------------------------------- control

@@ -75,6 +75,14 @@ DEFAULT_TOLERANCES: dict[str, Tolerance] = {
     "stitch_velocity_jump_rad_s": Tolerance(0.25, 0.10),
     "foot_skate_m": Tolerance(0.01, 0.10),
     "penetration_max_m": Tolerance(0.005, 0.10),
+    # the reaction itself: a smaller reaction is not better, a change is a change
+    "reaction_displacement_m": Tolerance(0.01, 0.10, "both"),
+    "reaction_direction_error_deg": Tolerance(2.0, 0.10),
+    "transition_s": Tolerance(0.02, 0.10, "both"),
+    "contact_impulse_Ns": Tolerance(1.0, 0.10, "both"),
+    "character_overlap_max_m": Tolerance(0.003, 0.10),
+    "attacker_speed_ratio": Tolerance(0.05, 0.05),
+    "warnings": Tolerance(0.0, 0.0),  # count per scenario
     "fell": Tolerance(0.05, 0.0),  # rate
     "intended_fall": Tolerance(0.05, 0.0, "both"),  # rate; neither direction is better
     "failures": Tolerance(0.0, 0.0),  # count

@@ -47,6 +47,13 @@ QUALITY_METRICS = (
     "penetration_max_m",
     "fell",
     "intended_fall",
+    "reaction_displacement_m",
+    "reaction_direction_error_deg",
+    "transition_s",
+    "contact_impulse_Ns",
+    "character_overlap_max_m",
+    "attacker_speed_ratio",
+    "warnings",
 )
 TIMING_STAGES = ("scan", "sim1", "search", "sim2", "blend", "total")
 TIMING_COLUMNS = tuple(f"time_{s}_s" for s in TIMING_STAGES)
@@ -85,6 +92,7 @@ def report_row(
         distance=matched.get("distance"),
     )
     row.update({m: _plain(quality.get(m)) for m in QUALITY_METRICS})
+    row["warnings"] = len(report.get("warnings", []))
     row.update({f"time_{s}_s": _plain(timings.get(s)) for s in TIMING_STAGES})
     row["matched_frame"] = _plain(row["matched_frame"])
     row["distance"] = _plain(row["distance"])

@@ -66,6 +66,10 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     register_run(inner)  # run, vault
 
+    from reactmocap.commands.athletics_bicycle import register as register_bicycle
+
+    register_bicycle(inner)
+
 
 def _run(args: argparse.Namespace) -> int:
     from reactmocap.athletics.behaviours import run

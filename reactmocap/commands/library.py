@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
-from reactmocap.errors import ReactMocapError
+from reactmocap.errors import ConfigError, ReactMocapError
 
 __all__ = ["register"]
 
@@ -22,8 +23,12 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     info.add_argument("--up", choices=["y", "z"], default="y", help="source up axis")
     info.set_defaults(func=_info)
 
-    check = lsub.add_parser("check", help="lint BVH files; non-zero exit on any bad file")
+    check = lsub.add_parser(
+        "check", help="lint BVH files (non-zero exit on any bad file or on none found); warn "
+        "about clips whose skeleton cannot be mapped onto body parts",
+    )  # fmt: skip
     check.add_argument("paths", type=Path, nargs="+")
+    check.add_argument("--parts", type=Path, help="body-part rules TOML ([parts], [aliases])")
     check.set_defaults(func=_check)
 
     conv = sub.add_parser("convert", help="read a BVH and write it back (resample, mirror)")
@@ -62,11 +67,12 @@ def _info(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
+    from reactmocap.library.bodyparts import load_rules, parts_for
     from reactmocap.library.bvh import read_bvh
     from reactmocap.library.clip_library import find_bvh_files
 
-    bad = 0
-    total = 0
+    rules = load_rules(args.parts) if args.parts else None
+    bad = total = unmapped = 0
     for path in args.paths:
         try:
             files = find_bvh_files(path)
@@ -74,6 +80,9 @@ def _check(args: argparse.Namespace) -> int:
             print(f"error: {exc}")
             bad += 1
             continue
+        if not files:
+            print(f"error: {path}: no .bvh files found")
+            bad += 1
         for f in files:
             total += 1
             try:
@@ -81,15 +90,22 @@ def _check(args: argparse.Namespace) -> int:
             except ReactMocapError as exc:
                 bad += 1
                 print(f"error: {exc}")
-            else:
-                print(f"ok: {f} ({m.num_frames} frames, {m.fps:g} fps)")
-    print(f"{total - bad} ok, {bad} bad")
-    return 1 if bad else 0
+                continue
+            print(f"ok: {f} ({m.num_frames} frames, {m.fps:g} fps)")
+            try:
+                parts_for(m.skeleton, rules)
+            except ReactMocapError as exc:
+                unmapped += 1
+                print(f"warning: {f}: {exc}")
+    print(f"{total - bad} ok, {bad} bad, {unmapped} not mappable onto body parts")
+    return 1 if bad or total == 0 else 0
 
 
 def _convert(args: argparse.Namespace) -> int:
     from reactmocap.library.bvh import read_bvh, write_bvh
 
+    if args.fps is not None and not (math.isfinite(args.fps) and args.fps > 0):
+        raise ConfigError(f"--fps must be a positive frame rate, got {args.fps!r}")
     motion = read_bvh(args.input, unit=args.unit, up=args.up)
     if args.fps:
         motion = motion.resample(args.fps)

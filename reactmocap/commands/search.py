@@ -8,7 +8,7 @@ import math
 import time
 from pathlib import Path
 
-from reactmocap.errors import SearchError
+from reactmocap.errors import ReactMocapError, SearchError
 
 __all__ = ["register"]
 
@@ -34,6 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     b.add_argument("--fps", type=float, default=None, help="index rate (default 30)")
     b.add_argument("--duration", type=float, default=None, help="window length in s (default 0.3)")
     b.add_argument("--feature-set", default=None, help="feature set key (default 'paper')")
+    b.add_argument("--parts", type=Path, help="body-part rules TOML ([parts], [aliases])")
     b.set_defaults(func=_build)
 
     q = ssub.add_parser(
@@ -60,6 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 def _build(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
+    from reactmocap.library.bodyparts import load_rules, parts_for
     from reactmocap.library.clip_library import load_library
     from reactmocap.search import MotionIndex, SearchWeights, WindowConfig
 
@@ -73,7 +75,16 @@ def _build(args: argparse.Namespace) -> int:
         SearchWeights() if args.feature_set is None else SearchWeights(feature_set=args.feature_set)
     )
     t0 = time.perf_counter()
-    index = MotionIndex.build(lib, weights, window, mirror=args.mirror)
+    rules = load_rules(args.parts) if args.parts else None
+    parts, skipped = {}, []
+    for name, m in lib.clips.items():
+        try:
+            parts[name] = parts_for(m.skeleton, rules)
+        except ReactMocapError as exc:
+            skipped.append(f"skipped {lib.paths.get(name, name)}: {exc}")
+    if skipped:
+        lib = replace(lib, clips={n: m for n, m in lib.clips.items() if n in parts})
+    index = MotionIndex.build(lib, weights, window, mirror=args.mirror, parts=parts)
     index.info["source"] = str(Path(args.library).resolve())
     index.save(args.out)
     print(
@@ -83,6 +94,8 @@ def _build(args: argparse.Namespace) -> int:
     )
     for fail in lib.failures:
         print(f"skipped {fail.path}: {fail.reason}")
+    for line in skipped:
+        print(line)
     return 0
 
 

@@ -101,7 +101,10 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--kv", type=float, help="joint damping (1/s; default: critical)")
     p.add_argument("--friction", type=float, default=1.0, help="ground friction coefficient")
     p.add_argument("--fps", type=float, default=60.0, help="output frame rate")
+    p.add_argument("--parts", type=Path, help="body-part rules TOML ([parts], [aliases])")
     p.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
+    p.add_argument("--strict", action="store_true",
+                   help="exit 3 unless the character stayed up and stable (status ok)")  # fmt: skip
     p.add_argument(
         "--root-assist",
         type=float,
@@ -150,6 +153,9 @@ def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # t
             for k, v in data.items()
         }
         atomic_write_text(args.report, json.dumps(clean, indent=2) + "\n")
+    if data["status"] != "ok":
+        print(f"{data['clip']}: {data['status'].upper()}: {data['reason']}; the outputs stop "
+              "there")  # fmt: skip
     print(
         f"{data['clip']}: {data['seconds']:.2f} s tracked, fell={data['fell']}, "
         f"mean joint error {data['mean_joint_error_rad']:.3f} rad, root error "
@@ -200,11 +206,14 @@ class _SimProgress:
 def _simulate(args: argparse.Namespace, label: str, run: Callable[..., Any], **call: object) -> int:
     """Read the clip, run ``run`` (``track_clip`` or ``push_clip``) on it with a progress bar
     and the shared flags, write the outputs."""
+    from reactmocap.library.bodyparts import load_rules, parts_for
+
     motion = _read(args.clip)
+    parts = parts_for(motion.skeleton, load_rules(args.parts)) if args.parts else None
     with _SimProgress(label) as tick:
-        result = run(motion, on_tick=tick, **call, **_kwargs(args))
+        result = run(motion, on_tick=tick, parts=parts, **call, **_kwargs(args))
     _write_outputs(args, motion, result.motion, result.report)
-    return 0
+    return 3 if args.strict and result.report.status != "ok" else 0
 
 
 def _track(args: argparse.Namespace) -> int:

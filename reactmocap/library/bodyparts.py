@@ -1,4 +1,5 @@
-"""Map any skeleton's joints onto the canonical body parts the physics character needs.
+"""Map any skeleton's joints onto the canonical body parts the physics character needs (on a
+skeleton with a single spine joint, the waist and the chest share it).
 
 Each part is named by the joint that *rotates* that segment (``l_thigh`` is the hip joint, whose
 bone runs to the knee). Name rules cover the ``_L/_R`` style of the Bandai Namco clips,
@@ -31,7 +32,9 @@ __all__ = [
     "OPTIONAL_PARTS",
     "TRUNK_PARTS",
     "BodyPartMap",
+    "load_rules",
     "map_body_parts",
+    "parts_for",
 ]
 
 TRUNK_PARTS = ("pelvis", "waist", "chest", "neck", "head")
@@ -122,6 +125,23 @@ class BodyPartMap:
         """Map with left/right parts swapped (for a mirrored motion whose joints kept names)."""
         swap = {p: ("r_" + p[2:] if p.startswith("l_") else "l_" + p[2:]) for p in LIMB_PARTS}
         return BodyPartMap(self.skeleton, {swap.get(p, p): j for p, j in self.joints.items()})
+
+
+def load_rules(path: str | Path) -> dict[str, object]:
+    """A body-part rules TOML (``[parts]``, ``[aliases]``), checked; errors name the file."""
+    return _load_overrides(Path(path))
+
+
+def parts_for(
+    skeleton: Skeleton, rules: str | Path | Mapping[str, object] | None = None
+) -> BodyPartMap:
+    """:func:`map_body_parts` with ``rules`` where they fit the skeleton (it has every joint
+    their ``[parts]`` name), by the name rules alone otherwise: one rules file serves a library
+    that mixes skeletons."""
+    over = _load_overrides(rules)
+    named = dict(over.get("parts", {}) or {})  # type: ignore[call-overload]
+    fits = all(j in skeleton.names for j in named.values())
+    return map_body_parts(skeleton, over if fits else None)
 
 
 def _load_overrides(rules: str | Path | Mapping[str, object] | None) -> dict[str, object]:
@@ -225,3 +245,5 @@ def _map_spine(skeleton: Skeleton, out: dict[str, int], find, used: set[int]) ->
             if between:
                 named = find("waist", None, used)
                 out["waist"] = named if named in between else between[0]
+            elif out["chest"] != out["pelvis"]:
+                out["waist"] = out["chest"]  # one spine joint: waist and chest share it

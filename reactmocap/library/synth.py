@@ -101,15 +101,16 @@ def _leg(
 def _punch() -> Clip:
     c = Clip(2.0).hold(0.15, "root", "rootrot", "Spine", "Spine1", "rhand", "lhand")
     c.at(0.3, root=(0.0, 0.0, 0.90), rootrot=(-5.0, 3.0, 0.0), rhand=(0.14, 0.10, -0.03))
+    # the cross lands 0.1 s after it starts: the fist near 7 m/s, as in measured punches
     c.at(
-        0.48,
+        0.40,
         root=(0.06, 0.0, 0.89), rootrot=(25.0, 6.0, 0.0), Spine=(0.0, 5.0, 8.0),
         Spine1=(0.0, 5.0, 8.0), Neck=(0.0, -3.0, -20.0), Head=(0.0, -3.0, -16.0),
         RightShoulder=(0.0, 0.0, 15.0), rhand=_heading((0.535, 0.09, 0.02), 25.0),
         relbow=(0.0, -0.3, -1.0), lhand=(0.16, -0.05, 0.02), rfoot=(-30.0, 25.0, 0.0),
     )  # fmt: skip
-    c.hold(0.56, "root", "rootrot", "Spine", "Spine1", "rhand", "RightShoulder", "Neck", "Head")
-    c.at(0.75, rhand=(0.22, 0.08, -0.05), RightShoulder=(0.0, 0.0, 0.0))
+    c.hold(0.48, "root", "rootrot", "Spine", "Spine1", "rhand", "RightShoulder", "Neck", "Head")
+    c.at(0.70, rhand=(0.22, 0.08, -0.05), RightShoulder=(0.0, 0.0, 0.0))
     return c.guard(1.05, home=True).at(1.05, rfoot=GUARD["rfoot"]).hold(2.0, "root")
 
 
@@ -135,19 +136,21 @@ def _front_kick() -> Clip:
     c = Clip(2.4)
     lean: Pose = dict(root=(0.10, 0.05, 0.90), rootrot=(0.0, -3.0, 0.0), Spine=(0.0, 0.0, -8.0))
     c.at(0.3, **lean).at(0.3, lhand=(0.22, -0.06, 0.0), rhand=(0.16, 0.08, 0.0))
-    chamber: Pose = dict(rball=(0.45, -0.10, 0.42), rfoot=(0.0, 30.0, 0.0), rknee=(0.4, 0.0, 1.0))
+    # a high chamber: the snap then travels at the height of the target's abdomen
+    chamber: Pose = dict(rball=(0.40, -0.10, 0.58), rfoot=(0.0, 20.0, 0.0), rknee=(1.0, 0.0, 0.3))
     c.at(0.35, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.04)), rfoot=(-30.0, 20.0, 0.0))
     c.at(0.58, **chamber).at(0.58, rootrot=(0.0, -6.0, 0.0), root=(0.12, 0.05, 0.90))
+    # the snap: ~0.5 m in 0.1 s, the foot near 9 m/s mid-way, as in measured front kicks
     c.at(
-        0.8,
-        rball=(0.93, -0.08, 0.93), rfoot=(0.0, -50.0, 0.0), root=(0.15, 0.05, 0.90),
+        0.68,
+        rball=(0.93, -0.08, 0.95), rfoot=(0.0, -50.0, 0.0), root=(0.15, 0.05, 0.90),
         rootrot=(0.0, -15.0, 0.0), Spine=(0.0, -4.0, -8.0), Spine1=(0.0, -2.0, -8.0),
         Neck=(0.0, 8.0, 8.0), Head=(0.0, 5.0, 8.0), rhand=(0.0, 0.15, -0.25),
     )  # fmt: skip
-    c.hold(0.86, "rball", "rfoot", "root", "rootrot", "Spine", "Spine1", "Neck", "Head")
-    c.at(1.05, **chamber).at(1.05, root=(0.12, 0.05, 0.90), rootrot=(0.0, -4.0, 0.0))
-    c.at(1.05, Spine=GUARD["Spine"], Spine1=GUARD["Spine1"], Neck=GUARD["Neck"])
-    c.at(1.05, Head=GUARD["Head"], rhand=(0.16, 0.08, 0.0))
+    c.hold(0.74, "rball", "rfoot", "root", "rootrot", "Spine", "Spine1", "Neck", "Head")
+    c.at(0.95, **chamber).at(0.95, root=(0.12, 0.05, 0.90), rootrot=(0.0, -4.0, 0.0))
+    c.at(0.95, Spine=GUARD["Spine"], Spine1=GUARD["Spine1"], Neck=GUARD["Neck"])
+    c.at(0.95, Head=GUARD["Head"], rhand=(0.16, 0.08, 0.0))
     c.at(1.3, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.05)), rfoot=GUARD["rfoot"])
     c.at(1.3, rknee=GUARD["rknee"]).at(1.45, rball=GUARD["rball"])
     return c.guard(1.75, home=True).hold(2.4, "root")
@@ -179,8 +182,8 @@ def _side_kick() -> Clip:
         root=ext_root, rootrot=ext_rot, Spine=(-8.0, 0.0, -10.0), Spine1=(-6.0, 0.0, -10.0),
         Neck=(10.0, 0.0, -30.0), Head=(8.0, 0.0, -25.0),
     )  # fmt: skip
-    c.at(0.92, **ext).hold(0.98, *ext)
-    c.at(1.18, **chamber).at(1.18, **turn)
+    c.at(0.84, **ext).hold(0.90, *ext)  # a fast thrust: 0.12 s from the chamber
+    c.at(1.12, **chamber).at(1.12, **turn)
     c.at(1.35, rootrot=(50.0, 0.0, -4.0), rknee=(0.6, 0.6, 0.4), rfoot=lift["rfoot"])
     c.at(1.5, **half, rknee=(0.87, -0.5, 0.0))
     c.at(1.5, rball=np.add(GUARD["rball"], (0.0, 0.0, 0.06)), rfoot=GUARD["rfoot"])

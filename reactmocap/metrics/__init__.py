@@ -6,19 +6,29 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 
 __all__ = [
+    "REACTION_WINDOW_S",
+    "WARN_ATTACKER_SPEED_RATIO",
+    "WARN_JOINT_CORRECTION_RAD",
+    "WARN_OVERLAP_M",
+    "WARN_ROOT_OFFSET_M",
     "blend_joint_correction_max_rad",
+    "direction_error_deg",
     "blend_root_offset_max_m",
     "fell",
     "foot_skate_m",
     "intended_fall",
+    "joint_speed_max_m_s",
     "match_distance",
     "penetration_max_m",
+    "reaction_displacement",
+    "speed_ratio",
     "stitch_velocity_jump_rad_s",
 ]
 
@@ -35,10 +45,11 @@ def match_distance(distance: float) -> float:
     return float(distance)
 
 
-def blend_root_offset_max_m(simulated: Motion, blended: Motion) -> float:
-    """Largest root displacement the final blend applied (m): how far Simulation 2 ended from
+def blend_root_offset_max_m(simulated: Motion, blended: Motion, parts: BodyPartMap) -> float:
+    """Largest pelvis displacement the final blend applied (m): how far Simulation 2 ended from
     the found clip on its own. 0 means the simulation landed exactly."""
-    d = blended.global_positions()[:, 0] - simulated.global_positions()[:, 0]
+    p = parts.joint_of("pelvis")
+    d = blended.global_positions()[:, p] - simulated.global_positions()[:, p]
     return float(np.max(np.linalg.norm(d, axis=-1)))
 
 
@@ -107,3 +118,57 @@ def intended_fall(found_clip: Motion, parts: BodyPartMap, from_frame: int = 0) -
     ``FALL_FRACTION`` of its standing height, taken as the clip's highest pelvis height)."""
     h = _pelvis_height(found_clip, parts)
     return bool(np.min(h[from_frame:]) < FALL_FRACTION * np.max(h))
+
+
+#: how long after the impact the reaction is measured (s)
+REACTION_WINDOW_S = 0.6
+
+
+def _chest_xy(motion: Motion, parts: BodyPartMap) -> NDArray[np.float64]:
+    return motion.global_positions()[:, parts.joint_of("chest"), :2]
+
+
+def reaction_displacement(
+    output: Motion, undisturbed: Motion, parts: BodyPartMap, impact_frame: int,
+    seconds: float = REACTION_WINDOW_S,
+) -> NDArray[np.float64]:  # fmt: skip
+    """``(2,)`` the largest horizontal chest displacement (m, world x/y) of ``output`` against
+    ``undisturbed`` (the recipient's own clip over the same frames) in the ``seconds`` after
+    ``impact_frame``: the reaction itself, zero when the character does nothing."""
+    n = min(output.num_frames, undisturbed.num_frames)
+    a = min(max(impact_frame, 0), n - 1)
+    b = min(n, a + int(round(seconds * output.fps)) + 1)
+    d = _chest_xy(output, parts)[a:b] - _chest_xy(undisturbed, parts)[a:b]
+    return np.asarray(d[int(np.argmax(np.linalg.norm(d, axis=1)))], dtype=np.float64)
+
+
+def direction_error_deg(displacement: ArrayLike, impulse: ArrayLike) -> float:
+    """Angle (deg) between a horizontal displacement and the horizontal part of an impulse;
+    NaN when either is zero (no direction to compare)."""
+    a = np.asarray(displacement, dtype=np.float64)[:2]
+    b = np.asarray(impulse, dtype=np.float64)[:2]
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    if na < 1e-9 or nb < 1e-9:
+        return float("nan")
+    return float(np.degrees(np.arccos(np.clip(a @ b / (na * nb), -1.0, 1.0))))
+
+
+def joint_speed_max_m_s(motion: Motion) -> float:
+    """Fastest joint (or end site) of ``motion`` (m/s), from frame-to-frame displacements."""
+    if motion.num_frames < 2:
+        return 0.0
+    pos = np.concatenate([motion.global_positions(), motion.end_site_positions()], axis=1)
+    return float(np.linalg.norm(np.diff(pos, axis=0), axis=-1).max() * motion.fps)
+
+
+def speed_ratio(output: Motion, source: Motion) -> float:
+    """``output``'s fastest joint over ``source``'s (e.g. the attacker's output against its
+    source clip): above 1 means the output moves a joint faster than the capture ever did."""
+    return joint_speed_max_m_s(output) / max(joint_speed_max_m_s(source), 1e-9)
+
+
+#: report warnings fire above these (the report's ``warnings`` list; ``respond --strict``)
+WARN_OVERLAP_M = 0.02
+WARN_ROOT_OFFSET_M = 0.3
+WARN_JOINT_CORRECTION_RAD = 0.6
+WARN_ATTACKER_SPEED_RATIO = 1.5

@@ -12,8 +12,11 @@ from typing import Generic, TypeVar
 import numpy as np
 
 from reactmocap import __version__
+from reactmocap.errors import LibraryError, ReactMocapError
+from reactmocap.library.bodyparts import BodyPartMap, parts_for
 from reactmocap.library.clip_library import (
     ClipLibrary,
+    ClipLoadFailure,
     default_cache_dir,
     find_bvh_files,
     load_library,
@@ -66,22 +69,29 @@ class LibraryCache:
                tuple((str(f), (st := f.stat()).st_size, st.st_mtime_ns) for f in files))  # fmt: skip
         return self._libraries.get(key) or self._libraries.put(key, load_library(path))
 
-    def search(self, path: Path, recipient: Motion) -> tuple[ClipLibrary, MotionIndex]:
+    def search(
+        self, path: Path, recipient: Motion, rules: Path | None = None
+    ) -> tuple[ClipLibrary, MotionIndex]:
         """The library as continuations for ``recipient`` (retargeted onto its skeleton) and
-        their index."""
-        return prepare_library(path, recipient, self.library(path), self)
+        their index; clips no rule maps are skipped (listed in the library's ``failures``)."""
+        return prepare_library(path, recipient, self.library(path), self, rules)
 
     def _index(
-        self, key: tuple[str, ...], build: tuple[ClipLibrary, dict[str, Motion]]
+        self,
+        key: tuple[str, ...],
+        lib: ClipLibrary,
+        clips: dict[str, Motion],
+        parts: dict[str, BodyPartMap],
+        skipped: list[ClipLoadFailure],
     ) -> tuple[ClipLibrary, MotionIndex]:
         hit = self._indexes.get(key)
         if hit is not None:
             return hit
-        lib, clips = build
         digest = hashlib.sha256("\0".join(key).encode()).hexdigest()[:16]  # stable across runs
         index_path = default_cache_dir().parent / "indexes" / f"{digest}.npz"
-        index = MotionIndex.load_or_build(index_path, clips, SearchWeights(), WindowConfig())
-        sub = ClipLibrary(lib.root, clips, lib.paths, lib.hashes, lib.failures)
+        index = MotionIndex.load_or_build(index_path, clips, SearchWeights(), WindowConfig(),
+                                          parts=parts)  # fmt: skip
+        sub = ClipLibrary(lib.root, clips, lib.paths, lib.hashes, [*lib.failures, *skipped])
         return self._indexes.put(key, (sub, index))
 
 
@@ -90,27 +100,44 @@ def prepare_library(
     skeleton_of: Motion | None = None,
     lib: ClipLibrary | None = None,
     cache: LibraryCache | None = None,
+    rules: Path | None = None,
 ) -> tuple[ClipLibrary, MotionIndex]:
     """A clip library (loaded unless given) and its search index (cached on disk, keyed by
-    content and by ``skeleton_of``'s skeleton). With ``skeleton_of``, clips on other skeletons
-    are retargeted onto it (each side's reference pose is frame 0 of its alphabetically first
-    clip)."""
+    content, by ``skeleton_of``'s skeleton and the body-part ``rules``). Clips whose skeleton no
+    rule maps are skipped and listed in the returned library's ``failures``. With
+    ``skeleton_of``, clips on other skeletons are retargeted onto it (each side's reference
+    pose is frame 0 of its alphabetically first clip)."""
     lib = load_library(path) if lib is None else lib
-    clips = dict(lib.clips)
+    clips: dict[str, Motion] = {}
+    skipped: list[ClipLoadFailure] = []
+    for name, m in lib.clips.items():
+        try:
+            parts_for(m.skeleton, rules)
+        except ReactMocapError as exc:
+            skipped.append(ClipLoadFailure(lib.paths.get(name, Path(name)), str(exc)))
+            continue
+        clips[name] = m
+    if not clips:
+        raise LibraryError(f"{path}: no clip of the library can be mapped onto body parts "
+                           f"({skipped[0].reason})")  # fmt: skip
     target = ""
     if skeleton_of is not None:
-        clips = _retargeted(clips, skeleton_of)
+        clips = _retargeted(clips, skeleton_of, rules)
         sk = skeleton_of.skeleton
         target = hashlib.sha256(
             ("\0".join(sk.names) + repr(np.round(sk.offsets, 6).tolist())).encode()
         ).hexdigest()[:12]
+    rules_key = hashlib.sha256(Path(rules).read_bytes()).hexdigest()[:12] if rules else ""
     # the code versions are part of the key: an index written by older search code is not reused
     key = (str(Path(path).resolve()), ",".join(sorted(clips)) + lib.fingerprint(),
-           f"{__version__}/{INDEX_FORMAT_VERSION}/retarget{RETARGET_VERSION}/{target}")  # fmt: skip
-    return (cache or LibraryCache(1))._index(key, (lib, clips))
+           f"{__version__}/{INDEX_FORMAT_VERSION}/retarget{RETARGET_VERSION}/{target}/{rules_key}")  # fmt: skip
+    parts = {n: parts_for(m.skeleton, rules) for n, m in clips.items()}
+    return (cache or LibraryCache(1))._index(key, lib, clips, parts, skipped)
 
 
-def _retargeted(clips: dict[str, Motion], recipient: Motion) -> dict[str, Motion]:
+def _retargeted(
+    clips: dict[str, Motion], recipient: Motion, rules: Path | None = None
+) -> dict[str, Motion]:
     """Every clip on ``recipient``'s skeleton: same-structure clips as they are, the rest
     retargeted (one Retargeter per source skeleton)."""
     target_char = None
@@ -122,10 +149,10 @@ def _retargeted(clips: dict[str, Motion], recipient: Motion) -> dict[str, Motion
             out[name] = m
             continue
         if target_char is None:
-            target_char = build_character(recipient, frame=0)
+            target_char = build_character(recipient, parts_for(recipient.skeleton, rules), frame=0)
         r = next((r for r in by_skeleton if r.source.skeleton.same_structure(m.skeleton)), None)
         if r is None:
-            r = Retargeter(build_character(m, frame=0), target_char)
+            r = Retargeter(build_character(m, parts_for(m.skeleton, rules), frame=0), target_char)
             by_skeleton.append(r)
         out[name] = r(m)
     return out

@@ -72,6 +72,7 @@ def _video(result: ResponseResult, out: Path) -> tuple[Path, str]:
             out / "video.mp4",
             fps=min(fps, 30.0),
             ghost=(ghost.replace(fps=fps), (0.3, 0.8, 0.35, 0.3)),
+            hit=result.hit,
         )
         return Path(path), "mujoco"
     except RenderUnavailable as exc:
@@ -86,10 +87,10 @@ def _video(result: ResponseResult, out: Path) -> tuple[Path, str]:
 
 
 def _plot(result: ResponseResult, path: Path, scenario: Scenario) -> Path:
-    from reactmocap.response.plots import pelvis_height_plot
+    from reactmocap.response.plots import response_plot
 
-    parts = map_body_parts(result.recipient.skeleton)
-    pj = parts.joint_of("pelvis")
+    parts = result.parts or map_body_parts(result.recipient.skeleton)
+    pj, cj = parts.joint_of("pelvis"), parts.joint_of("chest")
 
     def curve(m: Motion, t0: float) -> tuple[F64, F64]:
         return m.times + t0, m.global_positions()[:, pj, 2]
@@ -107,8 +108,17 @@ def _plot(result: ResponseResult, path: Path, scenario: Scenario) -> Path:
         "final blend": curve(result.blended, np.ceil(t_imp * fps - 1e-9) / fps),
         "found clip": (np.arange(found_m.num_frames) / fps, found_m.global_positions()[:, pj, 2]),
     }
-    return Path(pelvis_height_plot(curves, path, impact_time=t_imp, transition=(t_imp, t_end),
-                                   title=f"{scenario.name}: matched {result.matched.clip}"))  # fmt: skip
+    paths = {"output": result.recipient.global_positions()[:, cj, :2]}
+    if result.undisturbed is not None:
+        paths["undisturbed clip"] = result.undisturbed.global_positions()[:, cj, :2]
+    paths["simulation 1"] = result.sim1.global_positions()[:, cj, :2]
+    hit = None
+    if result.hit is not None and len(result.hit[0]):
+        times, points, forces = result.hit
+        dt = float(np.median(np.diff(times))) if len(times) > 1 else 1.0 / fps
+        hit = (points[int(np.argmax(np.linalg.norm(forces, axis=1)))], forces.sum(axis=0) * dt)
+    return Path(response_plot(paths, curves, path, impact_time=t_imp, transition=(t_imp, t_end),
+                              hit=hit, title=f"{scenario.name}: matched {result.matched.clip}"))  # fmt: skip
 
 
 def jsonable(x: Any) -> Any:

@@ -17,11 +17,15 @@ from numpy.typing import NDArray
 
 from reactmocap import __version__
 from reactmocap import metrics as qm
+from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
-from reactmocap.response import stages
+from reactmocap.response import final, stages
 from reactmocap.response.library_cache import LibraryCache, prepare_library
 from reactmocap.response.scenario import Scenario
 from reactmocap.search import SearchResult
+from reactmocap.sim.bodies import SIM_BODIES
+from reactmocap.sim.character import Character
+from reactmocap.sim.impacts import overlap_depths
 
 __all__ = ["LibraryCache", "ResponseResult", "prepare_library", "run_response", "run_scenario"]
 
@@ -38,6 +42,8 @@ class ResponseResult:
     matched: SearchResult
     candidates: list[SearchResult]
     impact_time: float
+    #: the match time: the scenario time at which ``found`` is at ``matched.time`` (the
+    #: physical mode lands later, at the report's ``transition.end``)
     transition_end: float
     sim1: Motion
     sim2: Motion
@@ -48,6 +54,13 @@ class ResponseResult:
     #: the simulated world and its pre-impact state (to measure bare stepping of the same model)
     model: mujoco.MjModel | None = None
     start_state: F64 | None = None
+    #: the recipient's body parts
+    parts: BodyPartMap | None = None
+    #: the hit over time, for the video: scenario times ``(n,)``, contact points and the world
+    #: forces on the recipient ``(n, 3)``
+    hit: tuple[F64, F64, F64] | None = None
+    #: the recipient's own clip over the output's frames, as if nothing had happened
+    undisturbed: Motion | None = None
 
 
 def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> ResponseResult:
@@ -68,7 +81,7 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     naive = timed("sim1", stages.naive_simulation, scenario, cast, contact)
     cont = timed("search", stages.search_continuation, scenario, cast, contact, naive)
     sim2 = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, cont)
-    out = timed("blend", stages.blend, scenario, cast, contact, naive, cont, sim2)
+    out = timed("blend", final.blend, scenario, cast, contact, naive, cont, sim2)
     timings["total"] = time.perf_counter() - t_all
     report = _report(scenario, cast, contact, naive, cont, sim2, out, timings)
     rec = cast.recipient
@@ -88,6 +101,9 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
         report=report,
         model=sim2.world.model,
         start_state=naive.start_state,
+        parts=rec.parts,
+        hit=_hit_marks(scenario, cast, contact, sim2, out),
+        undisturbed=rec.motion.sample(out.recipient.times + rec.clock0).replace(fps=fps),
     )
 
 
@@ -98,15 +114,26 @@ def _report(
     naive: stages.NaiveSimulation,
     cont: stages.Continuation,
     sim2: stages.TransitionSimulation,
-    out: stages.Blend,
+    out: final.Blend,
     timings: dict[str, float],
 ) -> dict[str, Any]:
     cfg = scenario.response
-    parts = cast.recipient.parts
+    rec = cast.recipient
+    parts = rec.parts
     best = cont.best
+    fps = rec.motion.fps
+    undisturbed = rec.motion.sample(out.recipient.times + rec.clock0).replace(fps=fps)
+    impact_frame = int(np.ceil(naive.impact_time * fps - 1e-9))
+    shift = qm.reaction_displacement(out.recipient, undisturbed, parts, impact_frame)
+    impulse = _impulse(scenario, sim2)
+    overlap = 0.0
+    if cast.attacker is not None and out.attacker is not None:
+        att = out.attacker.sample(out.recipient.times).replace(fps=fps)
+        world = cast.pair
+        overlap = float(overlap_depths(world, [out.recipient, att]).max())
     quality = {
         "match_distance": qm.match_distance(best.distance),
-        "blend_root_offset_max_m": qm.blend_root_offset_max_m(out.simulated, out.blended),
+        "blend_root_offset_max_m": qm.blend_root_offset_max_m(out.simulated, out.blended, parts),
         "blend_joint_correction_max_rad": qm.blend_joint_correction_max_rad(
             out.simulated, out.blended
         ),
@@ -115,9 +142,31 @@ def _report(
         "penetration_max_m": qm.penetration_max_m(out.recipient),
         "fell": qm.fell(out.recipient, parts),
         "intended_fall": qm.intended_fall(cont.found_clip, parts, best.frame),
+        "reaction_displacement_m": float(np.linalg.norm(shift)),
+        "reaction_direction_error_deg": qm.direction_error_deg(shift, impulse),
+        "transition_s": sim2.landed - naive.impact_time,
+        "contact_impulse_Ns": float(np.linalg.norm(impulse)),
+        "character_overlap_max_m": overlap,
+        "attacker_speed_ratio": (
+            qm.speed_ratio(out.attacker, cast.attacker.motion)
+            if out.attacker is not None and cast.attacker is not None
+            else None
+        ),
     }
+    warnings = _warnings(scenario, cast, contact, naive, cont, quality)
+    if sim2.unstable is not None:
+        warnings.append(f"physical mode: Simulation 2 stopped early ({sim2.unstable})")
+    elif not sim2.on_clip:
+        gap = sim2.landing_gap
+        warnings.append(
+            f"physical mode: the body did not reach the found clip within {cfg.land_within} s "
+            f"(pelvis {gap[0]:.2f} m, root {gap[1]:.2f} rad, a joint {gap[2]:.2f} rad off; "
+            f"tolerances {cfg.land_position} m, {cfg.land_angle} rad, {cfg.land_joint} rad): "
+            "the blend closed the rest"
+        )
     return {
         "scenario": scenario.name,
+        "warnings": warnings,
         "reactmocap_version": __version__,
         "mujoco_version": mujoco.__version__,
         "matched": {
@@ -131,17 +180,25 @@ def _report(
             "breakdown": best.breakdown.to_dict(),
         },
         "candidates": [c.to_dict() for c in cont.candidates],
+        "library_skipped": [
+            {"clip": str(f.path), "reason": f.reason} for f in cast.library.failures
+        ],
         "impact": {
             "time": naive.impact_time,
             "body": contact.body,
             "peak_force_N": naive.peak_force,
             "rewind_time": contact.rewind,
             "contact_end": naive.contact_end,
+            "impulse_Ns": impulse.tolist(),
         },
         "transition": {
             "start": naive.impact_time,
-            "end": cont.time,
+            "end": sim2.landed,
+            "match": cont.time,
             "reaction_delay": cfg.reaction_delay,
+            "mode": cfg.mode,
+            "landed_on_clip": sim2.on_clip,
+            "landing_gap": dict(zip(("pelvis_m", "root_rad", "joint_rad"), sim2.landing_gap)),
         },
         "timings_s": timings,
         "steps": {"sim1": naive.steps, "sim2": sim2.steps},
@@ -149,6 +206,75 @@ def _report(
         "config": asdict(cfg),
         "outputs": {},
     }
+
+
+def _warnings(
+    scenario: Scenario,
+    cast: stages.Cast,
+    contact: stages.ContactEstimate,
+    naive: stages.NaiveSimulation,
+    cont: stages.Continuation,
+    quality: dict[str, Any],
+) -> list[str]:
+    """What a user should know before trusting the animation (thresholds in
+    :mod:`reactmocap.metrics`)."""
+    out = []
+    q = quality
+    if q["character_overlap_max_m"] > qm.WARN_OVERLAP_M:
+        out.append(f"the characters overlap by {100 * q['character_overlap_max_m']:.1f} cm in "
+                   f"the output (more than {100 * qm.WARN_OVERLAP_M:.0f} cm)")  # fmt: skip
+    if q["blend_root_offset_max_m"] > qm.WARN_ROOT_OFFSET_M:
+        out.append(f"the final blend moves the root by {q['blend_root_offset_max_m']:.2f} m "
+                   f"(more than {qm.WARN_ROOT_OFFSET_M} m): the simulation ended far from the "
+                   "found clip")  # fmt: skip
+    if q["blend_joint_correction_max_rad"] > qm.WARN_JOINT_CORRECTION_RAD:
+        out.append(f"the final blend turns a joint by {q['blend_joint_correction_max_rad']:.2f} "
+                   f"rad (more than {qm.WARN_JOINT_CORRECTION_RAD})")  # fmt: skip
+    ratio = q["attacker_speed_ratio"]
+    if ratio is not None and ratio > qm.WARN_ATTACKER_SPEED_RATIO:
+        out.append(f"the attacker moves a joint {ratio:.2f}x faster than its clip ever does "
+                   f"(more than {qm.WARN_ATTACKER_SPEED_RATIO}x)")  # fmt: skip
+    if cast.attacker is not None and contact.time <= 0.0:
+        out.append("the characters already touch when the scenario starts (place them apart)")
+    if cast.attacker is not None and naive.contacts.empty:
+        out.append("the attacker never touched the recipient: nothing was hit")
+    rec = cast.recipient
+    if naive.impact_time > rec.motion.duration - rec.clock0:
+        out.append(f"the impact ({naive.impact_time:.2f} s) comes after the recipient's clip "
+                   f"ends ({rec.motion.duration - rec.clock0:.2f} s into the scenario)")  # fmt: skip
+    cfg = scenario.response
+    own = rec.clock0 + cont.time  # the recipient's own clip time had nothing happened
+    if (naive.impulse >= cfg.react_impulse and cont.best.clip == rec.clip.name
+            and abs(cont.best.time - own) < cfg.own_clip_margin):  # fmt: skip
+        out.append(f"the recipient carries on with its own clip after an impulse of "
+                   f"{naive.impulse:.1f} N s (from {cfg.react_impulse} N s it should react)")  # fmt: skip
+    return out
+
+
+def _hit_marks(scenario: Scenario, cast: stages.Cast, contact: stages.ContactEstimate,
+               sim2: stages.TransitionSimulation, out: final.Blend) -> tuple[F64, F64, F64]:  # fmt: skip
+    """Where and how hard the recipient was hit, over time (for the video)."""
+    if scenario.impact is not None:
+        imp = scenario.impact
+        fps = out.recipient.fps
+        frames = np.arange(
+            int(np.ceil(imp.at * fps)), int(np.floor((imp.at + imp.duration) * fps)) + 1
+        )
+        frames = frames[frames < out.recipient.num_frames]
+        joint = cast.recipient.character.anchors[SIM_BODIES.index(Character.body_name(imp.body))]
+        points = out.recipient.global_positions()[frames, int(joint)]
+        forces = np.tile(np.asarray(imp.force, dtype=np.float64), (frames.size, 1))
+        return frames / fps, points, forces
+    log = sim2.contacts
+    return log.times + contact.rewind, log.point, log.force
+
+
+def _impulse(scenario: Scenario, sim2: stages.TransitionSimulation) -> F64:
+    """``(3,)`` the world impulse on the recipient (N s): the explicit impact's, or what the
+    attacker's contacts delivered in Simulation 2."""
+    if scenario.impact is not None:
+        return np.asarray(scenario.impact.force) * scenario.impact.duration
+    return sim2.contacts.impulse
 
 
 def run_scenario(

@@ -1,4 +1,5 @@
-"""Figures of a response: the paper's Figure 1 pelvis-height plot and a stick-figure video.
+"""Figures of a response: the chest path from above beside the paper's Figure 1 pelvis height,
+and a stick-figure video.
 
 matplotlib and imageio are optional extras (``pip install reactmocap[plot,video]``); a missing
 one raises a ReactMocapError that says which extra to install.
@@ -17,7 +18,7 @@ from reactmocap.errors import ReactMocapError
 from reactmocap.io import atomic_write, atomic_write_bytes
 from reactmocap.library.motion import Motion
 
-__all__ = ["pelvis_height_plot", "stick_figure_video", "write_video"]
+__all__ = ["response_plot", "stick_figure_video", "write_video"]
 
 
 def _pyplot():  # type: ignore[no-untyped-def]
@@ -53,29 +54,49 @@ def write_video(frames: NDArray[np.uint8], path: str | Path, fps: float) -> Path
     return out
 
 
-def pelvis_height_plot(
+def response_plot(
+    paths: Mapping[str, NDArray[np.float64]],
     curves: Mapping[str, tuple[NDArray[np.float64], NDArray[np.float64]]],
     path: str | Path,
     *,
     impact_time: float,
     transition: tuple[float, float],
+    hit: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
     title: str = "",
 ) -> Path:
-    """Pelvis height over time for each labelled curve (like the paper's Figure 1), with the
-    impact and the transition interval marked."""
+    """Left: the horizontal chest path of each labelled motion seen from above ``(T, 2)``, with
+    the hit as an arrow (``hit``: point and impulse, 0.02 m per N s); right: pelvis height over
+    time (like the paper's Figure 1) with the impact and the transition marked."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8, 4), dpi=100)
+    fig, (top, ax) = plt.subplots(1, 2, figsize=(12, 4.5), dpi=100,
+                                  gridspec_kw={"width_ratios": [1, 1.4]})  # fmt: skip
     styles = {"mocap before": "b-", "found clip": "g-", "final blend": "r-",
-              "simulation 1": "k:", "simulation 2": "m--"}  # fmt: skip
+              "simulation 1": "k:", "simulation 2": "m--", "undisturbed clip": "c:",
+              "output": "r-"}  # fmt: skip
+    for label, xy in paths.items():
+        top.plot(xy[:, 0], xy[:, 1], styles.get(label, "-"), label=label, lw=1.5)
+        top.plot(xy[-1, 0], xy[-1, 1], styles.get(label, "-")[0] + "o", ms=4)
+    if hit is not None:
+        (px, py), (jx, jy) = hit[0][:2], 0.02 * np.asarray(hit[1])[:2]
+        top.annotate("", xy=(px, py), xytext=(px - jx, py - jy),
+                     arrowprops={"arrowstyle": "->", "color": "orange", "lw": 2})  # fmt: skip
+        top.plot([px - jx, px], [py - jy, py], color="orange", alpha=0.0)  # in the limits
+        top.plot([], [], color="orange", label="impulse (0.02 m per N s)")
+    top.set_aspect("equal", adjustable="datalim")
+    top.set_xlabel("x (m)")
+    top.set_ylabel("y (m)")
+    top.set_title("chest path, top view")
+    top.legend(loc="best", fontsize=7)
     for label, (t, h) in curves.items():
         ax.plot(t, h, styles.get(label, "-"), label=label, lw=2 if label == "final blend" else 1.2)
     ax.axvline(impact_time, color="orange", lw=1, label="impact")
     ax.axvspan(transition[0], transition[1], color="0.9", label="transition")
     ax.set_xlabel("time (s)")
     ax.set_ylabel("pelvis height (m)")
+    ax.set_title("pelvis height")
+    ax.legend(loc="best", fontsize=7)
     if title:
-        ax.set_title(title)
-    ax.legend(loc="best", fontsize=8)
+        fig.suptitle(title)
     fig.tight_layout()
     out = Path(path)
     with atomic_write(out, "wb") as fh:

@@ -49,9 +49,17 @@ def _scene(chars: Sequence[mujoco.MjSpec]) -> mujoco.MjModel:
     spec.worldbody.add_light(
         pos=[0.0, 0.0, 6.0], dir=[0.0, 0.0, -1.0], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
     )
-    spec.worldbody.add_geom(
-        type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05], rgba=[0.82, 0.84, 0.86, 1.0]
-    )
+    # a sky and a checkered floor to the horizon: no black bands around the scene
+    spec.add_texture(name="sky", type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+                     builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT, rgb1=[0.75, 0.85, 0.95],
+                     rgb2=[0.97, 0.97, 0.98], width=256, height=256)  # fmt: skip
+    spec.add_texture(name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D,
+                     builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER, rgb1=[0.80, 0.82, 0.84],
+                     rgb2=[0.72, 0.74, 0.77], width=256, height=256)  # fmt: skip
+    mat = spec.add_material(name="grid", texrepeat=[1.0, 1.0], texuniform=True)
+    mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05],
+                            material="grid")  # fmt: skip
     for k, ch in enumerate(chars):
         spec.attach(ch, prefix=f"c{k}/", frame=spec.worldbody.add_frame())
     model = spec.compile()
@@ -68,9 +76,12 @@ def render_video(
     fps: float = 30.0,
     size: tuple[int, int] = (512, 384),
     ghost: tuple[Motion, RGBA] | None = None,
+    hit: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> Path:
     """Render ``motions`` (each with a colour; the first is followed by the camera) and an
-    optional ``ghost`` into an MP4 (or GIF, by ``path``'s suffix), written atomically.
+    optional ``ghost`` into an MP4 (or GIF, by ``path``'s suffix), written atomically. ``hit``
+    (times, points, forces on the recipient) draws the contact point and its force as an arrow
+    while the hit lasts (1 kN: 0.25 m).
 
     Raises RenderUnavailable if no GL context can be created, ReactMocapError if the video
     writer (imageio, the ``video`` extra) is missing.
@@ -111,7 +122,35 @@ def render_video(
             mujoco.mj_kinematics(model, data)
             cam.lookat[:] = (look[i, 0], look[i, 1], 0.9)
             renderer.update_scene(data, camera=cam)
+            if hit is not None:
+                _mark_hit(renderer.scene, hit, times[i], 0.5 / fps)
             frames[i] = renderer.render()
     finally:
         renderer.close()
     return write_video(frames, path, fps)
+
+
+def _mark_hit(
+    scene: mujoco.MjvScene, hit: tuple[np.ndarray, np.ndarray, np.ndarray], t: float, tol: float
+) -> None:
+    """The contact point (a yellow sphere) and the force on the recipient (an arrow into it) at
+    time ``t``, if the hit lasts then."""
+    times, points, forces = hit
+    near = np.flatnonzero(np.abs(times - t) <= tol)
+    if near.size == 0 or scene.ngeom + 2 > scene.maxgeom:
+        return
+    k = near[np.argmax(np.linalg.norm(forces[near], axis=1))]
+    p, f = points[k], forces[k]
+    red = np.array([1.0, 0.85, 0.0, 1.0])  # yellow: visible on both characters
+    g = scene.geoms[scene.ngeom]
+    mujoco.mjv_initGeom(g, mujoco.mjtGeom.mjGEOM_SPHERE, np.array([0.03, 0, 0]), p,
+                        np.eye(3).ravel(), red)  # fmt: skip
+    scene.ngeom += 1
+    n = float(np.linalg.norm(f))
+    if n > 1e-6:
+        tail = p - f / n * max(0.08, 0.25 * n / 1000.0)  # the arrow ends at the point
+        g = scene.geoms[scene.ngeom]
+        mujoco.mjv_initGeom(g, mujoco.mjtGeom.mjGEOM_ARROW, np.zeros(3), np.zeros(3),
+                            np.eye(3).ravel(), red)  # fmt: skip
+        mujoco.mjv_connector(g, mujoco.mjtGeom.mjGEOM_ARROW, 0.015, tail, p)
+        scene.ngeom += 1

@@ -17,6 +17,7 @@ from typing import Any, Literal
 from reactmocap.errors import ConfigError
 
 __all__ = [
+    "MODES",
     "SIM1_MODES",
     "AttackerSpec",
     "CharacterSpec",
@@ -27,7 +28,8 @@ __all__ = [
     "parse_scenario",
 ]
 
-SIM1_MODES = ("passive", "holding")
+SIM1_MODES = ("yielding", "holding", "passive")
+MODES = ("blend", "physical")
 
 
 @dataclass(frozen=True)
@@ -75,12 +77,29 @@ class ResponseConfig:
     kv: float | None = None
     friction_sim1: float = 1.0
     friction_sim2: float = 0.5
-    sim1_mode: Literal["passive", "holding"] = "holding"
+    #: Simulation 1: ``yielding`` (the recipient gives way to the hit with its stiffness cut to
+    #: ``yield_gain`` for the reaction delay, holding its pose at impact, then recovers over
+    #: ``yield_recover`` s; Simulation 2 keeps the same passive phase), ``holding`` (keeps
+    #: tracking the old clip at full stiffness) or ``passive`` (a ragdoll from the impact on)
+    sim1_mode: Literal["yielding", "holding", "passive"] = "yielding"
+    yield_gain: float = 0.1
+    yield_recover: float = 0.3
     sim1_duration: float = 1.0  # s after the impact
     search_start: float = 0.1  # s after the impact
+    #: an impulse (N s) from which the recipient reacts: its own clip cannot be the
+    #: continuation within ``reaction_delay + active_min`` s of the impact (below it, carrying
+    #: on with the own clip is right)
+    react_impulse: float = 5.0
+    active_min: float = 0.2
+    #: after a hit from ``react_impulse`` on, windows of the recipient's own clip within this
+    #: many seconds of its undisturbed time cannot be the continuation (s)
+    own_clip_margin: float = 1.0
     search_end: float = 1.0
     contact_shift_max: float = 0.25  # s the search start moves later while contact lasts
     attacker_follow: float = 0.1  # s the attacker follows its own simulation
+    #: kp (1/s^2) of a NON-PHYSICAL root assist holding the attacker on its clip's path until
+    #: it first touches the recipient (0: off), for strikes no body performs on its own
+    attacker_assist: float = 0.0
     attacker_blend: float = 0.3  # s to blend the attacker back to its clip
     tail: float = 1.0  # s of the found clip played after landing
     top_k: int = 5
@@ -88,6 +107,17 @@ class ResponseConfig:
     total_mass: float = 75.0
     #: pin planted feet that slide during the transition (two-bone IK; not in the paper)
     foot_lock: bool = True
+    #: ``blend``: the paper's final blend lands on the found clip at the match time, whatever
+    #: the simulation did; ``physical``: Simulation 2 runs on past the match, tracking the
+    #: found clip, until the body is within ``land_position`` m (pelvis), ``land_angle`` rad
+    #: (root turn) and ``land_joint`` rad (every joint) of it; the blend then only closes that
+    #: small gap. If it is not there within ``land_within`` s, the report warns and the blend
+    #: closes what is left
+    mode: Literal["blend", "physical"] = "blend"
+    land_position: float = 0.05
+    land_angle: float = 0.17
+    land_joint: float = 0.1
+    land_within: float = 1.5
 
 
 @dataclass(frozen=True)
@@ -99,12 +129,14 @@ class Scenario:
     response: ResponseConfig = field(default_factory=ResponseConfig)
     source: Path | None = None
     name: str = "scenario"
+    #: body-part rules TOML for skeletons the name rules cannot map
+    parts: Path | None = None
 
     def with_changes(self, **changes: Any) -> Scenario:
         return replace(self, **changes)
 
 
-_TOP_KEYS = {"library", "recipient", "attacker", "impact", "response", "name"}
+_TOP_KEYS = {"library", "recipient", "attacker", "impact", "response", "name", "parts"}
 
 
 class _Reader:
@@ -167,9 +199,10 @@ class _Reader:
                 kwargs[name] = self.string(where, value)
             elif name.endswith("_controller"):
                 kwargs[name] = self.controller(where, value)
-            elif name == "sim1_mode":
-                if value not in SIM1_MODES:
-                    raise self.fail(where, f"expected one of {list(SIM1_MODES)}, got {value!r}")
+            elif name in ("sim1_mode", "mode"):
+                options = SIM1_MODES if name == "sim1_mode" else MODES
+                if value not in options:
+                    raise self.fail(where, f"expected one of {list(options)}, got {value!r}")
                 kwargs[name] = value
             elif ftype == "bool":
                 if not isinstance(value, bool):
@@ -186,9 +219,12 @@ class _Reader:
             else:
                 nonneg = name in {"start", "at", "reaction_delay", "search_start", "tail",
                                   "contact_shift_max", "attacker_follow", "attacker_blend",
-                                  "friction_sim1", "friction_sim2", "kv"}  # fmt: skip
+                                  "friction_sim1", "friction_sim2", "kv", "yield_gain",
+                                  "react_impulse", "active_min", "own_clip_margin", "attacker_assist",
+                                  "yield_recover", "land_within"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
-                                    "total_mass"}  # fmt: skip
+                                    "total_mass", "land_position", "land_angle",
+                                    "land_joint"}  # fmt: skip
                 kwargs[name] = self.number(
                     where, value, positive=positive, min_=0.0 if nonneg else None
                 )
@@ -220,6 +256,14 @@ def parse_scenario(
         r.build(AttackerSpec, "attacker", r.table(data, "attacker")) if "attacker" in data else None
     )
     impact = r.build(ImpactSpec, "impact", r.table(data, "impact")) if "impact" in data else None
+    if impact is not None:
+        from reactmocap.errors import ReactMocapError
+        from reactmocap.sim.impacts import Impact
+
+        try:  # the body, the force's size: checked as the simulation will
+            Impact(impact.body, force=impact.force, point=impact.point, duration=impact.duration)
+        except ReactMocapError as exc:
+            raise r.fail("[impact]", str(exc)) from None
     if attacker is None and impact is None:
         raise r.fail("top level", "give either an [attacker] or an [impact]")
     if attacker is not None and impact is not None:
@@ -232,7 +276,13 @@ def parse_scenario(
     if response.search_end <= response.search_start:
         raise r.fail("[response].search_end", "must be greater than search_start")
     name = r.string("name", data["name"]) if "name" in data else Path(source).stem
-    return Scenario(library, recipient, attacker, impact, response, Path(source), name)
+    parts = None
+    if "parts" in data:
+        parts = _resolve(r, "parts", r.string("parts", data["parts"]), base_dir)
+        from reactmocap.library.bodyparts import load_rules
+
+        load_rules(parts)  # a bad rules file fails here, naming it
+    return Scenario(library, recipient, attacker, impact, response, Path(source), name, parts)
 
 
 def _resolve(r: _Reader, where: str, value: str, base_dir: Path | None) -> Path:

@@ -6,47 +6,57 @@ the recipient clip at ``recipient.start``; outputs are at the recipient clip's f
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, ReactMocapError, SearchError
-from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
+from reactmocap.library.bodyparts import BodyPartMap, parts_for
 from reactmocap.library.bvh import read_bvh
 from reactmocap.library.clip_library import ClipLibrary
 from reactmocap.library.motion import Motion
-from reactmocap.library.placement import place
-from reactmocap.response.blend import blend_poses, final_blend, transition_weights
-from reactmocap.response.footlock import lock_feet
+from reactmocap.library.placement import ground_root, place
+from reactmocap.response.blend import blend_poses, transition_weights
 from reactmocap.response.library_cache import LibraryCache
-from reactmocap.response.scenario import CharacterSpec, ResponseConfig, Scenario
-from reactmocap.rotations import quat_slerp
+from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_schedule
+from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
+from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.search import MotionIndex, SearchResult
 from reactmocap.sim.character import Character, build_character
-from reactmocap.sim.controllers import Controller, State, StateMachine, after, build
+from reactmocap.sim.controllers import (
+    Controller,
+    GainScalable,
+    Scheduled,
+    State,
+    StateMachine,
+    after,
+    build,
+)
 from reactmocap.sim.controllers.registry import controller_spec
-from reactmocap.sim.impacts import Impact, first_contact
+from reactmocap.sim.impacts import Impact, first_contact, overlap_depths
 from reactmocap.sim.reference import reference_path
 from reactmocap.sim.rollout import ContactLog, rollout
 from reactmocap.sim.world import World, WorldConfig
 
 __all__ = [
     "CONTACT_EVERY",
+    "PHYSICAL_TRACKERS",
     "SCAN_FPS",
     "Actor",
-    "Blend",
     "Cast",
     "ContactEstimate",
     "Continuation",
     "NaiveSimulation",
     "TransitionSimulation",
-    "blend",
     "cast",
+    "desired_motion",
     "estimate_contact",
     "naive_simulation",
     "search_continuation",
     "transition_simulation",
+    "yields_to",
 ]
 
 F64 = NDArray[np.float64]
@@ -83,6 +93,12 @@ class Cast:
     def actors(self) -> list[Actor]:
         return [self.recipient] + ([self.attacker] if self.attacker is not None else [])
 
+    @cached_property
+    def pair(self) -> World:
+        """Both characters in one World for kinematic contact and overlap checks (poses are
+        set, it is never stepped); built once, since building a World costs ~10 ms."""
+        return World([a.character for a in self.actors])
+
 
 def _clip(scenario: Scenario, spec: CharacterSpec, cache: LibraryCache) -> Motion:
     """A clip by file (``x.bvh``: the scenario's folder first, then the working folder) or by
@@ -101,7 +117,7 @@ def _clip(scenario: Scenario, spec: CharacterSpec, cache: LibraryCache) -> Motio
 
 def _actor(scenario: Scenario, spec: CharacterSpec, cache: LibraryCache) -> Actor:
     clip = _clip(scenario, spec, cache)
-    parts = map_body_parts(clip.skeleton)
+    parts = parts_for(clip.skeleton, scenario.parts)
     frame = int(round(spec.start * clip.fps))
     if not 0 <= frame < clip.num_frames:
         raise ConfigError(
@@ -116,7 +132,7 @@ def cast(scenario: Scenario, cache: LibraryCache) -> Cast:
     """Load and place the clips, build the characters, prepare the search library."""
     recipient = _actor(scenario, scenario.recipient, cache)
     attacker = _actor(scenario, scenario.attacker, cache) if scenario.attacker else None
-    library, index = cache.search(scenario.library, recipient.clip)
+    library, index = cache.search(scenario.library, recipient.clip, scenario.parts)
     return Cast(recipient, attacker, library, index)
 
 
@@ -134,24 +150,30 @@ def estimate_contact(scenario: Scenario, cast: Cast) -> ContactEstimate:
     """The explicit impact's time, or the first kinematic contact of the two clips scanned at
     :data:`SCAN_FPS`; then rewind to the last recipient frame before it."""
     rec, att = cast.recipient, cast.attacker
+    fps = rec.motion.fps
     if att is not None:
         horizon = min(rec.motion.duration - rec.clock0, att.motion.duration - att.clock0)
         shifted = [a.motion.sample(np.arange(0, horizon, 1 / a.motion.fps) + a.clock0)
                    .replace(fps=a.motion.fps) for a in (rec, att)]  # fmt: skip
-        world = World([rec.character, att.character])
-        kc = first_contact(world, shifted, fps=SCAN_FPS, end=horizon)
-        # never touching: the scan runs to the end and the clip plays on
-        t, body = (horizon, "contact") if kc is None else (kc.time, "/".join(kc.pairs[0]))
-    else:
-        assert scenario.impact is not None
-        t, body = scenario.impact.at, scenario.impact.body
-    fps = rec.motion.fps
-    return ContactEstimate(t, max(0.0, float(np.floor(t * fps - 1e-9) / fps)), body)
+        kc = first_contact(cast.pair, shifted, fps=SCAN_FPS, end=horizon)
+        if kc is None:  # never touching: the scan runs to the end and the clip plays on
+            return ContactEstimate(horizon, max(0.0, np.floor(horizon * fps - 1e-9) / fps),
+                                   "contact")  # fmt: skip
+        # the last scanned frame without contact, on the recipient's frames: apart at the start
+        rewind = np.floor(kc.rewind_time * fps + 1e-9) / fps
+        return ContactEstimate(kc.time, max(0.0, float(rewind)), "/".join(kc.pairs[0]))
+    assert scenario.impact is not None
+    t = scenario.impact.at
+    return ContactEstimate(t, max(0.0, float(np.floor(t * fps - 1e-9) / fps)),
+                           scenario.impact.body)  # fmt: skip
 
 
-def _world(cast: Cast, friction: float, cfg: ResponseConfig) -> World:
+def _world(cast: Cast, cfg: ResponseConfig, recipient_friction: float) -> World:
+    """The simulations' world: the attacker always on ``friction_sim1`` (its strike should not
+    depend on the pass), the recipient on ``recipient_friction``."""
     world = World([a.character for a in cast.actors],
-                  WorldConfig(friction=friction, timestep=cfg.timestep))  # fmt: skip
+                  WorldConfig(friction=cfg.friction_sim1, timestep=cfg.timestep))  # fmt: skip
+    world.set_friction(recipient_friction, character=0)
     return world
 
 
@@ -194,6 +216,30 @@ class NaiveSimulation:
     peak_force: float
     contacts: ContactLog
     steps: int
+    impulse: float  # |impulse| on the recipient (N s)
+
+
+def _attacker(world: World, cast: Cast, cfg: ResponseConfig, rewind: float) -> list[Controller]:
+    """The attacker's controllers: ``attacker_controller`` on its clip, and the root assist
+    until the hit when ``attacker_assist`` asks for it."""
+    att = cast.attacker
+    assert att is not None
+    out = [_controller(cfg.attacker_controller, cfg, world, 1, att.motion, rewind + att.clock0,
+                       att.motion.fps)]  # fmt: skip
+    if cfg.attacker_assist > 0:
+        assist = build("root_assist", world, att.motion, {"kp": cfg.attacker_assist},
+                       character=1, start=rewind + att.clock0)  # fmt: skip
+        out.append(AssistUntilHit(assist, int(world.characters[1].body_ids[0])))
+    return out
+
+
+def _impulse_of(impact: ImpactSpec) -> float:
+    return float(np.linalg.norm(impact.force)) * impact.duration
+
+
+def yields_to(cfg: ResponseConfig, impulse: float) -> bool:
+    """Whether the recipient gives way to a hit of ``impulse`` N s (``yielding`` mode)."""
+    return cfg.sim1_mode == "yielding" and impulse >= cfg.react_impulse
 
 
 def _start(world: World, cast: Cast, rewind: float) -> None:
@@ -201,19 +247,56 @@ def _start(world: World, cast: Cast, rewind: float) -> None:
         world.set_from_motion(k, a.motion, a.frame_at(rewind))
 
 
+def desired_motion(cast: Cast, cfg: ResponseConfig, times: F64, impact: float, yields: bool,
+                   target: Continuation) -> Motion:  # fmt: skip
+    """What Simulation 2 asks of the recipient at scenario ``times``: the old clip until
+    ``impact``; from there (``yields``) its pose at the impact, held through the reaction delay
+    while moving on with the body's velocity (or the old clip on); eased (smoothstep) into the
+    found clip by the match time, where it is exactly the found clip."""
+    rec = cast.recipient
+    times = np.asarray(times, dtype=np.float64)
+    prev = rec.motion.sample((np.minimum(times, impact) if yields else times) + rec.clock0)
+    prev = ground_root(prev, rec.parts, turn=False)
+    if yields:
+        pelvis = rec.parts.joint_of("pelvis")
+        ends = rec.motion.sample(impact + rec.clock0 + np.array([-0.5, 0.5]) / rec.motion.fps)
+        g = ends.global_positions()[:, pelvis]
+        velocity = (g[1] - g[0]) * rec.motion.fps
+        coast = np.maximum(times - impact, 0.0)[:, None] * velocity
+        prev = prev.replace(root_positions=prev.root_positions + coast)
+    found = ground_root(target.found.sample(target.best.time + (times - target.time)), rec.parts,
+                        turn=False)  # fmt: skip
+    return blend_poses(prev, found, transition_weights(times, impact, cfg.reaction_delay,
+                                                       target.time))  # fmt: skip
+
+
+def _recipient_path(cast: Cast, cfg: ResponseConfig, rewind: float, seconds: float, every: int,
+                    impact: float, yields: bool, target: Continuation) -> tuple[F64, float]:  # fmt: skip
+    """Simulation 2's desired qpos (:func:`desired_motion`) at each control tick from the rewind,
+    and its rate."""
+    n = int(np.ceil(seconds / cfg.timestep / every)) + 1
+    ticks = np.arange(n, dtype=np.float64) * every * cfg.timestep + rewind
+    motion = desired_motion(cast, cfg, ticks, impact, yields, target)
+    return cast.recipient.character.qpos_from_motion(motion), 1.0 / (every * cfg.timestep)
+
+
 def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -> NaiveSimulation:
-    """Simulation 1 (friction ``friction_sim1``): ``holding`` tracks the old clip on with
-    ``sim1_controller``; ``passive`` lets go at the contact (a ragdoll)."""
+    """Simulation 1 (friction ``friction_sim1``) with ``sim1_controller``: the recipient
+    ``yielding`` to the hit (the default), ``holding`` its old clip or ``passive`` from the
+    contact (see :class:`~reactmocap.response.scenario.ResponseConfig`)."""
     cfg = scenario.response
     rewind = contact.rewind
     end = contact.time + cfg.sim1_duration + cast.index.window.length / cast.index.window.fps
-    world = _world(cast, cfg.friction_sim1, cfg)
+    world = _world(cast, cfg, cfg.friction_sim1)
     _start(world, cast, rewind)
     state = world.get_state()
+    fps = cast.recipient.motion.fps
     rec = cast.recipient
-    fps = rec.motion.fps
     hold = _controller(cfg.sim1_controller, cfg, world, 0, rec.motion, rewind + rec.clock0, fps)
-    if cfg.sim1_mode == "passive":
+    imp = scenario.impact
+    if (imp is None and cfg.sim1_mode == "yielding") or (imp and yields_to(cfg, _impulse_of(imp))):
+        hold = YieldOnImpact(hold, cfg, imp.at - rewind if imp is not None else None)
+    elif cfg.sim1_mode == "passive":
         hold = StateMachine(
             [State("holding", hold, exits=((after(contact.time - rewind), "passive"),)),
              State("passive", on_enter=lambda w, _t: w.servo.enable(0, on=False))],
@@ -221,9 +304,7 @@ def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -
         )  # fmt: skip
     ctrls = [hold]
     if cast.attacker is not None:
-        att = cast.attacker
-        ctrls.append(_controller(cfg.attacker_controller, cfg, world, 1, att.motion,
-                                 rewind + att.clock0, fps))  # fmt: skip
+        ctrls += _attacker(world, cast, cfg, rewind)
     res = rollout(
         world, end - rewind, controllers=ctrls, impacts=_impacts(scenario, rewind),
         record_fps=fps, references=[a.motion for a in cast.actors],
@@ -234,15 +315,16 @@ def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -
     assert log is not None
     if not log.empty:
         t_impact, contact_end = rewind + log.times[0], rewind + log.times[-1]
-        peak = log.peak_force
+        peak, impulse = log.peak_force, float(np.linalg.norm(log.impulse))
     elif scenario.impact is not None:
         t_impact = scenario.impact.at
         contact_end = t_impact + scenario.impact.duration
         peak = float(np.linalg.norm(scenario.impact.force))
+        impulse = _impulse_of(scenario.impact)
     else:
-        t_impact, contact_end, peak = contact.time, contact.time, 0.0
+        t_impact, contact_end, peak, impulse = contact.time, contact.time, 0.0, 0.0
     return NaiveSimulation(res.motion(0, name="sim1"), state, t_impact, contact_end, peak, log,
-                           res.steps)  # fmt: skip
+                           res.steps, impulse)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -268,6 +350,10 @@ def search_continuation(
     t_impact = naive.impact_time
     first = t_impact + float(np.clip(naive.contact_end - t_impact, cfg.search_start,
                                      cfg.contact_shift_max))  # fmt: skip
+    if naive.impulse >= cfg.react_impulse:
+        # a real hit: the active response after the reaction delay needs time to show, so the
+        # recipient's own clip right after the hit cannot win by being closest
+        first = max(first, t_impact + cfg.reaction_delay + cfg.active_min)
     last = t_impact + cfg.search_end
     q_fps = index.window.fps
     query = naive.motion.resample(q_fps)
@@ -277,12 +363,79 @@ def search_continuation(
     if starts.size == 0:
         raise SearchError("the simulated trajectory is too short for one search window")
     parts = cast.recipient.parts
-    results = [(index.query(query, int(s), parts=parts), int(s)) for s in starts]
-    best, best_start = min(results, key=lambda r: r[0].distance)
+    rec = cast.recipient
+    hit = naive.impulse >= cfg.react_impulse
+
+    def allowed(r: SearchResult, start: float) -> bool:
+        # after a real hit the recipient's own clip around its undisturbed time is no reaction
+        own = rec.clock0 + contact.rewind + start / q_fps
+        return not (hit and r.clip == rec.clip.name and abs(r.time - own) < cfg.own_clip_margin)
+
+    results = []
+    for s in starts.tolist():
+        r: SearchResult | None = index.query(query, s, parts=parts)
+        if r is not None and not allowed(r, s):
+            r = next((c for c in index.top_k(query, s, n=4, parts=parts) if allowed(c, s)), None)
+        if r is not None:
+            results.append((r, s))
+    if not results:
+        raise SearchError("no library window continues the response (only the recipient's own "
+                          "clip matched, and a real hit rules it out)")  # fmt: skip
+    results.sort(key=lambda r: r[0].distance)
+    # a continuation that walks into the attacker (back on its own clip) is no continuation
+    best, best_start = next((r for r in results
+                             if not _runs_into(cast, cfg, r[0], contact.rewind + r[1] / q_fps)),
+                            results[0])  # fmt: skip
     candidates = index.top_k(query, best_start, n=cfg.top_k, parts=parts)
     found_clip = cast.library[best.clip]
     found = found_clip.transformed(best.yaw, best.translation).replace(name=best.clip)
     return Continuation(best, candidates, contact.rewind + best_start / q_fps, found, found_clip)
+
+
+def _runs_into(cast: Cast, cfg: ResponseConfig, r: SearchResult, at: float) -> bool:
+    """Whether window ``r``'s clip, matched at scenario time ``at`` and played for ``tail``
+    seconds, runs into the attacker's own clip (scanned at :data:`SCAN_FPS`)."""
+    att = cast.attacker
+    if att is None:
+        return False
+    clip = cast.library[r.clip]
+    t = np.arange(0.0, min(cfg.tail, clip.duration - r.time), 1.0 / SCAN_FPS)
+    if t.size == 0:
+        return False
+    found = clip.transformed(r.yaw, r.translation).sample(r.time + t).replace(fps=SCAN_FPS)
+    own = att.motion.sample(at + t + att.clock0).replace(fps=SCAN_FPS)
+    return bool(overlap_depths(cast.pair, [found, own]).max() > 0.02)
+
+
+#: Simulation 2's controllers in the physical mode: trackers that keep a free-rooted body
+#: balanced while it follows the found clip (the joint-only ``pd`` servo cannot)
+PHYSICAL_TRACKERS = ("wholebody", "predictive")
+
+
+class _Landing:
+    """The physical mode's stop condition: from ``after`` s into the rollout, the recipient is
+    within the landing tolerances of the desired path ``q`` (qpos per control tick, ``rate``
+    Hz from the rollout's start); ``at`` is then that time (None until it is)."""
+
+    def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float) -> None:
+        self.cfg, self.q, self.rate, self.after = cfg, q, rate, after
+        self.at: float | None = None
+        self.gap = np.full(3, np.inf)  # the last check's pelvis (m), root and joint (rad) gaps
+
+    def __call__(self, world: World, t: float) -> str | None:
+        if t < self.after - 1e-9:
+            return None
+        want = self.q[min(int(round(t * self.rate)), len(self.q) - 1)]
+        cur = world.data.qpos[world.characters[0].qpos_slice]
+        turn = np.linalg.norm(
+            quat_log(quat_mul(quat_conj(want[3:].reshape(-1, 4)), cur[3:].reshape(-1, 4))), axis=1
+        )
+        self.gap = np.array([np.linalg.norm(cur[:3] - want[:3]), turn[0], turn[1:].max()])
+        cfg = self.cfg
+        if np.all(self.gap <= (cfg.land_position, cfg.land_angle, cfg.land_joint)):
+            self.at = t
+            return "landed on the found clip"
+        return None
 
 
 @dataclass(frozen=True)
@@ -294,99 +447,100 @@ class TransitionSimulation:
     attacker: Motion | None
     steps: int
     world: World
-
-
-def _desired_path(cast: Cast, cfg: ResponseConfig, naive: NaiveSimulation, cont: Continuation,
-                  rewind: float, seconds: float, every: int) -> tuple[F64, float]:  # fmt: skip
-    """The recipient's desired qpos at each control tick from the rewind: the old clip until
-    the reaction delay, then eased into the found clip (root lerped, rotations slerped)."""
-    ch = cast.recipient.character
-    dt = cfg.timestep
-    n = int(np.ceil(seconds / dt / every)) + 1
-    ticks = np.arange(n) * every * dt + rewind
-    prev = ch.qpos_from_motion(cast.recipient.motion.sample(ticks + cast.recipient.clock0))
-    found = ch.qpos_from_motion(cont.found.sample(cont.best.time + (ticks - cont.time)))
-    w = transition_weights(ticks, naive.impact_time, cfg.reaction_delay, cont.time)
-    q = np.empty_like(prev)
-    q[:, :3] = prev[:, :3] + w[:, None] * (found[:, :3] - prev[:, :3])
-    quats = quat_slerp(prev[:, 3:].reshape(n, -1, 4), found[:, 3:].reshape(n, -1, 4), w[:, None])
-    q[:, 3:] = quats.reshape(n, -1)
-    return q, 1.0 / (every * dt)
+    contacts: ContactLog
+    #: scenario time from which the attacker's own clip no longer runs into the recipient: its
+    #: output follows the simulation until then (or the end of ``attacker_follow``)
+    attacker_release: float = 0.0
+    #: scenario time the blend lands on the found clip: the match time in the ``blend`` mode;
+    #: in the ``physical`` mode when the body got there (or the simulation's end)
+    landed: float = 0.0
+    #: physical mode: the body reached the found clip within the landing tolerances
+    on_clip: bool = True
+    #: physical mode: the pelvis (m), root and largest joint (rad) gaps to the found clip at
+    #: the landing (or the simulation's end)
+    landing_gap: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    #: physical mode: why Simulation 2 stopped early (it went unstable), else None; it ends at
+    #: its last stable frame and the blend closes the rest
+    unstable: str | None = None
 
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
                           naive: NaiveSimulation, cont: Continuation) -> TransitionSimulation:  # fmt: skip
     """Simulation 2 (friction ``friction_sim2``) from the same start and impact: the recipient
-    tracks the desired path with ``sim2_controller`` (the reaction delay is in the path)."""
+    follows the desired path to the found clip with ``sim2_controller``, yielding through the
+    reaction delay as in Simulation 1 (the passive response), then recovering (the active).
+    In the ``physical`` mode it runs on along the found clip until the body lands on it."""
     cfg = scenario.response
     rewind = contact.rewind
     end = cont.time
+    physical = cfg.mode == "physical"
+    if physical:  # no further than the found clip goes
+        end += max(0.0, min(cfg.land_within, cont.found.duration - cont.best.time))
+    release = 0.0
     if cast.attacker is not None:
-        end = max(end, naive.impact_time + cfg.attacker_follow + cfg.attacker_blend)
+        release = max(naive.impact_time + cfg.attacker_follow,
+                      _attacker_clear(cast, cfg, naive, cont))  # fmt: skip
+        end = max(end, release + cfg.attacker_blend)
     seconds = max(end - rewind, cfg.timestep)
-    world = _world(cast, cfg.friction_sim2, cfg)
+    world = _world(cast, cfg, cfg.friction_sim2)
     world.set_state(naive.start_state)
-    every = int(controller_spec(cfg.sim2_controller).defaults["control_every"] or 1)
-    q, rate = _desired_path(cast, cfg, naive, cont, rewind, seconds, every)
-    ctrls = [_controller(cfg.sim2_controller, cfg, world, 0, q, 0.0, rate)]
+    name = cfg.sim2_controller
+    if physical and name not in PHYSICAL_TRACKERS:
+        name = PHYSICAL_TRACKERS[0]
+    every = int(controller_spec(name).defaults["control_every"] or 1)
+    yields = yields_to(cfg, naive.impulse)
+    q, rate = _recipient_path(cast, cfg, rewind, seconds, every, naive.impact_time, yields, cont)
+    recipient = _controller(name, cfg, world, 0, q, 0.0, rate)
+    if yields and isinstance(recipient, GainScalable):
+        recipient = Scheduled(recipient, yield_schedule(cfg, naive.impact_time - rewind))
+    ctrls = [recipient]
     fps = [cast.recipient.motion.fps]
     if cast.attacker is not None:
-        att = cast.attacker
-        ctrls.append(_controller(cfg.attacker_controller, cfg, world, 1, att.motion,
-                                 rewind + att.clock0, att.motion.fps))  # fmt: skip
-        fps.append(att.motion.fps)
+        ctrls += _attacker(world, cast, cfg, rewind)
+        fps.append(cast.attacker.motion.fps)
+    landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind) if physical else None
     res = rollout(
         world, seconds, controllers=ctrls, impacts=_impacts(scenario, rewind), record_fps=fps,
         references=[a.motion for a in cast.actors],
-        reference_start=[rewind + a.clock0 for a in cast.actors],
+        reference_start=[rewind + a.clock0 for a in cast.actors], contact_every=CONTACT_EVERY,
+        stop=landing, on_unstable="stop" if physical else "raise",
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
-    return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world)
+    assert res.contact_log is not None
+    landed, on_clip, gap = cont.time, True, (0.0, 0.0, 0.0)
+    if landing is not None:
+        on_clip = landing.at is not None
+        # a simulation that went unstable before the match still lands no earlier than it
+        landed = max(cont.time, rewind + (res.duration if landing.at is None else landing.at))
+        gap = (float(landing.gap[0]), float(landing.gap[1]), float(landing.gap[2]))
+    unstable = res.reason if res.status == "unstable" else None
+    return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
+                                res.contact_log, release, landed, on_clip, gap,
+                                unstable)  # fmt: skip
 
 
-@dataclass(frozen=True)
-class Blend:
-    """The outputs: the ``recipient`` animation (mocap before the impact, the blended
-    transition, the found clip after), the ``attacker``'s, the ``blended`` transition alone,
-    Simulation 2 over the same frames (``simulated``), and the ``seams`` between pieces."""
-
-    recipient: Motion
-    attacker: Motion | None
-    blended: Motion
-    simulated: Motion
-    seams: list[int]
+def _output_end(cfg: ResponseConfig, cont: Continuation, landed: float | None = None) -> float:
+    """Scenario time of the recipient output's last frame (the found clip's tail included)
+    when the blend lands on the found clip at ``landed`` (the match time if None)."""
+    land = cont.time if landed is None else landed
+    return land + max(0.0, min(cfg.tail, cont.found.duration - cont.best.time - (land - cont.time)))
 
 
-def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
-          cont: Continuation, sim2: TransitionSimulation) -> Blend:  # fmt: skip
-    """The paper's final blend over [impact, match], then the found clip plays on; the attacker
-    follows its simulation briefly, then blends back to its clip."""
-    cfg = scenario.response
-    rec = cast.recipient
-    fps = rec.motion.fps
-    i_imp = int(np.ceil(naive.impact_time * fps - 1e-9))
-    i_end = int(round(cont.time * fps))
-    before = rec.motion.sample(np.arange(0, i_imp) / fps + rec.clock0) if i_imp > 0 else None
-    times = np.arange(i_imp, i_end + 1) / fps
-    simulated = sim2.motion.sample(times - contact.rewind)
-    blended = final_blend(simulated, cont.found.sample(cont.best.time + (times - cont.time)))
-    if cfg.foot_lock:
-        blended = lock_feet(blended, rec.parts)
-    tail_n = int(np.floor(min(cfg.tail, cont.found.duration - cont.best.time) * fps))
-    tail = (cont.found.sample(cont.best.time + np.arange(1, tail_n + 1) / fps)
-            if tail_n > 0 else None)  # fmt: skip
-    pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]
-    recipient = Motion.concatenate(pieces, name="recipient")
-    attacker = None
-    if cast.attacker is not None and sim2.attacker is not None:
-        att = cast.attacker
-        afps = att.motion.fps
-        t = np.arange(0, int(np.floor(recipient.duration * afps)) + 1) / afps
-        own = att.motion.sample(t + att.clock0).replace(fps=afps)
-        simulated_att = sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration))
-        t1 = naive.impact_time + cfg.attacker_follow
-        w = np.where(t < naive.impact_time, 1.0,
-                     np.clip((t - t1) / max(cfg.attacker_blend, 1e-9), 0, 1))  # fmt: skip
-        attacker = blend_poses(simulated_att, own, w).replace(name="attacker")
-    seams = [i_imp, i_end + 1] if before is not None else [i_end + 1]
-    return Blend(recipient, attacker, blended, simulated, seams)
+def _attacker_clear(cast: Cast, cfg: ResponseConfig, naive: NaiveSimulation,
+                    cont: Continuation) -> float:  # fmt: skip
+    """The last scenario time at which the attacker's own clip still runs into the recipient's
+    planned output (its clip eased into the found clip), scanned at :data:`SCAN_FPS` from the
+    impact: until then the attacker's output must stay simulated (physical), not its clip."""
+    att, rec = cast.attacker, cast.recipient
+    assert att is not None
+    t = np.arange(naive.impact_time, _output_end(cfg, cont), 1.0 / SCAN_FPS)
+    if t.size == 0:
+        return naive.impact_time
+    w = transition_weights(t, naive.impact_time, cfg.reaction_delay, cont.time)
+    planned = blend_poses(rec.motion.sample(t + rec.clock0),
+                          cont.found.sample(cont.best.time + (t - cont.time)), w)  # fmt: skip
+    own = att.motion.sample(t + att.clock0)
+    world = cast.pair
+    depth = overlap_depths(world, [planned.replace(fps=SCAN_FPS), own.replace(fps=SCAN_FPS)])
+    hit = np.flatnonzero(depth > 0.0)
+    return float(t[hit[-1]] + 1.0 / SCAN_FPS) if hit.size else naive.impact_time

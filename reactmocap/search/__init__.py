@@ -1,5 +1,5 @@
-"""Motion search: weighted window features, the paper's window distance ``D`` and a KD-tree index
-with exact re-ranking and local refinement (Zordan et al. 2005, section 3).
+"""Motion search: the paper's window distance ``D`` and a KD-tree index over library windows with
+exact re-ranking and local refinement (Zordan et al. 2005, section 3).
 
 Typical use::
 
@@ -10,6 +10,7 @@ Typical use::
     found = library.clips[best.clip].transformed(best.yaw, best.translation)  # overlays the query
 """
 
+from reactmocap.search.build import build_index, library_fingerprint
 from reactmocap.search.config import SearchWeights, WindowConfig
 from reactmocap.search.distance import BREAKDOWN_TERMS, QueryWindow
 from reactmocap.search.features import (
@@ -20,13 +21,9 @@ from reactmocap.search.features import (
     frame_features,
     get_feature_set,
 )
-from reactmocap.search.index import (
-    Breakdown,
-    MotionIndex,
-    SearchResult,
-    brute_force,
-    library_fingerprint,
-)
+from reactmocap.search.index import MotionIndex
+from reactmocap.search.query import QueryCache, brute_force, prepare_query, search_window
+from reactmocap.search.types import Breakdown, QueryStats, SearchResult
 
 __all__ = [
     "BREAKDOWN_TERMS",
@@ -35,13 +32,18 @@ __all__ = [
     "FeatureSet",
     "FrameFeatures",
     "MotionIndex",
+    "QueryCache",
+    "QueryStats",
     "QueryWindow",
     "SearchResult",
     "SearchWeights",
     "WindowConfig",
     "brute_force",
+    "build_index",
     "calibrate",
     "frame_features",
     "get_feature_set",
     "library_fingerprint",
+    "prepare_query",
+    "search_window",
 ]

@@ -1,33 +1,7 @@
-"""Per-frame body features of a Motion: positions and orientations of the mapped body parts,
-the root heading and ground origin, and an approximate centre of mass.
-
-Nothing here knows about simulation: a simulated trajectory read back as a Motion goes through
-the same code.
-
-Definitions (documented in ``docs``-style detail because the search must be explainable):
-
-* **Body frame and heading.** From the skeleton's rest pose (identity local rotations, skeleton
-  offsets) we build an anatomical pelvis frame: ``up`` = pelvis -> chest, ``left`` = right thigh
-  joint -> left thigh joint (orthogonalised), ``forward = left x up``. It is stored in the pelvis
-  joint's local frame, so it is body-fixed whatever the rest pose looks like (the Bandai Namco
-  files'
-  rest pose lies along +X; the frame still comes out anatomical). Each frame, the body frame's world
-  orientation is ``q_pelvis(t) * B``; the **heading** is its twist about world +Z
-  (``yaw = 2 atan2(q_z, q_w)`` of the swing-twist decomposition ``q = twist_z * swing``). Unlike the
-  projected forward axis, this stays defined when the character lies face down or face up; it is
-  singular only when the pelvis is exactly upside down.
-* **Root origin.** The pelvis joint's horizontal position (not joint 0, which may be a dummy such as
-  the Bandai ``joint_Root``).
-* **Part orientations.** Part ``b``'s canonical frame is the rest body frame, swung so that the
-  canonical bone direction (trunk: up, arms: out to their side, legs: down, feet: forward) lands on
-  the part's rest bone direction. Its world orientation at ``t`` is ``q_b(t) * c_b`` with
-  ``c_b = q_b_rest^-1 * W_rest * S_b^-1``. Within one skeleton family (and its mirror) this is
-  exact;
-  across families it is the swing-aligned approximation (twist about a bone can differ).
-* **Centre of mass.** Fixed mass fractions (Winter's tables, trunk split into pelvis/abdomen/
-  thorax) at segment midpoints (part joint to the next part's joint; hand, foot and head at their
-  joint). An approximation: good enough to pick which support body is nearest to it.
-"""
+"""Per-frame body features of a Motion for the search: positions and canonical orientations of
+the mapped body parts, the heading and ground origin of the body frame, and an approximate centre
+of mass (to pick the support body). A simulated trajectory read back as a Motion goes through the
+same code. The definitions are in ``docs/design.md (Search)``."""
 
 from __future__ import annotations
 
@@ -38,26 +12,33 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import BodyPartMappingError, SearchError, UnknownKeyError
+from reactmocap.library.anthropometry import MASS_FRACTIONS
 from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
 from reactmocap.library.motion import Motion
+from reactmocap.library.placement import body_frame, body_heading, rest_pose
 from reactmocap.library.skeleton import Skeleton
-from reactmocap.rotations import quat_conj, quat_from_matrix, quat_mul, quat_rotate
+from reactmocap.rotations import (
+    quat_canonical,
+    quat_conj,
+    quat_from_matrix,
+    quat_mul,
+    quat_rotate,
+    quat_to_matrix,
+)
 
 __all__ = [
     "FEATURE_SETS",
-    "MASS_FRACTIONS",
     "FeatureSet",
     "FrameFeatures",
     "SkeletonCalibration",
     "calibrate",
     "calibrations_for",
+    "depth_levels",
     "features_from_arrays",
     "forward_kinematics_fast",
     "frame_features",
-    "matrix_to_quat_fast",
-    "quat_mul_fast",
     "get_feature_set",
-    "quat_to_matrix_fast",
+    "skeleton_key",
 ]
 
 F64 = NDArray[np.float64]
@@ -121,15 +102,6 @@ def get_feature_set(name: str) -> FeatureSet:
         ) from None
 
 
-#: mass fraction of each part (Winter; trunk 0.497 split into pelvis/abdomen/thorax; the neck is
-#: folded into the head). Sums to 1 over the required parts.
-MASS_FRACTIONS: dict[str, float] = {
-    "pelvis": 0.142, "waist": 0.139, "chest": 0.216, "head": 0.081,
-    **{f"{s}_{p}": m for s in ("l", "r") for p, m in (
-        ("upper_arm", 0.028), ("forearm", 0.016), ("hand", 0.006),
-        ("thigh", 0.100), ("shin", 0.0465), ("foot", 0.0145))},
-}  # fmt: skip
-
 # Next part down each chain (bone direction and segment midpoint); the first present one is used.
 _NEXT_PART: dict[str, tuple[str, ...]] = {
     "pelvis": ("waist", "chest"),
@@ -178,8 +150,9 @@ def _swing(a: F64, b: F64) -> F64:
 
 @dataclass(frozen=True)
 class SkeletonCalibration:
-    """Per-skeleton constants: part joints, body frame ``B`` in pelvis-local coordinates and each
-    part's canonical-frame offset ``c_b`` (see the module docstring)."""
+    """Per-skeleton constants: part joints, the body frame ``B`` (pelvis-local), each part's
+    canonical-frame offset ``c_b``, the centre-of-mass segments and the joints grouped by depth
+    for the batched forward kinematics."""
 
     feature_set: FeatureSet
     joints: NDArray[np.int64]  # (P,) joint index of each feature part
@@ -189,15 +162,7 @@ class SkeletonCalibration:
     com_joints: NDArray[np.int64]  # (M,) joint of each massed part
     com_next: NDArray[np.int64]  # (M,) joint of the next part (== com_joints when none)
     com_mass: F64  # (M,) normalised mass fractions
-
-
-def _rest_pose(skeleton: Skeleton) -> tuple[F64, F64]:
-    j = skeleton.num_joints
-    rot = np.zeros((1, j, 4))
-    rot[..., 0] = 1.0
-    m = Motion(skeleton, 30.0, np.zeros((1, 3)), rot)
-    pos, grot = m.forward_kinematics()
-    return pos[0], grot[0]
+    levels: tuple[NDArray[np.int64], ...]  # non-root joints by depth (for the FK)
 
 
 def calibrate(
@@ -211,23 +176,13 @@ def calibrate(
     try:
         bp = parts if parts is not None else map_body_parts(skeleton)
         joints = bp.indices(list(feature_set.parts))
+        body = body_frame(skeleton, bp)
     except BodyPartMappingError as exc:
         raise SearchError(f"cannot compute search features: {exc}") from None
-    pos, grot = _rest_pose(skeleton)
+    pos, grot = rest_pose(skeleton)
     jm = bp.joints
     pelvis = jm["pelvis"]
-    up = pos[jm["chest"]] - pos[pelvis]
-    left = pos[jm["l_thigh"]] - pos[jm["r_thigh"]]
-    if np.linalg.norm(up) < 1e-6 or np.linalg.norm(left) < 1e-6:
-        raise SearchError("cannot compute search features: degenerate rest pose (pelvis frame)")
-    z = up / np.linalg.norm(up)
-    y = left - np.dot(left, z) * z
-    if np.linalg.norm(y) < 1e-6:
-        raise SearchError("cannot compute search features: thighs are collinear with the spine")
-    y /= np.linalg.norm(y)
-    x = np.cross(y, z)
-    w_rest = quat_from_matrix(np.stack([x, y, z], axis=1))
-    body = quat_mul(quat_conj(grot[pelvis]), w_rest)
+    w_rest = quat_mul(grot[pelvis], body)  # the body frame in the rest pose, world
 
     def bone_dir(part: str) -> F64 | None:
         for nxt in _NEXT_PART.get(part, ()):
@@ -281,6 +236,7 @@ def calibrate(
         com_joints=np.asarray(com_j, dtype=np.int64),
         com_next=np.asarray(com_n, dtype=np.int64),
         com_mass=mass_arr,
+        levels=depth_levels(skeleton.parents),
     )
 
 
@@ -310,19 +266,29 @@ def frame_features(motion: Motion, calib: SkeletonCalibration) -> FrameFeatures:
     )
 
 
+def depth_levels(parents: NDArray[np.int64]) -> tuple[NDArray[np.int64], ...]:
+    """Non-root joints grouped by depth (parents precede children, so depth is one pass)."""
+    depth = np.zeros(len(parents), dtype=np.int64)
+    for k in range(1, len(parents)):
+        depth[k] = depth[parents[k]] + 1
+    return tuple(np.flatnonzero(depth == d) for d in range(1, int(depth.max(initial=0)) + 1))
+
+
 def forward_kinematics_fast(
     skeleton: Skeleton,
     root_positions: F64,
     rotations: F64,
     translations: F64 | None,
+    levels: tuple[NDArray[np.int64], ...] | None = None,
 ) -> tuple[F64, F64]:
     """Global joint positions ``(T, J, 3)`` and rotation matrices ``(T, J, 3, 3)``.
 
-    Same result as :meth:`Motion.forward_kinematics` but with batched 3x3 products, which is
-    several times faster for the short windows a query needs.
+    Same result as :meth:`Motion.forward_kinematics` but with batched 3x3 products, all joints of
+    one depth at once, which is several times faster for the short windows a query needs.
+    ``levels``: :func:`depth_levels` of the skeleton, when already known.
     """
     t, j = rotations.shape[:2]
-    local_r = quat_to_matrix_fast(np.asarray(rotations, dtype=np.float64))
+    local_r = quat_to_matrix(np.asarray(rotations, dtype=np.float64))
     local_t = (
         np.asarray(translations, dtype=np.float64)
         if translations is not None
@@ -333,30 +299,12 @@ def forward_kinematics_fast(
     pos[:, 0] = root_positions
     rot[:, 0] = local_r[:, 0]
     parents = skeleton.parents
-    for lvl in _depth_levels(parents):  # all joints of one depth at once
+    for lvl in levels if levels is not None else depth_levels(parents):
         par = parents[lvl]
         prot = rot[:, par]
         rot[:, lvl] = prot @ local_r[:, lvl]
         pos[:, lvl] = pos[:, par] + (prot @ local_t[:, lvl, :, None])[..., 0]
     return pos, rot
-
-
-_LEVELS: dict[bytes, list[NDArray[np.int64]]] = {}
-
-
-def _depth_levels(parents: NDArray[np.int64]) -> list[NDArray[np.int64]]:
-    """Non-root joints grouped by depth (parents precede children, so depth is one pass)."""
-    key = parents.tobytes()
-    levels = _LEVELS.get(key)
-    if levels is None:
-        depth = np.zeros(len(parents), dtype=np.int64)
-        for k in range(1, len(parents)):
-            depth[k] = depth[parents[k]] + 1
-        levels = [np.flatnonzero(depth == d) for d in range(1, int(depth.max()) + 1)]
-        if len(_LEVELS) > 256:
-            _LEVELS.clear()
-        _LEVELS[key] = levels
-    return levels
 
 
 def features_from_arrays(
@@ -369,13 +317,12 @@ def features_from_arrays(
 ) -> FrameFeatures:
     """:func:`frame_features` on raw motion arrays (no Motion construction in the query path).
     ``com_frames``: compute the centre of mass for the first frames only (a query needs one)."""
-    pos, grot = forward_kinematics_fast(skeleton, root_positions, rotations, translations)
-    gq = matrix_to_quat_fast(grot[:, np.append(calib.joints, calib.pelvis)])
-    ori = quat_mul_fast(gq[:, :-1], calib.offsets[None])
-    ori = np.where(ori[..., :1] < 0, -ori, ori)
-    body = quat_mul_fast(gq[:, -1], calib.body_frame[None])
-    heading = 2.0 * np.arctan2(body[:, 3], body[:, 0])
-    heading = (heading + np.pi) % (2 * np.pi) - np.pi
+    pos, grot = forward_kinematics_fast(
+        skeleton, root_positions, rotations, translations, calib.levels
+    )
+    gq = quat_from_matrix(grot[:, np.append(calib.joints, calib.pelvis)])
+    ori = quat_canonical(quat_mul(gq[:, :-1], calib.offsets[None]))
+    heading = body_heading(gq[:, -1], calib.body_frame)
     origin = pos[:, calib.pelvis, :2].copy()
     cp = pos[:com_frames]
     seg = 0.5 * (cp[:, calib.com_joints] + cp[:, calib.com_next])
@@ -383,72 +330,14 @@ def features_from_arrays(
     return FrameFeatures(pos[:, calib.joints], ori, heading, origin, com)
 
 
-def quat_mul_fast(a: NDArray[np.floating], b: NDArray[np.floating]) -> NDArray[np.floating]:
-    """Hamilton product of wxyz quaternions (broadcasting), without stacking overhead."""
-    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
-    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.result_type(a, b))
-    out[..., 0] = aw * bw - ax * bx - ay * by - az * bz
-    out[..., 1] = aw * bx + ax * bw + ay * bz - az * by
-    out[..., 2] = aw * by - ax * bz + ay * bw + az * bx
-    out[..., 3] = aw * bz + ax * by - ay * bx + az * bw
-    return out
-
-
-def matrix_to_quat_fast(m: NDArray[np.floating]) -> NDArray[np.floating]:
-    """wxyz quaternions (``w >= 0``) of rotation matrices ``(..., 3, 3)`` (Shepperd's method)."""
-    m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
-    tr = m00 + m11 + m22
-    s21, d21 = m[..., 2, 1] + m[..., 1, 2], m[..., 2, 1] - m[..., 1, 2]
-    s02, d02 = m[..., 0, 2] + m[..., 2, 0], m[..., 0, 2] - m[..., 2, 0]
-    s10, d10 = m[..., 1, 0] + m[..., 0, 1], m[..., 1, 0] - m[..., 0, 1]
-    cands = np.empty((*m.shape[:-2], 4, 4), dtype=m.dtype)  # row c: 4 q_c-scaled quaternion
-    cands[..., 0, 0], cands[..., 0, 1], cands[..., 0, 2], cands[..., 0, 3] = 1 + tr, d21, d02, d10
-    cands[..., 1, 0], cands[..., 1, 1], cands[..., 1, 2], cands[..., 1, 3] = (
-        d21,
-        1 + m00 - m11 - m22,
-        s10,
-        s02,
-    )
-    cands[..., 2, 0], cands[..., 2, 1], cands[..., 2, 2], cands[..., 2, 3] = (
-        d02,
-        s10,
-        1 - m00 + m11 - m22,
-        s21,
-    )
-    cands[..., 3, 0], cands[..., 3, 1], cands[..., 3, 2], cands[..., 3, 3] = (
-        d10,
-        s02,
-        s21,
-        1 - m00 - m11 + m22,
-    )
-    choice = np.argmax(np.stack([tr, m00, m11, m22], -1), axis=-1)
-    q = np.take_along_axis(cands, choice[..., None, None], axis=-2)[..., 0, :]
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    return np.where(q[..., :1] < 0, -q, q)
-
-
-def quat_to_matrix_fast(q: NDArray[np.floating]) -> NDArray[np.floating]:
-    """``(..., 3, 3)`` rotation matrices of unit wxyz quaternions (no scipy round trip)."""
-    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    xx, yy, zz = x * x, y * y, z * z
-    xy, xz, yz = x * y, x * z, y * z
-    wx, wy, wz = w * x, w * y, w * z
-    m = np.empty((*q.shape[:-1], 3, 3), dtype=q.dtype)
-    m[..., 0, 0] = 1 - 2 * (yy + zz)
-    m[..., 0, 1] = 2 * (xy - wz)
-    m[..., 0, 2] = 2 * (xz + wy)
-    m[..., 1, 0] = 2 * (xy + wz)
-    m[..., 1, 1] = 1 - 2 * (xx + zz)
-    m[..., 1, 2] = 2 * (yz - wx)
-    m[..., 2, 0] = 2 * (xz - wy)
-    m[..., 2, 1] = 2 * (yz + wx)
-    m[..., 2, 2] = 1 - 2 * (xx + yy)
-    return m
-
-
 def skeleton_key(skeleton: Skeleton) -> tuple[object, ...]:
-    return (skeleton.names, skeleton.parents.tobytes(), np.asarray(skeleton.offsets).tobytes())
+    """Hashable content of everything :func:`calibrate` reads from a skeleton."""
+    return (
+        skeleton.names,
+        skeleton.parents.tobytes(),
+        np.asarray(skeleton.offsets).tobytes(),
+        tuple((int(j), *map(float, o)) for j, o in sorted(skeleton.layout.end_sites.items())),
+    )
 
 
 def calibrations_for(

@@ -49,11 +49,16 @@ __all__ = [
     "Character",
     "SegmentInertia",
     "build_character",
+    "qvel_between",
     "qvel_from_qpos",
 ]
 
 F64 = NDArray[np.float64]
 MassModel = Literal["table", "geometry"]
+
+
+#: where a virtual chest starts on a single spine joint: this fraction of the way to the neck
+VIRTUAL_CHEST = 0.45
 
 
 def _kind(part: str) -> str:
@@ -76,11 +81,12 @@ def qvel_from_qpos(q: F64, fps: float) -> F64:
         return np.zeros((n, 6 + 3 * len(BALL_JOINTS)))
     lo = np.r_[0, np.arange(n - 1)]
     hi = np.r_[np.arange(1, n), n - 1]
-    return _differentiate(q[lo], q[hi], (hi - lo) / fps)
+    return qvel_between(q[lo], q[hi], (hi - lo) / fps)
 
 
-def _differentiate(qa: F64, qb: F64, span: F64) -> F64:
-    """qvel taking qpos rows ``qa`` to ``qb`` in ``span`` seconds each."""
+def qvel_between(qa: F64, qb: F64, span: F64) -> F64:
+    """``(N, 51)`` the constant qvel taking qpos rows ``qa`` ``(N, 67)`` to ``qb`` in ``span``
+    ``(N,)`` seconds each (MuJoCo's ``mj_differentiatePos``)."""
     n = qa.shape[0]
     lin = (qb[:, :3] - qa[:, :3]) / span[:, None]
     rel = quat_mul(quat_conj(qa[:, 3:].reshape(n, -1, 4)), qb[:, 3:].reshape(n, -1, 4))
@@ -106,7 +112,8 @@ class Character:
     Attributes:
         skeleton: the source skeleton (outputs are written on it).
         parts: body-part map of ``skeleton``.
-        anchors: ``(16,)`` skeleton joint index whose frame each sim body carries.
+        anchors: ``(16,)`` skeleton joint index whose frame each sim body carries (the waist
+            and chest share one on a skeleton with a single spine joint).
         body_pos, body_quat: ``(16, 3)``, ``(16, 4)`` rest transform of each body relative to its
             parent body (the pelvis: relative to the world).
         ref_rotations, ref_translations, ref_root: the reference pose the frames were taken from
@@ -117,6 +124,8 @@ class Character:
     skeleton: Skeleton
     parts: BodyPartMap
     anchors: NDArray[np.int64]
+    #: ``(16, 3)`` each body's origin in its anchor joint's frame: zero but for a virtual chest
+    anchor_offsets: F64
     body_pos: F64
     body_quat: F64
     ref_rotations: F64
@@ -244,7 +253,7 @@ class Character:
         lo = np.clip(idx - 1, 0, n - 1)
         hi = np.clip(idx + 1, 0, n - 1)
         q_lo, q_hi = self.qpos_from_motion(motion, lo), self.qpos_from_motion(motion, hi)
-        return _differentiate(q_lo, q_hi, (hi - lo) / motion.fps)
+        return qvel_between(q_lo, q_hi, (hi - lo) / motion.fps)
 
     # ------------------------------------------------------------------ state -> Motion
     def body_transforms_from_qpos(self, qpos: F64) -> tuple[F64, F64]:
@@ -357,7 +366,8 @@ class Character:
         d.qpos[:] = self.qpos_from_motion(motion, [frame])[0]
         mujoco.mj_kinematics(m, d)
         ids = [m.body(b).id for b in SIM_BODIES]
-        lib = _take_frames(motion, np.array([frame])).global_positions()[0, self.anchors]
+        pos, rot = _take_frames(motion, np.array([frame])).forward_kinematics()
+        lib = pos[0, self.anchors] + quat_rotate(rot[0, self.anchors], self.anchor_offsets)
         return np.linalg.norm(d.xpos[ids] - lib, axis=1)
 
     def check_fk(self, motion: Motion, frame: int = 0, tol: float = 1e-3) -> float:
@@ -480,7 +490,12 @@ def build_character(
     if "neck" in parts.joints:
         anchor_part["head"] = "neck"  # the head body pivots at the neck base
     anchors = np.array([parts.joint_of(anchor_part[b]) for b in SIM_BODIES], dtype=np.int64)
-    if len(set(anchors.tolist())) != len(anchors):
+    waist, chest = SIM_BODIES.index("waist"), SIM_BODIES.index("chest")
+    # one spine joint: the waist and chest share it; the chest body then starts part-way up
+    # the spine (a virtual joint the mocap holds straight)
+    shared = anchors[waist] == anchors[chest]
+    rest = np.delete(anchors, chest) if shared else anchors
+    if len(set(rest.tolist())) != len(rest):
         raise SimulationError(f"two sim bodies map to the same skeleton joint: {anchors.tolist()}")
     for b in range(1, len(SIM_BODIES)):
         if int(anchors[SIM_PARENTS[b]]) not in skeleton.chain(int(anchors[b])):
@@ -505,6 +520,11 @@ def build_character(
     gpos, grot = gpos_all[0], grot_all[0]
     P = gpos[anchors]
     G = grot[anchors]
+    anchor_offsets = np.zeros((len(SIM_BODIES), 3))
+    if shared:
+        up = P[SIM_BODIES.index("head")] - P[chest]
+        P[chest] = P[chest] + VIRTUAL_CHEST * up
+        anchor_offsets[chest] = quat_rotate(quat_conj(G[chest]), VIRTUAL_CHEST * up)
 
     body_quat = np.empty((len(SIM_BODIES), 4))
     body_pos = np.empty((len(SIM_BODIES), 3))
@@ -519,6 +539,7 @@ def build_character(
         skeleton=skeleton,
         parts=parts,
         anchors=anchors,
+        anchor_offsets=anchor_offsets,
         body_pos=body_pos,
         body_quat=quat_canonical(body_quat),
         ref_rotations=np.array(one.rotations[0]),

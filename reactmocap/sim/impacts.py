@@ -7,7 +7,7 @@ first contact between two characters."""
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -27,10 +27,20 @@ __all__ = [
     "ImpactSchedule",
     "KinematicContact",
     "contact_report",
+    "MAX_FORCE_N",
+    "MAX_IMPULSE_NS",
     "first_contact",
+    "overlap_depths",
 ]
 
 F64 = NDArray[np.float64]
+
+
+#: the largest push accepted: beyond this a character is not pushed but destroyed (the hardest
+#: human strikes peak near 10 kN; the simulation would only diverge)
+MAX_FORCE_N = 20_000.0
+#: the largest momentum an impact may deliver (a 75 kg body thrown at over 13 m/s)
+MAX_IMPULSE_NS = 1_000.0
 
 
 def _vec3(value: object, what: str) -> tuple[float, float, float]:
@@ -100,6 +110,16 @@ class Impact:
             raise ConfigError(f"impact duration must be >= 0 s, got {self.duration}")
         if self.duration == 0 and self.force is not None:
             raise ConfigError("a force impact needs a positive duration (use impulse= for a kick)")
+        dt = 0.0005
+        force = np.linalg.norm(self.force_vector(dt)) if self.force is not None else 0.0
+        total = (np.linalg.norm(self.impulse) if self.impulse is not None
+                 else force * max(self.duration, dt))  # fmt: skip
+        if force > MAX_FORCE_N or total > MAX_IMPULSE_NS:
+            raise ConfigError(
+                f"impact of {force:.0f} N / {total:.0f} N s is beyond the physical limit this "
+                f"simulation accepts ({MAX_FORCE_N:.0f} N, {MAX_IMPULSE_NS:.0f} N s): it would "
+                "destroy a human body, and the simulation would diverge"
+            )
         if not isinstance(self.character, int) or self.character < 0:
             raise ConfigError(f"impact character must be an index >= 0, got {self.character!r}")
 
@@ -264,31 +284,18 @@ class KinematicContact:
     pairs: tuple[tuple[str, str], ...]
 
 
-def first_contact(
-    world: World,
-    motions: Sequence[Motion],
-    fps: float = 30.0,
-    start: float = 0.0,
-    end: float | None = None,
-    margin: float = 0.0,
-) -> KinematicContact | None:
-    """Scan two characters' motions at ``fps`` (kinematic playback, no dynamics) for the first
-    frame where their geoms touch (penetration deeper than ``-margin``). Times are seconds
-    from the motions' start. Returns None if they never touch. The world's state is
-    overwritten (positions set with ``mj_kinematics`` + ``mj_collision``)."""
+def _kinematic_contacts(
+    world: World, motions: Sequence[Motion], times: F64, margin: float = 0.0
+) -> Iterator[tuple[int, list[tuple[int, int, float]]]]:
+    """Per frame of ``times``: the contacts between the two characters playing their motions
+    kinematically (``mj_kinematics`` + ``mj_collision``, no dynamics), as ``(geom of character
+    0, geom of character 1, distance)`` (negative: penetration). Overwrites the world's state."""
     if len(world.characters) != 2 or len(motions) != 2:
-        raise ConfigError("first_contact needs a world with two characters and two motions")
-    if not (np.isfinite(fps) and fps > 0):
-        raise ConfigError(f"fps must be positive, got {fps!r}")
+        raise ConfigError("a two-character scan needs a world with two characters and two motions")
     m, d = world.model, world.data
-    stop = min(mo.duration for mo in motions) if end is None else float(end)
-    times = np.arange(start, stop + 1e-9, 1.0 / fps)
-    if times.size == 0:
-        return None
-    qs = [
-        wc.character.qpos_from_motion(mo.sample(times)) for wc, mo in zip(world.characters, motions)
-    ]
-    char, body = world.geom_character, world.geom_body
+    qs = [wc.character.qpos_from_motion(mo.sample(times))
+          for wc, mo in zip(world.characters, motions)]  # fmt: skip
+    char = world.geom_character
     old_margin = m.geom_margin.copy()
     m.geom_margin[:] = max(margin, 0.0)
     try:
@@ -297,22 +304,54 @@ def first_contact(
                 d.qpos[wc.qpos_slice] = q[k]
             mujoco.mj_kinematics(m, d)
             mujoco.mj_collision(m, d)
-            pairs = set()
+            hits = []
             for i in range(d.ncon):
                 g1, g2 = int(d.contact[i].geom1), int(d.contact[i].geom2)
                 c1, c2 = int(char[g1]), int(char[g2])
                 if c1 >= 0 and c2 >= 0 and c1 != c2 and d.contact[i].dist <= margin:
-                    a, b = (g1, g2) if c1 == 0 else (g2, g1)
-                    pairs.add((SIM_BODIES[body[a]], SIM_BODIES[body[b]]))
-            if pairs:
-                rk = max(k - 1, 0)
-                return KinematicContact(
-                    k + round(start * fps),
-                    float(times[k]),
-                    rk + round(start * fps),
-                    float(times[rk]),
-                    tuple(sorted(pairs)),
-                )
+                    hits.append((g1, g2, float(d.contact[i].dist)) if c1 == 0
+                                else (g2, g1, float(d.contact[i].dist)))  # fmt: skip
+            yield k, hits
     finally:
         m.geom_margin[:] = old_margin
+
+
+def first_contact(
+    world: World,
+    motions: Sequence[Motion],
+    fps: float = 30.0,
+    start: float = 0.0,
+    end: float | None = None,
+    margin: float = 0.0,
+) -> KinematicContact | None:
+    """Scan two characters' motions at ``fps`` (kinematic playback) for the first frame where
+    their geoms touch (penetration deeper than ``-margin``). Times are seconds from the
+    motions' start. Returns None if they never touch. Overwrites the world's state."""
+    if not (np.isfinite(fps) and fps > 0):
+        raise ConfigError(f"fps must be positive, got {fps!r}")
+    stop = min(mo.duration for mo in motions) if end is None else float(end)
+    times = np.arange(start, stop + 1e-9, 1.0 / fps)
+    body = world.geom_body
+    for k, hits in _kinematic_contacts(world, motions, times, margin):
+        if hits:
+            rk = max(k - 1, 0)
+            pairs = {(SIM_BODIES[body[a]], SIM_BODIES[body[b]]) for a, b, _ in hits}
+            return KinematicContact(k + round(start * fps), float(times[k]),
+                                    rk + round(start * fps), float(times[rk]),
+                                    tuple(sorted(pairs)))  # fmt: skip
     return None
+
+
+def overlap_depths(world: World, motions: Sequence[Motion], per_body: bool = False) -> F64:
+    """Per frame of two same-rate motions, the deepest interpenetration (m) between the two
+    characters' bodies playing them (0 where apart): ``(T,)``, or with ``per_body`` ``(T, 16)``
+    for each body of the first character."""
+    n = min(mo.num_frames for mo in motions)
+    times = np.arange(n) / motions[0].fps
+    out = np.zeros((n, len(SIM_BODIES)))
+    body = world.geom_body
+    for k, hits in _kinematic_contacts(world, motions, times):
+        for g0, _, dist in hits:
+            b = body[g0]
+            out[k, b] = max(out[k, b], -dist)
+    return out if per_body else out.max(axis=1)

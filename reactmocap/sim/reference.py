@@ -3,7 +3,7 @@ clock that maps rollout time onto it (:class:`ClipClock`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -26,12 +26,13 @@ NV = 6 + 3 * NJ
 
 @dataclass(frozen=True)
 class ClipClock:
-    """Rollout time ``t`` -> fractional frame ``(start + t) fps`` of a clip of ``frames``
-    frames, clamped to the clip."""
+    """Rollout time ``t`` -> fractional frame ``(start + min(t, until)) fps`` of a clip of
+    ``frames`` frames, clamped to the clip (``until``: the clip stops there, its pose held)."""
 
     fps: float
     frames: int
     start: float = 0.0
+    until: float = float("inf")
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.fps) and self.fps > 0) or self.frames < 1:
@@ -40,7 +41,15 @@ class ClipClock:
             raise ConfigError(f"clip clock start must be finite, got {self.start!r}")
 
     def frame(self, t: float) -> float:
-        return min(max((self.start + t) * self.fps, 0.0), self.frames - 1.0)
+        return min(max((self.start + min(t, self.until)) * self.fps, 0.0), self.frames - 1.0)
+
+    def held_from(self, t: float) -> ClipClock:
+        """This clock with the clip stopped at rollout time ``t``."""
+        return replace(self, until=float(t))
+
+    def coast(self, t: float) -> float:
+        """Seconds past the hold at rollout time ``t`` (0 before it)."""
+        return max(0.0, t - self.until)
 
     def bracket(self, t: float) -> tuple[int, int, float]:
         """The frames either side of ``t`` and the weight of the later one."""
@@ -74,9 +83,11 @@ class ReferencePath:
     def clock(self, start: float = 0.0) -> ClipClock:
         return ClipClock(self.fps, self.num_frames, start)
 
-    def sample(self, x: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
+    def sample(self, x: float, coast: float = 0.0) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """``q``, ``v``, ``a`` interpolated linearly at fractional frame ``x`` (clamped to
-        the path; quaternions renormalised) and ``planted`` at the nearest frame."""
+        the path; quaternions renormalised) and ``planted`` at the nearest frame. ``coast``
+        seconds past a held frame: the pose is held but the root keeps its linear velocity
+        (a held pose of a walking body moves on with it); joints and root turn no more."""
         x = min(max(x, 0.0), self.num_frames - 1.0)
         i0 = int(x)
         i1 = min(i0 + 1, self.num_frames - 1)
@@ -86,6 +97,10 @@ class ReferencePath:
         quats /= np.linalg.norm(quats, axis=1, keepdims=True)
         v = (1 - w) * self.v[i0] + w * self.v[i1]
         acc = (1 - w) * self.a[i0] + w * self.a[i1]
+        if coast > 0:
+            q[:3] += coast * v[:3]
+            v[3:] = 0.0
+            acc[:] = 0.0
         return q, v, acc, self.planted[round(x)]
 
 

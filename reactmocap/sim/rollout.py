@@ -29,25 +29,31 @@ from reactmocap.sim.controllers.base import Controller
 from reactmocap.sim.impacts import ContactReport, Impact, ImpactSchedule, contact_report
 from reactmocap.sim.world import World
 
-__all__ = ["ContactLog", "RolloutResult", "rollout"]
+__all__ = ["ContactLog", "RolloutResult", "StopCondition", "rollout"]
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
-Status = Literal["ok", "unstable"]
+Status = Literal["ok", "unstable", "stopped"]
+#: ``stop(world, t)``: a reason to end the rollout early (e.g. "fell"), or None to go on
+StopCondition = Callable[[World, float], str | None]
 
 
 @dataclass(frozen=True)
 class ContactLog:
-    """Contacts between characters, sampled every ``period`` seconds while any exist:
-    ``times`` ``(n,)`` seconds from the rollout's start, ``normal`` ``(n,)`` the summed normal
-    force between characters (N), ``force`` ``(n, 3)`` the world force on character 0 from the
-    others (N), ``depth`` ``(n,)`` the deepest interpenetration between characters (m)."""
+    """Contacts between characters while any exist, sampled at every step (the engine looks
+    for them every ``period`` seconds and samples every step from the first it finds until
+    they part): ``times`` ``(n,)`` seconds from the rollout's start, ``normal`` ``(n,)`` the
+    summed normal force between characters (N), ``force`` ``(n, 3)`` the world force on
+    character 0 from the others (N), ``depth`` ``(n,)`` the deepest interpenetration between
+    characters (m), ``point`` ``(n, 3)`` the contacts' centre, weighted by normal force."""
 
     times: F64
     normal: F64
     force: F64
     depth: F64
     period: float
+    dt: float  # seconds per sample (the physics step)
+    point: F64 = field(default_factory=lambda: np.zeros((0, 3)))
 
     @property
     def empty(self) -> bool:
@@ -55,8 +61,9 @@ class ContactLog:
 
     @property
     def impulse(self) -> F64:
-        """``(3,)`` world impulse on character 0 from the others (N s), by the rectangle rule."""
-        return self.force.sum(axis=0) * self.period
+        """``(3,)`` world impulse on character 0 from the others (N s), by the rectangle rule
+        over the sampled steps."""
+        return self.force.sum(axis=0) * self.dt
 
     @property
     def peak_force(self) -> float:
@@ -67,8 +74,8 @@ class ContactLog:
 class RolloutResult:
     """What a rollout recorded: ``qpos`` ``(R, nq)`` after each of ``record_steps`` ``(R,)``
     step counts, for the frame rates ``fps`` (the first is the primary rate); ``status``
-    ``"ok"`` or ``"unstable"`` (with ``reason``; then the records stop at the last stable
-    frame); ``seconds`` simulated; ``contacts``: a report per primary frame when asked for;
+    ``"ok"``, ``"unstable"`` or ``"stopped"`` by a stop condition (with ``reason``; the
+    records end there); ``seconds`` simulated; ``contacts``: a report per primary frame when asked for;
     ``references``: per character the motion its non-simulated joints come from, sampled at
     ``reference_starts + t``."""
 
@@ -173,39 +180,46 @@ class _Guard:
 class _ContactLogger:
     def __init__(self, world: World) -> None:
         self.world = world
-        self.rows: list[tuple[float, float, F64, float]] = []
+        self.rows: list[tuple[float, float, F64, float, F64]] = []
         self._f6 = np.zeros(6)
 
-    def log(self, t: float) -> None:
+    def log(self, t: float) -> bool:
+        """Log the contacts between characters now; whether there are any."""
         w = self.world
         m, d = w.model, w.data
         n = d.ncon
         if n == 0:
-            return
+            return False
         geoms = d.contact.geom[:n]
         own = w.geom_character[geoms]
         between = np.flatnonzero((own[:, 0] >= 0) & (own[:, 1] >= 0) & (own[:, 0] != own[:, 1]))
         if not between.size:
-            return
+            return False
         total = 0.0
         force = np.zeros(3)
+        point = np.zeros(3)
         for i in between:  # a handful of contacts, only while the characters touch
             mujoco.mj_contactForce(m, d, int(i), self._f6)
             total += abs(self._f6[0])
+            point += abs(self._f6[0]) * d.contact.pos[i]
             fw = d.contact.frame[i].reshape(3, 3).T @ self._f6[:3]  # on geom2 from geom1
             if own[i, 1] == 0:
                 force += fw
             elif own[i, 0] == 0:
                 force -= fw
         depth = float(max(0.0, -d.contact.dist[between].min()))
-        self.rows.append((t, total, force, depth))
+        point = point / total if total > 0 else d.contact.pos[between].mean(axis=0)
+        self.rows.append((t, total, force, depth, point))
+        return True
 
     def result(self, period: float) -> ContactLog:
+        dt = self.world.timestep
         if not self.rows:
             z = np.zeros(0)
-            return ContactLog(z, z, np.zeros((0, 3)), z, period)
-        t, f, v, dep = zip(*self.rows)
-        return ContactLog(np.array(t), np.array(f), np.array(v), np.array(dep), period)
+            return ContactLog(z, z, np.zeros((0, 3)), z, period, dt)
+        t, f, v, dep, pt = zip(*self.rows)
+        return ContactLog(np.array(t), np.array(f), np.array(v), np.array(dep), period, dt,
+                          np.array(pt))  # fmt: skip
 
 
 @dataclass
@@ -225,6 +239,7 @@ class _Plan:
     on_tick: Callable[[float], None] | None
     tick_every: int
     record_contacts: bool
+    stop: StopCondition | None = None
 
 
 def rollout(
@@ -243,6 +258,7 @@ def rollout(
     on_unstable: Literal["raise", "stop"] = "raise",
     on_tick: Callable[[float], None] | None = None,
     tick_every: int = 100,
+    stop: StopCondition | None = None,
 ) -> RolloutResult:
     """Run ``duration`` seconds from the world's current state (see the module docstring).
 
@@ -259,6 +275,8 @@ def rollout(
         on_unstable: ``"raise"`` a SimulationError, or ``"stop"`` and return what was recorded
             with ``status = "unstable"``. MuJoCo's own warnings join the reason.
         on_tick: called with ``t`` every ``tick_every`` steps (a progress bar).
+        stop: checked at every primary frame; a reason it returns ends the rollout there
+            with ``status = "stopped"``.
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ConfigError(f"duration must be > 0 s, got {duration!r}")
@@ -291,7 +309,7 @@ def rollout(
         nsteps, controllers, schedule, np.array(events, dtype=np.int64), sorted(periods),
         rec_steps, set(_frame_steps(duration, rates[0], dt).tolist()), check_every,
         _ContactLogger(world) if contact_every else None, contact_every or 0, on_tick,
-        tick_every, record_contacts,
+        tick_every, record_contacts, stop,
     )  # fmt: skip
     qpos = np.empty((rec_steps.size, world.model.nq))
     contacts: list[ContactReport] = []
@@ -301,14 +319,16 @@ def rollout(
     mujoco.set_mju_user_warning(lambda msg: warnings.append(str(msg).strip()))
     wall = _time.perf_counter()
     try:
-        reason, ri, k = _loop(world, plan, guard, qpos, contacts)
+        reason, ri, k, stopped = _loop(world, plan, guard, qpos, contacts)
     finally:
         mujoco.set_mju_user_warning(handler)
         if schedule is not None:
             schedule.clear()
     wall = _time.perf_counter() - wall
     status: Status = "ok"
-    if reason is not None:
+    if stopped:
+        status = "stopped"
+    elif reason is not None:
         if warnings:
             reason += f" (MuJoCo: {warnings[0]})"
         if on_unstable == "raise":
@@ -336,8 +356,9 @@ def rollout(
 
 def _loop(
     world: World, plan: _Plan, guard: _Guard, qpos: F64, contacts: list[ContactReport]
-) -> tuple[str | None, int, int]:
-    """The stepping loop; returns the instability (or None), the records made, the steps."""
+) -> tuple[str | None, int, int, bool]:
+    """The stepping loop; returns the instability or stop reason (or None), the records made,
+    the steps, and whether a stop condition ended it."""
     d = world.data
     t0 = float(d.time)
     for c in plan.controllers:
@@ -346,25 +367,31 @@ def _loop(
     ri = 0  # next record
     ei = 0  # next event
     k = 0
+    touching = False  # contacts between characters: logged every step while they last
     while True:
         is_record = ri < rec.size and rec[ri] == k
         if is_record or k % plan.check_every == 0 or k >= nsteps:
             reason = guard.problem(float(d.time) - t0)
             if reason is not None:
-                return reason, ri, k
+                return reason, ri, k, False
         if is_record:
             qpos[ri] = d.qpos
-            if plan.record_contacts and k in plan.primary:
+            primary = k in plan.primary
+            if plan.record_contacts and primary:
                 contacts.append(contact_report(world))
             ri += 1
+            if primary and plan.stop is not None:
+                why = plan.stop(world, float(d.time) - t0)
+                if why is not None:
+                    return why, ri, k, True
         if k >= nsteps:
-            return None, ri, k
+            return None, ri, k, False
         t = float(d.time) - t0
         for c in plan.controllers:
             if k % c.control_every == 0:
                 c.control(world, t)
-        if plan.logger is not None and k % plan.contact_every == 0:
-            plan.logger.log(t)
+        if plan.logger is not None and (touching or k % plan.contact_every == 0):
+            touching = plan.logger.log(t)
         if plan.on_tick is not None and k % plan.tick_every == 0:
             plan.on_tick(t)
         if plan.schedule is not None:
@@ -375,5 +402,7 @@ def _loop(
         nxt = int(events[ei]) if ei < events.size else nsteps
         for p in plan.periods:
             nxt = min(nxt, (k // p + 1) * p)
+        if touching:
+            nxt = k + 1
         world.step(nxt - k)
         k = nxt

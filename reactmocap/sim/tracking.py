@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError
+from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.metrics import FALL_FRACTION
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
@@ -42,8 +43,12 @@ class TrackReport:
     clip: str
     start: float
     seconds: float
+    #: ``"ok"``, ``"fell"`` (the pelvis below half its start height: the run ends there) or
+    #: ``"unstable"`` (the simulation diverged: it ends at the last stable frame)
+    status: str
+    reason: str | None
     fell: bool
-    fall_time: float | None
+    fell_at_s: float | None
     mean_joint_error_rad: float
     root_error_m: float
     max_root_error_m: float
@@ -76,7 +81,7 @@ class TrackErrors:
     upright: NDArray[np.bool_]
 
     @property
-    def fall_time(self) -> float | None:
+    def fell_at_s(self) -> float | None:
         fallen = np.flatnonzero(~self.upright)
         return float(self.times[fallen[0]]) if fallen.size else None
 
@@ -129,13 +134,18 @@ def track_clip(
     total_mass: float = 75.0,
     config: WorldConfig | None = None,
     character_kwargs: dict[str, Any] | None = None,
+    parts: BodyPartMap | None = None,
     on_tick: Callable[[float, float], None] | None = None,
+    stop_on_fall: bool = True,
 ) -> TrackResult:
     """Track ``motion`` from ``start`` for ``seconds`` (default: to its end) with the registered
     ``controller`` (``params`` over its defaults; ``kp``/``kv`` are shortcuts for those) on a
     character built from the clip, optionally with impacts (their ``start`` relative to
     ``start``). ``root_assist > 0`` adds the NON-PHYSICAL root assist with that kp (only with
-    ``"pd"``). ``on_tick(t, seconds)`` reports progress."""
+    ``"pd"``). ``parts``: the clip's body parts (default: mapped by name). ``on_tick(t,
+    seconds)`` reports progress. A failure is a result, not an exception: a fall ends the run
+    there (``stop_on_fall``), a diverging simulation at its last stable frame, and the report's
+    ``status`` says which."""
     if not (np.isfinite(start) and 0 <= start <= motion.duration):
         raise ConfigError(f"start {start!r} s is outside the clip (0..{motion.duration:.3f} s)")
     remaining = motion.duration - start
@@ -157,7 +167,7 @@ def track_clip(
     given = {**(params or {}), **{k: v for k, v in (("kp", kp), ("kv", kv)) if v is not None}}
     resolved = spec.params(given)
     frame = round(start * motion.fps)
-    character = build_character(motion, total_mass=total_mass, frame=frame,
+    character = build_character(motion, parts, total_mass=total_mass, frame=frame,
                                 **(character_kwargs or {}))  # fmt: skip
     character.check_fk(motion, frame)
     cfg = config or WorldConfig(friction=friction)
@@ -167,6 +177,12 @@ def track_clip(
     ctrls = [build(controller, world, path, given, start=start)]
     if root_assist > 0:
         ctrls.append(build("root_assist", world, path, {"kp": root_assist}, start=start))
+    pelvis = world.characters[0].qpos_adr + 2
+    low = FALL_FRACTION * float(world.data.qpos[pelvis])
+
+    def fallen(w: World, t: float) -> str | None:
+        return f"fell at {t:.2f} s" if w.data.qpos[pelvis] < low else None
+
     result = rollout(
         world,
         seconds,
@@ -176,22 +192,31 @@ def track_clip(
         references=[motion],
         reference_start=start,
         on_tick=None if on_tick is None else (lambda t: on_tick(t, seconds)),
+        on_unstable="stop",
+        stop=fallen if stop_on_fall else None,
     )
     err = tracking_errors(result, motion, start)
+    status = {"ok": "ok", "stopped": "fell", "unstable": "unstable"}[result.status]
+    if status == "ok" and err.fell_at_s is not None:
+        status = "fell"
     kp_used = float(resolved.get("kp", 0.0))
     kv_used = resolved.get("kv")
     report = TrackReport(
         clip=motion.name,
         start=float(start),
         seconds=float(seconds),
-        fell=err.fall_time is not None,
-        fall_time=err.fall_time,
+        status=status,
+        reason=result.reason,
+        fell=err.fell_at_s is not None,
+        fell_at_s=err.fell_at_s,
         mean_joint_error_rad=float(err.joint.mean()),
         root_error_m=float(err.root.mean()),
         max_root_error_m=float(err.root.max()),
         root_angle_error_rad=float(err.angle.mean()),
         wall_s=float(result.wall_s),
-        realtime_factor=float(seconds / result.wall_s) if result.wall_s > 0 else float("inf"),
+        realtime_factor=(
+            float(result.seconds / result.wall_s) if result.wall_s > 0 else float("inf")
+        ),
         kp=kp_used,
         kv=critical_kv(kp_used) if kv_used is None else float(kv_used),
         friction=cfg.friction,

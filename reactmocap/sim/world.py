@@ -1,13 +1,14 @@
-"""The simulated world: a floor, gravity, friction, one or two characters (each attached to one
-MjSpec under a prefix, ``a/`` and ``b/``), the servo actuators every ball joint carries, and
-which character and body each geom belongs to. Why the contact and solver settings are what
-they are: ``docs/design.md``."""
+"""The simulated world: a floor, gravity, friction, characters (each attached to one MjSpec under
+a prefix, ``a/``, ``b/``, ...), an optional :class:`Scene` (extra bodies such as bicycles and
+obstacles), the servo actuators every ball joint carries, and which character and body each geom
+belongs to. Why the contact and solver settings are what they are: ``docs/design.md``."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import string
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Literal, Protocol
 
 import mujoco
 import numpy as np
@@ -20,10 +21,31 @@ from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, Character
 if TYPE_CHECKING:
     from reactmocap.sim.servo import PDServo
 
-__all__ = ["PATCH_ROLL", "PATCH_TORSION", "PREFIXES", "World", "WorldCharacter", "WorldConfig"]
+__all__ = [
+    "PATCH_ROLL",
+    "PATCH_TORSION",
+    "PREFIXES",
+    "Scene",
+    "World",
+    "WorldCharacter",
+    "WorldConfig",
+]
 
 F64 = NDArray[np.float64]
-PREFIXES = ("a/", "b/")
+#: name prefixes of a world's characters, in order (``a/`` and ``b/`` for the usual pair)
+PREFIXES = tuple(f"{c}/" for c in string.ascii_lowercase)
+
+
+class Scene(Protocol):
+    """Extra bodies in a World (bicycles, obstacles): :meth:`build` adds them to the MjSpec
+    after the characters are attached (so constraints may name character bodies) and before it
+    is compiled; :meth:`configure` runs once the World has applied its own contact settings to
+    every geom (a scene re-applies its own there)."""
+
+    def build(self, spec: mujoco.MjSpec) -> None: ...
+
+    def configure(self, world: World) -> None: ...
+
 
 _INTEGRATORS = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
@@ -71,6 +93,10 @@ class WorldConfig:
     iterations: int = 50
     contact_solref: tuple[float, float] = (0.01, 1.0)
     contact_solimp: tuple[float, float, float] = (0.9, 0.95, 0.001)
+    #: contacts between characters: stiffer than the floor's, so a kick's foot stops within
+    #: about a centimetre of the body it hits (MuJoCo's soft contact would otherwise let a
+    #: 10 m/s foot sink ~4 cm per 10 ms of time constant)
+    body_contact_solref: tuple[float, float] = (0.002, 1.0)
     self_collision: bool = False
     #: light joint damping (Deva: a weak damper everywhere), in 1/s: each ball DOF gets
     #: ``joint_damping * I_dof`` with ``I_dof`` its outboard inertia in the reference pose
@@ -91,11 +117,13 @@ class WorldConfig:
             raise ConfigError(f"solver must be one of {list(_SOLVERS)}, got {self.solver!r}")
         if self.cone not in _CONES:
             raise ConfigError(f"cone must be one of {list(_CONES)}, got {self.cone!r}")
-        if self.contact_solref[0] < 2 * self.timestep:
-            raise ConfigError(
-                f"contact_solref time constant {self.contact_solref[0]} must be at least twice "
-                f"the timestep {self.timestep} (MuJoCo would silently clamp it)"
-            )
+        for name in ("contact_solref", "body_contact_solref"):
+            tc = getattr(self, name)[0]
+            if tc < 2 * self.timestep:
+                raise ConfigError(
+                    f"{name} time constant {tc} must be at least twice the timestep "
+                    f"{self.timestep} (MuJoCo would silently clamp it)"
+                )
         if self.joint_damping < 0:
             raise ConfigError(f"joint_damping must be >= 0, got {self.joint_damping!r}")
 
@@ -145,20 +173,21 @@ PATCH_ROLL = 0.03
 
 
 class World:
-    """A MuJoCo model and data with a floor and one or two characters; ``extras(spec)``, if
-    given, adds apparatus (bodies, geoms, joints) to the spec after the characters."""
+    """A MuJoCo model and data with a floor, characters (one or two for tracking and responses;
+    none or many with a :class:`Scene`) and the scene's bodies."""
 
     def __init__(
         self,
         characters: Character | Sequence[Character],
         config: WorldConfig | None = None,
         *,
-        extras: Callable[[mujoco.MjSpec], None] | None = None,
+        scene: Scene | None = None,
         **overrides: object,
     ) -> None:
         chars = [characters] if isinstance(characters, Character) else list(characters)
-        if not 1 <= len(chars) <= len(PREFIXES):
-            raise ConfigError(f"a World holds 1 or 2 characters, got {len(chars)}")
+        least = 0 if scene is not None else 1
+        if not least <= len(chars) <= len(PREFIXES):
+            raise ConfigError(f"a World holds {least}-{len(PREFIXES)} characters, got {len(chars)}")
         cfg = config or WorldConfig()
         if overrides:
             from dataclasses import replace
@@ -189,12 +218,10 @@ class World:
         for k, ch in enumerate(chars):
             frame = spec.worldbody.add_frame()
             spec.attach(ch.make_spec(), prefix=PREFIXES[k], frame=frame)
-        if extras is not None:
-            # apparatus (a springboard, a horse): bodies added after the characters', so the
-            # characters' ids, qpos and dofs come first and keep their addresses
-            extras(spec)
         for k in range(len(chars)):
             _add_servo_actuators(spec, PREFIXES[k])
+        if scene is not None:
+            scene.build(spec)
         try:
             self.model = spec.compile()
         except Exception as exc:  # mujoco raises ValueError with the compiler's message
@@ -262,6 +289,9 @@ class World:
         self._apply_contact_settings()
         self._apply_joint_settings()
         self.set_friction(cfg.friction)
+        self.scene = scene
+        if scene is not None:
+            scene.configure(self)
         mujoco.mj_forward(m, self.data)
 
     # ------------------------------------------------------------------ settings
@@ -280,7 +310,13 @@ class World:
             m.geom_conaffinity[wc.patch_ids] = 0
             m.geom_condim[wc.patch_ids] = 6
             m.geom_friction[wc.patch_ids, 1:] = (PATCH_TORSION, PATCH_ROLL)
-        m.geom_solref[:] = cfg.contact_solref
+        # characters' geoms carry the body-body settings; the floor's dominate its contacts
+        # through solmix (MuJoCo mixes solref by solmix weights; condim and friction unaffected)
+        floor = m.geom("floor").id
+        m.geom_solref[:] = cfg.body_contact_solref
+        m.geom_solref[floor] = cfg.contact_solref
+        m.geom_solmix[:] = 1.0
+        m.geom_solmix[floor] = 1e9
         m.geom_solimp[:, :3] = cfg.contact_solimp
 
     def _apply_joint_settings(self) -> None:
@@ -288,7 +324,10 @@ class World:
         m, d, cfg = self.model, self.data, self.config
         for wc in self.characters:
             d.qpos[wc.qpos_slice] = wc.character.model.qpos0
-        mujoco.mj_forward(m, d)
+        # the mass matrix only: no collision pass (characters all at their origin would touch)
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_makeM(m, d)
         diag = np.empty(m.nv)
         diag[:] = d.M[m.M_rowadr + m.M_rownnz - 1]  # diagonal = last entry of each CSR row
         for wc in self.characters:
@@ -315,11 +354,29 @@ class World:
         """``(2,)`` whether each foot (left, right) currently touches through its patch."""
         return self.model.geom_contype[self.characters[character].patch_ids] != 0
 
-    def set_friction(self, mu: float) -> None:
-        """Sliding friction coefficient of every contact (floor and characters)."""
+    def set_friction(self, mu: float, character: int | None = None) -> None:
+        """Sliding friction coefficient of every contact, or of one character's contacts.
+        MuJoCo takes the larger of two geoms' coefficients, so the floor keeps the smallest
+        any character has and each character's geoms carry its own."""
         if not (np.isfinite(mu) and mu >= 0):
             raise ConfigError(f"friction must be >= 0, got {mu!r}")
-        self.model.geom_friction[:, 0] = mu
+        m = self.model
+        if character is None:
+            m.geom_friction[:, 0] = mu
+            return
+        m.geom_friction[self.characters[character].geom_ids, 0] = mu
+        floor = m.geom("floor").id
+        m.geom_friction[floor, 0] = min(
+            float(m.geom_friction[wc.geom_ids, 0].min()) for wc in self.characters
+        )
+
+    def characters_touching(self) -> bool:
+        """Whether two characters are in contact now (MuJoCo's contacts of the last step)."""
+        d = self.data
+        if d.ncon == 0 or len(self.characters) < 2:
+            return False
+        own = self.geom_character[d.contact.geom[: d.ncon]]
+        return bool(np.any((own[:, 0] >= 0) & (own[:, 1] >= 0) & (own[:, 0] != own[:, 1])))
 
     # ------------------------------------------------------------------ state
     @property

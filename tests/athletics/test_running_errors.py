@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reactmocap.athletics.course import (
+from reactmocap.athletics.paths import (
     Circle,
     Facing,
     Polyline,

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from reactmocap.athletics.course import Facing
+from reactmocap.athletics.paths import Facing
 from reactmocap.athletics.run_course import run_course
 
 

@@ -86,7 +86,7 @@ def test_pool_worker_crash_is_retried_once_then_recorded(write_sweep, tmp_path) 
 
 
 def test_ray_worker_crash_is_retried_once_then_recorded(write_sweep, tmp_path, ray_runtime) -> None:  # type: ignore[no-untyped-def]
-    import cloudpickle
+    from ray import cloudpickle  # the copy Ray pickles tasks with (no separate package)
 
     cloudpickle.register_pickle_by_value(fake_tasks)  # Ray workers need not import tests/
     try:

@@ -55,4 +55,5 @@ def test_stitch_jump_and_blend_corrections() -> None:
     jumped = m.replace(rotations=rot)
     assert metrics.stitch_velocity_jump_rad_s(jumped, [20]) > smooth + 1.0
     assert metrics.blend_joint_correction_max_rad(m, m) < 1e-7
-    assert abs(metrics.blend_root_offset_max_m(m, m.transformed(0.0, (0.2, 0.0))) - 0.2) < 1e-12
+    shifted = m.transformed(0.0, (0.2, 0.0))
+    assert abs(metrics.blend_root_offset_max_m(m, shifted, parts_for(m)) - 0.2) < 1e-12

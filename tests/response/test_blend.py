@@ -28,6 +28,17 @@ def test_final_blend_starts_on_simulation_and_lands_on_target() -> None:
     np.testing.assert_allclose(mid_offset, err * 20 / 39, atol=1e-12)
 
 
+def test_a_delayed_root_keeps_its_simulated_place_then_still_lands() -> None:
+    sim = random_motion(t=40, seed=1)
+    target = random_motion(t=40, seed=2).transformed(0.4, (0.3, -0.2))
+    out = final_blend(sim, target, root_start=15.0)
+    np.testing.assert_allclose(out.root_positions[:16], sim.root_positions[:16], atol=1e-12)
+    np.testing.assert_allclose(out.root_positions[-1], target.root_positions[-1], atol=1e-12)
+    err = target.root_positions[-1] - sim.root_positions[-1]
+    np.testing.assert_allclose(out.root_positions[27] - sim.root_positions[27], err * 12 / 24,
+                               atol=1e-12)  # fmt: skip
+
+
 def test_blend_poses_weight_limits() -> None:
     a, b = random_motion(seed=3), random_motion(seed=4)
     w = np.linspace(0, 1, a.num_frames)

@@ -17,6 +17,7 @@ from reactmocap.search import (
 )
 from reactmocap.search.distance import localize, select_support
 from reactmocap.search.features import calibrate, frame_features
+from reactmocap.search.query import distances
 
 
 def test_heading_of_synthetic_clips_starts_at_zero(synth_clips: dict[str, Motion]) -> None:
@@ -52,9 +53,7 @@ def test_heading_ignores_height_and_tilt(synth_clips: dict[str, Motion]) -> None
     m = synth_clips["guard"].slice(0, 5)
     cal = calibrate(m.skeleton, get_feature_set("paper"))
     base = frame_features(m, cal)
-    pitch = quat_exp(
-        np.array([0.0, np.radians(60) / 2, 0.0])
-    )  # about +Y (the left axis at heading 0)
+    pitch = quat_exp(np.array([0.0, np.radians(60), 0.0]))  # about +Y (left, at heading 0)
     rot = np.array(m.rotations)
     rot[:, 0] = quat_mul(pitch, rot[:, 0])
     tilted = frame_features(
@@ -92,8 +91,8 @@ def test_orientation_distance_is_sign_safe_and_equals_chordal_angle(
 
     q2 = replace(qw, orientations=ori)
     start = np.array([synth_index.clip_offsets[synth_index.clip_index("punch")] + 5])
-    d0, _ = synth_index._distances(qw, start)
-    d1, br = synth_index._distances(q2, start, breakdown=True)
+    d0, _ = distances(synth_index, qw, start)
+    d1, br = distances(synth_index, q2, start, breakdown=True)
     expect = SearchWeights().trunk_orientation * 2 * np.sin(phi / 2)
     assert d0[0] < 1e-6
     assert d1[0] == pytest.approx(expect, rel=1e-4)

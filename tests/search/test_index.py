@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import replace
 from pathlib import Path
@@ -12,7 +13,19 @@ import pytest
 from reactmocap.errors import SearchError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_exp, quat_mul
-from reactmocap.search import MotionIndex, SearchWeights, WindowConfig, brute_force, get_feature_set
+from reactmocap.search import (
+    MotionIndex,
+    QueryCache,
+    QueryStats,
+    SearchWeights,
+    WindowConfig,
+    brute_force,
+    get_feature_set,
+    prepare_query,
+    search_window,
+)
+from reactmocap.search.query import distances
+from reactmocap.search.types import DEFAULT_K
 
 
 def _wrap(a: float) -> float:
@@ -126,7 +139,7 @@ def test_weights_matter(synth_index: MotionIndex, synth_clips: dict[str, Motion]
     qw = synth_index.prepare_query(m, 20)
     start = np.array([synth_index.clip_offsets[synth_index.clip_index("side_kick")] + 10])
     parts = get_feature_set("paper").parts
-    assert synth_index._distances(qw, start)[0][0] < 1e-6
+    assert distances(synth_index, qw, start)[0][0] < 1e-6
 
     def moved(part: str, dp=(0.0, 0.0, 0.0), turn: float = 0.0) -> float:
         b = parts.index(part)
@@ -136,7 +149,7 @@ def test_weights_matter(synth_index: MotionIndex, synth_clips: dict[str, Motion]
         q = np.array([np.cos(turn / 2), np.sin(turn / 2), 0, 0], dtype=np.float32)
         ori[:, b] = quat_mul(ori[:, b], q)
         return float(
-            synth_index._distances(replace(qw, positions=pos, orientations=ori), start)[0][0]
+            distances(synth_index, replace(qw, positions=pos, orientations=ori), start)[0][0]
         )
 
     for trunk, limb in (("chest", "l_forearm"), ("head", "r_hand"), ("waist", "l_shin")):
@@ -293,3 +306,52 @@ def test_no_leftover_temp_files_on_failed_save(tmp_path: Path, synth_index: Moti
         synth_index.save(target)  # cannot replace a directory
     assert [p.name for p in tmp_path.iterdir()] == ["dir_not_file"]
     assert not os.listdir(target)
+
+
+def test_a_search_returns_its_stats_and_leaves_the_index_alone(
+    synth_index: MotionIndex, synth_clips: dict[str, Motion]
+) -> None:
+    def state() -> dict[str, object]:
+        return {k: np.array(v) if isinstance(v, np.ndarray) else repr(v)
+                for k, v in vars(synth_index).items() if k != "tree"}  # fmt: skip
+
+    before = state()
+    objects = {k: id(v) for k, v in vars(synth_index).items()}
+    m = _noisy(synth_clips["push"], np.random.default_rng(1), 0.05)
+    qw = prepare_query(synth_index, m, 30)
+    results, stats = search_window(synth_index, qw, n=3)
+    again, stats2 = search_window(synth_index, qw, n=3)
+    assert isinstance(stats, QueryStats)
+    assert stats.candidates == min(DEFAULT_K, synth_index.num_indexed)
+    assert stats.exact_windows >= 3 and stats.refined_windows >= 0 and stats.seconds > 0
+    assert (stats.candidates, stats.exact_windows) == (stats2.candidates, stats2.exact_windows)
+    assert [r.to_dict() for r in results] == [r.to_dict() for r in again]
+    # every other way in, too
+    synth_index.query(m, 30)
+    synth_index.top_k(m, 30, n=4)
+    synth_index.window_distance(m, 30, "push", 10)
+    brute_force(synth_index, qw, n=2)
+    assert {k: id(v) for k, v in vars(synth_index).items()} == objects
+    after = state()
+    assert after.keys() == before.keys()
+    for k, v in after.items():
+        np.testing.assert_array_equal(v, before[k], err_msg=k)  # type: ignore[arg-type]
+    assert not hasattr(synth_index, "last_stats")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        synth_index.kept = synth_index.kept  # type: ignore[misc]
+
+
+def test_an_explicit_query_cache(synth_index: MotionIndex, synth_clips: dict[str, Motion]) -> None:
+    m = synth_clips["side_kick"].transformed(0.5, (1.0, 2.0))
+    cache = QueryCache()
+    assert synth_index.query(m, 12, cache=cache) == synth_index.query(m, 12)
+    fs = synth_index.feature_set
+    # keyed by content: an equal skeleton (another object) reuses the calibration
+    twin = replace(m.skeleton)
+    assert twin is not m.skeleton
+    assert cache.calibration(twin, fs, None) is cache.calibration(m.skeleton, fs, None)
+    assert cache.constants(synth_index.weights, synth_index.window) is cache.constants(
+        synth_index.weights, synth_index.window
+    )
+    cache.clear()
+    assert synth_index.top_k(m, 12, n=2, cache=cache) == synth_index.top_k(m, 12, n=2)

@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from reactmocap.sim.character import BALL_JOINTS
+from reactmocap.sim.character import BALL_JOINTS, qvel_between
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.reference import ReferencePath, as_path
@@ -120,6 +120,10 @@ class StanceBalance:
         self.clock = path.clock(start)
         self._reference(path)
 
+    def hold(self, t: float) -> None:
+        """From rollout time ``t`` on, follow the reference's pose at ``t``."""
+        self.clock = self.clock.held_from(t)
+
     def reset(self, world: World) -> None:
         del world
         self._stance = ()
@@ -149,7 +153,13 @@ class StanceBalance:
         speed = np.linalg.norm(grad(foot), axis=-1)
         self.planted = (sole < self.reach) & (speed < 0.6)  # (n, 2)
         self.root_quat = q[:, 3:7]
-        self.joint_vel = path.v[:, 6:].reshape(n, NJ, 3)
+        # the velocity of each frame-to-frame segment (the targets interpolate linearly)
+        seg = qvel_between(q[:-1], q[1:], np.full(max(n - 1, 0), 1.0 / path.fps))
+        self.joint_vel = (
+            np.concatenate([seg, seg[-1:]])[:, 6:].reshape(n, NJ, 3)
+            if n > 1
+            else (np.zeros((n, NJ, 3)))
+        )
 
     def _sample(self, t: float) -> tuple[F64, F64, F64, F64, NDArray[np.bool_], F64]:
         """Mocap COM position, velocity, acceleration, pelvis rotation, planted feet and

@@ -17,7 +17,16 @@ import numpy as np
 from reactmocap.errors import ConfigError
 from reactmocap.sim.world import World
 
-__all__ = ["Controller", "FunctionController", "Group", "check_character", "check_params"]
+__all__ = [
+    "Controller",
+    "FunctionController",
+    "GainScalable",
+    "Group",
+    "Holdable",
+    "Scheduled",
+    "check_character",
+    "check_params",
+]
 
 
 @runtime_checkable
@@ -32,6 +41,41 @@ class Controller(Protocol):
 
     def control(self, world: World, t: float) -> None:
         """Act at rollout time ``t`` (seconds since the rollout started)."""
+
+
+@runtime_checkable
+class GainScalable(Protocol):
+    """A controller whose feedback gains can be scaled on the fly (a gain schedule)."""
+
+    def scale_gains(self, scale: float) -> None:
+        """Stiffness times ``scale`` (damping times its square root) from the next tick."""
+
+
+@runtime_checkable
+class Holdable(Protocol):
+    """A controller following a clip that can stop the clip and hold its pose."""
+
+    def hold(self, t: float) -> None:
+        """From rollout time ``t`` on, follow the clip's pose at ``t``."""
+
+
+class Scheduled:
+    """``inner`` with its gains scaled by ``schedule(t)`` at each tick (e.g. yielding to an
+    impact, then recovering)."""
+
+    def __init__(self, inner: Controller, schedule: Callable[[float], float]) -> None:
+        if not isinstance(inner, GainScalable):
+            raise ConfigError(f"{type(inner).__name__} has no gains to schedule")
+        self.inner = inner
+        self.schedule = schedule
+        self.control_every = inner.control_every
+
+    def reset(self, world: World) -> None:
+        self.inner.reset(world)
+
+    def control(self, world: World, t: float) -> None:
+        self.inner.scale_gains(self.schedule(t))  # type: ignore[attr-defined]
+        self.inner.control(world, t)
 
 
 class FunctionController:
@@ -70,6 +114,16 @@ class Group:
     def control(self, world: World, t: float) -> None:
         for c in self.controllers:
             c.control(world, t)
+
+    def scale_gains(self, scale: float) -> None:
+        for c in self.controllers:
+            if isinstance(c, GainScalable):
+                c.scale_gains(scale)
+
+    def hold(self, t: float) -> None:
+        for c in self.controllers:
+            if isinstance(c, Holdable):
+                c.hold(t)
 
 
 def check_params(params: Mapping[str, float | None]) -> None:

@@ -10,6 +10,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.reference import ReferencePath, as_path
+from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
 
 __all__ = ["PDTracker", "Passive"]
@@ -47,6 +48,13 @@ class PDTracker:
         self.clock = path.clock(start)
         self.quats = path.q[:, 7:].reshape(path.num_frames, NJ, 4)
         self._buf = np.empty((NJ, 4))
+        self._scale = 1.0
+        self._applied = 1.0
+
+    def scale_gains(self, scale: float) -> None:
+        """Stiffness times ``scale`` (damping times its square root, staying critical) from
+        the next tick on: a gain schedule, e.g. yielding to an impact."""
+        self._scale = float(scale)
 
     def targets_at(self, t: float) -> F64:
         i0, i1, a = self.clock.bracket(t)
@@ -54,13 +62,25 @@ class PDTracker:
         self._buf += a * self.quats[i1]
         return self._buf
 
+    def hold(self, t: float) -> None:
+        """From rollout time ``t`` on, follow the reference's pose at ``t``."""
+        self.clock = self.clock.held_from(t)
+
     def reset(self, world: World) -> None:
         servo = world.servo
         servo.enable(self.character, on=True)
-        servo.set_gains(self.kp, self.kv, self.character)
+        self._set_gains(world)
         servo.refresh_every = self.refresh_every
 
+    def _set_gains(self, world: World) -> None:
+        kv = critical_kv(self.kp) if self.kv is None else self.kv
+        s = self._scale
+        world.servo.set_gains(self.kp * s, kv * np.sqrt(s), self.character)
+        self._applied = s
+
     def control(self, world: World, t: float) -> None:
+        if self._scale != self._applied:
+            self._set_gains(world)
         world.servo.set_targets(self.character, self.targets_at(t))
 
 

@@ -175,6 +175,12 @@ class PredictiveTracker:
         self.last_costs = costs
         self.choice = candidates[int(np.argmin(costs))].copy()
 
+    def scale_gains(self, scale: float) -> None:
+        self.tracker.scale_gains(scale)
+
+    def hold(self, t: float) -> None:
+        self.tracker.hold(t)
+
     def reset(self, world: World) -> None:
         self.tracker.reset(world)
         self._rng = np.random.default_rng(self.seed)

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
-from reactmocap.athletics.controller import ATHLETIC_BALANCE_DEFAULTS, athletic_balance
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.controllers.balance import StanceBalance
@@ -122,6 +121,15 @@ def _root_assist(
     return RootAssist(world, c, ref, start, **p)
 
 
+def _athletic_balance(
+    world: World, c: int, ref: Reference, start: float, p: dict[str, Any]
+) -> Controller:
+    # imported here: the engine does not import the layer above it at load time
+    from reactmocap.athletics.controller import athletic_balance
+
+    return athletic_balance(world, c, ref, start, p)
+
+
 _PD = {"kp": 4000.0, "kv": None, "control_every": 10, "refresh_every": 10}
 _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 
@@ -147,8 +155,8 @@ _REGISTRY: dict[str, ControllerSpec] = {
         physical=False),
     "athletic_balance": ControllerSpec(
         "athletic_balance", "the thesis's balance (athletics, ch. 7): COM over the feet by ankle "
-        "and hip offsets; does not follow the clip", ATHLETIC_BALANCE_DEFAULTS,
-        athletic_balance, ("pitch", "leg", "com_offset_x", "com_offset_y")),
+        "and hip offsets; does not follow the clip", {"control_every": 8},
+        _athletic_balance, ("pitch", "leg", "com_offset_x", "com_offset_y")),
 }  # fmt: skip
 #: every registered controller (read-only view; :func:`register` adds); the gains and rates
 #: here are the only defaults (the CLI help and the scenario docs print them from this table)

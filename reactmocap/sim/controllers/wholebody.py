@@ -155,6 +155,7 @@ class WholeBodyTracker:
             np.full(3, critical_kv(kp_rot) if kv_rot is None else kv_rot),
             np.full(3 * NJ, kvj),
         ]
+        self._kp0, self._kv0 = self.kp.copy(), self.kv.copy()
         self.w = np.r_[np.full(6, root_weight), np.ones(3 * NJ)]
         self._w_air = np.r_[np.zeros(6), np.ones(3 * NJ)]
         self.sqrt_wc = float(np.sqrt(contact_weight))
@@ -196,7 +197,7 @@ class WholeBodyTracker:
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
         the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
-        return self.path.sample(self.clock.frame(t))
+        return self.path.sample(self.clock.frame(t), self.clock.coast(t))
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
@@ -349,6 +350,15 @@ class WholeBodyTracker:
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
+
+    def scale_gains(self, scale: float) -> None:
+        """The tracking gains (joints and pelvis) times ``scale``, damping times its root."""
+        self.kp[:] = self._kp0 * scale
+        self.kv[:] = self._kv0 * np.sqrt(scale)
+
+    def hold(self, t: float) -> None:
+        """From rollout time ``t`` on, follow the reference's pose at ``t``."""
+        self.clock = self.clock.held_from(t)
 
     def reset(self, world: World) -> None:
         servo = world.servo

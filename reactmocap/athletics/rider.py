@@ -1,0 +1,714 @@
+"""The bicycle's rider (Hodgins et al. 1995, "Bicycling"): any athlete body (the thesis male by
+default) whose pelvis pivots on the saddle, whose hands and feet are tied to the grips and
+pedals by two-sided spring-dampers (MuJoCo soft ``connect`` equalities: toe-clips and a fixed
+gear, so a leg can pull up), and the control laws of the paper's eqs. 7-11 as an engine
+:class:`~reactmocap.sim.controllers.base.Controller`:
+
+* **speed** (eqs. 7-10): a crank torque from the speed error, split between the legs by the
+  crank-angle weight ``w = (1 + sin theta) / 2`` (the leg whose pedal is ahead pushes), each
+  leg's pedal force turned into hip and knee torques through the leg's Jacobian (``J^T f``);
+* **steering** (eq. 11): a fork angle from the roll and yaw errors and rates, its gains scheduled
+  with speed (see :class:`SteerGains`), reached by placing the hands where the grips are at that
+  fork angle (arm inverse kinematics) and letting the shoulder and elbow servos pull;
+* **posture**: waist, back, neck and wrists held by the PD servo at a riding posture; the legs
+  follow the pedals through leg inverse kinematics; the ankles follow a pedalling pattern
+  (:func:`ankle_pitch`: a stated approximation of the recorded data the paper used).
+
+All inverse kinematics is closed-form (two-link, knee and elbow poles) in the bicycle's frame,
+from the *desired* posture of the pelvis and trunk: the servos then also hold that posture.
+Why the laws are built this way and what they achieve: ``docs/athletics.md``."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import brentq
+
+from reactmocap.athletics.bicycle import Bicycle, BicycleParams, Fit
+from reactmocap.athletics.bodies import Athlete
+from reactmocap.errors import ConfigError
+from reactmocap.rotations import quat_conj, quat_mul, quat_rotate
+from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
+from reactmocap.sim.world import World, WorldConfig
+
+__all__ = [
+    "RIDER_WORLD",
+    "Posture",
+    "Rider",
+    "RiderLog",
+    "RiderMount",
+    "SpeedGains",
+    "SteerGains",
+    "ankle_pitch",
+    "fit_bicycle",
+]
+
+F64 = NDArray[np.float64]
+NJ = len(BALL_JOINTS)
+_B = {b: i for i, b in enumerate(SIM_BODIES)}
+#: the rider's world: 2 ms steps (the mounts are 10-20 ms spring-dampers, the wheels 4 ms
+#: contacts), the athletics contact time constant for the body, also between riders (the
+#: strike-stiff 2 ms of the response worlds needs 1 ms steps)
+RIDER_WORLD = WorldConfig(
+    timestep=0.002, contact_solref=(0.02, 1.0), body_contact_solref=(0.02, 1.0)
+)
+#: sit bones relative to the pelvis origin (anatomical frame: x forward, y left, z up; m)
+SIT_OFFSET = (-0.03, 0.06, -0.09)
+#: mount spring-dampers (time constant s, damping ratio): saddle, hands, feet
+SEAT_SPRING = (0.01, 1.0)
+HAND_SPRING = (0.02, 1.0)
+FOOT_SPRING = (0.02, 1.0)
+
+
+# small-array helpers for the control tick (numpy's cross and the general quaternion helpers
+# cost 25-40 us a call on (4, 3) arrays, these 5-10 us)
+_C1 = np.array([1, 2, 0])
+_C2 = np.array([2, 0, 1])
+_HAMILTON = np.zeros((4, 4, 4))
+for _i, _j, _k, _s in ((0, 0, 0, 1), (0, 1, 1, -1), (0, 2, 2, -1), (0, 3, 3, -1),
+                       (1, 0, 1, 1), (1, 1, 0, 1), (1, 2, 3, 1), (1, 3, 2, -1),
+                       (2, 0, 2, 1), (2, 1, 3, -1), (2, 2, 0, 1), (2, 3, 1, 1),
+                       (3, 0, 3, 1), (3, 1, 2, 1), (3, 2, 1, -1), (3, 3, 0, 1)):  # fmt: skip
+    _HAMILTON[_i, _j, _k] = _s
+_HAMILTON_T = _HAMILTON.reshape(4, 16).T.copy()
+
+
+def _cross(a: F64, b: F64) -> F64:
+    """Row-wise cross product of ``(..., 3)`` arrays."""
+    return a.take(_C1, -1) * b.take(_C2, -1) - a.take(_C2, -1) * b.take(_C1, -1)
+
+
+def _qmul(a: F64, b: F64) -> F64:
+    """Hamilton product of ``(n, 4)`` or ``(4,)`` quaternions (w, x, y, z), broadcast."""
+    outer = a[..., :, None] * b[..., None, :]
+    return outer.reshape(*outer.shape[:-2], 16) @ _HAMILTON_T
+
+
+def _qconj(q: F64) -> F64:
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def _qrot(q: F64, v: F64) -> F64:
+    """Rotate ``(..., 3)`` vectors by ``(..., 4)`` unit quaternions."""
+    u = q[..., 1:]
+    t = 2.0 * _cross(u, v)
+    return v + q[..., :1] * t + _cross(u, t)
+
+
+def _minrot(u: F64, v: F64) -> F64:
+    """``(n, 4)`` shortest-arc rotations taking unit vectors ``u`` to ``v`` ``(n, 3)``."""
+    q = np.empty((u.shape[0], 4))
+    q[:, 0] = 1.0 + np.einsum("ij,ij->i", u, v)
+    q[:, 1:] = _cross(u, v)
+    bad = q[:, 0] < 1e-9
+    if np.any(bad):  # opposite: any perpendicular axis
+        q[bad, 0] = 0.0
+        q[bad, 1:] = _cross(u[bad], np.array([1.0, 0.0, 0.0]))
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def _unit(v: F64) -> F64:
+    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+
+
+def _quat_y(angle: F64 | float) -> F64:
+    a = np.asarray(angle, dtype=np.float64)
+    return np.stack([np.cos(a / 2), np.zeros_like(a), np.sin(a / 2), np.zeros_like(a)], axis=-1)
+
+
+def two_link(base: F64, target: F64, l1: F64, l2: F64, pole: F64) -> tuple[F64, F64]:
+    """Unit directions ``(n, 3)`` of the first and second links of two-link chains from
+    ``base`` to ``target`` (``(n, 3)``), lengths ``l1, l2`` ``(n,)``, bending toward ``pole``;
+    an unreachable target is approached along the straight line."""
+    d = target - base
+    dist = np.linalg.norm(d, axis=1)
+    dist = np.clip(dist, np.abs(l1 - l2) + 1e-6, (l1 + l2) * 0.9999)
+    dh = _unit(d)
+    cos_a = np.clip((l1**2 + dist**2 - l2**2) / (2 * l1 * dist), -1.0, 1.0)
+    n = pole - np.einsum("ij,ij->i", pole, dh)[:, None] * dh
+    n = _unit(n)
+    u1 = cos_a[:, None] * dh + np.sqrt(1.0 - cos_a**2)[:, None] * n
+    elbow = base + l1[:, None] * u1
+    u2 = _unit(base + dist[:, None] * dh - elbow)
+    return u1, u2
+
+
+def ankle_pitch(crank: F64 | float) -> F64:
+    """Toes-down pitch (rad) of a foot relative to the bicycle for its crank angle (0: that
+    pedal at the top, increasing forward). Stated approximation of recorded pedalling (ankle
+    angle data of Ericson et al. 1985 and Hull & Jorge 1985, as summarised by Bini et al.
+    2011): the sole 15 degrees toes-down on average, 10 degrees either way, flattest (heel
+    down) just after the top of the power stroke (crank 110 degrees), most toes-down on the
+    up-stroke (crank 290 degrees)."""
+    return np.radians(15.0) - np.radians(10.0) * np.cos(np.asarray(crank) - math.radians(110.0))
+
+
+@dataclass(frozen=True)
+class Posture:
+    """The riding posture: pelvis tilt forward on the saddle, waist and back pitch (anatomical,
+    > 0 forward), neck pitch (< 0 lifts the head to look ahead), rad."""
+
+    pelvis: float = math.radians(15.0)
+    waist: float = math.radians(12.0)
+    back: float = math.radians(12.0)
+    neck: float = math.radians(-30.0)
+
+
+@dataclass(frozen=True)
+class SpeedGains:
+    """Eq. 7 with an integral term and a feed-forward, as a force at the rear contact turned
+    into a crank torque through the gear (``T = F r G``, ``r`` the rear wheel's radius, ``G``
+    the gear): ``F = k (v_d - v) + ki int (v_d - v) + F_ff``, ``F_ff`` the force the known
+    rolling resistance and grade need at ``v_d``; the crank torque is clipped to
+    ``max_torque`` (N m: a strong rider's sustained pedal force, ~1000 N on a 17 cm crank)."""
+
+    k: float = 220.0
+    ki: float = 80.0
+    max_torque: float = 180.0
+    integral_limit: float = 2.0
+
+
+@dataclass(frozen=True)
+class SteerGains:
+    """Eq. 11 as a cascade, gains scheduled with the speed ``v``:
+
+    ``fork = w' psi'_d / v - (w' / v^2) ((h wn^2 + g)(roll - roll_d) + 2 zeta wn h roll')``
+
+    (``w' = w / cos lambda``), i.e. eq. 11's roll gains ``k_roll = (w'/v^2)(h wn^2 + g)``,
+    ``k_roll' = (w'/v^2) 2 zeta wn h``; the yaw terms enter through the desired yaw rate
+    ``psi'_d = psi'_ref + k_yaw (psi_ref - psi)`` toward a reference heading that turns at most
+    as fast as ``max_lean`` allows, reaching that rate in ``turn_in`` s, and the
+    desired roll ``roll_d = -atan(v psi'_d / g)`` (the steady-turn lean). ``h``: the height of
+    the rider and bicycle's centre of mass; ``wn``, ``zeta``: the lean servo's natural
+    frequency (1/s) and damping ratio."""
+
+    height: float = 1.1
+    wn: float = 5.0
+    wn_per_speed: float = 1.25
+    zeta: float = 0.9
+    k_yaw: float = 1.0
+    max_lean: float = 0.5
+    turn_in: float = 0.5
+    lag: float = 0.4
+    k_steer: float = 8.0
+    max_steer_offset: float = 0.3
+    max_fork: float = math.radians(45.0)
+    min_speed: float = 1.0
+
+
+def trunk_pose(athlete: Athlete, posture: Posture) -> tuple[F64, F64, F64]:
+    """The posture's trunk in the bicycle frame with the pelvis origin at 0: anatomical
+    rotations ``(16, 4)`` (pelvis, waist, chest and head rows; the rest identity), the
+    shoulders' and hips' offsets ``(4, 3)`` (left and right shoulder, left and right hip) and
+    the sit bones' midpoint ``(3,)``."""
+    n, bpos = athlete.neutral, athlete.character.body_pos
+    a = np.tile([1.0, 0.0, 0.0, 0.0], (16, 1))
+    a[_B["pelvis"]] = _quat_y(posture.pelvis)
+    a[_B["waist"]] = _qmul(a[_B["pelvis"]], _quat_y(posture.waist))
+    a[_B["chest"]] = _qmul(a[_B["waist"]], _quat_y(posture.back))
+    a[_B["head"]] = _qmul(a[_B["chest"]], _quat_y(posture.neck))
+    g = _qmul(a, n)
+    pos = np.zeros((16, 3))
+    for b in ("waist", "chest"):
+        i = _B[b]
+        pos[i] = pos[SIM_PARENTS[i]] + _qrot(g[SIM_PARENTS[i]], bpos[i])
+    bases = np.empty((4, 3))
+    for k, b in enumerate(("l_upper_arm", "r_upper_arm", "l_thigh", "r_thigh")):
+        i = _B[b]
+        bases[k] = pos[SIM_PARENTS[i]] + _qrot(g[SIM_PARENTS[i]], bpos[i])
+    sit = _qrot(a[0], np.array([SIT_OFFSET[0], 0.0, SIT_OFFSET[2]]))
+    return a, bases, sit
+
+
+def fit_bicycle(params: BicycleParams, athlete: Athlete, *, knee_at_bottom: float = 0.45,
+                posture: Posture | None = None, elbow: float = math.radians(30.0),
+                arm_drop: float = math.radians(60.0),
+                seat_angle: float = math.radians(73.0)) -> BicycleParams:  # fmt: skip
+    """The bicycle fitted to the athlete in ``posture``: the saddle up the seat tube
+    (``seat_angle`` from horizontal through the bottom bracket) until the knee bends
+    ``knee_at_bottom`` rad with the pedal at the bottom, and the grips where the hands reach
+    with ``elbow`` rad of elbow bend, the arms ``arm_drop`` rad below horizontal."""
+    dt = params.drivetrain
+    if dt is None:
+        raise ConfigError("a rider needs a bicycle with a drivetrain")
+    pose = posture or Posture()
+    _, bases, sit = trunk_pose(athlete, pose)
+    thigh, shin = float(athlete.thigh.mean()), float(athlete.shin.mean())
+    leg = math.sqrt(thigh**2 + shin**2 + 2 * thigh * shin * math.cos(knee_at_bottom))
+    ball = _ball_offset(athlete)
+    reach = math.hypot(leg + abs(float(ball[2])) * 0.5, float(ball[0]))  # hip to ball of foot
+    bb = np.array([dt.bottom_bracket[0], 0.0, dt.bottom_bracket[1]])
+    pedal = bb - [0.0, 0.0, dt.crank_length]
+    up = np.array([-math.cos(seat_angle), 0.0, math.sin(seat_angle)])
+    hip = 0.5 * (bases[2] + bases[3]) - sit  # from the sit point
+    gap = lambda s: float(np.linalg.norm(bb + s * up + hip - pedal)) - reach  # noqa: E731
+    along = float(brentq(gap, 0.0, 2.0))
+    seat = bb + along * up
+    shoulder = seat - sit + bases[0]
+    v1 = quat_rotate(
+        athlete.neutral[_B["l_upper_arm"]], athlete.character.body_pos[_B["l_forearm"]]
+    )
+    v2 = quat_rotate(athlete.neutral[_B["l_forearm"]], athlete.character.body_pos[_B["l_hand"]])
+    v2 = v2 + quat_rotate(athlete.neutral[_B["l_hand"]], _hand_offset(athlete))
+    l1, l2 = float(np.linalg.norm(v1)), float(np.linalg.norm(v2))
+    arm = math.sqrt(l1**2 + l2**2 + 2 * l1 * l2 * math.cos(elbow))
+    half = params.fit.grip_offset if params.fit else 0.25
+    lateral = half - float(shoulder[1])
+    flat = math.sqrt(max(arm**2 - lateral**2, 0.01))
+    grips = shoulder + flat * np.array([math.cos(arm_drop), 0.0, -math.sin(arm_drop)])
+    fit = Fit(seat=(float(seat[0]), float(seat[2])), grips=(float(grips[0]), float(grips[2])),
+              grip_offset=half)  # fmt: skip
+    return replace(params, fit=fit)
+
+
+def _ball_offset(athlete: Athlete, side: str = "l") -> F64:
+    """The ball of the foot (the foot's patch geom) in that foot's frame."""
+    m = athlete.character.model
+    return m.geom_pos[m.geom(f"{side}_foot_ball").id].copy()
+
+
+def _hand_offset(athlete: Athlete, side: str = "l") -> F64:
+    """The grip point (the hand's capsule centre) in that hand's frame."""
+    m = athlete.character.model
+    geoms = np.flatnonzero(m.geom_bodyid == m.body(f"{side}_hand").id)
+    return m.geom_pos[geoms[0]].copy()
+
+
+class RiderMount:
+    """A :class:`~reactmocap.athletics.cycling_scene.ScenePart`: sites on the rider (sit bones,
+    grip points, balls of the feet) and on the bicycle (saddle, grips, pedals) tied by soft
+    ``connect`` equalities: two at the saddle (a pivot about the saddle's lateral axis), one
+    per hand and foot. Also stops the rider's shins and feet colliding with the floor (a loaded
+    pedal sits 10 cm up: a foot brushing the ground in a lean would trip the simulation)."""
+
+    def __init__(self, athlete: Athlete, bicycle: Bicycle, prefix: str) -> None:
+        fit = bicycle.params.fit
+        dt = bicycle.params.drivetrain
+        if fit is None or dt is None:
+            raise ConfigError("a rider's bicycle needs a fit and a drivetrain (fit_bicycle)")
+        self.athlete, self.bicycle, self.prefix = athlete, bicycle, prefix
+
+    def build(self, spec: mujoco.MjSpec) -> None:
+        pre, bp, ath = self.prefix, self.bicycle.prefix, self.athlete
+        p = self.bicycle.params
+        fit = p.fit
+        assert fit is not None
+        neutral = ath.neutral
+        rr = p.rear.radius
+        pelvis = spec.body(pre + "pelvis")
+        # compiled beside its bicycle (the characters' reference poses all stand at the origin:
+        # many riders there would touch each other)
+        pl = self.bicycle.placement
+        pelvis.pos = [pelvis.pos[0] + pl.x, pelvis.pos[1] + pl.y, pelvis.pos[2]]
+        frame = spec.body(bp + "frame")
+        fork = spec.body(bp + "fork")
+        head = p.steer_foot + p.steer_axis * (p.front.radius / p.steer_axis[2])
+        sx, sz = fit.seat
+        for side, sign in (("l", 1.0), ("r", -1.0)):
+            off = np.array([SIT_OFFSET[0], sign * SIT_OFFSET[1], SIT_OFFSET[2]])
+            local = quat_rotate(quat_conj(neutral[0]), off)
+            pelvis.add_site(name=f"{pre}{side}_sit", pos=local.tolist())
+            frame.add_site(name=f"{bp}{side}_seat", pos=[sx, sign * SIT_OFFSET[1], sz - rr])
+            spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_SITE,
+                              name1=f"{pre}{side}_sit", name2=f"{bp}{side}_seat",
+                              solref=list(SEAT_SPRING))  # fmt: skip
+            hand = spec.body(f"{pre}{side}_hand")
+            hand.add_site(name=f"{pre}{side}_grip", pos=_hand_offset(ath, side).tolist())
+            gx, gz = fit.grips
+            fork.add_site(name=f"{bp}{side}_grip",
+                          pos=[gx - head[0], sign * fit.grip_offset, gz - head[2]])  # fmt: skip
+            spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_SITE,
+                              name1=f"{pre}{side}_grip", name2=f"{bp}{side}_grip",
+                              solref=list(HAND_SPRING))  # fmt: skip
+            foot = spec.body(f"{pre}{side}_foot")
+            foot.add_site(name=f"{pre}{side}_ball", pos=_ball_offset(ath, side).tolist())
+            pedal = "left_pedal" if side == "l" else "right_pedal"
+            spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_SITE,
+                              name1=f"{pre}{side}_ball", name2=f"{bp}{pedal}",
+                              solref=list(FOOT_SPRING))  # fmt: skip
+
+    def bind(self, world: World) -> None:
+        m = world.model
+        pre, bp = self.prefix, self.bicycle.prefix
+        self.world = world
+        self.sites = {
+            name: int(m.site(n).id)
+            for name, n in (("l_grip", f"{bp}l_grip"), ("r_grip", f"{bp}r_grip"),
+                            ("l_pedal", f"{bp}left_pedal"), ("r_pedal", f"{bp}right_pedal"),
+                            ("l_ball", f"{pre}l_ball"), ("r_ball", f"{pre}r_ball"),
+                            ("l_seat", f"{bp}l_seat"), ("r_seat", f"{bp}r_seat"),
+                            ("l_sit", f"{pre}l_sit"), ("r_sit", f"{pre}r_sit"))
+        }  # fmt: skip
+        for part in ("l_shin", "r_shin", "l_foot", "r_foot"):
+            geoms = np.flatnonzero(m.geom_bodyid == m.body(pre + part).id)
+            m.geom_contype[geoms] = 0
+            m.geom_conaffinity[geoms] = 0
+
+
+@dataclass
+class RiderLog:
+    """Per control tick: time, speed and its command, heading and its command, roll, steer and
+    its command, crank torque, position ``(x, y)``."""
+
+    rows: list[tuple[float, ...]] = field(default_factory=list)
+
+    COLUMNS = ("t", "speed", "speed_cmd", "heading", "heading_cmd", "roll", "steer",
+               "steer_cmd", "crank_torque", "x", "y", "yaw_rate")  # fmt: skip
+
+    def arrays(self) -> dict[str, F64]:
+        a = np.array(self.rows, dtype=np.float64).reshape(-1, len(self.COLUMNS))
+        return {c: a[:, k] for k, c in enumerate(self.COLUMNS)}
+
+
+#: limb order of the inverse kinematics: left arm, right arm, left leg, right leg; the poles
+#: the elbows (out, back and down) and knees (forward) bend toward
+_UPPER = np.array([_B[b] for b in ("l_upper_arm", "r_upper_arm", "l_thigh", "r_thigh")])
+_LOWER = np.array([_B[b] for b in ("l_forearm", "r_forearm", "l_shin", "r_shin")])
+_HANDS = np.array([_B["l_hand"], _B["r_hand"]])
+_POLES = np.array([[-0.5, 0.7, -0.5], [-0.5, -0.7, -0.5], [1.0, 0.1, 0.3], [1.0, -0.1, 0.3]])
+
+
+_LEG_JOINTS = np.array(
+    [BALL_JOINTS.index(f"{s}_{j}") for s in "lr" for j in ("hip", "knee", "ankle")]
+)
+
+
+def _turn_pedals(pedals: F64, centre: F64, angle: float) -> F64:
+    """Pedal points ``(2, 3)`` turned forward by ``angle`` about the crank axle (bicycle +y)
+    through ``centre``."""
+    c, s = math.cos(angle), math.sin(angle)
+    rel = pedals - centre
+    out = centre + rel
+    out[:, 0] = centre[0] + c * rel[:, 0] + s * rel[:, 2]
+    out[:, 2] = centre[2] - s * rel[:, 0] + c * rel[:, 2]
+    return out
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+class Rider:
+    """The rider's controller (module docstring) for character ``character`` on ``bicycle``,
+    tied to it by ``mount`` (bound in ``world``).
+
+    Commands: :attr:`speed_cmd` (m/s) and :attr:`heading_cmd` (rad), settable at any time (a
+    group behaviour sets them every tick). Servo: stiffness ``kp`` (1/s^2, times each joint's
+    outboard inertia), scaled by ``arm_scale`` at the shoulders, elbows and wrists (the fork
+    follows the hands) and ``leg_scale`` at the hips, knees and ankles (the pedals lead the
+    legs); waist and back x3."""
+
+    def __init__(
+        self,
+        world: World,
+        athlete: Athlete,
+        bicycle: Bicycle,
+        mount: RiderMount,
+        character: int = 0,
+        *,
+        speed: float = 5.0,
+        heading: float = 0.0,
+        posture: Posture | None = None,
+        speed_gains: SpeedGains | None = None,
+        steer_gains: SteerGains | None = None,
+        kp: float = 900.0,
+        arm_scale: float = 4.0,
+        leg_scale: float = 0.5,
+        control_every: int = 4,
+    ) -> None:
+        if not (0 <= character < len(world.characters)):
+            raise ConfigError(f"character {character} is not in the world")
+        if not (kp > 0 and arm_scale > 0 and leg_scale > 0 and control_every >= 1):
+            raise ConfigError("kp, arm_scale and leg_scale must be > 0, control_every >= 1")
+        if not (math.isfinite(speed) and math.isfinite(heading)):
+            raise ConfigError("speed and heading commands must be finite")
+        self.world, self.athlete, self.bicycle, self.character = world, athlete, bicycle, character
+        self.speed_cmd = float(speed)
+        self.heading_cmd = float(heading)
+        self.posture = posture or Posture()
+        self.speed_gains = speed_gains or SpeedGains()
+        self.steer_gains = steer_gains or SteerGains()
+        self.kp = float(kp)
+        self.arm_scale = float(arm_scale)
+        self.leg_scale = float(leg_scale)
+        self.control_every = int(control_every)
+        self.log = RiderLog()
+        m = world.model
+        wc = world.characters[character]
+        self.wc = wc
+        self.servo = world.servo
+        p = bicycle.params
+        if p.drivetrain is None or p.fit is None:
+            raise ConfigError("a rider's bicycle needs a drivetrain and a fit (fit_bicycle)")
+        self.dt_params = p.drivetrain
+        ch = athlete.character
+        self._bq = ch.body_quat  # (16, 4)
+        self._bpos = ch.body_pos  # (16, 3)
+        self._neutral = athlete.neutral  # (16, 4)
+        # the limbs' link vectors in the anatomical frame (neutral pose) and their lengths
+        self._ball = np.array([_ball_offset(athlete, s) for s in "lr"])  # in the foot frames
+        links = []
+        for up, mid, end, extra in (("l_upper_arm", "l_forearm", "l_hand", _hand_offset(athlete, "l")),
+                                     ("r_upper_arm", "r_forearm", "r_hand", _hand_offset(athlete, "r")),
+                                     ("l_thigh", "l_shin", "l_foot", None),
+                                     ("r_thigh", "r_shin", "r_foot", None)):  # fmt: skip
+            v1 = quat_rotate(self._neutral[_B[up]], self._bpos[_B[mid]])
+            v2 = quat_rotate(self._neutral[_B[mid]], self._bpos[_B[end]])
+            if extra is not None:  # the grip point beyond the (straight) wrist
+                v2 = v2 + quat_rotate(self._neutral[_B[end]], extra)
+            links.append((v1, v2))
+        self._v1 = np.array([a for a, _ in links])
+        self._v2 = np.array([b for _, b in links])
+        self._l1 = np.linalg.norm(self._v1, axis=1)
+        self._l2 = np.linalg.norm(self._v2, axis=1)
+        # the bicycle frame: the rider's frame body; steer axis and head in its frame
+        self._head = (p.steer_foot + p.steer_axis * (p.front.radius / p.steer_axis[2])
+                      - np.array([0.0, 0.0, p.rear.radius]))  # fmt: skip
+        self._axis = p.steer_axis
+        fit = p.fit
+        self._grip0 = np.array([[fit.grips[0], s * fit.grip_offset, fit.grips[1] - p.rear.radius]
+                                for s in (1.0, -1.0)])  # fmt: skip
+        self._wheelbase = p.wheelbase / math.cos(p.steer_tilt)
+        self._resist = p.rolling_resistance
+        self._mass = float(m.body_subtreemass[wc.body_ids[0]]) + p.mass
+        # leg Jacobian columns: hip, knee and ankle (the ankle passes the pedal force's moment
+        # about it on to the foot; its servo alone, scaled by a foot's inertia, would fold)
+        self._leg_cols = [
+            np.concatenate([wc.ball_dof_start + 3 * BALL_JOINTS.index(f"{s}_{j}") + np.arange(3)
+                            for j in ("hip", "knee", "ankle")])
+            for s in "lr"
+        ]  # fmt: skip
+        self._feet = [int(wc.body_ids[_B[f"{s}_foot"]]) for s in "lr"]
+        self._jac = np.zeros((3, m.nv))
+        self._balls = wc.ball_dof_start + np.arange(3 * NJ)
+        self._ff_rows = self.servo.character_indices.index(character) * NJ
+        self._d1 = _unit(self._v1)
+        self._d2 = _unit(self._v2)
+        self._bq_inv = _qconj(self._bq[1:])
+        self._foot_rows = np.array([_B["l_foot"], _B["r_foot"]])
+        self._trunk_cache: tuple[Posture, F64, F64] | None = None
+        self._integral = 0.0
+        self._torque = 0.0
+        self._fork_cmd = 0.0
+        if mount.bicycle is not bicycle or mount.world is not world:
+            raise ConfigError("the rider's mount must tie it to this bicycle in this world")
+        self.mount = mount
+
+    # ---------------------------------------------------------------- pose
+    def _frame(self) -> tuple[F64, F64]:
+        d = self.world.data
+        fid = self.bicycle.frame_id
+        return d.xpos[fid].copy(), d.xquat[fid].copy()
+
+    def _trunk(self) -> tuple[F64, F64]:
+        """:func:`trunk_pose` of the current posture (cached)."""
+        if self._trunk_cache is None or self._trunk_cache[0] is not self.posture:
+            a, bases, _ = trunk_pose(self.athlete, self.posture)
+            self._trunk_cache = (self.posture, a, bases)
+        return self._trunk_cache[1], self._trunk_cache[2]
+
+    def pose(self, fork: float, pedals: F64, pelvis_pos: F64, crank: float) -> F64:
+        """``(16, 4)`` desired body rotations in the bicycle frame: the posture's pelvis and
+        trunk, arms reaching the grips at fork angle ``fork``, legs reaching ``pedals``
+        ``(2, 3)`` (left, right; bicycle frame) with the ankle pattern at crank angle
+        ``crank``; the pelvis at ``pelvis_pos`` (bicycle frame)."""
+        trunk, offsets = self._trunk()
+        a = trunk.copy()
+        bases = pelvis_pos + offsets
+        turn = np.r_[math.cos(fork / 2), math.sin(fork / 2) * self._axis]
+        grips = self._head + _qrot(turn, self._grip0 - self._head)
+        a_foot = _quat_y(ankle_pitch(np.array([crank + math.pi, crank])))  # left, right
+        g_foot = _qmul(a_foot, self._neutral[self._foot_rows])
+        ankles = pedals - _qrot(g_foot, self._ball)
+        u1, u2 = two_link(bases, np.vstack([grips, ankles]), self._l1, self._l2, _POLES)
+        a_up = _minrot(self._d1, u1)
+        a_low = _qmul(_minrot(_qrot(a_up, self._d2), u2), a_up)
+        a[_UPPER] = a_up
+        a[_LOWER] = a_low
+        a[_HANDS] = a_low[:2]
+        a[self._foot_rows] = a_foot
+        return _qmul(a, self._neutral)
+
+    def joint_quats(self, g: F64) -> F64:
+        """``(15, 4)`` ball-joint quaternions of body rotations ``g`` ``(16, 4)`` (any common
+        frame): ``q = bq^-1 g_parent^-1 g_child``."""
+        return _qmul(self._bq_inv, _qmul(_qconj(g[SIM_PARENTS[1:]]), g[1:]))
+
+    def _local(self, origin: F64, quat: F64, points: F64) -> F64:
+        return _qrot(_qconj(quat), points - origin)
+
+    def initial_qpos(self) -> F64:
+        """``(67,)`` the rider's qpos sitting on the placed bicycle: sit bones on the saddle,
+        hands on the grips, feet on the pedals."""
+        d = self.world.data
+        o, q = self._frame()
+        s = self._sites()
+        seat = self._local(o, q, 0.5 * (d.site_xpos[s["l_seat"]] + d.site_xpos[s["r_seat"]]))
+        g_pelvis = quat_mul(_quat_y(self.posture.pelvis), self._neutral[0])
+        sit = quat_rotate(quat_conj(self._neutral[0]), np.array(SIT_OFFSET) * [1.0, 0.0, 1.0])
+        pelvis_pos = seat - quat_rotate(g_pelvis, sit)
+        pedals = self._local(o, q, d.site_xpos[[s["l_pedal"], s["r_pedal"]]])
+        g = self.pose(0.0, pedals, pelvis_pos, self.bicycle.crank_angle)
+        out = np.empty(7 + 4 * NJ)
+        out[:3] = o + quat_rotate(q, pelvis_pos)
+        out[3:7] = quat_mul(q, g[0])
+        out[7:] = self.joint_quats(g).reshape(-1)
+        return out
+
+    def _sites(self) -> dict[str, int]:
+        return self.mount.sites
+
+    def seat(self) -> None:
+        """Put the rider on the placed bicycle, moving with it (run after the bicycle's
+        ``place``)."""
+        qv = np.zeros(6 + 3 * NJ)
+        qv[:3] = self.bicycle.velocity
+        self.world.set_pose(self.character, self.initial_qpos(), qv)
+
+    # ---------------------------------------------------------------- control
+    def reset(self, world: World) -> None:
+        del world
+        servo = self.servo
+        servo.enable(self.character, on=True)
+        servo.set_gains(self.kp, None, self.character)
+        scale = np.ones(NJ)
+        for joints, k in ((("hip", "knee", "ankle"), self.leg_scale), (("waist", "back"), 3.0),
+                          (("shoulder", "elbow", "wrist"), self.arm_scale)):  # fmt: skip
+            names = [j for j in BALL_JOINTS if j.removeprefix("l_").removeprefix("r_") in joints]
+            servo.set_gain_scale(self.character, names, k)
+            scale[[BALL_JOINTS.index(j) for j in names]] = k
+        # the servo damps toward rest; its damping times the targets' own velocity goes into
+        # the feed-forward, so it damps toward the pedalling and steering motion instead
+        self._kv = 2.0 * math.sqrt(self.kp) * np.sqrt(scale)
+        self._integral = 0.0
+        self._ref = self.bicycle.yaw
+        self._ref_rate = 0.0
+        self._expected = self._ref
+        self._steer_int = 0.0
+        self.log = RiderLog()
+
+    def fork_command(self, v: float) -> tuple[float, float]:
+        """The fork angle (rad) eq. 11 asks for now, and the desired yaw rate (rad/s). The
+        heading command is first shaped into a reference that turns no faster than the lean
+        allows (:attr:`SteerGains.max_lean`) and speeds up and slows down over
+        :attr:`SteerGains.turn_in` seconds (the time the lean takes to build), so a step in
+        heading is ridden as a turn, not as a saturated error."""
+        b, sg = self.bicycle, self.steer_gains
+        g = 9.81
+        vv = max(abs(v), sg.min_speed)
+        h = self.control_every * self.world.timestep
+        # as fast as the lean allows, and at low speed as the fork allows (half its range)
+        max_rate = min(
+            g * math.tan(sg.max_lean) / vv, vv * math.tan(0.5 * sg.max_fork) / self._wheelbase
+        )
+        wn = min(sg.wn, sg.wn_per_speed * vv)  # slower lean servo at low speed: gains ~ 1/v^2
+        lag = sg.lag * (sg.wn / wn) ** 1.5  # the lean servo's lag grows at low speed
+        accel = max_rate / max(sg.turn_in, lag)
+        left = _wrap(self.heading_cmd - self._ref)
+        # as fast as allowed, braking in time (sqrt(2 a e)); near the target a first-order
+        # approach (the square root's gain is unbounded at zero: it would chatter)
+        want = math.copysign(
+            min(max_rate, math.sqrt(2.0 * accel * abs(left)), abs(left) / lag), left
+        )
+        self._ref_rate += min(max(want - self._ref_rate, -accel * h), accel * h)
+        self._ref = _wrap(self._ref + self._ref_rate * h)
+        # the heading the bicycle can have by now: the reference through the lean's lag; the
+        # feedback compares with it (no wind-up while the lean builds), the feed-forward is the
+        # reference's own rate (the lean starts at once)
+        self._expected = _wrap(
+            self._expected + _wrap(self._ref - self._expected) * min(h / lag, 1.0)
+        )
+        rate = self._ref_rate + sg.k_yaw * _wrap(self._expected - b.yaw)
+        rate = min(max(rate, -max_rate), max_rate)
+        roll_d = -math.atan(vv * rate / g)
+        w = self._wheelbase
+        k = w / vv**2
+        fork = w * rate / vv - k * ((sg.height * wn**2 + g) * (b.roll - roll_d)
+                                    + 2 * sg.zeta * wn * sg.height * b.roll_rate)  # fmt: skip
+        return min(max(fork, -sg.max_fork), sg.max_fork), rate
+
+    def crank_torque(self, v: float) -> float:
+        """Eq. 7 (with the integral and feed-forward of :class:`SpeedGains`), N m. The integral
+        stops while the torque is at its limit (no wind-up)."""
+        sg, dt = self.speed_gains, self.dt_params
+        err = self.speed_cmd - v
+        h = self.control_every * self.world.timestep
+        # resistive force at the command: rolling resistance and gravity along the slope
+        slope = float(self.bicycle.rotation()[2, 0])  # sine of the climb angle
+        ff = self._resist * self.speed_cmd + self._mass * 9.81 * slope
+        arm = self.bicycle.params.rear.radius * dt.gear
+        trial = self._integral + err * h
+        trial = min(max(trial, -sg.integral_limit), sg.integral_limit)
+        t = (ff + sg.k * err + sg.ki * trial) * arm
+        if abs(t) <= sg.max_torque:
+            self._integral = trial
+        else:
+            t = (ff + sg.k * err + sg.ki * self._integral) * arm
+        return min(max(t, -sg.max_torque), sg.max_torque)
+
+    def control(self, world: World, t: float) -> None:
+        d = world.data
+        b = self.bicycle
+        s = self._sites()
+        v = b.speed
+        fork, rate = self.fork_command(v)
+        torque = self.crank_torque(v)
+        h = self.control_every * world.timestep
+        # the arms give a little under the bar's load: aim the hands past the fork angle by
+        # the integrated tracking error, so the fork reaches the angle eq. 11 asks for
+        sg = self.steer_gains
+        self._steer_int += sg.k_steer * (fork - b.steer) * h
+        self._steer_int = min(max(self._steer_int, -sg.max_steer_offset), sg.max_steer_offset)
+        self._torque, self._fork_cmd = torque, fork
+        o, q = self._frame()
+        crank = b.crank_angle
+        rate = b.crank_rate
+        bb = self._local(o, q, d.xpos[b.crank_id])
+        pedals = self._local(o, q, d.site_xpos[[s["l_pedal"], s["r_pedal"]]])
+        pelvis = self._local(o, q, d.xpos[self.wc.body_ids[0]])
+        # aim a little ahead along the pedal circle (the servo's lag), and one tick further for
+        # the legs' velocity: the pedalling motion is the crank's, not the feet's (feet-driven
+        # velocity targets would cancel the servo's damping)
+        lead = rate * 0.03
+        grip = fork + self._steer_int
+        now = self.pose(grip, _turn_pedals(pedals, bb, lead), pelvis, crank + lead)
+        ahead = self.pose(grip, _turn_pedals(pedals, bb, lead + rate * h), pelvis,
+                          crank + lead + rate * h)  # fmt: skip
+        targets = self.joint_quats(now)
+        self.servo.set_targets(self.character, targets)
+        self._feedforward(torque, crank)
+        rel = _qmul(_qconj(targets[_LEG_JOINTS]), self.joint_quats(ahead)[_LEG_JOINTS])
+        w = 2.0 * rel[:, 1:] * np.sign(rel[:, :1]) / h
+        inertia = self.servo.joint_inertia(self.character)[_LEG_JOINTS]
+        ff = self.servo.feedforward[self._ff_rows : self._ff_rows + NJ]
+        ff[_LEG_JOINTS] += self._kv[_LEG_JOINTS, None] * np.einsum("nij,nj->ni", inertia, w)
+        yaw = b.yaw
+        pos = b.position
+        self.log.rows.append((t, v, self.speed_cmd, yaw, self.heading_cmd, b.roll, b.steer,
+                              fork, torque, float(pos[0]), float(pos[1]), b.yaw_rate))  # fmt: skip
+
+    def _feedforward(self, torque: float, crank: float) -> None:
+        """Gravity compensation of every joint plus the legs' ``J^T f`` pedal forces (eqs. 8-10)."""
+        m, d = self.world.model, self.world.data
+        ff = self.servo.feedforward[self._ff_rows : self._ff_rows + NJ].reshape(-1)
+        ff[:] = d.qfrc_bias[self._balls]
+        arm = self.dt_params.crank_length
+        w_right = 0.5 * (1.0 + math.sin(crank))
+        if torque < 0:
+            w_right = 1.0 - w_right
+        s = self._sites()
+        axis = self.bicycle.rotation()[:, 1]  # the crank axle (bicycle's left)
+        centre = d.xpos[self.bicycle.crank_id]
+        for k, (side, share) in enumerate((("l", 1.0 - w_right), ("r", w_right))):
+            pedal = d.site_xpos[s[f"{side}_pedal"]]
+            r = pedal - centre
+            r = r - (r @ axis) * axis
+            tangent = _cross(axis, r) / max(float(np.linalg.norm(r)), 1e-9)
+            force = share * torque / arm * tangent  # the foot pushes the pedal with this
+            mujoco.mj_jac(m, d, self._jac, None, d.site_xpos[s[f"{side}_ball"]], self._feet[k])
+            cols = self._leg_cols[k]
+            ff[cols - self.wc.ball_dof_start] += self._jac[:, cols].T @ force

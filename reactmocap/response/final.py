@@ -1,0 +1,217 @@
+"""The last stage of a response: the final blend onto the found clip and the attacker's
+output around the recipient's (see :mod:`reactmocap.response.stages` for the ones before)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.library.motion import Motion
+from reactmocap.library.placement import ground_root
+from reactmocap.metrics import joint_speed_max_m_s
+from reactmocap.response.blend import blend_poses, final_blend
+from reactmocap.response.footlock import lock_feet
+from reactmocap.response.scenario import ResponseConfig, Scenario
+from reactmocap.response.stages import (
+    Actor,
+    Cast,
+    ContactEstimate,
+    Continuation,
+    NaiveSimulation,
+    TransitionSimulation,
+    desired_motion,
+    yields_to,
+)
+from reactmocap.rotations import quat_conj, quat_mul
+from reactmocap.sim.bodies import SIM_BODIES, SIM_PARENTS
+from reactmocap.sim.impacts import overlap_depths
+
+__all__ = ["Blend", "blend"]
+
+F64 = NDArray[np.float64]
+
+
+def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
+    """The last time after ``impact`` at which the attacker's own clip runs into the recipient's
+    output (``impact`` if never)."""
+    att = cast.attacker
+    assert att is not None
+    fps = recipient.fps
+    i0 = int(np.ceil(impact * fps))
+    t = np.arange(i0, recipient.num_frames) / fps
+    if t.size == 0:
+        return impact
+    own = att.motion.sample(t + att.clock0).replace(fps=fps)
+    world = cast.pair
+    depth = overlap_depths(world, [recipient.sample(t).replace(fps=fps), own])
+    hit = np.flatnonzero(depth > 0.0)
+    return float(t[hit[-1]] + 1.0 / fps) if hit.size else impact
+
+
+def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
+                     sim2: TransitionSimulation, duration: float, shift_times: F64,
+                     shift: F64, release: float, speed: float) -> Motion:  # fmt: skip
+    """The attacker's output: its clip until the rewind, its simulation (moved by the
+    recipient's blend ``shift`` at ``shift_times``, held after) until ``release``, then
+    blended back to its clip over ``attacker_blend`` or longer: no faster than half its
+    clip's fastest joint ``speed`` (m/s)."""
+    assert sim2.attacker is not None
+    afps = att.motion.fps
+    t = np.arange(0, int(np.floor(duration * afps)) + 1) / afps
+    own = ground_root(att.motion.sample(t + att.clock0).replace(fps=afps), att.parts, turn=False)
+    sim = ground_root(sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration)),
+                      att.parts, turn=False)  # fmt: skip
+    if shift_times.size:
+        moved = np.stack([np.interp(t, shift_times, shift[:, k]) for k in range(3)], axis=1)
+        moved[t < shift_times[0]] = 0.0
+        sim = sim.replace(root_positions=sim.root_positions + moved)
+    # back to the clip no faster than the capture moves: the blend adds (gap / duration) to
+    # the joints' speed, kept within half the clip's fastest joint speed
+    i = min(int(np.searchsorted(t, release)), t.size - 1)
+    gap = float(np.linalg.norm(sim.slice(i, i + 1).global_positions()[0]
+                               - own.slice(i, i + 1).global_positions()[0], axis=1).max())  # fmt: skip
+    span = max(cfg.attacker_blend, gap / max(0.5 * speed, 1e-9))
+    w = np.where(t < contact.rewind, 1.0, np.clip((t - release) / span, 0, 1))
+    return ground_root(blend_poses(sim, own, w), att.parts).replace(name="attacker")
+
+
+@dataclass(frozen=True)
+class Blend:
+    """The outputs: the ``recipient`` animation (mocap before the impact, the blended
+    transition, the found clip after), the ``attacker``'s, the ``blended`` transition alone,
+    Simulation 2 over the same frames (``simulated``), and the ``seams`` between pieces."""
+
+    recipient: Motion
+    attacker: Motion | None
+    blended: Motion
+    simulated: Motion
+    seams: list[int]
+
+
+def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
+          cont: Continuation, sim2: TransitionSimulation) -> Blend:  # fmt: skip
+    """The paper's final blend over [impact, match], then the found clip plays on; the attacker
+    follows its simulation from the rewind until its own clip no longer runs into the recipient
+    (:attr:`TransitionSimulation.attacker_release`), then blends back to its clip."""
+    cfg = scenario.response
+    rec = cast.recipient
+    fps = rec.motion.fps
+    i_imp = int(np.ceil(naive.impact_time * fps - 1e-9))
+    i_end = int(round(sim2.landed * fps))
+    # every piece with a dummy top joint on the ground under the pelvis, unturned while blending
+    # (ground_root): the blend then moves the body, not meters of offset between the clips'
+    # dummy roots; the output is grounded and turned to the heading as a whole
+    grounded = lambda m: ground_root(m, rec.parts, turn=False)  # noqa: E731
+    before = (grounded(rec.motion.sample(np.arange(0, i_imp) / fps + rec.clock0))
+              if i_imp > 0 else None)  # fmt: skip
+    times = np.arange(i_imp, i_end + 1) / fps
+    simulated = grounded(sim2.motion.sample(times - contact.rewind))
+    # the blend corrects the simulation toward what it was asked to do, which ends exactly on
+    # the found clip: it then corrects only the tracking error, not the whole way to the clip
+    found = desired_motion(cast, cfg, times, naive.impact_time, yields_to(cfg, naive.impulse), cont)
+    if cfg.mode == "physical":  # close only the gap left at the landing, spread over the blend
+        found = _with_end_gap(simulated, found)
+    on = cont.best.time + (sim2.landed - cont.time)  # the found clip's time at the landing
+    tail_n = int(np.floor(max(0.0, min(cfg.tail, cont.found.duration - on)) * fps))
+    tail = (grounded(cont.found.sample(on + np.arange(1, tail_n + 1) / fps))
+            if tail_n > 0 else None)  # fmt: skip
+    start = np.zeros(rec.motion.num_joints)
+    pelvis = rec.parts.joint_of("pelvis")  # its delayed start delays the root offset too
+    speed = joint_speed_max_m_s(cast.attacker.motion) if cast.attacker is not None else 0.0
+    held = 0.0  # the attacker follows its simulation at least until then
+    for _ in range(8):  # limbs still touching the attacker keep their simulated pose longer
+        blended = final_blend(simulated, found, start, root_start=start[pelvis])
+        if cfg.foot_lock and cfg.mode == "blend":  # the physics holds the feet otherwise
+            blended = lock_feet(blended, rec.parts)
+        pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]
+        recipient = ground_root(Motion.concatenate(pieces, name="recipient"), rec.parts)
+        if cast.attacker is None or sim2.attacker is None:
+            return Blend(recipient, None, blended, simulated, _seams(i_imp, i_end, before))
+        # the blend moved the recipient off its simulation: the attacker's simulated part
+        # moves with the body it hit, so the two keep the spacing the physics gave them
+        hit = int(rec.character.anchors[SIM_BODIES.index(_hit_body(contact))])
+        shift = blended.global_positions()[:, hit] - simulated.global_positions()[:, hit]
+        release = max(sim2.attacker_release, _clear_of(cast, recipient, naive.impact_time), held)
+        attacker = _attacker_output(cfg, cast.attacker, contact, sim2, recipient.duration,
+                                    times, shift, release, speed)  # fmt: skip
+        depth = overlap_depths(cast.pair, [blended, attacker.sample(times).replace(fps=fps)],
+                               per_body=True)  # fmt: skip
+        later = _blend_later(cast, depth > 0.005, start)
+        if later is not None:
+            start = later
+            continue
+        # nothing left to delay on the recipient's side: if the attacker, blending back to
+        # its clip, runs into the recipient's output, it follows its simulation past that
+        out_t = recipient.times
+        after = out_t >= release
+        if not after.any():
+            break
+        whole = overlap_depths(cast.pair, [recipient.slice(int(np.argmax(after))),
+                                           attacker.sample(out_t[after]).replace(fps=fps)])  # fmt: skip
+        late = np.flatnonzero(whole > 0.005)
+        if late.size == 0:
+            break
+        held = float(out_t[after][late[-1]]) + 1.0 / fps
+    return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
+
+
+def _with_end_gap(simulated: Motion, target: Motion) -> Motion:
+    """``simulated`` carrying the gap of its last frame to ``target``'s last frame on every
+    frame (each local rotation turned by the last frame's correction, the root moved by its
+    offset): a final blend toward it corrects nothing but that gap and still lands exactly."""
+    fix = quat_mul(quat_conj(simulated.rotations[-1]), target.rotations[-1])
+    offset = target.root_positions[-1] - simulated.root_positions[-1]
+    tr = None
+    if simulated.translations is not None or target.translations is not None:
+        ts = simulated.local_translations()
+        tr = ts + (target.local_translations()[-1] - ts[-1])[None]
+    return simulated.replace(rotations=quat_mul(simulated.rotations, fix[None]),
+                             root_positions=simulated.root_positions + offset,
+                             translations=tr)  # fmt: skip
+
+
+def _hit_body(contact: ContactEstimate) -> str:
+    """The recipient's body the hit landed on (the pelvis when unknown)."""
+    body = contact.body.split("/")[0]
+    return body if body in SIM_BODIES else "pelvis"
+
+
+def _seams(i_imp: int, i_end: int, before: Motion | None) -> list[int]:
+    return [i_imp, i_end + 1] if before is not None else [i_end + 1]
+
+
+def _limb_root(body: int) -> int:
+    """The first body of the chain whose blend an overlap of ``body`` delays: a leg from its
+    thigh; anything above the pelvis from the waist (holding an arm alone still lets the
+    blended trunk carry it into the other character)."""
+    name = SIM_BODIES[body]
+    if name == "pelvis":
+        return body
+    if name.endswith(("thigh", "shin", "foot")):
+        return SIM_BODIES.index(name[:2] + "thigh")
+    return SIM_BODIES.index("waist")
+
+
+def _blend_later(cast: Cast, hit: NDArray[np.bool_], start: F64) -> F64 | None:
+    """New per-joint blend starts when limbs of the blended transition run into the attacker's
+    output (``hit`` ``(n, 16)``: each recipient body overlapping it, per frame): each such limb (its joints and the folded ones above it) keeps its simulated pose
+    until two frames after its last overlap. None when nothing overlaps (or nothing changes)."""
+    rec = cast.recipient
+    if not hit.any():
+        return None
+    out = start.copy()
+    skel = rec.motion.skeleton
+    anchors = rec.character.anchors
+    for b in np.flatnonzero(hit.any(axis=0)):
+        root = _limb_root(int(b))
+        a = int(anchors[root])
+        parent = int(anchors[SIM_PARENTS[root]]) if root > 0 else -1
+        above = [j for j in skel.chain(a) if parent < 0 or j not in skel.chain(parent)]
+        joints = above + [j for j in range(skel.num_joints) if a in skel.chain(j)]
+        if SIM_BODIES[root] == "waist":  # the pelvis's turn carries the trunk too
+            joints += skel.chain(int(anchors[0]))
+        last = int(np.flatnonzero(hit[:, b])[-1]) + 2
+        out[joints] = np.maximum(out[joints], last)
+    return None if np.array_equal(out, start) else out
