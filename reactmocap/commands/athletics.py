@@ -37,7 +37,9 @@ _HELP = {
 def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     from reactmocap.athletics.behaviours import BEHAVIOURS
 
-    ath = sub.add_parser("athletics", help="athletic controllers: leap, broad jump, land, balance")
+    ath = sub.add_parser(
+        "athletics", help="athletic controllers: leap, broad jump, land, balance, run, vault"
+    )
     inner = ath.add_subparsers(dest="behaviour", metavar="BEHAVIOUR", required=True)
     for name, flags in _FLAGS.items():
         b = BEHAVIOURS[name]
@@ -60,6 +62,10 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         p.add_argument("--any-range", action="store_true",
                        help="run outside the measured supported range (reported honestly)")  # fmt: skip
         p.set_defaults(func=_run, flags=flags)
+    from reactmocap.commands.athletics_run import register_run
+
+    register_run(inner)  # run, vault
+
     from reactmocap.commands.athletics_bicycle import register as register_bicycle
 
     register_bicycle(inner)

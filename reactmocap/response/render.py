@@ -22,13 +22,26 @@ from reactmocap.library.motion import Motion
 from reactmocap.response.plots import _imageio, write_video
 from reactmocap.sim.character import build_character
 
-__all__ = ["RenderUnavailable", "render_video"]
+__all__ = ["RenderUnavailable", "offscreen_renderer", "render_video"]
 
 RGBA = tuple[float, float, float, float]
 
 
 class RenderUnavailable(ReactMocapError):
     """No OpenGL context for MuJoCo's offscreen renderer on this machine."""
+
+
+def offscreen_renderer(model: mujoco.MjModel, size: tuple[int, int]) -> mujoco.Renderer:
+    """MuJoCo's offscreen renderer for ``model`` at ``size`` (width, height); raises
+    RenderUnavailable where no GL context can be made."""
+    width, height = size
+    try:
+        return mujoco.Renderer(model, height=height, width=width)
+    except Exception as exc:  # each GL backend fails in its own way
+        raise RenderUnavailable(
+            f"MuJoCo offscreen rendering unavailable (MUJOCO_GL="
+            f"{os.environ.get('MUJOCO_GL', 'unset')!r}): {exc}"
+        ) from exc
 
 
 def _scene(chars: Sequence[mujoco.MjSpec]) -> mujoco.MjModel:
@@ -89,13 +102,7 @@ def render_video(
         bodies = [b for b in range(model.nbody) if model.body(b).name.startswith(f"c{k}/")]
         model.geom_rgba[np.isin(model.geom_bodyid, bodies)] = rgba
     width, height = size
-    try:
-        renderer = mujoco.Renderer(model, height=height, width=width)
-    except Exception as exc:  # each GL backend fails in its own way
-        raise RenderUnavailable(
-            f"MuJoCo offscreen rendering unavailable (MUJOCO_GL="
-            f"{os.environ.get('MUJOCO_GL', 'unset')!r}): {exc}"
-        ) from exc
+    renderer = offscreen_renderer(model, size)
     cam = mujoco.MjvCamera()
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
     cam.distance, cam.elevation, cam.azimuth = 4.0, -15.0, 135.0

@@ -1,0 +1,321 @@
+"""Running, vaulting and cloth against the issue's experiments (prints Markdown tables; run
+``.venv/bin/python benchmarks/bench_athletics_running.py --all`` or pick sections).
+
+Sections:
+
+* ``--speeds``: 30 s runs at 2.5, 3, 3.5, 4, 4.5 and 5 m/s: falls, mean speed, RMS stride-speed
+  error, cadence, stride, real-time factor (goal: no falls, error <= 0.15 m/s, >= 2x real
+  time).
+* ``--paths``: a circle of radius 10 m and a figure eight of 10 m loops: RMS cross-track error
+  (goal <= 0.3 m).
+* ``--phase``: the hip-knee phase plot (Fig. 6) of a run at the shared run clip's speed beside
+  the clip's, and their cadence and stride (goal: within 10%); writes the figure.
+* ``--push``: the largest sideways impulse on the chest (over 0.1 s) the runner survives.
+* ``--vault``: the handspring vault against Table 1 (goal: all 16 rows inside the human range,
+  velocities within 10% of the mean).
+* ``--cloth``: the same run with and without trousers: penetration and the slow-down ratio
+  (goal: <= 1 cm, <= 1.5x).
+* ``--tune-speed S`` and ``--tune-vault``: the searches that found the defaults (a (1+3)
+  evolution strategy; slow: an hour or more on two cores).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from reactmocap.athletics.run_course import run_course
+from reactmocap.athletics.running import TUNED_SPEEDS, RunParams
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT / ".." / "shared" / "mocap"
+RUN_CLIP = SHARED / "bandai-namco-1" / "dataset-1_run_normal_001.bvh"
+SPEEDS = (2.5, 3.0, 3.5, 4.0, 4.5, 5.0)
+
+
+def _fmt(v: object, digits: int = 3) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, float):
+        return f"{v:.{digits}f}"
+    return str(v)
+
+
+def speeds(seconds: float) -> None:
+    print(f"## Speed range ({seconds:g} s runs, thesis male, figures after the first 3 s)\n")
+    print("| speed (m/s) | fell | mean speed (m/s) | stride speed RMS error (m/s) | "
+          "cadence (steps/s) | stride (m) | real time |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    rtf = []
+    for v in SPEEDS:
+        r = run_course(v, seconds=seconds, fps=30.0).report
+        rtf.append(r["realtime_factor"])
+        fell = f"at {r['fell_at_s']:.1f} s" if r["fell"] and r.get("fell_at_s") else _fmt(r["fell"])
+        print(f"| {v:g} | {fell} | {_fmt(r['mean_speed_m_s'], 2)} | "
+              f"{_fmt(r['speed_error_m_s'])} | {_fmt(r['cadence_steps_s'], 2)} | "
+              f"{_fmt(r['stride_m'], 2)} | {r['realtime_factor']:.2f}x |")  # fmt: skip
+    print(f"\nmedian real-time factor without cloth: {np.median(rtf):.2f}x\n")
+
+
+def paths(seconds: float, speed: float) -> None:
+    print(f"## Path following ({seconds:g} s at {speed:g} m/s)\n")
+    print("| path | fell | RMS cross-track error (m) | stride speed RMS error (m/s) |")
+    print("|---|---|---|---|")
+    for spec in ("circle:10", "eight:10"):
+        r = run_course(speed, seconds=seconds, path=spec, fps=10.0).report
+        fell = f"at {r['fell_at_s']:.1f} s" if r["fell"] and r.get("fell_at_s") else _fmt(r["fell"])
+        print(f"| {spec} | {fell} | {_fmt(r['path_error_m'])} | {_fmt(r['speed_error_m_s'])} |")
+    print()
+
+
+def phase(figures: Path) -> None:
+    from reactmocap.athletics.running import SPEED_RANGE
+    from reactmocap.athletics.running_plots import clip_gait, hip_knee_angles, phase_plot
+    from reactmocap.library.bvh import read_bvh
+
+    print("## Hip-knee phase plot against the shared run clip\n")
+    if not RUN_CLIP.is_file():
+        print(f"(no shared run clip at {RUN_CLIP.resolve()})\n")
+        return
+    clip = read_bvh(RUN_CLIP)
+    gait = clip_gait(clip)
+    v = float(np.clip(gait["speed_m_s"] or 3.0, *SPEED_RANGE))
+    res = run_course(v, seconds=10.0, fps=60.0)
+    r = res.report
+    print(f"clip: {RUN_CLIP.name}, {gait['duration_s']:.2f} s, {gait['touchdowns']} touchdowns; "
+          f"simulated at {v:.2f} m/s for 10 s\n")  # fmt: skip
+    print("| | speed (m/s) | cadence (steps/s) | stride (m) |")
+    print("|---|---|---|---|")
+    print(f"| clip | {_fmt(gait['speed_m_s'], 2)} | {_fmt(gait['cadence_steps_s'], 2)} | "
+          f"{_fmt(gait['stride_m'], 2)} |")  # fmt: skip
+    print(f"| simulated | {_fmt(r['mean_speed_m_s'], 2)} | {_fmt(r['cadence_steps_s'], 2)} | "
+          f"{_fmt(r['stride_m'], 2)} |")  # fmt: skip
+    for key in ("cadence_steps_s", "stride_m"):
+        a, b = r[key], gait[key]
+        if a and b:
+            print(f"\n{key}: simulated / clip = {a / b:.2f}")
+    hip, knee = hip_knee_angles(res.motion)
+    last = res.motion.times >= res.motion.duration - 2.0
+    chip, cknee = hip_knee_angles(clip)
+    figures.mkdir(parents=True, exist_ok=True)
+    out = phase_plot({"simulated (left leg, last 2 s)": (hip[last, 0], knee[last, 0]),
+                      "motion capture (left leg)": (chip[:, 0], cknee[:, 0])},
+                     figures / "running_phase.png",
+                     title=f"hip-knee phase plot at {v:.2f} m/s")  # fmt: skip
+    print(f"\nranges: simulated hip {np.degrees(hip[last, 0]).min():.0f} to "
+          f"{np.degrees(hip[last, 0]).max():.0f} deg, knee {np.degrees(knee[last, 0]).min():.0f} to "
+          f"{np.degrees(knee[last, 0]).max():.0f} deg; clip hip {np.degrees(chip[:, 0]).min():.0f} to "
+          f"{np.degrees(chip[:, 0]).max():.0f} deg, knee {np.degrees(cknee[:, 0]).min():.0f} to "
+          f"{np.degrees(cknee[:, 0]).max():.0f} deg")  # fmt: skip
+    print(f"figure: {out.relative_to(ROOT) if out.is_relative_to(ROOT) else out}\n")
+
+
+def push(speed: float) -> None:
+    print(f"## Sideways push on the chest while running ({speed:g} m/s, 0.1 s at t = 4 s)\n")
+
+    def survives(impulse: float) -> bool:
+        r = run_course(speed, seconds=7.0, push=(4.0, impulse, math.pi / 2), fps=10.0).report
+        return not r["fell"]
+
+    lo, hi = 0.0, 40.0
+    while survives(hi) and hi < 640:
+        lo, hi = hi, 2 * hi
+    for _ in range(6):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if survives(mid) else (lo, mid)
+    print(
+        f"largest impulse survived: {lo:.1f} N s (falls at {hi:.1f} N s; "
+        f"{lo / 97.84:.2f} m/s of the body's velocity)\n"
+    )
+
+
+def vault_section() -> None:
+    from reactmocap.athletics.vault import TABLE1, vault
+
+    print("## Handspring vault against Table 1 (scaled thesis female)\n")
+    r = vault().report
+    rows = r["table1"]
+    print("| row | ours | human mean | human min | human max | inside | Hodgins 1995 |")
+    print("|---|---|---|---|---|---|---|")
+    for row in TABLE1:
+        v = rows[row.key]
+        inside = v is not None and row.low <= v <= row.high
+        print(f"| {row.label} ({row.unit}) | {_fmt(v)} | {row.mean:g} | {row.low:g} | "
+              f"{row.high:g} | {_fmt(inside)} | {row.hodgins:g} |")  # fmt: skip
+    print(f"\nrows inside the human range: {r['table1_inside']}/16; velocities within 10% of "
+          f"the mean: {r['velocities_within_10pct']}/8; cleared the horse: "
+          f"{_fmt(r['cleared'])} (lowest {_fmt(r['min_clearance_over_horse_m'])} m over its top); "
+          f"landed: {_fmt(r['landed'])}; rotation {r['rotation_deg']:.0f} deg\n")  # fmt: skip
+
+
+def cloth(seconds: float, speed: float, repeats: int = 3) -> None:
+    print(f"## Cloth ({seconds:g} s at {speed:g} m/s, the same run with and without; wall "
+          f"times the median of {repeats} alternating runs)\n")  # fmt: skip
+    print("| garment | vertices | penetration max (cm) | mean (cm) | slow-down | "
+          "same motion as bare |")  # fmt: skip
+    print("|---|---|---|---|---|---|")
+    bare_walls = []
+    for kind in ("pants", "pants-light", "shorts"):
+        ratios = []
+        for _ in range(repeats):
+            bare = run_course(speed, seconds=seconds, fps=30.0)
+            res = run_course(speed, seconds=seconds, cloth=kind, fps=30.0)
+            bare_walls.append(bare.rollout.wall_s)
+            ratios.append(res.rollout.wall_s / bare.rollout.wall_s)
+        r = res.report
+        same = bool(np.array_equal(bare.rollout.qpos, res.rollout.qpos))
+        print(f"| {kind} | {r['cloth_vertices']} | {100 * r['cloth_penetration_max_m']:.2f} | "
+              f"{100 * r['cloth_penetration_mean_m']:.2f} | {np.median(ratios):.2f}x | "
+              f"{_fmt(same)} |")  # fmt: skip
+    print(f"\nbare run: median {np.median(bare_walls):.1f} s wall for {seconds:g} s\n")
+
+
+# ------------------------------------------------------------------------------ the searches
+_RUN_SPACE = {
+    "stance_time": (0.1, 0.3, 0.02), "speed_gain": (0.0, 0.3, 0.03),
+    "speed_integral": (0.0, 0.1, 0.015), "touchdown_leg": (0.9, 0.995, 0.01),
+    "leg_stiffness": (8, 60, 3), "leg_damping": (0.0, 0.4, 0.04), "thrust": (0.0, 3.5, 0.3),
+    "takeoff_vz": (0.2, 1.2, 0.08), "toe_fraction": (0.15, 0.7, 0.05),
+    "pitch": (-0.05, 0.3, 0.03), "swing_ready": (-0.9, -0.1, 0.08),
+    "reach_knee": (0.3, 1.5, 0.1), "idle_knee": (1.0, 2.2, 0.1),
+    "speed_matching": (0.0, 0.2, 0.02), "step_width": (-0.05, 0.15, 0.02),
+    "arm_gain": (0.0, 1.6, 0.15), "smoothing": (0.0, 0.04, 0.005),
+}  # fmt: skip
+
+
+def _run_score(params: RunParams, speed: float, seconds: float) -> float:
+    r = run_course(speed, seconds=seconds, params=params, fps=10.0).report
+    lasted = r["fell_at_s"] if r["fell"] and r.get("fell_at_s") else (
+        seconds if not r["fell"] else 0.0)  # fmt: skip
+    err = r["speed_error_m_s"] if r["speed_error_m_s"] is not None else speed
+    return 10.0 * (seconds - lasted) + 4.0 * err
+
+
+def tune_speed(speed: float, iterations: int, seconds: float, seed: int) -> None:
+    """Tune the runner's values at one of the tuned speeds (the others kept)."""
+    if speed not in TUNED_SPEEDS:
+        raise SystemExit(f"--tune-speed takes one of {TUNED_SPEEDS}")
+    end = TUNED_SPEEDS.index(speed)
+    base = RunParams()
+    rng = np.random.default_rng(seed)
+
+    def make(x: dict[str, float]) -> RunParams:
+        kw = {}
+        for k, v in x.items():
+            cur = getattr(base, k)
+            triple = list(cur) if isinstance(cur, tuple) else [cur] * 3
+            triple[end] = v
+            kw[k] = tuple(triple)
+        return dataclasses.replace(base, **kw)  # type: ignore[arg-type]
+
+    best = {k: base.at(speed)[k] for k in _RUN_SPACE}
+    best_j = _run_score(make(best), speed, seconds)
+    sigma = 1.0
+    for it in range(iterations):
+        improved = False
+        for _ in range(3):
+            keys = rng.choice(list(_RUN_SPACE), size=int(rng.integers(2, 6)), replace=False)
+            x = dict(best)
+            for k in keys:
+                lo, hi, step = _RUN_SPACE[k]
+                x[k] = float(np.clip(best[k] + sigma * step * rng.standard_normal(), lo, hi))
+            j = _run_score(make(x), speed, seconds)
+            if j < best_j:
+                best_j, best, improved = j, x, True
+        sigma = min(2.0, sigma * 1.3) if improved else max(0.3, sigma * 0.9)
+        print(f"iteration {it + 1}: score {best_j:.3f}", flush=True)
+    print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
+
+
+def tune_vault(iterations: int, seed: int) -> None:
+    from reactmocap.athletics.vault import TABLE1, VaultParams, vault
+
+    space = {
+        "board_stiffness": (15000, 120000, 8000), "board_damping": (0, 1500, 100),
+        "horse_distance": (1.2, 2.6, 0.08), "start_x": (-0.7, 0.0, 0.05),
+        "block": (-0.9, 0.1, 0.06), "knee_touchdown": (0.0, 0.8, 0.05),
+        "knee_stiffness": (0.5, 12.0, 0.8), "push_stiffness": (0.5, 20.0, 1.2),
+        "arms_board": (-3.1, -1.0, 0.15), "hand_target": (-0.2, 0.2, 0.04),
+        "pike": (-0.3, 0.8, 0.08), "flight_stiffness": (0.5, 8.0, 0.6),
+        "horse_push": (0.0, 4.0, 0.3), "landing_height": (0.9, 1.6, 0.06),
+    }  # fmt: skip
+
+    def score(x: dict[str, float]) -> float:
+        rep = vault(params=dataclasses.replace(VaultParams(), **x)).report
+        j = 0.0
+        for row in TABLE1:
+            v = rep["table1"][row.key]
+            if v is None:
+                j += 3.0
+                continue
+            span = row.high - row.low
+            j += 2.0 * max(row.low - v, v - row.high, 0.0) / span + 0.3 * abs(v - row.mean) / span
+        return j + 3.0 * (not rep["cleared"]) + 2.0 * (not rep["landed"])
+
+    rng = np.random.default_rng(seed)
+    base = VaultParams()
+    best = {k: float(getattr(base, k)) for k in space}
+    best_j = score(best)
+    sigma = 1.0
+    for it in range(iterations):
+        improved = False
+        for _ in range(4):
+            keys = rng.choice(list(space), size=int(rng.integers(1, 5)), replace=False)
+            x = dict(best)
+            for k in keys:
+                lo, hi, step = space[k]
+                x[k] = float(np.clip(best[k] + sigma * step * rng.standard_normal(), lo, hi))
+            j = score(x)
+            if j < best_j:
+                best_j, best, improved = j, x, True
+        sigma = min(3.0, sigma * 1.3) if improved else max(0.3, sigma * 0.9)
+        print(f"iteration {it + 1}: score {best_j:.3f}", flush=True)
+    print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    for name in ("speeds", "paths", "phase", "push", "vault", "cloth", "all"):
+        ap.add_argument(f"--{name}", action="store_true")
+    ap.add_argument("--seconds", type=float, default=30.0, help="length of the speed runs")
+    ap.add_argument("--path-speed", type=float, default=2.5, help="speed of the path runs")
+    ap.add_argument("--figures", type=Path, default=ROOT / "docs" / "figures")
+    ap.add_argument("--tune-speed", type=float, help="search the runner's values at a speed")
+    ap.add_argument("--tune-vault", action="store_true", help="search the vault's values")
+    ap.add_argument("--iterations", type=int, default=30)
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    if args.tune_speed is not None:
+        tune_speed(args.tune_speed, args.iterations, 6.0, args.seed)
+        return 0
+    if args.tune_vault:
+        tune_vault(args.iterations, args.seed)
+        return 0
+    every = args.all
+    if every or args.speeds:
+        speeds(args.seconds)
+    if every or args.paths:
+        paths(30.0, args.path_speed)
+    if every or args.phase:
+        phase(args.figures)
+    if every or args.push:
+        push(3.5)
+    if every or args.vault:
+        vault_section()
+    if every or args.cloth:
+        cloth(10.0, 3.5)
+    print(f"(benchmark wall time {time.perf_counter() - t0:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

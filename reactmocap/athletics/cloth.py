@@ -1,0 +1,406 @@
+"""Cloth driven by the runner (Hodgins et al. 1995, "Secondary motions": sweatpants driven by
+the simulated runner): loose trousers as MuJoCo flex cloth (``flexcomp``, one tube per leg
+hanging from the waist, inextensible edges), in a model of their own where the runner's
+bodies are copies of its collision geoms, set at every cloth step to where the runner's
+bodies are and how fast they move (so the contacts see them move). The cloth collides with them and drapes and swings; by
+default nothing acts back on the runner (the paper's one-way coupling), and with
+``feedback`` the cloth's contact forces are applied to the runner's bodies (one tick late).
+Why a model of its own: ``docs/athletics.md``."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.errors import ConfigError, ReactMocapError, SimulationError
+from reactmocap.sim.bodies import SIM_BODIES
+from reactmocap.sim.world import World
+
+__all__ = ["CLOTHES", "Cloth", "ClothSpec", "render_cloth_video"]
+
+F64 = NDArray[np.float64]
+
+
+class ClothSpec:
+    """A garment's make: tube rings and points per ring, slack over the limb's radius (m),
+    total mass (kg), the cloth's thickness (collision radius of its vertices, m), the cloth
+    model's time step (s) and where the hem is (0 the waist, 1 the knee, 2 the ankle)."""
+
+    def __init__(
+        self, rings: int = 9, around: int = 8, slack: float = 0.05, mass: float = 0.4,
+        thickness: float = 0.006, timestep: float = 0.002, hem: float = 1.6,
+    ) -> None:  # fmt: skip
+        if rings < 3 or around < 4:
+            raise ConfigError("a cloth tube needs at least 3 rings of 4 points")
+        for name, v in (("slack", slack), ("mass", mass), ("thickness", thickness),
+                        ("timestep", timestep), ("hem", hem)):  # fmt: skip
+            if not (math.isfinite(v) and v > 0):
+                raise ConfigError(f"cloth {name} must be > 0, got {v!r}")
+        self.rings, self.around, self.slack, self.mass = rings, around, slack, mass
+        self.iterations = 15
+        #: stretchy (sweatpants): the edges are soft equality constraints of this time
+        #: constant (s), with damping
+        self.stretch = 0.03
+        self.stretch_damping = 0.002
+        self.thickness, self.timestep, self.hem = thickness, timestep, hem
+
+
+#: collision bits of the copies of the runner's bodies in the cloth model (per leg)
+_BITS = {"l_": 4, "r_": 8}
+#: the garments by name: ``pants`` (loose trousers, hem 60% of the way down the shin),
+#: ``pants-light`` (the same with fewer points and 4 ms steps: cheaper, coarser) and
+#: ``shorts`` (hem above the knee)
+CLOTHES: dict[str, ClothSpec] = {
+    "pants": ClothSpec(),
+    "pants-light": ClothSpec(rings=7, around=6, timestep=0.004),
+    "shorts": ClothSpec(rings=6, hem=0.85),
+}
+
+
+def _geom_xml(m: mujoco.MjModel, g: int, bits: int) -> str:
+    kind = {int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule", int(mujoco.mjtGeom.mjGEOM_BOX): "box",
+            int(mujoco.mjtGeom.mjGEOM_SPHERE): "sphere",
+            int(mujoco.mjtGeom.mjGEOM_ELLIPSOID): "ellipsoid",
+            int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder"}.get(int(m.geom_type[g]))  # fmt: skip
+    if kind is None:
+        return ""
+    size = " ".join(f"{x:.5f}" for x in m.geom_size[g][: {"sphere": 1, "capsule": 2,
+                                                          "cylinder": 2}.get(kind, 3)])  # fmt: skip
+    pos = " ".join(f"{x:.5f}" for x in m.geom_pos[g])
+    quat = " ".join(f"{x:.6f}" for x in m.geom_quat[g])
+    return (f'<geom type="{kind}" size="{size}" pos="{pos}" quat="{quat}" contype="{bits}" '
+            f'conaffinity="0" density="0" rgba="0.35 0.55 0.85 1"/>')  # fmt: skip
+
+
+class Cloth:
+    """A garment on character ``character`` of ``world``, as an engine controller: at every
+    tick it steps the cloth over the tick's duration with the copies of the character's bodies
+    carried along at their velocities.
+
+    Attributes (after a rollout): ``penetration_max`` and ``penetration_mean`` (m, the
+    deepest overlap of cloth and body over the run, and its mean over ticks with contact),
+    ``finite`` (the cloth's state stayed finite), ``frames`` ``(F, V, 3)`` vertex positions
+    and ``frame_bodies`` ``(F, 16, 7)`` the body poses at ``frame_times``.
+    """
+
+    def __init__(
+        self, world: World, kind: str | ClothSpec = "pants", *, feedback: bool = False,
+        character: int = 0, control_every: int = 8, record_fps: float = 30.0,
+    ) -> None:  # fmt: skip
+        if isinstance(kind, str):
+            if kind not in CLOTHES:
+                raise ConfigError(f"unknown cloth {kind!r}; valid clothes are {sorted(CLOTHES)}")
+            spec = CLOTHES[kind]
+        else:
+            spec = kind
+        if not (isinstance(control_every, int) and control_every >= 1):
+            raise ConfigError(f"control_every must be an int >= 1, got {control_every!r}")
+        self.world = world
+        self.spec = spec
+        self.feedback = bool(feedback)
+        self.character = character
+        self.control_every = control_every
+        self.record_fps = float(record_fps)
+        self.wc = world.characters[character]
+        self.model: mujoco.MjModel | None = None
+        self.data: mujoco.MjData | None = None
+        self._reset_record()
+
+    def _reset_record(self) -> None:
+        self.penetration_max = 0.0
+        self._pen_sum = 0.0
+        self._pen_n = 0
+        self.penetration_mean = 0.0
+        self.finite = True
+        self.frames: list[F64] = []
+        self.frame_bodies: list[F64] = []
+        self.frame_times: list[float] = []
+        self.wall_s = 0.0
+        self._next_frame = 0.0
+        self._applied = np.zeros((len(SIM_BODIES), 6))
+
+    # ------------------------------------------------------------------ building
+    def _tube(self, side: str) -> F64:
+        """``(rings, around, 3)`` world points of one trouser leg around the leg's current
+        pose: rings from the waistband down the thigh and, for a hem below the knee, the
+        shin; radius the limb's plus slack. The ring at the knee lies in the plane halving
+        the knee's bend (it stays clear of both segments' capsules)."""
+        m, d = self.world.model, self.world.data
+        pre = self.wc.prefix
+        hip = d.xanchor[m.joint(pre + f"{side}_hip").id]
+        knee = d.xanchor[m.joint(pre + f"{side}_knee").id]
+        ankle = d.xanchor[m.joint(pre + f"{side}_ankle").id]
+
+        def radius(body: str) -> float:
+            b = self.wc.body_id(f"{side}_{body}")
+            g = np.flatnonzero(m.geom_bodyid == b)
+            return float(m.geom_size[g, 0].max()) if g.size else 0.06
+
+        r_thigh, r_shin = radius("thigh"), radius("shin")
+        top = d.xpos[self.wc.body_id("pelvis")]
+        # the waistband: a little above the hip joint, toward the body's middle
+        start = hip + np.array([0.0, 0.0, 0.06]) + 0.2 * (top - hip) * np.array([1.0, 1.0, 0.0])
+        up = (knee - start) / np.linalg.norm(knee - start)
+        down = (ankle - knee) / np.linalg.norm(ankle - knee)
+        hem = self.spec.hem  # 0 waist, 1 knee, 2 ankle
+        fwd = d.xmat[self.wc.body_ids[0]].reshape(3, 3)[:, 0]
+        ang = 2 * np.pi * np.arange(self.spec.around) / self.spec.around
+        pts = []
+        for u in np.linspace(0.0, hem, self.spec.rings):
+            if u < 1.0:
+                c = start + u * (knee - start)
+                axis = up
+                r = r_thigh + self.spec.slack * (1.3 if u < 0.2 else 1.0)
+                if u > 0.8:  # toward the knee the ring turns into the bend's halving plane
+                    w = (u - 0.8) / 0.2
+                    axis = (1 - 0.5 * w) * up + 0.5 * w * down
+            else:
+                c = knee + (u - 1.0) * (ankle - knee)
+                axis = down
+                r = max(r_shin, r_thigh * (2.0 - u)) + self.spec.slack * (1.0 + 0.4 * (u - 1.0))
+                if u < 1.2:
+                    w = (1.2 - u) / 0.2
+                    axis = (1 - 0.5 * w) * down + 0.5 * w * up
+            axis = axis / np.linalg.norm(axis)
+            e1 = fwd - axis * float(fwd @ axis)
+            e1 /= np.linalg.norm(e1)
+            e2 = np.cross(axis, e1)
+            pts.append(c + r * (np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * e2))
+        return np.array(pts)
+
+    def _build(self) -> None:
+        m, d = self.world.model, self.world.data
+        wc = self.wc
+        root = wc.body_ids[0]
+        rot0 = d.xmat[root].reshape(3, 3)
+        pos0 = d.xpos[root]
+        patches = set(wc.patch_ids.tolist())
+        bodies = []
+        for i, b in enumerate(wc.body_ids):
+            own = [int(g) for g in np.flatnonzero(m.geom_bodyid == b) if int(g) not in patches]
+            bits = _BITS.get(SIM_BODIES[i][:2], 2) if i else 0
+            bodies.append((i, "".join(_geom_xml(m, g, bits) for g in own)))
+        sp = self.spec
+        ring = sp.around
+        flexes = []
+        for side in ("l", "r"):
+            pts = self._tube(side).reshape(-1, 3)
+            # each trouser leg meets its own leg and the trunk and arms; the two legs of the
+            # trousers do not squeeze between the thighs (there is no crotch), and the
+            # waistband is sewn to the pelvis (pinned), so the pelvis is left out
+            affinity = _BITS[side + "_"] | 2
+            local = (pts - pos0) @ rot0  # in the pelvis frame
+            tris = []
+            for j in range(sp.rings - 1):
+                for i in range(ring):
+                    a, b = j * ring + i, j * ring + (i + 1) % ring
+                    tris += [(a, b, a + ring), (b, b + ring, a + ring)]
+            flexes.append(
+                f'<flexcomp name="{side}_leg" type="direct" dim="2" radius="{sp.thickness}" '
+                f'mass="{0.5 * sp.mass}" rgba="0.2 0.2 0.25 1" '
+                f'point="{" ".join(f"{x:.5f}" for x in local.ravel())}" '
+                f'element="{" ".join(str(x) for x in np.ravel(tris))}">'
+                f'<edge equality="true" solref="{sp.stretch} 1" damping="{sp.stretch_damping}"/>'
+                f'<contact contype="0" conaffinity="{affinity}" selfcollide="none" '
+                f'solref="{2 * sp.timestep} 1" solimp="0.99 0.999 0.001"/>'
+                f'<pin id="{" ".join(str(i) for i in range(ring))}"/></flexcomp>'
+            )
+        parts = []
+        for i, geoms in bodies:
+            extra = "".join(flexes) if i == 0 else ""
+            pos = " ".join(map(str, d.xpos[wc.body_ids[i]]))
+            quat = " ".join(map(str, d.xquat[wc.body_ids[i]]))
+            # heavy and weightless: the cloth barely moves it, and it is set each step
+            parts.append(f'<body name="b{i}" pos="{pos}" quat="{quat}" gravcomp="1"><freejoint/>'
+                         '<inertial pos="0 0 0" mass="1000" diaginertia="10 10 10"/>'
+                         f"{geoms}{extra}</body>")  # fmt: skip
+        xml = (
+            f'<mujoco><option timestep="{sp.timestep}" solver="CG" iterations="{sp.iterations}" '
+            'integrator="implicitfast" gravity="0 0 -9.81"/>'
+            '<visual><global offwidth="640" offheight="480"/></visual>'
+            '<worldbody><light pos="0 0 6" dir="0 0 -1" directional="true"/>'
+            '<geom name="floor" type="plane" size="0 0 0.05" rgba="0.82 0.84 0.86 1" '
+            'contype="16" conaffinity="0"/>' + "".join(parts) + "</worldbody></mujoco>"
+        )
+        try:
+            self.model = mujoco.MjModel.from_xml_string(xml)
+        except ValueError as exc:
+            raise SimulationError(f"MuJoCo could not compile the cloth: {exc}") from exc
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)
+        m = self.model
+        joints = [int(m.body_jntadr[m.body(f"b{i}").id]) for i in range(len(SIM_BODIES))]
+        self._qadr = np.array([m.jnt_qposadr[j] for j in joints])
+        self._dadr = np.array([m.jnt_dofadr[j] for j in joints])
+        mb = self.model.geom_bodyid
+        ids = {int(self.model.body(f"b{i}").id): i for i in range(len(SIM_BODIES))}
+        self._geom_part = np.array([ids.get(int(b), -1) for b in mb])
+
+    # ------------------------------------------------------------------ controller
+    def reset(self, world: World) -> None:
+        del world
+        self._reset_record()
+        self._build()
+        self._record(0.0)
+
+    def _poses(self) -> tuple[F64, F64]:
+        d = self.world.data
+        ids = self.wc.body_ids
+        return d.xpos[ids].copy(), d.xquat[ids].copy()
+
+    def _velocities(self) -> tuple[F64, F64]:
+        """World linear velocity of each body's origin and world angular velocity."""
+        m, d = self.world.model, self.world.data
+        out = np.empty((len(SIM_BODIES), 6))
+        for i, b in enumerate(self.wc.body_ids):
+            mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, int(b), out[i], 0)
+        return out[:, 3:], out[:, :3]
+
+    def control(self, world: World, t: float) -> None:
+        import time
+
+        assert self.model is not None and self.data is not None
+        wall = time.perf_counter()
+        m, d = self.model, self.data
+        pos, quat = self._poses()
+        vel, omega = self._velocities()
+        rot = world.data.xmat[self.wc.body_ids].reshape(-1, 3, 3)
+        local = np.einsum("bji,bj->bi", rot, omega)
+        dt = self.control_every * world.timestep
+        n = max(1, round(dt / m.opt.timestep))
+        h = dt / n
+        for k in range(n):
+            # the runner's bodies carried over the tick by their velocities (the contacts
+            # see them move, so the cloth is pushed along rather than overlapped)
+            tau = k * h
+            for i in range(len(SIM_BODIES)):
+                qa, da = self._qadr[i], self._dadr[i]
+                d.qpos[qa : qa + 3] = pos[i] + vel[i] * tau
+                q = d.qpos[qa + 3 : qa + 7]
+                q[:] = quat[i]
+                if tau > 0:
+                    mujoco.mju_quatIntegrate(q, local[i], tau)
+                d.qvel[da : da + 3] = vel[i]
+                d.qvel[da + 3 : da + 6] = local[i]
+            mujoco.mj_step(m, d)
+        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
+            self.finite = False
+            raise SimulationError(f"the cloth went non-finite at t = {t:.3f} s")
+        self._measure(world)
+        if t + 1e-9 >= self._next_frame:
+            self._record(t)
+        self.wall_s += time.perf_counter() - wall
+
+    def _measure(self, world: World) -> None:
+        assert self.model is not None and self.data is not None
+        m, d = self.model, self.data
+        n = d.ncon
+        deepest = 0.0
+        force = np.zeros((len(SIM_BODIES), 6)) if self.feedback else None
+        f6 = np.zeros(6)
+        for i in range(n):
+            c = d.contact[i]
+            if c.flex[0] < 0 and c.flex[1] < 0:
+                continue
+            g = c.geom[1] if c.flex[0] >= 0 else c.geom[0]
+            part = int(self._geom_part[g]) if g >= 0 else -1
+            if part < 0:
+                continue  # the floor
+            # the contact distance is to the cloth's surface inflated by its thickness: the
+            # cloth itself is inside the body by what is left after that
+            deepest = max(deepest, -float(c.dist) - self.spec.thickness)
+            if force is not None:
+                mujoco.mj_contactForce(m, d, i, f6)
+                fw = c.frame.reshape(3, 3).T @ f6[:3]  # on the second element from the first
+                on_body = fw if c.flex[0] >= 0 else -fw
+                body = self.wc.body_ids[part]
+                arm = c.pos - world.data.xipos[body]
+                force[part, :3] += on_body
+                force[part, 3:] += np.cross(arm, on_body)
+        # the flex vertices' own thickness is part of the contact distance: an overlap
+        # beyond the cloth's half-thickness is the cloth inside the body
+        self.penetration_max = max(self.penetration_max, deepest)
+        if deepest > 0:
+            self._pen_sum += deepest
+            self._pen_n += 1
+            self.penetration_mean = self._pen_sum / self._pen_n
+        if force is not None:
+            xfrc = world.data.xfrc_applied
+            ids = self.wc.body_ids
+            xfrc[ids] -= self._applied
+            xfrc[ids] += force
+            self._applied = force
+
+    def _record(self, t: float) -> None:
+        assert self.data is not None
+        pos, quat = self._poses()
+        self.frames.append(self.data.flexvert_xpos.copy())
+        self.frame_bodies.append(np.concatenate([pos, quat], axis=1))
+        self.frame_times.append(t)
+        self._next_frame = t + 1.0 / self.record_fps
+
+    def report(self) -> dict[str, float | bool]:
+        return {
+            "cloth": True,
+            "cloth_feedback": self.feedback,
+            "cloth_penetration_max_m": self.penetration_max,
+            "cloth_penetration_mean_m": self.penetration_mean,
+            "cloth_finite": self.finite,
+            "cloth_wall_s": self.wall_s,
+            "cloth_vertices": int(self.model.nflexvert) if self.model is not None else 0,
+        }
+
+
+def render_cloth_video(cloth: Cloth, path: str | Path, size: tuple[int, int] = (512, 384)) -> Path:
+    """The recorded frames of a dressed run rendered with MuJoCo (the body as its collision
+    geoms, the cloth as its flex). Raises :class:`~reactmocap.response.render.RenderUnavailable`
+    where no GL context exists."""
+    from reactmocap.response.plots import write_video
+    from reactmocap.response.render import offscreen_renderer
+
+    if cloth.model is None or not cloth.frames:
+        raise ReactMocapError("the cloth has no recorded frames (run it first)")
+    m = cloth.model
+    d = mujoco.MjData(m)
+    width, height = size
+    renderer = offscreen_renderer(m, size)
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    cam.distance, cam.elevation, cam.azimuth = 3.2, -12.0, 120.0
+    frames = np.empty((len(cloth.frames), height, width, 3), dtype=np.uint8)
+    try:
+        for i, (verts, bodies) in enumerate(zip(cloth.frames, cloth.frame_bodies)):
+            for k in range(len(SIM_BODIES)):
+                qa = cloth._qadr[k]
+                d.qpos[qa : qa + 7] = bodies[k]
+            mujoco.mj_kinematics(m, d)
+            # the flex vertices as recorded (they are bodies with slide joints: set them by
+            # their world positions through the free-vertex qpos)
+            _set_vertices(m, d, verts)
+            cam.lookat[:] = (bodies[0, 0], bodies[0, 1], 0.8)
+            renderer.update_scene(d, camera=cam)
+            frames[i] = renderer.render()
+    finally:
+        renderer.close()
+    return Path(write_video(frames, path, cloth.record_fps))
+
+
+def _set_vertices(m: mujoco.MjModel, d: mujoco.MjData, verts: F64) -> None:
+    """Put the flex's free vertices at world positions ``verts`` (pinned ones follow their
+    body), through their slide joints."""
+    mujoco.mj_kinematics(m, d)
+    for v in range(m.nflexvert):
+        body = int(m.flex_vertbodyid[v])
+        jnt = int(m.body_jntadr[body])
+        if jnt < 0 or m.body_jntnum[body] != 3:
+            continue
+        parent = int(m.body_parentid[body])
+        rot = d.xmat[parent].reshape(3, 3)
+        local = rot.T @ (verts[v] - d.xpos[parent]) - m.body_pos[body]
+        adr = int(m.jnt_qposadr[jnt])
+        d.qpos[adr : adr + 3] = local
+    mujoco.mj_fwdPosition(m, d)  # the flex's vertex positions are made here

@@ -1,0 +1,249 @@
+"""Where a runner goes: a facing direction (optionally changed at given times) or a path on the
+ground (a polyline, a circle, a figure eight) followed by pure pursuit: the desired facing
+points at the path point a look-ahead distance beyond the closest one. Each course answers
+:meth:`Course.steer` with the desired facing (rad), the path's signed curvature there (1/m,
+> 0 turning left: the runner leans into it) and the signed cross-track error (m, > 0: the
+runner is left of the path; NaN without a path)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from reactmocap.errors import ConfigError
+
+__all__ = [
+    "LOOKAHEAD",
+    "TURN_RATE",
+    "Circle",
+    "Course",
+    "Facing",
+    "Polyline",
+    "Straight",
+    "figure_eight",
+    "parse_course",
+]
+
+F64 = NDArray[np.float64]
+#: pure-pursuit look-ahead distance (m)
+LOOKAHEAD = 3.0
+#: how fast a commanded facing is turned toward (rad/s)
+TURN_RATE = 0.2
+
+
+class Course(Protocol):
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
+        """Desired facing, curvature and cross-track error at ground position ``pos (2,)``."""
+        ...
+
+
+class Facing:
+    """A facing direction without a path: ``schedule`` is ``(time, heading)`` pairs, the
+    heading in force being the last one whose time has come. The desired facing turns toward
+    it at no more than ``rate`` rad/s (an abrupt change of facing throws a runner down, as
+    Hodgins et al. note); its curvature for the lean is the turn rate over ``speed``."""
+
+    def __init__(self, schedule: Sequence[tuple[float, float]] | float = 0.0,
+                 rate: float = TURN_RATE) -> None:  # fmt: skip
+        sched = [(0.0, float(schedule))] if isinstance(schedule, (int, float)) else list(schedule)
+        if not sched or not all(math.isfinite(a) and math.isfinite(b) for a, b in sched):
+            raise ConfigError(f"facing schedule must be finite (time, heading) pairs: {sched}")
+        if not (math.isfinite(rate) and rate > 0):
+            raise ConfigError(f"turn rate must be > 0 rad/s, got {rate!r}")
+        self.schedule = sorted((float(a), float(b)) for a, b in sched)
+        self.rate = float(rate)
+        self.speed = 1.0
+        self.reset()
+
+    def reset(self) -> None:
+        self.heading = self.schedule[0][1]
+        self.time = self.schedule[0][0]
+
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
+        del pos
+        goal = self.schedule[0][1]
+        for when, heading in self.schedule:
+            if t >= when:
+                goal = heading
+        dt = max(t - self.time, 0.0)
+        self.time = t
+        step = float(np.clip(goal - self.heading, -self.rate * dt, self.rate * dt))
+        self.heading += step
+        turning = dt > 0 and abs(step) > 1e-9
+        curvature = (step / dt) / max(self.speed, 0.1) if turning else 0.0
+        return self.heading, curvature, math.nan
+
+
+class Circle:
+    """A circle of ``radius`` m about ``centre``, run anticlockwise (``ccw``) or clockwise."""
+
+    def __init__(self, centre: ArrayLike, radius: float, ccw: bool = True,
+                 lookahead: float = LOOKAHEAD) -> None:  # fmt: skip
+        if not (math.isfinite(radius) and radius > 0):
+            raise ConfigError(f"circle radius must be > 0 m, got {radius!r}")
+        self.centre = np.asarray(centre, dtype=np.float64)[:2]
+        self.radius = float(radius)
+        self.sign = 1.0 if ccw else -1.0
+        self.lookahead = float(lookahead)
+
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
+        del t
+        r = np.asarray(pos[:2], dtype=np.float64) - self.centre
+        dist = max(float(np.hypot(*r)), 1e-6)
+        ang = math.atan2(r[1], r[0]) + self.sign * self.lookahead / self.radius
+        target = self.centre + self.radius * np.array([math.cos(ang), math.sin(ang)])
+        d = target - pos[:2]
+        # left of the path: inside an anticlockwise circle, outside a clockwise one
+        cross = self.sign * (self.radius - dist)
+        return math.atan2(d[1], d[0]), self.sign / self.radius, cross
+
+
+class Polyline:
+    """A path through ``points (N, 2)`` (m); progress along it only moves forward, so a path
+    that crosses itself (a figure eight) is followed in order. ``closed`` joins the last
+    point to the first and laps."""
+
+    def __init__(self, points: F64 | Sequence[Sequence[float]], closed: bool = False,
+                 lookahead: float = LOOKAHEAD) -> None:  # fmt: skip
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[0] < 2 or pts.shape[1] < 2 or not np.isfinite(pts).all():
+            raise ConfigError(f"a path needs at least 2 finite (x, y) points, got {pts.shape}")
+        pts = pts[:, :2]
+        if closed:
+            pts = np.vstack([pts, pts[:1]])
+        seg = np.diff(pts, axis=0)
+        length = np.hypot(seg[:, 0], seg[:, 1])
+        keep = length > 1e-9
+        if not keep.any():
+            raise ConfigError("a path needs points that are not all the same")
+        self.points = np.vstack([pts[:1], pts[1:][keep]])
+        self.seg = np.diff(self.points, axis=0)
+        self.len = np.hypot(self.seg[:, 0], self.seg[:, 1])
+        self.cum = np.concatenate([[0.0], np.cumsum(self.len)])
+        self.closed = closed
+        self.lookahead = float(lookahead)
+        self.index = 0
+        self.total = float(self.cum[-1])
+
+    def reset(self) -> None:
+        self.index = 0
+
+    def _closest(self, p: F64) -> tuple[int, float, float]:
+        """Segment, arc length and signed distance of the closest point, searched a window
+        ahead of the current segment."""
+        n = len(self.len)
+        span = max(
+            4,
+            int(np.searchsorted(self.cum, self.cum[self.index] + 2 * self.lookahead)) - self.index,
+        )
+        idx = np.arange(self.index, self.index + span + 1)
+        if self.closed:
+            idx = idx % n
+        else:
+            idx = idx[idx < n]
+        a = self.points[idx]
+        sv = self.seg[idx]
+        u = np.clip(np.einsum("ij,ij->i", p - a, sv) / self.len[idx] ** 2, 0.0, 1.0)
+        q = a + u[:, None] * sv
+        dist = np.hypot(*(p - q).T)
+        j = int(np.argmin(dist))
+        i = int(idx[j])
+        side = float(np.sign(sv[j, 0] * (p[1] - q[j, 1]) - sv[j, 1] * (p[0] - q[j, 0])))
+        return i, float(self.cum[i] + u[j] * self.len[i]), side * float(dist[j])
+
+    def point_at(self, s: float) -> F64:
+        if self.closed:
+            s = s % self.total
+        s = float(np.clip(s, 0.0, self.total))
+        i = int(np.clip(np.searchsorted(self.cum, s, side="right") - 1, 0, len(self.len) - 1))
+        u = (s - self.cum[i]) / self.len[i]
+        return self.points[i] + u * self.seg[i]
+
+    def direction_at(self, s: float) -> float:
+        if self.closed:
+            s = s % self.total
+        i = int(np.clip(np.searchsorted(self.cum, s, side="right") - 1, 0, len(self.len) - 1))
+        return math.atan2(self.seg[i, 1], self.seg[i, 0])
+
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
+        del t
+        p = np.asarray(pos[:2], dtype=np.float64)
+        i, s, cross = self._closest(p)
+        self.index = i
+        target = self.point_at(s + self.lookahead)
+        if not self.closed and s + self.lookahead > self.total:  # past the end: straight on
+            d = self.points[-1] - self.points[-2]
+            target = p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead
+        d = target - p
+        a0, a1 = self.direction_at(s), self.direction_at(s + self.lookahead)
+        turn = (a1 - a0 + math.pi) % (2 * math.pi) - math.pi
+        return math.atan2(d[1], d[0]), turn / self.lookahead, cross
+
+
+def Straight(heading: float = 0.0, start: ArrayLike = (0.0, 0.0)) -> Polyline:
+    """A straight line from ``start`` along ``heading`` (rad), 10 km long."""
+    p0 = np.asarray(start, dtype=np.float64)[:2]
+    return Polyline(np.stack([p0, p0 + 1e4 * np.array([math.cos(heading), math.sin(heading)])]))
+
+
+def figure_eight(radius: float, start: ArrayLike = (0.0, 0.0), heading: float = 0.0,
+                 per_circle: int = 120) -> Polyline:  # fmt: skip
+    """Two circles of ``radius`` m meeting at ``start``: the first anticlockwise, the second
+    clockwise, leaving ``start`` along ``heading``; closed (it laps)."""
+    if not (math.isfinite(radius) and radius > 0):
+        raise ConfigError(f"figure-eight radius must be > 0 m, got {radius!r}")
+    th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
+    left = np.column_stack([radius * np.sin(th), radius * (1 - np.cos(th))])
+    right = np.column_stack([radius * np.sin(th), -radius * (1 - np.cos(th))])
+    pts = np.vstack([left, right])
+    c, s = math.cos(heading), math.sin(heading)
+    rot = np.array([[c, -s], [s, c]])
+    return Polyline(pts @ rot.T + np.asarray(start, dtype=np.float64)[:2], closed=True)
+
+
+def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0) -> Course:
+    """A course from the CLI's ``--path``: ``line``, ``circle:R`` (anticlockwise, starting
+    tangent to the runner's heading, centre on its left), ``eight:R`` (figure eight) or a CSV
+    file of ``x,y`` rows in metres (a header line is allowed)."""
+    spec = spec.strip()
+    p0 = np.asarray(start, dtype=np.float64)[:2]
+    if spec == "line":
+        return Straight(heading, p0)
+    for kind in ("circle", "eight"):
+        if spec.startswith(kind + ":"):
+            try:
+                r = float(spec.split(":", 1)[1])
+            except ValueError:
+                raise ConfigError(
+                    f"--path {kind}:R needs a radius in metres, got {spec!r}"
+                ) from None
+            if kind == "eight":
+                return figure_eight(r, p0, heading)
+            left = np.array([-math.sin(heading), math.cos(heading)])
+            return Circle(p0 + r * left, r, ccw=True)
+    path = Path(spec)
+    if path.suffix.lower() == ".csv":
+        if not path.is_file():
+            raise ConfigError(f"path file {spec!r} does not exist")
+        rows = []
+        for n, line in enumerate(path.read_text().splitlines()):
+            bits = [b.strip() for b in line.replace(";", ",").split(",") if b.strip()]
+            if not bits:
+                continue
+            try:
+                rows.append((float(bits[0]), float(bits[1])))
+            except (ValueError, IndexError):
+                if n == 0 and not rows:
+                    continue  # a header
+                raise ConfigError(
+                    f"{spec}:{n + 1}: expected 'x,y' in metres, got {line!r}"
+                ) from None
+        return Polyline(np.array(rows))
+    raise ConfigError(
+        f"unknown path {spec!r}; valid paths are 'line', 'circle:R', 'eight:R' or FILE.csv"
+    )

@@ -1,0 +1,759 @@
+"""Running (Hodgins et al. 1995, "Running"): a state machine over the active leg's contact with
+the ground (flight, loading, heel, heel and toe, toe, unloading; the legs swap roles at
+lift-off), foot placement by eqs. 1-2 with ground-speed matching, a knee that acts as a passive
+spring in stance and an ankle that gives the thrust, the stance hip servoing the body's
+attitude (roll, pitch, yaw, with a lean into curves), the idle leg mirroring the active one
+(eqs. 3-4) and shortened, the arms swinging with the opposite hip (eq. 5), and every joint
+following a smooth trajectory toward its desired angle (eq. 6). The user gives a speed
+(2.5-5 m/s) and a facing direction or a path (:mod:`reactmocap.athletics.paths`).
+
+The feet: the thesis bodies' toes are merged into the feet (the engine's characters have 15
+ball joints), so the paper's two-part foot is a rigid sole box here. Heel and toe contact are
+told apart by which of the box's corners touch the floor: heel contact is the rear corners,
+toe contact the front ones; the toe phase rolls the foot about its front edge, as the paper's
+foot rolls about the ball. Design and measurements: ``docs/athletics.md``."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.athletics.balance import knee_for_length
+from reactmocap.athletics.bodies import Athlete
+from reactmocap.athletics.paths import Course, Straight
+from reactmocap.athletics.rig import Rig, joint_index, per_joint
+from reactmocap.athletics.senses import Senses
+from reactmocap.errors import ConfigError
+from reactmocap.rotations import (
+    quat_conj,
+    quat_from_yaw,
+    quat_mul,
+)
+from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
+from reactmocap.sim.controllers.base import FunctionController
+from reactmocap.sim.controllers.machine import State, StateMachine, after
+from reactmocap.sim.world import World
+
+__all__ = [
+    "RUN_STATES",
+    "SPEED_RANGE",
+    "TUNED_SPEEDS",
+    "RunLog",
+    "RunParams",
+    "Runner",
+    "check_speed",
+    "running_start",
+]
+
+F64 = NDArray[np.float64]
+NJ = len(BALL_JOINTS)
+#: the speeds the runner is built for (m/s), the paper's range
+SPEED_RANGE = (2.5, 5.0)
+#: the states of the active leg (Fig. 3)
+RUN_STATES = ("flight", "loading", "heel", "heel_toe", "toe", "unloading")
+_HIP = (joint_index("l_hip"), joint_index("r_hip"))
+_KNEE = (joint_index("l_knee"), joint_index("r_knee"))
+_ANKLE = (joint_index("l_ankle"), joint_index("r_ankle"))
+_SHOULDER = (joint_index("l_shoulder"), joint_index("r_shoulder"))
+_ELBOW = (joint_index("l_elbow"), joint_index("r_elbow"))
+_SPINE = (joint_index("waist"), joint_index("back"))
+_NECK = joint_index("neck")
+_LEG_JOINTS = (*_HIP, *_KNEE, *_ANKLE)
+_BODY = {b: i for i, b in enumerate(SIM_BODIES)}
+_THIGH = (_BODY["l_thigh"], _BODY["r_thigh"])
+_SHIN = (_BODY["l_shin"], _BODY["r_shin"])
+_FOOT = (_BODY["l_foot"], _BODY["r_foot"])
+#: a sole corner closer than this to the floor (m) counts as touching
+CORNER_TOUCH = 0.004
+
+
+# ---------------------------------------------------------------------------------- small math
+# single quaternions at every tick: MuJoCo's C routines and closed forms instead of the
+# vectorised helpers (scipy), which cost 100-400 us a call and dominated the tick
+def _qmul(a: F64, b: F64) -> F64:
+    out = np.empty(4)
+    mujoco.mju_mulQuat(out, a, b)
+    return out
+
+
+def _clamp(x: float, lo: float, hi: float) -> float:
+    return float(min(max(x, lo), hi))
+
+
+def _qconj(q: F64) -> F64:
+    return np.array([q[0], -q[1], -q[2], -q[3]])
+
+
+def _qyaw(yaw: float) -> F64:
+    return np.array([math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw)])
+
+
+def _quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
+    """Quaternion of intrinsic Y-X-Z Euler angles (:data:`~reactmocap.athletics.bodies.
+    EULER_ORDER`)."""
+    qy = np.array([math.cos(0.5 * pitch), 0.0, math.sin(0.5 * pitch), 0.0])
+    qx = np.array([math.cos(0.5 * roll), math.sin(0.5 * roll), 0.0, 0.0])
+    return _qmul(_qmul(qy, qx), _qyaw(yaw))
+
+
+def _euler_yxz(q: F64) -> tuple[float, float, float]:
+    """Intrinsic Y-X-Z Euler angles (pitch, roll, yaw) of a quaternion: with
+    ``R = Ry Rx Rz``, pitch = atan2(R02, R22), roll = asin(-R12), yaw = atan2(R10, R11)."""
+    w, x, y, z = q
+    r02 = 2.0 * (x * z + w * y)
+    r22 = 1.0 - 2.0 * (x * x + y * y)
+    r12 = 2.0 * (y * z - w * x)
+    r10 = 2.0 * (x * y + w * z)
+    r11 = 1.0 - 2.0 * (x * x + z * z)
+    return (math.atan2(r02, r22), math.asin(max(-1.0, min(1.0, -r12))), math.atan2(r10, r11))
+
+
+def check_speed(speed: float) -> float:
+    """``speed`` if it lies in :data:`SPEED_RANGE`, else a ConfigError naming the range."""
+    lo, hi = SPEED_RANGE
+    if not (isinstance(speed, (int, float)) and math.isfinite(speed) and lo <= speed <= hi):
+        raise ConfigError(
+            f"running speed {speed!r} m/s is outside the supported range {lo:g}-{hi:g} m/s"
+        )
+    return float(speed)
+
+
+#: a tuning value at 2.5, 3.5 and 5 m/s (:data:`TUNED_SPEEDS`), interpolated piecewise linearly
+Speeds = tuple[float, float, float]
+#: the speeds the tuning triples are given at (m/s)
+TUNED_SPEEDS = (2.5, 3.5, 5.0)
+
+
+@dataclass(frozen=True)
+class RunParams:
+    """The runner's tuning. Values given as three numbers are at 2.5, 3.5 and 5 m/s,
+    interpolated piecewise linearly by speed (a single number is used at every speed). Angles in radians, joint
+    stiffness in units of ``m g L`` N m/rad (body mass, leg length), leg stiffness in
+    ``m g / L`` N/m, times in seconds. The defaults were found by a search over these
+    parameters (``benchmarks/bench_athletics_running.py --tune``), see ``docs/athletics.md``.
+
+    Args:
+        stance_time: first estimate of the stance duration ``t_s`` (eqs. 1-2); later steps
+            use the previous stance's.
+        speed_gain: ``k`` of eqs. 1-2, the velocity-error gain (s).
+        speed_integral: per step, the placement's slow correction (m) per m/s of the last
+            step's speed error (0: eqs. 1-2 alone).
+        touchdown_leg: hip-to-ankle length at touchdown (fraction of the straight leg).
+        speed_matching, retract_time: ground-speed matching: how far (m) the swing foot
+            reaches beyond its touchdown place and how long before touchdown it comes back.
+        heel_up: foot pitch at touchdown (rad, toes up): the heel strikes first.
+        step_width: lateral distance between the feet's touchdown places (m).
+        leg_stiffness, leg_damping: the stance leg's spring (``m g / L`` N/m) and its
+            damping ratio.
+        thrust: the toe phase's extra leg force (body weights), until the body rises at
+            ``takeoff_vz`` (m/s).
+        toe_fraction: the heel-and-toe phase ends at this fraction of the expected stance
+            (the paper: 30-50% by speed).
+        pitch: desired forward pitch of the trunk (rad).
+        attitude_kp, attitude_kv: the stance hip's attitude servo (roll, pitch, yaw), per
+            unit of the body's mass times its leg length squared (1/s^2, 1/s).
+        yaw_grip: the twisting moment a stance foot can hold, in units of its length times
+            the vertical ground force (a friction coefficient times the lever).
+        knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
+            keep only their roll and yaw (the leg spring drives their pitch).
+        idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
+            by the end of the stance ready for touchdown (rad).
+        swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
+        arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
+        elbow: elbow flexion (rad).
+        turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
+        lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
+        smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
+        stiffness: the servos' stiffness by joint kind outside the stance leg.
+    """
+
+    stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
+    speed_gain: float | Speeds = (0.1914, 0.0835, 0.08567)
+    speed_integral: float | Speeds = (0, 0, 0.001824)
+    touchdown_leg: float | Speeds = (0.93, 0.948, 0.9475)
+    speed_matching: float | Speeds = (0, 0.009, 0.03712)
+    retract_time: float | Speeds = 0.06
+    heel_up: float | Speeds = 0.2
+    step_width: float | Speeds = (0.06929, 0.065, 0.05902)
+    leg_stiffness: float | Speeds = (32.11, 21.6, 21.19)
+    leg_damping: float | Speeds = (0.08527, 0.04, 0.06971)
+    thrust: float | Speeds = (1.683, 1.71, 1.716)
+    takeoff_vz: float | Speeds = (0.5575, 0.517, 0.5806)
+    toe_fraction: float | Speeds = (0.3849, 0.42, 0.3199)
+    pitch: float | Speeds = (0.1207, 0.013, -0.01578)
+    attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
+    attitude_kv: tuple[float, float, float] = (14.0, 14.0, 5.42)
+    yaw_grip: float | Speeds = 0.181
+    knee_hold: float | Speeds = 3.0
+    ankle_hold: float | Speeds = 1.0
+    idle_knee: float | Speeds = (2.182, 1.813, 1.692)
+    reach_knee: float | Speeds = (1.192, 1.066, 1.102)
+    swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
+    arm_gain: float | Speeds = (0.7815, 1.273, 1.336)
+    arm_offset: float | Speeds = 0.05
+    elbow: float | Speeds = 1.4
+    turn_rate: float | Speeds = 0.35
+    lean: float | Speeds = 1.0
+    smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
+    stiffness: dict[str, float] = field(
+        default_factory=lambda: {
+            "waist": 4.0, "back": 4.0, "neck": 0.3, "shoulder": 0.4, "elbow": 0.2,
+            "wrist": 0.05, "hip": 3.935, "knee": 0.70, "ankle": 0.4,
+        }
+    )  # fmt: skip
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            vals = v.values() if isinstance(v, dict) else v if isinstance(v, tuple) else (v,)
+            if not all(isinstance(x, (int, float)) and math.isfinite(x) for x in vals):
+                raise ConfigError(f"running parameter {f.name} must be finite, got {v!r}")
+            if isinstance(v, tuple) and f.name not in _AXES and len(v) != 3:
+                raise ConfigError(
+                    f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
+                )
+        per_joint(self.stiffness)  # unknown joint kinds are named there
+        lo, hi = SPEED_RANGE
+        for speed in (lo, hi):
+            r = self.at(speed)
+            if not 0.5 < r["touchdown_leg"] <= 1.0:
+                raise ConfigError(f"touchdown_leg must be in (0.5, 1], got {self.touchdown_leg}")
+            if r["stance_time"] <= 0 or r["smoothing"] < 0 or r["leg_stiffness"] <= 0:
+                raise ConfigError("stance_time and leg_stiffness must be > 0, smoothing >= 0")
+
+    def at(self, speed: float) -> dict[str, float]:
+        """Every scalar tuning value at ``speed`` (triples interpolated, clamped to the
+        range)."""
+        out = {}
+        for f in fields(self):
+            if f.name in _AXES or f.name == "stiffness":
+                continue
+            v = getattr(self, f.name)
+            out[f.name] = (
+                float(np.interp(speed, TUNED_SPEEDS, v)) if isinstance(v, tuple) else float(v)
+            )
+        return out
+
+
+#: per-axis (roll, pitch, yaw) values, not per-speed
+_AXES = ("attitude_kp", "attitude_kv")
+
+
+@dataclass
+class RunLog:
+    """Per control tick: time, COM, COM velocity, pelvis heading, state index, active leg,
+    feet in contact (bit 0 left, bit 1 right), pelvis height, whether anything but the feet
+    touched the floor, hip and knee pitch of both legs; and the touchdown and lift-off
+    events (time, leg, foot position)."""
+
+    rows: list[tuple] = field(default_factory=list)
+    touchdowns: list[tuple[float, int, float, float]] = field(default_factory=list)
+    liftoffs: list[tuple[float, int]] = field(default_factory=list)
+
+    def arrays(self) -> dict[str, NDArray]:
+        names = ("t", "com", "com_vel", "heading", "state", "active", "feet", "pelvis",
+                 "others", "hip", "knee", "desired_heading", "cross_track")  # fmt: skip
+        if not self.rows:
+            return {n: np.zeros(0) for n in names}
+        cols = list(zip(*self.rows))
+        return {n: np.array(c) for n, c in zip(names, cols)}
+
+
+class Runner:
+    """The running controller for one athlete in a world (an engine controller).
+
+    Args:
+        world: the world (the athlete is character ``character``).
+        athlete: the athlete's anatomical frames.
+        speed: desired speed (m/s, within :data:`SPEED_RANGE`).
+        course: facing direction or path to follow (default: straight ahead along +X).
+        params: tuning.
+        control_every: physics steps per control tick.
+    """
+
+    def __init__(
+        self,
+        world: World,
+        athlete: Athlete,
+        speed: float,
+        course: Course | None = None,
+        params: RunParams | None = None,
+        character: int = 0,
+        control_every: int = 8,
+    ) -> None:
+        if not (isinstance(control_every, int) and control_every >= 1):
+            raise ConfigError(f"control_every must be an int >= 1, got {control_every!r}")
+        self.world = world
+        self.athlete = athlete
+        self.speed = check_speed(speed)
+        self.course = course or Straight(0.0)
+        self.params = params or RunParams()
+        self.k = self.params.at(self.speed)
+        self.character = character
+        self.control_every = control_every
+        self.p_frame = True
+        self.rig = Rig(world, athlete, character)
+        self.senses = Senses(world, athlete, character)
+        self.log = RunLog()
+        wc = world.characters[character]
+        self.wc = wc
+        m = world.model
+        self.mass = self.rig.mass
+        self.g = float(np.linalg.norm(m.opt.gravity))
+        self.inertia_unit = self.mass * athlete.leg_length**2
+        self._hips = [m.joint(wc.prefix + f"{s}_hip").id for s in "lr"]
+        self._knees = [m.joint(wc.prefix + f"{s}_knee").id for s in "lr"]
+        self._ankles = [m.joint(wc.prefix + f"{s}_ankle").id for s in "lr"]
+        self._root = int(wc.body_ids[0])
+        self._chest = int(wc.body_ids[_BODY["chest"]])
+        self._thighs = wc.body_ids[list(_THIGH)]
+        self._shins = wc.body_ids[list(_SHIN)]
+        self._feet = wc.body_ids[list(_FOOT)]
+        self._neutral = athlete.neutral
+        self._neutral_conj = quat_conj(athlete.neutral)
+        self._bodies = np.asarray(wc.body_ids)
+        self._jacp = np.zeros((3, m.nv))
+        b = wc.ball_dof_start
+        # the knee's and ankle's dofs of each leg
+        self._leg_cols = [
+            np.r_[
+                b + 3 * _KNEE[k] : b + 3 * _KNEE[k] + 3, b + 3 * _ANKLE[k] : b + 3 * _ANKLE[k] + 3
+            ]
+            for k in range(2)
+        ]
+        # heel-to-ball length l_f of eqs. 1-2: the sole box's length
+        self.foot_length = 2.0 * float(m.geom_size[wc.sole_ids[0], 0])
+        self._base_stiffness = per_joint(self.params.stiffness)
+        self.machine = StateMachine(self._states(), "flight", control_every)
+        self._reset_state()
+
+    # ------------------------------------------------------------------ state
+    def _reset_state(self) -> None:
+        k = self.k
+        self.active = 0  # the leg on the ground or being placed (0 left, 1 right)
+        self.t_touchdown = 0.0
+        self.t_heel_toe = 0.0
+        self.stance_estimate = k["stance_time"]
+        self.targets = np.zeros((NJ, 3))
+        self.goal = np.zeros((NJ, 3))
+        self.heel = np.zeros(2, dtype=bool)
+        self.toe = np.zeros(2, dtype=bool)
+        self.heading_d = 0.0
+        self._steered = False
+        self.curvature = 0.0
+        self.cross_track = math.nan
+        self.knee_td = 0.3
+        self.leg_rest = 0.0
+        self.leg_prev = 0.0
+        self.leg_force = 0.0
+        self.lo_pitch = [0.0, 0.0]
+        self.td_pitch = 0.0
+        self.speed_bias = 0.0
+        self.step_start: tuple[float, F64] | None = None
+        self.thrust_force = k["thrust"] * self.mass * self.g
+        self.released = False
+        self.steps = 0
+
+    def reset(self, world: World) -> None:
+        del world
+        self._reset_state()
+        self.rig.reset()
+        self.senses.time = -1.0
+        # the pitch of the legs' joints (the only joint angles the laws read)
+        angles = np.zeros((NJ, 3))
+        for j in _LEG_JOINTS:
+            angles[j, 0] = self._joint_pitch(j)
+        self.targets[:] = angles
+        self.goal[:] = angles
+        self.machine.reset(self.world)
+        self.rig.set_stiffness(self._base_stiffness)
+        self.rig.gravity_compensation = True
+
+    # ------------------------------------------------------------------ geometry
+    def heading(self) -> float:
+        """The pelvis's heading (rad about +Z)."""
+        return self.senses.heading()
+
+    def _anat(self, body: int, neutral: int) -> F64:
+        """A body's anatomical world rotation."""
+        return _qmul(self.world.data.xquat[body], self._neutral_conj[neutral])
+
+    def _pitch(self, body: int, neutral: int, heading: float) -> float:
+        """Anatomical pitch (rad) of a body in the heading frame (thigh forward < 0)."""
+        return _euler_yxz(_qmul(_qyaw(-heading), self._anat(body, neutral)))[0]
+
+    def _joint_pitch(self, joint: int) -> float:
+        """Anatomical pitch (rad) of a ball joint: its child's rotation relative to its
+        parent's, both in their anatomical frames (as ``Athlete.joint_angles``)."""
+        child = joint + 1
+        parent = int(SIM_PARENTS[child])
+        rel = _qmul(_qconj(self._anat(self._bodies[parent], parent)),
+                    self._anat(self._bodies[child], child))  # fmt: skip
+        return _euler_yxz(rel)[0]
+
+    def trunk_euler(self) -> tuple[float, float, float]:
+        """Chest pitch, roll and yaw (anatomical, heading frame, rad)."""
+        chest = _BODY["chest"]
+        return _euler_yxz(_qmul(_qyaw(-self.heading()), self._anat(self._chest, chest)))
+
+    def _contacts(self) -> None:
+        """Which feet touch with their heel (rear corners) and toe (front corners)."""
+        s = self.senses
+        z = s.sole_corners()[..., 2] - self.world.data.geom_xpos[s.floor][2]
+        near = z < CORNER_TOUCH
+        touch = s.foot_contact
+        self.toe[:] = touch & near[:, :2].any(axis=1)
+        self.heel[:] = touch & near[:, 2:].any(axis=1)
+        self.heel[touch & ~(self.toe | self.heel)] = True  # touching by an edge only
+
+    # ------------------------------------------------------------------ control laws
+    def _placement(self, leg: int, heading: float) -> None:
+        """Eqs. 1-2 and the inverse kinematics of ``leg``: hip and knee goals that put the
+        heel at the placement point with the touchdown leg length, ankle goal for a heel
+        strike, and ground-speed matching."""
+        k = self.k
+        d = self.world.data
+        s = self.senses
+        v = s.com_vel[:2]
+        hd = self.heading_d
+        vd = self.speed * np.array([math.cos(hd), math.sin(hd)])
+        ts, lf = self.stance_estimate, self.foot_length
+        x_hh = 0.5 * (ts * v[0] - math.cos(heading) * lf) + k["speed_gain"] * (v[0] - vd[0])
+        y_hh = 0.5 * (ts * v[1] - math.sin(heading) * lf) + k["speed_gain"] * (v[1] - vd[1])
+        # the slow part of the speed error (the strides' losses, which the proportional gain
+        # alone leaves as a steady error) moves the placement along the desired direction
+        x_hh += self.speed_bias * math.cos(hd)
+        y_hh += self.speed_bias * math.sin(hd)
+        # eqs. 1-2 place the heel relative to the body's centre line (the COM), a step width
+        # apart, rather than under the hip joint 8 cm to the side (runners land near the
+        # midline); the hip-to-heel vector follows from where the hip is now
+        c, sn = math.cos(heading), math.sin(heading)
+        hip = d.xanchor[self._hips[leg]]
+        off = np.array([x_hh, y_hh]) + s.com[:2] - hip[:2]
+        fwd = c * off[0] + sn * off[1]
+        lat = -sn * off[0] + c * off[1] + (0.5 if leg == 0 else -0.5) * k["step_width"]
+        # ground-speed matching: the foot reaches further forward while it is high and comes
+        # back over the last moments before touchdown (predicted from the lowest sole corner
+        # and the body's vertical speed), so it meets the ground moving back under the body
+        vz = float(s.com_vel[2])
+        low = float(s.sole_corners()[leg, :, 2].min())
+        to_go = low / -vz if vz < -1e-3 else np.inf
+        fwd += k["speed_matching"] * _clamp(to_go / k["retract_time"], 0.0, 1.0)
+        fwd += 0.3 * lf  # the heel sits behind the ankle
+        length = k["touchdown_leg"] * (self.athlete.thigh[leg] + self.athlete.shin[leg])
+        fwd = _clamp(fwd, -0.5 * length, 0.75 * length)
+        lat = _clamp(lat, -0.3 * length, 0.3 * length)
+        down = math.sqrt(max(length * length - fwd * fwd - lat * lat, 0.04))
+        swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
+        roll = math.atan2(lat, math.hypot(fwd, down))
+        knee, geom = knee_for_length(self.athlete.thigh[leg], self.athlete.shin[leg], length)
+        thigh = _qmul(_qyaw(heading), _quat_yxz(-swing + float(geom), roll, 0.0))
+        pelvis = self._anat(self._root, 0)
+        hip_pitch, hip_roll, _ = _euler_yxz(_qmul(_qconj(pelvis), thigh))
+        self.goal[_HIP[leg]] = (hip_pitch, hip_roll, 0.0)
+        self.goal[_KNEE[leg]] = (float(knee), 0.0, 0.0)
+        self.knee_td = float(knee)
+        shin = self._pitch(self._shins[leg], _SHIN[leg], heading)
+        self.goal[_ANKLE[leg]] = (_clamp(-k["heel_up"] - shin, -0.5, 0.9), 0.0, 0.0)
+
+    def _idle(self, t: float, heading: float) -> None:
+        """The idle leg. In flight, eqs. 3-4: the idle thigh mirrors the active one's travel
+        since lift-off (pitches in the heading frame), so their reactions on the body
+        cancel. In stance it swings forward with the stance's progress (time since touchdown
+        over the expected stance) to where the next touchdown needs it: at lift-off it is
+        forward and moving, and its momentum cancels the stance leg's. The knee is bent
+        (shortened leg) and opens late in the stance; the ankle is flexed (toes up)."""
+        k = self.k
+        a, i = self.active, 1 - self.active
+        knee = k["idle_knee"]
+        if self.machine.current.name == "flight":
+            act = self._pitch(self._thighs[a], _THIGH[a], heading)
+            want = self.lo_pitch[i] - (act - self.lo_pitch[a])
+        else:
+            prog = (t - self.t_touchdown) / max(self.stance_estimate, 0.05)
+            sm = _clamp(prog, 0.0, 1.0)
+            want = self.td_pitch + (k["swing_ready"] - self.td_pitch) * sm * sm * (3.0 - 2.0 * sm)
+            late = _clamp(2.0 * prog - 1.0, 0.0, 1.0)
+            knee += (k["reach_knee"] - k["idle_knee"]) * late * late * (3.0 - 2.0 * late)
+        hip = _clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
+        self.goal[_HIP[i]] = (hip, 0.03 * (1 - 2 * i), 0.0)
+        self.goal[_KNEE[i]] = (knee, 0.0, 0.0)
+        self.goal[_ANKLE[i]] = (-0.15, 0.0, 0.0)
+
+    def _upper(self, hips: F64) -> None:
+        """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
+        k = self.k
+        for leg in range(2):
+            self.goal[_SHOULDER[leg]] = (k["arm_gain"] * hips[1 - leg] + k["arm_offset"],
+                                         0.15 * (1 - 2 * leg), 0.0)  # fmt: skip
+            self.goal[_ELBOW[leg]] = (-k["elbow"], 0.0, 0.0)
+        for j in _SPINE:
+            self.goal[j] = 0.0
+        self.goal[_NECK] = (-0.1, 0.0, 0.0)
+
+    def _attitude_torque(self, heading: float) -> F64:
+        """World torque on the trunk that servos its attitude toward the desired roll (a
+        lean into the curve), pitch (slightly forward) and yaw (the desired facing)."""
+        k = self.k
+        lean = k["lean"] * math.atan(self.speed**2 * self.curvature / self.g)
+        want = _qmul(_qyaw(self.heading_d), _quat_yxz(k["pitch"], -lean, 0.0))
+        # the chest's attitude and rate: the pelvis alone is light and sits between two
+        # servoed joints, and damping its rate explicitly at the control rate rings
+        d = self.world.data
+        now = self._anat(self._chest, _BODY["chest"])
+        err = np.empty(3)
+        mujoco.mju_quat2Vel(err, _qmul(want, _qconj(now)), 1.0)  # world rotation vector
+        c, s = math.cos(heading), math.sin(heading)
+        axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
+        gain = self.inertia_unit * (
+            np.asarray(self.params.attitude_kp) * (axes @ err)
+            - np.asarray(self.params.attitude_kv) * (axes @ d.cvel[self._chest, :3])
+        )
+        torque = axes.T @ gain
+        # the part about the stance thigh's long axis only twists the leg against the foot's
+        # grip on the ground: it stays within what the foot can hold, or the leg spins
+        leg = self.active
+        axis = d.xanchor[self._knees[leg]] - d.xanchor[self._hips[leg]]
+        axis /= max(float(np.linalg.norm(axis)), 1e-9)
+        along = float(torque @ axis)
+        limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
+        return torque - (along - _clamp(along, -limit, limit)) * axis
+
+    def _support_point(self, t: float) -> F64:
+        """Where the stance foot bears on the ground (world): the heel until the ball is
+        down, then rolling toward the ball by the expected end of the heel-and-toe phase,
+        then the ball (the paper's heel-to-metatarsus travel)."""
+        corners = self.senses.sole_corners()[self.active]
+        ball = 0.5 * (corners[0] + corners[1])
+        heel = 0.5 * (corners[2] + corners[3])
+        state = self.machine.current.name
+        if state in ("loading", "heel"):
+            return heel
+        if state == "heel_toe":
+            end = self.t_touchdown + self.k["toe_fraction"] * self.stance_estimate
+            span = max(end - self.t_heel_toe, 1e-3)
+            frac = _clamp((t - self.t_heel_toe) / span, 0.0, 1.0)
+            return heel + frac * (ball - heel)
+        return ball
+
+    def _leg_spring(self, t: float, dt: float, angles: F64) -> None:
+        """The stance knee as a spring and the ankle as the thrust: the leg's length is the
+        hip-to-ankle distance (what the knee's bend sets), ``L0`` the planned touchdown
+        length, and the force ``k (L0 - L) - c dL/dt`` (plus the thrust in the toe phase)
+        acts along the line from the support point to the hip, made by the knee's and
+        ankle's torques ``-J^T f`` (their columns of the support point's Jacobian). The force
+        passes through the hip, which stays free for the attitude servo; the knee carries
+        the spring and the ankle the lever to the ball. While only the heel touches the
+        ankle is left free, so the forefoot comes down. The knee's and ankle's own servos
+        hold only their roll and yaw."""
+        leg = self.active
+        k = self.k
+        d = self.world.data
+        hip = d.xanchor[self._hips[leg]]
+        length = float(np.linalg.norm(hip - d.xanchor[self._ankles[leg]]))
+        point = self._support_point(t)
+        line = hip - point
+        u = line / max(float(np.linalg.norm(line)), 1e-6)
+        rate = (length - self.leg_prev) / dt if self.leg_prev > 0 else 0.0
+        self.leg_prev = length
+        stiff = k["leg_stiffness"] * self.mass * self.g / self.athlete.leg_length
+        damp = 2.0 * k["leg_damping"] * math.sqrt(stiff * self.mass)
+        force = stiff * (self.leg_rest - length) - damp * rate
+        state = self.machine.current.name
+        if state in ("toe", "unloading") and not self.released:
+            force += self.thrust_force
+        force = max(force, 0.0)
+        self.leg_force = force
+        mujoco.mj_jac(self.world.model, d, self._jacp, None, point, self._feet[leg])
+        tau = -self._jacp[:, self._leg_cols[leg]].T @ (force * u)
+        ff = self.rig._ff
+        ff[_KNEE[leg]] += tau[0:3]
+        if state not in ("loading", "heel"):
+            ff[_ANKLE[leg]] += tau[3:6]
+        # the knee's and ankle's servos keep no pitch stiffness of their own
+        for j in (_KNEE[leg], _ANKLE[leg]):
+            self.targets[j, 0] = self.goal[j, 0] = angles[j, 0]
+
+    # ------------------------------------------------------------------ states
+    def _states(self) -> list[State]:
+        every = self.control_every
+
+        def law(fn) -> FunctionController:  # type: ignore[no-untyped-def]
+            return FunctionController(fn, every)
+
+        def touching(_w: World, _t: float, _ti: float) -> bool:
+            return bool(self.senses.foot_contact[self.active])
+
+        def knee_bends(_w: World, _t: float, t_in: float) -> bool:
+            return t_in >= 0.008
+
+        def ball_down(_w: World, _t: float, _ti: float) -> bool:
+            return bool(self.toe[self.active])
+
+        def stance_fraction(_w: World, t: float, _ti: float) -> bool:
+            return t - self.t_touchdown >= self.k["toe_fraction"] * self.stance_estimate
+
+        def knee_extended(_w: World, _t: float, t_in: float) -> bool:
+            knee = self._joint_pitch(_KNEE[self.active])
+            return t_in > 0.02 and knee <= self.knee_td + 0.05
+
+        def left_ground(_w: World, _t: float, _ti: float) -> bool:
+            return not bool(self.senses.foot_contact[self.active])
+
+        return [
+            State("flight", law(self._flight), self._enter_flight, ((touching, "loading"),)),
+            State("loading", law(self._stance), self._enter_loading,
+                  ((ball_down, "heel_toe"), (knee_bends, "heel"))),
+            State("heel", law(self._stance), None,
+                  ((ball_down, "heel_toe"), (after(0.12), "heel_toe"))),
+            State("heel_toe", law(self._stance), self._enter_heel_toe,
+                  ((stance_fraction, "toe"),)),
+            State("toe", law(self._stance), None,
+                  ((knee_extended, "unloading"), (left_ground, "flight"),
+                   (after(0.3), "unloading"))),
+            State("unloading", law(self._stance), None,
+                  ((left_ground, "flight"), (after(0.08), "flight"))),
+        ]  # fmt: skip
+
+    def _set_stiffness(self, stance: bool) -> None:
+        """The base stiffness; in stance the active hip's servo is off (the attitude torque
+        only) and its knee and ankle servos hold roll and yaw."""
+        stiff = self._base_stiffness.copy()
+        if stance:
+            a = self.active
+            stiff[_HIP[a]] = 0.0
+            stiff[_KNEE[a]] = self.k["knee_hold"]
+            stiff[_ANKLE[a]] = self.k["ankle_hold"]
+        self.rig.set_stiffness(stiff)
+
+    def _enter_flight(self, world: World, t: float) -> None:
+        del world
+        if self.machine.transitions:  # lift-off (not the first tick): swap the legs
+            self.stance_estimate = _clamp(t - self.t_touchdown, 0.12, 0.4)
+            self.log.liftoffs.append((t, self.active))
+            self.active = 1 - self.active
+        h = self.heading()
+        self.lo_pitch = [self._pitch(self._thighs[j], _THIGH[j], h) for j in range(2)]
+        self._set_stiffness(False)
+
+    def _enter_loading(self, world: World, t: float) -> None:
+        del world
+        self.t_touchdown = t
+        self.released = False
+        leg = self.active
+        d = self.world.data
+        self.td_pitch = self._pitch(self._thighs[1 - leg], _THIGH[1 - leg], self.heading())
+        foot = d.xpos[self._feet[leg]]
+        self.log.touchdowns.append((t, leg, float(foot[0]), float(foot[1])))
+        self.steps += 1
+        # the placement's slow correction from the last step's speed (distance along the
+        # desired direction over its duration)
+        com = self.senses.com[:2].copy()
+        if self.step_start is not None and t > self.step_start[0] + 0.05:
+            h = self.heading_d
+            dist = float((com - self.step_start[1]) @ np.array([math.cos(h), math.sin(h)]))
+            err = dist / (t - self.step_start[0]) - self.speed
+            bias = self.speed_bias + self.k["speed_integral"] * err
+            self.speed_bias = _clamp(bias, -0.3, 0.3)
+        self.step_start = (t, com)
+        # the spring's rest length: the hip-to-ankle length at touchdown as planned, or as
+        # it landed if longer
+        now = float(np.linalg.norm(d.xanchor[self._hips[leg]] - d.xanchor[self._ankles[leg]]))
+        planned = self.k["touchdown_leg"] * (self.athlete.thigh[leg] + self.athlete.shin[leg])
+        self.leg_rest = max(now, planned)
+        self.leg_prev = 0.0
+        self._set_stiffness(True)
+
+    def _enter_heel_toe(self, world: World, t: float) -> None:
+        del world
+        self.t_heel_toe = t
+
+    def _flight(self, world: World, t: float) -> None:
+        del world, t
+        self._placement(self.active, self.heading_d if self.p_frame else self.heading())
+
+    def _stance(self, world: World, t: float) -> None:
+        del world, t
+        if not self.released and self.machine.current.name in ("toe", "unloading"):
+            # the thrust stops once the body rises at the take-off speed wanted
+            self.released = float(self.senses.com_vel[2]) >= self.k["takeoff_vz"]
+
+    # ------------------------------------------------------------------ tick
+    def control(self, world: World, t: float) -> None:
+        s = self.senses
+        s.update(t)
+        self._contacts()
+        want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
+        # the facing turns at a limited rate whatever the course asks (an abrupt change of
+        # facing throws the runner down)
+        if self._steered:
+            step = (want - self.heading_d + math.pi) % (2 * math.pi) - math.pi
+            limit = self.k["turn_rate"] * self.control_every * world.timestep
+            self.heading_d += _clamp(step, -limit, limit)
+        else:
+            self.heading_d, self._steered = want, True
+        self.machine.control(world, t)
+        # the frame the legs are placed and swung in: the desired facing, not the pelvis's
+        # (which yaws back and forth with every stride)
+        heading = self.heading_d if self.p_frame else self.heading()
+        # the pitch of the legs' joints (the only joint angles the laws read)
+        angles = np.zeros((NJ, 3))
+        for j in _LEG_JOINTS:
+            angles[j, 0] = self._joint_pitch(j)
+        self._idle(t, heading)
+        self._upper(angles[list(_HIP), 0])
+        # eq. 6: the targets move smoothly toward the goals (first order, time constant)
+        dt = self.control_every * world.timestep
+        smoothing = self.k["smoothing"]
+        self.targets += min(1.0, dt / smoothing if smoothing > 0 else 1.0) * (
+            self.goal - self.targets
+        )
+        rig = self.rig
+        rig.move(self.targets, 0.0, t)
+        rig.apply(t)
+        if self.machine.current.name != "flight":
+            # the stance hip makes the attitude torque on the trunk (its reaction is on the
+            # thigh); then the leg spring adds the knee's and ankle's torques
+            rot = world.data.xmat[self._thighs[self.active]].reshape(3, 3)
+            rig._ff[_HIP[self.active]] = -rot.T @ self._attitude_torque(heading)
+            self._leg_spring(t, dt, angles)
+        self._log(t, angles)
+
+    def _log(self, t: float, angles: F64) -> None:
+        s = self.senses
+        feet = int(s.foot_contact[0]) | (int(s.foot_contact[1]) << 1)
+        self.log.rows.append((
+            t, s.com.copy(), s.com_vel.copy(), s.heading(),
+            RUN_STATES.index(self.machine.current.name), self.active, feet,
+            float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
+            angles[list(_HIP), 0], angles[list(_KNEE), 0], self.heading_d, self.cross_track,
+        ))  # fmt: skip
+
+
+def running_start(athlete: Athlete, speed: float, heading: float = 0.0) -> tuple[F64, F64]:
+    """qpos ``(67,)`` and qvel ``(51,)`` of the runner in flight at ``speed`` along
+    ``heading``, its soles 5 cm up: the left leg reaching forward for touchdown, the right
+    trailing with its knee bent."""
+    angles = np.zeros((NJ, 3))
+    angles[_HIP[0]] = (-0.45, 0.0, 0.0)
+    angles[_KNEE[0]] = (0.25, 0.0, 0.0)
+    angles[_ANKLE[0]] = (-0.05, 0.0, 0.0)
+    angles[_HIP[1]] = (0.25, 0.0, 0.0)
+    angles[_KNEE[1]] = (1.2, 0.0, 0.0)
+    angles[_ANKLE[1]] = (0.2, 0.0, 0.0)
+    for k in range(2):
+        angles[_SHOULDER[k]] = (0.9 * angles[_HIP[1 - k], 0] + 0.05, 0.15 * (1 - 2 * k), 0.0)
+        angles[_ELBOW[k]] = (-1.4, 0.0, 0.0)
+    q = athlete.standing_qpos(angles, pitch=0.08, clearance=0.05)
+    if heading:
+        q[3:7] = quat_mul(quat_from_yaw(heading), q[3:7])
+        c, s = math.cos(heading), math.sin(heading)
+        q[0], q[1] = c * q[0] - s * q[1], s * q[0] + c * q[1]
+    v = np.zeros(6 + 3 * NJ)
+    v[0] = speed * math.cos(heading)
+    v[1] = speed * math.sin(heading)
+    return q, v

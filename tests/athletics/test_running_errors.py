@@ -1,0 +1,97 @@
+"""Clear errors for bad running inputs, and the courses' geometry (no simulation)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reactmocap.athletics.paths import (
+    Circle,
+    Facing,
+    Polyline,
+    Straight,
+    figure_eight,
+    parse_course,
+)
+from reactmocap.athletics.run_course import run_course
+from reactmocap.athletics.running import SPEED_RANGE, RunParams, check_speed
+from reactmocap.cli import main
+from reactmocap.errors import ConfigError, ReactMocapError
+
+
+@pytest.mark.parametrize("speed", [2.4, 5.1, -1.0, float("nan"), 0.0])
+def test_out_of_range_speed_names_the_range(speed: float) -> None:
+    with pytest.raises(ConfigError, match=r"supported range 2\.5-5 m/s"):
+        check_speed(speed)
+    with pytest.raises(ReactMocapError, match="2.5-5 m/s"):
+        run_course(speed, seconds=1.0)
+
+
+def test_speed_range_is_the_papers() -> None:
+    assert SPEED_RANGE == (2.5, 5.0)
+    assert check_speed(2.5) == 2.5 and check_speed(5) == 5.0
+
+
+def test_cli_out_of_range_speed(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "x.bvh"
+    assert main(["athletics", "run", "--speed", "7", "--out", str(out)]) == 2
+    assert "2.5-5 m/s" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_run_params_are_checked() -> None:
+    with pytest.raises(ConfigError, match="touchdown_leg"):
+        RunParams(touchdown_leg=1.5)
+    with pytest.raises(ConfigError, match="a number or three"):
+        RunParams(thrust=(1.0, 2.0))  # type: ignore[arg-type]
+    with pytest.raises(ConfigError, match="finite"):
+        RunParams(pitch=float("nan"))
+    p = RunParams(thrust=(1.0, 2.0, 4.0))
+    assert p.at(2.5)["thrust"] == 1.0 and p.at(3.0)["thrust"] == pytest.approx(1.5)
+    assert p.at(4.25)["thrust"] == pytest.approx(3.0) and p.at(9.0)["thrust"] == 4.0
+
+
+def test_unknown_path_lists_the_valid_ones() -> None:
+    with pytest.raises(ConfigError, match="'line', 'circle:R', 'eight:R' or FILE.csv"):
+        parse_course("spiral")
+    with pytest.raises(ConfigError, match="radius"):
+        parse_course("circle:wide")
+    with pytest.raises(ConfigError, match="does not exist"):
+        parse_course("nowhere.csv")
+
+
+def test_csv_path(tmp_path: Path) -> None:
+    f = tmp_path / "p.csv"
+    f.write_text("x,y\n0,0\n10,0\n10,10\n")
+    c = parse_course(str(f))
+    assert isinstance(c, Polyline) and c.total == pytest.approx(20.0)
+    f.write_text("x,y\n0,0\nten,0\n")
+    with pytest.raises(ConfigError, match="p.csv:3"):
+        parse_course(str(f))
+
+
+def test_circle_steering() -> None:
+    c = Circle((0.0, 10.0), 10.0)  # anticlockwise, through the origin heading +X
+    heading, curvature, cross = c.steer(np.array([0.0, 0.0]), 0.0)
+    assert 0 < heading < 0.5 and curvature == pytest.approx(0.1) and cross == pytest.approx(0.0)
+    _, _, inside = c.steer(np.array([0.0, 1.0]), 0.0)
+    assert inside == pytest.approx(1.0)  # left of an anticlockwise path: inside
+
+
+def test_polyline_follows_in_order() -> None:
+    eight = figure_eight(5.0)
+    heading, _, cross = eight.steer(np.array([0.0, 0.0]), 0.0)
+    assert abs(heading) < 0.7 and abs(cross) < 1e-6
+    line = Straight(0.5, (1.0, 1.0))
+    heading, curvature, cross = line.steer(np.array([1.0, 1.0]), 0.0)
+    assert heading == pytest.approx(0.5) and curvature == 0.0 and cross == pytest.approx(0.0)
+
+
+def test_facing_turns_at_a_limited_rate() -> None:
+    f = Facing([(0.0, 0.0), (1.0, math.pi / 2)], rate=0.5)
+    assert f.steer(np.zeros(2), 0.5)[0] == 0.0
+    h1, curv, cross = f.steer(np.zeros(2), 1.5)
+    assert h1 == pytest.approx(0.5) and curv == pytest.approx(0.5) and math.isnan(cross)
