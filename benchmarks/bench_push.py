@@ -85,6 +85,10 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
     motion = _clip(name)
     yaw = heading(motion, at)
     params = json.loads(args.params)
+    if not survives((name, at, yaw, 0.0, duration, args.after, params)):
+        # a clip that falls unpushed in the window measures the tracker, not the push
+        print(f"{name} falls unpushed within {args.after} s after {at} s: choose another clip")
+        return [float("nan")] * 8
     jobs = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.max_force,
              args.steps) for k in range(8)]  # fmt: skip
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
