@@ -134,11 +134,13 @@ def reference_path(
     fps: float | None = None,
     reach: float = 0.05,
     pivot_rate: float | None = 2.0,
-    slide_speed: float | None = 0.5,
+    slide_speed: float | None = None,
 ) -> ReferencePath:
     """``source`` on ``world``'s ``character`` as a :class:`ReferencePath`: a Motion on the
     character's skeleton, or a ``(T, 67)`` qpos path sampled at ``fps``. Foot stance is
-    measured on the character's own sole boxes (``pivot_rate`` rad/s; ``None``: no pivots)."""
+    measured on the character's own sole boxes (``pivot_rate`` rad/s; ``None``: no pivots); a
+    foot whose lowest corner moves faster than ``slide_speed`` (m/s) is not planted (``None``:
+    any foot within ``reach``, the short-window and response trackers' stance)."""
     for name, value in (
         ("reach", reach),
         ("pivot_rate", 0.0 if pivot_rate is None else pivot_rate),
