@@ -23,6 +23,7 @@ __all__ = [
     "Slope",
     "add_backpack",
     "athletics_world",
+    "shins_off_floor",
     "stand_angles",
 ]
 
@@ -133,18 +134,23 @@ class Slope:
             self.tilt(self.angle * s * s * (3.0 - 2.0 * s))
 
 
+def shins_off_floor(world: World, character: int = 0) -> None:
+    """The shins of ``character`` collide with nothing (see :func:`athletics_world`)."""
+    m = world.model
+    for side in "lr":
+        body = world.characters[character].body_id(f"{side}_shin")
+        geoms = np.flatnonzero(m.geom_bodyid == body)
+        m.geom_contype[geoms] = 0
+        m.geom_conaffinity[geoms] = 0
+
+
 def athletics_world(athlete: Athlete, *, backpack: float = 0.0) -> World:
     """A World holding ``athlete`` standing on level ground (:data:`ATHLETICS_WORLD`). The
     shins do not collide with the floor: their capsules end at the ankle joint, a loaded sole
     sinks a little into the soft contact, and a shin touching the floor under a flat foot is a
     rigid stop that threw landing athletes back into the air (a real shin is well clear)."""
     world = World(athlete.character, ATHLETICS_WORLD)
-    m = world.model
-    for side in "lr":
-        body = world.characters[0].body_id(f"{side}_shin")
-        geoms = np.flatnonzero(m.geom_bodyid == body)
-        m.geom_contype[geoms] = 0
-        m.geom_conaffinity[geoms] = 0
+    shins_off_floor(world)
     add_backpack(world, athlete, backpack)
     world.set_pose(0, athlete.standing_qpos(stand_angles(athlete), clearance=0.0005))
     return world

@@ -28,7 +28,7 @@ from reactmocap.athletics.bodies import Athlete, athlete
 from reactmocap.athletics.land import Landing, LandingParams
 from reactmocap.athletics.machine import NEXT, Basis, Context
 from reactmocap.athletics.rig import joint_index, per_joint
-from reactmocap.athletics.scene import ATHLETICS_WORLD
+from reactmocap.athletics.scene import ATHLETICS_WORLD, shins_off_floor
 from reactmocap.athletics.sequencer import Sequencer
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
@@ -270,11 +270,7 @@ class _Apparatus:
     def configure(self, world: World) -> None:
         # the shins do not touch the floor (as in the athletics world); the mat is softer
         m = world.model
-        for side in "lr":
-            body = world.characters[0].body_id(f"{side}_shin")
-            geoms = np.flatnonzero(m.geom_bodyid == body)
-            m.geom_contype[geoms] = 0
-            m.geom_conaffinity[geoms] = 0
+        shins_off_floor(world)
         # the apparatus is as soft as the floor (the values were found with it so) and, like
         # the floor, dominates the solref of its contacts with the gymnast
         for name in ("board_plate", "horse_box"):
@@ -720,30 +716,15 @@ def table1(log: dict[str, NDArray], transitions: list[tuple[float, str, str]],
     horse = span(log["on_horse"].astype(bool), t[board[1]] if board else -1.0)
     floor = span(log["on_floor"].astype(bool), t[horse[1]] if horse else -1.0)
     vel = log["com_vel"]
-    if board:
-        a, b = board
-        out["board_contact_s"] = float(t[b] - t[a])
-        out["board_touchdown_vx_m_s"], out["board_touchdown_vz_m_s"] = (
-            float(vel[a, 0]),
-            float(vel[a, 2]),
-        )
-        out["board_liftoff_vx_m_s"], out["board_liftoff_vz_m_s"] = (
-            float(vel[b, 0]),
-            float(vel[b, 2]),
-        )
-        out["board_force_n"] = float(np.mean(log["board_force"][a : b + 1]))
+    for name, contact in (("board", board), ("horse", horse)):
+        if contact:
+            a, b = contact
+            out[f"{name}_contact_s"] = float(t[b] - t[a])
+            for event, i in (("touchdown", a), ("liftoff", b)):
+                out[f"{name}_{event}_vx_m_s"] = float(vel[i, 0])
+                out[f"{name}_{event}_vz_m_s"] = float(vel[i, 2])
+            out[f"{name}_force_n"] = float(np.mean(log[f"{name}_force"][a : b + 1]))
     if horse:
-        a, b = horse
-        out["horse_contact_s"] = float(t[b] - t[a])
-        out["horse_touchdown_vx_m_s"], out["horse_touchdown_vz_m_s"] = (
-            float(vel[a, 0]),
-            float(vel[a, 2]),
-        )
-        out["horse_liftoff_vx_m_s"], out["horse_liftoff_vz_m_s"] = (
-            float(vel[b, 0]),
-            float(vel[b, 2]),
-        )
-        out["horse_force_n"] = float(np.mean(log["horse_force"][a : b + 1]))
         if board:
             out["first_flight_s"] = float(t[horse[0]] - t[board[1]])
     if floor and horse:
