@@ -26,6 +26,7 @@ import dataclasses
 import json
 import math
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -217,22 +218,36 @@ def tune_speed(speed: float, iterations: int, seconds: float, seed: int) -> None
         return dataclasses.replace(base, **kw)  # type: ignore[arg-type]
 
     best = {k: base.at(speed)[k] for k in _RUN_SPACE}
-    best_j = _run_score(make(best), speed, seconds)
+    best = _random_search(lambda x: _run_score(make(x), speed, seconds), _RUN_SPACE, best,
+                          iterations, rng, tries=3, changed=(2, 6), sigma_max=2.0)  # fmt: skip
+    print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
+
+
+def _random_search(score: Callable[[dict[str, float]], float],
+                   space: dict[str, tuple[float, float, float]], best: dict[str, float],
+                   iterations: int, rng: np.random.Generator, *, tries: int,
+                   changed: tuple[int, int], sigma_max: float) -> dict[str, float]:  # fmt: skip
+    """A (1+1)-style random search: each iteration perturbs a few keys of the best point
+    (``changed`` keys, by ``sigma`` steps of ``space``'s ``(low, high, step)``) ``tries``
+    times and keeps any improvement; the step widens after a success and narrows otherwise.
+    By hand because the scores are noisy simulation outcomes (falls) that gradient-based and
+    scipy's bounded optimisers handle poorly."""
+    best_j = score(best)
     sigma = 1.0
     for it in range(iterations):
         improved = False
-        for _ in range(3):
-            keys = rng.choice(list(_RUN_SPACE), size=int(rng.integers(2, 6)), replace=False)
+        for _ in range(tries):
+            keys = rng.choice(list(space), size=int(rng.integers(*changed)), replace=False)
             x = dict(best)
             for k in keys:
-                lo, hi, step = _RUN_SPACE[k]
+                lo, hi, step = space[k]
                 x[k] = float(np.clip(best[k] + sigma * step * rng.standard_normal(), lo, hi))
-            j = _run_score(make(x), speed, seconds)
+            j = score(x)
             if j < best_j:
                 best_j, best, improved = j, x, True
-        sigma = min(2.0, sigma * 1.3) if improved else max(0.3, sigma * 0.9)
+        sigma = min(sigma_max, sigma * 1.3) if improved else max(0.3, sigma * 0.9)
         print(f"iteration {it + 1}: score {best_j:.3f}", flush=True)
-    print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
+    return best
 
 
 def tune_vault(iterations: int, seed: int) -> None:
@@ -263,21 +278,8 @@ def tune_vault(iterations: int, seed: int) -> None:
     rng = np.random.default_rng(seed)
     base = VaultParams()
     best = {k: float(getattr(base, k)) for k in space}
-    best_j = score(best)
-    sigma = 1.0
-    for it in range(iterations):
-        improved = False
-        for _ in range(4):
-            keys = rng.choice(list(space), size=int(rng.integers(1, 5)), replace=False)
-            x = dict(best)
-            for k in keys:
-                lo, hi, step = space[k]
-                x[k] = float(np.clip(best[k] + sigma * step * rng.standard_normal(), lo, hi))
-            j = score(x)
-            if j < best_j:
-                best_j, best, improved = j, x, True
-        sigma = min(3.0, sigma * 1.3) if improved else max(0.3, sigma * 0.9)
-        print(f"iteration {it + 1}: score {best_j:.3f}", flush=True)
+    best = _random_search(score, space, best, iterations, rng, tries=4, changed=(1, 5),
+                          sigma_max=3.0)  # fmt: skip
     print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
 
 
