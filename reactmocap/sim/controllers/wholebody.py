@@ -14,11 +14,13 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
+from scipy.linalg.blas import dtrsm
+from scipy.linalg.lapack import dposv, dpotrf, dpotrs
 from scipy.optimize import nnls
 
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_conj, quat_from_yaw, quat_log, quat_mul
+from reactmocap.rotations import quat_from_yaw, quat_mul
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import (
@@ -50,7 +52,17 @@ _SLOW_PERIOD = 0.008
 # a heading error's dead band is the position dead band over this lever (m)
 _DEADBAND_ARM = 0.5
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
-_PATCH_CORNERS = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
+_PATCH_SIGNS = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+# a patch's five points: its centre (a pyramid's 4 edges), then its 4 corners (straight up)
+_PATCH_OWNER = np.array([0, 0, 0, 0, 1, 2, 3, 4])
+
+
+def _skew(r: F64) -> F64:
+    """``(k, 3, 3)`` the cross-product matrices ``[r]x`` of ``r`` ``(k, 3)``."""
+    out = np.zeros((len(r), 3, 3))
+    out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -r[:, 2], r[:, 1], -r[:, 0]
+    out -= out.transpose(0, 2, 1)
+    return out
 
 
 def _rot2(yaw: float) -> F64:
@@ -230,8 +242,8 @@ class WholeBodyTracker:
             np.full(3 * NJ, kvj),
         ]
         self._kp0, self._kv0 = self.kp.copy(), self.kv.copy()
-        self.w = np.r_[np.full(6, root_weight), np.ones(3 * NJ)]
-        self._w_air = np.r_[np.zeros(6), np.ones(3 * NJ)]
+        self._w_root = np.full((6, 1), float(root_weight))
+        self._wj = np.ones(3 * NJ)
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
         self.mu = float(friction) * float(world.config.friction)
@@ -245,6 +257,8 @@ class WholeBodyTracker:
         self._jacd = np.zeros((3, m.nv))
         self._jacr = np.zeros((3, m.nv))
         self._jacrd = np.zeros((3, m.nv))
+        self._qref = np.zeros(m.nq)
+        self._dq = np.zeros(m.nv)
         self.patch = wc.patch_ids
         self.patch_half = m.geom_size[self.patch, 2].copy()
         self.patch_arm = m.geom_friction[self.patch, 2].copy()
@@ -253,6 +267,9 @@ class WholeBodyTracker:
         self._servo_rows = slice(rows, rows + NJ)
         edges = np.column_stack([self.mu * _PYRAMID, np.ones(4)])  # (4, 3)
         self._edges = edges.T  # (3, 4) columns: unnormalised pyramid edges
+        self._corner_basis = np.tile(edges, (4, 1, 1))  # (corner, edge, xyz)
+        self._corner_owner = np.repeat(np.arange(4), 4)
+        self._patch_basis = np.concatenate([edges, np.tile(_UP.T, (4, 1))])
         self.last_plan: WholeBodyPlan | None = None
         #: ``(6,)`` extra pelvis acceleration asked of the plan (world linear m/s^2, local
         #: angular rad/s^2), on top of its feedback; set by
@@ -323,7 +340,7 @@ class WholeBodyTracker:
         legs = [
             [BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"
         ]
-        self._leg_rows = [np.concatenate([6 + 3 * k + np.arange(3) for k in leg]) for leg in legs]
+        self._leg_rows = [np.concatenate([3 * k + np.arange(3) for k in leg]) for leg in legs]
         #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
         #: ``x -> Rz(yaw) x + shift``
         self.anchor_yaw = 0.0
@@ -573,70 +590,84 @@ class WholeBodyTracker:
         m = self.world.model
         corners = self._sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
-        qdot = d.qvel[self._dofs]
         sl = self._dofs
+        qdot = d.qvel[sl]
         feet: list[int] = []
+        jacs: list[F64] = []  # (k, 3, ndof) per foot: its points' Jacobians
+        bases: list[F64] = []  # (nb_f, 3) world force per unit coefficient
+        owners: list[NDArray[np.int64]] = []  # (nb_f,) the point of each coefficient
         pts: list[F64] = []
-        gens: list[F64] = []  # (3, ne) world force per unit coefficient, per point
-        jacs: list[F64] = []
         rows: list[F64] = []
         bias: list[F64] = []
-
-        def point(p: F64, body: int, edges: F64, still: bool) -> None:
-            mujoco.mj_jac(m, d, self._jacp, None, p, body)
-            jac = self._jacp[:, sl].copy()
-            pts.append(p)
-            gens.append(edges)
-            jacs.append(jac)
-            if still:
-                mujoco.mj_jacDot(m, d, self._jacd, None, p, body)
-                rows.append(jac)
-                bias.append(self._jacd[:, sl] @ qdot)
-
+        k0 = 0
         for f in range(2):
             if not planted[f]:
                 continue
-            body = int(self.feet[f])
             if patch_on[f]:
                 rot = d.geom_xmat[self.patch[f]].reshape(3, 3)
                 p = d.geom_xpos[self.patch[f]] - rot[:, 2] * self.patch_half[f]  # bottom face
                 low = p[2] - self.patch_half[f] * np.abs(rot[2, :2]).sum()  # its lowest corner
                 if low - self.floor_z >= self.touch:
                     continue
-                feet.append(f)
-                point(p, body, self._edges, True)
-                # the foot does not roll or pitch on its patch; its yaw is free
-                mujoco.mj_jac(m, d, None, self._jacr, p, body)
-                mujoco.mj_jacDot(m, d, None, self._jacrd, p, body)
-                rows.append(self._jacr[:2, sl].copy())
-                bias.append(self._jacrd[:2, sl] @ qdot)
                 axes = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, :2].T.copy()
                 axes[:, 2] = 0.0  # the centre-of-pressure range lies on the floor
                 axes /= np.linalg.norm(axes, axis=1, keepdims=True)
-                for sx, sy in _PATCH_CORNERS:
-                    cop = p + self.patch_arm[f] * (sx * axes[0] + sy * axes[1])
-                    point(cop, body, _UP, False)
-                continue
-            touching = corners[f, :, 2] - self.floor_z < self.touch
-            if not touching.any():
-                continue
-            if (touching & held[f]).any():
-                touching &= held[f]
+                # the patch's centre holds still (pyramid), its centre-of-pressure corners push
+                p_f = np.concatenate([p[None], p + self.patch_arm[f] * (_PATCH_SIGNS @ axes)])
+                basis, owner, still = self._patch_basis, _PATCH_OWNER, 1
+            else:
+                touching = corners[f, :, 2] - self.floor_z < self.touch
+                if not touching.any():
+                    continue
+                if (touching & held[f]).any():
+                    touching &= held[f]
+                p_f = corners[f, touching]
+                k = len(p_f)
+                basis, owner, still = self._corner_basis[:k], self._corner_owner[: 4 * k], k
             feet.append(f)
-            for p in corners[f, touching]:
-                point(p, body, self._edges, True)
+            # every point of the foot from the foot's Jacobians at its origin (two calls, not
+            # two per point): a point r from it moves at v + w x r and accelerates (qdd = 0) at
+            # a + alpha x r + w x (w' x r), w' the body's velocity of MuJoCo's last forward
+            # pass (``cvel``), as ``mj_jacDot`` has it (with w' = w, results moved: a whole walk
+            # drifted 1.1 m instead of 0.45 m)
+            body = int(self.feet[f])
+            o = d.xpos[body]
+            mujoco.mj_jac(m, d, self._jacp, self._jacr, o, body)
+            mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, o, body)
+            jr = self._jacr[:, sl]
+            w = jr @ qdot
+            alpha = self._jacrd[:, sl] @ qdot
+            r = p_f - o
+            skew = _skew(r)
+            jac = self._jacp[:, sl] - skew @ jr  # (k, 3, ndof)
+            jacs.append(jac)
+            pts.append(p_f)
+            bases.append(basis.reshape(-1, 3))
+            owners.append(owner + k0)
+            k0 += len(p_f)
+            rows.append(jac[:still].reshape(-1, jac.shape[-1]))
+            # r x u = skew(r) u, for the points held still
+            wxr = skew[:still] @ -d.cvel[body, :3]
+            acc = self._jacd[:, sl] @ qdot - skew[:still] @ alpha - _skew(wxr) @ w
+            bias.append(acc.reshape(-1))
+            if patch_on[f]:
+                # the foot does not roll or pitch on its patch; its yaw is free
+                rows.append(jr[:2].copy())  # the buffer is the next foot's
+                bias.append(alpha[:2])
         if not feet:
             z = np.zeros((0, 3))
             return _Support(
                 (), z, z, np.zeros(0, np.int64), np.zeros((NV, 0)), np.zeros((0, NV)), np.zeros(0)
             )
-        owner = np.concatenate([np.full(e.shape[1], k) for k, e in enumerate(gens)])
+        basis = np.concatenate(bases)
+        owner = np.concatenate(owners)
+        jac = np.concatenate(jacs)
         return _Support(
             feet=tuple(feet),
-            points=np.array(pts),
-            basis=np.concatenate(gens, axis=1).T,
+            points=np.concatenate(pts),
+            basis=basis,
             owner=owner,
-            gen=np.concatenate([j.T @ e for j, e in zip(jacs, gens)], axis=1),
+            gen=np.einsum("cin,ci->nc", jac[owner], basis),
             rows=np.concatenate(rows),
             bias=np.concatenate(bias),
         )
@@ -648,15 +679,14 @@ class WholeBodyTracker:
         qr, vr, ar, planted = self.reference(t)
         held = self._held(t)
         sl = self._dofs
-        q = d.qpos[self.wc.qpos_slice]
         v = d.qvel[sl]
-        if not (np.isfinite(q).all() and np.isfinite(v).all()):
+        if not (np.isfinite(d.qpos[self.wc.qpos_slice]).all() and np.isfinite(v).all()):
             raise SimulationError(f"WholeBodyTracker: the state at t = {t:.4f} s is not finite")
         # position error in qvel coordinates: world translation, local rotation vectors
-        rel = quat_mul(quat_conj(q[3:].reshape(NJ + 1, 4)), qr[3:].reshape(NJ + 1, 4))
-        rel *= np.where(rel[:, :1] < 0, -1.0, 1.0)
-        err = np.concatenate([qr[:3] - q[:3], quat_log(rel).reshape(-1)])
-        acc_des = ar + self.kp * err + self.kv * (vr - v)
+        np.copyto(self._qref, d.qpos)
+        self._qref[self.wc.qpos_slice] = qr
+        mujoco.mj_differentiatePos(m, self._dq, 1.0, d.qpos, self._qref)
+        acc_des = ar + self.kp * self._dq[sl] + self.kv * (vr - v)
         acc_des[:6] += self.root_bias
 
         mujoco.mj_fullM(m, d, self._full)
@@ -667,75 +697,76 @@ class WholeBodyTracker:
         h = d.qfrc_bias[sl]
         sup = self._support(d, planted, held)
         nc = len(sup.points)
-        nb = sup.gen.shape[1]
-        nj = 3 * NJ
-        # qdd = G z + g0 with z = [joint accelerations (45), pyramid coefficients (4 nc)]:
-        # the pelvis rows come from the pelvis's Newton-Euler equation
         qb = sup.gen
-        rhs = np.linalg.solve(big_m[:6, :6], np.column_stack([big_m[:6, 6:], qb[:6], h[:6]]))
-        g = np.zeros((NV, nj + nb))
-        g[:6, :nj] = -rhs[:, :nj]
-        g[:6, nj:] = rhs[:, nj : nj + nb]
-        g[6:, :nj] = np.eye(nj)
-        g0 = np.zeros(NV)
-        g0[:6] = -rhs[:, -1]
-        # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
-        # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
-        w = self.w if nc else self._w_air
-        swing = self._swing_targets(t)
-        if swing:
-            # a stepping leg follows its foot's target, not the mocap's leg
-            w = w.copy()
-            for f in swing:
-                w[self._leg_rows[f]] = 0.1
-        rows_a = [w[:, None] * g]
-        rows_b = [w * (acc_des - g0)]
+        nb = qb.shape[1]
+        nj = 3 * NJ
+        # unknowns: the joint accelerations y (45) and the pyramid coefficients beta (nb); the
+        # pelvis follows from its Newton-Euler equation, qdd_root = r_0 + r_b beta - r_y y
+        _, sol, info = dposv(big_m[:6, :6], np.column_stack([big_m[:6, 6:], qb[:6], h[:6]]))
+        if info:
+            raise SimulationError(f"WholeBodyTracker: singular pelvis inertia at t = {t:.4f} s")
+        r_y, r_b, r_0 = sol[:, :nj], sol[:, nj:-1], -sol[:, -1]
+        # every row but the joints' is s (P qdd - target): P (r, 51), target (r,), s (r,)
+        tasks: list[tuple[F64, F64, float | F64]] = []
         if nc:
             # the corners in contact do not move (J_c qdd + Jdot_c qdot = -k_c v_c), so the
             # planned forces are the ones MuJoCo's rigid-ish contact will produce: with only
             # the tangential rows and a soft weight, joint accelerations missed the plan by
             # 100-350 rad/s^2 in double support
             jt = sup.rows
-            rows_a.append(self.sqrt_wc * (jt @ g))
-            rows_b.append(-self.sqrt_wc * (jt @ g0 + sup.bias + self.contact_kv * (jt @ v)))
+            tasks.append((jt, -(sup.bias + self.contact_kv * (jt @ v)), self.sqrt_wc))
+        # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
+        # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
+        wj = self._wj
+        swing = self._swing_targets(t)
+        if swing:
+            # a stepping leg follows its foot's target, not the mocap's leg
+            wj = wj.copy()
+            for f in swing:
+                wj[self._leg_rows[f]] = 0.1
         for f, (p_d, v_d, a_d, up_d) in swing.items():
-            # a swinging foot goes where balance needs it (the mocap's landing moved by the
-            # capture point's error, or a balance step), level with the floor
-            body = int(self.feet[f])
-            rot = d.geom_xmat[self.sole[f]].reshape(3, 3)
-            point = d.geom_xpos[self.sole[f]] - rot[:, 2] * self._sole_half[f]
-            mujoco.mj_jac(m, d, self._jacp, self._jacr, point, body)
-            mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, point, body)
-            jf = np.concatenate([self._jacp[:, sl], self._jacr[:2, sl]])
-            jdv = np.concatenate([self._jacd[:, sl] @ v, self._jacrd[:2, sl] @ v])
-            vel = jf @ v
-            want = np.r_[
-                a_d + self.kp_swing * (p_d - point) + self.kv_swing * (v_d - vel[:3]),
-                self.kp_swing * np.cross(rot[:, 2], up_d if up_d is not None else rot[:, 2])[:2]
-                - self.kv_swing * vel[3:],
-            ]
-            # bounded: an out-of-reach target must not whip the leg
-            want[:3] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[:3])), 1e-9))
-            want[3:] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[3:])), 1e-9))
-            if up_d is None:  # a placement: where the foot lands, not how it swings
-                jf, jdv, want = jf[:2], jdv[:2], want[:2]
-            rows_a.append(self.sqrt_ws * (jf @ g))
-            rows_b.append(self.sqrt_ws * (want - jf @ g0 - jdv))
-        a_mat = np.concatenate(rows_a)
-        b_vec = np.concatenate(rows_b)
-        ay, ab = a_mat[:, :nj], a_mat[:, nj:]
-        qmat, rmat = np.linalg.qr(ay)
-        if nb:
-            # project the free joint accelerations out, then NNLS over the pyramid coefficients
-            pab = ab - qmat @ (qmat.T @ ab)
-            pb = b_vec - qmat @ (qmat.T @ b_vec)
-            scale = float(np.linalg.norm(pab, axis=0).max()) or 1.0
-            lhs = np.concatenate([pab, self.sqrt_reg * scale * np.eye(nb)])
-            beta, _ = nnls(lhs, np.concatenate([pb, np.zeros(nb)]), maxiter=50 * nb)
+            tasks.append(self._swing_task(f, v, p_d, v_d, a_d, up_d))
+        u_rows = [-self._w_root * r_y] if nc else []
+        v_rows = [self._w_root * r_b] if nc else []
+        c_rows = [self._w_root[:, 0] * (acc_des[:6] - r_0)] if nc else []
+        for p_mat, target, s in tasks:
+            p0 = p_mat[:, :6]
+            u_rows.append(s * (p_mat[:, 6:] - p0 @ r_y))
+            v_rows.append(s * (p0 @ r_b))
+            c_rows.append(s * (target - p0 @ r_0))
+        a = acc_des[6:]
+        beta = np.zeros(0)
+        if not u_rows:
+            y = a.copy()
         else:
-            beta = np.zeros(0)
-        y = np.linalg.solve(rmat, qmat.T @ (b_vec - ab @ beta))
-        qdd = g @ np.concatenate([y, beta]) + g0
+            # min |wj (y - a)|^2 + |U y + V beta - c|^2 + reg |beta|^2, beta >= 0: y eliminated
+            # in closed form leaves e^T S^-1 e, e = U a + V beta - c, S = I + U D^-1 U^T
+            # (a few rows instead of the QR of all 51 + r)
+            u = np.concatenate(u_rows)
+            vb = np.concatenate(v_rows)
+            ud = u / (wj * wj)
+            s_mat = ud @ u.T
+            s_mat.flat[:: len(u) + 1] += 1.0
+            chol, info = dpotrf(s_mat, lower=1)
+            e0 = u @ a - np.concatenate(c_rows)
+            # BLAS's trsm: LAPACK's trtrs went multi-threaded here and cost 1-2 ms a call on a
+            # busy machine
+            x = dtrsm(1.0, chol, np.column_stack([vb, e0]), lower=1)
+            if info:
+                raise SimulationError(f"WholeBodyTracker: singular program at t = {t:.4f} s")
+            if nb:
+                mt = x[:, :nb]
+                scale = float(np.sqrt((mt * mt).sum(axis=0).max())) or 1.0
+                lhs = np.concatenate([mt, self.sqrt_reg * scale * np.eye(nb)])
+                rhs = np.zeros(len(lhs))
+                rhs[: len(mt)] = -x[:, nb]
+                beta, _ = nnls(lhs, rhs, maxiter=50 * nb)
+                e0 = e0 + vb @ beta
+            z, _ = dpotrs(chol, e0, lower=1)
+            y = a - ud.T @ z
+        qdd = np.empty(NV)
+        qdd[6:] = y
+        qdd[:6] = r_0 + r_b @ beta - r_y @ y
         tau = big_m[6:] @ qdd + h[6:] - qb[6:] @ beta
         forces = np.zeros((nc, 3))
         np.add.at(forces, sup.owner, sup.basis * beta[:, None])
@@ -743,6 +774,34 @@ class WholeBodyTracker:
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
+
+    def _swing_task(
+        self, f: int, v: F64, p_d: F64, v_d: F64, a_d: F64, up_d: F64 | None
+    ) -> tuple[F64, F64, float]:
+        """The rows of foot ``f`` swinging to a target (see :meth:`plan`): a swinging foot goes
+        where balance needs it (the mocap's landing moved by the capture point's error, or a
+        balance step), level with the floor."""
+        m, d = self.world.model, self.world.data
+        sl = self._dofs
+        body = int(self.feet[f])
+        rot = d.geom_xmat[self.sole[f]].reshape(3, 3)
+        point = d.geom_xpos[self.sole[f]] - rot[:, 2] * self._sole_half[f]
+        mujoco.mj_jac(m, d, self._jacp, self._jacr, point, body)
+        mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, point, body)
+        jf = np.concatenate([self._jacp[:, sl], self._jacr[:2, sl]])
+        jdv = np.concatenate([self._jacd[:, sl] @ v, self._jacrd[:2, sl] @ v])
+        vel = jf @ v
+        want = np.r_[
+            a_d + self.kp_swing * (p_d - point) + self.kv_swing * (v_d - vel[:3]),
+            self.kp_swing * np.cross(rot[:, 2], up_d if up_d is not None else rot[:, 2])[:2]
+            - self.kv_swing * vel[3:],
+        ]
+        # bounded: an out-of-reach target must not whip the leg
+        want[:3] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[:3])), 1e-9))
+        want[3:] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[3:])), 1e-9))
+        if up_d is None:  # a placement: where the foot lands, not how it swings
+            jf, jdv, want = jf[:2], jdv[:2], want[:2]
+        return jf, want - jdv, self.sqrt_ws
 
     def scale_gains(self, scale: float) -> None:
         """The tracking gains (joints and pelvis) times ``scale``, damping times its root."""
