@@ -405,17 +405,18 @@ class PDServo:
         rows = self._rows(character, None)
         return self.world.data.M[self._midx[rows]]
 
-    def torques(self) -> F64:
+    def torques(self, character: int | None = None) -> F64:
         """``(n, 3)`` full servo torques ``I (kp e - kv qdot)`` at the current state, with the
-        exact log and the full 3x3 damping (reference computation; allocates). Excludes
-        :attr:`feedforward`."""
+        exact log and the full 3x3 damping (reference computation; allocates), or ``(15, 3)``
+        those of one ``character``. Excludes :attr:`feedforward`."""
         d = self.world.data
-        inertia = d.M[self._midx]
-        q = quat_normalize(d.qpos[self._qidx].reshape(self.n, 4))
-        r = np.matmul(self._rd, q[:, :, None])[:, :, 0]
-        e = quat_log(r)
-        qd = d.qvel[self._didx].reshape(self.n, 3)
-        u = self._kp[:, None] * e - self._kv[:, None] * qd
+        rows = slice(None) if character is None else self._rows(character, None)
+        inertia = d.M[self._midx[rows]]
+        u = -self._kv[rows, None] * d.qvel[self._didx].reshape(self.n, 3)[rows]
+        kp = self._kp[rows]
+        if kp.any():  # a damping-only servo (the whole-body tracker's) needs no log
+            q = quat_normalize(d.qpos[self._qidx].reshape(self.n, 4)[rows])
+            u += kp[:, None] * quat_log(np.matmul(self._rd[rows], q[:, :, None])[:, :, 0])
         return np.matmul(inertia, u[:, :, None])[:, :, 0]
 
     def clear(self) -> None:

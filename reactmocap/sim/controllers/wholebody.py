@@ -52,17 +52,14 @@ _SLOW_PERIOD = 0.008
 # a heading error's dead band is the position dead band over this lever (m)
 _DEADBAND_ARM = 0.5
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
+# r @ _LEVI_CIVITA, reshaped (3, 3), is -[r]x (the cross-product matrix's negative)
+_LEVI_CIVITA = np.array(
+    [[0, 0, 0, 0, 0, 1, 0, -1, 0], [0, 0, -1, 0, 0, 0, 1, 0, 0], [0, 1, 0, -1, 0, 0, 0, 0, 0]],
+    dtype=np.float64,
+)
 _PATCH_SIGNS = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
 # a patch's five points: its centre (a pyramid's 4 edges), then its 4 corners (straight up)
 _PATCH_OWNER = np.array([0, 0, 0, 0, 1, 2, 3, 4])
-
-
-def _skew(r: F64) -> F64:
-    """``(k, 3, 3)`` the cross-product matrices ``[r]x`` of ``r`` ``(k, 3)``."""
-    out = np.zeros((len(r), 3, 3))
-    out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -r[:, 2], r[:, 1], -r[:, 0]
-    out -= out.transpose(0, 2, 1)
-    return out
 
 
 def _rot2(yaw: float) -> F64:
@@ -242,7 +239,9 @@ class WholeBodyTracker:
             np.full(3 * NJ, kvj),
         ]
         self._kp0, self._kv0 = self.kp.copy(), self.kv.copy()
-        self._w_root = np.full((6, 1), float(root_weight))
+        self._w_root = float(root_weight)
+        self._root_rows = np.eye(6, NV) * self._w_root
+        self._free = np.zeros(0, dtype=bool)  # the last NNLS solution's positive coefficients
         self._wj = np.ones(3 * NJ)
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
@@ -253,10 +252,11 @@ class WholeBodyTracker:
         self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
         self._dofs = wc.qvel_slice
         self._full = np.zeros((m.nv, m.nv))
-        self._jacp = np.zeros((3, m.nv))
-        self._jacd = np.zeros((3, m.nv))
-        self._jacr = np.zeros((3, m.nv))
-        self._jacrd = np.zeros((3, m.nv))
+        # translation rows over rotation rows, filled by mj_jac / mj_jacDot through views
+        self._jac6 = np.zeros((6, m.nv))
+        self._jacd6 = np.zeros((6, m.nv))
+        self._jacp, self._jacr = self._jac6[:3], self._jac6[3:]
+        self._jacd, self._jacrd = self._jacd6[:3], self._jacd6[3:]
         self._qref = np.zeros(m.nq)
         self._dq = np.zeros(m.nv)
         self.patch = wc.patch_ids
@@ -264,7 +264,6 @@ class WholeBodyTracker:
         self.patch_arm = m.geom_friction[self.patch, 2].copy()
         rows = character * NJ
         self._ff = servo.feedforward[rows : rows + NJ]  # (15, 3) view
-        self._servo_rows = slice(rows, rows + NJ)
         edges = np.column_stack([self.mu * _PYRAMID, np.ones(4)])  # (4, 3)
         self._edges = edges.T  # (3, 4) columns: unnormalised pyramid edges
         self._corner_basis = np.tile(edges, (4, 1, 1))  # (corner, edge, xyz)
@@ -593,7 +592,7 @@ class WholeBodyTracker:
         sl = self._dofs
         qdot = d.qvel[sl]
         feet: list[int] = []
-        jacs: list[F64] = []  # (k, 3, ndof) per foot: its points' Jacobians
+        gens: list[F64] = []  # (nb_f, ndof) the generators as generalised forces
         bases: list[F64] = []  # (nb_f, 3) world force per unit coefficient
         owners: list[NDArray[np.int64]] = []  # (nb_f,) the point of each coefficient
         pts: list[F64] = []
@@ -634,40 +633,43 @@ class WholeBodyTracker:
             o = d.xpos[body]
             mujoco.mj_jac(m, d, self._jacp, self._jacr, o, body)
             mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, o, body)
-            jr = self._jacr[:, sl]
+            jr = self._jac6[3:, sl]
             w = jr @ qdot
-            alpha = self._jacrd[:, sl] @ qdot
+            acc0 = self._jacd6[:, sl] @ qdot  # (a, alpha) of the origin
             r = p_f - o
-            skew = _skew(r)
-            jac = self._jacp[:, sl] - skew @ jr  # (k, 3, ndof)
-            jacs.append(jac)
+            neg_skew = (r @ _LEVI_CIVITA).reshape(-1, 3, 3)  # -[r]x: r x u = -neg_skew u
+            jac = self._jac6[:3, sl] + neg_skew @ jr  # (k, 3, ndof)
             pts.append(p_f)
             bases.append(basis.reshape(-1, 3))
             owners.append(owner + k0)
             k0 += len(p_f)
             rows.append(jac[:still].reshape(-1, jac.shape[-1]))
-            # r x u = skew(r) u, for the points held still
-            wxr = skew[:still] @ -d.cvel[body, :3]
-            acc = self._jacd[:, sl] @ qdot - skew[:still] @ alpha - _skew(wxr) @ w
+            rs = r[:still]
+            w_old = d.cvel[body, :3]
+            # w x (w' x r) = w' (w . r) - r (w . w')
+            acc = (
+                acc0[:3] + neg_skew[:still] @ acc0[3:] + np.outer(rs @ w, w_old) - rs * (w @ w_old)
+            )
             bias.append(acc.reshape(-1))
-            if patch_on[f]:
+            if patch_on[f]:  # its centre's pyramid, its corners' upward pushes
+                gens.append(self._edges.T @ jac[0])
+                gens.append(jac[1:, 2])
                 # the foot does not roll or pitch on its patch; its yaw is free
                 rows.append(jr[:2].copy())  # the buffer is the next foot's
-                bias.append(alpha[:2])
+                bias.append(acc0[3:5])
+            else:  # corners: one pyramid each
+                gens.append((self._edges.T @ jac).reshape(-1, jac.shape[-1]))
         if not feet:
             z = np.zeros((0, 3))
             return _Support(
                 (), z, z, np.zeros(0, np.int64), np.zeros((NV, 0)), np.zeros((0, NV)), np.zeros(0)
             )
-        basis = np.concatenate(bases)
-        owner = np.concatenate(owners)
-        jac = np.concatenate(jacs)
         return _Support(
             feet=tuple(feet),
             points=np.concatenate(pts),
-            basis=basis,
-            owner=owner,
-            gen=np.einsum("cin,ci->nc", jac[owner], basis),
+            basis=np.concatenate(bases),
+            owner=np.concatenate(owners),
+            gen=np.concatenate(gens).T,
             rows=np.concatenate(rows),
             bias=np.concatenate(bias),
         )
@@ -706,15 +708,18 @@ class WholeBodyTracker:
         if info:
             raise SimulationError(f"WholeBodyTracker: singular pelvis inertia at t = {t:.4f} s")
         r_y, r_b, r_0 = sol[:, :nj], sol[:, nj:-1], -sol[:, -1]
-        # every row but the joints' is s (P qdd - target): P (r, 51), target (r,), s (r,)
-        tasks: list[tuple[F64, F64, float | F64]] = []
+        # the rows other than the joints': (P, target), weights folded in
+        tasks: list[tuple[F64, F64]] = []
         if nc:
+            tasks.append((self._root_rows, self._w_root * acc_des[:6]))
             # the corners in contact do not move (J_c qdd + Jdot_c qdot = -k_c v_c), so the
             # planned forces are the ones MuJoCo's rigid-ish contact will produce: with only
             # the tangential rows and a soft weight, joint accelerations missed the plan by
             # 100-350 rad/s^2 in double support
             jt = sup.rows
-            tasks.append((jt, -(sup.bias + self.contact_kv * (jt @ v)), self.sqrt_wc))
+            tasks.append(
+                (self.sqrt_wc * jt, -self.sqrt_wc * (sup.bias + self.contact_kv * (jt @ v)))
+            )
         # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
         # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
         wj = self._wj
@@ -726,29 +731,25 @@ class WholeBodyTracker:
                 wj[self._leg_rows[f]] = 0.1
         for f, (p_d, v_d, a_d, up_d) in swing.items():
             tasks.append(self._swing_task(f, v, p_d, v_d, a_d, up_d))
-        u_rows = [-self._w_root * r_y] if nc else []
-        v_rows = [self._w_root * r_b] if nc else []
-        c_rows = [self._w_root[:, 0] * (acc_des[:6] - r_0)] if nc else []
-        for p_mat, target, s in tasks:
-            p0 = p_mat[:, :6]
-            u_rows.append(s * (p_mat[:, 6:] - p0 @ r_y))
-            v_rows.append(s * (p0 @ r_b))
-            c_rows.append(s * (target - p0 @ r_0))
         a = acc_des[6:]
         beta = np.zeros(0)
-        if not u_rows:
+        if not tasks:
             y = a.copy()
         else:
+            # the rows P qdd - target = U y + V beta - c, with the pelvis's row of qdd from sol
+            pmat = np.concatenate([task[0] for task in tasks])
+            x = pmat[:, :6] @ sol
+            u = pmat[:, 6:] - x[:, :nj]
+            vb = x[:, nj:-1]
+            c = np.concatenate([task[1] for task in tasks]) + x[:, -1]
             # min |wj (y - a)|^2 + |U y + V beta - c|^2 + reg |beta|^2, beta >= 0: y eliminated
             # in closed form leaves e^T S^-1 e, e = U a + V beta - c, S = I + U D^-1 U^T
             # (a few rows instead of the QR of all 51 + r)
-            u = np.concatenate(u_rows)
-            vb = np.concatenate(v_rows)
             ud = u / (wj * wj)
             s_mat = ud @ u.T
             s_mat.flat[:: len(u) + 1] += 1.0
             chol, info = dpotrf(s_mat, lower=1)
-            e0 = u @ a - np.concatenate(c_rows)
+            e0 = u @ a - c
             # BLAS's trsm: LAPACK's trtrs went multi-threaded here and cost 1-2 ms a call on a
             # busy machine
             x = dtrsm(1.0, chol, np.column_stack([vb, e0]), lower=1)
@@ -760,7 +761,7 @@ class WholeBodyTracker:
                 lhs = np.concatenate([mt, self.sqrt_reg * scale * np.eye(nb)])
                 rhs = np.zeros(len(lhs))
                 rhs[: len(mt)] = -x[:, nb]
-                beta, _ = nnls(lhs, rhs, maxiter=50 * nb)
+                beta = self._nnls(lhs, rhs)
                 e0 = e0 + vb @ beta
             z, _ = dpotrs(chol, e0, lower=1)
             y = a - ud.T @ z
@@ -777,7 +778,7 @@ class WholeBodyTracker:
 
     def _swing_task(
         self, f: int, v: F64, p_d: F64, v_d: F64, a_d: F64, up_d: F64 | None
-    ) -> tuple[F64, F64, float]:
+    ) -> tuple[F64, F64]:
         """The rows of foot ``f`` swinging to a target (see :meth:`plan`): a swinging foot goes
         where balance needs it (the mocap's landing moved by the capture point's error, or a
         balance step), level with the floor."""
@@ -801,7 +802,26 @@ class WholeBodyTracker:
         want[3:] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[3:])), 1e-9))
         if up_d is None:  # a placement: where the foot lands, not how it swings
             jf, jdv, want = jf[:2], jdv[:2], want[:2]
-        return jf, want - jdv, self.sqrt_ws
+        return self.sqrt_ws * jf, self.sqrt_ws * (want - jdv)
+
+    def _nnls(self, a: F64, b: F64) -> F64:
+        """``argmin |a x - b|, x >= 0``: first the last solution's free set as a plain least
+        squares, kept when it is optimal (its coefficients positive, no other one's gradient
+        pointing in; between contact changes it mostly is), else scipy's NNLS."""
+        n = a.shape[1]
+        free = self._free
+        if len(free) == n and free.any():
+            af = a[:, free]
+            _, xf, info = dposv(af.T @ af, af.T @ b[:, None])
+            if not info and (xf > 0).all():
+                x = np.zeros(n)
+                x[free] = xf[:, 0]
+                grad = a.T @ (b - a @ x)
+                if (grad[~free] <= 1e-10 * np.abs(grad[free]).max(initial=1.0)).all():
+                    return x
+        x = nnls(a, b, maxiter=50 * n)[0]
+        self._free = x > 0
+        return x
 
     def scale_gains(self, scale: float) -> None:
         """The tracking gains (joints and pelvis) times ``scale``, damping times its root."""
@@ -868,4 +888,4 @@ class WholeBodyTracker:
         self.last_plan = plan
         # the servo (damping only by default) keeps acting between ticks; at the tick the
         # total joint torque is the plan's
-        self._ff[:] = plan.torques - self.servo.torques()[self._servo_rows]
+        self._ff[:] = plan.torques - self.servo.torques(self.character)
