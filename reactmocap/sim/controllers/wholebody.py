@@ -20,17 +20,9 @@ from scipy.optimize import nnls
 
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_from_yaw, quat_mul
 from reactmocap.sim.character import BALL_JOINTS
+from reactmocap.sim.controllers.anchoring import AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
-from reactmocap.sim.controllers.stepping import (
-    Step,
-    clamp_to_support,
-    convex_hull,
-    outside_distance,
-    step_target,
-)
-from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
@@ -45,12 +37,6 @@ _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 _UP = np.array([[0.0], [0.0], [1.0]])
 # largest acceleration a swinging foot's rows ask for (m/s^2, and rad/s^2 for its tilt)
 _SWING_ACC = 100.0
-# no balance step once the pelvis has tilted this far from its start (cos 35 deg)
-_STEP_TILT_COS = float(np.cos(np.radians(35.0)))
-# seconds between updates of the ground path, the balance shift and the step decision
-_SLOW_PERIOD = 0.008
-# a heading error's dead band is the position dead band over this lever (m)
-_DEADBAND_ARM = 0.5
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
 # r @ _LEVI_CIVITA, reshaped (3, 3), is -[r]x (the cross-product matrix's negative)
 _LEVI_CIVITA = np.array(
@@ -60,11 +46,6 @@ _LEVI_CIVITA = np.array(
 _PATCH_SIGNS = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
 # a patch's five points: its centre (a pyramid's 4 edges), then its 4 corners (straight up)
 _PATCH_OWNER = np.array([0, 0, 0, 0, 1, 2, 3, 4])
-
-
-def _rot2(yaw: float) -> F64:
-    c, s = np.cos(yaw), np.sin(yaw)
-    return np.array([[c, -s], [s, c]])
 
 
 @dataclass(frozen=True)
@@ -102,7 +83,7 @@ class WholeBodyPlan:
     generalized_contact: F64
 
 
-class WholeBodyTracker:
+class WholeBodyTracker(AnchoredReference):
     """Tracks ``reference`` from clip time ``start`` with inverse dynamics and optimised ground
     forces (see the module docstring), through the servo's feed-forward of one character. The
     servo itself is damping only (``servo_kv``, inertia-scaled): its stiffness, held between
@@ -225,8 +206,6 @@ class WholeBodyTracker:
         if np.any(m.opt.gravity[:2]):
             raise ConfigError("WholeBodyTracker assumes vertical gravity")
         self.servo = servo
-        self.world = world
-        self.character = character
         self.servo_kv = float(servo_kv)
         self.control_every = int(control_every)
         wc = world.characters[character]
@@ -248,8 +227,6 @@ class WholeBodyTracker:
         self.mu = float(friction) * float(world.config.friction)
         self.touch = float(touch)
         self.sqrt_reg = float(np.sqrt(force_reg))
-        self.feet, self.sole, self._corners = foot_soles(world, character, "WholeBodyTracker")
-        self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
         self._dofs = wc.qvel_slice
         self._full = np.zeros((m.nv, m.nv))
         # translation rows over rotation rows, filled by mj_jac / mj_jacDot through views
@@ -259,9 +236,6 @@ class WholeBodyTracker:
         self._jacd, self._jacrd = self._jacd6[:3], self._jacd6[3:]
         self._qref = np.zeros(m.nq)
         self._dq = np.zeros(m.nv)
-        self.patch = wc.patch_ids
-        self.patch_half = m.geom_size[self.patch, 2].copy()
-        self.patch_arm = m.geom_friction[self.patch, 2].copy()
         rows = character * NJ
         self._ff = servo.feedforward[rows : rows + NJ]  # (15, 3) view
         edges = np.column_stack([self.mu * _PYRAMID, np.ones(4)])  # (4, 3)
@@ -274,8 +248,7 @@ class WholeBodyTracker:
         #: angular rad/s^2), on top of its feedback; set by
         #: :class:`~reactmocap.sim.controllers.predictive.PredictiveTracker`, zero otherwise
         self.root_bias = np.zeros(6)
-        #: the clip as this tracker follows it
-        self.path = with_soles(
+        path = with_soles(
             world,
             character,
             reference
@@ -289,289 +262,22 @@ class WholeBodyTracker:
                 slide_speed=slide_speed or None,
             ),
         )
-        self.clock = self.path.clock(start)
-        dt_tick = self.control_every * world.timestep
-        dt_slow = np.ceil(_SLOW_PERIOD / dt_tick - 1e-9) * dt_tick  # see control()
-        self._anchor_rate = min(1.0, dt_slow / anchor_tau) if anchor_tau > 0 else 0.0
-        self.anchor_touch = float(anchor_touch)
-        self.anchor_deadband = float(anchor_deadband)
-        self._return_rate = min(1.0, dt_slow / anchor_return) if anchor_return > 0 else 0.0
-        self.roll_band = float(roll_band) if roll_band > 0 else np.inf
-        self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
-        assert self.path.com is not None and self.path.sole is not None
-        self._com: F64 = self.path.com
-        dt_f = 1.0 / self.path.fps
-        n = self.path.num_frames
-        self._com_v = np.gradient(self._com, dt_f, axis=0) if n > 1 else 0 * self._com
-        self._com_a = np.gradient(self._com_v, dt_f, axis=0) if n > 2 else 0 * self._com
-        self._sole_v = np.gradient(self.path.sole, dt_f, axis=0) if n > 1 else 0 * self.path.sole
-        self.balance_margin = float(balance_margin)
-        self._balance_rate = min(1.0, dt_slow / balance_tau) if balance_tau > 0 else 0.0
-        #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
-        #: capture point inside the feet (see :meth:`rebalance`)
-        self.balance_shift = np.zeros(2)
-        self.stepping = bool(stepping)
-        self.step_margin = float(step_margin)
-        self.step_time = float(step_time)
-        self.step_height = float(step_height)
+        super().__init__(
+            world, character, path, start, dt_tick=self.control_every * world.timestep,
+            roll_band=roll_band, anchor_tau=anchor_tau, anchor_touch=anchor_touch,
+            anchor_return=anchor_return, anchor_deadband=anchor_deadband,
+            balance_margin=balance_margin, balance_tau=balance_tau, stepping=stepping,
+            step_margin=step_margin, step_time=step_time, step_height=step_height,
+            place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
+        )  # fmt: skip
         self.sqrt_ws = float(np.sqrt(swing_weight))
         self.kp_swing = float(kp_swing)
         self.kv_swing = critical_kv(kp_swing)
-        self.place_gain = float(place_gain)
-        self.place_deadband = float(place_deadband)
-        self.place_height = float(place_height)
-        #: horizontal shift of a mocap swing foot's landing (m): the capture point's error
-        #: against the mocap's beyond ``place_deadband``
-        self.place_shift = np.zeros(2)
-        #: the balance step under way (None: none)
-        self.step: Step | None = None
-        #: rollout times of the balance steps taken
-        self.steps_taken: list[float] = []
-        self._step_ready = 0.0
-        self._gravity = m.opt.gravity.copy()
-        self._root = int(wc.body_ids[0])
-        self._slow_next = 0.0
-        self._z_adr = wc.qpos_slice.start + 2
-        self._z0 = float(world.data.qpos[self._z_adr])
-        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
-        self._corners_at: tuple[float, bytes] = (float("nan"), b"")
-        self._corners_now = np.zeros((2, 4, 3))
         legs = [
             [BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"
         ]
         self._leg_rows = [np.concatenate([3 * k + np.arange(3) for k in leg]) for leg in legs]
-        #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
-        #: ``x -> Rz(yaw) x + shift``
-        self.anchor_yaw = 0.0
-        self.anchor_shift = np.zeros(2)
         self.release()
-
-    # ------------------------------------------------------------------ reference
-    def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
-        """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
-        the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
-        q, v, a, _ = self.path.sample(self.clock.frame(t), self.clock.coast(t))
-        planted = self.planted_now(t)
-        if self.anchor_yaw or self.anchor_shift.any():
-            rot = _rot2(self.anchor_yaw)
-            q[:2] = rot @ q[:2] + self.anchor_shift
-            q[3:7] = quat_mul(quat_from_yaw(self.anchor_yaw), q[3:7])
-            v[:2] = rot @ v[:2]  # free-joint angular velocity is local: unchanged
-            a[:2] = rot @ a[:2]
-        q[:2] += self.balance_shift
-        return q, v, a, planted
-
-    def _sole_corners(self) -> F64:
-        """``(2, 4, 3)`` the sole corners now (computed once per simulation time)."""
-        d = self.world.data
-        key = (float(d.time), d.geom_xpos[self.sole].tobytes())
-        if self._corners_at != key:
-            self._corners_now = sole_corners_world(d, self.sole, self._corners)
-            self._corners_at = key
-        return self._corners_now
-
-    def planted_now(self, t: float) -> NDArray[np.bool_]:
-        """``(2,)`` the feet the tracker stands on at ``t``: those planted in the mocap, but
-        for the foot of a balance step under way."""
-        planted = self.path.planted[self.clock.nearest(t)].copy()
-        if self.step is not None:
-            planted[self.step.foot] = False
-        return planted
-
-    def com_reference(self, t: float) -> tuple[F64, F64, F64]:
-        """The mocap's centre of mass at ``t``: position, velocity, acceleration (world, as
-        re-anchored)."""
-        x = self.clock.frame(t)
-        i0 = int(x)
-        i1 = min(i0 + 1, self.path.num_frames - 1)
-        w = x - i0
-        c = (1 - w) * self._com[i0] + w * self._com[i1]
-        v = (1 - w) * self._com_v[i0] + w * self._com_v[i1]
-        a = (1 - w) * self._com_a[i0] + w * self._com_a[i1]
-        coast = self.clock.coast(t)
-        if coast > 0:
-            c = c + coast * v
-            a = np.zeros(3)
-        rot = _rot2(self.anchor_yaw)
-        c[:2] = rot @ c[:2] + self.anchor_shift + self.balance_shift
-        v[:2] = rot @ v[:2]
-        a[:2] = rot @ a[:2]
-        return c, v, a
-
-    def _footprint(self, t: float) -> list[F64]:
-        """Per foot planted in the mocap, the ground points ``(k, 2)`` it can push through now:
-        its sole corners within ``anchor_touch`` of the floor, or its ball patch's
-        centre-of-pressure range; empty for a foot in the air."""
-        d = self.world.data
-        planted = self.planted_now(t)
-        corners = self._sole_corners()
-        patch_on = self.world.foot_patch_on(self.character)
-        out: list[F64] = []
-        for f in range(2):  # two feet
-            if not planted[f]:
-                out.append(np.zeros((0, 2)))
-            elif patch_on[f]:
-                rot = d.geom_xmat[self.patch[f]].reshape(3, 3)
-                p = d.geom_xpos[self.patch[f]] - rot[:, 2] * self.patch_half[f]
-                if p[2] - self.floor_z >= self.anchor_touch:
-                    out.append(np.zeros((0, 2)))
-                    continue
-                axes = rot[:2, :2].T * self.patch_arm[f]
-                out.append(p[:2] + np.array([axes[0], -axes[0], axes[1], -axes[1]]))
-            else:
-                down = corners[f, :, 2] - self.floor_z < self.anchor_touch
-                out.append(corners[f, down, :2])
-        return out
-
-    def capture_point(self) -> tuple[F64, float]:
-        """The simulated body's capture point ``c + v / omega`` (2,) and ``omega`` (1/s), the
-        natural frequency of its centre of mass as an inverted pendulum."""
-        d = self.world.data
-        mujoco.mj_subtreeVel(self.world.model, d)
-        c = d.subtree_com[self._root]
-        omega = float(np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3)))
-        return c[:2] + d.subtree_linvel[self._root][:2] / omega, omega
-
-    def _swing_targets(self, t: float) -> dict[int, tuple[F64, F64, F64, F64 | None]]:
-        """Per foot stepping for balance: its sole centre's target position, velocity and
-        acceleration, and its sole's target normal (``None``: free; a placement moves only
-        the foot's horizontal position): a balance step's path, or a mocap swing foot whose
-        landing the capture point's error moves (see :attr:`place_shift`)."""
-        out: dict[int, tuple[F64, F64, F64, F64 | None]] = {}
-        if self.step is not None:
-            p, v, a = self.step.at(t)
-            out[self.step.foot] = (p, v, a, np.array([0.0, 0.0, 1.0]))
-        if not self.place_shift.any():
-            return out
-        assert self.path.sole is not None
-        x = self.clock.frame(t)
-        i = self.clock.nearest(t)
-        i0 = int(x)
-        i1 = min(i0 + 1, self.path.num_frames - 1)
-        w = x - i0
-        rot = _rot2(self.anchor_yaw)
-        for f in range(2):  # two feet
-            if self.path.planted[i, f] or f in out:
-                continue
-            p = (1 - w) * self.path.sole[i0, f] + w * self.path.sole[i1, f]
-            if p[2] - self.floor_z < self.place_height:
-                continue
-            v = (1 - w) * self._sole_v[i0, f] + w * self._sole_v[i1, f]
-            p[:2] = rot @ p[:2] + self.anchor_shift + self.place_shift
-            v[:2] = rot @ v[:2]
-            out[f] = (p, v, np.zeros(3), None)
-        return out
-
-    def _update_step(self, t: float) -> None:
-        """End a balance step that has landed; start one when the capture point has left both
-        feet's support by ``step_margin`` while the mocap keeps both feet planted; update
-        nothing else."""
-        d = self.world.data
-        self.place_shift = np.zeros(2)
-        if self.place_gain and not self.path.planted[self.clock.nearest(t)].all():
-            xi, omega = self.capture_point()
-            c_ref, cv_ref, _ = self.com_reference(t)
-            miss = xi - c_ref[:2] - cv_ref[:2] / omega
-            n = float(np.linalg.norm(miss))
-            if n > self.place_deadband:
-                # beyond the dead band a walk's own capture-point error never reaches
-                self.place_shift = self.place_gain * miss * min(1.0, 0.4 / n)
-        if self.step is not None:
-            s = self.step
-            corners = self._sole_corners()
-            down = corners[s.foot, :, 2].min() - self.floor_z < self.anchor_touch
-            if (s.phase(t) >= 0.6 and down) or t > s.t0 + 1.5 * s.duration:
-                self.step = None
-                self._step_ready = t + 0.05
-        if self.step is not None or not self.stepping or t < self._step_ready:
-            return
-        i = self.clock.nearest(t)
-        up = d.xmat[self._root].reshape(3, 3)[:, 2]
-        if up @ self._root_up0 < _STEP_TILT_COS or d.qpos[self._z_adr] < 0.75 * self._z0:
-            return  # already going down: a step would only flail
-        ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
-        feet = self._footprint(t)
-        if not (ahead.all() and all(len(f) for f in feet)):
-            return
-        xi, omega = self.capture_point()
-        if outside_distance(xi, np.concatenate(feet)) <= self.step_margin:
-            return
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
-        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
-        left = np.array([-np.sin(heading), np.cos(heading)])
-        fall = xi - convex_hull(np.concatenate(feet)).mean(axis=0)
-        side = float(fall @ left)
-        if abs(side) > abs(float(fall @ np.array([left[1], -left[0]]))):
-            foot = 0 if side > 0 else 1  # a side step with the foot on that side
-        else:  # the trailing foot
-            foot = int(np.argmax(np.linalg.norm(centre[:, :2] - xi, axis=1)))
-        stance = centre[1 - foot, :2]
-        lateral = left if foot == 0 else -left
-        target = step_target(
-            xi, stance, centre[foot, :2], omega, self.step_time, beyond=0.05, max_length=0.6,
-            min_width=0.12, lateral=lateral,
-        )  # fmt: skip
-        self.step = Step(foot, t, self.step_time, centre[foot].copy(),
-                         np.r_[target, self.floor_z], self.step_height)  # fmt: skip
-        self.steps_taken.append(t)
-
-    def rebalance(self, t: float) -> None:
-        """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
-        capture point ``balance_margin`` inside both feet's soles on the floor (zero unless
-        both feet support: a walk's capture point leaves the stance foot on purpose)."""
-        if not self._balance_rate:
-            return
-        target = np.zeros(2)
-        feet = self._footprint(t)
-        if all(len(f) for f in feet):
-            c, v, _ = self.com_reference(t)
-            omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
-            xi = c[:2] - self.balance_shift + v[:2] / omega
-            target = clamp_to_support(xi, np.concatenate(feet), self.balance_margin) - xi
-        self.balance_shift += self._balance_rate * (target - self.balance_shift)
-
-    def _held(self, t: float) -> NDArray[np.bool_]:
-        """``(2, 4)`` the sole corners the mocap keeps on the ground at ``t`` (within
-        ``roll_band`` of its foot's lowest corner)."""
-        assert self.path.corners is not None
-        z = self.path.corners[self.clock.nearest(t), :, :, 2]
-        return z - z.min(axis=1, keepdims=True) < self.roll_band
-
-    def reanchor(self, t: float) -> None:
-        """Move the mocap's ground path a step (``anchor_tau``) toward the supporting feet:
-        their mean heading error is turned about their centre and their mean position error
-        shifted away. Without a foot both planted in the mocap and on the floor, no change."""
-        if not self._anchor_rate:
-            return
-        d = self.world.data
-        i = self.clock.nearest(t)
-        corners = self._sole_corners()
-        on = self.planted_now(t) & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
-        if not on.any():
-            return
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        sim = (d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half)[on, :2]
-        ref, ref_yaw = self.path.sole_at(self.clock.frame(t))
-        ref = ref[on, :2] @ _rot2(self.anchor_yaw).T + self.anchor_shift
-        centre = sim.mean(axis=0)
-        err = centre - ref.mean(axis=0)
-        turn = on & ~self.path.pivoting[i]  # a pivoting foot's heading is the clip's own turn
-        dyaw = 0.0
-        if turn.any():
-            yaw = np.arctan2(rot[turn, 1, 0], rot[turn, 0, 0]) - ref_yaw[turn] - self.anchor_yaw
-            dyaw = float(np.mean((yaw + np.pi) % (2 * np.pi) - np.pi))
-        # only what is beyond the dead band: a small offset is the tracking's own to correct
-        db = self.anchor_deadband
-        n = float(np.linalg.norm(err))
-        err = err * max(0.0, 1.0 - db / n) if n > 0 else err
-        dyaw = float(np.sign(dyaw) * max(0.0, abs(dyaw) - db / _DEADBAND_ARM))
-        k = self._anchor_rate
-        self.anchor_yaw += k * dyaw
-        self.anchor_shift = _rot2(k * dyaw) @ (self.anchor_shift + k * err - centre) + centre
-        # and slowly back toward the captured path, which the gait then follows step by step
-        self.anchor_yaw -= self._return_rate * self.anchor_yaw
-        self.anchor_shift -= self._return_rate * self.anchor_shift
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
@@ -828,40 +534,8 @@ class WholeBodyTracker:
         self.kp[:] = self._kp0 * scale
         self.kv[:] = self._kv0 * np.sqrt(scale)
 
-    def hold(self, t: float) -> None:
-        """From rollout time ``t`` on, follow the reference's pose at ``t``."""
-        self.clock = self.clock.held_from(t)
-
-    def memory(self) -> tuple[object, ...]:
-        """What the tracker carries from tick to tick (the ground path's anchoring, the
-        balance shift, a step under way), for :meth:`restore` after a look ahead."""
-        return (self.anchor_yaw, self.anchor_shift.copy(), self.balance_shift.copy(),
-                self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
-                self._slow_next)  # fmt: skip
-
-    def restore(self, memory: tuple[object, ...]) -> None:
-        """Back to a :meth:`memory`."""
-        yaw, shift, bal, place, step, taken, ready, slow = memory
-        self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
-        self.anchor_shift = np.array(shift)
-        self.balance_shift = np.array(bal)
-        self.place_shift = np.array(place)
-        self.step = step  # type: ignore[assignment]
-        del self.steps_taken[int(taken) :]  # type: ignore[call-overload]
-        self._step_ready = float(ready)  # type: ignore[arg-type]
-        self._slow_next = float(slow)  # type: ignore[arg-type]
-
     def reset(self, world: World) -> None:
-        self.anchor_yaw = 0.0
-        self.anchor_shift = np.zeros(2)
-        self.balance_shift = np.zeros(2)
-        self.place_shift = np.zeros(2)
-        self.step = None
-        self.steps_taken = []
-        self._step_ready = 0.0
-        self._slow_next = 0.0
-        self._z0 = float(world.data.qpos[self._z_adr])
-        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
+        self.reset_ground(world)
         servo = world.servo
         servo.enable(self.character, on=True)
         servo.set_gains(0.0, self.servo_kv, self.character)
@@ -878,12 +552,7 @@ class WholeBodyTracker:
         patch = self.path.pivoting[i]
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(patch[f]))
-        if t >= self._slow_next - 1e-9:
-            # the ground path and the balance targets move slowly: every few ticks is enough
-            self._slow_next = t + _SLOW_PERIOD
-            self._update_step(t)
-            self.reanchor(t)
-            self.rebalance(t)
+        self.update_ground(t)
         plan = self.plan(t)
         self.last_plan = plan
         # the servo (damping only by default) keeps acting between ticks; at the tick the
