@@ -313,7 +313,13 @@ class PDServo:
         into ``qfrc_applied``. After it the actuators' torque equals :meth:`torques`."""
         d = self.world.data
         np.take(d.M, self._midx, out=self._inertia)
-        lt = np.linalg.cholesky(self._inertia).transpose(0, 2, 1)  # row k: column l_k of L
+        try:
+            lt = np.linalg.cholesky(self._inertia).transpose(0, 2, 1)  # row k: column l_k of L
+        except np.linalg.LinAlgError:  # only a state that diverged since the engine's check
+            raise SimulationError(
+                f"simulation went unstable at t = {float(d.time):.4f} s: a joint inertia of "
+                "the servo is not positive definite"
+            ) from None
         np.take(d.qpos, self._qidx, out=self._q0_flat)
         np.matmul(self._rd, self._q0_col, out=self._p_col)  # conj(q0) * q_d
         # both logs at once, as mju_quat2Vel: 2 atan2(|v|, |w|) sign(w) v / |v| (shortest arc)
