@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.rotations import quat_from_yaw, quat_mul
+from reactmocap.rotations import quat_from_yaw
 from reactmocap.sim.controllers.stepping import (
     Step,
     clamp_to_support,
@@ -125,6 +125,7 @@ class AnchoredReference:
         #: ``x -> Rz(yaw) x + shift``
         self.anchor_yaw = 0.0
         self.anchor_shift = np.zeros(2)
+        self._turn = (0.0, _rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
 
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
@@ -132,9 +133,15 @@ class AnchoredReference:
         q, v, a, _ = self.path.sample(self.clock.frame(t), self.clock.coast(t))
         planted = self.planted_now(t)
         if self.anchor_yaw or self.anchor_shift.any():
-            rot = _rot2(self.anchor_yaw)
+            if self._turn[0] != self.anchor_yaw:  # it moves every few ticks only
+                self._turn = (
+                    self.anchor_yaw,
+                    _rot2(self.anchor_yaw),
+                    quat_from_yaw(self.anchor_yaw),
+                )
+            _, rot, turn = self._turn
             q[:2] = rot @ q[:2] + self.anchor_shift
-            q[3:7] = quat_mul(quat_from_yaw(self.anchor_yaw), q[3:7])
+            mujoco.mju_mulQuat(q[3:7], turn, q[3:7].copy())
             v[:2] = rot @ v[:2]  # free-joint angular velocity is local: unchanged
             a[:2] = rot @ a[:2]
         q[:2] += self.balance_shift
