@@ -404,5 +404,8 @@ def _loop(
             nxt = min(nxt, (k // p + 1) * p)
         if touching:
             nxt = k + 1
-        world.step(nxt - k)
+        try:
+            world.step(nxt - k)
+        except SimulationError as exc:  # met by the servo between the guard's checks
+            return guard.problem(float(d.time) - t0) or str(exc), ri, k, False
         k = nxt

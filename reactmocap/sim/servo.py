@@ -313,7 +313,13 @@ class PDServo:
         into ``qfrc_applied``. After it the actuators' torque equals :meth:`torques`."""
         d = self.world.data
         np.take(d.M, self._midx, out=self._inertia)
-        lt = np.linalg.cholesky(self._inertia).transpose(0, 2, 1)  # row k: column l_k of L
+        try:
+            lt = np.linalg.cholesky(self._inertia).transpose(0, 2, 1)  # row k: column l_k of L
+        except np.linalg.LinAlgError:  # only a state that diverged since the engine's check
+            raise SimulationError(
+                f"simulation went unstable at t = {float(d.time):.4f} s: a joint inertia of "
+                "the servo is not positive definite"
+            ) from None
         np.take(d.qpos, self._qidx, out=self._q0_flat)
         np.matmul(self._rd, self._q0_col, out=self._p_col)  # conj(q0) * q_d
         # both logs at once, as mju_quat2Vel: 2 atan2(|v|, |w|) sign(w) v / |v| (shortest arc)
@@ -405,17 +411,18 @@ class PDServo:
         rows = self._rows(character, None)
         return self.world.data.M[self._midx[rows]]
 
-    def torques(self) -> F64:
+    def torques(self, character: int | None = None) -> F64:
         """``(n, 3)`` full servo torques ``I (kp e - kv qdot)`` at the current state, with the
-        exact log and the full 3x3 damping (reference computation; allocates). Excludes
-        :attr:`feedforward`."""
+        exact log and the full 3x3 damping (reference computation; allocates), or ``(15, 3)``
+        those of one ``character``. Excludes :attr:`feedforward`."""
         d = self.world.data
-        inertia = d.M[self._midx]
-        q = quat_normalize(d.qpos[self._qidx].reshape(self.n, 4))
-        r = np.matmul(self._rd, q[:, :, None])[:, :, 0]
-        e = quat_log(r)
-        qd = d.qvel[self._didx].reshape(self.n, 3)
-        u = self._kp[:, None] * e - self._kv[:, None] * qd
+        rows = slice(None) if character is None else self._rows(character, None)
+        inertia = d.M[self._midx[rows]]
+        u = -self._kv[rows, None] * d.qvel[self._didx].reshape(self.n, 3)[rows]
+        kp = self._kp[rows]
+        if kp.any():  # a damping-only servo (the whole-body tracker's) needs no log
+            q = quat_normalize(d.qpos[self._qidx].reshape(self.n, 4)[rows])
+            u += kp[:, None] * quat_log(np.matmul(self._rd[rows], q[:, :, None])[:, :, 0])
         return np.matmul(inertia, u[:, :, None])[:, :, 0]
 
     def clear(self) -> None:

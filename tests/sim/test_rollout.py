@@ -4,6 +4,8 @@ controller interface (state machines, groups, the registry) works through it."""
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,7 @@ from reactmocap.sim import (
     Impact,
     ImpactSchedule,
     PDTracker,
+    RolloutResult,
     State,
     StateMachine,
     World,
@@ -115,6 +118,26 @@ def test_instability_raises_or_stops(guard: Motion, capfd: pytest.CaptureFixture
     assert res.motion(0).num_frames == times.size
     out, err = capfd.readouterr()
     assert "WARNING" not in out + err  # MuJoCo's own warnings are caught, not printed
+
+
+def test_a_state_diverged_between_checks_is_unstable_not_a_crash(guard: Motion) -> None:
+    # a mass matrix gone indefinite (as a diverging state's can be, still finite): the servo's
+    # Cholesky meets it first; the same result as the engine's own check, not a LinAlgError
+    def run(on_unstable: Literal["raise", "stop"]) -> RolloutResult:
+        world = World(build_character(guard))
+        world.set_from_motion(0, guard, 0)
+        tracker = PDTracker(world, 0, guard, kp=4000.0, control_every=4, refresh_every=4)
+        spoil = FunctionController(
+            lambda w, t: w.data.M.__setitem__(slice(None), -1.0) if t >= 0.1 else None,
+            control_every=4,
+        )
+        return rollout(world, 0.3, controllers=[tracker, spoil], check_every=1000,
+                       on_unstable=on_unstable)  # fmt: skip
+
+    with pytest.raises(SimulationError, match="not positive definite"):
+        run("raise")
+    res = run("stop")
+    assert res.status == "unstable" and "positive definite" in (res.reason or "")
 
 
 def test_contacts_between_characters_are_logged(guard: Motion) -> None:

@@ -14,21 +14,15 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
+from scipy.linalg.blas import dtrsm
+from scipy.linalg.lapack import dposv, dpotrf, dpotrs
 from scipy.optimize import nnls
 
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_conj, quat_from_yaw, quat_log, quat_mul
 from reactmocap.sim.character import BALL_JOINTS
+from reactmocap.sim.controllers.anchoring import AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
-from reactmocap.sim.controllers.stepping import (
-    Step,
-    clamp_to_support,
-    convex_hull,
-    outside_distance,
-    step_target,
-)
-from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
@@ -43,19 +37,15 @@ _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 _UP = np.array([[0.0], [0.0], [1.0]])
 # largest acceleration a swinging foot's rows ask for (m/s^2, and rad/s^2 for its tilt)
 _SWING_ACC = 100.0
-# no balance step once the pelvis has tilted this far from its start (cos 35 deg)
-_STEP_TILT_COS = float(np.cos(np.radians(35.0)))
-# seconds between updates of the ground path, the balance shift and the step decision
-_SLOW_PERIOD = 0.008
-# a heading error's dead band is the position dead band over this lever (m)
-_DEADBAND_ARM = 0.5
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
-_PATCH_CORNERS = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
-
-
-def _rot2(yaw: float) -> F64:
-    c, s = np.cos(yaw), np.sin(yaw)
-    return np.array([[c, -s], [s, c]])
+# r @ _LEVI_CIVITA, reshaped (3, 3), is -[r]x (the cross-product matrix's negative)
+_LEVI_CIVITA = np.array(
+    [[0, 0, 0, 0, 0, 1, 0, -1, 0], [0, 0, -1, 0, 0, 0, 1, 0, 0], [0, 1, 0, -1, 0, 0, 0, 0, 0]],
+    dtype=np.float64,
+)
+_PATCH_SIGNS = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+# a patch's five points: its centre (a pyramid's 4 edges), then its 4 corners (straight up)
+_PATCH_OWNER = np.array([0, 0, 0, 0, 1, 2, 3, 4])
 
 
 @dataclass(frozen=True)
@@ -93,7 +83,7 @@ class WholeBodyPlan:
     generalized_contact: F64
 
 
-class WholeBodyTracker:
+class WholeBodyTracker(AnchoredReference):
     """Tracks ``reference`` from clip time ``start`` with inverse dynamics and optimised ground
     forces (see the module docstring), through the servo's feed-forward of one character. The
     servo itself is damping only (``servo_kv``, inertia-scaled): its stiffness, held between
@@ -216,8 +206,6 @@ class WholeBodyTracker:
         if np.any(m.opt.gravity[:2]):
             raise ConfigError("WholeBodyTracker assumes vertical gravity")
         self.servo = servo
-        self.world = world
-        self.character = character
         self.servo_kv = float(servo_kv)
         self.control_every = int(control_every)
         wc = world.characters[character]
@@ -230,36 +218,37 @@ class WholeBodyTracker:
             np.full(3 * NJ, kvj),
         ]
         self._kp0, self._kv0 = self.kp.copy(), self.kv.copy()
-        self.w = np.r_[np.full(6, root_weight), np.ones(3 * NJ)]
-        self._w_air = np.r_[np.zeros(6), np.ones(3 * NJ)]
+        self._w_root = float(root_weight)
+        self._root_rows = np.eye(6, NV) * self._w_root
+        self._free = np.zeros(0, dtype=bool)  # the last NNLS solution's positive coefficients
+        self._wj = np.ones(3 * NJ)
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
         self.mu = float(friction) * float(world.config.friction)
         self.touch = float(touch)
         self.sqrt_reg = float(np.sqrt(force_reg))
-        self.feet, self.sole, self._corners = foot_soles(world, character, "WholeBodyTracker")
-        self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
         self._dofs = wc.qvel_slice
         self._full = np.zeros((m.nv, m.nv))
-        self._jacp = np.zeros((3, m.nv))
-        self._jacd = np.zeros((3, m.nv))
-        self._jacr = np.zeros((3, m.nv))
-        self._jacrd = np.zeros((3, m.nv))
-        self.patch = wc.patch_ids
-        self.patch_half = m.geom_size[self.patch, 2].copy()
-        self.patch_arm = m.geom_friction[self.patch, 2].copy()
+        # translation rows over rotation rows, filled by mj_jac / mj_jacDot through views
+        self._jac6 = np.zeros((6, m.nv))
+        self._jacd6 = np.zeros((6, m.nv))
+        self._jacp, self._jacr = self._jac6[:3], self._jac6[3:]
+        self._jacd, self._jacrd = self._jacd6[:3], self._jacd6[3:]
+        self._qref = np.zeros(m.nq)
+        self._dq = np.zeros(m.nv)
         rows = character * NJ
         self._ff = servo.feedforward[rows : rows + NJ]  # (15, 3) view
-        self._servo_rows = slice(rows, rows + NJ)
         edges = np.column_stack([self.mu * _PYRAMID, np.ones(4)])  # (4, 3)
         self._edges = edges.T  # (3, 4) columns: unnormalised pyramid edges
+        self._corner_basis = np.tile(edges, (4, 1, 1))  # (corner, edge, xyz)
+        self._corner_owner = np.repeat(np.arange(4), 4)
+        self._patch_basis = np.concatenate([edges, np.tile(_UP.T, (4, 1))])
         self.last_plan: WholeBodyPlan | None = None
         #: ``(6,)`` extra pelvis acceleration asked of the plan (world linear m/s^2, local
         #: angular rad/s^2), on top of its feedback; set by
         #: :class:`~reactmocap.sim.controllers.predictive.PredictiveTracker`, zero otherwise
         self.root_bias = np.zeros(6)
-        #: the clip as this tracker follows it
-        self.path = with_soles(
+        path = with_soles(
             world,
             character,
             reference
@@ -273,289 +262,22 @@ class WholeBodyTracker:
                 slide_speed=slide_speed or None,
             ),
         )
-        self.clock = self.path.clock(start)
-        dt_tick = self.control_every * world.timestep
-        dt_slow = np.ceil(_SLOW_PERIOD / dt_tick - 1e-9) * dt_tick  # see control()
-        self._anchor_rate = min(1.0, dt_slow / anchor_tau) if anchor_tau > 0 else 0.0
-        self.anchor_touch = float(anchor_touch)
-        self.anchor_deadband = float(anchor_deadband)
-        self._return_rate = min(1.0, dt_slow / anchor_return) if anchor_return > 0 else 0.0
-        self.roll_band = float(roll_band) if roll_band > 0 else np.inf
-        self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
-        assert self.path.com is not None and self.path.sole is not None
-        self._com: F64 = self.path.com
-        dt_f = 1.0 / self.path.fps
-        n = self.path.num_frames
-        self._com_v = np.gradient(self._com, dt_f, axis=0) if n > 1 else 0 * self._com
-        self._com_a = np.gradient(self._com_v, dt_f, axis=0) if n > 2 else 0 * self._com
-        self._sole_v = np.gradient(self.path.sole, dt_f, axis=0) if n > 1 else 0 * self.path.sole
-        self.balance_margin = float(balance_margin)
-        self._balance_rate = min(1.0, dt_slow / balance_tau) if balance_tau > 0 else 0.0
-        #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
-        #: capture point inside the feet (see :meth:`rebalance`)
-        self.balance_shift = np.zeros(2)
-        self.stepping = bool(stepping)
-        self.step_margin = float(step_margin)
-        self.step_time = float(step_time)
-        self.step_height = float(step_height)
+        super().__init__(
+            world, character, path, start, dt_tick=self.control_every * world.timestep,
+            roll_band=roll_band, anchor_tau=anchor_tau, anchor_touch=anchor_touch,
+            anchor_return=anchor_return, anchor_deadband=anchor_deadband,
+            balance_margin=balance_margin, balance_tau=balance_tau, stepping=stepping,
+            step_margin=step_margin, step_time=step_time, step_height=step_height,
+            place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
+        )  # fmt: skip
         self.sqrt_ws = float(np.sqrt(swing_weight))
         self.kp_swing = float(kp_swing)
         self.kv_swing = critical_kv(kp_swing)
-        self.place_gain = float(place_gain)
-        self.place_deadband = float(place_deadband)
-        self.place_height = float(place_height)
-        #: horizontal shift of a mocap swing foot's landing (m): the capture point's error
-        #: against the mocap's beyond ``place_deadband``
-        self.place_shift = np.zeros(2)
-        #: the balance step under way (None: none)
-        self.step: Step | None = None
-        #: rollout times of the balance steps taken
-        self.steps_taken: list[float] = []
-        self._step_ready = 0.0
-        self._gravity = m.opt.gravity.copy()
-        self._root = int(wc.body_ids[0])
-        self._slow_next = 0.0
-        self._z_adr = wc.qpos_slice.start + 2
-        self._z0 = float(world.data.qpos[self._z_adr])
-        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
-        self._corners_at: tuple[float, bytes] = (float("nan"), b"")
-        self._corners_now = np.zeros((2, 4, 3))
         legs = [
             [BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"
         ]
-        self._leg_rows = [np.concatenate([6 + 3 * k + np.arange(3) for k in leg]) for leg in legs]
-        #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
-        #: ``x -> Rz(yaw) x + shift``
-        self.anchor_yaw = 0.0
-        self.anchor_shift = np.zeros(2)
+        self._leg_rows = [np.concatenate([3 * k + np.arange(3) for k in leg]) for leg in legs]
         self.release()
-
-    # ------------------------------------------------------------------ reference
-    def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
-        """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
-        the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
-        q, v, a, _ = self.path.sample(self.clock.frame(t), self.clock.coast(t))
-        planted = self.planted_now(t)
-        if self.anchor_yaw or self.anchor_shift.any():
-            rot = _rot2(self.anchor_yaw)
-            q[:2] = rot @ q[:2] + self.anchor_shift
-            q[3:7] = quat_mul(quat_from_yaw(self.anchor_yaw), q[3:7])
-            v[:2] = rot @ v[:2]  # free-joint angular velocity is local: unchanged
-            a[:2] = rot @ a[:2]
-        q[:2] += self.balance_shift
-        return q, v, a, planted
-
-    def _sole_corners(self) -> F64:
-        """``(2, 4, 3)`` the sole corners now (computed once per simulation time)."""
-        d = self.world.data
-        key = (float(d.time), d.geom_xpos[self.sole].tobytes())
-        if self._corners_at != key:
-            self._corners_now = sole_corners_world(d, self.sole, self._corners)
-            self._corners_at = key
-        return self._corners_now
-
-    def planted_now(self, t: float) -> NDArray[np.bool_]:
-        """``(2,)`` the feet the tracker stands on at ``t``: those planted in the mocap, but
-        for the foot of a balance step under way."""
-        planted = self.path.planted[self.clock.nearest(t)].copy()
-        if self.step is not None:
-            planted[self.step.foot] = False
-        return planted
-
-    def com_reference(self, t: float) -> tuple[F64, F64, F64]:
-        """The mocap's centre of mass at ``t``: position, velocity, acceleration (world, as
-        re-anchored)."""
-        x = self.clock.frame(t)
-        i0 = int(x)
-        i1 = min(i0 + 1, self.path.num_frames - 1)
-        w = x - i0
-        c = (1 - w) * self._com[i0] + w * self._com[i1]
-        v = (1 - w) * self._com_v[i0] + w * self._com_v[i1]
-        a = (1 - w) * self._com_a[i0] + w * self._com_a[i1]
-        coast = self.clock.coast(t)
-        if coast > 0:
-            c = c + coast * v
-            a = np.zeros(3)
-        rot = _rot2(self.anchor_yaw)
-        c[:2] = rot @ c[:2] + self.anchor_shift + self.balance_shift
-        v[:2] = rot @ v[:2]
-        a[:2] = rot @ a[:2]
-        return c, v, a
-
-    def _footprint(self, t: float) -> list[F64]:
-        """Per foot planted in the mocap, the ground points ``(k, 2)`` it can push through now:
-        its sole corners within ``anchor_touch`` of the floor, or its ball patch's
-        centre-of-pressure range; empty for a foot in the air."""
-        d = self.world.data
-        planted = self.planted_now(t)
-        corners = self._sole_corners()
-        patch_on = self.world.foot_patch_on(self.character)
-        out: list[F64] = []
-        for f in range(2):  # two feet
-            if not planted[f]:
-                out.append(np.zeros((0, 2)))
-            elif patch_on[f]:
-                rot = d.geom_xmat[self.patch[f]].reshape(3, 3)
-                p = d.geom_xpos[self.patch[f]] - rot[:, 2] * self.patch_half[f]
-                if p[2] - self.floor_z >= self.anchor_touch:
-                    out.append(np.zeros((0, 2)))
-                    continue
-                axes = rot[:2, :2].T * self.patch_arm[f]
-                out.append(p[:2] + np.array([axes[0], -axes[0], axes[1], -axes[1]]))
-            else:
-                down = corners[f, :, 2] - self.floor_z < self.anchor_touch
-                out.append(corners[f, down, :2])
-        return out
-
-    def capture_point(self) -> tuple[F64, float]:
-        """The simulated body's capture point ``c + v / omega`` (2,) and ``omega`` (1/s), the
-        natural frequency of its centre of mass as an inverted pendulum."""
-        d = self.world.data
-        mujoco.mj_subtreeVel(self.world.model, d)
-        c = d.subtree_com[self._root]
-        omega = float(np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3)))
-        return c[:2] + d.subtree_linvel[self._root][:2] / omega, omega
-
-    def _swing_targets(self, t: float) -> dict[int, tuple[F64, F64, F64, F64 | None]]:
-        """Per foot stepping for balance: its sole centre's target position, velocity and
-        acceleration, and its sole's target normal (``None``: free; a placement moves only
-        the foot's horizontal position): a balance step's path, or a mocap swing foot whose
-        landing the capture point's error moves (see :attr:`place_shift`)."""
-        out: dict[int, tuple[F64, F64, F64, F64 | None]] = {}
-        if self.step is not None:
-            p, v, a = self.step.at(t)
-            out[self.step.foot] = (p, v, a, np.array([0.0, 0.0, 1.0]))
-        if not self.place_shift.any():
-            return out
-        assert self.path.sole is not None
-        x = self.clock.frame(t)
-        i = self.clock.nearest(t)
-        i0 = int(x)
-        i1 = min(i0 + 1, self.path.num_frames - 1)
-        w = x - i0
-        rot = _rot2(self.anchor_yaw)
-        for f in range(2):  # two feet
-            if self.path.planted[i, f] or f in out:
-                continue
-            p = (1 - w) * self.path.sole[i0, f] + w * self.path.sole[i1, f]
-            if p[2] - self.floor_z < self.place_height:
-                continue
-            v = (1 - w) * self._sole_v[i0, f] + w * self._sole_v[i1, f]
-            p[:2] = rot @ p[:2] + self.anchor_shift + self.place_shift
-            v[:2] = rot @ v[:2]
-            out[f] = (p, v, np.zeros(3), None)
-        return out
-
-    def _update_step(self, t: float) -> None:
-        """End a balance step that has landed; start one when the capture point has left both
-        feet's support by ``step_margin`` while the mocap keeps both feet planted; update
-        nothing else."""
-        d = self.world.data
-        self.place_shift = np.zeros(2)
-        if self.place_gain and not self.path.planted[self.clock.nearest(t)].all():
-            xi, omega = self.capture_point()
-            c_ref, cv_ref, _ = self.com_reference(t)
-            miss = xi - c_ref[:2] - cv_ref[:2] / omega
-            n = float(np.linalg.norm(miss))
-            if n > self.place_deadband:
-                # beyond the dead band a walk's own capture-point error never reaches
-                self.place_shift = self.place_gain * miss * min(1.0, 0.4 / n)
-        if self.step is not None:
-            s = self.step
-            corners = self._sole_corners()
-            down = corners[s.foot, :, 2].min() - self.floor_z < self.anchor_touch
-            if (s.phase(t) >= 0.6 and down) or t > s.t0 + 1.5 * s.duration:
-                self.step = None
-                self._step_ready = t + 0.05
-        if self.step is not None or not self.stepping or t < self._step_ready:
-            return
-        i = self.clock.nearest(t)
-        up = d.xmat[self._root].reshape(3, 3)[:, 2]
-        if up @ self._root_up0 < _STEP_TILT_COS or d.qpos[self._z_adr] < 0.75 * self._z0:
-            return  # already going down: a step would only flail
-        ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
-        feet = self._footprint(t)
-        if not (ahead.all() and all(len(f) for f in feet)):
-            return
-        xi, omega = self.capture_point()
-        if outside_distance(xi, np.concatenate(feet)) <= self.step_margin:
-            return
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
-        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
-        left = np.array([-np.sin(heading), np.cos(heading)])
-        fall = xi - convex_hull(np.concatenate(feet)).mean(axis=0)
-        side = float(fall @ left)
-        if abs(side) > abs(float(fall @ np.array([left[1], -left[0]]))):
-            foot = 0 if side > 0 else 1  # a side step with the foot on that side
-        else:  # the trailing foot
-            foot = int(np.argmax(np.linalg.norm(centre[:, :2] - xi, axis=1)))
-        stance = centre[1 - foot, :2]
-        lateral = left if foot == 0 else -left
-        target = step_target(
-            xi, stance, centre[foot, :2], omega, self.step_time, beyond=0.05, max_length=0.6,
-            min_width=0.12, lateral=lateral,
-        )  # fmt: skip
-        self.step = Step(foot, t, self.step_time, centre[foot].copy(),
-                         np.r_[target, self.floor_z], self.step_height)  # fmt: skip
-        self.steps_taken.append(t)
-
-    def rebalance(self, t: float) -> None:
-        """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
-        capture point ``balance_margin`` inside both feet's soles on the floor (zero unless
-        both feet support: a walk's capture point leaves the stance foot on purpose)."""
-        if not self._balance_rate:
-            return
-        target = np.zeros(2)
-        feet = self._footprint(t)
-        if all(len(f) for f in feet):
-            c, v, _ = self.com_reference(t)
-            omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
-            xi = c[:2] - self.balance_shift + v[:2] / omega
-            target = clamp_to_support(xi, np.concatenate(feet), self.balance_margin) - xi
-        self.balance_shift += self._balance_rate * (target - self.balance_shift)
-
-    def _held(self, t: float) -> NDArray[np.bool_]:
-        """``(2, 4)`` the sole corners the mocap keeps on the ground at ``t`` (within
-        ``roll_band`` of its foot's lowest corner)."""
-        assert self.path.corners is not None
-        z = self.path.corners[self.clock.nearest(t), :, :, 2]
-        return z - z.min(axis=1, keepdims=True) < self.roll_band
-
-    def reanchor(self, t: float) -> None:
-        """Move the mocap's ground path a step (``anchor_tau``) toward the supporting feet:
-        their mean heading error is turned about their centre and their mean position error
-        shifted away. Without a foot both planted in the mocap and on the floor, no change."""
-        if not self._anchor_rate:
-            return
-        d = self.world.data
-        i = self.clock.nearest(t)
-        corners = self._sole_corners()
-        on = self.planted_now(t) & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
-        if not on.any():
-            return
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        sim = (d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half)[on, :2]
-        ref, ref_yaw = self.path.sole_at(self.clock.frame(t))
-        ref = ref[on, :2] @ _rot2(self.anchor_yaw).T + self.anchor_shift
-        centre = sim.mean(axis=0)
-        err = centre - ref.mean(axis=0)
-        turn = on & ~self.path.pivoting[i]  # a pivoting foot's heading is the clip's own turn
-        dyaw = 0.0
-        if turn.any():
-            yaw = np.arctan2(rot[turn, 1, 0], rot[turn, 0, 0]) - ref_yaw[turn] - self.anchor_yaw
-            dyaw = float(np.mean((yaw + np.pi) % (2 * np.pi) - np.pi))
-        # only what is beyond the dead band: a small offset is the tracking's own to correct
-        db = self.anchor_deadband
-        n = float(np.linalg.norm(err))
-        err = err * max(0.0, 1.0 - db / n) if n > 0 else err
-        dyaw = float(np.sign(dyaw) * max(0.0, abs(dyaw) - db / _DEADBAND_ARM))
-        k = self._anchor_rate
-        self.anchor_yaw += k * dyaw
-        self.anchor_shift = _rot2(k * dyaw) @ (self.anchor_shift + k * err - centre) + centre
-        # and slowly back toward the captured path, which the gait then follows step by step
-        self.anchor_yaw -= self._return_rate * self.anchor_yaw
-        self.anchor_shift -= self._return_rate * self.anchor_shift
 
     # ------------------------------------------------------------------ control
     def release(self) -> None:
@@ -573,70 +295,87 @@ class WholeBodyTracker:
         m = self.world.model
         corners = self._sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
-        qdot = d.qvel[self._dofs]
         sl = self._dofs
+        qdot = d.qvel[sl]
         feet: list[int] = []
+        gens: list[F64] = []  # (nb_f, ndof) the generators as generalised forces
+        bases: list[F64] = []  # (nb_f, 3) world force per unit coefficient
+        owners: list[NDArray[np.int64]] = []  # (nb_f,) the point of each coefficient
         pts: list[F64] = []
-        gens: list[F64] = []  # (3, ne) world force per unit coefficient, per point
-        jacs: list[F64] = []
         rows: list[F64] = []
         bias: list[F64] = []
-
-        def point(p: F64, body: int, edges: F64, still: bool) -> None:
-            mujoco.mj_jac(m, d, self._jacp, None, p, body)
-            jac = self._jacp[:, sl].copy()
-            pts.append(p)
-            gens.append(edges)
-            jacs.append(jac)
-            if still:
-                mujoco.mj_jacDot(m, d, self._jacd, None, p, body)
-                rows.append(jac)
-                bias.append(self._jacd[:, sl] @ qdot)
-
+        k0 = 0
         for f in range(2):
             if not planted[f]:
                 continue
-            body = int(self.feet[f])
             if patch_on[f]:
                 rot = d.geom_xmat[self.patch[f]].reshape(3, 3)
                 p = d.geom_xpos[self.patch[f]] - rot[:, 2] * self.patch_half[f]  # bottom face
                 low = p[2] - self.patch_half[f] * np.abs(rot[2, :2]).sum()  # its lowest corner
                 if low - self.floor_z >= self.touch:
                     continue
-                feet.append(f)
-                point(p, body, self._edges, True)
-                # the foot does not roll or pitch on its patch; its yaw is free
-                mujoco.mj_jac(m, d, None, self._jacr, p, body)
-                mujoco.mj_jacDot(m, d, None, self._jacrd, p, body)
-                rows.append(self._jacr[:2, sl].copy())
-                bias.append(self._jacrd[:2, sl] @ qdot)
                 axes = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, :2].T.copy()
                 axes[:, 2] = 0.0  # the centre-of-pressure range lies on the floor
                 axes /= np.linalg.norm(axes, axis=1, keepdims=True)
-                for sx, sy in _PATCH_CORNERS:
-                    cop = p + self.patch_arm[f] * (sx * axes[0] + sy * axes[1])
-                    point(cop, body, _UP, False)
-                continue
-            touching = corners[f, :, 2] - self.floor_z < self.touch
-            if not touching.any():
-                continue
-            if (touching & held[f]).any():
-                touching &= held[f]
+                # the patch's centre holds still (pyramid), its centre-of-pressure corners push
+                p_f = np.concatenate([p[None], p + self.patch_arm[f] * (_PATCH_SIGNS @ axes)])
+                basis, owner, still = self._patch_basis, _PATCH_OWNER, 1
+            else:
+                touching = corners[f, :, 2] - self.floor_z < self.touch
+                if not touching.any():
+                    continue
+                if (touching & held[f]).any():
+                    touching &= held[f]
+                p_f = corners[f, touching]
+                k = len(p_f)
+                basis, owner, still = self._corner_basis[:k], self._corner_owner[: 4 * k], k
             feet.append(f)
-            for p in corners[f, touching]:
-                point(p, body, self._edges, True)
+            # every point of the foot from the foot's Jacobians at its origin (two calls, not
+            # two per point): a point r from it moves at v + w x r and accelerates (qdd = 0) at
+            # a + alpha x r + w x (w' x r), w' the body's velocity of MuJoCo's last forward
+            # pass (``cvel``), as ``mj_jacDot`` has it (with w' = w, results moved: a whole walk
+            # drifted 1.1 m instead of 0.45 m)
+            body = int(self.feet[f])
+            o = d.xpos[body]
+            mujoco.mj_jac(m, d, self._jacp, self._jacr, o, body)
+            mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, o, body)
+            jr = self._jac6[3:, sl]
+            w = jr @ qdot
+            acc0 = self._jacd6[:, sl] @ qdot  # (a, alpha) of the origin
+            r = p_f - o
+            neg_skew = (r @ _LEVI_CIVITA).reshape(-1, 3, 3)  # -[r]x: r x u = -neg_skew u
+            jac = self._jac6[:3, sl] + neg_skew @ jr  # (k, 3, ndof)
+            pts.append(p_f)
+            bases.append(basis.reshape(-1, 3))
+            owners.append(owner + k0)
+            k0 += len(p_f)
+            rows.append(jac[:still].reshape(-1, jac.shape[-1]))
+            rs = r[:still]
+            w_old = d.cvel[body, :3]
+            # w x (w' x r) = w' (w . r) - r (w . w')
+            acc = (
+                acc0[:3] + neg_skew[:still] @ acc0[3:] + np.outer(rs @ w, w_old) - rs * (w @ w_old)
+            )
+            bias.append(acc.reshape(-1))
+            if patch_on[f]:  # its centre's pyramid, its corners' upward pushes
+                gens.append(self._edges.T @ jac[0])
+                gens.append(jac[1:, 2])
+                # the foot does not roll or pitch on its patch; its yaw is free
+                rows.append(jr[:2].copy())  # the buffer is the next foot's
+                bias.append(acc0[3:5])
+            else:  # corners: one pyramid each
+                gens.append((self._edges.T @ jac).reshape(-1, jac.shape[-1]))
         if not feet:
             z = np.zeros((0, 3))
             return _Support(
                 (), z, z, np.zeros(0, np.int64), np.zeros((NV, 0)), np.zeros((0, NV)), np.zeros(0)
             )
-        owner = np.concatenate([np.full(e.shape[1], k) for k, e in enumerate(gens)])
         return _Support(
             feet=tuple(feet),
-            points=np.array(pts),
-            basis=np.concatenate(gens, axis=1).T,
-            owner=owner,
-            gen=np.concatenate([j.T @ e for j, e in zip(jacs, gens)], axis=1),
+            points=np.concatenate(pts),
+            basis=np.concatenate(bases),
+            owner=np.concatenate(owners),
+            gen=np.concatenate(gens).T,
             rows=np.concatenate(rows),
             bias=np.concatenate(bias),
         )
@@ -648,15 +387,14 @@ class WholeBodyTracker:
         qr, vr, ar, planted = self.reference(t)
         held = self._held(t)
         sl = self._dofs
-        q = d.qpos[self.wc.qpos_slice]
         v = d.qvel[sl]
-        if not (np.isfinite(q).all() and np.isfinite(v).all()):
+        if not (np.isfinite(d.qpos[self.wc.qpos_slice]).all() and np.isfinite(v).all()):
             raise SimulationError(f"WholeBodyTracker: the state at t = {t:.4f} s is not finite")
         # position error in qvel coordinates: world translation, local rotation vectors
-        rel = quat_mul(quat_conj(q[3:].reshape(NJ + 1, 4)), qr[3:].reshape(NJ + 1, 4))
-        rel *= np.where(rel[:, :1] < 0, -1.0, 1.0)
-        err = np.concatenate([qr[:3] - q[:3], quat_log(rel).reshape(-1)])
-        acc_des = ar + self.kp * err + self.kv * (vr - v)
+        np.copyto(self._qref, d.qpos)
+        self._qref[self.wc.qpos_slice] = qr
+        mujoco.mj_differentiatePos(m, self._dq, 1.0, d.qpos, self._qref)
+        acc_des = ar + self.kp * self._dq[sl] + self.kv * (vr - v)
         acc_des[:6] += self.root_bias
 
         mujoco.mj_fullM(m, d, self._full)
@@ -667,75 +405,75 @@ class WholeBodyTracker:
         h = d.qfrc_bias[sl]
         sup = self._support(d, planted, held)
         nc = len(sup.points)
-        nb = sup.gen.shape[1]
-        nj = 3 * NJ
-        # qdd = G z + g0 with z = [joint accelerations (45), pyramid coefficients (4 nc)]:
-        # the pelvis rows come from the pelvis's Newton-Euler equation
         qb = sup.gen
-        rhs = np.linalg.solve(big_m[:6, :6], np.column_stack([big_m[:6, 6:], qb[:6], h[:6]]))
-        g = np.zeros((NV, nj + nb))
-        g[:6, :nj] = -rhs[:, :nj]
-        g[:6, nj:] = rhs[:, nj : nj + nb]
-        g[6:, :nj] = np.eye(nj)
-        g0 = np.zeros(NV)
-        g0[:6] = -rhs[:, -1]
-        # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
-        # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
-        w = self.w if nc else self._w_air
-        swing = self._swing_targets(t)
-        if swing:
-            # a stepping leg follows its foot's target, not the mocap's leg
-            w = w.copy()
-            for f in swing:
-                w[self._leg_rows[f]] = 0.1
-        rows_a = [w[:, None] * g]
-        rows_b = [w * (acc_des - g0)]
+        nb = qb.shape[1]
+        nj = 3 * NJ
+        # unknowns: the joint accelerations y (45) and the pyramid coefficients beta (nb); the
+        # pelvis follows from its Newton-Euler equation, qdd_root = r_0 + r_b beta - r_y y
+        _, sol, info = dposv(big_m[:6, :6], np.column_stack([big_m[:6, 6:], qb[:6], h[:6]]))
+        if info:
+            raise SimulationError(f"WholeBodyTracker: singular pelvis inertia at t = {t:.4f} s")
+        r_y, r_b, r_0 = sol[:, :nj], sol[:, nj:-1], -sol[:, -1]
+        # the rows other than the joints': (P, target), weights folded in
+        tasks: list[tuple[F64, F64]] = []
         if nc:
+            tasks.append((self._root_rows, self._w_root * acc_des[:6]))
             # the corners in contact do not move (J_c qdd + Jdot_c qdot = -k_c v_c), so the
             # planned forces are the ones MuJoCo's rigid-ish contact will produce: with only
             # the tangential rows and a soft weight, joint accelerations missed the plan by
             # 100-350 rad/s^2 in double support
             jt = sup.rows
-            rows_a.append(self.sqrt_wc * (jt @ g))
-            rows_b.append(-self.sqrt_wc * (jt @ g0 + sup.bias + self.contact_kv * (jt @ v)))
+            tasks.append(
+                (self.sqrt_wc * jt, -self.sqrt_wc * (sup.bias + self.contact_kv * (jt @ v)))
+            )
+        # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
+        # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
+        wj = self._wj
+        swing = self._swing_targets(t)
+        if swing:
+            # a stepping leg follows its foot's target, not the mocap's leg
+            wj = wj.copy()
+            for f in swing:
+                wj[self._leg_rows[f]] = 0.1
         for f, (p_d, v_d, a_d, up_d) in swing.items():
-            # a swinging foot goes where balance needs it (the mocap's landing moved by the
-            # capture point's error, or a balance step), level with the floor
-            body = int(self.feet[f])
-            rot = d.geom_xmat[self.sole[f]].reshape(3, 3)
-            point = d.geom_xpos[self.sole[f]] - rot[:, 2] * self._sole_half[f]
-            mujoco.mj_jac(m, d, self._jacp, self._jacr, point, body)
-            mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, point, body)
-            jf = np.concatenate([self._jacp[:, sl], self._jacr[:2, sl]])
-            jdv = np.concatenate([self._jacd[:, sl] @ v, self._jacrd[:2, sl] @ v])
-            vel = jf @ v
-            want = np.r_[
-                a_d + self.kp_swing * (p_d - point) + self.kv_swing * (v_d - vel[:3]),
-                self.kp_swing * np.cross(rot[:, 2], up_d if up_d is not None else rot[:, 2])[:2]
-                - self.kv_swing * vel[3:],
-            ]
-            # bounded: an out-of-reach target must not whip the leg
-            want[:3] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[:3])), 1e-9))
-            want[3:] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[3:])), 1e-9))
-            if up_d is None:  # a placement: where the foot lands, not how it swings
-                jf, jdv, want = jf[:2], jdv[:2], want[:2]
-            rows_a.append(self.sqrt_ws * (jf @ g))
-            rows_b.append(self.sqrt_ws * (want - jf @ g0 - jdv))
-        a_mat = np.concatenate(rows_a)
-        b_vec = np.concatenate(rows_b)
-        ay, ab = a_mat[:, :nj], a_mat[:, nj:]
-        qmat, rmat = np.linalg.qr(ay)
-        if nb:
-            # project the free joint accelerations out, then NNLS over the pyramid coefficients
-            pab = ab - qmat @ (qmat.T @ ab)
-            pb = b_vec - qmat @ (qmat.T @ b_vec)
-            scale = float(np.linalg.norm(pab, axis=0).max()) or 1.0
-            lhs = np.concatenate([pab, self.sqrt_reg * scale * np.eye(nb)])
-            beta, _ = nnls(lhs, np.concatenate([pb, np.zeros(nb)]), maxiter=50 * nb)
+            tasks.append(self._swing_task(f, v, p_d, v_d, a_d, up_d))
+        a = acc_des[6:]
+        beta = np.zeros(0)
+        if not tasks:
+            y = a.copy()
         else:
-            beta = np.zeros(0)
-        y = np.linalg.solve(rmat, qmat.T @ (b_vec - ab @ beta))
-        qdd = g @ np.concatenate([y, beta]) + g0
+            # the rows P qdd - target = U y + V beta - c, with the pelvis's row of qdd from sol
+            pmat = np.concatenate([task[0] for task in tasks])
+            x = pmat[:, :6] @ sol
+            u = pmat[:, 6:] - x[:, :nj]
+            vb = x[:, nj:-1]
+            c = np.concatenate([task[1] for task in tasks]) + x[:, -1]
+            # min |wj (y - a)|^2 + |U y + V beta - c|^2 + reg |beta|^2, beta >= 0: y eliminated
+            # in closed form leaves e^T S^-1 e, e = U a + V beta - c, S = I + U D^-1 U^T
+            # (a few rows instead of the QR of all 51 + r)
+            ud = u / (wj * wj)
+            s_mat = ud @ u.T
+            s_mat.flat[:: len(u) + 1] += 1.0
+            chol, info = dpotrf(s_mat, lower=1)
+            e0 = u @ a - c
+            # BLAS's trsm: LAPACK's trtrs went multi-threaded here and cost 1-2 ms a call on a
+            # busy machine
+            x = dtrsm(1.0, chol, np.column_stack([vb, e0]), lower=1)
+            if info:
+                raise SimulationError(f"WholeBodyTracker: singular program at t = {t:.4f} s")
+            if nb:
+                mt = x[:, :nb]
+                scale = float(np.sqrt((mt * mt).sum(axis=0).max())) or 1.0
+                lhs = np.concatenate([mt, self.sqrt_reg * scale * np.eye(nb)])
+                rhs = np.zeros(len(lhs))
+                rhs[: len(mt)] = -x[:, nb]
+                beta = self._nnls(lhs, rhs)
+                e0 = e0 + vb @ beta
+            z, _ = dpotrs(chol, e0, lower=1)
+            y = a - ud.T @ z
+        qdd = np.empty(NV)
+        qdd[6:] = y
+        qdd[:6] = r_0 + r_b @ beta - r_y @ y
         tau = big_m[6:] @ qdd + h[6:] - qb[6:] @ beta
         forces = np.zeros((nc, 3))
         np.add.at(forces, sup.owner, sup.basis * beta[:, None])
@@ -744,45 +482,60 @@ class WholeBodyTracker:
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
 
+    def _swing_task(
+        self, f: int, v: F64, p_d: F64, v_d: F64, a_d: F64, up_d: F64 | None
+    ) -> tuple[F64, F64]:
+        """The rows of foot ``f`` swinging to a target (see :meth:`plan`): a swinging foot goes
+        where balance needs it (the mocap's landing moved by the capture point's error, or a
+        balance step), level with the floor."""
+        m, d = self.world.model, self.world.data
+        sl = self._dofs
+        body = int(self.feet[f])
+        rot = d.geom_xmat[self.sole[f]].reshape(3, 3)
+        point = d.geom_xpos[self.sole[f]] - rot[:, 2] * self._sole_half[f]
+        mujoco.mj_jac(m, d, self._jacp, self._jacr, point, body)
+        mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, point, body)
+        jf = np.concatenate([self._jacp[:, sl], self._jacr[:2, sl]])
+        jdv = np.concatenate([self._jacd[:, sl] @ v, self._jacrd[:2, sl] @ v])
+        vel = jf @ v
+        want = np.r_[
+            a_d + self.kp_swing * (p_d - point) + self.kv_swing * (v_d - vel[:3]),
+            self.kp_swing * np.cross(rot[:, 2], up_d if up_d is not None else rot[:, 2])[:2]
+            - self.kv_swing * vel[3:],
+        ]
+        # bounded: an out-of-reach target must not whip the leg
+        want[:3] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[:3])), 1e-9))
+        want[3:] *= min(1.0, _SWING_ACC / max(float(np.linalg.norm(want[3:])), 1e-9))
+        if up_d is None:  # a placement: where the foot lands, not how it swings
+            jf, jdv, want = jf[:2], jdv[:2], want[:2]
+        return self.sqrt_ws * jf, self.sqrt_ws * (want - jdv)
+
+    def _nnls(self, a: F64, b: F64) -> F64:
+        """``argmin |a x - b|, x >= 0``: first the last solution's free set as a plain least
+        squares, kept when it is optimal (its coefficients positive, no other one's gradient
+        pointing in; between contact changes it mostly is), else scipy's NNLS."""
+        n = a.shape[1]
+        free = self._free
+        if len(free) == n and free.any():
+            af = a[:, free]
+            _, xf, info = dposv(af.T @ af, af.T @ b[:, None])
+            if not info and (xf > 0).all():
+                x = np.zeros(n)
+                x[free] = xf[:, 0]
+                grad = a.T @ (b - a @ x)
+                if (grad[~free] <= 1e-10).all():  # no bound coefficient would lower it
+                    return x
+        x = nnls(a, b, maxiter=50 * n)[0]
+        self._free = x > 0
+        return x
+
     def scale_gains(self, scale: float) -> None:
         """The tracking gains (joints and pelvis) times ``scale``, damping times its root."""
         self.kp[:] = self._kp0 * scale
         self.kv[:] = self._kv0 * np.sqrt(scale)
 
-    def hold(self, t: float) -> None:
-        """From rollout time ``t`` on, follow the reference's pose at ``t``."""
-        self.clock = self.clock.held_from(t)
-
-    def memory(self) -> tuple[object, ...]:
-        """What the tracker carries from tick to tick (the ground path's anchoring, the
-        balance shift, a step under way), for :meth:`restore` after a look ahead."""
-        return (self.anchor_yaw, self.anchor_shift.copy(), self.balance_shift.copy(),
-                self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
-                self._slow_next)  # fmt: skip
-
-    def restore(self, memory: tuple[object, ...]) -> None:
-        """Back to a :meth:`memory`."""
-        yaw, shift, bal, place, step, taken, ready, slow = memory
-        self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
-        self.anchor_shift = np.array(shift)
-        self.balance_shift = np.array(bal)
-        self.place_shift = np.array(place)
-        self.step = step  # type: ignore[assignment]
-        del self.steps_taken[int(taken) :]  # type: ignore[call-overload]
-        self._step_ready = float(ready)  # type: ignore[arg-type]
-        self._slow_next = float(slow)  # type: ignore[arg-type]
-
     def reset(self, world: World) -> None:
-        self.anchor_yaw = 0.0
-        self.anchor_shift = np.zeros(2)
-        self.balance_shift = np.zeros(2)
-        self.place_shift = np.zeros(2)
-        self.step = None
-        self.steps_taken = []
-        self._step_ready = 0.0
-        self._slow_next = 0.0
-        self._z0 = float(world.data.qpos[self._z_adr])
-        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
+        self.reset_ground(world)
         servo = world.servo
         servo.enable(self.character, on=True)
         servo.set_gains(0.0, self.servo_kv, self.character)
@@ -799,14 +552,9 @@ class WholeBodyTracker:
         patch = self.path.pivoting[i]
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(patch[f]))
-        if t >= self._slow_next - 1e-9:
-            # the ground path and the balance targets move slowly: every few ticks is enough
-            self._slow_next = t + _SLOW_PERIOD
-            self._update_step(t)
-            self.reanchor(t)
-            self.rebalance(t)
+        self.update_ground(t)
         plan = self.plan(t)
         self.last_plan = plan
         # the servo (damping only by default) keeps acting between ticks; at the tick the
         # total joint torque is the plan's
-        self._ff[:] = plan.torques - self.servo.torques()[self._servo_rows]
+        self._ff[:] = plan.torques - self.servo.torques(self.character)

@@ -1,0 +1,406 @@
+"""The mocap as the whole-body tracker follows a whole clip: its ground path (heading and
+horizontal position) re-anchored to where the feet really are, its pelvis and centre-of-mass
+targets shifted so its capture point stays inside the feet, a mocap swing foot's landing moved
+by the capture point's error, and capture-point balance steps. The base of
+:class:`~reactmocap.sim.controllers.wholebody.WholeBodyTracker`, which turns these targets into
+joint torques; why each part exists: ``docs/tracking.md``."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.rotations import quat_from_yaw
+from reactmocap.sim.controllers.stepping import (
+    Step,
+    clamp_to_support,
+    convex_hull,
+    outside_distance,
+    step_target,
+)
+from reactmocap.sim.feet import foot_soles, sole_corners_world
+from reactmocap.sim.reference import ReferencePath
+from reactmocap.sim.world import World
+
+__all__ = ["AnchoredReference"]
+
+F64 = NDArray[np.float64]
+# no balance step once the pelvis has tilted this far from its start (cos 35 deg)
+_STEP_TILT_COS = float(np.cos(np.radians(35.0)))
+# seconds between updates of the ground path, the balance shift and the step decision
+_SLOW_PERIOD = 0.008
+# a heading error's dead band is the position dead band over this lever (m)
+_DEADBAND_ARM = 0.5
+
+
+def _rot2(yaw: float) -> F64:
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.array([[c, -s], [s, c]])
+
+
+class AnchoredReference:
+    """The reference ``path`` of one ``character`` of ``world`` from clip time ``start``, as
+    the whole-body tracker follows it; ``dt_tick`` its control period (s). The options are
+    :class:`~reactmocap.sim.controllers.wholebody.WholeBodyTracker`'s (see there)."""
+
+    def __init__(
+        self,
+        world: World,
+        character: int,
+        path: ReferencePath,
+        start: float,
+        *,
+        dt_tick: float,
+        roll_band: float,
+        anchor_tau: float,
+        anchor_touch: float,
+        anchor_return: float,
+        anchor_deadband: float,
+        balance_margin: float,
+        balance_tau: float,
+        stepping: bool,
+        step_margin: float,
+        step_time: float,
+        step_height: float,
+        place_gain: float,
+        place_deadband: float,
+        place_height: float,
+    ) -> None:
+        m = world.model
+        wc = world.characters[character]
+        self.world = world
+        self.character = character
+        #: the clip as this tracker follows it
+        self.path = path
+        self.clock = path.clock(start)
+        self.feet, self.sole, self._corners = foot_soles(world, character, "WholeBodyTracker")
+        self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
+        self.patch = wc.patch_ids
+        self.patch_half = m.geom_size[self.patch, 2].copy()
+        self.patch_arm = m.geom_friction[self.patch, 2].copy()
+        dt_slow = np.ceil(_SLOW_PERIOD / dt_tick - 1e-9) * dt_tick  # see update_ground()
+        self._anchor_rate = min(1.0, dt_slow / anchor_tau) if anchor_tau > 0 else 0.0
+        self.anchor_touch = float(anchor_touch)
+        self.anchor_deadband = float(anchor_deadband)
+        self._return_rate = min(1.0, dt_slow / anchor_return) if anchor_return > 0 else 0.0
+        self.roll_band = float(roll_band) if roll_band > 0 else np.inf
+        self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
+        assert self.path.com is not None and self.path.sole is not None
+        self._com: F64 = self.path.com
+        dt_f = 1.0 / self.path.fps
+        n = self.path.num_frames
+        self._com_v = np.gradient(self._com, dt_f, axis=0) if n > 1 else 0 * self._com
+        self._com_a = np.gradient(self._com_v, dt_f, axis=0) if n > 2 else 0 * self._com
+        self._sole_v = np.gradient(self.path.sole, dt_f, axis=0) if n > 1 else 0 * self.path.sole
+        self.balance_margin = float(balance_margin)
+        self._balance_rate = min(1.0, dt_slow / balance_tau) if balance_tau > 0 else 0.0
+        #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
+        #: capture point inside the feet (see :meth:`rebalance`)
+        self.balance_shift = np.zeros(2)
+        self.stepping = bool(stepping)
+        self.step_margin = float(step_margin)
+        self.step_time = float(step_time)
+        self.step_height = float(step_height)
+        self.place_gain = float(place_gain)
+        self.place_deadband = float(place_deadband)
+        self.place_height = float(place_height)
+        #: horizontal shift of a mocap swing foot's landing (m): the capture point's error
+        #: against the mocap's beyond ``place_deadband``
+        self.place_shift = np.zeros(2)
+        #: the balance step under way (None: none)
+        self.step: Step | None = None
+        #: rollout times of the balance steps taken
+        self.steps_taken: list[float] = []
+        self._step_ready = 0.0
+        self._gravity = m.opt.gravity.copy()
+        self._root = int(wc.body_ids[0])
+        self._slow_next = 0.0
+        self._z_adr = wc.qpos_slice.start + 2
+        self._z0 = float(world.data.qpos[self._z_adr])
+        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
+        self._corners_at: tuple[float, bytes] = (float("nan"), b"")
+        self._corners_now = np.zeros((2, 4, 3))
+        #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
+        #: ``x -> Rz(yaw) x + shift``
+        self.anchor_yaw = 0.0
+        self.anchor_shift = np.zeros(2)
+        self._turn = (0.0, _rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
+
+    def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
+        """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
+        the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
+        q, v, a, _ = self.path.sample(self.clock.frame(t), self.clock.coast(t))
+        planted = self.planted_now(t)
+        if self.anchor_yaw or self.anchor_shift.any():
+            if self._turn[0] != self.anchor_yaw:  # it moves every few ticks only
+                self._turn = (
+                    self.anchor_yaw,
+                    _rot2(self.anchor_yaw),
+                    quat_from_yaw(self.anchor_yaw),
+                )
+            _, rot, turn = self._turn
+            q[:2] = rot @ q[:2] + self.anchor_shift
+            mujoco.mju_mulQuat(q[3:7], turn, q[3:7].copy())
+            v[:2] = rot @ v[:2]  # free-joint angular velocity is local: unchanged
+            a[:2] = rot @ a[:2]
+        q[:2] += self.balance_shift
+        return q, v, a, planted
+
+    def _sole_corners(self) -> F64:
+        """``(2, 4, 3)`` the sole corners now (computed once per simulation time)."""
+        d = self.world.data
+        key = (float(d.time), d.geom_xpos[self.sole].tobytes())
+        if self._corners_at != key:
+            self._corners_now = sole_corners_world(d, self.sole, self._corners)
+            self._corners_at = key
+        return self._corners_now
+
+    def planted_now(self, t: float) -> NDArray[np.bool_]:
+        """``(2,)`` the feet the tracker stands on at ``t``: those planted in the mocap, but
+        for the foot of a balance step under way."""
+        planted = self.path.planted[self.clock.nearest(t)].copy()
+        if self.step is not None:
+            planted[self.step.foot] = False
+        return planted
+
+    def com_reference(self, t: float) -> tuple[F64, F64, F64]:
+        """The mocap's centre of mass at ``t``: position, velocity, acceleration (world, as
+        re-anchored)."""
+        x = self.clock.frame(t)
+        i0 = int(x)
+        i1 = min(i0 + 1, self.path.num_frames - 1)
+        w = x - i0
+        c = (1 - w) * self._com[i0] + w * self._com[i1]
+        v = (1 - w) * self._com_v[i0] + w * self._com_v[i1]
+        a = (1 - w) * self._com_a[i0] + w * self._com_a[i1]
+        coast = self.clock.coast(t)
+        if coast > 0:
+            c = c + coast * v
+            a = np.zeros(3)
+        rot = _rot2(self.anchor_yaw)
+        c[:2] = rot @ c[:2] + self.anchor_shift + self.balance_shift
+        v[:2] = rot @ v[:2]
+        a[:2] = rot @ a[:2]
+        return c, v, a
+
+    def _footprint(self, t: float) -> list[F64]:
+        """Per foot planted in the mocap, the ground points ``(k, 2)`` it can push through now:
+        its sole corners within ``anchor_touch`` of the floor, or its ball patch's
+        centre-of-pressure range; empty for a foot in the air."""
+        d = self.world.data
+        planted = self.planted_now(t)
+        corners = self._sole_corners()
+        patch_on = self.world.foot_patch_on(self.character)
+        out: list[F64] = []
+        for f in range(2):  # two feet
+            if not planted[f]:
+                out.append(np.zeros((0, 2)))
+            elif patch_on[f]:
+                rot = d.geom_xmat[self.patch[f]].reshape(3, 3)
+                p = d.geom_xpos[self.patch[f]] - rot[:, 2] * self.patch_half[f]
+                if p[2] - self.floor_z >= self.anchor_touch:
+                    out.append(np.zeros((0, 2)))
+                    continue
+                axes = rot[:2, :2].T * self.patch_arm[f]
+                out.append(p[:2] + np.array([axes[0], -axes[0], axes[1], -axes[1]]))
+            else:
+                down = corners[f, :, 2] - self.floor_z < self.anchor_touch
+                out.append(corners[f, down, :2])
+        return out
+
+    def capture_point(self) -> tuple[F64, float]:
+        """The simulated body's capture point ``c + v / omega`` (2,) and ``omega`` (1/s), the
+        natural frequency of its centre of mass as an inverted pendulum."""
+        d = self.world.data
+        mujoco.mj_subtreeVel(self.world.model, d)
+        c = d.subtree_com[self._root]
+        omega = float(np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3)))
+        return c[:2] + d.subtree_linvel[self._root][:2] / omega, omega
+
+    def _swing_targets(self, t: float) -> dict[int, tuple[F64, F64, F64, F64 | None]]:
+        """Per foot stepping for balance: its sole centre's target position, velocity and
+        acceleration, and its sole's target normal (``None``: free; a placement moves only
+        the foot's horizontal position): a balance step's path, or a mocap swing foot whose
+        landing the capture point's error moves (see :attr:`place_shift`)."""
+        out: dict[int, tuple[F64, F64, F64, F64 | None]] = {}
+        if self.step is not None:
+            p, v, a = self.step.at(t)
+            out[self.step.foot] = (p, v, a, np.array([0.0, 0.0, 1.0]))
+        if not self.place_shift.any():
+            return out
+        assert self.path.sole is not None
+        x = self.clock.frame(t)
+        i = self.clock.nearest(t)
+        i0 = int(x)
+        i1 = min(i0 + 1, self.path.num_frames - 1)
+        w = x - i0
+        rot = _rot2(self.anchor_yaw)
+        for f in range(2):  # two feet
+            if self.path.planted[i, f] or f in out:
+                continue
+            p = (1 - w) * self.path.sole[i0, f] + w * self.path.sole[i1, f]
+            if p[2] - self.floor_z < self.place_height:
+                continue
+            v = (1 - w) * self._sole_v[i0, f] + w * self._sole_v[i1, f]
+            p[:2] = rot @ p[:2] + self.anchor_shift + self.place_shift
+            v[:2] = rot @ v[:2]
+            out[f] = (p, v, np.zeros(3), None)
+        return out
+
+    def _update_step(self, t: float) -> None:
+        """End a balance step that has landed; start one when the capture point has left both
+        feet's support by ``step_margin`` while the mocap keeps both feet planted; update
+        nothing else."""
+        d = self.world.data
+        self.place_shift = np.zeros(2)
+        if self.place_gain and not self.path.planted[self.clock.nearest(t)].all():
+            xi, omega = self.capture_point()
+            c_ref, cv_ref, _ = self.com_reference(t)
+            miss = xi - c_ref[:2] - cv_ref[:2] / omega
+            n = float(np.linalg.norm(miss))
+            if n > self.place_deadband:
+                # beyond the dead band a walk's own capture-point error never reaches
+                self.place_shift = self.place_gain * miss * min(1.0, 0.4 / n)
+        if self.step is not None:
+            s = self.step
+            corners = self._sole_corners()
+            down = corners[s.foot, :, 2].min() - self.floor_z < self.anchor_touch
+            if (s.phase(t) >= 0.6 and down) or t > s.t0 + 1.5 * s.duration:
+                self.step = None
+                self._step_ready = t + 0.05
+        if self.step is not None or not self.stepping or t < self._step_ready:
+            return
+        i = self.clock.nearest(t)
+        up = d.xmat[self._root].reshape(3, 3)[:, 2]
+        if up @ self._root_up0 < _STEP_TILT_COS or d.qpos[self._z_adr] < 0.75 * self._z0:
+            return  # already going down: a step would only flail
+        ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
+        feet = self._footprint(t)
+        if not (ahead.all() and all(len(f) for f in feet)):
+            return
+        xi, omega = self.capture_point()
+        if outside_distance(xi, np.concatenate(feet)) <= self.step_margin:
+            return
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
+        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
+        left = np.array([-np.sin(heading), np.cos(heading)])
+        fall = xi - convex_hull(np.concatenate(feet)).mean(axis=0)
+        side = float(fall @ left)
+        if abs(side) > abs(float(fall @ np.array([left[1], -left[0]]))):
+            foot = 0 if side > 0 else 1  # a side step with the foot on that side
+        else:  # the trailing foot
+            foot = int(np.argmax(np.linalg.norm(centre[:, :2] - xi, axis=1)))
+        stance = centre[1 - foot, :2]
+        lateral = left if foot == 0 else -left
+        target = step_target(
+            xi, stance, centre[foot, :2], omega, self.step_time, beyond=0.05, max_length=0.6,
+            min_width=0.12, lateral=lateral,
+        )  # fmt: skip
+        self.step = Step(foot, t, self.step_time, centre[foot].copy(),
+                         np.r_[target, self.floor_z], self.step_height)  # fmt: skip
+        self.steps_taken.append(t)
+
+    def rebalance(self, t: float) -> None:
+        """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
+        capture point ``balance_margin`` inside both feet's soles on the floor (zero unless
+        both feet support: a walk's capture point leaves the stance foot on purpose)."""
+        if not self._balance_rate:
+            return
+        target = np.zeros(2)
+        feet = self._footprint(t)
+        if all(len(f) for f in feet):
+            c, v, _ = self.com_reference(t)
+            omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
+            xi = c[:2] - self.balance_shift + v[:2] / omega
+            target = clamp_to_support(xi, np.concatenate(feet), self.balance_margin) - xi
+        self.balance_shift += self._balance_rate * (target - self.balance_shift)
+
+    def _held(self, t: float) -> NDArray[np.bool_]:
+        """``(2, 4)`` the sole corners the mocap keeps on the ground at ``t`` (within
+        ``roll_band`` of its foot's lowest corner)."""
+        assert self.path.corners is not None
+        z = self.path.corners[self.clock.nearest(t), :, :, 2]
+        return z - z.min(axis=1, keepdims=True) < self.roll_band
+
+    def reanchor(self, t: float) -> None:
+        """Move the mocap's ground path a step (``anchor_tau``) toward the supporting feet:
+        their mean heading error is turned about their centre and their mean position error
+        shifted away. Without a foot both planted in the mocap and on the floor, no change."""
+        if not self._anchor_rate:
+            return
+        d = self.world.data
+        i = self.clock.nearest(t)
+        corners = self._sole_corners()
+        on = self.planted_now(t) & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
+        if not on.any():
+            return
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        sim = (d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half)[on, :2]
+        ref, ref_yaw = self.path.sole_at(self.clock.frame(t))
+        ref = ref[on, :2] @ _rot2(self.anchor_yaw).T + self.anchor_shift
+        centre = sim.mean(axis=0)
+        err = centre - ref.mean(axis=0)
+        turn = on & ~self.path.pivoting[i]  # a pivoting foot's heading is the clip's own turn
+        dyaw = 0.0
+        if turn.any():
+            yaw = np.arctan2(rot[turn, 1, 0], rot[turn, 0, 0]) - ref_yaw[turn] - self.anchor_yaw
+            dyaw = float(np.mean((yaw + np.pi) % (2 * np.pi) - np.pi))
+        # only what is beyond the dead band: a small offset is the tracking's own to correct
+        db = self.anchor_deadband
+        n = float(np.linalg.norm(err))
+        err = err * max(0.0, 1.0 - db / n) if n > 0 else err
+        dyaw = float(np.sign(dyaw) * max(0.0, abs(dyaw) - db / _DEADBAND_ARM))
+        k = self._anchor_rate
+        self.anchor_yaw += k * dyaw
+        self.anchor_shift = _rot2(k * dyaw) @ (self.anchor_shift + k * err - centre) + centre
+        # and slowly back toward the captured path, which the gait then follows step by step
+        self.anchor_yaw -= self._return_rate * self.anchor_yaw
+        self.anchor_shift -= self._return_rate * self.anchor_shift
+
+    def update_ground(self, t: float) -> None:
+        """The slow part of a control tick: the balance step decision, the ground path and
+        the balance shift move slowly, so every ``_SLOW_PERIOD`` is enough (run every tick
+        they cost ~35% of one)."""
+        if t >= self._slow_next - 1e-9:
+            self._slow_next = t + _SLOW_PERIOD
+            self._update_step(t)
+            self.reanchor(t)
+            self.rebalance(t)
+
+    def reset_ground(self, world: World) -> None:
+        """Back to the captured path, no shift, no step (a rollout's start)."""
+        self.anchor_yaw = 0.0
+        self.anchor_shift = np.zeros(2)
+        self.balance_shift = np.zeros(2)
+        self.place_shift = np.zeros(2)
+        self.step = None
+        self.steps_taken = []
+        self._step_ready = 0.0
+        self._slow_next = 0.0
+        self._z0 = float(world.data.qpos[self._z_adr])
+        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
+
+    def hold(self, t: float) -> None:
+        """From rollout time ``t`` on, follow the reference's pose at ``t``."""
+        self.clock = self.clock.held_from(t)
+
+    def memory(self) -> tuple[object, ...]:
+        """What the tracker carries from tick to tick (the ground path's anchoring, the
+        balance shift, a step under way), for :meth:`restore` after a look ahead."""
+        return (self.anchor_yaw, self.anchor_shift.copy(), self.balance_shift.copy(),
+                self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
+                self._slow_next)  # fmt: skip
+
+    def restore(self, memory: tuple[object, ...]) -> None:
+        """Back to a :meth:`memory`."""
+        yaw, shift, bal, place, step, taken, ready, slow = memory
+        self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
+        self.anchor_shift = np.array(shift)
+        self.balance_shift = np.array(bal)
+        self.place_shift = np.array(place)
+        self.step = step  # type: ignore[assignment]
+        del self.steps_taken[int(taken) :]  # type: ignore[call-overload]
+        self._step_ready = float(ready)  # type: ignore[arg-type]
+        self._slow_next = float(slow)  # type: ignore[arg-type]
