@@ -1,0 +1,458 @@
+"""Composed maneuvers (thesis ch. 8): a maneuver is a sequence of phases, each a basis controller
+from :data:`CONTROLLERS` (``balance``, ``leap``, ``tumble``, ``land``) with its parameters and the
+event that ends it; the sequencer runs them with automatic transitions. A user writes one in a
+TOML file (:func:`load_maneuver`, ``reactmocap athletics maneuver FILE.toml``); the somersaults
+are built-in maneuvers (:func:`somersault`).
+
+A maneuver file::
+
+    name = "back_somersault"
+    body = "male"            # male, female or a BVH file
+    seconds = 4.5            # how long to simulate
+    backpack = 0.0           # kg on the chest (optional)
+
+    [[phase]]
+    controller = "balance"
+    exit = { event = "after", seconds = 0.3 }
+
+    [[phase]]
+    controller = "leap"
+    params = { effort = 0.6, spin = -55.0, spin_limit = 1.0 }
+    exit = { event = "liftoff" }
+
+    ...
+
+Parameters are SI, angles in radians; each controller's parameters and exit events are listed
+by :func:`describe` (and in ``docs/athletics.md``)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from reactmocap.athletics import tables
+from reactmocap.athletics.balance import Balance, Posture
+from reactmocap.athletics.behaviours import (
+    AthleticsResult,
+    _landing,
+    _plausible,
+    _result,
+    _simulate,
+    _standing,
+)
+from reactmocap.athletics.bodies import BODIES, Athlete, athlete
+from reactmocap.athletics.land import Landing, LandingParams
+from reactmocap.athletics.leap import Leap, LeapParams
+from reactmocap.athletics.machine import Basis
+from reactmocap.athletics.scene import athletics_world
+from reactmocap.athletics.tumble import POSITIONS, Tumble, TumbleParams
+from reactmocap.errors import ConfigError, UnknownKeyError
+
+__all__ = [
+    "CONTROLLERS",
+    "SOMERSAULT_PRESETS",
+    "BasisSpec",
+    "Maneuver",
+    "Phase",
+    "describe",
+    "load_maneuver",
+    "run_maneuver",
+    "somersault",
+    "somersault_maneuver",
+]
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One phase of a maneuver: a basis controller by name, its parameters (SI, radians), and
+    the event that ends it (``exit``; ``seconds`` for ``after``)."""
+
+    controller: str
+    exit: str
+    params: Mapping[str, Any] = field(default_factory=dict)
+    seconds: float | None = None
+
+
+@dataclass(frozen=True)
+class Maneuver:
+    """A named sequence of phases on a body, simulated for ``seconds``."""
+
+    name: str
+    phases: tuple[Phase, ...]
+    body: str = "male"
+    seconds: float = 5.0
+    backpack: float = 0.0
+
+
+@dataclass(frozen=True)
+class BasisSpec:
+    """A basis controller a phase can name: its parameters (name -> kind: ``number``,
+    ``bool``, ``string``, ``numbers``), its exit events, and how it is built."""
+
+    name: str
+    description: str
+    params: Mapping[str, str]
+    exits: Mapping[str, str]
+    build: Callable[[Phase, Athlete], Basis]
+
+
+def _kinds(cls: type, skip: tuple[str, ...] = ()) -> dict[str, str]:
+    """Parameter kinds of a parameter dataclass, from its fields' defaults."""
+    out = {}
+    for f in dataclasses.fields(cls):
+        if f.name in skip:
+            continue
+        d = f.default
+        if isinstance(d, bool):
+            out[f.name] = "bool"
+        elif isinstance(d, (int, float)) or d is None:
+            out[f.name] = "number"
+        elif isinstance(d, str):
+            out[f.name] = "string"
+        else:
+            out[f.name] = "numbers"
+    return out
+
+
+def _build_balance(phase: Phase, ath: Athlete) -> Basis:
+    del ath
+    p = dict(phase.params)
+    if "com_offset" in p:
+        p["com_offset"] = tuple(p["com_offset"])
+    seconds = phase.seconds if phase.exit == "after" else None
+    return Balance(Posture(**p), seconds=seconds)
+
+
+def _build_leap(phase: Phase, ath: Athlete) -> Basis:
+    p = dict(phase.params)
+    effort = p.pop("effort", None)
+    broad = bool(p.get("broad", False))
+    if effort is not None:
+        base = (tables.broad_params if broad else tables.leap_params)(float(effort))
+    else:
+        base = LeapParams(broad=broad)
+    if "timing" in p:
+        p["timing"] = tuple(p["timing"])
+    del ath
+    return Leap(replace(base, handover=phase.exit, **p))
+
+
+def _build_tumble(phase: Phase, ath: Athlete) -> Basis:
+    del ath
+    p = dict(phase.params)
+    if phase.exit == "after":
+        p["open_at"] = phase.seconds
+    return Tumble(TumbleParams(**p))
+
+
+def _build_land(phase: Phase, ath: Athlete) -> Basis:
+    base = tables.landing_params(ath.name, 0.0)
+    return Landing(replace(base, **phase.params))
+
+
+_LEAP_KINDS = {"effort": "number", **_kinds(LeapParams, skip=("handover",))}
+CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
+    "balance": BasisSpec(
+        "balance", "stand balanced in a posture (thesis ch. 7)", _kinds(Posture),
+        {"after": "after `seconds`", "never": "holds to the end of the run"}, _build_balance),
+    "leap": BasisSpec(
+        "leap", "crouch and leap (ch. 4); `effort` 0-1 picks the measured leap (broad = true: "
+        "the broad jump's), any other parameter overrides it; `spin` (kg m^2/s, pitch, "
+        "forward > 0) is the take-off angular momentum aimed for",
+        _LEAP_KINDS,
+        {"apex": "at the top of the flight", "liftoff": "as the feet leave the floor",
+         "auto": "apex for a vertical leap, lift-off for a broad jump"}, _build_leap),
+    "tumble": BasisSpec(
+        "tumble", "somersault in the air in a layout, pike or tuck (ch. 5)",
+        _kinds(TumbleParams, skip=("open_at",)),
+        {"open": "when the rotation predicted at touchdown reaches `turns`",
+         "after": "after `seconds` in the air (the thesis's timed transition)"}, _build_tumble),
+    "land": BasisSpec(
+        "land", "passive landing (ch. 6); ends once it has settled and handed over",
+        _kinds(LandingParams), {"settled": "once the landing has settled"}, _build_land),
+})  # fmt: skip
+
+
+def describe() -> str:
+    """The controllers a phase can name, their parameters and exit events (for help)."""
+    lines = []
+    for spec in CONTROLLERS.values():
+        lines.append(f"{spec.name}: {spec.description}")
+        lines.append("  params: " + ", ".join(f"{k} ({v})" for k, v in spec.params.items()))
+        lines.append("  exits: " + "; ".join(f"{k}: {v}" for k, v in spec.exits.items()))
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------------- loading
+def _check_value(kind: str, value: Any, where: str) -> Any:
+    if kind == "number":
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{where} must be a number, got {value!r}")
+        if not math.isfinite(value):
+            raise ConfigError(f"{where} must be a finite number, got {value!r}")
+        return float(value)
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise ConfigError(f"{where} must be true or false, got {value!r}")
+        return value
+    if kind == "string":
+        if not isinstance(value, str):
+            raise ConfigError(f"{where} must be a string, got {value!r}")
+        return value
+    if not (isinstance(value, list) and value
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                    and math.isfinite(v) for v in value)):  # fmt: skip
+        raise ConfigError(f"{where} must be a list of finite numbers, got {value!r}")
+    return [float(v) for v in value]
+
+
+def check_phase(phase: Phase, where: str) -> Phase:
+    """``phase`` with its parameters checked against its controller (``where`` names it in
+    the errors, e.g. ``"FILE: phase[2]"``); builds nothing."""
+    spec = CONTROLLERS.get(phase.controller)
+    if spec is None:
+        raise UnknownKeyError(
+            f"{where}.controller: unknown basis controller {phase.controller!r}; valid "
+            f"controllers are {sorted(CONTROLLERS)}"
+        )
+    if phase.exit not in spec.exits:
+        raise ConfigError(
+            f"{where}.exit.event: {phase.controller} has no exit event {phase.exit!r}; its "
+            f"exit events are {sorted(spec.exits)}"
+        )
+    if phase.exit == "after" and (
+        phase.seconds is None or not math.isfinite(phase.seconds) or phase.seconds < 0
+    ):
+        raise ConfigError(f"{where}.exit.seconds: exit 'after' needs seconds >= 0")
+    params = {}
+    for key, value in phase.params.items():
+        if key not in spec.params:
+            raise ConfigError(
+                f"{where}.params.{key}: {phase.controller} has no parameter {key!r}; its "
+                f"parameters are {sorted(spec.params)}"
+            )
+        params[key] = _check_value(spec.params[key], value, f"{where}.params.{key}")
+    if phase.controller == "tumble" and params.get("position", "tuck") not in POSITIONS:
+        raise ConfigError(
+            f"{where}.params.position: unknown position {params['position']!r}; valid "
+            f"positions are {sorted(POSITIONS)}"
+        )
+    return replace(phase, params=MappingProxyType(params))
+
+
+_TOP = {"name": "string", "body": "string", "seconds": "number", "backpack": "number"}
+
+
+def load_maneuver(path: str | Path) -> Maneuver:
+    """Read and check a maneuver file (format: the module docstring). Every error is a
+    :class:`~reactmocap.errors.ConfigError` naming the file and the field."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except OSError as exc:
+        raise ConfigError(f"cannot read maneuver file {str(path)!r}: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    return maneuver_from_dict(data, str(path), default_name=path.stem)
+
+
+def maneuver_from_dict(
+    data: Mapping[str, Any], source: str, default_name: str = "maneuver"
+) -> Maneuver:
+    """A :class:`Maneuver` from parsed TOML ``data`` (``source`` names it in errors)."""
+    unknown = sorted(set(data) - set(_TOP) - {"phase"})
+    if unknown:
+        raise ConfigError(
+            f"{source}: unknown field(s) {unknown}; a maneuver has {sorted([*_TOP, 'phase'])}"
+        )
+    top = {
+        k: _check_value(kind, data[k], f"{source}: {k}") for k, kind in _TOP.items() if k in data
+    }
+    seconds = float(top.get("seconds", 5.0))
+    if not 0 < seconds <= 60:
+        raise ConfigError(f"{source}: seconds must be in (0, 60], got {seconds}")
+    backpack = float(top.get("backpack", 0.0))
+    if backpack < 0:
+        raise ConfigError(f"{source}: backpack must be >= 0 kg, got {backpack}")
+    rows = data.get("phase")
+    if not isinstance(rows, list) or not rows:
+        raise ConfigError(f"{source}: phase: a maneuver needs at least one [[phase]] table")
+    phases = []
+    for i, row in enumerate(rows):
+        where = f"{source}: phase[{i + 1}]"
+        if not isinstance(row, dict):
+            raise ConfigError(f"{where} must be a table")
+        extra = sorted(set(row) - {"controller", "params", "exit"})
+        if extra:
+            raise ConfigError(
+                f"{where}: unknown field(s) {extra}; a phase has controller, params, exit"
+            )
+        if "controller" not in row:
+            raise ConfigError(
+                f"{where}.controller is missing; valid controllers are {sorted(CONTROLLERS)}"
+            )
+        controller = _check_value("string", row["controller"], f"{where}.controller")
+        exit_ = row.get("exit")
+        spec = CONTROLLERS.get(controller)
+        valid = sorted(spec.exits) if spec is not None else []
+        if exit_ is None:
+            raise ConfigError(
+                f"{where}.exit is missing: every phase names the event that ends it, e.g. "
+                f'exit = {{ event = "{valid[0] if valid else "after"}" }}'
+                + (f"; {controller}'s exit events are {valid}" if valid else "")
+            )
+        if not isinstance(exit_, dict) or "event" not in exit_:
+            raise ConfigError(f"{where}.exit must be a table with an event, e.g. "
+                              "exit = { event = \"after\", seconds = 0.5 }")  # fmt: skip
+        if sorted(set(exit_) - {"event", "seconds"}):
+            raise ConfigError(f"{where}.exit: only event and seconds are allowed")
+        event = _check_value("string", exit_["event"], f"{where}.exit.event")
+        secs = exit_.get("seconds")
+        if secs is not None:
+            secs = _check_value("number", secs, f"{where}.exit.seconds")
+        params = row.get("params", {})
+        if not isinstance(params, dict):
+            raise ConfigError(f"{where}.params must be a table")
+        phases.append(check_phase(Phase(controller, event, params, secs), where))
+    body = str(top.get("body", "male"))
+    if body not in BODIES and not body.lower().endswith(".bvh"):
+        raise ConfigError(
+            f"{source}: body must be one of {list(BODIES)} or a BVH file, got {body!r}"
+        )
+    return Maneuver(str(top.get("name", default_name)), tuple(phases), body, seconds, backpack)
+
+
+# ---------------------------------------------------------------------------------- running
+def run_maneuver(
+    maneuver: Maneuver,
+    body: str | Path | None = None,
+    *,
+    on_tick: Callable[[float], None] | None = None,
+    fps: float = 60.0,
+) -> AthleticsResult:
+    """Simulate ``maneuver`` (on ``body`` instead of the maneuver's own, if given). The
+    report: ``rotation_deg`` (the somersault rotation at the end, the trunk's pitch in the
+    take-off plane unwrapped, backward < 0), ``rotation_at_touchdown_deg``, ``twist_deg``,
+    ``landed``, ``fell``, the take-off angular momentum and its drift in the air, the peak
+    somersault angular velocity, the phases' transitions."""
+    phases = [check_phase(p, f"{maneuver.name}: phase[{i + 1}]")
+              for i, p in enumerate(maneuver.phases)]  # fmt: skip
+    ath = athlete(body if body is not None else maneuver.body)
+    bases = [CONTROLLERS[p.controller].build(p, ath) for p in phases]
+    world = athletics_world(ath, backpack=maneuver.backpack)
+    ctx, seq, res = _simulate(ath, world, bases, maneuver.seconds, behaviour=maneuver.name,
+                              on_tick=on_tick, fps=fps)  # fmt: skip
+    log = ctx.log.arrays()
+    _, pelvis0 = _standing(ctx)
+    t = log["t"]
+    td, lift = ctx.touchdown_time, ctx.liftoff_time
+    rot = log["rotation"]
+    i_td = min(int(np.searchsorted(t, td)), t.size - 1) if td is not None else t.size - 1
+    rep: dict[str, Any] = {
+        "maneuver": maneuver.name,
+        "phases": [p.controller for p in phases],
+        "backpack_kg": maneuver.backpack,
+        "rotation_deg": math.degrees(float(rot[-1])) if rot.size else 0.0,
+        "rotation_at_touchdown_deg": math.degrees(float(rot[i_td])) if rot.size else 0.0,
+        "twist_deg": math.degrees(float(log["twist"][-1])) if rot.size else 0.0,
+        "time_to_liftoff_s": lift,
+        "liftoff_pitch_momentum": ctx.handover.get("liftoff_pitch_momentum"),
+        "achieved_height_m": float(log["com"][:, 2].max() - log["com"][0, 2])
+        if lift is not None else 0.0,
+    }  # fmt: skip
+    if lift is not None and td is not None and td > lift + 0.05:
+        flight = (t > lift + 0.01) & (t < td - 0.01)
+        m = log["momentum"][flight]
+        if m.shape[0] > 2:
+            ref = float(np.linalg.norm(m[0]))
+            rep["flight_momentum_drift"] = float(np.abs(m - m[0]).max() / max(ref, 1e-9))
+            rate = np.abs(np.gradient(rot[flight], t[flight]))
+            rep["peak_somersault_rate_rad_s"] = float(rate.max())
+        rep["flight_s"] = td - lift
+    rep.update(_landing(ctx, log, pelvis0))
+    rep.update(_plausible(ctx, ath, 0.0, np.inf))
+    result = _result(maneuver.name, ath, ctx, seq, res, rep)
+    return result
+
+
+# ---------------------------------------------------------------------------------- somersaults
+#: the built-in somersaults, tuned by hand (as the thesis's, section 8.4) on the male body:
+#: body -> direction -> (leap parameters, tumble lead (rad), landing foot-servo delta (m)).
+#: A pike or layout uses the tuck's leap and landing with the position's own inertia.
+SOMERSAULT_PRESETS: Mapping[str, Mapping[str, tuple[Mapping[str, float], float, float]]] = (
+    MappingProxyType({
+        "male": MappingProxyType({
+            "backward": (MappingProxyType({"effort": 0.6, "spin": -55.0, "spin_limit": 1.0}),
+                         2.8, -0.15),
+        }),
+    })
+)  # fmt: skip
+DIRECTIONS = ("backward", "forward")
+
+
+def somersault_maneuver(
+    position: str = "tuck", direction: str = "backward", body: str = "male", backpack: float = 0.0
+) -> Maneuver:
+    """The standing somersault (thesis 8.4-8.5) as a maneuver: balance, leap with rotation,
+    tumble in ``position``, land, balance. Uses the male preset for a body or direction that
+    has none of its own (forward: the backward preset's spin turned forward); such runs are
+    untuned and their reports say what happened."""
+    if direction not in DIRECTIONS:
+        raise UnknownKeyError(
+            f"unknown somersault direction {direction!r}; valid directions are {list(DIRECTIONS)}"
+        )
+    if position not in POSITIONS:
+        raise UnknownKeyError(
+            f"unknown somersault position {position!r}; valid positions are {sorted(POSITIONS)}"
+        )
+    presets = SOMERSAULT_PRESETS.get(body, SOMERSAULT_PRESETS["male"])
+    leap, lead, delta = presets.get(
+        direction, presets.get("backward", next(iter(presets.values())))
+    )
+    leap = dict(leap)
+    if direction == "forward" and "forward" not in presets:
+        leap["spin"] = abs(leap["spin"])
+        delta = -delta
+    phases = (
+        Phase("balance", "after", {}, 0.3),
+        Phase("leap", "liftoff", leap),
+        Phase("tumble", "open", {"position": position, "lead": lead}),
+        Phase("land", "settled", {"delta": delta}),
+        Phase("balance", "never", {"settle": 0.5}),
+    )
+    name = f"{direction}_somersault_{position}"
+    return Maneuver(name, phases, body, 4.5, backpack)
+
+
+def somersault(
+    position: str = "tuck",
+    direction: str = "backward",
+    body: str = "male",
+    *,
+    twist: float = 0.0,
+    backpack: float = 0.0,
+    on_tick: Callable[[float], None] | None = None,
+    fps: float = 60.0,
+) -> AthleticsResult:
+    """A standing somersault (:func:`somersault_maneuver`); ``twist`` (turns) is refused:
+    twisting is not built yet (``docs/athletics.md``)."""
+    if not math.isfinite(twist):
+        raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
+    if twist != 0.0:
+        raise ConfigError(
+            "twisting somersaults are not built yet (issue 19, thesis 5.2); run without --twist"
+        )
+    if not (math.isfinite(backpack) and backpack >= 0):
+        raise ConfigError(f"backpack must be >= 0 kg, got {backpack!r}")
+    m = somersault_maneuver(position, direction, body, backpack)
+    result = run_maneuver(m, on_tick=on_tick, fps=fps)
+    result.report.update(position=position, direction=direction, twist_turns=0.0)
+    return result
