@@ -363,6 +363,7 @@ def run_maneuver(
         "rotation_deg": math.degrees(float(rot[-1])) if rot.size else 0.0,
         "rotation_at_touchdown_deg": math.degrees(float(rot[i_td])) if rot.size else 0.0,
         "twist_deg": math.degrees(float(log["twist"][-1])) if rot.size else 0.0,
+        "travel_m": float(log["com"][-1, 0] - log["com"][0, 0]) if rot.size else 0.0,
         "time_to_liftoff_s": lift,
         "liftoff_pitch_momentum": ctx.handover.get("liftoff_pitch_momentum"),
         "achieved_height_m": float(log["com"][:, 2].max() - log["com"][0, 2])
