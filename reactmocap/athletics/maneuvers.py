@@ -52,16 +52,19 @@ from reactmocap.athletics.bodies import BODIES, Athlete, athlete
 from reactmocap.athletics.land import Landing, LandingParams
 from reactmocap.athletics.leap import Leap, LeapParams
 from reactmocap.athletics.machine import Basis
-from reactmocap.athletics.scene import athletics_world
+from reactmocap.athletics.scene import athletics_world, stand_angles
 from reactmocap.athletics.tumble import POSITIONS, Tumble, TumbleParams
 from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.sim.world import World
 
 __all__ = [
     "CONTROLLERS",
     "SOMERSAULT_PRESETS",
     "BasisSpec",
     "Maneuver",
+    "Perturbation",
     "Phase",
+    "capture_region",
     "describe",
     "load_maneuver",
     "run_maneuver",
@@ -331,23 +334,99 @@ def maneuver_from_dict(
 
 
 # ---------------------------------------------------------------------------------- running
+@dataclass(frozen=True)
+class Perturbation:
+    """A perturbed start: every joint angle of the standing pose (pitch, roll, yaw) off by
+    ``joint_rad`` each, the pelvis pitched by ``pitch_rad``, the body moving at ``velocity``
+    (m/s, world ``x, y, z``) and turning at ``spin`` (rad/s, the free joint's pelvis frame). The feet are
+    put back on the floor (lowest sole corner 0.5 mm up)."""
+
+    joint_rad: tuple[tuple[float, float, float], ...]
+    pitch_rad: float = 0.0
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    spin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    @classmethod
+    def sample(
+        cls, rng: np.random.Generator, joint_sd: float = math.radians(3.0),
+        pitch_sd: float = math.radians(2.0), velocity_sd: float = 0.05, spin_sd: float = 0.1,
+    ) -> Perturbation:  # fmt: skip
+        """Independent normal perturbations with the given standard deviations (the
+        distribution the capture regions state: 3 deg per joint axis, 2 deg of pelvis pitch,
+        0.05 m/s per velocity axis, 0.1 rad/s per spin axis)."""
+        joints = rng.normal(0.0, joint_sd, (15, 3))
+        return cls(tuple(tuple(float(x) for x in row) for row in joints),  # type: ignore[misc]
+                   float(rng.normal(0.0, pitch_sd)),
+                   tuple(float(x) for x in rng.normal(0.0, velocity_sd, 3)),  # type: ignore[arg-type]
+                   tuple(float(x) for x in rng.normal(0.0, spin_sd, 3)))  # type: ignore[arg-type]  # fmt: skip
+
+    def apply(self, world: World, ath: Athlete) -> None:
+        angles = stand_angles(ath) + np.asarray(self.joint_rad, dtype=np.float64)
+        q = ath.standing_qpos(angles, pitch=self.pitch_rad, clearance=0.0005)
+        v = np.zeros(world.model.nv)
+        wc = world.characters[0]
+        qv = v[wc.qvel_slice]
+        qv[0:3] = self.velocity
+        qv[3:6] = self.spin
+        world.set_pose(0, q, qv)
+
+
+def capture_region(
+    maneuver: Maneuver, starts: int = 50, seed: int = 0, workers: int = 1, **sd: float
+) -> dict[str, Any]:
+    """Run ``maneuver`` from ``starts`` perturbed starts (:meth:`Perturbation.sample`, seeded)
+    and report the success rate (``landed`` and not ``fell``) and, per perturbation, its size
+    (RMS joint offset, pelvis pitch, horizontal speed, pitch spin) and whether it landed."""
+    rng = np.random.default_rng(seed)
+    perts = [Perturbation.sample(rng, **sd) for _ in range(starts)]
+    jobs = [(maneuver, p) for p in perts]
+    if workers > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(workers) as ex:
+            outcomes = list(ex.map(_capture_one, jobs))
+    else:
+        outcomes = [_capture_one(j) for j in jobs]
+    rows = []
+    for p, (ok, rot) in zip(perts, outcomes):
+        rows.append({
+            "joint_rms_deg": math.degrees(float(np.sqrt(np.mean(np.square(p.joint_rad))))),
+            "pitch_deg": math.degrees(p.pitch_rad),
+            "speed_mps": float(np.hypot(p.velocity[0], p.velocity[1])),
+            "pitch_spin_rad_s": p.spin[1], "landed": ok, "rotation_deg": rot,
+        })  # fmt: skip
+    wins = sum(r["landed"] for r in rows)
+    return {"maneuver": maneuver.name, "starts": starts, "seed": seed, "landed": wins,
+            "success_rate": wins / max(starts, 1), "runs": rows}  # fmt: skip
+
+
+def _capture_one(job: tuple[Maneuver, Perturbation]) -> tuple[bool, float]:
+    m, p = job
+    r = run_maneuver(m, perturbation=p, fps=10.0).report
+    return bool(r["landed"] and not r["fell"] and r["status"] == "ok"), float(r["rotation_deg"])
+
+
 def run_maneuver(
     maneuver: Maneuver,
     body: str | Path | None = None,
     *,
     on_tick: Callable[[float], None] | None = None,
     fps: float = 60.0,
+    perturbation: Perturbation | None = None,
 ) -> AthleticsResult:
     """Simulate ``maneuver`` (on ``body`` instead of the maneuver's own, if given). The
     report: ``rotation_deg`` (the somersault rotation at the end, the trunk's pitch in the
     take-off plane unwrapped, backward < 0), ``rotation_at_touchdown_deg``, ``twist_deg``,
     ``landed``, ``fell``, the take-off angular momentum and its drift in the air, the peak
-    somersault angular velocity, the phases' transitions."""
+    somersault angular velocity, the phases' transitions. ``perturbation`` starts it from a
+    perturbed pose and velocity (:class:`Perturbation`; the capture regions)."""
     phases = [check_phase(p, f"{maneuver.name}: phase[{i + 1}]")
               for i, p in enumerate(maneuver.phases)]  # fmt: skip
     ath = athlete(body if body is not None else maneuver.body)
     bases = [CONTROLLERS[p.controller].build(p, ath) for p in phases]
     world = athletics_world(ath, backpack=maneuver.backpack)
+    if perturbation is not None:
+        perturbation.apply(world, ath)
     ctx, seq, res = _simulate(ath, world, bases, maneuver.seconds, behaviour=maneuver.name,
                               on_tick=on_tick, fps=fps)  # fmt: skip
     log = ctx.log.arrays()
