@@ -455,8 +455,11 @@ def run_maneuver(
             ref = float(np.linalg.norm(m[0]))
             rep["flight_momentum_drift"] = float(np.abs(m - m[0]).max() / max(ref, 1e-9))
             rate = np.abs(np.gradient(rot[flight], t[flight]))
-            rep["peak_somersault_rate_rad_s"] = float(rate.max())
+            rep["peak_trunk_rate_rad_s"] = float(rate.max())
         rep["flight_s"] = td - lift
+    if "tumble_peak_rate" in ctx.handover:
+        rep["peak_somersault_rate_rad_s"] = ctx.handover["tumble_peak_rate"]
+        rep["tumble_min_inertia_kgm2"] = ctx.handover["tumble_min_inertia"]
     rep.update(_landing(ctx, log, pelvis0))
     rep.update(_plausible(ctx, ath, 0.0, np.inf))
     result = _result(maneuver.name, ath, ctx, seq, res, rep)

@@ -188,6 +188,7 @@ class Tumble(Basis):
                 landing[joint_index(f"{side}_{key}")] = val
         i_open = somersault_inertia(ctx.athlete, landing)
         memo: dict[str, float] = {}
+        bodies = np.asarray(ctx.world.characters[ctx.character].body_ids)
 
         def enter(world: World, t: float) -> None:
             del world
@@ -213,6 +214,15 @@ class Tumble(Basis):
                 ctx, p.touchdown_height * (ctx.standing_com or float(s.com[2]))
             )
             memo["predicted"] = ctx.rotation + momentum / i_open * memo["t_td"]
+            # the whole body's angular velocity about the axis (Fig. 5.3): L over the inertia
+            # of the pose it is in now
+            inertia = float(axis @ composite_inertia(world.model, world.data, bodies)[0] @ axis)
+            low = float(ctx.handover.get("tumble_min_inertia", math.inf))  # type: ignore[arg-type]
+            if inertia < low:
+                ctx.handover["tumble_min_inertia"] = inertia
+            rate = abs(momentum) / inertia
+            peak = float(ctx.handover.get("tumble_peak_rate", 0.0))  # type: ignore[arg-type]
+            ctx.handover["tumble_peak_rate"] = max(peak, rate)
 
         def opened(world: World, t: float, t_in: float) -> bool:
             del world, t
