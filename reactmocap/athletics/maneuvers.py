@@ -248,7 +248,7 @@ def check_phase(phase: Phase, where: str) -> Phase:
             f"{where}.params.position: unknown position {params['position']!r}; valid "
             f"positions are {sorted(POSITIONS)}"
         )
-    return replace(phase, params=MappingProxyType(params))
+    return replace(phase, params=params)
 
 
 _TOP = {"name": "string", "body": "string", "seconds": "number", "backpack": "number"}
