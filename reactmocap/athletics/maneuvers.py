@@ -442,10 +442,12 @@ def run_maneuver(
         "rotation_deg": math.degrees(float(rot[-1])) if rot.size else 0.0,
         "rotation_at_touchdown_deg": math.degrees(float(rot[i_td])) if rot.size else 0.0,
         "twist_deg": math.degrees(float(log["twist"][-1])) if rot.size else 0.0,
+        "twist_at_touchdown_deg": math.degrees(float(log["twist"][i_td])) if rot.size else 0.0,
         "travel_m": float(log["com"][-1, 0] - log["com"][0, 0]) if rot.size else 0.0,
         "time_to_liftoff_s": lift,
         "liftoff_pitch_momentum": ctx.handover.get("liftoff_pitch_momentum"),
-        "achieved_height_m": float(log["com"][:, 2].max() - log["com"][0, 2])
+        # the COM's rise over standing, up to the first touchdown after lift-off
+        "achieved_height_m": float(log["com"][: i_td + 1, 2].max() - log["com"][0, 2])
         if lift is not None else 0.0,
     }  # fmt: skip
     if lift is not None and td is not None and td > lift + 0.05:
@@ -509,10 +511,12 @@ def somersault_maneuver(
         Phase("leap", "liftoff", leap),
         Phase("tumble", "open", {"position": position, "lead": lead}),
         Phase("land", "settled", {"delta": delta}),
-        Phase("balance", "never", {"settle": 0.5}),
+        # stand up slowly out of the landing's deep crouch: a quicker stand-up (0.5 s) carried
+        # the COM forward off the feet after most perturbed landings (docs/athletics.md)
+        Phase("balance", "never", {"settle": 2.0}),
     )
     name = f"{direction}_somersault_{position}"
-    return Maneuver(name, phases, body, 4.5, backpack)
+    return Maneuver(name, phases, body, 5.5, backpack)
 
 
 def somersault(

@@ -42,6 +42,7 @@ __all__ = [
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
+_SHOULDERS = [joint_index(f"{s}_shoulder") for s in "lr"]
 
 #: the predetermined joint angles of each somersault position (anatomical ``[pitch, roll,
 #: yaw]``, rad; both sides alike, shoulder roll mirrored): layout: straight, arms out to the
@@ -143,6 +144,11 @@ class TumbleParams:
         open_at: open at this many seconds in the air instead of predicting (the thesis's
             timed transition); None predicts.
         max_seconds: open at the latest after this long.
+        arm_tilt: the tilt-twist arm throw (rad, section 5.2): both shoulders turn by this
+            much about the body's front-back axis once the position is reached (one arm up
+            over the head, the other down and across); the body tilts the other way out of
+            the somersault plane and starts to twist. 0: no throw.
+        arm_throw: seconds the throw takes.
     """
 
     position: str = "tuck"
@@ -153,15 +159,18 @@ class TumbleParams:
     latest: float = 0.12
     open_at: float | None = None
     max_seconds: float = 3.0
+    arm_tilt: float = 0.0
+    arm_throw: float = 0.15
 
     def __post_init__(self) -> None:
         position_angles(self.position)  # an unknown position lists the valid ones
-        for name in ("turns", "entry", "lead", "touchdown_height", "latest", "max_seconds"):
+        for name in ("turns", "entry", "lead", "touchdown_height", "latest", "max_seconds",
+                     "arm_tilt", "arm_throw"):  # fmt: skip
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"tumble {name} must be a finite number, got {v!r}")
-        if self.turns <= 0 or self.entry <= 0 or self.max_seconds <= 0:
-            raise ConfigError("tumble turns, entry and max_seconds must be > 0")
+        if self.turns <= 0 or self.entry <= 0 or self.max_seconds <= 0 or self.arm_throw <= 0:
+            raise ConfigError("tumble turns, entry, arm_throw and max_seconds must be > 0")
         if self.open_at is not None and not (math.isfinite(self.open_at) and self.open_at >= 0):
             raise ConfigError(f"tumble open_at must be >= 0 s, got {self.open_at!r}")
 
@@ -201,8 +210,16 @@ class Tumble(Basis):
             rig.move(goal, p.entry, t)
             memo["predicted"] = ctx.rotation
             memo["t_td"] = math.inf
+            memo["t0"] = t
+            memo.pop("thrown", None)
 
         def control(world: World, t: float) -> None:
+            if p.arm_tilt and "thrown" not in memo and t - memo["t0"] >= p.entry:
+                memo["thrown"] = t  # the tilt twist: both arms turn the same way
+                throw = np.full((NJ, 3), np.nan)
+                for side in _SHOULDERS:
+                    throw[side] = goal[side] + (0.0, p.arm_tilt, 0.0)
+                rig.move(throw, p.arm_throw, t, _SHOULDERS)
             # the rotation the body would still turn, opened now, before its feet touch:
             # the angular momentum about the somersault axis over the open body's inertia,
             # times the time the COM takes to fall to its touchdown height
