@@ -3,11 +3,13 @@ on the simulated motion."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from reactmocap.athletics import athlete
-from reactmocap.athletics.maneuvers import somersault
+from reactmocap.athletics.maneuvers import run_maneuver, somersault, somersault_maneuver
 from reactmocap.athletics.tumble import POSITIONS, TumbleParams, somersault_inertia
 from reactmocap.errors import ConfigError, UnknownKeyError
 
@@ -66,3 +68,26 @@ def test_angular_momentum_is_conserved_in_the_somersault_flight(back_tuck) -> No
     # tucking speeds the rotation up (Fig. 5.3): peak rate well above the layout's L / I
     layout = np.linalg.norm(m[0]) / somersault_inertia(athlete("male"), "layout")
     assert r["peak_somersault_rate_rad_s"] > 2.5 * layout
+
+
+def test_a_4_kg_backpack_still_lands_the_back_somersault_untuned() -> None:
+    # thesis 8.5.2 (there on the forward somersault, which needed re-tuning)
+    r = somersault("tuck", "backward", "male", backpack=4.0).report
+    assert r["backpack_kg"] == 4.0 and r["liftoff_pitch_momentum"] < -50.0  # heavier: more L
+    assert r["landed"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+
+
+def _layout_flight(arm_tilt: float) -> dict:  # type: ignore[type-arg]
+    m = somersault_maneuver("layout")
+    phases = list(m.phases)
+    phases[2] = replace(phases[2], params={**phases[2].params, "arm_tilt": arm_tilt})
+    return run_maneuver(replace(m, phases=tuple(phases), seconds=2.3)).report
+
+
+def test_the_arm_throw_starts_a_twist_in_the_air() -> None:
+    # section 5.2: both arms turned the same way about the front-back axis tilt the body out of
+    # the somersault plane; with no throw the layout somersault does not twist
+    still, thrown = _layout_flight(0.0), _layout_flight(1.0)
+    assert abs(still["twist_at_touchdown_deg"]) < 10.0
+    assert abs(thrown["twist_at_touchdown_deg"]) > 90.0
+    assert thrown["flight_momentum_drift"] <= 0.01
