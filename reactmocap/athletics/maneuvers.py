@@ -222,7 +222,7 @@ def check_phase(phase: Phase, where: str) -> Phase:
     the errors, e.g. ``"FILE: phase[2]"``); builds nothing."""
     spec = CONTROLLERS.get(phase.controller)
     if spec is None:
-        raise UnknownKeyError(
+        raise ConfigError(
             f"{where}.controller: unknown basis controller {phase.controller!r}; valid "
             f"controllers are {sorted(CONTROLLERS)}"
         )

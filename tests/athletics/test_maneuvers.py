@@ -30,7 +30,7 @@ def test_an_unknown_controller_names_the_file_the_phase_and_the_valid_ones(tmp_p
     path = _file(
         tmp_path, GOOD_PHASE + '[[phase]]\ncontroller = "flip"\nexit = { event = "open" }\n'
     )
-    with pytest.raises(UnknownKeyError) as err:
+    with pytest.raises(ConfigError) as err:
         load_maneuver(path)
     msg = str(err.value)
     assert str(path) in msg and "phase[2].controller" in msg and "'flip'" in msg
