@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import athlete
+from reactmocap.athletics.backdrop import arm_windmill
 from reactmocap.athletics.maneuvers import run_maneuver, somersault, somersault_maneuver
 from reactmocap.athletics.tumble import POSITIONS, TumbleParams, somersault_inertia
 from reactmocap.errors import ConfigError, UnknownKeyError
@@ -91,3 +92,16 @@ def test_the_arm_throw_starts_a_twist_in_the_air() -> None:
     assert abs(still["twist_at_touchdown_deg"]) < 10.0
     assert abs(thrown["twist_at_touchdown_deg"]) > 90.0
     assert thrown["flight_momentum_drift"] <= 0.01
+
+
+def test_windmilling_the_arms_with_no_momentum_tilts_the_body_about_20_degrees() -> None:
+    # thesis 5.1.1: one clockwise windmill of the arms tilts the male torso ~20 degrees the
+    # other way; torque-free, so the angular momentum stays at zero
+    one, back = arm_windmill("male", 1.0), arm_windmill("male", -1.0)
+    assert one["status"] == "ok" and one["max_momentum"] < 0.1
+    assert 15.0 <= one["rotation_per_cycle_deg"] <= 25.0
+    assert back["rotation_deg"] == pytest.approx(-one["rotation_deg"], abs=1.0)
+    # it adds up cycle by cycle (a somersault by repetition, given the time)
+    assert arm_windmill("male", 2.0)["rotation_deg"] == pytest.approx(
+        2 * one["rotation_deg"], rel=0.05
+    )
