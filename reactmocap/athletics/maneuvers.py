@@ -49,11 +49,12 @@ from reactmocap.athletics.behaviours import (
     _standing,
 )
 from reactmocap.athletics.bodies import BODIES, Athlete, athlete
+from reactmocap.athletics.dive import Platform, Stretch, entry_report, stretch_angles
 from reactmocap.athletics.land import Landing, LandingParams
 from reactmocap.athletics.leap import Leap, LeapParams
 from reactmocap.athletics.machine import Basis
 from reactmocap.athletics.scene import athletics_world, stand_angles
-from reactmocap.athletics.tumble import POSITIONS, Tumble, TumbleParams
+from reactmocap.athletics.tumble import POSITIONS, Tumble, TumbleParams, somersault_inertia
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.sim.world import World
 
@@ -65,6 +66,8 @@ __all__ = [
     "Perturbation",
     "Phase",
     "capture_region",
+    "dive",
+    "dive_maneuver",
     "describe",
     "load_maneuver",
     "run_maneuver",
@@ -93,6 +96,9 @@ class Maneuver:
     body: str = "male"
     seconds: float = 5.0
     backpack: float = 0.0
+    #: platform height (m) over the water: 0 stands on the floor; > 0 the floor drops away
+    #: after lift-off and the run is judged at the water (a dive, :mod:`.dive`)
+    platform: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -156,6 +162,11 @@ def _build_tumble(phase: Phase, ath: Athlete) -> Basis:
     return Tumble(TumbleParams(**p))
 
 
+def _build_stretch(phase: Phase, ath: Athlete) -> Basis:
+    del ath
+    return Stretch(**phase.params)
+
+
 def _build_land(phase: Phase, ath: Athlete) -> Basis:
     base = tables.landing_params(ath.name, 0.0)
     return Landing(replace(base, **phase.params))
@@ -181,6 +192,9 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
     "land": BasisSpec(
         "land", "passive landing (ch. 6); ends once it has settled and handed over",
         _kinds(LandingParams), {"settled": "once the landing has settled"}, _build_land),
+    "stretch": BasisSpec(
+        "stretch", "straighten with the arms over the head for a dive's entry; holds to the "
+        "end", {"seconds": "number"}, {"never": "holds to the end of the run"}, _build_stretch),
 })  # fmt: skip
 
 
@@ -251,7 +265,8 @@ def check_phase(phase: Phase, where: str) -> Phase:
     return replace(phase, params=params)
 
 
-_TOP = {"name": "string", "body": "string", "seconds": "number", "backpack": "number"}
+_TOP = {"name": "string", "body": "string", "seconds": "number", "backpack": "number",
+        "platform": "number"}  # fmt: skip
 
 
 def load_maneuver(path: str | Path) -> Maneuver:
@@ -285,6 +300,11 @@ def maneuver_from_dict(
     backpack = float(top.get("backpack", 0.0))
     if backpack < 0:
         raise ConfigError(f"{source}: backpack must be >= 0 kg, got {backpack}")
+    platform = float(top.get("platform", 0.0))
+    if not (platform == 0.0 or 1.0 <= platform <= PLATFORM_MAX):
+        raise ConfigError(
+            f"{source}: platform must be 0 (none) or 1-{PLATFORM_MAX:g} m, got {platform}"
+        )
     rows = data.get("phase")
     if not isinstance(rows, list) or not rows:
         raise ConfigError(f"{source}: phase: a maneuver needs at least one [[phase]] table")
@@ -330,7 +350,8 @@ def maneuver_from_dict(
         raise ConfigError(
             f"{source}: body must be one of {list(BODIES)} or a BVH file, got {body!r}"
         )
-    return Maneuver(str(top.get("name", default_name)), tuple(phases), body, seconds, backpack)
+    name = str(top.get("name", default_name))
+    return Maneuver(name, tuple(phases), body, seconds, backpack, platform)
 
 
 # ---------------------------------------------------------------------------------- running
@@ -427,8 +448,12 @@ def run_maneuver(
     world = athletics_world(ath, backpack=maneuver.backpack)
     if perturbation is not None:
         perturbation.apply(world, ath)
+    high = maneuver.platform
+    platform = (lambda c: Platform(c, high)) if high > 0 else None
+    # a dive's fall reaches 10-13 m/s: above the rollout's default kinetic-energy check
     ctx, seq, res = _simulate(ath, world, bases, maneuver.seconds, behaviour=maneuver.name,
-                              on_tick=on_tick, fps=fps)  # fmt: skip
+                              on_tick=on_tick, fps=fps, extra_from_ctx=platform,
+                              energy_limit_per_kg=400.0 if high > 0 else 100.0)  # fmt: skip
     log = ctx.log.arrays()
     _, pelvis0 = _standing(ctx)
     t = log["t"]
@@ -462,7 +487,11 @@ def run_maneuver(
     if "tumble_peak_rate" in ctx.handover:
         rep["peak_somersault_rate_rad_s"] = ctx.handover["tumble_peak_rate"]
         rep["tumble_min_inertia_kgm2"] = ctx.handover["tumble_min_inertia"]
-    rep.update(_landing(ctx, log, pelvis0))
+    if high > 0:  # judged at the water: entry angle, rotation and twist there
+        rep.update(entry_report(ctx, high, res.status == "ok"))
+        rep["touchdown_s"] = None
+    else:
+        rep.update(_landing(ctx, log, pelvis0))
     rep.update(_plausible(ctx, ath, 0.0, np.inf))
     result = _result(maneuver.name, ath, ctx, seq, res, rep)
     return result
@@ -542,4 +571,72 @@ def somersault(
     m = somersault_maneuver(position, direction, body, backpack)
     result = run_maneuver(m, on_tick=on_tick, fps=fps)
     result.report.update(position=position, direction=direction, twist_turns=0.0)
+    return result
+
+
+# ---------------------------------------------------------------------------------- dives
+#: highest platform (m): a higher fall outruns the rollout's kinetic-energy check
+PLATFORM_MAX = 7.5
+#: the dive's tumble lead (rad) per position, tuned by hand on the male body (5 m, 1.5 turns)
+DIVE_LEADS: Mapping[str, float] = MappingProxyType({"pike": 2.0, "tuck": 1.7, "layout": 0.0})
+DIVE_DIRECTIONS = ("backward",)
+
+
+def dive_maneuver(
+    position: str = "pike", direction: str = "backward", body: str = "male",
+    height: float = 5.0, turns: float = 1.5,
+) -> Maneuver:  # fmt: skip
+    """A backward dive of ``turns`` somersaults (1.5: head first) in ``position`` from a
+    ``height`` m platform: balance, the back somersault's leap, tumble (aimed at the water),
+    stretch. The tumble's opening predicts with the stretched body's inertia."""
+    if direction not in DIVE_DIRECTIONS:
+        raise UnknownKeyError(
+            f"unknown dive direction {direction!r}; built: {list(DIVE_DIRECTIONS)}"
+        )
+    if position not in POSITIONS:
+        raise UnknownKeyError(
+            f"unknown dive position {position!r}; valid positions are {sorted(POSITIONS)}"
+        )
+    if not (math.isfinite(height) and 1.0 <= height <= PLATFORM_MAX):
+        raise ConfigError(f"dive platform height must be 1-{PLATFORM_MAX:g} m, got {height!r}")
+    if not (math.isfinite(turns) and turns > 0):
+        raise ConfigError(f"dive turns must be > 0, got {turns!r}")
+    leap = dict(SOMERSAULT_PRESETS["male"]["backward"][0])
+    i_open = round(somersault_inertia(athlete(body), stretch_angles()), 2)
+    tumble = {"position": position, "turns": turns, "lead": DIVE_LEADS[position],
+              "target_height": -height, "open_inertia": i_open, "latest": 0.3,
+              "max_seconds": 5.0}  # fmt: skip
+    phases = (
+        Phase("balance", "after", {}, 0.3),
+        Phase("leap", "liftoff", leap),
+        Phase("tumble", "open", tumble),
+        Phase("stretch", "never", {}),
+    )
+    seconds = round(1.7 + math.sqrt(2.0 * (height + 2.0) / 9.81), 1)
+    return Maneuver(f"dive_{direction}_{position}", phases, body, seconds, 0.0, height)
+
+
+def dive(
+    position: str = "pike",
+    direction: str = "backward",
+    body: str = "male",
+    *,
+    height: float = 5.0,
+    turns: float = 1.5,
+    twist: float = 0.0,
+    on_tick: Callable[[float], None] | None = None,
+    fps: float = 60.0,
+) -> AthleticsResult:
+    """A platform dive (:func:`dive_maneuver`). ``landed`` is a clean entry (head first within
+    ``dive.ENTRY_TOLERANCE`` of straight down when the COM reaches the water), ``fell`` its
+    opposite. ``twist`` (turns) is refused: twists are not aimed yet (``docs/athletics.md``)."""
+    if not math.isfinite(twist):
+        raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
+    if twist != 0.0:
+        raise ConfigError(
+            "twisting dives are not built yet (issue 19, thesis 5.2); run without --twist"
+        )
+    result = run_maneuver(dive_maneuver(position, direction, body, height, turns),
+                          on_tick=on_tick, fps=fps)  # fmt: skip
+    result.report.update(position=position, direction=direction, turns=turns, twist_turns=0.0)
     return result

@@ -149,6 +149,10 @@ class TumbleParams:
             over the head, the other down and across); the body tilts the other way out of
             the somersault plane and starts to twist. 0: no throw.
         arm_throw: seconds the throw takes.
+        target_height: the COM height (m) the prediction aims at instead (a dive: the water
+            surface); None: ``touchdown_height`` of the standing COM.
+        open_inertia: the opened body's inertia about the somersault axis (kg m^2) the
+            prediction uses; None: the landing pose's (:data:`LANDING_POSE`).
     """
 
     position: str = "tuck"
@@ -161,6 +165,8 @@ class TumbleParams:
     max_seconds: float = 3.0
     arm_tilt: float = 0.0
     arm_throw: float = 0.15
+    target_height: float | None = None
+    open_inertia: float | None = None
 
     def __post_init__(self) -> None:
         position_angles(self.position)  # an unknown position lists the valid ones
@@ -173,6 +179,12 @@ class TumbleParams:
             raise ConfigError("tumble turns, entry, arm_throw and max_seconds must be > 0")
         if self.open_at is not None and not (math.isfinite(self.open_at) and self.open_at >= 0):
             raise ConfigError(f"tumble open_at must be >= 0 s, got {self.open_at!r}")
+        if self.target_height is not None and not math.isfinite(self.target_height):
+            raise ConfigError(f"tumble target_height must be finite, got {self.target_height!r}")
+        if self.open_inertia is not None and not (
+            math.isfinite(self.open_inertia) and self.open_inertia > 0
+        ):
+            raise ConfigError(f"tumble open_inertia must be > 0, got {self.open_inertia!r}")
 
 
 class Tumble(Basis):
@@ -195,7 +207,7 @@ class Tumble(Basis):
         for key, val in LANDING_POSE.items():
             for side in "lr":
                 landing[joint_index(f"{side}_{key}")] = val
-        i_open = somersault_inertia(ctx.athlete, landing)
+        i_open = p.open_inertia or somersault_inertia(ctx.athlete, landing)
         memo: dict[str, float] = {}
         bodies = np.asarray(ctx.world.characters[ctx.character].body_ids)
 
@@ -227,9 +239,10 @@ class Tumble(Basis):
             h = ctx.heading0 if ctx.heading0 is not None else s.heading()
             axis = np.array([-math.sin(h), math.cos(h), 0.0])
             momentum = float(world.data.subtree_angmom[s.root] @ axis)
-            memo["t_td"] = time_to_height(
-                ctx, p.touchdown_height * (ctx.standing_com or float(s.com[2]))
-            )
+            aim = p.target_height
+            if aim is None:
+                aim = p.touchdown_height * (ctx.standing_com or float(s.com[2]))
+            memo["t_td"] = time_to_height(ctx, aim)
             memo["predicted"] = ctx.rotation + momentum / i_open * memo["t_td"]
             # the whole body's angular velocity about the axis (Fig. 5.3): L over the inertia
             # of the pose it is in now

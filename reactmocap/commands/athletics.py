@@ -40,7 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     ath = sub.add_parser(
         "athletics",
         help="athletic controllers: leap, broad jump, land, balance, run, vault, maneuver, "
-        "somersault",
+        "somersault, dive",
     )
     inner = ath.add_subparsers(dest="behaviour", metavar="BEHAVIOUR", required=True)
     for name, flags in _FLAGS.items():
@@ -70,7 +70,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     from reactmocap.commands.athletics_maneuver import register_maneuvers
 
-    register_maneuvers(inner)  # maneuver, somersault
+    register_maneuvers(inner)  # maneuver, somersault, dive
 
     from reactmocap.commands.athletics_bicycle import register as register_bicycle
 

@@ -8,7 +8,13 @@ from pathlib import Path
 
 import pytest
 
-from reactmocap.athletics.maneuvers import CONTROLLERS, load_maneuver, run_maneuver, somersault
+from reactmocap.athletics.maneuvers import (
+    CONTROLLERS,
+    dive,
+    load_maneuver,
+    run_maneuver,
+    somersault,
+)
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.bvh import read_bvh
@@ -69,7 +75,7 @@ def test_bad_files_are_refused_naming_the_field(tmp_path: Path, text: str, field
 
 def test_every_example_is_valid_and_names_a_maneuver_the_issue_asks_for() -> None:
     names = {p.stem for p in EXAMPLES}
-    assert {"back_somersault", "vertical_leap", "broad_jump"} <= names
+    assert {"back_somersault", "vertical_leap", "broad_jump", "dive_pike"} <= names
     for path in EXAMPLES:
         m = load_maneuver(path)
         assert m.name == path.stem and m.phases[0].controller == "balance"
@@ -82,6 +88,9 @@ def test_each_example_maneuver_runs_and_lands(path: Path) -> None:
     assert r["landed"] and not r["fell"]
     if path.stem == "back_somersault":
         assert abs(r["rotation_deg"] + 360.0) <= 30.0
+    elif path.stem.startswith("dive"):  # 1.5 somersaults: head first into the water
+        assert abs(r["rotation_deg"] + 540.0) <= 30.0 and r["entry_angle_deg"] <= 30.0
+        assert r["flight_momentum_drift"] <= 0.01
     else:
         assert abs(r["rotation_deg"]) <= 30.0
     if path.stem == "broad_jump":
@@ -120,3 +129,18 @@ def test_somersault_refuses_what_is_not_built(
         somersault("straddle")
     with pytest.raises(UnknownKeyError, match="valid directions"):
         somersault("tuck", "sideways")
+
+
+def test_the_dive_command_enters_head_first_and_a_layout_dive_does_not(tmp_path: Path) -> None:
+    out, rep = tmp_path / "d.bvh", tmp_path / "d.json"
+    assert (
+        main(["athletics", "dive", "--position", "tuck", "--out", str(out), "--report", str(rep)])
+        == 0
+    )
+    report = json.loads(rep.read_text())
+    assert {"rotation_deg", "twist_deg", "landed", "fell", "entry_angle_deg"} <= set(report)
+    assert report["landed"] is True and report["fell"] is False
+    assert abs(report["rotation_deg"] + 540.0) <= 30.0
+    # the report tells the truth: a layout has too little rotation for 1.5 somersaults
+    layout = dive("layout").report
+    assert layout["landed"] is False and layout["fell"] is True and layout["entry_angle_deg"] > 30
