@@ -88,16 +88,17 @@ class Platform:
 
 def entry_report(ctx: Context, height: float, ok: bool) -> dict[str, Any]:
     """The entry at the water ``height`` m below the platform: the first tick the COM is at or
-    below it; ``rotation_deg`` and ``twist_deg`` there, ``entry_angle_deg`` (the pelvis-to-head
-    line from straight down, in the somersault plane: 180 degrees of rotation mod 360 is head
-    first), ``landed`` (a clean entry, within :data:`ENTRY_TOLERANCE`) and ``fell``. ``ok``:
+    below it; ``rotation_deg`` and ``twist_deg`` there, ``entry_angle_deg`` (the angle between the
+    pelvis-to-head line and straight down, in 3D), ``landed`` (a clean entry, within :data:`ENTRY_TOLERANCE`) and ``fell``. ``ok``:
     the simulation ran to its end."""
     log = ctx.log.arrays()
     t, com = log["t"], log["com"]
     below = np.flatnonzero(com[:, 2] <= -height)
     i = int(below[0]) if below.size else t.size - 1
     rot = math.degrees(float(log["rotation"][i])) if t.size else 0.0
-    angle = abs((rot % 360.0) - 180.0)
+    # the pelvis-to-head line from straight down (in 3D: a twisted body leaves the plane)
+    down = float(-log["trunk"][i, 2]) if t.size else -1.0
+    angle = math.degrees(math.acos(float(np.clip(down, -1.0, 1.0))))
     entered = bool(below.size) and ok
     clean = entered and angle <= ENTRY_TOLERANCE
     rep: dict[str, Any] = {

@@ -57,6 +57,8 @@ class Log:
     #: heading's sagittal plane, > 0 forward) and twist so far (rad, about the trunk's axis)
     rotation: list[float] = field(default_factory=list)
     twist: list[float] = field(default_factory=list)
+    #: per tick: the pelvis-to-head line (world, unit)
+    trunk: list[F64] = field(default_factory=list)
 
     def arrays(self) -> dict[str, NDArray]:
         if not self.rows:
@@ -65,7 +67,8 @@ class Log:
                     "grf": np.zeros((0, 3)), "feet": z.astype(int), "state": np.array([]),
                     "torque": np.zeros((0, 15)), "power": np.zeros((0, 15)),
                     "others": z.astype(bool), "pelvis": z, "offset": z,
-                    "momentum": np.zeros((0, 3)), "rotation": z, "twist": z}  # fmt: skip
+                    "momentum": np.zeros((0, 3)), "rotation": z, "twist": z,
+                    "trunk": np.zeros((0, 3))}  # fmt: skip
         t, com, vel, grf, feet, state = zip(*self.rows)
         return {
             "t": np.array(t), "com": np.array(com), "com_vel": np.array(vel),
@@ -74,6 +77,7 @@ class Log:
             "others": np.array(self.others), "pelvis": np.array(self.pelvis),
             "offset": np.array(self.offsets), "momentum": np.array(self.momentum),
             "rotation": np.array(self.rotation), "twist": np.array(self.twist),
+            "trunk": np.array(self.trunk),
         }  # fmt: skip
 
 

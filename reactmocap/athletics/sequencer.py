@@ -52,6 +52,7 @@ class Sequencer:
         self._dofs = slice(dofs, dofs + 3 * NJ)
         self._head = ctx.senses.body("head")
         self._trunk = 0.0
+        self._trunk_dir = np.array([0.0, 0.0, 1.0])
         self._t = 0.0
 
     @property
@@ -90,6 +91,7 @@ class Sequencer:
         ctx.log.pelvis.append(float(d.xpos[s.root][2]))
         ctx.log.rotation.append(ctx.rotation)
         ctx.log.twist.append(ctx.twist)
+        ctx.log.trunk.append(self._trunk_dir)
 
     def _turn(self, d, s, t: float) -> None:  # type: ignore[no-untyped-def]
         """Update the somersault rotation (the pelvis-to-head line's pitch in the first
@@ -98,6 +100,7 @@ class Sequencer:
         ctx = self.ctx
         trunk = d.xpos[self._head] - d.xpos[s.root]
         trunk = trunk / max(float(np.linalg.norm(trunk)), 1e-9)
+        self._trunk_dir = trunk
         if ctx.heading0 is None:
             ctx.heading0 = s.heading()
             self._trunk = somersault_pitch(trunk, ctx.heading0)
