@@ -348,6 +348,10 @@ def capture(workers: int, starts: int = 50) -> dict[str, Any]:
             print(f"capture {name} ({label} perturbation): landed {r['landed']}/{starts} "
                   f"({100 * r['success_rate']:.0f}%; thesis: not measured; goal >= 90%) "
                   f"[{time.time() - t0:.0f} s]", flush=True)  # fmt: skip
+            for key, reg in r["region"].items():
+                print(f"    {key}: median {reg['median']:.3g}, success below/above it "
+                      f"{reg['success_below_median']:.0%}/{reg['success_above_median']:.0%}, "
+                      f"largest that landed {reg['largest_success']}")  # fmt: skip
     return out
 
 

@@ -66,6 +66,7 @@ __all__ = [
     "Perturbation",
     "Phase",
     "capture_region",
+    "capture_summary",
     "dive",
     "dive_maneuver",
     "describe",
@@ -418,7 +419,32 @@ def capture_region(
         })  # fmt: skip
     wins = sum(r["landed"] for r in rows)
     return {"maneuver": maneuver.name, "starts": starts, "seed": seed, "landed": wins,
-            "success_rate": wins / max(starts, 1), "runs": rows}  # fmt: skip
+            "success_rate": wins / max(starts, 1), "region": capture_summary(rows),
+            "runs": rows}  # fmt: skip
+
+
+#: the perturbation measures a capture region is described by
+CAPTURE_MEASURES = ("joint_rms_deg", "pitch_deg", "speed_mps", "pitch_spin_rad_s")
+
+
+def capture_summary(rows: list[dict[str, Any]]) -> dict[str, dict[str, float | None]]:
+    """Where a maneuver succeeds, per perturbation measure (its size, ``abs``): the success
+    rate of the starts below and above the median, and the largest size that still
+    succeeded."""
+    out: dict[str, dict[str, float | None]] = {}
+    ok = np.array([bool(r["landed"]) for r in rows])
+    for key in CAPTURE_MEASURES:
+        v = np.abs(np.array([float(r[key]) for r in rows]))
+        if v.size == 0:
+            continue
+        small = v <= np.median(v)
+        out[key] = {
+            "median": float(np.median(v)),
+            "success_below_median": float(ok[small].mean()) if small.any() else None,
+            "success_above_median": float(ok[~small].mean()) if (~small).any() else None,
+            "largest_success": float(v[ok].max()) if ok.any() else None,
+        }
+    return out
 
 
 def _capture_one(job: tuple[Maneuver, Perturbation]) -> tuple[bool, float]:
