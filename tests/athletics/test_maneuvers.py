@@ -10,6 +10,7 @@ import pytest
 
 from reactmocap.athletics.maneuvers import (
     CONTROLLERS,
+    capture_region,
     dive,
     load_maneuver,
     run_maneuver,
@@ -144,3 +145,15 @@ def test_the_dive_command_enters_head_first_and_a_layout_dive_does_not(tmp_path:
     # the report tells the truth: a layout has too little rotation for 1.5 somersaults
     layout = dive("layout").report
     assert layout["landed"] is False and layout["fell"] is True and layout["entry_angle_deg"] > 30
+
+
+def test_capture_region_runs_perturbed_starts_and_says_where_they_succeed() -> None:
+    m = load_maneuver(EXAMPLES[[p.stem for p in EXAMPLES].index("vertical_leap")])
+    small = {"joint_sd": 0.005, "pitch_sd": 0.003, "velocity_sd": 0.005, "spin_sd": 0.01}
+    r = capture_region(m, starts=2, seed=1, **small)
+    assert r["starts"] == 2 and len(r["runs"]) == 2
+    assert r["landed"] == 2 and r["success_rate"] == 1.0
+    assert {"joint_rms_deg", "speed_mps"} <= set(r["region"])
+    # the starts really were perturbed, differently, by the stated sizes
+    a, b = r["runs"]
+    assert a["joint_rms_deg"] != b["joint_rms_deg"] and 0.05 < a["joint_rms_deg"] < 1.0
