@@ -524,7 +524,7 @@ def run_maneuver(
 
 
 # ---------------------------------------------------------------------------------- somersaults
-#: the built-in somersaults, tuned by hand (as the thesis's, section 8.4) on the male body:
+#: the built-in somersaults, tuned by hand (as the thesis's, section 8.4) per body:
 #: body -> direction -> (leap parameters, tumble lead (rad), landing foot-servo delta (m)).
 #: A pike or layout uses the tuck's leap and landing with the position's own inertia.
 SOMERSAULT_PRESETS: Mapping[str, Mapping[str, tuple[Mapping[str, float], float, float]]] = (
@@ -532,6 +532,10 @@ SOMERSAULT_PRESETS: Mapping[str, Mapping[str, tuple[Mapping[str, float], float, 
         "male": MappingProxyType({
             "backward": (MappingProxyType({"effort": 0.6, "spin": -55.0, "spin_limit": 1.0}),
                          2.8, -0.15),
+        }),
+        "female": MappingProxyType({
+            "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0}),
+                         3.2, -0.12),
         }),
     })
 )  # fmt: skip

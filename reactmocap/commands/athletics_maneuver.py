@@ -35,8 +35,8 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     s = inner.add_parser(
         "somersault", help="standing somersault: leap, tumble, land, balance (thesis 8.4-8.5)",
         description="A standing somersault composed of the leap, tumble, land and balance basis "
-        "controllers. Tuned: the male backward tuck; the other combinations run untuned and "
-        "their reports say what happened.",
+        "controllers. Tuned: the backward tuck (male, female); the other combinations run untuned "
+        "and their reports say what happened.",
     )  # fmt: skip
     s.add_argument("--position", choices=sorted(POSITIONS), default="tuck")
     s.add_argument("--direction", choices=list(DIRECTIONS), default="backward")

@@ -105,3 +105,11 @@ def test_windmilling_the_arms_with_no_momentum_tilts_the_body_about_20_degrees()
     assert arm_windmill("male", 2.0)["rotation_deg"] == pytest.approx(
         2 * one["rotation_deg"], rel=0.05
     )
+
+
+def test_the_female_back_somersault_lands_too() -> None:
+    r = somersault("tuck", "backward", "female").report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    # her tuck: about a third of the male's momentum, and faster (Fig. 5.2: 1.92 kg m^2)
+    assert -30.0 < r["liftoff_pitch_momentum"] < -15.0
+    assert r["tumble_min_inertia_kgm2"] < 2.2 and r["peak_somersault_rate_rad_s"] > 10.0
