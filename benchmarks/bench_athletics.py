@@ -4,6 +4,7 @@ the thesis-style plots and a JSON of every figure.
 
     python benchmarks/bench_athletics.py --tables      # rebuild the tables and supported ranges
     python benchmarks/bench_athletics.py --out docs/athletics   # the experiments and plots
+    python benchmarks/bench_athletics.py --capture --json docs/athletics/capture.json  # issue 19
 
 ``--workers N`` runs simulations in N processes (the figures do not depend on it).
 """
@@ -329,6 +330,31 @@ def print_table(res: dict[str, Any]) -> None:
           f"{res['speed']['cpu_median']:.2f}x (CPU time); thesis 70x slower")  # fmt: skip
 
 
+def capture(workers: int, starts: int = 50) -> dict[str, Any]:
+    """Issue 19's capture regions: each working maneuver from ``starts`` perturbed starts
+    (``Perturbation.sample``: 3 deg per joint axis, 2 deg pelvis pitch, 0.05 m/s, 0.1 rad/s;
+    and the same at a tenth of that), success = landed and not fell."""
+    from reactmocap.athletics.maneuvers import capture_region, load_maneuver
+
+    out: dict[str, Any] = {}
+    for name in ("back_somersault", "vertical_leap", "broad_jump", "dive_pike"):
+        m = load_maneuver(ROOT / "examples" / "athletics" / "maneuvers" / f"{name}.toml")
+        for label, scale in (("full", 1.0), ("tenth", 0.1)):
+            sd = {"joint_sd": math.radians(3.0) * scale, "pitch_sd": math.radians(2.0) * scale,
+                  "velocity_sd": 0.05 * scale, "spin_sd": 0.1 * scale}  # fmt: skip
+            t0 = time.time()
+            r = capture_region(m, starts=starts, workers=workers, **sd)
+            out[f"{name}_{label}"] = r
+            print(f"capture {name} ({label} perturbation): landed {r['landed']}/{starts} "
+                  f"({100 * r['success_rate']:.0f}%; thesis: not measured; goal >= 90%) "
+                  f"[{time.time() - t0:.0f} s]", flush=True)  # fmt: skip
+            for key, reg in r["region"].items():
+                print(f"    {key}: median {reg['median']:.3g}, success below/above it "
+                      f"{reg['success_below_median']:.0%}/{reg['success_above_median']:.0%}, "
+                      f"largest that landed {reg['largest_success']}")  # fmt: skip
+    return out
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -339,10 +365,19 @@ def main() -> int:
     ap.add_argument("--out", type=Path, help="folder for the plots")
     ap.add_argument("--json", type=Path, help="write every figure as JSON")
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--capture", action="store_true",
+                    help="issue 19: capture regions of the example maneuvers (50 starts each)")  # fmt: skip
     ap.add_argument("--replot", type=Path, help="redraw the plots from a --json file into --out")
     args = ap.parse_args()
     if args.tables:
         build_tables(args.workers, tuple(args.parts.split(",")))
+        return 0
+    if args.capture:
+        res = capture(args.workers)
+        if args.json is not None:
+            from reactmocap.io import atomic_write_text
+
+            atomic_write_text(args.json, json.dumps(res, indent=1, default=str) + "\n")
         return 0
     if args.replot is not None:
         res = json.loads(args.replot.read_text())

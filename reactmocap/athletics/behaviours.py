@@ -114,14 +114,19 @@ def _simulate(
     ath: Athlete, world: World, bases: list, duration: float, *, behaviour: str,
     impacts: tuple[Impact, ...] = (), extra: tuple[Controller, ...] = (),
     on_tick: Callable[[float], None] | None = None, fps: float = 60.0,
+    extra_from_ctx: Callable[[Context], Controller] | None = None,
+    energy_limit_per_kg: float = 100.0,
 ) -> tuple[Context, Sequencer, RolloutResult]:  # fmt: skip
     ctx = Context.make(world, ath, control_every=CONTROL_EVERY)
     seq = Sequencer(ctx, bases)
+    if extra_from_ctx is not None:  # a controller that needs the run's context (a platform)
+        extra = (*extra, extra_from_ctx(ctx))
     tick = None if on_tick is None else (lambda t: on_tick(min(t / duration, 1.0)))
     cpu = time.process_time()
     try:
         res = rollout(world, duration, controllers=[seq, *extra], impacts=impacts,
-                      record_fps=fps, on_unstable="stop", on_tick=tick, tick_every=200)  # fmt: skip
+                      record_fps=fps, on_unstable="stop", on_tick=tick, tick_every=200,
+                      energy_limit_per_kg=energy_limit_per_kg)  # fmt: skip
     finally:
         ctx.rig.release()
     ctx.handover["cpu_s"] = time.process_time() - cpu

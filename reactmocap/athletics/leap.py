@@ -25,7 +25,7 @@ from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import Event, State, after
 from reactmocap.sim.world import World
 
-__all__ = ["BROAD_TIMING", "LEAP_STIFFNESS", "VERTICAL_TIMING", "Leap", "LeapParams"]
+__all__ = ["BROAD_TIMING", "HANDOVERS", "LEAP_STIFFNESS", "VERTICAL_TIMING", "Leap", "LeapParams"]
 
 NJ = len(BALL_JOINTS)
 #: seconds to full extension of hip, knee and ankle (section 4.1 and 4.2)
@@ -42,6 +42,8 @@ LEAP_STIFFNESS = {
     "waist": 3.0, "back": 3.0, "neck": 0.3, "shoulder": 0.6, "elbow": 0.15, "wrist": 0.05,
     "hip": 6.0, "knee": 6.0, "ankle": 3.0,
 }  # fmt: skip
+#: when a leap may hand over to the next basis controller (see LeapParams.handover)
+HANDOVERS = ("auto", "apex", "liftoff")
 #: stiffness in the air (the legs only position themselves)
 FLIGHT_STIFFNESS = {
     "waist": 2.0, "back": 2.0, "neck": 0.3, "shoulder": 0.3, "elbow": 0.15, "wrist": 0.05,
@@ -70,18 +72,27 @@ class LeapParams:
     spin: float = 0.0
     spin_gain: float = 0.0
     accelerate: bool = False
+    #: when the leap hands over: ``"auto"`` (at the apex for a vertical leap, at lift-off for
+    #: a broad jump), ``"apex"`` or ``"liftoff"`` (a somersault tucks at once)
+    handover: str = "auto"
+    #: the largest hip offset (rad) the angular-momentum feedback may make
+    spin_limit: float = 0.6
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
                 self.hold, *self.timing, self.ankle_gain, self.ankle_extension, self.liftoff_hip,
                 self.stiffness, self.lean,
-                self.spin, self.spin_gain]  # fmt: skip
+                self.spin, self.spin_gain, self.spin_limit]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.3 <= self.leg <= 1.0:
             raise ConfigError(f"leap crouch leg fraction must be in [0.3, 1.0], got {self.leg}")
         if min(self.timing) <= 0 or self.crouch <= 0 or self.hold < 0 or self.ankle_gain <= 0:
             raise ConfigError("leap timing, crouch and ankle gain must be > 0")
+        if self.handover not in HANDOVERS:
+            raise ConfigError(
+                f"leap handover must be one of {list(HANDOVERS)}, got {self.handover!r}"
+            )
 
 
 def pitch_momentum(world: World, s: Senses) -> float:
@@ -159,7 +170,7 @@ class Leap(Basis):
                 pitch_l = pitch_momentum(world, s)
                 err = (pitch_l - p.spin) / (ctx.athlete.mass * ctx.athlete.leg_length**2)
                 ramp = min(1.0, (t - memo["t_thrust"]) / SPIN_RAMP)
-                off = float(np.clip(ramp * p.spin_gain * err, -0.6, 0.6))
+                off = float(np.clip(ramp * p.spin_gain * err, -p.spin_limit, p.spin_limit))
                 for j in (joint_index("l_hip"), joint_index("r_hip")):
                     ctx.rig.offset[j, 0] = off
 
@@ -171,7 +182,8 @@ class Leap(Basis):
             ctx.rig.support_scale = 1.0
             ctx.rig.support_dir = None
 
-        flight_exit: Event = apex(ctx) if not p.broad else after(0.0)
+        at_apex = p.handover == "apex" or (p.handover == "auto" and not p.broad)
+        flight_exit: Event = apex(ctx) if at_apex else after(0.0)
         return [
             State(
                 "crouch", law(bl.control, every), crouch, ((after(p.crouch + p.hold), "thrust"),)

@@ -53,6 +53,12 @@ class Log:
     offsets: list[float] = field(default_factory=list)
     #: per tick: whole-body angular momentum about the COM (kg m^2/s, world)
     momentum: list[F64] = field(default_factory=list)
+    #: per tick: somersault rotation so far (rad, unwrapped trunk pitch in the starting
+    #: heading's sagittal plane, > 0 forward) and twist so far (rad, about the trunk's axis)
+    rotation: list[float] = field(default_factory=list)
+    twist: list[float] = field(default_factory=list)
+    #: per tick: the pelvis-to-head line (world, unit)
+    trunk: list[F64] = field(default_factory=list)
 
     def arrays(self) -> dict[str, NDArray]:
         if not self.rows:
@@ -61,7 +67,8 @@ class Log:
                     "grf": np.zeros((0, 3)), "feet": z.astype(int), "state": np.array([]),
                     "torque": np.zeros((0, 15)), "power": np.zeros((0, 15)),
                     "others": z.astype(bool), "pelvis": z, "offset": z,
-                    "momentum": np.zeros((0, 3))}  # fmt: skip
+                    "momentum": np.zeros((0, 3)), "rotation": z, "twist": z,
+                    "trunk": np.zeros((0, 3))}  # fmt: skip
         t, com, vel, grf, feet, state = zip(*self.rows)
         return {
             "t": np.array(t), "com": np.array(com), "com_vel": np.array(vel),
@@ -69,6 +76,8 @@ class Log:
             "torque": np.array(self.torques), "power": np.array(self.powers),
             "others": np.array(self.others), "pelvis": np.array(self.pelvis),
             "offset": np.array(self.offsets), "momentum": np.array(self.momentum),
+            "rotation": np.array(self.rotation), "twist": np.array(self.twist),
+            "trunk": np.array(self.trunk),
         }  # fmt: skip
 
 
@@ -91,6 +100,11 @@ class Context:
     standing_com: float | None = None
     #: anything a basis controller hands to the next (e.g. the landing's balance posture)
     handover: dict[str, object] = field(default_factory=dict)
+    #: somersault rotation and twist so far (rad; see :class:`Log`), kept by the sequencer
+    rotation: float = 0.0
+    twist: float = 0.0
+    #: the heading (rad) whose sagittal plane the rotation is measured in (the first tick's)
+    heading0: float | None = None
 
     @classmethod
     def make(

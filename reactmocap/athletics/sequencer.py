@@ -7,6 +7,7 @@ law, write the servo, log."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -17,7 +18,7 @@ from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import State, StateMachine
 from reactmocap.sim.world import World
 
-__all__ = ["Sequencer"]
+__all__ = ["Sequencer", "somersault_pitch"]
 
 NJ = len(BALL_JOINTS)
 
@@ -49,6 +50,10 @@ class Sequencer:
                                     ctx.control_every)  # fmt: skip
         dofs = ctx.rig.wc.ball_dof_start
         self._dofs = slice(dofs, dofs + 3 * NJ)
+        self._head = ctx.senses.body("head")
+        self._trunk = 0.0
+        self._trunk_dir = np.array([0.0, 0.0, 1.0])
+        self._t = 0.0
 
     @property
     def state(self) -> str:
@@ -61,14 +66,17 @@ class Sequencer:
     def reset(self, world: World) -> None:
         self.ctx.rig.reset()
         self.ctx.senses.time = -1.0
+        self.ctx.rotation = self.ctx.twist = 0.0
+        self.ctx.heading0 = None
         self.machine.reset(world)
 
     def control(self, world: World, t: float) -> None:
         ctx = self.ctx
         s = ctx.sense(t)
+        d = world.data
+        self._turn(d, s, t)
         self.machine.control(world, t)
         ctx.rig.apply(t)
-        d = world.data
         tau = (d.qfrc_actuator[self._dofs] + d.qfrc_applied[self._dofs]
                + d.qfrc_damper[self._dofs]).reshape(NJ, 3)  # fmt: skip
         w = d.qvel[self._dofs].reshape(NJ, 3)
@@ -81,3 +89,31 @@ class Sequencer:
         centre = s.support_center()
         ctx.log.offsets.append(float(np.hypot(*(s.com[:2] - centre[:2]))))
         ctx.log.pelvis.append(float(d.xpos[s.root][2]))
+        ctx.log.rotation.append(ctx.rotation)
+        ctx.log.twist.append(ctx.twist)
+        ctx.log.trunk.append(self._trunk_dir)
+
+    def _turn(self, d, s, t: float) -> None:  # type: ignore[no-untyped-def]
+        """Update the somersault rotation (the pelvis-to-head line's pitch in the first
+        tick's sagittal plane, unwrapped) and the twist (the pelvis's angular velocity about
+        that line, integrated)."""
+        ctx = self.ctx
+        trunk = d.xpos[self._head] - d.xpos[s.root]
+        trunk = trunk / max(float(np.linalg.norm(trunk)), 1e-9)
+        self._trunk_dir = trunk
+        if ctx.heading0 is None:
+            ctx.heading0 = s.heading()
+            self._trunk = somersault_pitch(trunk, ctx.heading0)
+            self._t = t
+        a = somersault_pitch(trunk, ctx.heading0)
+        ctx.rotation += (a - self._trunk + math.pi) % (2.0 * math.pi) - math.pi
+        self._trunk = a
+        ctx.twist += float(d.cvel[s.root, :3] @ trunk) * (t - self._t)
+        self._t = t
+
+
+def somersault_pitch(trunk: np.ndarray, heading: float) -> float:
+    """Pitch (rad, ``(-pi, pi]``, 0 upright, > 0 forward) of the direction ``trunk`` in the
+    sagittal plane of ``heading``."""
+    fwd = float(trunk[0] * math.cos(heading) + trunk[1] * math.sin(heading))
+    return math.atan2(fwd, float(trunk[2]))

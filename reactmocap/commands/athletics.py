@@ -38,7 +38,9 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     from reactmocap.athletics.behaviours import BEHAVIOURS
 
     ath = sub.add_parser(
-        "athletics", help="athletic controllers: leap, broad jump, land, balance, run, vault"
+        "athletics",
+        help="athletic controllers: leap, broad jump, land, balance, run, vault, maneuver, "
+        "somersault, dive",
     )
     inner = ath.add_subparsers(dest="behaviour", metavar="BEHAVIOUR", required=True)
     for name, flags in _FLAGS.items():
@@ -65,6 +67,10 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     from reactmocap.commands.athletics_run import register_run
 
     register_run(inner)  # run, vault
+
+    from reactmocap.commands.athletics_maneuver import register_maneuvers
+
+    register_maneuvers(inner)  # maneuver, somersault, dive
 
     from reactmocap.commands.athletics_bicycle import register as register_bicycle
 

@@ -1,0 +1,142 @@
+"""``athletics maneuver FILE.toml``, ``athletics somersault`` and ``athletics dive``: thin
+wrappers over :func:`reactmocap.athletics.maneuvers.run_maneuver`,
+:func:`~reactmocap.athletics.maneuvers.somersault` and :func:`~reactmocap.athletics.maneuvers.dive`
+that write a BVH, a JSON report and
+optionally a video (each written atomically)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+__all__ = ["register_maneuvers"]
+
+
+def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Add ``maneuver``, ``somersault`` and ``dive`` to the ``athletics`` command's
+    sub-commands."""
+    from reactmocap.athletics.maneuvers import DIRECTIONS, describe
+    from reactmocap.athletics.tumble import POSITIONS
+
+    m = inner.add_parser(
+        "maneuver", help="run a maneuver file: phases of basis controllers with exit events",
+        description="Runs a TOML maneuver (examples/athletics/maneuvers/*.toml): phases, each "
+        "naming a basis controller, its parameters and the event that ends it.\n\n" + describe(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )  # fmt: skip
+    m.add_argument("file", type=Path, help="MANEUVER.toml")
+    m.add_argument("--out", type=Path, required=True,
+                   help="folder for NAME.bvh and NAME.json (the report)")  # fmt: skip
+    m.add_argument("--body", help="male, female or a BVH file (default: the file's body)")
+    m.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
+    m.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
+    m.set_defaults(func=_maneuver)
+
+    s = inner.add_parser(
+        "somersault", help="standing somersault: leap, tumble, land, balance (thesis 8.4-8.5)",
+        description="A standing somersault composed of the leap, tumble, land and balance basis "
+        "controllers. Tuned: the backward tuck (male, female); the other combinations run untuned "
+        "and their reports say what happened.",
+    )  # fmt: skip
+    s.add_argument("--position", choices=sorted(POSITIONS), default="tuck")
+    s.add_argument("--direction", choices=list(DIRECTIONS), default="backward")
+    s.add_argument("--twist", type=float, default=0.0,
+                   help="twist turns (not built yet: anything but 0 is refused)")  # fmt: skip
+    s.add_argument("--body", default="male", help="male, female or a BVH file (default male)")
+    s.add_argument("--backpack", type=float, default=0.0, help="kg on the chest (thesis 8.5.2)")
+    s.add_argument("--out", type=Path, help="BVH of the motion (default: NAME_BODY.bvh)")
+    s.add_argument("--report", type=Path, help="JSON report")
+    s.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
+    s.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
+    s.set_defaults(func=_somersault)
+
+    from reactmocap.athletics.maneuvers import DIVE_DIRECTIONS, PLATFORM_MAX
+
+    d = inner.add_parser(
+        "dive", help="platform dive: leap, somersault, stretch, enter the water (thesis ch. 8)",
+        description="A backward dive from a platform, judged at the water (a plane at the "
+        "platform's foot): `landed` is a clean, head-first entry.",
+    )  # fmt: skip
+    d.add_argument("--position", choices=sorted(POSITIONS), default="pike")
+    d.add_argument("--direction", choices=list(DIVE_DIRECTIONS), default="backward")
+    d.add_argument("--height", type=float, default=5.0,
+                   help=f"platform height over the water (1-{PLATFORM_MAX:g} m; default 5)")  # fmt: skip
+    d.add_argument("--turns", type=float, default=1.5, help="somersaults (1.5: head first)")
+    d.add_argument("--twist", type=float, default=0.0,
+                   help="twist turns (not built yet: anything but 0 is refused)")  # fmt: skip
+    d.add_argument("--body", default="male", help="male, female or a BVH file (default male)")
+    d.add_argument("--out", type=Path, help="BVH of the motion (default: NAME_BODY.bvh)")
+    d.add_argument("--report", type=Path, help="JSON report")
+    d.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
+    d.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
+    d.set_defaults(func=_dive)
+
+
+def _maneuver(args: argparse.Namespace) -> int:
+    from reactmocap.athletics.maneuvers import load_maneuver, run_maneuver
+    from reactmocap.commands.athletics import _Bar
+    from reactmocap.io import atomic_write_text
+
+    maneuver = load_maneuver(args.file)
+    with _Bar(maneuver.name) as bar:
+        result = run_maneuver(maneuver, args.body, on_tick=bar.tick, fps=args.fps)
+    out: Path = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    bvh = out / f"{maneuver.name}.bvh"
+    result.write_bvh(bvh)
+    atomic_write_text(out / f"{maneuver.name}.json", result.report_json())
+    _finish(result, args.video, bvh)
+    return 0
+
+
+def _somersault(args: argparse.Namespace) -> int:
+    from reactmocap.athletics.maneuvers import somersault
+    from reactmocap.commands.athletics import _Bar
+    from reactmocap.io import atomic_write_text
+
+    with _Bar("somersault") as bar:
+        result = somersault(args.position, args.direction, str(args.body), twist=args.twist,
+                            backpack=args.backpack, on_tick=bar.tick, fps=args.fps)  # fmt: skip
+    out = args.out or Path(f"{result.behaviour}_{result.body}.bvh")
+    result.write_bvh(out)
+    if args.report is not None:
+        atomic_write_text(args.report, result.report_json())
+    _finish(result, args.video, out)
+    return 0
+
+
+def _dive(args: argparse.Namespace) -> int:
+    from reactmocap.athletics.maneuvers import dive
+    from reactmocap.commands.athletics import _Bar
+    from reactmocap.io import atomic_write_text
+
+    with _Bar("dive") as bar:
+        result = dive(args.position, args.direction, str(args.body), height=args.height,
+                      turns=args.turns, twist=args.twist, on_tick=bar.tick, fps=args.fps)  # fmt: skip
+    out = args.out or Path(f"{result.behaviour}_{result.body}.bvh")
+    result.write_bvh(out)
+    if args.report is not None:
+        atomic_write_text(args.report, result.report_json())
+    _finish(result, args.video, out)
+    return 0
+
+
+def _finish(result, video: Path | None, out: Path) -> None:  # type: ignore[no-untyped-def]
+    if video is not None:
+        from reactmocap.athletics.plots import run_video
+
+        path, renderer = run_video(result, video)
+        print(f"video: {path} ({renderer})")
+    r = result.report
+    print(f"{r['behaviour']} ({r['body']}): rotation {r['rotation_deg']:.0f} deg, twist "
+          f"{r['twist_deg']:.0f} deg, landed={r['landed']}, fell={r['fell']} -> {out}")  # fmt: skip
+    if r.get("status") != "ok":
+        print(f"note: the simulation stopped early: {r.get('reason')}")
+    if "entry_angle_deg" in r:
+        print(f"entry: {r['entry_angle_deg']:.0f} deg from head first, straight down "
+              f"({'clean' if r['landed'] else 'not clean'})")  # fmt: skip
+    elif not r["landed"] or r["fell"]:
+        print("note: the athlete did not end balanced on its feet")
+    if r.get("human_plausible") is False:
+        print("note: this needs more joint torque than the strength model allows "
+              "(docs/athletics.md)")  # fmt: skip

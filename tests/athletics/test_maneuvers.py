@@ -1,0 +1,159 @@
+"""Maneuvers in TOML (issue 19): strict validation naming the file and field, every shipped
+example runs, and the ``maneuver`` and ``somersault`` commands write what they say."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from reactmocap.athletics.maneuvers import (
+    CONTROLLERS,
+    capture_region,
+    dive,
+    load_maneuver,
+    run_maneuver,
+    somersault,
+)
+from reactmocap.cli import main
+from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.library.bvh import read_bvh
+
+EXAMPLES = sorted(
+    (Path(__file__).resolve().parents[2] / "examples/athletics/maneuvers").glob("*.toml")
+)
+
+GOOD_PHASE = '[[phase]]\ncontroller = "balance"\nexit = { event = "after", seconds = 0.2 }\n'
+
+
+def _file(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    return path
+
+
+def test_an_unknown_controller_names_the_file_the_phase_and_the_valid_ones(tmp_path: Path) -> None:
+    path = _file(
+        tmp_path, GOOD_PHASE + '[[phase]]\ncontroller = "flip"\nexit = { event = "open" }\n'
+    )
+    with pytest.raises(ConfigError) as err:
+        load_maneuver(path)
+    msg = str(err.value)
+    assert str(path) in msg and "phase[2].controller" in msg and "'flip'" in msg
+    assert all(name in msg for name in CONTROLLERS)
+
+
+def test_a_missing_exit_event_is_a_config_error_naming_the_field(tmp_path: Path) -> None:
+    path = _file(tmp_path, '[[phase]]\ncontroller = "leap"\nparams = { effort = 0.5 }\n')
+    with pytest.raises(ConfigError, match=r"phase\[1\]\.exit is missing") as err:
+        load_maneuver(path)
+    assert str(path) in str(err.value) and "liftoff" in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("text", "field"),
+    [
+        ('[[phase]]\ncontroller = "tumble"\nexit = { event = "apex" }\n', r"phase\[1\]\.exit\.event"),
+        ('[[phase]]\ncontroller = "leap"\nparams = { spinn = 1.0 }\nexit = { event = "apex" }\n',
+         r"phase\[1\]\.params\.spinn"),
+        ('[[phase]]\ncontroller = "leap"\nparams = { spin = "fast" }\nexit = { event = "apex" }\n',
+         r"phase\[1\]\.params\.spin must be a number"),
+        ('[[phase]]\ncontroller = "tumble"\nparams = { position = "straddle" }\n'
+         'exit = { event = "open" }\n', r"phase\[1\]\.params\.position"),
+        ('[[phase]]\ncontroller = "balance"\nexit = { event = "after" }\n',
+         r"phase\[1\]\.exit\.seconds"),
+        ('seconds = -1\n' + GOOD_PHASE, "seconds must be"),
+        ('name = "x"\n', "phase"),
+        ('nmae = "x"\n' + GOOD_PHASE, "unknown field"),
+        ('[[phase]\n', "not valid TOML"),
+    ],
+)  # fmt: skip
+def test_bad_files_are_refused_naming_the_field(tmp_path: Path, text: str, field: str) -> None:
+    with pytest.raises(ConfigError, match=field):
+        load_maneuver(_file(tmp_path, text))
+
+
+def test_every_example_is_valid_and_names_a_maneuver_the_issue_asks_for() -> None:
+    names = {p.stem for p in EXAMPLES}
+    assert {"back_somersault", "vertical_leap", "broad_jump", "dive_pike"} <= names
+    for path in EXAMPLES:
+        m = load_maneuver(path)
+        assert m.name == path.stem and m.phases[0].controller == "balance"
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_each_example_maneuver_runs_and_lands(path: Path) -> None:
+    r = run_maneuver(load_maneuver(path)).report
+    assert r["status"] == "ok" and r["time_to_liftoff_s"] is not None
+    assert r["landed"] and not r["fell"]
+    if path.stem == "back_somersault":
+        assert abs(r["rotation_deg"] + 360.0) <= 30.0
+    elif path.stem.startswith("dive"):  # 1.5 somersaults: head first into the water
+        assert abs(r["rotation_deg"] + 540.0) <= 30.0 and r["entry_angle_deg"] <= 30.0
+        assert r["flight_momentum_drift"] <= 0.01
+    else:
+        assert abs(r["rotation_deg"]) <= 30.0
+    if path.stem == "broad_jump":
+        assert r["travel_m"] > 0.6
+
+
+def test_the_maneuver_command_writes_bvh_and_report(tmp_path: Path) -> None:
+    src = EXAMPLES[[p.stem for p in EXAMPLES].index("vertical_leap")]
+    out = tmp_path / "out"
+    assert main(["athletics", "maneuver", str(src), "--out", str(out)]) == 0
+    report = json.loads((out / "vertical_leap.json").read_text())
+    assert report["landed"] is True and report["achieved_height_m"] > 0.2
+    assert read_bvh(out / "vertical_leap.bvh").num_frames > 100
+
+
+def test_the_somersault_command_reports_rotation_twist_landed_and_fell(tmp_path: Path) -> None:
+    out, rep = tmp_path / "s.bvh", tmp_path / "s.json"
+    args = ["athletics", "somersault", "--position", "tuck", "--direction", "backward"]
+    assert main([*args, "--out", str(out), "--report", str(rep)]) == 0
+    report = json.loads(rep.read_text())
+    assert {"rotation_deg", "twist_deg", "landed", "fell"} <= set(report)
+    assert report["landed"] is True and abs(report["rotation_deg"] + 360) <= 30
+    assert abs(report["twist_deg"]) < 30
+    assert read_bvh(out).num_frames > 100
+
+
+def test_somersault_refuses_what_is_not_built(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "s.bvh"
+    assert main(["athletics", "somersault", "--twist", "1", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("reactmocap: error:") and "twist" in err[0]
+    assert not out.exists()
+    with pytest.raises(UnknownKeyError, match="valid positions"):
+        somersault("straddle")
+    with pytest.raises(UnknownKeyError, match="valid directions"):
+        somersault("tuck", "sideways")
+
+
+def test_the_dive_command_enters_head_first_and_a_layout_dive_does_not(tmp_path: Path) -> None:
+    out, rep = tmp_path / "d.bvh", tmp_path / "d.json"
+    assert (
+        main(["athletics", "dive", "--position", "tuck", "--out", str(out), "--report", str(rep)])
+        == 0
+    )
+    report = json.loads(rep.read_text())
+    assert {"rotation_deg", "twist_deg", "landed", "fell", "entry_angle_deg"} <= set(report)
+    assert report["landed"] is True and report["fell"] is False
+    assert abs(report["rotation_deg"] + 540.0) <= 30.0
+    # the report tells the truth: a layout has too little rotation for 1.5 somersaults
+    layout = dive("layout").report
+    assert layout["landed"] is False and layout["fell"] is True and layout["entry_angle_deg"] > 30
+
+
+def test_capture_region_runs_perturbed_starts_and_says_where_they_succeed() -> None:
+    m = load_maneuver(EXAMPLES[[p.stem for p in EXAMPLES].index("vertical_leap")])
+    small = {"joint_sd": 0.005, "pitch_sd": 0.003, "velocity_sd": 0.005, "spin_sd": 0.01}
+    r = capture_region(m, starts=2, seed=1, **small)
+    assert r["starts"] == 2 and len(r["runs"]) == 2
+    assert r["landed"] == 2 and r["success_rate"] == 1.0
+    assert {"joint_rms_deg", "speed_mps"} <= set(r["region"])
+    # the starts really were perturbed, differently, by the stated sizes
+    a, b = r["runs"]
+    assert a["joint_rms_deg"] != b["joint_rms_deg"] and 0.05 < a["joint_rms_deg"] < 1.0

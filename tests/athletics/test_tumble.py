@@ -1,0 +1,115 @@
+"""Tumbling (thesis ch. 5) and the standing back somersault (ch. 8.4), measured on the bodies and
+on the simulated motion."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from reactmocap.athletics import athlete
+from reactmocap.athletics.backdrop import arm_windmill
+from reactmocap.athletics.maneuvers import run_maneuver, somersault, somersault_maneuver
+from reactmocap.athletics.tumble import POSITIONS, TumbleParams, somersault_inertia
+from reactmocap.errors import ConfigError, UnknownKeyError
+
+#: Fig. 5.2: moment of inertia about the somersault axis (kg m^2)
+THESIS_FIG_5_2 = {
+    "male": {"layout": 18.31, "pike": 5.84, "tuck": 4.84},
+    "female": {"layout": 7.43, "pike": 2.52, "tuck": 1.92},
+}
+
+
+@pytest.mark.parametrize("body", ["male", "female"])
+def test_somersault_inertia_within_10_percent_of_the_thesis(body: str) -> None:
+    a = athlete(body)
+    for position, thesis in THESIS_FIG_5_2[body].items():
+        measured = somersault_inertia(a, position)
+        assert abs(measured - thesis) <= 0.10 * thesis, (position, measured, thesis)
+    # the tuck is the tightest: about a third of the layout's (section 5.1)
+    assert (
+        somersault_inertia(a, "tuck")
+        < somersault_inertia(a, "pike")
+        < somersault_inertia(a, "layout") / 2.5
+    )
+
+
+def test_positions_and_params_are_checked() -> None:
+    assert set(POSITIONS) == {"layout", "pike", "tuck"}
+    with pytest.raises(UnknownKeyError, match="valid positions"):
+        TumbleParams(position="straddle")
+    with pytest.raises(ConfigError, match="> 0"):
+        TumbleParams(turns=0.0)
+
+
+@pytest.fixture(scope="module")
+def back_tuck():  # type: ignore[no-untyped-def]
+    return somersault("tuck", "backward", "male")
+
+
+def test_a_back_somersault_turns_360_and_lands(back_tuck) -> None:  # type: ignore[no-untyped-def]
+    r = back_tuck.report
+    assert abs(abs(r["rotation_deg"]) - 360.0) <= 30.0
+    assert r["rotation_deg"] < 0  # backward
+    assert r["landed"] and not r["fell"] and r["status"] == "ok"
+    # the rotation is the log's: the trunk came back upright, one turn round
+    assert np.degrees(back_tuck.log["rotation"][-1]) == pytest.approx(r["rotation_deg"])
+    assert [t for _, _, t in back_tuck.transitions][3:5] == ["tumble.tumble", "land.reach"]
+
+
+def test_angular_momentum_is_conserved_in_the_somersault_flight(back_tuck) -> None:  # type: ignore[no-untyped-def]
+    r = back_tuck.report
+    t, momentum = back_tuck.log["t"], back_tuck.log["momentum"]
+    flight = (t > r["time_to_liftoff_s"] + 0.01) & (t < r["touchdown_s"] - 0.01)
+    assert flight.sum() > 100
+    m = momentum[flight]
+    assert np.linalg.norm(m[0]) > 30.0  # a real back somersault's momentum
+    assert np.abs(m - m[0]).max() / np.linalg.norm(m[0]) <= 0.01
+    # tucking speeds the rotation up (Fig. 5.3): peak rate well above the layout's L / I
+    layout = np.linalg.norm(m[0]) / somersault_inertia(athlete("male"), "layout")
+    assert r["peak_somersault_rate_rad_s"] > 2.5 * layout
+
+
+def test_a_4_kg_backpack_still_lands_the_back_somersault_untuned() -> None:
+    # thesis 8.5.2 (there on the forward somersault, which needed re-tuning)
+    r = somersault("tuck", "backward", "male", backpack=4.0).report
+    assert r["backpack_kg"] == 4.0 and r["liftoff_pitch_momentum"] < -50.0  # heavier: more L
+    assert r["landed"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+
+
+def _layout_flight(arm_tilt: float) -> dict:  # type: ignore[type-arg]
+    m = somersault_maneuver("layout")
+    phases = list(m.phases)
+    phases[2] = replace(phases[2], params={**phases[2].params, "arm_tilt": arm_tilt})
+    return run_maneuver(replace(m, phases=tuple(phases), seconds=2.3)).report
+
+
+def test_the_arm_throw_starts_a_twist_in_the_air() -> None:
+    # section 5.2: both arms turned the same way about the front-back axis tilt the body out of
+    # the somersault plane; with no throw the layout somersault does not twist
+    still, thrown = _layout_flight(0.0), _layout_flight(1.0)
+    assert abs(still["twist_at_touchdown_deg"]) < 10.0
+    assert abs(thrown["twist_at_touchdown_deg"]) > 90.0
+    assert thrown["flight_momentum_drift"] <= 0.01
+
+
+def test_windmilling_the_arms_with_no_momentum_tilts_the_body_about_20_degrees() -> None:
+    # thesis 5.1.1: one clockwise windmill of the arms tilts the male torso ~20 degrees the
+    # other way; torque-free, so the angular momentum stays at zero
+    one, back = arm_windmill("male", 1.0), arm_windmill("male", -1.0)
+    assert one["status"] == "ok" and one["max_momentum"] < 0.1
+    assert 15.0 <= one["rotation_per_cycle_deg"] <= 25.0
+    assert back["rotation_deg"] == pytest.approx(-one["rotation_deg"], abs=1.0)
+    # it adds up cycle by cycle (a somersault by repetition, given the time)
+    assert arm_windmill("male", 2.0)["rotation_deg"] == pytest.approx(
+        2 * one["rotation_deg"], rel=0.05
+    )
+
+
+def test_the_female_back_somersault_lands_too() -> None:
+    r = somersault("tuck", "backward", "female").report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    # her tuck: about a third of the male's momentum, and faster (Fig. 5.2: 1.92 kg m^2)
+    assert -30.0 < r["liftoff_pitch_momentum"] < -15.0
+    assert r["tumble_min_inertia_kgm2"] < 2.2 and r["peak_somersault_rate_rad_s"] > 10.0
