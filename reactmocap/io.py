@@ -1,16 +1,20 @@
 """Atomic file writing: outputs are written to a temporary sibling and renamed into place, so a
-crash or an exception never leaves a half-written file."""
+crash or an exception never leaves a half-written file. Reading TOML input files with errors
+that name the file."""
 
 from __future__ import annotations
 
 import contextlib
 import os
 import tempfile
+import tomllib
 from collections.abc import Iterator
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
-__all__ = ["atomic_write", "atomic_write_bytes", "atomic_write_text"]
+from reactmocap.errors import ConfigError
+
+__all__ = ["atomic_write", "atomic_write_bytes", "atomic_write_text", "read_toml"]
 
 
 def _umask() -> int:
@@ -46,3 +50,20 @@ def atomic_write_text(path: str | Path, text: str) -> None:
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     with atomic_write(path, "wb") as fh:
         fh.write(data)
+
+
+def read_toml(path: str | Path, what: str) -> dict[str, Any]:
+    """The table of TOML file ``path`` (a ``what`` file: "scenario", "course", ...); a missing
+    or unreadable file or invalid TOML raises :class:`~reactmocap.errors.ConfigError` naming
+    the file (and TOML's line and column)."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError(f"{what} file {str(p)!r} does not exist")
+    try:
+        text = p.read_text()
+    except OSError as exc:
+        raise ConfigError(f"{p}: cannot read {what} file: {exc.strerror or exc}") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{p}: invalid TOML: {exc}") from None

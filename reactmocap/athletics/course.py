@@ -26,7 +26,6 @@ Example (``examples/athletics/courses/corner_on_a_hill.toml``)::
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,6 +36,7 @@ from numpy.typing import NDArray
 
 from reactmocap.athletics.cycling_scene import Obstacle, Terrain
 from reactmocap.errors import ConfigError
+from reactmocap.io import read_toml
 
 __all__ = ["Course", "Route", "load_course", "parse_course"]
 
@@ -215,10 +215,4 @@ def parse_course(data: Mapping[str, Any], source: str = "<course>") -> Course:
 def load_course(path: str | Path) -> Course:
     """Read and check a course file."""
     p = Path(path)
-    if not p.is_file():
-        raise ConfigError(f"course file {str(p)!r} does not exist")
-    try:
-        data = tomllib.loads(p.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{p}: not valid TOML: {exc}") from None
-    return parse_course(data, str(p))
+    return parse_course(read_toml(p, "course"), str(p))

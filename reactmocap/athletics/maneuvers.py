@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -56,6 +55,7 @@ from reactmocap.athletics.machine import Basis
 from reactmocap.athletics.scene import athletics_world, stand_angles
 from reactmocap.athletics.tumble import POSITIONS, Tumble, TumbleParams, somersault_inertia
 from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.io import read_toml
 from reactmocap.sim.world import World
 
 __all__ = [
@@ -274,12 +274,7 @@ def load_maneuver(path: str | Path) -> Maneuver:
     """Read and check a maneuver file (format: the module docstring). Every error is a
     :class:`~reactmocap.errors.ConfigError` naming the file and the field."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise ConfigError(f"cannot read maneuver file {str(path)!r}: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    data = read_toml(path, "maneuver")
     return maneuver_from_dict(data, str(path), default_name=path.stem)
 
 

@@ -48,6 +48,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.io import read_toml
 from reactmocap.response.scenario import (
     AttackerSpec,
     CharacterSpec,
@@ -571,10 +572,5 @@ def _base(source: str, spec: Any, base_dir: Path) -> tuple[dict[str, Any], Path]
 def load_sweep(path: str | Path) -> Sweep:
     """Read and validate a sweep TOML file."""
     p = Path(path)
-    try:
-        data = tomllib.loads(p.read_text())
-    except OSError as exc:
-        raise ConfigError(f"{p}: cannot read sweep file: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{p}: invalid TOML: {exc}") from None
+    data = read_toml(p, "sweep")
     return parse_sweep(data, source=str(p), base_dir=p.parent)

@@ -15,7 +15,6 @@ lower-case ``lfemur`` style of ASF-derived files. A TOML file can override them:
 from __future__ import annotations
 
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import BodyPartMappingError, ConfigError
+from reactmocap.io import read_toml
 from reactmocap.library.skeleton import Skeleton
 
 __all__ = [
@@ -150,10 +150,7 @@ def _load_overrides(rules: str | Path | Mapping[str, object] | None) -> dict[str
     if isinstance(rules, Mapping):
         return dict(rules)
     path = Path(rules)
-    try:
-        data = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read body-part rules: {exc}") from None
+    data = read_toml(path, "body-part rules")
     unknown = set(data) - {"parts", "aliases"}
     if unknown:
         raise ConfigError(

@@ -8,13 +8,13 @@ Angles are degrees in the file and radians inside.
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import MISSING, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, Literal
 
 from reactmocap.errors import ConfigError
+from reactmocap.io import read_toml
 
 __all__ = [
     "MODES",
@@ -297,12 +297,5 @@ def _resolve(r: _Reader, where: str, value: str, base_dir: Path | None) -> Path:
 def load_scenario(path: str | Path) -> Scenario:
     """Read and validate a scenario TOML file."""
     p = Path(path)
-    try:
-        text = p.read_text()
-    except OSError as exc:
-        raise ConfigError(f"{p}: cannot read scenario: {exc.strerror}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{p}: invalid TOML: {exc}") from None
+    data = read_toml(p, "scenario")
     return parse_scenario(data, source=str(p), base_dir=p.parent)

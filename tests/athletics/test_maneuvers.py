@@ -66,7 +66,7 @@ def test_a_missing_exit_event_is_a_config_error_naming_the_field(tmp_path: Path)
         ('seconds = -1\n' + GOOD_PHASE, "seconds must be"),
         ('name = "x"\n', "phase"),
         ('nmae = "x"\n' + GOOD_PHASE, "unknown field"),
-        ('[[phase]\n', "not valid TOML"),
+        ('[[phase]\n', "invalid TOML"),
     ],
 )  # fmt: skip
 def test_bad_files_are_refused_naming_the_field(tmp_path: Path, text: str, field: str) -> None:
