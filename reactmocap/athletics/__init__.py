@@ -11,14 +11,8 @@ from reactmocap.athletics.bodies import BODIES, Athlete, athlete, thesis_charact
 from reactmocap.athletics.land import Landing, LandingParams
 from reactmocap.athletics.leap import Leap, LeapParams
 from reactmocap.athletics.machine import NEXT, Basis, Context, angle, apex, liftoff, touchdown
-from reactmocap.athletics.maneuvers import (
-    Maneuver,
-    Phase,
-    dive,
-    load_maneuver,
-    run_maneuver,
-    somersault,
-)
+from reactmocap.athletics.maneuvers import Maneuver, Phase, load_maneuver, run_maneuver
+from reactmocap.athletics.routines import dive, somersault
 from reactmocap.athletics.sequencer import Sequencer
 from reactmocap.athletics.tumble import Tumble, TumbleParams
 

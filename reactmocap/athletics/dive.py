@@ -1,5 +1,5 @@
 """What a platform dive (thesis ch. 8's dives) adds to a maneuver: the platform, the stretch for
-the entry, and the entry's report (:func:`reactmocap.athletics.maneuvers.dive` composes it:
+the entry, and the entry's report (:func:`reactmocap.athletics.routines.dive` composes it:
 balance on the platform, leap with rotation, tumble, stretch, the water ``height`` m below).
 
 The platform is the athletics floor; once the athlete has left it the floor drops away (it is
@@ -25,11 +25,20 @@ from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import State
 from reactmocap.sim.world import World
 
-__all__ = ["ENTRY_TOLERANCE", "Platform", "Stretch", "entry_report", "stretch_angles"]
+__all__ = [
+    "ENTRY_TOLERANCE",
+    "PLATFORM_MAX",
+    "Platform",
+    "Stretch",
+    "entry_report",
+    "stretch_angles",
+]
 
 NJ = len(BALL_JOINTS)
 #: largest angle (deg) between the pelvis-to-head line and straight down at a clean entry
 ENTRY_TOLERANCE = 30.0
+#: highest platform (m): a higher fall outruns the rollout's kinetic-energy check
+PLATFORM_MAX = 7.5
 
 
 def stretch_angles() -> np.ndarray:

@@ -1,6 +1,6 @@
 """``athletics maneuver FILE.toml``, ``athletics somersault`` and ``athletics dive``: thin
 wrappers over :func:`reactmocap.athletics.maneuvers.run_maneuver`,
-:func:`~reactmocap.athletics.maneuvers.somersault` and :func:`~reactmocap.athletics.maneuvers.dive`
+:func:`~reactmocap.athletics.routines.somersault` and :func:`~reactmocap.athletics.routines.dive`
 that write a BVH, a JSON report and
 optionally a video (each written atomically)."""
 
@@ -15,7 +15,8 @@ __all__ = ["register_maneuvers"]
 def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Add ``maneuver``, ``somersault`` and ``dive`` to the ``athletics`` command's
     sub-commands."""
-    from reactmocap.athletics.maneuvers import DIRECTIONS, describe
+    from reactmocap.athletics.maneuvers import describe
+    from reactmocap.athletics.routines import DIRECTIONS
     from reactmocap.athletics.tumble import POSITIONS
 
     m = inner.add_parser(
@@ -50,7 +51,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     s.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
     s.set_defaults(func=_somersault)
 
-    from reactmocap.athletics.maneuvers import DIVE_DIRECTIONS, PLATFORM_MAX
+    from reactmocap.athletics.routines import DIVE_DIRECTIONS, PLATFORM_MAX
 
     d = inner.add_parser(
         "dive", help="platform dive: leap, somersault, stretch, enter the water (thesis ch. 8)",
@@ -90,7 +91,7 @@ def _maneuver(args: argparse.Namespace) -> int:
 
 
 def _somersault(args: argparse.Namespace) -> int:
-    from reactmocap.athletics.maneuvers import somersault
+    from reactmocap.athletics.routines import somersault
     from reactmocap.commands.athletics import _Bar
     from reactmocap.io import atomic_write_text
 
@@ -106,7 +107,7 @@ def _somersault(args: argparse.Namespace) -> int:
 
 
 def _dive(args: argparse.Namespace) -> int:
-    from reactmocap.athletics.maneuvers import dive
+    from reactmocap.athletics.routines import dive
     from reactmocap.commands.athletics import _Bar
     from reactmocap.io import atomic_write_text
 

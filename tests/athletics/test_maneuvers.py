@@ -8,14 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from reactmocap.athletics.maneuvers import (
-    CONTROLLERS,
-    capture_region,
-    dive,
-    load_maneuver,
-    run_maneuver,
-    somersault,
-)
+from reactmocap.athletics.maneuvers import CONTROLLERS, capture_region, load_maneuver, run_maneuver
+from reactmocap.athletics.routines import dive, somersault
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.bvh import read_bvh

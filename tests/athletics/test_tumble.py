@@ -10,7 +10,8 @@ import pytest
 
 from reactmocap.athletics import athlete
 from reactmocap.athletics.backdrop import arm_windmill
-from reactmocap.athletics.maneuvers import run_maneuver, somersault, somersault_maneuver
+from reactmocap.athletics.maneuvers import run_maneuver
+from reactmocap.athletics.routines import somersault, somersault_maneuver
 from reactmocap.athletics.tumble import POSITIONS, TumbleParams, somersault_inertia
 from reactmocap.errors import ConfigError, UnknownKeyError
 

@@ -1,0 +1,175 @@
+"""The built-in composed maneuvers (thesis ch. 8): the standing somersaults and the platform
+dives, each a :class:`~reactmocap.athletics.maneuvers.Maneuver` of basis controllers run by
+:func:`~reactmocap.athletics.maneuvers.run_maneuver`, with their reports (rotation, twist,
+landed or entered cleanly)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
+
+from reactmocap.athletics.behaviours import AthleticsResult
+from reactmocap.athletics.bodies import athlete
+from reactmocap.athletics.dive import PLATFORM_MAX, stretch_angles
+from reactmocap.athletics.maneuvers import Maneuver, Phase, run_maneuver
+from reactmocap.athletics.tumble import POSITIONS, somersault_inertia
+from reactmocap.errors import ConfigError, UnknownKeyError
+
+__all__ = [
+    "DIRECTIONS",
+    "DIVE_DIRECTIONS",
+    "PLATFORM_MAX",
+    "SOMERSAULT_PRESETS",
+    "dive",
+    "dive_maneuver",
+    "somersault",
+    "somersault_maneuver",
+]
+
+
+# ---------------------------------------------------------------------------------- somersaults
+#: the built-in somersaults, tuned by hand (as the thesis's, section 8.4) per body:
+#: body -> direction -> (leap parameters, tumble lead (rad), landing foot-servo delta (m)).
+#: A pike or layout uses the tuck's leap and landing with the position's own inertia.
+SOMERSAULT_PRESETS: Mapping[str, Mapping[str, tuple[Mapping[str, float], float, float]]] = (
+    MappingProxyType({
+        "male": MappingProxyType({
+            "backward": (MappingProxyType({"effort": 0.6, "spin": -55.0, "spin_limit": 1.0}),
+                         2.8, -0.15),
+        }),
+        "female": MappingProxyType({
+            "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0}),
+                         3.2, -0.12),
+        }),
+    })
+)  # fmt: skip
+DIRECTIONS = ("backward", "forward")
+
+
+def somersault_maneuver(
+    position: str = "tuck", direction: str = "backward", body: str = "male", backpack: float = 0.0
+) -> Maneuver:
+    """The standing somersault (thesis 8.4-8.5) as a maneuver: balance, leap with rotation,
+    tumble in ``position``, land, balance. Uses the male preset for a body or direction that
+    has none of its own (forward: the backward preset's spin turned forward); such runs are
+    untuned and their reports say what happened."""
+    if direction not in DIRECTIONS:
+        raise UnknownKeyError(
+            f"unknown somersault direction {direction!r}; valid directions are {list(DIRECTIONS)}"
+        )
+    if position not in POSITIONS:
+        raise UnknownKeyError(
+            f"unknown somersault position {position!r}; valid positions are {sorted(POSITIONS)}"
+        )
+    presets = SOMERSAULT_PRESETS.get(body, SOMERSAULT_PRESETS["male"])
+    leap, lead, delta = presets.get(
+        direction, presets.get("backward", next(iter(presets.values())))
+    )
+    leap = dict(leap)
+    if direction == "forward" and "forward" not in presets:
+        leap["spin"] = abs(leap["spin"])
+        delta = -delta
+    phases = (
+        Phase("balance", "after", {}, 0.3),
+        Phase("leap", "liftoff", leap),
+        Phase("tumble", "open", {"position": position, "lead": lead}),
+        Phase("land", "settled", {"delta": delta}),
+        # stand up slowly out of the landing's deep crouch: a quicker stand-up (0.5 s) carried
+        # the COM forward off the feet after most perturbed landings (docs/athletics.md)
+        Phase("balance", "never", {"settle": 2.0}),
+    )
+    name = f"{direction}_somersault_{position}"
+    return Maneuver(name, phases, body, 5.5, backpack)
+
+
+def somersault(
+    position: str = "tuck",
+    direction: str = "backward",
+    body: str = "male",
+    *,
+    twist: float = 0.0,
+    backpack: float = 0.0,
+    on_tick: Callable[[float], None] | None = None,
+    fps: float = 60.0,
+) -> AthleticsResult:
+    """A standing somersault (:func:`somersault_maneuver`); ``twist`` (turns) is refused:
+    twisting is not built yet (``docs/athletics.md``)."""
+    if not math.isfinite(twist):
+        raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
+    if twist != 0.0:
+        raise ConfigError(
+            "twisting somersaults are not built yet (issue 19, thesis 5.2); run without --twist"
+        )
+    if not (math.isfinite(backpack) and backpack >= 0):
+        raise ConfigError(f"backpack must be >= 0 kg, got {backpack!r}")
+    m = somersault_maneuver(position, direction, body, backpack)
+    result = run_maneuver(m, on_tick=on_tick, fps=fps)
+    result.report.update(position=position, direction=direction, twist_turns=0.0)
+    return result
+
+
+# ---------------------------------------------------------------------------------- dives
+#: the dive's tumble lead (rad) per position, tuned by hand on the male body (5 m, 1.5 turns)
+DIVE_LEADS: Mapping[str, float] = MappingProxyType({"pike": 2.0, "tuck": 1.7, "layout": 0.0})
+DIVE_DIRECTIONS = ("backward",)
+
+
+def dive_maneuver(
+    position: str = "pike", direction: str = "backward", body: str = "male",
+    height: float = 5.0, turns: float = 1.5,
+) -> Maneuver:  # fmt: skip
+    """A backward dive of ``turns`` somersaults (1.5: head first) in ``position`` from a
+    ``height`` m platform: balance, the back somersault's leap, tumble (aimed at the water),
+    stretch. The tumble's opening predicts with the stretched body's inertia."""
+    if direction not in DIVE_DIRECTIONS:
+        raise UnknownKeyError(
+            f"unknown dive direction {direction!r}; built: {list(DIVE_DIRECTIONS)}"
+        )
+    if position not in POSITIONS:
+        raise UnknownKeyError(
+            f"unknown dive position {position!r}; valid positions are {sorted(POSITIONS)}"
+        )
+    if not (math.isfinite(height) and 1.0 <= height <= PLATFORM_MAX):
+        raise ConfigError(f"dive platform height must be 1-{PLATFORM_MAX:g} m, got {height!r}")
+    if not (math.isfinite(turns) and turns > 0):
+        raise ConfigError(f"dive turns must be > 0, got {turns!r}")
+    leap = dict(SOMERSAULT_PRESETS["male"]["backward"][0])
+    i_open = round(somersault_inertia(athlete(body), stretch_angles()), 2)
+    tumble = {"position": position, "turns": turns, "lead": DIVE_LEADS[position],
+              "target_height": -height, "open_inertia": i_open, "latest": 0.3,
+              "max_seconds": 5.0}  # fmt: skip
+    phases = (
+        Phase("balance", "after", {}, 0.3),
+        Phase("leap", "liftoff", leap),
+        Phase("tumble", "open", tumble),
+        Phase("stretch", "never", {}),
+    )
+    seconds = round(1.7 + math.sqrt(2.0 * (height + 2.0) / 9.81), 1)
+    return Maneuver(f"dive_{direction}_{position}", phases, body, seconds, 0.0, height)
+
+
+def dive(
+    position: str = "pike",
+    direction: str = "backward",
+    body: str = "male",
+    *,
+    height: float = 5.0,
+    turns: float = 1.5,
+    twist: float = 0.0,
+    on_tick: Callable[[float], None] | None = None,
+    fps: float = 60.0,
+) -> AthleticsResult:
+    """A platform dive (:func:`dive_maneuver`). ``landed`` is a clean entry (head first within
+    ``dive.ENTRY_TOLERANCE`` of straight down when the COM reaches the water), ``fell`` its
+    opposite. ``twist`` (turns) is refused: twists are not aimed yet (``docs/athletics.md``)."""
+    if not math.isfinite(twist):
+        raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
+    if twist != 0.0:
+        raise ConfigError(
+            "twisting dives are not built yet (issue 19, thesis 5.2); run without --twist"
+        )
+    result = run_maneuver(dive_maneuver(position, direction, body, height, turns),
+                          on_tick=on_tick, fps=fps)  # fmt: skip
+    result.report.update(position=position, direction=direction, turns=turns, twist_turns=0.0)
+    return result
