@@ -78,6 +78,8 @@ def build_tables(
                     btable[0][1],
                     btable[-1][1],
                 )
+        if "deltas" in parts:  # before "land" (a later run): its ranges use this table
+            out["LANDING_DELTAS"][body] = _delta_table(body, workers)
         if "land" in parts:
             drops = np.round(np.arange(0.0, 2.51, 0.1), 2)
             dr = calibrate.sweep("land", body, [{"drop": float(d)} for d in drops], workers)
@@ -102,6 +104,36 @@ def build_tables(
     header = "Measured tables (written by ``benchmarks/bench_athletics.py --tables``; do not edit)."
     calibrate.write_measured(MEASURED, out, header)
     return out
+
+
+#: the landing delta table's grid (thesis Table 6.1): horizontal velocities (m/s), deltas (m)
+DELTA_VELOCITIES = np.round(np.arange(-1.0, 3.01, 0.5), 2)
+DELTA_GRID = np.round(np.arange(-0.5, 0.31, 0.02), 2)
+
+
+def _land_with_delta(job: tuple[str, float, float, float]) -> bool:
+    """Whether a landing at ``vx`` lands with one foot-servo delta (in a worker process)."""
+    body, drop, vx, delta = job
+    tables.LANDING_DELTAS = {body: ((0.0, delta),)}  # one row: this delta at every speed
+    return _landed(run("land", body, drop=drop, vx=vx, check_range=False).report)
+
+
+def _delta_table(body: str, workers: int) -> tuple[tuple[float, float], ...]:
+    """Thesis Table 6.1 for our landing: per horizontal velocity (COM 1.25 m up), the middle
+    of the longest stretch of deltas that land; a velocity where none lands is left out."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    drop = _drop_for_com(body, 1.25)
+    jobs = [(body, drop, float(v), float(d)) for v in DELTA_VELOCITIES for d in DELTA_GRID]
+    with ProcessPoolExecutor(max(workers, 1)) as ex:  # always apart: the jobs patch tables
+        ok = list(ex.map(_land_with_delta, jobs))
+    n = len(DELTA_GRID)
+    rows = []
+    for i, v in enumerate(DELTA_VELOCITIES):
+        rng = _longest([float(d) for d in DELTA_GRID], ok[i * n : (i + 1) * n])
+        if rng:
+            rows.append((float(v), round((rng[0] + rng[1]) / 2.0, 3)))
+    return tuple(rows)
 
 
 def _longest(values: list[float], ok: list[bool]) -> tuple[float, float] | None:
@@ -361,7 +393,8 @@ def main() -> int:
     )
     ap.add_argument("--tables", action="store_true", help="rebuild tables and ranges")
     ap.add_argument("--parts", default="leap,broad,land",
-                    help="with --tables: which of leap,broad,land to rebuild")  # fmt: skip
+                    help="with --tables: which of leap,broad,deltas,land to rebuild (deltas: "
+                         "the landing's Table 6.1, ~15 min; run it before land)")  # fmt: skip
     ap.add_argument("--out", type=Path, help="folder for the plots")
     ap.add_argument("--json", type=Path, help="write every figure as JSON")
     ap.add_argument("--workers", type=int, default=1)

@@ -73,6 +73,10 @@ class LandingParams:
         lean: torso pitch per radian of knee flexion while absorbing (see ``Posture``).
         toes: ankle plantar flexion held in the air (rad): the forefoot lands first and the
             foot rolls flat under load, as people land (the thesis lands flat-footed).
+        deltas: the foot-servo delta per horizontal velocity, ``((v m/s, delta m), ...)``
+            (thesis Table 6.1), interpolated on the velocity sensed in the air, so that a
+            landing after a broad jump gets its own speed's delta; empty: ``delta`` at every
+            speed.
     """
 
     knee: float = 0.6
@@ -86,6 +90,7 @@ class LandingParams:
     toes: float = 0.0
     lean: float = 0.5
     knee_stiffness: float = 0.0
+    deltas: tuple[tuple[float, float], ...] = ()
 
     def __post_init__(self) -> None:
         for name in (
@@ -104,6 +109,18 @@ class LandingParams:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
+        for row in self.deltas:
+            if len(row) != 2 or not all(
+                isinstance(x, (int, float)) and math.isfinite(x) for x in row
+            ):
+                raise ConfigError(f"landing deltas rows must be two finite numbers, got {row!r}")
+
+    def delta_at(self, velocity: float) -> float:
+        """The foot-servo delta (m) for a horizontal velocity (m/s): the table's, else ``delta``."""
+        if not self.deltas:
+            return self.delta
+        v, d = np.array(sorted(self.deltas), dtype=float).T
+        return float(np.interp(velocity, v, d))
 
 
 class Landing(Basis):
@@ -152,7 +169,7 @@ class Landing(Basis):
             # time constant sqrt(z / g)), plus the foot-servo delta
             g = float(np.linalg.norm(world.model.opt.gravity))
             lead = p.lead * math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
-            want = np.array([lead * v[0] + p.delta, lead * v[1]])
+            want = np.array([lead * v[0] + p.delta_at(float(v[0])), lead * v[1]])
             # eq. 6.1 as a correction on top of the geometric placement below
             x = s.local(feet - s.com, h)
             xd = s.local(fvel - s.com_vel, h)

@@ -164,7 +164,9 @@ def _build_stretch(phase: Phase, ath: Athlete) -> Basis:
 
 
 def _build_land(phase: Phase, ath: Athlete) -> Basis:
-    base = tables.landing_params(ath.name, 0.0)
+    base = tables.landing_params(ath.name, 0.0, after_leap=True)
+    if "delta" in phase.params:  # an explicit delta holds at every speed
+        base = replace(base, deltas=())
     return Landing(replace(base, **phase.params))
 
 
@@ -187,7 +189,7 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
          "after": "after `seconds` in the air (the thesis's timed transition)"}, _build_tumble),
     "land": BasisSpec(
         "land", "passive landing (ch. 6); ends once it has settled and handed over",
-        _kinds(LandingParams), {"settled": "once the landing has settled"}, _build_land),
+        _kinds(LandingParams, skip=("deltas",)), {"settled": "once the landing has settled"}, _build_land),
     "stretch": BasisSpec(
         "stretch", "straighten with the arms over the head for a dive's entry; holds to the "
         "end", {"seconds": "number"}, {"never": "holds to the end of the run"}, _build_stretch),

@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 
 from reactmocap.athletics import run, tables
+from reactmocap.athletics.behaviours import LANDING_LEG
+from reactmocap.athletics.bodies import athlete
+from reactmocap.athletics.land import LandingParams
+from reactmocap.athletics.scene import stand_angles
 from reactmocap.errors import ConfigError
 
 
@@ -57,3 +62,43 @@ def test_commands_outside_the_measured_range_are_refused() -> None:
         run("leap", "male", hight=0.3)
     with pytest.raises(ConfigError, match=">= 0"):
         run("land", "male", drop=-1.0)
+
+
+def _drop_for_com_height(body: str, com_height: float) -> float:
+    """Sole clearance that puts the landing pose's COM at ``com_height`` (thesis ch. 6)."""
+    ath = athlete(body)
+    q = ath.standing_qpos(stand_angles(ath, LANDING_LEG), clearance=0.0)
+    data = mujoco.MjData(ath.character.model)
+    data.qpos[:] = q
+    mujoco.mj_forward(ath.character.model, data)
+    return com_height - float(data.subtree_com[1][2])
+
+
+def test_a_forward_landing_at_2_m_per_s_lands_with_the_delta_table(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Thesis ch. 6: COM 1.25 m up, 2 m/s forward. With one foot-servo delta for every speed
+    (the landing before the table) it falls: the feet land too close and the COM passes over
+    them still moving."""
+    drop = _drop_for_com_height("male", 1.25)
+    r = run("land", "male", drop=drop, vx=2.0)
+    assert r.report["landed"] and not r.report["fell"]
+    lp = tables.landing_params("male", 2.0)
+    assert r.report["foot_servo_delta_m"] == pytest.approx(lp.delta_at(2.0))
+    # it travelled forward and ended still over the feet
+    assert r.log["com"][-1, 0] - r.log["com"][0, 0] > 0.3
+    assert abs(r.log["offset"][-1]) < 0.05
+    # the same landing with the table removed (the constant delta) falls
+    monkeypatch.setattr(tables, "LANDING_DELTAS", {})
+    assert tables.landing_params("male", 2.0).delta != pytest.approx(lp.delta)
+    r0 = run("land", "male", drop=drop, vx=2.0)
+    assert r0.report["fell"] and not r0.report["landed"]
+
+
+def test_landing_deltas_are_validated_and_interpolated() -> None:
+    lp = LandingParams(delta=0.1, deltas=((0.0, -0.04), (1.0, 0.06)))
+    assert lp.delta_at(0.5) == pytest.approx(0.01)
+    assert lp.delta_at(5.0) == pytest.approx(0.06)
+    assert LandingParams(delta=0.1).delta_at(3.0) == pytest.approx(0.1)
+    with pytest.raises(ConfigError, match="deltas"):
+        LandingParams(deltas=((0.0, float("nan")),))
