@@ -18,6 +18,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     from reactmocap.athletics.maneuvers import describe
     from reactmocap.athletics.routines import DIRECTIONS
     from reactmocap.athletics.tumble import POSITIONS
+    from reactmocap.commands.athletics_run import output_args
 
     m = inner.add_parser(
         "maneuver", help="run a maneuver file: phases of basis controllers with exit events",
@@ -43,12 +44,8 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     s.add_argument("--direction", choices=list(DIRECTIONS), default="backward")
     s.add_argument("--twist", type=float, default=0.0,
                    help="twist turns (not built yet: anything but 0 is refused)")  # fmt: skip
-    s.add_argument("--body", default="male", help="male, female or a BVH file (default male)")
     s.add_argument("--backpack", type=float, default=0.0, help="kg on the chest (thesis 8.5.2)")
-    s.add_argument("--out", type=Path, help="BVH of the motion (default: NAME_BODY.bvh)")
-    s.add_argument("--report", type=Path, help="JSON report")
-    s.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
-    s.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
+    output_args(s, "male", plot=False)
     s.set_defaults(func=_somersault)
 
     from reactmocap.athletics.routines import DIVE_DIRECTIONS, PLATFORM_MAX
@@ -65,11 +62,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     d.add_argument("--turns", type=float, default=1.5, help="somersaults (1.5: head first)")
     d.add_argument("--twist", type=float, default=0.0,
                    help="twist turns (not built yet: anything but 0 is refused)")  # fmt: skip
-    d.add_argument("--body", default="male", help="male, female or a BVH file (default male)")
-    d.add_argument("--out", type=Path, help="BVH of the motion (default: NAME_BODY.bvh)")
-    d.add_argument("--report", type=Path, help="JSON report")
-    d.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
-    d.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
+    output_args(d, "male", plot=False)
     d.set_defaults(func=_dive)
 
 

@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 from reactmocap.errors import ConfigError
-from reactmocap.progress import Progress
 
 __all__ = ["register_run"]
 
@@ -42,7 +41,7 @@ def register_run(inner: argparse._SubParsersAction) -> None:  # type: ignore[typ
                    help="the cloth's contact forces act on the runner")  # fmt: skip
     p.add_argument("--push", help="a sideways push on the chest: TIME,IMPULSE (s, N s; "
                    "> 0 to the runner's left) over 0.1 s")  # fmt: skip
-    _common(p, "male")
+    output_args(p, "male")
     p.set_defaults(func=_run)
 
     v = inner.add_parser(
@@ -52,27 +51,19 @@ def register_run(inner: argparse._SubParsersAction) -> None:  # type: ignore[typ
     )  # fmt: skip
     v.add_argument("--seconds", type=float, default=None,
                    help="how long to simulate (s; default: until 2 s after landing)")  # fmt: skip
-    _common(v, "female")
+    output_args(v, "female")
     v.set_defaults(func=_vault)
 
 
-def _common(p: argparse.ArgumentParser, body: str) -> None:
+def output_args(p: argparse.ArgumentParser, body: str, *, plot: bool = True) -> None:
+    """The athletics commands' body and output options."""
     p.add_argument("--body", default=body, help=f"male, female or a BVH file (default {body})")
     p.add_argument("--out", type=Path, help="BVH of the motion (default: NAME_BODY.bvh)")
     p.add_argument("--report", type=Path, help="JSON report")
-    p.add_argument("--plot", type=Path, help="PNG figure")
+    if plot:
+        p.add_argument("--plot", type=Path, help="PNG figure")
     p.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
     p.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
-
-
-class _Bar:
-    """Progress over the simulated fraction (quiet unless stderr is a terminal)."""
-
-    def __init__(self, label: str) -> None:
-        self.bar = Progress(100, f"{label} (% simulated)")
-
-    def tick(self, fraction: float) -> None:
-        self.bar.update(round(100 * fraction) - self.bar.done)
 
 
 def _push(text: str | None) -> tuple[float, float, float] | None:
@@ -87,11 +78,13 @@ def _push(text: str | None) -> tuple[float, float, float] | None:
 
 def _run(args: argparse.Namespace) -> int:
     from reactmocap.athletics.run_course import run_course
+    from reactmocap.commands.athletics import _Bar
 
-    bar = _Bar("run")
-    result = run_course(args.speed, seconds=args.seconds, path=args.path, body=str(args.body),
-                        cloth=args.cloth, cloth_feedback=args.cloth_feedback,
-                        push=_push(args.push), fps=args.fps, on_tick=bar.tick)  # fmt: skip
+    with _Bar("run") as bar:
+        result = run_course(args.speed, seconds=args.seconds, path=args.path,
+                            body=str(args.body), cloth=args.cloth,
+                            cloth_feedback=args.cloth_feedback, push=_push(args.push),
+                            fps=args.fps, on_tick=bar.tick)  # fmt: skip
     out = args.out or Path(f"run_{result.report['body']}.bvh")
 
     def plot(path: Path) -> None:
@@ -118,9 +111,10 @@ def _run(args: argparse.Namespace) -> int:
 
 def _vault(args: argparse.Namespace) -> int:
     from reactmocap.athletics.vault import vault
+    from reactmocap.commands.athletics import _Bar
 
-    bar = _Bar("vault")
-    result = vault(body=str(args.body), seconds=args.seconds, fps=args.fps, on_tick=bar.tick)
+    with _Bar("vault") as bar:
+        result = vault(body=str(args.body), seconds=args.seconds, fps=args.fps, on_tick=bar.tick)
     out = args.out or Path(f"vault_{result.report['body']}.bvh")
 
     def plot(path: Path) -> None:
