@@ -14,7 +14,7 @@ from typing import IO, Any
 
 from reactmocap.errors import ConfigError
 
-__all__ = ["atomic_write", "atomic_write_bytes", "atomic_write_text", "read_toml"]
+__all__ = ["atomic_write", "atomic_write_bytes", "atomic_write_text", "read_toml", "save_png"]
 
 
 def _umask() -> int:
@@ -67,3 +67,14 @@ def read_toml(path: str | Path, what: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{p}: invalid TOML: {exc}") from None
+
+
+def save_png(fig: Any, path: str | Path) -> Path:
+    """Write a matplotlib figure as PNG (atomically) and close it."""
+    import matplotlib.pyplot as plt  # the plot extra; only callers that made a figure get here
+
+    out = Path(path)
+    with atomic_write(out, "wb") as fh:
+        fig.savefig(fh, format="png")
+    plt.close(fig)
+    return out

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from reactmocap.io import atomic_write
+from reactmocap.io import save_png
 from reactmocap.response.plots import _pyplot, write_video
 
 if TYPE_CHECKING:
@@ -53,11 +53,7 @@ def paths_plot(result: CyclingResult, path: str | Path) -> Path:
     hd.set_ylabel("heading (deg)")
     hd.set_xlabel("time (s)")
     fig.tight_layout()
-    out = Path(path)
-    with atomic_write(out, "wb") as fh:
-        fig.savefig(fh, format="png")
-    plt.close(fig)
-    return out
+    return save_png(fig, path)
 
 
 def ride_video(result: CyclingResult, path: str | Path, fps: float = 30.0,

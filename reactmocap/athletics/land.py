@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -115,11 +116,17 @@ class LandingParams:
             ):
                 raise ConfigError(f"landing deltas rows must be two finite numbers, got {row!r}")
 
+    @cached_property
+    def _delta_table(self) -> tuple[np.ndarray, np.ndarray]:
+        # sorted once: the lookup runs every control tick in the air
+        v, d = np.array(sorted(self.deltas), dtype=float).T
+        return v, d
+
     def delta_at(self, velocity: float) -> float:
         """The foot-servo delta (m) for a horizontal velocity (m/s): the table's, else ``delta``."""
         if not self.deltas:
             return self.delta
-        v, d = np.array(sorted(self.deltas), dtype=float).T
+        v, d = self._delta_table
         return float(np.interp(velocity, v, d))
 
 

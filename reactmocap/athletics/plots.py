@@ -9,20 +9,16 @@ from pathlib import Path
 
 import numpy as np
 
-from reactmocap.io import atomic_write
+from reactmocap.io import save_png
 from reactmocap.response.plots import _pyplot
 
-__all__ = ["commanded_plot", "run_plot", "run_video", "series_plot"]
+__all__ = ["commanded_plot", "run_plot", "series_plot"]
 
 
 def _save(plt, fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
     """Lay the figure out, write it as PNG (atomically) and close it."""
     fig.tight_layout()
-    out = Path(path)
-    with atomic_write(out, "wb") as fh:
-        fig.savefig(fh, format="png")
-    plt.close(fig)
-    return out
+    return save_png(fig, path)
 
 
 def run_plot(result, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
@@ -100,19 +96,3 @@ def series_plot(
         ax.set_title(title)
     ax.legend(fontsize=8)
     return _save(plt, fig, path)
-
-
-def run_video(result, path: str | Path, fps: float = 30.0) -> tuple[Path, str]:  # type: ignore[no-untyped-def]
-    """The run's motion as a video; MuJoCo's renderer, else the matplotlib stick figure.
-    Returns the path and which renderer made it."""
-    from reactmocap.response.plots import stick_figure_video
-    from reactmocap.response.render import RenderUnavailable, render_video
-
-    out = Path(path)
-    try:
-        return render_video([(result.motion, (0.35, 0.55, 0.85, 1.0))], out, fps=fps), "mujoco"
-    except RenderUnavailable as exc:
-        gif = out if out.suffix.lower() == ".gif" else out.with_suffix(".gif")
-        return Path(stick_figure_video([(result.motion, "C0")], gif, fps=fps)), (
-            f"stick figure ({exc})"
-        )

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import MotionError
-from reactmocap.io import atomic_write
+from reactmocap.io import save_png
 from reactmocap.library.bodyparts import map_body_parts
 from reactmocap.library.motion import Motion
 
@@ -89,13 +89,6 @@ def clip_gait(motion: Motion) -> dict[str, float | None]:
             "duration_s": dur, "touchdowns": len(events)}  # fmt: skip
 
 
-def _save(fig: Any, path: str | Path) -> Path:
-    out = Path(path)
-    with atomic_write(out, "wb") as fh:
-        fig.savefig(fh, format="png")
-    return out
-
-
 def phase_plot(curves: Mapping[str, tuple[F64, F64]], path: str | Path, title: str = "") -> Path:
     """Knee flexion against hip flexion (degrees), one panel per curve set (e.g.
     ``{"simulated": (hip, knee), "motion capture": (hip, knee)}``, each ``(T,)``), as
@@ -115,9 +108,7 @@ def phase_plot(curves: Mapping[str, tuple[F64, F64]], path: str | Path, title: s
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return save_png(fig, path)
 
 
 def run_plot(result: Any, path: str | Path) -> Path:
@@ -163,6 +154,4 @@ def run_plot(result: Any, path: str | Path) -> Path:
     a3.set_title("hip-knee phase plot (left leg, last 2 s)")
     fig.suptitle(f"run at {rep['speed_m_s']:g} m/s ({rep['body']})")
     fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return save_png(fig, path)

@@ -801,7 +801,7 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
 
 def vault_plot(result: VaultResult, path: str | Path) -> Path:
     """COM path with the apparatus, and Table 1: ours against the human range and mean."""
-    from reactmocap.athletics.running_plots import _save
+    from reactmocap.io import save_png
     from reactmocap.response.plots import _pyplot
 
     plt = _pyplot()
@@ -835,6 +835,4 @@ def vault_plot(result: VaultResult, path: str | Path) -> Path:
     a2.invert_yaxis()
     a2.set_title(f"Table 1: {result.report['table1_inside']}/16 rows inside the human range")
     fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return save_png(fig, path)

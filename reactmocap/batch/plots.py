@@ -19,7 +19,7 @@ import numpy as np
 from reactmocap.batch.results import QUALITY_METRICS, ResultStore
 from reactmocap.batch.sweep import AXES
 from reactmocap.errors import ConfigError, ReactMocapError
-from reactmocap.io import atomic_write
+from reactmocap.io import save_png
 
 __all__ = ["ANGLE_AXES", "contact_sheet", "plot_axes", "plot_batch"]
 
@@ -38,13 +38,6 @@ def _pyplot() -> Any:
     except ImportError:
         raise ReactMocapError("plots need matplotlib: pip install 'reactmocap[plot]'") from None
     return plt
-
-
-def _save(fig: Any, path: Path) -> Path:
-    with atomic_write(path, "wb") as fh:
-        fig.savefig(fh, format="png")
-    _pyplot().close(fig)
-    return path
 
 
 def _load(results_dir: Path) -> tuple[list[dict[str, Any]], dict[str, list[Any]]]:
@@ -114,7 +107,7 @@ def plot_axes(results_dir: str | Path) -> list[Path]:
                 ax.set_rlabel_position(112.5)  # radial labels between the angle labels
             fig.suptitle(f"{_stem(d)}: median over other axes vs {axis}")
             fig.subplots_adjust(wspace=0.45, top=0.8)
-            written.append(_save(fig, d / f"plot_{axis}.png"))
+            written.append(save_png(fig, d / f"plot_{axis}.png"))
             continue
         ncol = 3
         nrow = math.ceil(len(LINE_METRICS) / ncol)
@@ -131,7 +124,7 @@ def plot_axes(results_dir: str | Path) -> list[Path]:
             ax.set_title(metric, fontsize=9)
         fig.suptitle(f"{_stem(d)}: median over other axes vs {axis}")
         fig.tight_layout()
-        written.append(_save(fig, d / f"plot_{axis}.png"))
+        written.append(save_png(fig, d / f"plot_{axis}.png"))
     return written
 
 
@@ -201,7 +194,7 @@ def contact_sheet(
         label = ", ".join(f"{a}={r.get(a)}" for a in axes)
         row_axes[0].set_ylabel(f"{label}\n{r.get('matched_clip')}", fontsize=6)
     fig.tight_layout()
-    return _save(fig, d / "contact_sheet.png")
+    return save_png(fig, d / "contact_sheet.png")
 
 
 def plot_batch(results_dir: str | Path) -> list[Path]:

@@ -79,7 +79,6 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
 def _run(args: argparse.Namespace) -> int:
     from reactmocap.athletics.behaviours import run
-    from reactmocap.io import atomic_write_text
 
     params: dict[str, Any] = {"fps": args.fps}
     for flag, key, deg in args.flags:
@@ -100,18 +99,14 @@ def _run(args: argparse.Namespace) -> int:
         result = run(args.behaviour, body, on_tick=bar.tick, check_range=not args.any_range,
                      **params)  # fmt: skip
     out = args.out or Path(f"{args.behaviour}_{result.body}.bvh")
-    result.write_bvh(out)
-    if args.report is not None:
-        atomic_write_text(args.report, result.report_json())
-    if args.plot is not None:
-        from reactmocap.athletics.plots import run_plot
+    from reactmocap.athletics.plots import run_plot
+    from reactmocap.commands.athletics_run import _motion_video, _write_all
 
-        run_plot(result, args.plot)
-    if args.video is not None:
-        from reactmocap.athletics.plots import run_video
-
-        path, renderer = run_video(result, args.video)
-        print(f"video: {path} ({renderer})")
+    # all or nothing, like the other athletics commands
+    written = _write_all(args, out, result.motion, result.report_json,
+                         lambda p: run_plot(result, p), lambda p: _motion_video(result.motion, p))  # fmt: skip
+    if "video" in written:
+        print(f"video: {written['video']} ({written['video_renderer']})")
     _summary(result.report, out)
     return 0
 

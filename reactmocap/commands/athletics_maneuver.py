@@ -69,58 +69,46 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
 def _maneuver(args: argparse.Namespace) -> int:
     from reactmocap.athletics.maneuvers import load_maneuver, run_maneuver
     from reactmocap.commands.athletics import _Bar
-    from reactmocap.io import atomic_write_text
 
     maneuver = load_maneuver(args.file)
     with _Bar(maneuver.name) as bar:
         result = run_maneuver(maneuver, args.body, on_tick=bar.tick, fps=args.fps)
     out: Path = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    bvh = out / f"{maneuver.name}.bvh"
-    result.write_bvh(bvh)
-    atomic_write_text(out / f"{maneuver.name}.json", result.report_json())
-    _finish(result, args.video, bvh)
+    files = argparse.Namespace(**{**vars(args), "report": out / f"{maneuver.name}.json"})
+    _finish(result, files, out / f"{maneuver.name}.bvh")
     return 0
 
 
 def _somersault(args: argparse.Namespace) -> int:
     from reactmocap.athletics.routines import somersault
     from reactmocap.commands.athletics import _Bar
-    from reactmocap.io import atomic_write_text
 
     with _Bar("somersault") as bar:
         result = somersault(args.position, args.direction, str(args.body), twist=args.twist,
                             backpack=args.backpack, on_tick=bar.tick, fps=args.fps)  # fmt: skip
-    out = args.out or Path(f"{result.behaviour}_{result.body}.bvh")
-    result.write_bvh(out)
-    if args.report is not None:
-        atomic_write_text(args.report, result.report_json())
-    _finish(result, args.video, out)
+    _finish(result, args, args.out or Path(f"{result.behaviour}_{result.body}.bvh"))
     return 0
 
 
 def _dive(args: argparse.Namespace) -> int:
     from reactmocap.athletics.routines import dive
     from reactmocap.commands.athletics import _Bar
-    from reactmocap.io import atomic_write_text
 
     with _Bar("dive") as bar:
         result = dive(args.position, args.direction, str(args.body), height=args.height,
                       turns=args.turns, twist=args.twist, on_tick=bar.tick, fps=args.fps)  # fmt: skip
-    out = args.out or Path(f"{result.behaviour}_{result.body}.bvh")
-    result.write_bvh(out)
-    if args.report is not None:
-        atomic_write_text(args.report, result.report_json())
-    _finish(result, args.video, out)
+    _finish(result, args, args.out or Path(f"{result.behaviour}_{result.body}.bvh"))
     return 0
 
 
-def _finish(result, video: Path | None, out: Path) -> None:  # type: ignore[no-untyped-def]
-    if video is not None:
-        from reactmocap.athletics.plots import run_video
+def _finish(result, args: argparse.Namespace, out: Path) -> None:  # type: ignore[no-untyped-def]
+    """Write the BVH, the report and the video all or nothing, then say how it went."""
+    from reactmocap.commands.athletics_run import _motion_video, _write_all
 
-        path, renderer = run_video(result, video)
-        print(f"video: {path} ({renderer})")
+    written = _write_all(args, out, result.motion, result.report_json, lambda _p: None,
+                         lambda p: _motion_video(result.motion, p))  # fmt: skip
+    if "video" in written:
+        print(f"video: {written['video']} ({written['video_renderer']})")
     r = result.report
     print(f"{r['behaviour']} ({r['body']}): rotation {r['rotation_deg']:.0f} deg, twist "
           f"{r['twist_deg']:.0f} deg, landed={r['landed']}, fell={r['fell']} -> {out}")  # fmt: skip

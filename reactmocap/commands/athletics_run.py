@@ -147,7 +147,7 @@ def _motion_video(motion: Any, path: Path, note: str = "", scene: Any = None) ->
 
 def _write_all(
     args: argparse.Namespace, out: Path, motion: Any, report_json: Callable[[], str],
-    plot: Callable[[Path], None], video: Callable[[Path], str],
+    plot: Callable[[Path], Any], video: Callable[[Path], str],
 ) -> dict[str, str]:  # fmt: skip
     """Write every requested file to a temporary sibling, then move them all into place; on
     any failure remove what was written and re-raise."""
@@ -156,7 +156,7 @@ def _write_all(
     jobs: list[tuple[str, Path, Callable[[Path], Any]]] = [
         ("bvh", out, lambda p: write_bvh(motion, p))
     ]
-    if args.plot is not None:
+    if getattr(args, "plot", None) is not None:  # commands without a figure have no --plot
         jobs.append(("plot", args.plot, plot))
     if args.video is not None:
         if args.video.suffix.lower() not in (".mp4", ".gif"):

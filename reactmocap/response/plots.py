@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ReactMocapError
-from reactmocap.io import atomic_write, atomic_write_bytes
+from reactmocap.io import atomic_write_bytes, save_png
 from reactmocap.library.motion import Motion
 
 __all__ = ["response_plot", "stick_figure_video", "write_video"]
@@ -98,11 +98,7 @@ def response_plot(
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    out = Path(path)
-    with atomic_write(out, "wb") as fh:
-        fig.savefig(fh, format="png")
-    plt.close(fig)
-    return out
+    return save_png(fig, path)
 
 
 def stick_figure_video(
