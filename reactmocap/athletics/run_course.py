@@ -20,7 +20,13 @@ from reactmocap.athletics.behaviours import _clean
 from reactmocap.athletics.bodies import athlete as make_athlete
 from reactmocap.athletics.paths import Course, Facing, Polyline, parse_course
 from reactmocap.athletics.report import FALL_HEIGHT
-from reactmocap.athletics.running import Runner, RunParams, check_speed, running_start
+from reactmocap.athletics.running import (
+    START_SPEED,
+    Runner,
+    RunParams,
+    check_speed,
+    running_start,
+)
 from reactmocap.athletics.scene import athletics_world, stand_angles
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
@@ -92,7 +98,8 @@ def run_course(
         raise ConfigError(f"fps must be > 0, got {fps!r}")
     ath = make_athlete(body)
     world = athletics_world(ath)
-    qpos, qvel = running_start(ath, speed)
+    # faster runs start at START_SPEED and the runner accelerates (Runner's ramp)
+    qpos, qvel = running_start(ath, min(speed, START_SPEED))
     world.set_pose(0, qpos, qvel)
     start = world.com(0)[:2]
     course = parse_course(path, start, 0.0) if isinstance(path, str) else path

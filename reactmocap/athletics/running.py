@@ -16,24 +16,48 @@ foot rolls about the ball. Design and measurements: ``docs/athletics.md``."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
 from reactmocap.athletics.balance import knee_for_length
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.paths import Course, Straight
-from reactmocap.athletics.rig import Rig, joint_index, per_joint
+from reactmocap.athletics.rig import Rig, per_joint
+from reactmocap.athletics.running_body import (
+    _ANKLE,
+    _BODY,
+    _ELBOW,
+    _FOOT,
+    _HIP,
+    _KNEE,
+    _LEG_JOINTS,
+    _NECK,
+    _SHIN,
+    _SHOULDER,
+    _SPINE,
+    _THIGH,
+    F64,
+    NJ,
+    _clamp,
+    _euler_yxz,
+    _qconj,
+    _qmul,
+    _quat_yxz,
+    _qyaw,
+    running_start,
+)
+from reactmocap.athletics.running_params import (
+    SPEED_RANGE,
+    TUNED_SPEEDS,
+    RunLog,
+    RunParams,
+    check_speed,
+)
 from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
-from reactmocap.rotations import (
-    quat_conj,
-    quat_from_yaw,
-    quat_mul,
-)
-from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
+from reactmocap.rotations import quat_conj
+from reactmocap.sim.bodies import SIM_PARENTS
 from reactmocap.sim.controllers.base import FunctionController
 from reactmocap.sim.controllers.machine import State, StateMachine, after
 from reactmocap.sim.world import World
@@ -43,224 +67,24 @@ __all__ = [
     "SPEED_RANGE",
     "TUNED_SPEEDS",
     "RunLog",
+    "START_SPEED",
     "RunParams",
     "Runner",
     "check_speed",
     "running_start",
 ]
 
-F64 = NDArray[np.float64]
-NJ = len(BALL_JOINTS)
-#: the speeds the runner is built for (m/s), the paper's range
-SPEED_RANGE = (2.5, 5.0)
 #: the states of the active leg (Fig. 3)
 RUN_STATES = ("flight", "loading", "heel", "heel_toe", "toe", "unloading")
-_HIP = (joint_index("l_hip"), joint_index("r_hip"))
-_KNEE = (joint_index("l_knee"), joint_index("r_knee"))
-_ANKLE = (joint_index("l_ankle"), joint_index("r_ankle"))
-_SHOULDER = (joint_index("l_shoulder"), joint_index("r_shoulder"))
-_ELBOW = (joint_index("l_elbow"), joint_index("r_elbow"))
-_SPINE = (joint_index("waist"), joint_index("back"))
-_NECK = joint_index("neck")
-_LEG_JOINTS = (*_HIP, *_KNEE, *_ANKLE)
-_BODY = {b: i for i, b in enumerate(SIM_BODIES)}
-_THIGH = (_BODY["l_thigh"], _BODY["r_thigh"])
-_SHIN = (_BODY["l_shin"], _BODY["r_shin"])
-_FOOT = (_BODY["l_foot"], _BODY["r_foot"])
 #: a sole corner closer than this to the floor (m) counts as touching
 CORNER_TOUCH = 0.004
-
-
-# ---------------------------------------------------------------------------------- small math
-# single quaternions at every tick: MuJoCo's C routines and closed forms instead of the
-# vectorised helpers (scipy), which cost 100-400 us a call and dominated the tick
-def _qmul(a: F64, b: F64) -> F64:
-    out = np.empty(4)
-    mujoco.mju_mulQuat(out, a, b)
-    return out
-
-
-def _clamp(x: float, lo: float, hi: float) -> float:
-    return float(min(max(x, lo), hi))
-
-
-def _qconj(q: F64) -> F64:
-    return np.array([q[0], -q[1], -q[2], -q[3]])
-
-
-def _qyaw(yaw: float) -> F64:
-    return np.array([math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw)])
-
-
-def _quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
-    """Quaternion of intrinsic Y-X-Z Euler angles (:data:`~reactmocap.athletics.bodies.
-    EULER_ORDER`)."""
-    qy = np.array([math.cos(0.5 * pitch), 0.0, math.sin(0.5 * pitch), 0.0])
-    qx = np.array([math.cos(0.5 * roll), math.sin(0.5 * roll), 0.0, 0.0])
-    return _qmul(_qmul(qy, qx), _qyaw(yaw))
-
-
-def _euler_yxz(q: F64) -> tuple[float, float, float]:
-    """Intrinsic Y-X-Z Euler angles (pitch, roll, yaw) of a quaternion: with
-    ``R = Ry Rx Rz``, pitch = atan2(R02, R22), roll = asin(-R12), yaw = atan2(R10, R11)."""
-    w, x, y, z = q
-    r02 = 2.0 * (x * z + w * y)
-    r22 = 1.0 - 2.0 * (x * x + y * y)
-    r12 = 2.0 * (y * z - w * x)
-    r10 = 2.0 * (x * y + w * z)
-    r11 = 1.0 - 2.0 * (x * x + z * z)
-    return (math.atan2(r02, r22), math.asin(max(-1.0, min(1.0, -r12))), math.atan2(r10, r11))
-
-
-def check_speed(speed: float) -> float:
-    """``speed`` if it lies in :data:`SPEED_RANGE`, else a ConfigError naming the range."""
-    lo, hi = SPEED_RANGE
-    if not (isinstance(speed, (int, float)) and math.isfinite(speed) and lo <= speed <= hi):
-        raise ConfigError(
-            f"running speed {speed!r} m/s is outside the supported range {lo:g}-{hi:g} m/s"
-        )
-    return float(speed)
-
-
-#: a tuning value at 2.5, 3.5 and 5 m/s (:data:`TUNED_SPEEDS`), interpolated piecewise linearly
-Speeds = tuple[float, float, float]
-#: the speeds the tuning triples are given at (m/s)
-TUNED_SPEEDS = (2.5, 3.5, 5.0)
-
-
-@dataclass(frozen=True)
-class RunParams:
-    """The runner's tuning. Values given as three numbers are at 2.5, 3.5 and 5 m/s,
-    interpolated piecewise linearly by speed (a single number is used at every speed). Angles in radians, joint
-    stiffness in units of ``m g L`` N m/rad (body mass, leg length), leg stiffness in
-    ``m g / L`` N/m, times in seconds. The defaults were found by a search over these
-    parameters (``benchmarks/bench_athletics_running.py --tune``), see ``docs/athletics.md``.
-
-    Args:
-        stance_time: first estimate of the stance duration ``t_s`` (eqs. 1-2); later steps
-            use the previous stance's.
-        speed_gain: ``k`` of eqs. 1-2, the velocity-error gain (s).
-        speed_integral: per step, the placement's slow correction (m) per m/s of the last
-            step's speed error (0: eqs. 1-2 alone).
-        touchdown_leg: hip-to-ankle length at touchdown (fraction of the straight leg).
-        speed_matching, retract_time: ground-speed matching: how far (m) the swing foot
-            reaches beyond its touchdown place and how long before touchdown it comes back.
-        heel_up: foot pitch at touchdown (rad, toes up): the heel strikes first.
-        step_width: lateral distance between the feet's touchdown places (m).
-        leg_stiffness, leg_damping: the stance leg's spring (``m g / L`` N/m) and its
-            damping ratio.
-        thrust: the toe phase's extra leg force (body weights), until the body rises at
-            ``takeoff_vz`` (m/s).
-        toe_fraction: the heel-and-toe phase ends at this fraction of the expected stance
-            (the paper: 30-50% by speed).
-        pitch: desired forward pitch of the trunk (rad).
-        attitude_kp, attitude_kv: the stance hip's attitude servo (roll, pitch, yaw), per
-            unit of the body's mass times its leg length squared (1/s^2, 1/s).
-        yaw_grip: the twisting moment a stance foot can hold, in units of its length times
-            the vertical ground force (a friction coefficient times the lever).
-        knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
-            keep only their roll and yaw (the leg spring drives their pitch).
-        idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
-            by the end of the stance ready for touchdown (rad).
-        swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
-        arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
-        elbow: elbow flexion (rad).
-        turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
-        lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
-        smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
-        stiffness: the servos' stiffness by joint kind outside the stance leg.
-    """
-
-    stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
-    speed_gain: float | Speeds = (0.1914, 0.0835, 0.08567)
-    speed_integral: float | Speeds = (0, 0, 0.001824)
-    touchdown_leg: float | Speeds = (0.93, 0.948, 0.9475)
-    speed_matching: float | Speeds = (0, 0.009, 0.03712)
-    retract_time: float | Speeds = 0.06
-    heel_up: float | Speeds = 0.2
-    step_width: float | Speeds = (0.06929, 0.065, 0.05902)
-    leg_stiffness: float | Speeds = (32.11, 21.6, 21.19)
-    leg_damping: float | Speeds = (0.08527, 0.04, 0.06971)
-    thrust: float | Speeds = (1.683, 1.71, 1.716)
-    takeoff_vz: float | Speeds = (0.5575, 0.517, 0.5806)
-    toe_fraction: float | Speeds = (0.3849, 0.42, 0.3199)
-    pitch: float | Speeds = (0.1207, 0.013, -0.01578)
-    attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
-    attitude_kv: tuple[float, float, float] = (14.0, 14.0, 5.42)
-    yaw_grip: float | Speeds = 0.181
-    knee_hold: float | Speeds = 3.0
-    ankle_hold: float | Speeds = 1.0
-    idle_knee: float | Speeds = (2.182, 1.813, 1.692)
-    reach_knee: float | Speeds = (1.192, 1.066, 1.102)
-    swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
-    arm_gain: float | Speeds = (0.7815, 1.273, 1.336)
-    arm_offset: float | Speeds = 0.05
-    elbow: float | Speeds = 1.4
-    turn_rate: float | Speeds = 0.35
-    lean: float | Speeds = 1.0
-    smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
-    stiffness: dict[str, float] = field(
-        default_factory=lambda: {
-            "waist": 4.0, "back": 4.0, "neck": 0.3, "shoulder": 0.4, "elbow": 0.2,
-            "wrist": 0.05, "hip": 3.935, "knee": 0.70, "ankle": 0.4,
-        }
-    )  # fmt: skip
-
-    def __post_init__(self) -> None:
-        for f in fields(self):
-            v = getattr(self, f.name)
-            vals = v.values() if isinstance(v, dict) else v if isinstance(v, tuple) else (v,)
-            if not all(isinstance(x, (int, float)) and math.isfinite(x) for x in vals):
-                raise ConfigError(f"running parameter {f.name} must be finite, got {v!r}")
-            if isinstance(v, tuple) and f.name not in _AXES and len(v) != 3:
-                raise ConfigError(
-                    f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
-                )
-        per_joint(self.stiffness)  # unknown joint kinds are named there
-        lo, hi = SPEED_RANGE
-        for speed in (lo, hi):
-            r = self.at(speed)
-            if not 0.5 < r["touchdown_leg"] <= 1.0:
-                raise ConfigError(f"touchdown_leg must be in (0.5, 1], got {self.touchdown_leg}")
-            if r["stance_time"] <= 0 or r["smoothing"] < 0 or r["leg_stiffness"] <= 0:
-                raise ConfigError("stance_time and leg_stiffness must be > 0, smoothing >= 0")
-
-    def at(self, speed: float) -> dict[str, float]:
-        """Every scalar tuning value at ``speed`` (triples interpolated, clamped to the
-        range)."""
-        out = {}
-        for f in fields(self):
-            if f.name in _AXES or f.name == "stiffness":
-                continue
-            v = getattr(self, f.name)
-            out[f.name] = (
-                float(np.interp(speed, TUNED_SPEEDS, v)) if isinstance(v, tuple) else float(v)
-            )
-        return out
-
-
-#: per-axis (roll, pitch, yaw) values, not per-speed
-_AXES = ("attitude_kp", "attitude_kv")
-
-
-@dataclass
-class RunLog:
-    """Per control tick: time, COM, COM velocity, pelvis heading, state index, active leg,
-    feet in contact (bit 0 left, bit 1 right), pelvis height, whether anything but the feet
-    touched the floor, hip and knee pitch of both legs; and the touchdown and lift-off
-    events (time, leg, foot position)."""
-
-    rows: list[tuple] = field(default_factory=list)
-    touchdowns: list[tuple[float, int, float, float]] = field(default_factory=list)
-    liftoffs: list[tuple[float, int]] = field(default_factory=list)
-
-    def arrays(self) -> dict[str, NDArray]:
-        names = ("t", "com", "com_vel", "heading", "state", "active", "feet", "pelvis",
-                 "others", "hip", "knee", "desired_heading", "cross_track")  # fmt: skip
-        if not self.rows:
-            return {n: np.zeros(0) for n in names}
-        cols = list(zip(*self.rows))
-        return {n: np.array(c) for n, c in zip(names, cols)}
+#: the placement's slow correction integrates from this time on (s)
+INTEGRATE_AFTER = 1.0
+#: the fastest a run starts at (m/s): faster runs start at it and the desired speed ramps up
+#: at :data:`ACCEL` (m/s^2); from a set pose at 5 m/s the first stance lost 1.6 m/s and the
+#: runner fell recovering it
+START_SPEED = 3.5
+ACCEL = 1.5
 
 
 class Runner:
@@ -289,10 +113,14 @@ class Runner:
             raise ConfigError(f"control_every must be an int >= 1, got {control_every!r}")
         self.world = world
         self.athlete = athlete
-        self.speed = check_speed(speed)
+        #: the speed asked for; ``speed`` is the desired speed now, which starts at most at
+        #: :data:`START_SPEED` and ramps up to it
+        self.target = check_speed(speed)
+        self.speed = min(self.target, START_SPEED)
         self.course = course or Straight(0.0)
         self.params = params or RunParams()
         self.k = self.params.at(self.speed)
+        self.accel = ACCEL
         self.character = character
         self.control_every = control_every
         self.p_frame = True
@@ -333,7 +161,8 @@ class Runner:
 
     # ------------------------------------------------------------------ state
     def _reset_state(self) -> None:
-        k = self.k
+        self.speed = min(self.target, START_SPEED)
+        self.k = k = self.params.at(self.speed)
         self.active = 0  # the leg on the ground or being placed (0 left, 1 right)
         self.t_touchdown = 0.0
         self.t_heel_toe = 0.0
@@ -657,8 +486,11 @@ class Runner:
             h = self.heading_d
             dist = float((com - self.step_start[1]) @ np.array([math.cos(h), math.sin(h)]))
             err = dist / (t - self.step_start[0]) - self.speed
-            bias = self.speed_bias + self.k["speed_integral"] * err
-            self.speed_bias = _clamp(bias, -0.3, 0.3)
+            # not over the start (its first steps lose up to 1 m/s, which the proportional
+            # gain recovers and the slow part would wind up on) nor while the speed ramps up
+            if t >= INTEGRATE_AFTER and self.speed >= self.target:
+                bias = self.speed_bias + self.k["speed_integral"] * err
+                self.speed_bias = _clamp(bias, -0.3, 0.3)
         self.step_start = (t, com)
         # the spring's rest length: the hip-to-ankle length at touchdown as planned, or as
         # it landed if longer
@@ -696,6 +528,13 @@ class Runner:
             self.heading_d += _clamp(step, -limit, limit)
         else:
             self.heading_d, self._steered = want, True
+        if self.speed < self.target:
+            # the desired speed ramps up from the start's, and the tuning with it
+            self.speed = min(
+                self.target, self.speed + self.accel * self.control_every * world.timestep
+            )
+            self.k = self.params.at(self.speed)
+            self.thrust_force = self.k["thrust"] * self.mass * self.g
         self.machine.control(world, t)
         # the frame the legs are placed and swung in: the desired facing, not the pelvis's
         # (which yaws back and forth with every stride)
@@ -732,28 +571,3 @@ class Runner:
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
             angles[list(_HIP), 0], angles[list(_KNEE), 0], self.heading_d, self.cross_track,
         ))  # fmt: skip
-
-
-def running_start(athlete: Athlete, speed: float, heading: float = 0.0) -> tuple[F64, F64]:
-    """qpos ``(67,)`` and qvel ``(51,)`` of the runner in flight at ``speed`` along
-    ``heading``, its soles 5 cm up: the left leg reaching forward for touchdown, the right
-    trailing with its knee bent."""
-    angles = np.zeros((NJ, 3))
-    angles[_HIP[0]] = (-0.45, 0.0, 0.0)
-    angles[_KNEE[0]] = (0.25, 0.0, 0.0)
-    angles[_ANKLE[0]] = (-0.05, 0.0, 0.0)
-    angles[_HIP[1]] = (0.25, 0.0, 0.0)
-    angles[_KNEE[1]] = (1.2, 0.0, 0.0)
-    angles[_ANKLE[1]] = (0.2, 0.0, 0.0)
-    for k in range(2):
-        angles[_SHOULDER[k]] = (0.9 * angles[_HIP[1 - k], 0] + 0.05, 0.15 * (1 - 2 * k), 0.0)
-        angles[_ELBOW[k]] = (-1.4, 0.0, 0.0)
-    q = athlete.standing_qpos(angles, pitch=0.08, clearance=0.05)
-    if heading:
-        q[3:7] = quat_mul(quat_from_yaw(heading), q[3:7])
-        c, s = math.cos(heading), math.sin(heading)
-        q[0], q[1] = c * q[0] - s * q[1], s * q[0] + c * q[1]
-    v = np.zeros(6 + 3 * NJ)
-    v[0] = speed * math.cos(heading)
-    v[1] = speed * math.sin(heading)
-    return q, v

@@ -1,0 +1,99 @@
+"""The runner's body (:mod:`reactmocap.athletics.running`): the indices of the joints and
+bodies its laws read, the single-quaternion math they use at every tick, and the pose a run
+starts from (:func:`running_start`)."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.athletics.bodies import Athlete
+from reactmocap.athletics.rig import joint_index
+from reactmocap.rotations import quat_from_yaw, quat_mul
+from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
+
+__all__ = ["running_start"]
+
+F64 = NDArray[np.float64]
+NJ = len(BALL_JOINTS)
+_HIP = (joint_index("l_hip"), joint_index("r_hip"))
+_KNEE = (joint_index("l_knee"), joint_index("r_knee"))
+_ANKLE = (joint_index("l_ankle"), joint_index("r_ankle"))
+_SHOULDER = (joint_index("l_shoulder"), joint_index("r_shoulder"))
+_ELBOW = (joint_index("l_elbow"), joint_index("r_elbow"))
+_SPINE = (joint_index("waist"), joint_index("back"))
+_NECK = joint_index("neck")
+_LEG_JOINTS = (*_HIP, *_KNEE, *_ANKLE)
+_BODY = {b: i for i, b in enumerate(SIM_BODIES)}
+_THIGH = (_BODY["l_thigh"], _BODY["r_thigh"])
+_SHIN = (_BODY["l_shin"], _BODY["r_shin"])
+_FOOT = (_BODY["l_foot"], _BODY["r_foot"])
+
+
+# ---------------------------------------------------------------------------------- small math
+# single quaternions at every tick: MuJoCo's C routines and closed forms instead of the
+# vectorised helpers (scipy), which cost 100-400 us a call and dominated the tick
+def _qmul(a: F64, b: F64) -> F64:
+    out = np.empty(4)
+    mujoco.mju_mulQuat(out, a, b)
+    return out
+
+
+def _clamp(x: float, lo: float, hi: float) -> float:
+    return float(min(max(x, lo), hi))
+
+
+def _qconj(q: F64) -> F64:
+    return np.array([q[0], -q[1], -q[2], -q[3]])
+
+
+def _qyaw(yaw: float) -> F64:
+    return np.array([math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw)])
+
+
+def _quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
+    """Quaternion of intrinsic Y-X-Z Euler angles (:data:`~reactmocap.athletics.bodies.
+    EULER_ORDER`)."""
+    qy = np.array([math.cos(0.5 * pitch), 0.0, math.sin(0.5 * pitch), 0.0])
+    qx = np.array([math.cos(0.5 * roll), math.sin(0.5 * roll), 0.0, 0.0])
+    return _qmul(_qmul(qy, qx), _qyaw(yaw))
+
+
+def _euler_yxz(q: F64) -> tuple[float, float, float]:
+    """Intrinsic Y-X-Z Euler angles (pitch, roll, yaw) of a quaternion: with
+    ``R = Ry Rx Rz``, pitch = atan2(R02, R22), roll = asin(-R12), yaw = atan2(R10, R11)."""
+    w, x, y, z = q
+    r02 = 2.0 * (x * z + w * y)
+    r22 = 1.0 - 2.0 * (x * x + y * y)
+    r12 = 2.0 * (y * z - w * x)
+    r10 = 2.0 * (x * y + w * z)
+    r11 = 1.0 - 2.0 * (x * x + z * z)
+    return (math.atan2(r02, r22), math.asin(max(-1.0, min(1.0, -r12))), math.atan2(r10, r11))
+
+
+def running_start(athlete: Athlete, speed: float, heading: float = 0.0) -> tuple[F64, F64]:
+    """qpos ``(67,)`` and qvel ``(51,)`` of the runner in flight at ``speed`` along
+    ``heading``, its soles 5 cm up: the left leg reaching forward for touchdown, the right
+    trailing with its knee bent."""
+    angles = np.zeros((NJ, 3))
+    angles[_HIP[0]] = (-0.45, 0.0, 0.0)
+    angles[_KNEE[0]] = (0.25, 0.0, 0.0)
+    angles[_ANKLE[0]] = (-0.05, 0.0, 0.0)
+    angles[_HIP[1]] = (0.25, 0.0, 0.0)
+    angles[_KNEE[1]] = (1.2, 0.0, 0.0)
+    angles[_ANKLE[1]] = (0.2, 0.0, 0.0)
+    for k in range(2):
+        angles[_SHOULDER[k]] = (0.9 * angles[_HIP[1 - k], 0] + 0.05, 0.15 * (1 - 2 * k), 0.0)
+        angles[_ELBOW[k]] = (-1.4, 0.0, 0.0)
+    q = athlete.standing_qpos(angles, pitch=0.08, clearance=0.05)
+    if heading:
+        q[3:7] = quat_mul(quat_from_yaw(heading), q[3:7])
+        c, s = math.cos(heading), math.sin(heading)
+        q[0], q[1] = c * q[0] - s * q[1], s * q[0] + c * q[1]
+    v = np.zeros(6 + 3 * NJ)
+    v[0] = speed * math.cos(heading)
+    v[1] = speed * math.sin(heading)
+    return q, v

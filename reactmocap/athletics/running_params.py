@@ -1,0 +1,170 @@
+"""The runner's inputs and tuning (:mod:`reactmocap.athletics.running`): the speed range,
+the tuning values given at three speeds and interpolated between them, and the per-tick log.
+Design and measurements: ``docs/athletics.md``."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+from numpy.typing import NDArray
+
+from reactmocap.athletics.rig import per_joint
+from reactmocap.errors import ConfigError
+
+__all__ = ["SPEED_RANGE", "TUNED_SPEEDS", "RunLog", "RunParams", "Speeds", "check_speed"]
+
+#: the speeds the runner is built for (m/s), the paper's range
+SPEED_RANGE = (2.5, 5.0)
+
+
+def check_speed(speed: float) -> float:
+    """``speed`` if it lies in :data:`SPEED_RANGE`, else a ConfigError naming the range."""
+    lo, hi = SPEED_RANGE
+    if not (isinstance(speed, (int, float)) and math.isfinite(speed) and lo <= speed <= hi):
+        raise ConfigError(
+            f"running speed {speed!r} m/s is outside the supported range {lo:g}-{hi:g} m/s"
+        )
+    return float(speed)
+
+
+#: a tuning value at 2.5, 3.5 and 5 m/s (:data:`TUNED_SPEEDS`), interpolated piecewise linearly
+Speeds = tuple[float, float, float]
+#: the speeds the tuning triples are given at (m/s)
+TUNED_SPEEDS = (2.5, 3.5, 5.0)
+
+
+@dataclass(frozen=True)
+class RunParams:
+    """The runner's tuning. Values given as three numbers are at 2.5, 3.5 and 5 m/s,
+    interpolated piecewise linearly by speed (a single number is used at every speed). Angles in radians, joint
+    stiffness in units of ``m g L`` N m/rad (body mass, leg length), leg stiffness in
+    ``m g / L`` N/m, times in seconds. The defaults were found by a search over these
+    parameters (``benchmarks/bench_athletics_running.py --tune``), see ``docs/athletics.md``.
+
+    Args:
+        stance_time: first estimate of the stance duration ``t_s`` (eqs. 1-2); later steps
+            use the previous stance's.
+        speed_gain: ``k`` of eqs. 1-2, the velocity-error gain (s).
+        speed_integral: per step, the placement's slow correction (m) per m/s of the last
+            step's speed error (0: eqs. 1-2 alone).
+        touchdown_leg: hip-to-ankle length at touchdown (fraction of the straight leg).
+        speed_matching, retract_time: ground-speed matching: how far (m) the swing foot
+            reaches beyond its touchdown place and how long before touchdown it comes back.
+        heel_up: foot pitch at touchdown (rad, toes up): the heel strikes first.
+        step_width: lateral distance between the feet's touchdown places (m).
+        leg_stiffness, leg_damping: the stance leg's spring (``m g / L`` N/m) and its
+            damping ratio.
+        thrust: the toe phase's extra leg force (body weights), until the body rises at
+            ``takeoff_vz`` (m/s).
+        toe_fraction: the heel-and-toe phase ends at this fraction of the expected stance
+            (the paper: 30-50% by speed).
+        pitch: desired forward pitch of the trunk (rad).
+        attitude_kp, attitude_kv: the stance hip's attitude servo (roll, pitch, yaw), per
+            unit of the body's mass times its leg length squared (1/s^2, 1/s).
+        yaw_grip: the twisting moment a stance foot can hold, in units of its length times
+            the vertical ground force (a friction coefficient times the lever).
+        knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
+            keep only their roll and yaw (the leg spring drives their pitch).
+        idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
+            by the end of the stance ready for touchdown (rad).
+        swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
+        arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
+        elbow: elbow flexion (rad).
+        turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
+        lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
+        smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
+        stiffness: the servos' stiffness by joint kind outside the stance leg.
+    """
+
+    stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
+    speed_gain: float | Speeds = (0.1914, 0.0835, 0.08567)
+    speed_integral: float | Speeds = (0, 0, 0.001824)
+    touchdown_leg: float | Speeds = (0.93, 0.948, 0.9475)
+    speed_matching: float | Speeds = (0, 0.009, 0.03712)
+    retract_time: float | Speeds = 0.06
+    heel_up: float | Speeds = 0.2
+    step_width: float | Speeds = (0.06929, 0.065, 0.05902)
+    leg_stiffness: float | Speeds = (32.11, 21.6, 21.19)
+    leg_damping: float | Speeds = (0.08527, 0.04, 0.06971)
+    thrust: float | Speeds = (1.683, 1.71, 1.716)
+    takeoff_vz: float | Speeds = (0.5575, 0.517, 0.5806)
+    toe_fraction: float | Speeds = (0.3849, 0.42, 0.3199)
+    pitch: float | Speeds = (0.1207, 0.013, -0.01578)
+    attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
+    attitude_kv: tuple[float, float, float] = (14.0, 14.0, 5.42)
+    yaw_grip: float | Speeds = 0.181
+    knee_hold: float | Speeds = 3.0
+    ankle_hold: float | Speeds = 1.0
+    idle_knee: float | Speeds = (2.182, 1.813, 1.692)
+    reach_knee: float | Speeds = (1.192, 1.066, 1.102)
+    swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
+    arm_gain: float | Speeds = (0.7815, 1.273, 1.336)
+    arm_offset: float | Speeds = 0.05
+    elbow: float | Speeds = 1.4
+    turn_rate: float | Speeds = 0.35
+    lean: float | Speeds = 1.0
+    smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
+    stiffness: dict[str, float] = field(
+        default_factory=lambda: {
+            "waist": 4.0, "back": 4.0, "neck": 0.3, "shoulder": 0.4, "elbow": 0.2,
+            "wrist": 0.05, "hip": 3.935, "knee": 0.70, "ankle": 0.4,
+        }
+    )  # fmt: skip
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            vals = v.values() if isinstance(v, dict) else v if isinstance(v, tuple) else (v,)
+            if not all(isinstance(x, (int, float)) and math.isfinite(x) for x in vals):
+                raise ConfigError(f"running parameter {f.name} must be finite, got {v!r}")
+            if isinstance(v, tuple) and f.name not in _AXES and len(v) != 3:
+                raise ConfigError(
+                    f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
+                )
+        per_joint(self.stiffness)  # unknown joint kinds are named there
+        lo, hi = SPEED_RANGE
+        for speed in (lo, hi):
+            r = self.at(speed)
+            if not 0.5 < r["touchdown_leg"] <= 1.0:
+                raise ConfigError(f"touchdown_leg must be in (0.5, 1], got {self.touchdown_leg}")
+            if r["stance_time"] <= 0 or r["smoothing"] < 0 or r["leg_stiffness"] <= 0:
+                raise ConfigError("stance_time and leg_stiffness must be > 0, smoothing >= 0")
+
+    def at(self, speed: float) -> dict[str, float]:
+        """Every scalar tuning value at ``speed`` (triples interpolated, clamped to the
+        range)."""
+        out = {}
+        for f in fields(self):
+            if f.name in _AXES or f.name == "stiffness":
+                continue
+            v = getattr(self, f.name)
+            out[f.name] = (
+                float(np.interp(speed, TUNED_SPEEDS, v)) if isinstance(v, tuple) else float(v)
+            )
+        return out
+
+
+#: per-axis (roll, pitch, yaw) values, not per-speed
+_AXES = ("attitude_kp", "attitude_kv")
+
+
+@dataclass
+class RunLog:
+    """Per control tick: time, COM, COM velocity, pelvis heading, state index, active leg,
+    feet in contact (bit 0 left, bit 1 right), pelvis height, whether anything but the feet
+    touched the floor, hip and knee pitch of both legs; and the touchdown and lift-off
+    events (time, leg, foot position)."""
+
+    rows: list[tuple] = field(default_factory=list)
+    touchdowns: list[tuple[float, int, float, float]] = field(default_factory=list)
+    liftoffs: list[tuple[float, int]] = field(default_factory=list)
+
+    def arrays(self) -> dict[str, NDArray]:
+        names = ("t", "com", "com_vel", "heading", "state", "active", "feet", "pelvis",
+                 "others", "hip", "knee", "desired_heading", "cross_track")  # fmt: skip
+        if not self.rows:
+            return {n: np.zeros(0) for n in names}
+        cols = list(zip(*self.rows))
+        return {n: np.array(c) for n, c in zip(names, cols)}
