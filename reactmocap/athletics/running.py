@@ -80,6 +80,8 @@ RUN_STATES = ("flight", "loading", "heel", "heel_toe", "toe", "unloading")
 CORNER_TOUCH = 0.004
 #: the placement's slow correction integrates from this time on (s)
 INTEGRATE_AFTER = 1.0
+#: the most of a step's speed error (m/s) that correction integrates
+ERROR_CAP = 0.3
 #: the fastest a run starts at (m/s): faster runs start at it and the desired speed ramps up
 #: at :data:`ACCEL` (m/s^2); from a set pose at 5 m/s the first stance lost 1.6 m/s and the
 #: runner fell recovering it
@@ -489,7 +491,10 @@ class Runner:
             # not over the start (its first steps lose up to 1 m/s, which the proportional
             # gain recovers and the slow part would wind up on) nor while the speed ramps up
             if t >= INTEGRATE_AFTER and self.speed >= self.target:
-                bias = self.speed_bias + self.k["speed_integral"] * err
+                # a step's error counts at most ERROR_CAP: a bias that grew 5 cm a step moved
+                # the feet back faster than the legs could follow, and the runner sank
+                cap = ERROR_CAP
+                bias = self.speed_bias + self.k["speed_integral"] * _clamp(err, -cap, cap)
                 self.speed_bias = _clamp(bias, -0.3, 0.3)
         self.step_start = (t, com)
         # the spring's rest length: the hip-to-ankle length at touchdown as planned, or as

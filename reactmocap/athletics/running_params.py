@@ -80,7 +80,7 @@ class RunParams:
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
     speed_gain: float | Speeds = (0.1914, 0.0835, 0.08567)
-    speed_integral: float | Speeds = (0, 0, 0.001824)
+    speed_integral: float | Speeds = (0, 0, 0.03)
     touchdown_leg: float | Speeds = (0.93, 0.948, 0.9475)
     speed_matching: float | Speeds = (0, 0.009, 0.03712)
     retract_time: float | Speeds = 0.06

@@ -47,3 +47,18 @@ def test_the_states_cycle(run_35) -> None:  # type: ignore[no-untyped-def]
     assert {"flight", "loading", "heel_toe", "toe"} <= seen
     legs = [leg for _, leg, _, _ in run_35.runner.log.touchdowns]
     assert all(a != b for a, b in zip(legs, legs[1:]))
+
+
+def test_a_fast_run_starts_at_the_start_speed_and_ramps_up() -> None:
+    """Asked for 5 m/s, the run starts at START_SPEED and the desired speed (and the tuning
+    read at it) reaches 5 m/s after (5 - START_SPEED) / ACCEL seconds, and not before."""
+    from reactmocap.athletics.running import ACCEL, START_SPEED, RunParams
+
+    ramp = (5.0 - START_SPEED) / ACCEL
+    early = run_course(5.0, seconds=0.5 * ramp, fps=30.0)
+    assert early.log["com_vel"][0][0] == pytest.approx(START_SPEED, abs=0.05)
+    assert START_SPEED < early.runner.speed < 5.0
+    assert early.runner.k == RunParams().at(early.runner.speed)
+    late = run_course(5.0, seconds=ramp + 0.05, fps=30.0)
+    assert late.runner.speed == 5.0 and late.runner.target == 5.0
+    assert late.runner.k == RunParams().at(5.0)
