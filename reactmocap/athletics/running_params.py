@@ -48,7 +48,9 @@ class RunParams:
             use the previous stance's.
         speed_gain: ``k`` of eqs. 1-2, the velocity-error gain (s).
         speed_integral: per step, the placement's slow correction (m) per m/s of the last
-            step's speed error (0: eqs. 1-2 alone).
+            step's speed error, capped at 0.3 m/s (0: eqs. 1-2 alone). Set by hand, not by
+            the search, whose 6 s runs are too short to see it: without it the runner fell
+            0.3-0.5 m/s short above 3.5 m/s.
         touchdown_leg: hip-to-ankle length at touchdown (fraction of the straight leg).
         speed_matching, retract_time: ground-speed matching: how far (m) the swing foot
             reaches beyond its touchdown place and how long before touchdown it comes back.
