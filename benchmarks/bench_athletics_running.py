@@ -154,7 +154,8 @@ def vault_section() -> None:
     print(f"\nrows inside the human range: {r['table1_inside']}/16; velocities within 10% of "
           f"the mean: {r['velocities_within_10pct']}/8; cleared the horse: "
           f"{_fmt(r['cleared'])} (lowest {_fmt(r['min_clearance_over_horse_m'])} m over its top); "
-          f"landed: {_fmt(r['landed'])}; rotation {r['rotation_deg']:.0f} deg\n")  # fmt: skip
+          f"landed: {_fmt(r['landed'])} (stayed up {r['up_after_touchdown_s']:.2f} s after "
+          f"touchdown); rotation at touchdown {r['rotation_at_touchdown_deg']:.0f} deg\n")  # fmt: skip
 
 
 def cloth(seconds: float, speed: float, repeats: int = 3) -> None:
@@ -260,7 +261,12 @@ def tune_vault(iterations: int, seed: int) -> None:
         "knee_stiffness": (0.5, 12.0, 0.8), "push_stiffness": (0.5, 20.0, 1.2),
         "arms_board": (-3.1, -1.0, 0.15), "hand_target": (-0.2, 0.2, 0.04),
         "pike": (-0.3, 0.8, 0.08), "flight_stiffness": (0.5, 8.0, 0.6),
-        "horse_push": (0.0, 4.0, 0.3), "landing_height": (0.9, 1.6, 0.06),
+        "horse_push": (0.0, 4.0, 0.3), "layout2": (0.0, 0.3, 0.03),
+        "turns2": (0.8, 1.15, 0.03), "touchdown_com": (0.6, 1.2, 0.05),
+        "land_knee": (0.2, 1.2, 0.08), "land_lead": (0.3, 1.5, 0.1),
+        "land_delta": (-0.3, 0.2, 0.04), "land_damping": (0.2, 6.0, 0.4),
+        "land_restore": (0.0, 0.5, 0.04), "land_lean": (0.0, 1.2, 0.1),
+        "mat_solref": (0.01, 0.08, 0.006),
     }  # fmt: skip
 
     def score(x: dict[str, float]) -> float:
@@ -273,7 +279,9 @@ def tune_vault(iterations: int, seed: int) -> None:
                 continue
             span = row.high - row.low
             j += 2.0 * max(row.low - v, v - row.high, 0.0) / span + 0.3 * abs(v - row.mean) / span
-        return j + 3.0 * (not rep["cleared"]) + 2.0 * (not rep["landed"])
+        # the landing: how long she stayed up after touchdown (to the run's end: landed)
+        up = min(rep["up_after_touchdown_s"], 2.0) / 2.0
+        return j + 3.0 * (not rep["cleared"]) + 6.0 * (1.0 - up) + 2.0 * (not rep["landed"])
 
     rng = np.random.default_rng(seed)
     base = VaultParams()
