@@ -280,7 +280,7 @@ def tune_vault(iterations: int, seed: int) -> None:
             span = row.high - row.low
             j += 2.0 * max(row.low - v, v - row.high, 0.0) / span + 0.3 * abs(v - row.mean) / span
         # the landing: how long she stayed up after touchdown (to the run's end: landed)
-        up = min(rep["up_after_touchdown_s"], 2.0) / 2.0
+        up = min(rep["up_after_touchdown_s"], 3.0) / 3.0
         return j + 3.0 * (not rep["cleared"]) + 6.0 * (1.0 - up) + 2.0 * (not rep["landed"])
 
     rng = np.random.default_rng(seed)

@@ -137,6 +137,12 @@ def render_world_video(res: RolloutResult, path: str | Path, fps: float = 30.0,
 
 #: seconds the gymnast must stay up after landing for ``landed`` (and to the end of the run)
 LANDED_AFTER = 1.0
+#: at the end of the run (its last 0.1 s) the COM must be within this horizontal distance
+#: (m) of the feet's support centre and slower than this (m/s) for ``landed``
+SETTLED_OFFSET = 0.15
+SETTLED_SPEED = 0.3
+#: seconds simulated by default: the vault takes about 1.1 s to the floor, then 3 s standing
+DEFAULT_SECONDS = 4.2
 #: seconds both feet may be off the floor after touchdown (a bounce) before she is down
 BOUNCE_S = 0.15
 #: physics steps per control tick (4 ms; the board contact lasts about 0.14 s)
@@ -163,7 +169,7 @@ def vault(
         raise ConfigError(f"unknown vault body {body!r}; valid bodies are ['female', 'male']")
     if seconds is not None and not (math.isfinite(seconds) and seconds > 0):
         raise ConfigError(f"seconds must be > 0, got {seconds!r}")
-    duration = 2.2 + LANDED_AFTER if seconds is None else float(seconds)
+    duration = DEFAULT_SECONDS if seconds is None else float(seconds)
     world = vault_world(ath, p)
     q, v = vault_start(ath, p)
     world.set_pose(0, q, v)
@@ -236,7 +242,13 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
     up_s = 0.0
     if td is not None and feet_first:
         up_s = float(at[np.flatnonzero(down)[0]]) - td if down.any() else res.seconds - td
-    landed = bool(feet_first and not down.any() and res.seconds >= (td or 0) + LANDED_AFTER - 1e-6)
+    # and at the end she stands balanced: the COM over her feet and still (a fall that has
+    # not yet reached the floor when the run stops is no landing)
+    end = at >= at[-1] - 0.1 if at.size else at.astype(bool)
+    settled = bool(end.any() and (arr["offset"][end] < SETTLED_OFFSET).all()
+                   and (np.hypot(*arr["com_vel"][end, :2].T) < SETTLED_SPEED).all())  # fmt: skip
+    landed = bool(feet_first and not down.any() and settled
+                  and res.seconds >= (td or 0) + LANDED_AFTER - 1e-6)  # fmt: skip
     report: dict[str, Any] = {
         "behaviour": "vault", "body": ath.name, "mass_kg": round(ath.mass, 2),
         "table1": rows,
@@ -248,6 +260,7 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
         "landed": landed,
         "touchdown_s": td,
         "up_after_touchdown_s": up_s,
+        "settled_at_end": settled,
         "rotation_deg": rotation,
         "rotation_at_touchdown_deg": rotation_td,
         "board_stiffness_n_m": p.board_stiffness,
