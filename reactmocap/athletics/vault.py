@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.athletics.balance import Balance
+from reactmocap.athletics.balance import Balance, Posture
 from reactmocap.athletics.bodies import Athlete, athlete
 from reactmocap.athletics.land import Landing, LandingParams
 from reactmocap.athletics.machine import Context
@@ -180,6 +180,7 @@ def vault(
     ctx.standing_com = float(_com_of(ath, ath.standing_qpos(np.zeros((NJ, 3))))[2])
     tumble = Tumble(TumbleParams(position=p.position2, turns=p.turns2,
                                  touchdown_height=p.touchdown_com))  # fmt: skip
+    stand = Balance(Posture(leg=p.stand_leg, settle=p.stand_settle))
     landing = LandingParams(
         knee=p.land_knee,
         lead=p.land_lead,
@@ -189,7 +190,7 @@ def vault(
         restore=p.land_restore,
         lean=p.land_lean,
     )
-    seq = Sequencer(ctx, [basis, tumble, Landing(landing), Balance()])
+    seq = Sequencer(ctx, [basis, tumble, Landing(landing), stand])
     logger = _Logger(basis, seq)
     tick = None if on_tick is None else (lambda t: on_tick(min(t / duration, 1.0)))
     try:

@@ -90,6 +90,10 @@ class VaultParams:
             ``knee_stiffness``, ``restore`` and ``lean``
             (:class:`~reactmocap.athletics.land.LandingParams`): the vault lands faster than
             a broad jump (about 3.7 m/s forward, 4 m/s down).
+        stand_leg, stand_settle: the posture the balance controller stands her up into after
+            the landing (:class:`~reactmocap.athletics.balance.Posture` ``leg``, the
+            hip-to-ankle length as a fraction of the leg: knees a little bent, and
+            ``settle``, the seconds it takes).
         mat_solref: contact time constant of the floor (s): a landing mat, softer than the
             ground (the paper: "reducing the stiffness of the ground").
         mat_damping: the mat contact's damping ratio (1: critical; more: the mat gives back
@@ -131,6 +135,8 @@ class VaultParams:
     land_knee_stiffness: float = 0.0
     land_restore: float = 0.245
     land_lean: float = 0.396
+    stand_leg: float = 0.9
+    stand_settle: float = 0.5
 
     def __post_init__(self) -> None:
         position_angles(self.position2)  # an unknown position lists the valid ones
@@ -141,9 +147,11 @@ class VaultParams:
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"vault parameter {f.name} must be a finite number, got {v!r}")
         for name in ("board_stiffness", "board_mass", "horse_distance", "approach_vx",
-                     "mat_solref", "mat_damping", "turns2", "touchdown_com"):  # fmt: skip
+                     "mat_solref", "mat_damping", "turns2", "touchdown_com", "stand_settle"):  # fmt: skip
             if getattr(self, name) <= 0:
                 raise ConfigError(f"vault parameter {name} must be > 0")
+        if not 0.3 <= self.stand_leg <= 1.0:
+            raise ConfigError(f"vault stand_leg must be within [0.3, 1.0], got {self.stand_leg!r}")
 
 
 # ---------------------------------------------------------------------------------- the body

@@ -56,16 +56,14 @@ def test_the_tuck_turns_the_somersault_feet_first(result) -> None:  # type: igno
     assert rep["up_after_touchdown_s"] >= 1.0
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="feet first and upright, but she stands on one foot and topples forward about "
-    "2.1 s after touchdown (docs/athletics.md, issue 20)",
-)
 def test_the_vault_lands(result) -> None:  # type: ignore[no-untyped-def]
     rep = result.report
     assert rep["status"] == "ok", rep.get("reason")
     assert rep["landed"], rep["notes"]
+    # up from touchdown to the end of the run, and at the end standing still over her feet
     assert rep["settled_at_end"]
+    assert rep["simulated_s"] >= rep["touchdown_s"] + rep["up_after_touchdown_s"] - 0.01
+    assert rep["up_after_touchdown_s"] >= 2.0
 
 
 def test_without_the_tuck_she_under_rotates() -> None:
@@ -79,3 +77,5 @@ def test_without_the_tuck_she_under_rotates() -> None:
 def test_unknown_second_flight_position_is_a_clear_error() -> None:
     with pytest.raises(ReactMocapError, match="tuck"):
         VaultParams(position2="straddle")
+    with pytest.raises(ReactMocapError, match="stand_leg"):
+        VaultParams(stand_leg=1.5)
