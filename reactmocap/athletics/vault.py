@@ -279,7 +279,8 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
     if not landed:
         notes.append(
             "the gymnast did not land on her feet and stay up (feet down, nothing "
-            "else touching) for 1 s and to the end of the run"
+            "else touching) for 1 s and to the end of the run, standing still over her feet "
+            "at the end"
         )
     if report["table1_inside"] < len(TABLE1):
         notes.append(f"Table 1 rows outside the human range: {report['table1_outside']}")
