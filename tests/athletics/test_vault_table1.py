@@ -4,10 +4,12 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import pytest
 
-from reactmocap.athletics.vault import TABLE1, TABLE1_KEYS, vault, vault_athlete
+from reactmocap.athletics.vault import TABLE1, TABLE1_KEYS, VaultParams, vault, vault_athlete
+from reactmocap.errors import ReactMocapError
 
 
 @pytest.fixture(scope="module")
@@ -46,12 +48,34 @@ def test_the_vault_clears_the_horse(result) -> None:  # type: ignore[no-untyped-
     assert rep["min_clearance_over_horse_m"] > -0.01
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="under-rotated: about 290 of the somersault's 360 degrees by touchdown, so the "
-    "gymnast lands on her back (docs/athletics.md, issue 20)",
-)
+def test_the_tuck_turns_the_somersault_feet_first(result) -> None:  # type: ignore[no-untyped-def]
+    rep = result.report
+    assert rep["status"] == "ok", rep.get("reason")
+    # about one somersault by the floor, the feet first, and up for at least 1 s after
+    assert 330 <= rep["rotation_at_touchdown_deg"] <= 420
+    assert rep["up_after_touchdown_s"] >= 1.0
+
+
 def test_the_vault_lands(result) -> None:  # type: ignore[no-untyped-def]
     rep = result.report
     assert rep["status"] == "ok", rep.get("reason")
     assert rep["landed"], rep["notes"]
+    # up from touchdown to the end of the run, and at the end standing still over her feet
+    assert rep["settled_at_end"]
+    assert rep["simulated_s"] >= rep["touchdown_s"] + rep["up_after_touchdown_s"] - 0.01
+    assert rep["up_after_touchdown_s"] >= 2.0
+
+
+def test_without_the_tuck_she_under_rotates() -> None:
+    # the second flight held in the layout turns too slowly: on her back, not landed
+    rep = vault(params=replace(VaultParams(), position2="layout"), fps=30.0).report
+    assert rep["status"] == "ok", rep.get("reason")
+    assert rep["rotation_at_touchdown_deg"] < 320
+    assert not rep["landed"] and rep["notes"]
+
+
+def test_unknown_second_flight_position_is_a_clear_error() -> None:
+    with pytest.raises(ReactMocapError, match="tuck"):
+        VaultParams(position2="straddle")
+    with pytest.raises(ReactMocapError, match="stand_leg"):
+        VaultParams(stand_leg=1.5)
