@@ -35,8 +35,10 @@ __all__ = [
 #: the arms overhead and swings them forward and down through the push, the COM 8 cm ahead of
 #: the feet, the hips' momentum feedback aiming at +60 kg m^2/s; it stays tucked until the
 #: prediction reaches the full turn (the opening costs a forward somersault rotation: the legs
-#: swing down and the trunk back), extending hips and knees 30% toward the landing pose first
-#: (thesis 8.5.1), and lands with the feet 15 cm ahead of the capture point.
+#: swing down and the trunk back), extending hips and knees 60% toward the landing pose first
+#: (thesis 8.5.1: without it the legs are still folded at touchdown and the landing sinks the
+#: pelvis below the fall line), and lands with the feet 40 cm ahead of the capture point to
+#: stop the forward spin (landed at 35-45 cm; at 30 cm the crouch sank too deep).
 SOMERSAULT_PRESETS: Mapping[
     str, Mapping[str, tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]]
 ] = MappingProxyType({
@@ -45,9 +47,9 @@ SOMERSAULT_PRESETS: Mapping[
                      MappingProxyType({"lead": 2.8}), MappingProxyType({"delta": -0.15})),
         "forward": (MappingProxyType({"effort": 1.0, "spin": 60.0, "spin_limit": 1.0,
                                       "com_offset": 0.08, "arms_back": -2.8, "arms": 0.0}),
-                    MappingProxyType({"lead": 0.0, "latest": 0.0, "extend": 0.3,
+                    MappingProxyType({"lead": 0.0, "latest": 0.0, "extend": 0.6,
                                       "extend_lead": 0.15}),
-                    MappingProxyType({"delta": 0.15, "knee": 0.2, "restore": 0.5})),
+                    MappingProxyType({"delta": 0.4, "knee": 0.4, "restore": 0.2})),
     }),
     "female": MappingProxyType({
         "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0}),
