@@ -130,3 +130,11 @@ def test_the_forward_tuck_somersault_turns_360_forward_and_lands() -> None:
     # standing height (this landing's crouch is deep: docs/athletics.md)
     pelvis = res.log["pelvis"]
     assert not res.log["others"].any() and pelvis.min() >= FALL_HEIGHT * pelvis[0]
+
+
+def test_the_back_pike_lands_on_more_momentum_than_the_tuck(back_tuck) -> None:  # type: ignore[no-untyped-def]
+    r = somersault("pike", "backward", "male").report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    # the pike's larger inertia (Fig. 5.2) needs a larger take-off momentum for the same turn
+    assert r["liftoff_pitch_momentum"] < back_tuck.report["liftoff_pitch_momentum"] - 5.0
+    assert r["tumble_min_inertia_kgm2"] > back_tuck.report["tumble_min_inertia_kgm2"] + 0.5
