@@ -30,20 +30,39 @@ __all__ = [
 
 # ---------------------------------------------------------------------------------- somersaults
 #: the built-in somersaults, tuned by hand (as the thesis's, section 8.4) per body:
-#: body -> direction -> (leap parameters, tumble lead (rad), landing foot-servo delta (m)).
-#: A pike or layout uses the tuck's leap and landing with the position's own inertia.
-SOMERSAULT_PRESETS: Mapping[str, Mapping[str, tuple[Mapping[str, float], float, float]]] = (
-    MappingProxyType({
-        "male": MappingProxyType({
-            "backward": (MappingProxyType({"effort": 0.6, "spin": -55.0, "spin_limit": 1.0}),
-                         2.8, -0.15),
-        }),
-        "female": MappingProxyType({
-            "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0}),
-                         3.2, -0.12),
-        }),
-    })
-)  # fmt: skip
+#: body -> ``direction`` or ``direction/position`` -> (leap, tumble, landing parameters); a
+#: position with no preset of its own uses its direction's (the tuck's) leap and landing with
+#: the position's own inertia. The back pike needs more momentum for its larger inertia
+#: (aiming at -66 kg m^2/s with the hips' feedback allowed 1.3 rad, it gets -59.6 against the
+#: tuck's -49), opens earlier (lead 3.4 rad) and reaches for the floor with the knees bent
+#: 1.0 rad (at 0.6 its straight-legged touchdown bounced). The forward preset (male) crouches with
+#: the arms overhead and swings them forward and down through the push, the COM 8 cm ahead of
+#: the feet, the hips' momentum feedback aiming at +60 kg m^2/s; it stays tucked until the
+#: prediction reaches the full turn (the opening costs a forward somersault rotation: the legs
+#: swing down and the trunk back), extending hips and knees 60% toward the landing pose first
+#: (thesis 8.5.1: without it the legs are still folded at touchdown and the landing sinks the
+#: pelvis below the fall line), and lands with the feet 40 cm ahead of the capture point to
+#: stop the forward spin (landed at 35-45 cm; at 30 cm the crouch sank too deep).
+SOMERSAULT_PRESETS: Mapping[
+    str, Mapping[str, tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]]
+] = MappingProxyType({
+    "male": MappingProxyType({
+        "backward": (MappingProxyType({"effort": 0.6, "spin": -55.0, "spin_limit": 1.0}),
+                     MappingProxyType({"lead": 2.8}), MappingProxyType({"delta": -0.15})),
+        "backward/pike": (MappingProxyType({"effort": 0.6, "spin": -66.0, "spin_limit": 1.3}),
+                          MappingProxyType({"lead": 3.4}),
+                          MappingProxyType({"delta": -0.15, "knee": 1.0})),
+        "forward": (MappingProxyType({"effort": 1.0, "spin": 60.0, "spin_limit": 1.0,
+                                      "com_offset": 0.08, "arms_back": -2.8, "arms": 0.0}),
+                    MappingProxyType({"lead": 0.0, "latest": 0.0, "extend": 0.6,
+                                      "extend_lead": 0.15}),
+                    MappingProxyType({"delta": 0.4, "knee": 0.4, "restore": 0.2})),
+    }),
+    "female": MappingProxyType({
+        "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0}),
+                     MappingProxyType({"lead": 3.2}), MappingProxyType({"delta": -0.12})),
+    }),
+})  # fmt: skip
 DIRECTIONS = ("backward", "forward")
 
 
@@ -52,8 +71,7 @@ def somersault_maneuver(
 ) -> Maneuver:
     """The standing somersault (thesis 8.4-8.5) as a maneuver: balance, leap with rotation,
     tumble in ``position``, land, balance. Uses the male preset for a body or direction that
-    has none of its own (forward: the backward preset's spin turned forward); such runs are
-    untuned and their reports say what happened."""
+    has none of its own; such runs are untuned and their reports say what happened."""
     if direction not in DIRECTIONS:
         raise UnknownKeyError(
             f"unknown somersault direction {direction!r}; valid directions are {list(DIRECTIONS)}"
@@ -63,18 +81,14 @@ def somersault_maneuver(
             f"unknown somersault position {position!r}; valid positions are {sorted(POSITIONS)}"
         )
     presets = SOMERSAULT_PRESETS.get(body, SOMERSAULT_PRESETS["male"])
-    leap, lead, delta = presets.get(
-        direction, presets.get("backward", next(iter(presets.values())))
-    )
-    leap = dict(leap)
-    if direction == "forward" and "forward" not in presets:
-        leap["spin"] = abs(leap["spin"])
-        delta = -delta
+    if direction not in presets:
+        presets = SOMERSAULT_PRESETS["male"]
+    leap, tumble, land = presets.get(f"{direction}/{position}", presets[direction])
     phases = (
         Phase("balance", "after", {}, 0.3),
-        Phase("leap", "liftoff", leap),
-        Phase("tumble", "open", {"position": position, "lead": lead}),
-        Phase("land", "settled", {"delta": delta}),
+        Phase("leap", "liftoff", dict(leap)),
+        Phase("tumble", "open", {"position": position, **tumble}),
+        Phase("land", "settled", dict(land)),
         # stand up slowly out of the landing's deep crouch: a quicker stand-up (0.5 s) carried
         # the COM forward off the feet after most perturbed landings (docs/athletics.md)
         Phase("balance", "never", {"settle": 2.0}),

@@ -153,6 +153,11 @@ class TumbleParams:
             surface); None: ``touchdown_height`` of the standing COM.
         open_inertia: the opened body's inertia about the somersault axis (kg m^2) the
             prediction uses; None: the landing pose's (:data:`LANDING_POSE`).
+        extend: fraction (0-1) of the way from the position to the landing pose that the
+            hips and knees extend before the opening (thesis 8.5.1: in the forward somersault
+            they extend slightly in the air before the landing controller takes over, so the
+            legs are under the body at touchdown); 0: none.
+        extend_lead: rotation (rad) before the opening at which that extension starts.
     """
 
     position: str = "tuck"
@@ -167,16 +172,20 @@ class TumbleParams:
     arm_throw: float = 0.15
     target_height: float | None = None
     open_inertia: float | None = None
+    extend: float = 0.0
+    extend_lead: float = 0.5
 
     def __post_init__(self) -> None:
         position_angles(self.position)  # an unknown position lists the valid ones
         for name in ("turns", "entry", "lead", "touchdown_height", "latest", "max_seconds",
-                     "arm_tilt", "arm_throw"):  # fmt: skip
+                     "arm_tilt", "arm_throw", "extend", "extend_lead"):  # fmt: skip
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"tumble {name} must be a finite number, got {v!r}")
         if self.turns <= 0 or self.entry <= 0 or self.max_seconds <= 0 or self.arm_throw <= 0:
             raise ConfigError("tumble turns, entry, arm_throw and max_seconds must be > 0")
+        if not 0.0 <= self.extend <= 1.0:
+            raise ConfigError(f"tumble extend must be in [0, 1], got {self.extend!r}")
         if self.open_at is not None and not (math.isfinite(self.open_at) and self.open_at >= 0):
             raise ConfigError(f"tumble open_at must be >= 0 s, got {self.open_at!r}")
         if self.target_height is not None and not math.isfinite(self.target_height):
@@ -208,6 +217,9 @@ class Tumble(Basis):
             for side in "lr":
                 landing[joint_index(f"{side}_{key}")] = val
         i_open = p.open_inertia or somersault_inertia(ctx.athlete, landing)
+        legs = [joint_index(f"{side}_{j}") for side in "lr" for j in ("hip", "knee")]
+        extended = np.full((NJ, 3), np.nan)
+        extended[legs] = goal[legs] + p.extend * (landing[legs] - goal[legs])
         memo: dict[str, float] = {}
         bodies = np.asarray(ctx.world.characters[ctx.character].body_ids)
 
@@ -224,6 +236,7 @@ class Tumble(Basis):
             memo["t_td"] = math.inf
             memo["t0"] = t
             memo.pop("thrown", None)
+            memo.pop("extended", None)
 
         def control(world: World, t: float) -> None:
             if p.arm_tilt and "thrown" not in memo and t - memo["t0"] >= p.entry:
@@ -244,6 +257,11 @@ class Tumble(Basis):
                 aim = p.touchdown_height * (ctx.standing_com or float(s.com[2]))
             memo["t_td"] = time_to_height(ctx, aim)
             memo["predicted"] = ctx.rotation + momentum / i_open * memo["t_td"]
+            want = 2.0 * math.pi * p.turns - p.lead - p.extend_lead
+            if (p.extend and "extended" not in memo and t - memo["t0"] > p.entry
+                    and abs(memo["predicted"]) >= want):  # fmt: skip
+                memo["extended"] = t  # hips and knees part-way open before the landing
+                rig.move(extended, p.entry, t, legs)
             # the whole body's angular velocity about the axis (Fig. 5.3): L over the inertia
             # of the pose it is in now
             inertia = float(axis @ composite_inertia(world.model, world.data, bodies)[0] @ axis)

@@ -70,7 +70,8 @@ def test_bad_files_are_refused_naming_the_field(tmp_path: Path, text: str, field
 
 def test_every_example_is_valid_and_names_a_maneuver_the_issue_asks_for() -> None:
     names = {p.stem for p in EXAMPLES}
-    assert {"back_somersault", "vertical_leap", "broad_jump", "dive_pike"} <= names
+    assert {"back_somersault", "forward_somersault", "vertical_leap", "broad_jump",
+            "dive_pike"} <= names  # fmt: skip
     for path in EXAMPLES:
         m = load_maneuver(path)
         assert m.name == path.stem and m.phases[0].controller == "balance"
@@ -83,6 +84,8 @@ def test_each_example_maneuver_runs_and_lands(path: Path) -> None:
     assert r["landed"] and not r["fell"]
     if path.stem == "back_somersault":
         assert abs(r["rotation_deg"] + 360.0) <= 30.0
+    elif path.stem == "forward_somersault":
+        assert abs(r["rotation_deg"] - 360.0) <= 30.0
     elif path.stem.startswith("dive"):  # 1.5 somersaults: head first into the water
         assert abs(r["rotation_deg"] + 540.0) <= 30.0 and r["entry_angle_deg"] <= 30.0
         assert r["flight_momentum_drift"] <= 0.01

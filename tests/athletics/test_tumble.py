@@ -11,6 +11,7 @@ import pytest
 from reactmocap.athletics import athlete
 from reactmocap.athletics.backdrop import arm_windmill
 from reactmocap.athletics.maneuvers import run_maneuver
+from reactmocap.athletics.report import FALL_HEIGHT
 from reactmocap.athletics.routines import somersault, somersault_maneuver
 from reactmocap.athletics.tumble import POSITIONS, TumbleParams, somersault_inertia
 from reactmocap.errors import ConfigError, UnknownKeyError
@@ -114,3 +115,26 @@ def test_the_female_back_somersault_lands_too() -> None:
     # her tuck: about a third of the male's momentum, and faster (Fig. 5.2: 1.92 kg m^2)
     assert -30.0 < r["liftoff_pitch_momentum"] < -15.0
     assert r["tumble_min_inertia_kgm2"] < 2.2 and r["peak_somersault_rate_rad_s"] > 10.0
+
+
+def test_the_forward_tuck_somersault_turns_360_forward_and_lands() -> None:
+    res = somersault("tuck", "forward", "male")
+    r = res.report
+    assert r["status"] == "ok" and r["liftoff_pitch_momentum"] > 35.0  # forward momentum
+    # one full turn forward, the trunk upright again at the end (the mirrored back preset
+    # turned -635 degrees and fell)
+    assert abs(r["rotation_deg"] - 360.0) <= 45.0
+    assert r["landed"] and not r["fell"]
+    assert r["flight_momentum_drift"] <= 0.01
+    # `fell` is the log's: nothing but the feet touched and the pelvis stayed above half its
+    # standing height (this landing's crouch is deep: docs/athletics.md)
+    pelvis = res.log["pelvis"]
+    assert not res.log["others"].any() and pelvis.min() >= FALL_HEIGHT * pelvis[0]
+
+
+def test_the_back_pike_lands_on_more_momentum_than_the_tuck(back_tuck) -> None:  # type: ignore[no-untyped-def]
+    r = somersault("pike", "backward", "male").report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    # the pike's larger inertia (Fig. 5.2) needs a larger take-off momentum for the same turn
+    assert r["liftoff_pitch_momentum"] < back_tuck.report["liftoff_pitch_momentum"] - 5.0
+    assert r["tumble_min_inertia_kgm2"] > back_tuck.report["tumble_min_inertia_kgm2"] + 0.5
