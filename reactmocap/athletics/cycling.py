@@ -3,18 +3,16 @@ course (:func:`group_ride`), on the one engine (:func:`~reactmocap.sim.rollout`)
 riders seated on their bicycles, the controllers, a monitor that measures what happened
 (speed held, heading reached, falls, collisions, separation, finish times) and the outputs (a
 BVH per rider and per bicycle, a JSON report, a top-view plot, a video), written all or
-nothing. Figures and design: ``docs/athletics.md``."""
+nothing. The monitor is in :mod:`reactmocap.athletics.cycling_monitor`, the result and its
+outputs in :mod:`reactmocap.athletics.cycling_results` (re-exported here). Figures and design:
+``docs/athletics.md``."""
 
 from __future__ import annotations
 
-import contextlib
-import json
 import math
-import os
-import tempfile
 import time
-from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -24,12 +22,13 @@ from numpy.typing import NDArray
 from reactmocap.athletics.bicycle import RIDER_BICYCLE, Bicycle, BicycleParams, Placement
 from reactmocap.athletics.bodies import Athlete, athlete
 from reactmocap.athletics.course import SPEED_RANGE, Course, Route
+from reactmocap.athletics.cycling_monitor import Monitor
+from reactmocap.athletics.cycling_results import CyclingResult, bicycle_motion
 from reactmocap.athletics.cycling_scene import CyclingScene, Obstacle, Terrain
 from reactmocap.athletics.group import GroupGains, GroupRiding
 from reactmocap.athletics.rider import RIDER_WORLD, Rider, RiderMount, fit_bicycle
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
-from reactmocap.library.skeleton import BVHLayout, Skeleton
 from reactmocap.sim.controllers.base import Controller
 from reactmocap.sim.rollout import RolloutResult, rollout
 from reactmocap.sim.world import World
@@ -56,10 +55,6 @@ MIN_SEPARATION_BAR = 0.5
 SPEED_SETTLE = 5.0
 #: a heading is settled within this (deg)
 SETTLED_DEG = 5.0
-#: the group monitor's period (steps) and how long (s) two things must be apart before their
-#: next contact counts as a new collision
-MONITOR_EVERY = 10
-COLLISION_GAP = 0.5
 
 
 # ------------------------------------------------------------------------------- the setup
@@ -102,118 +97,6 @@ def setup(
     return Team(world, scene, ath, bikes, riders)
 
 
-# ------------------------------------------------------------------------------- monitoring
-def _segment_distances(a0: F64, a1: F64, b0: F64, b1: F64) -> F64:
-    """Closest distances ``(k,)`` between 2-D segments ``a0-a1`` and ``b0-b1`` ``(k, 2)``
-    (non-crossing: the four endpoint-to-segment distances; crossing: 0)."""
-
-    def point_seg(p: F64, s0: F64, s1: F64) -> F64:
-        d = s1 - s0
-        t = np.clip(
-            np.einsum("ij,ij->i", p - s0, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-12), 0, 1
-        )
-        return np.linalg.norm(p - (s0 + t[:, None] * d), axis=1)
-
-    def cross(o: F64, a: F64, b: F64) -> F64:
-        return (a[:, 0] - o[:, 0]) * (b[:, 1] - o[:, 1]) - (a[:, 1] - o[:, 1]) * (b[:, 0] - o[:, 0])
-
-    d = np.minimum.reduce([point_seg(a0, b0, b1), point_seg(a1, b0, b1),
-                           point_seg(b0, a0, a1), point_seg(b1, a0, a1)])  # fmt: skip
-    hit = (cross(a0, a1, b0) * cross(a0, a1, b1) < 0) & (cross(b0, b1, a0) * cross(b0, b1, a1) < 0)
-    return np.where(hit, 0.0, d)
-
-
-class Monitor:
-    """Measures a ride as it goes (an engine controller, every :data:`MONITOR_EVERY` steps):
-    collisions (a new contact between two riders, a rider's body or wheels with another's, or
-    with an obstacle; a pair counts again after :data:`COLLISION_GAP` s apart), falls (the
-    bicycle rolled past 60 degrees, or the rider's body touched the ground), the closest
-    distance between two bicycles (between their wheelbase lines, in the plane) and, with a
-    route, when each rider reaches its end."""
-
-    def __init__(self, team: Team, route: Route | None = None,
-                 control_every: int = MONITOR_EVERY) -> None:  # fmt: skip
-        self.team = team
-        self.route = route
-        self.control_every = control_every
-        w = team.world
-        m = w.model
-        n = len(team.riders)
-        owner = np.full(m.ngeom, -3, dtype=np.int64)  # -3: looks only
-        owner[w.geom_character >= 0] = w.geom_character[w.geom_character >= 0]
-        for k, b in enumerate(team.bicycles):
-            owner[b.wheel_geoms] = k
-        owner[team.scene.obstacle_geoms] = -2
-        owner[m.geom("floor").id] = -1
-        self.owner = owner
-        self.is_wheel = np.zeros(m.ngeom, dtype=bool)
-        for b in team.bicycles:
-            self.is_wheel[b.wheel_geoms] = True
-        self.n = n
-        self.collisions: list[tuple[float, int, int]] = []  # (t, i, j); j = -2: an obstacle
-        self._last: dict[tuple[int, int], float] = {}
-        self.fell_at = np.full(n, np.nan)
-        self.finish = np.full(n, np.nan)
-        self.min_separation = math.inf
-        self.separation_pair = (-1, -1)
-        self.separation_time = math.nan
-        iu = np.triu_indices(n, 1)
-        self._pairs = iu
-
-    def reset(self, world: World) -> None:
-        del world
-
-    def control(self, world: World, t: float) -> None:
-        d = world.data
-        nc = d.ncon
-        if nc:
-            g = d.contact.geom[:nc]
-            o = self.owner[g]
-            floor = (o == -1).any(axis=1)
-            # wheels on the floor (nearly every contact) and looks-only geoms are not events
-            other = np.where(o[:, 0] == -1, g[:, 1], g[:, 0])
-            keep = ~(o == -3).any(axis=1) & ~(floor & self.is_wheel[other]) & (o[:, 0] != o[:, 1])
-            for (a, b), on_floor in zip(o[keep], floor[keep]):
-                if on_floor:  # a rider's body on the ground: a fall
-                    k = int(b if a == -1 else a)
-                    if k >= 0 and np.isnan(self.fell_at[k]):
-                        self.fell_at[k] = t
-                    continue
-                pair = (int(min(a, b)), int(max(a, b))) if min(a, b) >= 0 else (int(max(a, b)), -2)
-                last = self._last.get(pair)
-                if last is None or t - last > COLLISION_GAP:
-                    self.collisions.append((t, *pair))
-                self._last[pair] = t
-        for k, b in enumerate(self.team.bicycles):
-            if b.fallen and np.isnan(self.fell_at[k]):
-                self.fell_at[k] = t
-        if self.n > 1:
-            a0, a1 = self._lines()
-            i, j = self._pairs
-            dist = _segment_distances(a0[i], a1[i], a0[j], a1[j])
-            k = int(np.argmin(dist))
-            if dist[k] < self.min_separation:
-                self.min_separation = float(dist[k])
-                self.separation_pair = (int(i[k]), int(j[k]))
-                self.separation_time = t
-        if self.route is not None:
-            a0, a1 = self._lines()
-            s, _ = self.route.project(0.5 * (a0 + a1))
-            done = (s >= self.route.length - 0.05) & np.isnan(self.finish)
-            self.finish[done] = t
-
-    def _lines(self) -> tuple[F64, F64]:
-        """Each bicycle's wheelbase line in the plane: ground points under the wheel centres."""
-        a0 = np.empty((self.n, 2))
-        a1 = np.empty((self.n, 2))
-        for k, b in enumerate(self.team.bicycles):
-            p = b.position
-            fwd = b.rotation()[:2, 0]
-            a0[k] = p[:2]
-            a1[k] = p[:2] + b.params.wheelbase * fwd / max(float(np.linalg.norm(fwd)), 1e-9)
-        return a0, a1
-
-
 class PathFollower:
     """Rides a route: the heading command points at the route ``lookahead`` m ahead of the
     rider's nearest route point (pure pursuit)."""
@@ -249,158 +132,6 @@ class _Step:
         del world
         if t >= self.at - 1e-9:
             self.rider.heading_cmd = self.heading
-
-
-# ------------------------------------------------------------------------------- results
-@dataclass
-class CyclingResult:
-    """A finished ride: the team, the rollout, per-rider logs and the report."""
-
-    kind: str
-    team: Team
-    rollout: RolloutResult
-    report: dict[str, Any]
-    logs: list[dict[str, F64]]
-    route: Route | None = None
-    obstacles: tuple[Obstacle, ...] = ()
-    cpu_s: float = 0.0
-    extra: dict[str, Any] = field(default_factory=dict)
-
-    def rider_motion(self, k: int) -> Motion:
-        return self.rollout.motion(k, name=f"rider{k}")
-
-    def bicycle_motion(self, k: int) -> Motion:
-        return bicycle_motion(self.rollout, self.team.bicycles[k], name=f"bicycle{k}")
-
-    def report_json(self) -> str:
-        return json.dumps(_clean(self.report), indent=2) + "\n"
-
-    def write(self, out: str | Path, *, report: str | Path | None = None,
-              plot: str | Path | None = None, video: str | Path | None = None) -> dict[str, str]:  # fmt: skip
-        """Write ``rider{k}.bvh`` and ``bicycle{k}.bvh`` into ``out``, and the report, plot
-        and video where asked; all staged and moved into place only when all succeeded."""
-        from reactmocap.library.bvh import write_bvh
-
-        out = Path(out)
-        written: dict[str, str] = {}
-        with _staging() as stage:
-            for k in range(len(self.team.riders)):
-                write_bvh(self.rider_motion(k), stage(out / f"rider{k}.bvh"))
-                write_bvh(self.bicycle_motion(k), stage(out / f"bicycle{k}.bvh"))
-            written["bvh"] = str(out)
-            if plot is not None:
-                from reactmocap.athletics.cycling_plots import paths_plot
-
-                paths_plot(self, stage(Path(plot)))
-                written["plot"] = str(plot)
-            if video is not None:
-                from reactmocap.athletics.cycling_plots import ride_video
-
-                target = Path(video)
-                made, renderer = ride_video(self, stage(target))
-                final = target if made.suffix == target.suffix else target.with_suffix(made.suffix)
-                if final != target:
-                    stage.rename(target, final)
-                written["video"] = str(final)
-                written["video_renderer"] = renderer
-            if report is not None:
-                self.report["outputs"] = written
-                Path(stage(Path(report))).write_text(self.report_json())
-                written["report"] = str(report)
-        return written
-
-
-class _Stage:
-    def __init__(self) -> None:
-        self.files: dict[Path, Path] = {}
-
-    def __call__(self, target: Path) -> Path:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix,
-                                   dir=target.parent)  # fmt: skip
-        os.close(fd)
-        self.files[target] = Path(tmp)
-        return Path(tmp)
-
-    def rename(self, old: Path, new: Path) -> None:
-        self.files[new] = self.files.pop(old)
-
-
-@contextlib.contextmanager
-def _staging() -> Iterator[_Stage]:
-    """Temporary siblings renamed over their targets only if the block succeeds."""
-    st = _Stage()
-    try:
-        yield st
-    except BaseException:
-        for tmp in st.files.values():
-            with contextlib.suppress(FileNotFoundError):
-                tmp.unlink()
-        raise
-    mask = os.umask(0)
-    os.umask(mask)
-    for target, tmp in st.files.items():
-        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600; honour the umask like open()
-        os.replace(tmp, target)
-
-
-def _clean(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {str(k): _clean(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_clean(v) for v in value]
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        return None if not math.isfinite(v) else round(v, 4)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
-def bicycle_motion(res: RolloutResult, bike: Bicycle, name: str = "bicycle") -> Motion:
-    """The bicycle's recorded motion as a Motion on a five-joint skeleton: the rear frame
-    (root, at the rear wheel's centre), the rear wheel, the fork (turning about the steer
-    axis), the front wheel and the crank."""
-    p = bike.params
-    m = res.world.model
-    rr = p.rear.radius
-    head = p.steer_foot + p.steer_axis * (p.front.radius / p.steer_axis[2]) - [0.0, 0.0, rr]
-    names = ["frame", "rear_wheel", "fork", "front_wheel"]
-    parents = [-1, 0, 0, 2]
-    offsets = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], head.tolist(),
-               [p.wheelbase - (head[0]), 0.0, p.front.radius - rr - head[2]]]  # fmt: skip
-    if bike.has_crank:
-        dt = p.drivetrain
-        assert dt is not None
-        names.append("crank")
-        parents.append(0)
-        offsets.append([dt.bottom_bracket[0], 0.0, dt.bottom_bracket[1] - rr])
-    rot = ("Zrotation", "Xrotation", "Yrotation")
-    chans = (("Xposition", "Yposition", "Zposition", *rot),) + (rot,) * (len(names) - 1)
-    ends = {1: (0.0, 0.0, rr), 3: (0.0, 0.0, p.front.radius)}
-    skel = Skeleton(
-        tuple(names), np.array(parents), np.array(offsets), BVHLayout(chans, "m", "z", ends)
-    )
-    _, q = res.frames()
-    qa = bike.qpos_adr
-    t = q.shape[0]
-    rots = np.zeros((t, len(names), 4))
-    rots[:, 0] = q[:, qa + 3 : qa + 7]
-
-    def about(axis: F64, angle: F64) -> F64:
-        return np.column_stack([np.cos(angle / 2), np.sin(angle / 2)[:, None] * axis[None]])
-
-    y = np.array([0.0, 1.0, 0.0])
-    rots[:, 1] = about(y, q[:, int(m.jnt_qposadr[bike.joint["rear_spin"].id])])
-    rots[:, 2] = about(p.steer_axis, q[:, int(m.jnt_qposadr[bike.joint["steer"].id])])
-    rots[:, 3] = about(y, q[:, int(m.jnt_qposadr[bike.joint["front_spin"].id])])
-    if bike.has_crank:
-        rots[:, 4] = about(y, q[:, int(m.jnt_qposadr[bike.joint["crank"].id])])
-    return Motion(skel, res.fps[0], q[:, qa : qa + 3], rots, name=name)
 
 
 # ------------------------------------------------------------------------------- running

@@ -9,7 +9,10 @@ plane,
 which we read as the change the rider makes to its current velocity ``v`` (with ``k_v = 1`` it is
 ``v_gl + k_p e``): its length is the rider's speed command and its direction the heading
 command for :class:`~reactmocap.athletics.rider.Rider`. Riders know each other only by
-observation: a rider's desired position is its own, the others see where it goes.
+observation: a rider's desired position is its own, the others see where it goes. The global
+velocity follows each rider's own lane (the route offset by the rider's distance from it, its
+corners mitred) on the outside of a turn, so round a corner the pack's outer riders ride wide
+instead of cutting across the riders inside them.
 
 The desired position, relative to the rider's own: for each visible neighbour closer than
 1.25 spacings, a point ``spacing`` from it on the rider's side (separation, as Reynolds); for each
@@ -45,7 +48,13 @@ class GroupGains:
     passes; the clearance kept from obstacles' surfaces (m); the speed command's range as
     fractions of the global speed; the largest position correction (m); the road's half width
     (m) around the route, inside which nothing pulls a rider back to the route; neighbours
-    closer than ``separation`` times the spacing push the desired position away."""
+    closer than ``separation`` times the spacing push the desired position away; ``lane``: the
+    global velocity follows the route offset by this fraction of the rider's own distance from
+    it (1: the rider keeps its lane round a corner; 0: along the centre line's chord, and a
+    pack slides across a corner instead of turning: its outer riders cut across the inner
+    riders of the row behind), ``inner_lane`` the same factor for a rider on the inside of the
+    turn ahead (0: it rides the centre line's chord; its own lane would cut the corner
+    closer to whatever stands on the inside, as the shipped course's obstacle)."""
 
     kp: float = 0.5
     kv: float = 1.0
@@ -58,11 +67,14 @@ class GroupGains:
     max_correction: float = 3.0
     road: float = 4.0
     separation: float = 1.25
+    lane: float = 1.0
+    inner_lane: float = 0.0
 
     def __post_init__(self) -> None:
         if not (self.kp >= 0 and self.kv >= 0 and self.view > 0 and 0 < self.fov <= 2 * math.pi
                 and self.horizon > 0 and self.clearance >= 0
-                and 0 < self.min_speed <= 1.0 <= self.max_speed):  # fmt: skip
+                and 0 < self.min_speed <= 1.0 <= self.max_speed
+                and 0 <= self.lane <= 1 and 0 <= self.inner_lane <= 1):  # fmt: skip
             raise ConfigError("group gains out of range (see GroupGains)")
 
 
@@ -79,6 +91,29 @@ def observe(riders: Sequence[Rider]) -> tuple[F64, F64, F64]:
         vel[k] = b.velocity[:2]
         head[k] = b.yaw
     return pos, vel, head
+
+
+def _offset(route: Route, p: F64) -> float:
+    """Signed distance (m, > 0 left) of ``p`` ``(2,)`` from ``route`` as its lane's offset: in a
+    corner's outer wedge (the nearest route point its vertex) the larger of the distances from
+    the two legs' lines, so the lane (:func:`_lane`) through ``p`` is mitred like the route."""
+    s, near = route.project(p[None])
+    r = p - near[0]
+    d = route.direction(np.array([s[0] - 1e-6, s[0] + 1e-6]))
+    off = d[:, 0] * r[1] - d[:, 1] * r[0]
+    return float(off[np.argmax(np.abs(off))])
+
+
+def _lane(route: Route, side: float) -> Route:
+    """``route`` offset ``side`` m to its left (< 0: right), its corners mitred: each leg
+    parallel to the route's at that distance."""
+    p = route.points
+    d = np.diff(p, axis=0)
+    n = np.column_stack([-d[:, 1], d[:, 0]]) / np.linalg.norm(d, axis=1, keepdims=True)
+    miter = np.vstack(
+        [n[:1], (n[:-1] + n[1:]) / (1.0 + np.einsum("ij,ij->i", n[:-1], n[1:]))[:, None], n[-1:]]
+    )
+    return Route(p + side * miter)
 
 
 def _pass_step(rel: F64, rel_vel: F64, clearance: F64, horizon: float, fallback: F64) -> F64:
@@ -136,18 +171,29 @@ class GroupRiding:
 
     def global_velocity(self, pos: F64) -> F64:
         """``(n, 2)`` the group's global velocity at each rider: the course speed along the
-        route (from the rider's nearest route point toward the one ``lookahead`` m further, so
-        corners are taken in time), plus a pull back toward the route for a rider more than
+        rider's lane, the route offset by the rider's distance from it (from the rider's
+        nearest lane point toward the one ``lookahead`` m further, so corners are taken in
+        time; :attr:`GroupGains.lane`), plus a pull back toward the route for a rider more than
         :attr:`GroupGains.road` m off it (the road's half width)."""
         out = np.empty_like(pos)
+        gn_road = self.gains.road
         for k, route in enumerate(self.routes):
             p = pos[k : k + 1]
             s, near = route.project(p)
-            ahead = route.point(s + self.lookahead) - near
-            n = float(np.linalg.norm(ahead))
-            along = ahead[0] / n if n > 1e-6 else route.direction(s)[0]
             off = (near - p)[0]
             dist = float(np.linalg.norm(off))
+            if self.gains.lane > 0:  # along the rider's own lane: round a corner the pack turns
+                side = self.gains.lane * float(np.clip(_offset(route, p[0]), -gn_road, gn_road))
+                d0, d1 = route.direction(np.array([s[0], s[0] + self.lookahead]))
+                if side * (d0[0] * d1[1] - d0[1] * d1[0]) > 0:  # inside the turn ahead
+                    side *= self.gains.inner_lane
+                lane = _lane(route, side)
+                s_lane, near_lane = lane.project(p)
+                ahead = lane.point(s_lane + self.lookahead) - near_lane
+            else:
+                ahead = route.point(s + self.lookahead) - near
+            n = float(np.linalg.norm(ahead))
+            along = ahead[0] / n if n > 1e-6 else route.direction(s)[0]
             excess = max(dist - self.gains.road, 0.0)
             out[k] = self.speed * along + self.gains.kp * excess * off / max(dist, 1e-6)
         return out

@@ -16,24 +16,47 @@ gear, so a leg can pull up), and the control laws of the paper's eqs. 7-11 as an
 
 All inverse kinematics is closed-form (two-link, knee and elbow poles) in the bicycle's frame,
 from the *desired* posture of the pelvis and trunk: the servos then also hold that posture.
-Why the laws are built this way and what they achieve: ``docs/athletics.md``."""
+The body's geometry (posture, limb IK, ankle pattern) is in
+:mod:`reactmocap.athletics.rider_kinematics`, the fit and the mount in
+:mod:`reactmocap.athletics.rider_mount` (their public names re-exported here). Why the laws are
+built this way and what they achieve: ``docs/athletics.md``."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
-from reactmocap.athletics.bicycle import Bicycle, BicycleParams, Fit
+from reactmocap.athletics.bicycle import Bicycle
 from reactmocap.athletics.bodies import Athlete
+from reactmocap.athletics.rider_kinematics import (
+    SIT_OFFSET,
+    Posture,
+    _cross,
+    _minrot,
+    _qconj,
+    _qmul,
+    _qrot,
+    _quat_y,
+    _unit,
+    ankle_pitch,
+    trunk_pose,
+    two_link,
+)
+from reactmocap.athletics.rider_mount import (
+    RIDER_WORLD,
+    RiderMount,
+    _ball_offset,
+    _hand_offset,
+    fit_bicycle,
+)
 from reactmocap.errors import ConfigError
 from reactmocap.rotations import quat_conj, quat_mul, quat_rotate
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
-from reactmocap.sim.world import World, WorldConfig
+from reactmocap.sim.world import World
 
 __all__ = [
     "RIDER_WORLD",
@@ -50,112 +73,6 @@ __all__ = [
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
 _B = {b: i for i, b in enumerate(SIM_BODIES)}
-#: the rider's world: 2 ms steps (the mounts are 10-20 ms spring-dampers, the wheels 4 ms
-#: contacts), the athletics contact time constant for the body, also between riders (the
-#: strike-stiff 2 ms of the response worlds needs 1 ms steps)
-RIDER_WORLD = WorldConfig(
-    timestep=0.002, contact_solref=(0.02, 1.0), body_contact_solref=(0.02, 1.0)
-)
-#: sit bones relative to the pelvis origin (anatomical frame: x forward, y left, z up; m)
-SIT_OFFSET = (-0.03, 0.06, -0.09)
-#: mount spring-dampers (time constant s, damping ratio): saddle, hands, feet
-SEAT_SPRING = (0.01, 1.0)
-HAND_SPRING = (0.02, 1.0)
-FOOT_SPRING = (0.02, 1.0)
-
-
-# small-array helpers for the control tick (numpy's cross and the general quaternion helpers
-# cost 25-40 us a call on (4, 3) arrays, these 5-10 us)
-_C1 = np.array([1, 2, 0])
-_C2 = np.array([2, 0, 1])
-_HAMILTON = np.zeros((4, 4, 4))
-for _i, _j, _k, _s in ((0, 0, 0, 1), (0, 1, 1, -1), (0, 2, 2, -1), (0, 3, 3, -1),
-                       (1, 0, 1, 1), (1, 1, 0, 1), (1, 2, 3, 1), (1, 3, 2, -1),
-                       (2, 0, 2, 1), (2, 1, 3, -1), (2, 2, 0, 1), (2, 3, 1, 1),
-                       (3, 0, 3, 1), (3, 1, 2, 1), (3, 2, 1, -1), (3, 3, 0, 1)):  # fmt: skip
-    _HAMILTON[_i, _j, _k] = _s
-_HAMILTON_T = _HAMILTON.reshape(4, 16).T.copy()
-
-
-def _cross(a: F64, b: F64) -> F64:
-    """Row-wise cross product of ``(..., 3)`` arrays."""
-    return a.take(_C1, -1) * b.take(_C2, -1) - a.take(_C2, -1) * b.take(_C1, -1)
-
-
-def _qmul(a: F64, b: F64) -> F64:
-    """Hamilton product of ``(n, 4)`` or ``(4,)`` quaternions (w, x, y, z), broadcast."""
-    outer = a[..., :, None] * b[..., None, :]
-    return outer.reshape(*outer.shape[:-2], 16) @ _HAMILTON_T
-
-
-def _qconj(q: F64) -> F64:
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
-
-
-def _qrot(q: F64, v: F64) -> F64:
-    """Rotate ``(..., 3)`` vectors by ``(..., 4)`` unit quaternions."""
-    u = q[..., 1:]
-    t = 2.0 * _cross(u, v)
-    return v + q[..., :1] * t + _cross(u, t)
-
-
-def _minrot(u: F64, v: F64) -> F64:
-    """``(n, 4)`` shortest-arc rotations taking unit vectors ``u`` to ``v`` ``(n, 3)``."""
-    q = np.empty((u.shape[0], 4))
-    q[:, 0] = 1.0 + np.einsum("ij,ij->i", u, v)
-    q[:, 1:] = _cross(u, v)
-    bad = q[:, 0] < 1e-9
-    if np.any(bad):  # opposite: any perpendicular axis
-        q[bad, 0] = 0.0
-        q[bad, 1:] = _cross(u[bad], np.array([1.0, 0.0, 0.0]))
-    return q / np.linalg.norm(q, axis=1, keepdims=True)
-
-
-def _unit(v: F64) -> F64:
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
-
-
-def _quat_y(angle: F64 | float) -> F64:
-    a = np.asarray(angle, dtype=np.float64)
-    return np.stack([np.cos(a / 2), np.zeros_like(a), np.sin(a / 2), np.zeros_like(a)], axis=-1)
-
-
-def two_link(base: F64, target: F64, l1: F64, l2: F64, pole: F64) -> tuple[F64, F64]:
-    """Unit directions ``(n, 3)`` of the first and second links of two-link chains from
-    ``base`` to ``target`` (``(n, 3)``), lengths ``l1, l2`` ``(n,)``, bending toward ``pole``;
-    an unreachable target is approached along the straight line."""
-    d = target - base
-    dist = np.linalg.norm(d, axis=1)
-    dist = np.clip(dist, np.abs(l1 - l2) + 1e-6, (l1 + l2) * 0.9999)
-    dh = _unit(d)
-    cos_a = np.clip((l1**2 + dist**2 - l2**2) / (2 * l1 * dist), -1.0, 1.0)
-    n = pole - np.einsum("ij,ij->i", pole, dh)[:, None] * dh
-    n = _unit(n)
-    u1 = cos_a[:, None] * dh + np.sqrt(1.0 - cos_a**2)[:, None] * n
-    elbow = base + l1[:, None] * u1
-    u2 = _unit(base + dist[:, None] * dh - elbow)
-    return u1, u2
-
-
-def ankle_pitch(crank: F64 | float) -> F64:
-    """Toes-down pitch (rad) of a foot relative to the bicycle for its crank angle (0: that
-    pedal at the top, increasing forward). Stated approximation of recorded pedalling (ankle
-    angle data of Ericson et al. 1985 and Hull & Jorge 1985, as summarised by Bini et al.
-    2011): the sole 15 degrees toes-down on average, 10 degrees either way, flattest (heel
-    down) just after the top of the power stroke (crank 110 degrees), most toes-down on the
-    up-stroke (crank 290 degrees)."""
-    return np.radians(15.0) - np.radians(10.0) * np.cos(np.asarray(crank) - math.radians(110.0))
-
-
-@dataclass(frozen=True)
-class Posture:
-    """The riding posture: pelvis tilt forward on the saddle, waist and back pitch (anatomical,
-    > 0 forward), neck pitch (< 0 lifts the head to look ahead), rad."""
-
-    pelvis: float = math.radians(15.0)
-    waist: float = math.radians(12.0)
-    back: float = math.radians(12.0)
-    neck: float = math.radians(-30.0)
 
 
 @dataclass(frozen=True)
@@ -198,155 +115,6 @@ class SteerGains:
     max_steer_offset: float = 0.3
     max_fork: float = math.radians(45.0)
     min_speed: float = 1.0
-
-
-def trunk_pose(athlete: Athlete, posture: Posture) -> tuple[F64, F64, F64]:
-    """The posture's trunk in the bicycle frame with the pelvis origin at 0: anatomical
-    rotations ``(16, 4)`` (pelvis, waist, chest and head rows; the rest identity), the
-    shoulders' and hips' offsets ``(4, 3)`` (left and right shoulder, left and right hip) and
-    the sit bones' midpoint ``(3,)``."""
-    n, bpos = athlete.neutral, athlete.character.body_pos
-    a = np.tile([1.0, 0.0, 0.0, 0.0], (16, 1))
-    a[_B["pelvis"]] = _quat_y(posture.pelvis)
-    a[_B["waist"]] = _qmul(a[_B["pelvis"]], _quat_y(posture.waist))
-    a[_B["chest"]] = _qmul(a[_B["waist"]], _quat_y(posture.back))
-    a[_B["head"]] = _qmul(a[_B["chest"]], _quat_y(posture.neck))
-    g = _qmul(a, n)
-    pos = np.zeros((16, 3))
-    for b in ("waist", "chest"):
-        i = _B[b]
-        pos[i] = pos[SIM_PARENTS[i]] + _qrot(g[SIM_PARENTS[i]], bpos[i])
-    bases = np.empty((4, 3))
-    for k, b in enumerate(("l_upper_arm", "r_upper_arm", "l_thigh", "r_thigh")):
-        i = _B[b]
-        bases[k] = pos[SIM_PARENTS[i]] + _qrot(g[SIM_PARENTS[i]], bpos[i])
-    sit = _qrot(a[0], np.array([SIT_OFFSET[0], 0.0, SIT_OFFSET[2]]))
-    return a, bases, sit
-
-
-def fit_bicycle(params: BicycleParams, athlete: Athlete, *, knee_at_bottom: float = 0.45,
-                posture: Posture | None = None, elbow: float = math.radians(30.0),
-                arm_drop: float = math.radians(60.0),
-                seat_angle: float = math.radians(73.0)) -> BicycleParams:  # fmt: skip
-    """The bicycle fitted to the athlete in ``posture``: the saddle up the seat tube
-    (``seat_angle`` from horizontal through the bottom bracket) until the knee bends
-    ``knee_at_bottom`` rad with the pedal at the bottom, and the grips where the hands reach
-    with ``elbow`` rad of elbow bend, the arms ``arm_drop`` rad below horizontal."""
-    dt = params.drivetrain
-    if dt is None:
-        raise ConfigError("a rider needs a bicycle with a drivetrain")
-    pose = posture or Posture()
-    _, bases, sit = trunk_pose(athlete, pose)
-    thigh, shin = float(athlete.thigh.mean()), float(athlete.shin.mean())
-    leg = math.sqrt(thigh**2 + shin**2 + 2 * thigh * shin * math.cos(knee_at_bottom))
-    ball = _ball_offset(athlete)
-    reach = math.hypot(leg + abs(float(ball[2])) * 0.5, float(ball[0]))  # hip to ball of foot
-    bb = np.array([dt.bottom_bracket[0], 0.0, dt.bottom_bracket[1]])
-    pedal = bb - [0.0, 0.0, dt.crank_length]
-    up = np.array([-math.cos(seat_angle), 0.0, math.sin(seat_angle)])
-    hip = 0.5 * (bases[2] + bases[3]) - sit  # from the sit point
-    gap = lambda s: float(np.linalg.norm(bb + s * up + hip - pedal)) - reach  # noqa: E731
-    along = float(brentq(gap, 0.0, 2.0))
-    seat = bb + along * up
-    shoulder = seat - sit + bases[0]
-    v1 = quat_rotate(
-        athlete.neutral[_B["l_upper_arm"]], athlete.character.body_pos[_B["l_forearm"]]
-    )
-    v2 = quat_rotate(athlete.neutral[_B["l_forearm"]], athlete.character.body_pos[_B["l_hand"]])
-    v2 = v2 + quat_rotate(athlete.neutral[_B["l_hand"]], _hand_offset(athlete))
-    l1, l2 = float(np.linalg.norm(v1)), float(np.linalg.norm(v2))
-    arm = math.sqrt(l1**2 + l2**2 + 2 * l1 * l2 * math.cos(elbow))
-    half = params.fit.grip_offset if params.fit else 0.25
-    lateral = half - float(shoulder[1])
-    flat = math.sqrt(max(arm**2 - lateral**2, 0.01))
-    grips = shoulder + flat * np.array([math.cos(arm_drop), 0.0, -math.sin(arm_drop)])
-    fit = Fit(seat=(float(seat[0]), float(seat[2])), grips=(float(grips[0]), float(grips[2])),
-              grip_offset=half)  # fmt: skip
-    return replace(params, fit=fit)
-
-
-def _ball_offset(athlete: Athlete, side: str = "l") -> F64:
-    """The ball of the foot (the foot's patch geom) in that foot's frame."""
-    m = athlete.character.model
-    return m.geom_pos[m.geom(f"{side}_foot_ball").id].copy()
-
-
-def _hand_offset(athlete: Athlete, side: str = "l") -> F64:
-    """The grip point (the hand's capsule centre) in that hand's frame."""
-    m = athlete.character.model
-    geoms = np.flatnonzero(m.geom_bodyid == m.body(f"{side}_hand").id)
-    return m.geom_pos[geoms[0]].copy()
-
-
-class RiderMount:
-    """A :class:`~reactmocap.athletics.cycling_scene.ScenePart`: sites on the rider (sit bones,
-    grip points, balls of the feet) and on the bicycle (saddle, grips, pedals) tied by soft
-    ``connect`` equalities: two at the saddle (a pivot about the saddle's lateral axis), one
-    per hand and foot. Also stops the rider's shins and feet colliding with the floor (a loaded
-    pedal sits 10 cm up: a foot brushing the ground in a lean would trip the simulation)."""
-
-    def __init__(self, athlete: Athlete, bicycle: Bicycle, prefix: str) -> None:
-        fit = bicycle.params.fit
-        dt = bicycle.params.drivetrain
-        if fit is None or dt is None:
-            raise ConfigError("a rider's bicycle needs a fit and a drivetrain (fit_bicycle)")
-        self.athlete, self.bicycle, self.prefix = athlete, bicycle, prefix
-
-    def build(self, spec: mujoco.MjSpec) -> None:
-        pre, bp, ath = self.prefix, self.bicycle.prefix, self.athlete
-        p = self.bicycle.params
-        fit = p.fit
-        assert fit is not None
-        neutral = ath.neutral
-        rr = p.rear.radius
-        pelvis = spec.body(pre + "pelvis")
-        # compiled beside its bicycle (the characters' reference poses all stand at the origin:
-        # many riders there would touch each other)
-        pl = self.bicycle.placement
-        pelvis.pos = [pelvis.pos[0] + pl.x, pelvis.pos[1] + pl.y, pelvis.pos[2]]
-        frame = spec.body(bp + "frame")
-        fork = spec.body(bp + "fork")
-        head = p.steer_foot + p.steer_axis * (p.front.radius / p.steer_axis[2])
-        sx, sz = fit.seat
-        for side, sign in (("l", 1.0), ("r", -1.0)):
-            off = np.array([SIT_OFFSET[0], sign * SIT_OFFSET[1], SIT_OFFSET[2]])
-            local = quat_rotate(quat_conj(neutral[0]), off)
-            pelvis.add_site(name=f"{pre}{side}_sit", pos=local.tolist())
-            frame.add_site(name=f"{bp}{side}_seat", pos=[sx, sign * SIT_OFFSET[1], sz - rr])
-            spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_SITE,
-                              name1=f"{pre}{side}_sit", name2=f"{bp}{side}_seat",
-                              solref=list(SEAT_SPRING))  # fmt: skip
-            hand = spec.body(f"{pre}{side}_hand")
-            hand.add_site(name=f"{pre}{side}_grip", pos=_hand_offset(ath, side).tolist())
-            gx, gz = fit.grips
-            fork.add_site(name=f"{bp}{side}_grip",
-                          pos=[gx - head[0], sign * fit.grip_offset, gz - head[2]])  # fmt: skip
-            spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_SITE,
-                              name1=f"{pre}{side}_grip", name2=f"{bp}{side}_grip",
-                              solref=list(HAND_SPRING))  # fmt: skip
-            foot = spec.body(f"{pre}{side}_foot")
-            foot.add_site(name=f"{pre}{side}_ball", pos=_ball_offset(ath, side).tolist())
-            pedal = "left_pedal" if side == "l" else "right_pedal"
-            spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_SITE,
-                              name1=f"{pre}{side}_ball", name2=f"{bp}{pedal}",
-                              solref=list(FOOT_SPRING))  # fmt: skip
-
-    def bind(self, world: World) -> None:
-        m = world.model
-        pre, bp = self.prefix, self.bicycle.prefix
-        self.world = world
-        self.sites = {
-            name: int(m.site(n).id)
-            for name, n in (("l_grip", f"{bp}l_grip"), ("r_grip", f"{bp}r_grip"),
-                            ("l_pedal", f"{bp}left_pedal"), ("r_pedal", f"{bp}right_pedal"),
-                            ("l_ball", f"{pre}l_ball"), ("r_ball", f"{pre}r_ball"),
-                            ("l_seat", f"{bp}l_seat"), ("r_seat", f"{bp}r_seat"),
-                            ("l_sit", f"{pre}l_sit"), ("r_sit", f"{pre}r_sit"))
-        }  # fmt: skip
-        for part in ("l_shin", "r_shin", "l_foot", "r_foot"):
-            geoms = np.flatnonzero(m.geom_bodyid == m.body(pre + part).id)
-            m.geom_contype[geoms] = 0
-            m.geom_conaffinity[geoms] = 0
 
 
 @dataclass

@@ -12,7 +12,7 @@ import pytest
 from reactmocap.athletics.bicycle import Placement
 from reactmocap.athletics.course import Route, load_course, parse_course
 from reactmocap.athletics.cycling import group_ride
-from reactmocap.athletics.group import GroupGains
+from reactmocap.athletics.group import GroupGains, GroupRiding
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError
 
@@ -39,6 +39,36 @@ def test_two_riders_on_a_collision_course_avoid_each_other() -> None:
     # the same riders without the avoidance rules do collide: the test can fail
     blind = _head_on(BLIND)
     assert blind["collisions"] > 0 or blind["min_separation_m"] < 0.5
+
+
+def test_round_a_corner_the_outer_rider_keeps_its_lane() -> None:
+    """The global velocity follows the rider's own lane (the route offset by the rider's
+    distance from it) on the outside of a turn: of a pair side by side before a left corner,
+    the outer rider rides on to its own corner while the inner one turns along the centre
+    line's chord; on the straights neither is pulled across. With ``lane=0`` both aim along
+    the chord, the same direction: the pair slides across the corner instead of turning (the
+    old behaviour); with ``inner_lane=1`` the inner rider turns on its own lane, sharper."""
+    c = load_course(COURSE)  # left corner at (90, 0)
+    pos = np.array([[84.0, 1.5], [84.0, -1.5], [40.0, 2.5], [90.0 + 2.5, 60.0]])
+
+    def angles(**gains: float) -> np.ndarray:
+        g = GroupRiding([None] * 4, c.route, c.speed, gains=GroupGains(**gains),  # type: ignore[list-item]
+                        spacing=c.spacing, lookahead=c.lookahead)  # fmt: skip
+        v = g.global_velocity(pos)
+        assert np.linalg.norm(v, axis=1) == pytest.approx(c.speed)
+        return np.degrees(np.arctan2(v[:, 1], v[:, 0]))
+
+    inner, outer, straight, after = angles()
+    chord = math.degrees(math.atan2(2.0, 6.0))  # (84, 0) to the route point 8 m on, (90, 2)
+    assert inner == pytest.approx(chord, abs=0.1)
+    assert outer == pytest.approx(math.degrees(math.atan2(0.5, 7.5)), abs=0.1)  # to (91.5, -1)
+    assert straight == pytest.approx(0.0) and after == pytest.approx(90.0)
+    old = angles(lane=0.0)
+    assert old[:2] == pytest.approx([chord, chord], abs=0.1)
+    own = angles(inner_lane=1.0)  # to (88.5, 5) on its own lane
+    assert own[0] == pytest.approx(math.degrees(math.atan2(3.5, 4.5)), abs=0.1)
+    with pytest.raises(ConfigError):
+        GroupGains(lane=2.0)
 
 
 def test_course_file_with_an_unknown_key_gets_a_clear_error(tmp_path: Path) -> None:

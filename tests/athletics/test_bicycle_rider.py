@@ -48,3 +48,22 @@ def test_out_of_range_ride_inputs_raise_clear_errors() -> None:
         ride(5.0, 2.0, gear=0.1)
     with pytest.raises(ConfigError, match="heading or a path"):
         ride(5.0, 2.0, heading=1.0, path=[(5.0, 0.0)])
+
+
+def test_rider_is_built_by_name_from_the_controller_registry() -> None:
+    from reactmocap.athletics.bicycle import Placement
+    from reactmocap.athletics.cycling import setup
+    from reactmocap.athletics.rider import Rider
+    from reactmocap.sim.controllers import build
+    from reactmocap.sim.rollout import rollout
+
+    team = setup([Placement(speed=4.0)])
+    # the registry's rider is the full controller, here asked to speed up to 5 m/s
+    rider = build("bicycle_rider", team.world, None, {"speed": 5.0})  # type: ignore[arg-type]
+    assert isinstance(rider, Rider) and rider.bicycle is team.bicycles[0]
+    res = rollout(team.world, 4.0, controllers=[rider], on_unstable="stop")
+    log = rider.log.arrays()
+    assert res.status == "ok" and not team.bicycles[0].fallen
+    assert log["speed"][-1] == pytest.approx(5.0, abs=0.2)
+    with pytest.raises(ConfigError, match="not mounted on a bicycle"):
+        build("bicycle_rider", team.world, None, {}, character=3)  # type: ignore[arg-type]

@@ -131,6 +131,14 @@ def _athletic_balance(
     return athletic_balance(world, c, ref, start, p)
 
 
+def _bicycle_rider(
+    world: World, c: int, ref: Reference, start: float, p: dict[str, Any]
+) -> Controller:
+    from reactmocap.athletics.controller import bicycle_rider
+
+    return bicycle_rider(world, c, ref, start, p)
+
+
 _PD = {"kp": 4000.0, "kv": None, "control_every": 10, "refresh_every": 10}
 _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: the whole-body tracker's options for whole clips (``track``, ``push``; see
@@ -167,6 +175,11 @@ _REGISTRY: dict[str, ControllerSpec] = {
         "athletic_balance", "the thesis's balance (athletics, ch. 7): COM over the feet by ankle "
         "and hip offsets; does not follow the clip", {"control_every": 8},
         _athletic_balance, ("pitch", "leg", "com_offset_x", "com_offset_y")),
+    "bicycle_rider": ControllerSpec(
+        "bicycle_rider", "Hodgins et al. 1995's bicycle rider (athletics): speed and heading "
+        "through the pedals and handlebars, on the bicycle the character is mounted on in a "
+        "cycling World; does not follow the clip", {"control_every": 4},
+        _bicycle_rider, ("speed", "heading", "kp", "arm_scale", "leg_scale")),
 }  # fmt: skip
 #: every registered controller (read-only view; :func:`register` adds); the gains and rates
 #: here are the only defaults (the CLI help and the scenario docs print them from this table)
