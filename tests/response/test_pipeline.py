@@ -193,3 +193,34 @@ def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
     assert fall.skeleton.same_structure(real)
     assert np.all(np.isfinite(fall.global_positions()))
     assert fall.global_positions()[..., 2].min() > -0.05  # retargeted onto the floor, roughly
+
+
+def test_an_unstable_simulation_1_is_reported_not_fatal(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real bow kicked by the real kick (bench_reactions' aim): the whole-body tracker's
+    # torques run away in Simulation 1 at 1.2 s; the response stops it there, searches what
+    # is left and says so, rather than failing
+    from reactmocap.response.scenario import ResponseConfig
+    from reactmocap.response.stages import UNSTABLE_TRIM_S
+
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    for f in [*shared_mocap_dir.glob("*.bvh"), *SYNTHETIC.glob("*.bvh")]:
+        (lib / f.name).symlink_to(f)
+    scenario = Scenario(
+        library=lib,
+        recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=167.42333060441473,
+                              position=(0.9101249775269609, 0.24847072154800792)),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                attacker_assist=100.0),
+        name="bow-kick",
+    )  # fmt: skip
+    res = run_response(scenario)
+    stopped = [w for w in res.report["warnings"] if w.startswith("Simulation 1 stopped early")]
+    assert len(stopped) == 1 and "unstable" in stopped[0]
+    assert res.sim1.duration < 1.2 - UNSTABLE_TRIM_S + 1e-6
+    assert np.all(np.isfinite(res.recipient.global_positions()))
+    assert res.report["quality"]["reaction_displacement_m"] > 0.05
