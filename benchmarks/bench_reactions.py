@@ -154,15 +154,18 @@ def _gap(att: AttackerSpec, rec: CharacterSpec, rec_clip: Path, kick: Path) -> f
     return float(np.linalg.norm(pel[0] - pel[1]))
 
 
-def real(cache: LibraryCache) -> None:
-    if not SHARED.is_dir():
-        print(f"\n(no shared mocap at {SHARED}: real recipients skipped)")
-        return
-    lib = _library()
+#: recipients held back from tuning the reaction (issue 15): reported on their own
+HELD_OUT = ("walk-right", "respond_normal_001")
+
+
+def real_scenarios(
+    lib: Path, keys: tuple[str, ...] = RECIPIENTS
+) -> list[tuple[str, str, Scenario]]:
+    """``(recipient, label, scenario)`` of the real-recipient runs: each recipient kicked by
+    the shared kick and pushed at the chest from 4 directions."""
     kick = SHARED / "dataset-1_kick_normal_001.bvh"
-    print("\n## real recipients (shared clips + synthetic reactions as the library)")
-    rows = []
-    for key in RECIPIENTS:
+    out = []
+    for key in keys:
         clip = next(SHARED.glob(f"*{key}*.bvh"))
         m = read_bvh(clip)
         start = 0.1 if m.duration < 1.5 else 0.5
@@ -175,9 +178,8 @@ def real(cache: LibraryCache) -> None:
         gaps = [_gap(a, rec, clip, kick) for _, a in options]
         hit, att = options[next((i for i, g in enumerate(gaps) if g >= 0.7),
                                 int(np.argmax(gaps)))]  # fmt: skip
-        runs: list[tuple[str, Scenario]] = [
-            ("kick", Scenario(lib, rec, attacker=att, response=REAL, name=f"{key}-kick"))
-        ]
+        out.append((key, "kick", Scenario(lib, rec, attacker=att, response=REAL,
+                                          name=f"{key}-kick")))  # fmt: skip
         parts = map_body_parts(m.skeleton)
         placed = place(m, parts, round(start * m.fps), 0.0, (0.0, 0.0))
         front = float(heading(placed.slice(round((start + hit) * m.fps), None), parts)[0])
@@ -186,31 +188,67 @@ def real(cache: LibraryCache) -> None:
             d = front + ang  # "front": pushed from the front, the force points backward
             force = (250.0 * np.cos(d), 250.0 * np.sin(d), 0.0)
             imp = ImpactSpec("chest", force, hit, 0.2, (0.0, 0.0, 0.0))
-            runs.append((f"push {label}",
-                         Scenario(lib, rec, impact=imp, response=REAL, name=f"{key}-{label}")))  # fmt: skip
-        for label, sc in runs:
-            t = time.perf_counter()
-            try:
-                rep = run_response(sc, cache).report
-            except Exception as exc:  # a failure is a figure too
-                print(f"{key[:16]:16s} {label:10s} FAILED: {exc}")
-                rows.append(None)
-                continue
-            print(_row(f"{key[:16]} {label}", rep), f"(wall {time.perf_counter() - t:.1f} s)")
-            for w in rep["warnings"]:
-                print(f"    warning: {w}")
-            rows.append(rep)
+            out.append((key, f"push {label}",
+                        Scenario(lib, rec, impact=imp, response=REAL, name=f"{key}-{label}")))  # fmt: skip
+    return out
+
+
+def _summary(title: str, rows: list[dict | None]) -> None:
     done = [r for r in rows if r is not None]
     clean = sum(not r["warnings"] for r in done)
-    over = max(r["quality"]["character_overlap_max_m"] for r in done)
-    print(f"REAL: {len(done)}/{len(rows)} ran; no warnings in {clean}/{len(rows)} = "
-          f"{100 * clean / len(rows):.0f}%; deepest overlap {over:.3f} m")  # fmt: skip
+    over = max((r["quality"]["character_overlap_max_m"] for r in done), default=0.0)
+    kinds = {
+        "joint": "turns a joint",
+        "root": "moves the root",
+        "overlap": "overlap by",
+        "speed": "attacker moves",
+        "physical": "physical mode",
+    }
+    count = {k: sum(any(v in w for w in r["warnings"]) for r in done) for k, v in kinds.items()}
+    disp = statistics.median(r["quality"]["reaction_displacement_m"] for r in done) if done else 0
+    print(f"{title}: {len(done)}/{len(rows)} ran; no warnings in {clean}/{len(rows)} = "
+          f"{100 * clean / max(len(rows), 1):.0f}%; deepest overlap {over:.3f} m; runs warned "
+          f"by kind {count}; median displacement {disp:.2f} m")  # fmt: skip
+
+
+def real(cache: LibraryCache, keys: tuple[str, ...] = RECIPIENTS) -> None:
+    if not SHARED.is_dir():
+        print(f"\n(no shared mocap at {SHARED}: real recipients skipped)")
+        return
+    lib = _library()
+    print("\n## real recipients (shared clips + synthetic reactions as the library)")
+    rows: dict[str, list[dict | None]] = {}
+    for key, label, sc in real_scenarios(lib, keys):
+        t = time.perf_counter()
+        try:
+            rep = run_response(sc, cache).report
+        except Exception as exc:  # a failure is a figure too
+            print(f"{key[:16]:16s} {label:10s} FAILED: {exc}")
+            rows.setdefault(key, []).append(None)
+            continue
+        print(_row(f"{key[:16]} {label}", rep), f"(wall {time.perf_counter() - t:.1f} s)")
+        for w in rep["warnings"]:
+            print(f"    warning: {w}")
+        rows.setdefault(key, []).append(rep)
+    tuned = [r for k, v in rows.items() if k not in HELD_OUT for r in v]
+    held = [r for k, v in rows.items() if k in HELD_OUT for r in v]
+    if tuned and held:
+        _summary("REAL (tuned on)", tuned)
+        _summary(f"REAL (held out: {', '.join(HELD_OUT)})", held)
+    _summary("REAL", tuned + held)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--skip", nargs="*", default=[], choices=["facing", "examples", "real"])
     ap.add_argument("--directions", type=int, default=36)
+    ap.add_argument(
+        "--recipients",
+        nargs="*",
+        default=list(RECIPIENTS),
+        choices=RECIPIENTS,
+        help="the real recipients to run (all by default)",
+    )
     args = ap.parse_args()
     cache = LibraryCache()
     if "examples" not in args.skip:
@@ -218,7 +256,7 @@ def main() -> None:
     if "facing" not in args.skip:
         facing(args.directions, cache)
     if "real" not in args.skip:
-        real(cache)
+        real(cache, tuple(args.recipients))
 
 
 if __name__ == "__main__":

@@ -31,6 +31,9 @@ from reactmocap.sim.impacts import overlap_depths
 __all__ = ["Blend", "blend"]
 
 F64 = NDArray[np.float64]
+#: the shortest span (s) over which the final blend moves the root (a contact that delays the
+#: root's correction cannot squeeze it into fewer frames)
+ROOT_BLEND_MIN_S = 0.2
 
 
 def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
@@ -122,7 +125,10 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     speed = joint_speed_max_m_s(cast.attacker.motion) if cast.attacker is not None else 0.0
     held = 0.0  # the attacker follows its simulation at least until then
     for _ in range(8):  # limbs still touching the attacker keep their simulated pose longer
-        blended = final_blend(simulated, found, start, root_start=start[pelvis])
+        # the root's correction is spread over ROOT_BLEND_MIN_S at least, even while the trunk
+        # still touches the attacker: held to the last frame, it would jump its whole gap there
+        root_last = max(0.0, times.size - 1 - ROOT_BLEND_MIN_S * fps)
+        blended = final_blend(simulated, found, start, root_start=min(start[pelvis], root_last))
         if cfg.foot_lock and cfg.mode == "blend":  # the physics holds the feet otherwise
             blended = lock_feet(blended, rec.parts)
         pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]

@@ -154,6 +154,9 @@ def _report(
         ),
     }
     warnings = _warnings(scenario, cast, contact, naive, cont, quality)
+    if naive.unstable is not None:
+        warnings.append(f"Simulation 1 stopped early ({naive.unstable}): the search used its "
+                        f"first {naive.motion.duration:.2f} s")  # fmt: skip
     if sim2.unstable is not None:
         warnings.append(f"physical mode: Simulation 2 stopped early ({sim2.unstable})")
     elif not sim2.on_clip:

@@ -44,6 +44,7 @@ __all__ = [
     "CONTACT_EVERY",
     "PHYSICAL_TRACKERS",
     "SCAN_FPS",
+    "UNSTABLE_TRIM_S",
     "Actor",
     "Cast",
     "ContactEstimate",
@@ -64,6 +65,8 @@ F64 = NDArray[np.float64]
 SCAN_FPS = 30.0
 #: steps between samples of the contacts between characters (200 Hz at dt = 0.5 ms)
 CONTACT_EVERY = 10
+#: seconds of Simulation 1 dropped before an instability (the body is already running away)
+UNSTABLE_TRIM_S = 0.1
 
 
 @dataclass(frozen=True)
@@ -217,6 +220,9 @@ class NaiveSimulation:
     contacts: ContactLog
     steps: int
     impulse: float  # |impulse| on the recipient (N s)
+    #: why Simulation 1 stopped early (it went unstable), else None: ``motion`` then ends
+    #: :data:`UNSTABLE_TRIM_S` before that, and the search uses what is left
+    unstable: str | None = None
 
 
 def _attacker(world: World, cast: Cast, cfg: ResponseConfig, rewind: float) -> list[Controller]:
@@ -309,8 +315,12 @@ def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -
         world, end - rewind, controllers=ctrls, impacts=_impacts(scenario, rewind),
         record_fps=fps, references=[a.motion for a in cast.actors],
         reference_start=[rewind + a.clock0 for a in cast.actors],
-        contact_every=CONTACT_EVERY,
+        contact_every=CONTACT_EVERY, on_unstable="stop",
     )  # fmt: skip
+    motion = res.motion(0, name="sim1")
+    unstable = res.reason if res.status == "unstable" else None
+    if unstable is not None:  # the frames just before the blow-up are already running away
+        motion = motion.slice(0, max(1, motion.num_frames - round(UNSTABLE_TRIM_S * fps)))
     log = res.contact_log
     assert log is not None
     if not log.empty:
@@ -323,8 +333,8 @@ def naive_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate) -
         impulse = _impulse_of(scenario.impact)
     else:
         t_impact, contact_end, peak, impulse = contact.time, contact.time, 0.0, 0.0
-    return NaiveSimulation(res.motion(0, name="sim1"), state, t_impact, contact_end, peak, log,
-                           res.steps, impulse)  # fmt: skip
+    return NaiveSimulation(motion, state, t_impact, contact_end, peak, log, res.steps, impulse,
+                           unstable)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -499,10 +509,17 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         ctrls += _attacker(world, cast, cfg, rewind)
         fps.append(cast.attacker.motion.fps)
     landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind) if physical else None
+    # the joints the body does not simulate (toes, clavicles, the head below a neck body) take
+    # what Simulation 2 was asked to do, not the old clip: the final blend then corrects only
+    # what the physics did not follow
+    rfps = cast.recipient.motion.fps
+    asked = desired_motion(cast, cfg, rewind + np.arange(int(np.ceil(seconds * rfps)) + 1) / rfps,
+                           naive.impact_time, yields, cont).replace(fps=rfps)  # fmt: skip
     res = rollout(
         world, seconds, controllers=ctrls, impacts=_impacts(scenario, rewind), record_fps=fps,
-        references=[a.motion for a in cast.actors],
-        reference_start=[rewind + a.clock0 for a in cast.actors], contact_every=CONTACT_EVERY,
+        references=[asked] + [a.motion for a in cast.actors[1:]],
+        reference_start=[0.0] + [rewind + a.clock0 for a in cast.actors[1:]],
+        contact_every=CONTACT_EVERY,
         stop=landing, on_unstable="stop" if physical else "raise",
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None

@@ -193,3 +193,68 @@ def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
     assert fall.skeleton.same_structure(real)
     assert np.all(np.isfinite(fall.global_positions()))
     assert fall.global_positions()[..., 2].min() > -0.05  # retargeted onto the floor, roughly
+
+
+def _shared_library(shared_mocap_dir: Path, tmp_path: Path) -> Path:
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    for f in [*shared_mocap_dir.glob("*.bvh"), *SYNTHETIC.glob("*.bvh")]:
+        (lib / f.name).symlink_to(f)
+    return lib
+
+
+def test_a_blend_held_by_contact_still_moves_the_root_smoothly(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real walk kicked (bench_reactions' aim) falls with its trunk against the kicker to
+    # the end of the transition: the blend's root correction (0.5 m) was held to the last
+    # frame and jumped there (16.6 m/s); it is now spread over ROOT_BLEND_MIN_S at least
+    from reactmocap.response.final import ROOT_BLEND_MIN_S
+    from reactmocap.response.scenario import ResponseConfig
+
+    scenario = Scenario(
+        library=_shared_library(shared_mocap_dir, tmp_path),
+        recipient=CharacterSpec("dataset-1_walk_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=164.64459363196647,
+                              position=(2.1888065748710512, 0.1540919325202299)),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                attacker_assist=100.0),
+        name="walk-kick",
+    )  # fmt: skip
+    res = run_response(scenario)
+    offset = res.report["quality"]["blend_root_offset_max_m"]
+    assert offset > 0.3  # the case: a large root correction
+    out = res.recipient
+    pelvis = out.global_positions()[:, res.parts.joint_of("pelvis")]
+    speed = np.linalg.norm(np.diff(pelvis, axis=0), axis=1) * out.fps
+    # the correction adds at most offset / ROOT_BLEND_MIN_S to the simulated body's own speed
+    assert speed.max() < 2.5 + offset / ROOT_BLEND_MIN_S, speed.max()
+    assert res.report["quality"]["attacker_speed_ratio"] <= 1.5
+
+
+def test_an_unstable_simulation_1_is_reported_not_fatal(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real bow kicked by the real kick (bench_reactions' aim): the whole-body tracker's
+    # torques run away in Simulation 1 at 1.2 s; the response stops it there, searches what
+    # is left and says so, rather than failing
+    from reactmocap.response.scenario import ResponseConfig
+    from reactmocap.response.stages import UNSTABLE_TRIM_S
+
+    scenario = Scenario(
+        library=_shared_library(shared_mocap_dir, tmp_path),
+        recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=167.42333060441473,
+                              position=(0.9101249775269609, 0.24847072154800792)),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                attacker_assist=100.0),
+        name="bow-kick",
+    )  # fmt: skip
+    res = run_response(scenario)
+    stopped = [w for w in res.report["warnings"] if w.startswith("Simulation 1 stopped early")]
+    assert len(stopped) == 1 and "unstable" in stopped[0]
+    assert res.sim1.duration < 1.2 - UNSTABLE_TRIM_S + 1e-6
+    assert np.all(np.isfinite(res.recipient.global_positions()))
+    assert res.report["quality"]["reaction_displacement_m"] > 0.05

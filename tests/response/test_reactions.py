@@ -184,3 +184,35 @@ def test_bad_inputs_get_clear_errors(tmp_path: Path, capsys: pytest.CaptureFixtu
     missing = sc.with_changes(recipient=CharacterSpec("nowhere.bvh"))
     with pytest.raises(ConfigError, match="nowhere.bvh"):
         run_response(missing, CACHE)
+
+
+def test_simulation_2_fills_the_joints_it_does_not_simulate_from_what_it_was_asked() -> None:
+    # the head, clavicles and toes are not simulated: in Simulation 2's output they follow the
+    # desired motion (eased into the found clip), not the old clip, so the final blend corrects
+    # only what the physics did not follow
+    from reactmocap.response import final, stages
+
+    sc = load_scenario(EXAMPLES / "medium_push.toml")
+    cast = stages.cast(sc, CACHE)
+    contact = stages.estimate_contact(sc, cast)
+    naive = stages.naive_simulation(sc, cast, contact)
+    cont = stages.search_continuation(sc, cast, contact, naive)
+    sim2 = stages.transition_simulation(sc, cast, contact, naive, cont)
+    out = final.blend(sc, cast, contact, naive, cont, sim2)
+    rec = cast.recipient
+    anchors = {int(a) for a in rec.character.anchors}
+    free = [j for j in range(1, rec.motion.num_joints) if j not in anchors]
+    assert free  # the synthetic skeleton has head, clavicles and toes
+    fps = rec.motion.fps
+    times = np.arange(round(naive.impact_time * fps), round(cont.time * fps) + 1) / fps
+    asked = stages.desired_motion(cast, sc.response, times, naive.impact_time,
+                                  stages.yields_to(sc.response, naive.impulse), cont)  # fmt: skip
+    got = sim2.motion.sample(times - contact.rewind)
+    dot = np.abs(np.sum(got.rotations[:, free] * asked.rotations[:, free], axis=-1))
+    assert dot.min() > 1 - 1e-6
+    old = rec.motion.sample(times + rec.clock0)
+    moved = np.abs(np.sum(old.rotations[-1, free] * asked.rotations[-1, free], axis=-1))
+    assert moved.min() < 0.999  # the old clip's would differ: the test can fail
+    # and the final blend leaves them as asked
+    rel = np.abs(np.sum(out.simulated.rotations[:, free] * out.blended.rotations[:, free], -1))
+    assert rel.min() > 1 - 1e-6
