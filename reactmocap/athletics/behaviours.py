@@ -243,7 +243,14 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
         rep["final_distance_m"] = float(log["com"][-1, 0] - log["com"][0, 0])
     else:
         rep["commanded_height_m"] = target
-        rep["achieved_height_m"] = float(log["com"][:, 2].max() - com0) if lift is not None else 0.0
+        # the apex of the flight (lift-off to touchdown), not a later bounce off the landing
+        td = ctx.touchdown_time
+        flight = (t >= (lift if lift is not None else np.inf)) & (
+            t <= (td if td is not None else np.inf)
+        )
+        rep["achieved_height_m"] = (
+            float(log["com"][flight, 2].max() - com0) if flight.any() else 0.0
+        )
     rep["time_to_liftoff_s"] = lift
     rep["peak_grf_bw"] = float(np.linalg.norm(force[push], axis=1).max() / weight) \
         if push.any() else None  # fmt: skip
