@@ -49,13 +49,15 @@ MAX_SUPPORT = 6.0
 #: fraction of the crouch left at touchdown that the planned stop uses
 PLAN_ROOM = 0.7
 
-#: knee flexion (rad) below which a knee switched off while absorbing is servoed again, and
-#: the flexion it is driven to: a knee is a hinge with an extension stop, but our ball joint's
+#: knee flexion (rad) below which a knee switched off while absorbing is servoed again, the
+#: flexion it is driven to, and how stiffly (m g L N m/rad; a soft stop: the balance's 3.0
+#: made the example broad-jump maneuver's landing fall): a knee is a hinge with an extension stop, but our ball joint's
 #: cone lets a passive, nearly straight knee (a short flight leaves no time to bend it) buckle
 #: backwards under the landing's push (seen to -1.5 rad, and the servo's return then launched
 #: the body)
 KNEE_STOP = 0.0
 KNEE_GUARD = 0.2
+KNEE_GUARD_STIFFNESS = 1.0
 #: a foot within this height (m) of the floor after touchdown carries weight
 STANCE_REACH = 0.02
 
@@ -230,7 +232,7 @@ class Landing(Basis):
                 return
             guard[:] = new
             stiff = rig.stiffness.copy()
-            stiff[_KNEE] = np.where(new, BALANCE_GAINS.stiffness_array()[_KNEE], p.knee_stiffness)
+            stiff[_KNEE] = np.where(new, KNEE_GUARD_STIFFNESS, p.knee_stiffness)
             rig.set_stiffness(stiff)
             goal = np.full((NJ, 3), np.nan)
             goal[np.asarray(_KNEE)[new]] = (KNEE_GUARD, 0.0, 0.0)
