@@ -50,11 +50,11 @@ MAX_SUPPORT = 6.0
 PLAN_ROOM = 0.7
 
 #: knee flexion (rad) below which a knee switched off while absorbing is servoed again, the
-#: flexion it is driven to, and how stiffly (m g L N m/rad; a soft stop: the balance's 3.0
-#: made the example broad-jump maneuver's landing fall): a knee is a hinge with an extension stop, but our ball joint's
-#: cone lets a passive, nearly straight knee (a short flight leaves no time to bend it) buckle
-#: backwards under the landing's push (seen to -1.5 rad, and the servo's return then launched
-#: the body)
+#: flexion it is driven to, and how stiffly (m g L N m/rad). Why: a knee is a hinge with an
+#: extension stop, but our ball joint's cone lets a passive, nearly straight knee (a short
+#: flight leaves no time to bend it) buckle backwards under the landing's push (seen to
+#: -1.5 rad; the servo's return then launched the body). A soft stop: at the balance's 3.0 the
+#: example broad-jump maneuver's landing fell.
 KNEE_STOP = 0.0
 KNEE_GUARD = 0.2
 KNEE_GUARD_STIFFNESS = 1.0
