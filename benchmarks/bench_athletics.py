@@ -4,6 +4,7 @@ the thesis-style plots and a JSON of every figure.
 
     python benchmarks/bench_athletics.py --tables      # rebuild the tables and supported ranges
     python benchmarks/bench_athletics.py --out docs/athletics   # the experiments and plots
+    python benchmarks/bench_athletics.py --leaps --json leaps.json   # Fig. 4.1 and 4.2 only
     python benchmarks/bench_athletics.py --capture --json docs/athletics/capture.json  # issue 19
 
 ``--workers N`` runs simulations in N processes (the figures do not depend on it).
