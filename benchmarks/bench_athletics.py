@@ -4,6 +4,7 @@ the thesis-style plots and a JSON of every figure.
 
     python benchmarks/bench_athletics.py --tables      # rebuild the tables and supported ranges
     python benchmarks/bench_athletics.py --out docs/athletics   # the experiments and plots
+    python benchmarks/bench_athletics.py --leaps --json leaps.json   # Fig. 4.1 and 4.2 only
     python benchmarks/bench_athletics.py --capture --json docs/athletics/capture.json  # issue 19
 
 ``--workers N`` runs simulations in N processes (the figures do not depend on it).
@@ -23,6 +24,7 @@ import numpy as np
 
 from reactmocap.athletics import calibrate, run, tables
 from reactmocap.athletics.plots import commanded_plot, series_plot
+from reactmocap.athletics.report import ground_force
 
 BODIES = ("male", "female")
 ROOT = Path(__file__).resolve().parents[1]
@@ -226,31 +228,40 @@ def _offset_limit(body: str, direction: float) -> float:
 
 
 # ---------------------------------------------------------------------------------- experiments
+def _leap_experiments(body: str, workers: int, res: dict[str, Any], panels: dict[str, Any],
+                      grf_curves: dict[str, Any]) -> list[tuple[float, float]]:  # fmt: skip
+    """Fig. 4.1 and 4.2 for one body into ``res`` (``leap_<body>``, ``leap05_<body>``);
+    returns the runs' real-time factors (wall, CPU)."""
+    commands = [round(x, 2) for x in np.linspace(0.1, 1.0, 10)]
+    rows = calibrate.sweep("leap", body, [{"height": h} for h in commands], workers)
+    speeds = [(r["realtime_factor"], r["realtime_factor_cpu"]) for r in rows]
+    got = [r["achieved_height_m"] for r in rows]
+    err = [abs(g - c) for g, c in zip(got, commands)]
+    res[f"leap_{body}"] = {
+        "commanded": commands, "achieved": got, "abs_error": err,
+        "landed": [_landed(r) for r in rows], "max_abs_error": max(err),
+        "human_plausible": [r["human_plausible"] for r in rows],
+        "peak_joint_torque_nm": [r["peak_joint_torque_nm"] for r in rows],
+        "peak_joint_power_w": [r["peak_joint_power_w"] for r in rows],
+    }  # fmt: skip
+    panels[body] = (commands, got)
+    half = calibrate.sweep("leap", body, [{"height": 0.5}], 1)[0]
+    res[f"leap05_{body}"] = {k: half[k] for k in ("time_to_liftoff_s", "peak_grf_bw",
+                                                   "achieved_height_m", "landed")}  # fmt: skip
+    for h in (0.2, 0.5, 0.8):
+        r = run("leap", body, height=h, check_range=False)
+        t, force = ground_force(r.log, r.report["mass_kg"], np.array([0.0, 0.0, -9.81]))
+        grf_curves[f"{body} {h} m"] = (t, force[:, 2] / (r.report["mass_kg"] * 9.81))
+    return speeds
+
+
 def experiments(out: Path | None, workers: int) -> dict[str, Any]:
     res: dict[str, Any] = {"date": datetime.date.today().isoformat()}
     speeds: list[tuple[float, float]] = []
-    commands = [round(x, 2) for x in np.linspace(0.1, 1.0, 10)]
-    panels, grf_curves = {}, {}
+    panels: dict[str, Any] = {}
+    grf_curves: dict[str, Any] = {}
     for body in BODIES:
-        rows = calibrate.sweep("leap", body, [{"height": h} for h in commands], workers)
-        speeds += [(r["realtime_factor"], r["realtime_factor_cpu"]) for r in rows]
-        got = [r["achieved_height_m"] for r in rows]
-        err = [abs(g - c) for g, c in zip(got, commands)]
-        res[f"leap_{body}"] = {
-            "commanded": commands, "achieved": got, "abs_error": err,
-            "landed": [_landed(r) for r in rows], "max_abs_error": max(err),
-            "human_plausible": [r["human_plausible"] for r in rows],
-            "peak_joint_torque_nm": [r["peak_joint_torque_nm"] for r in rows],
-            "peak_joint_power_w": [r["peak_joint_power_w"] for r in rows],
-        }  # fmt: skip
-        panels[body] = (commands, got)
-        half = calibrate.sweep("leap", body, [{"height": 0.5}], 1)[0]
-        res[f"leap05_{body}"] = {k: half[k] for k in ("time_to_liftoff_s", "peak_grf_bw",
-                                                       "achieved_height_m", "landed")}  # fmt: skip
-        for h in (0.2, 0.5, 0.8):
-            r = run("leap", body, height=h, check_range=False)
-            t = r.log["t"]
-            grf_curves[f"{body} {h} m"] = (t, r.log["grf"][:, 2] / (r.report["mass_kg"] * 9.81))
+        speeds += _leap_experiments(body, workers, res, panels, grf_curves)
         # broad jump: commanded over the table's span, and the longest landed jump
         btable = tables.BROAD_TABLES.get(body, ())
         if btable:
@@ -401,7 +412,21 @@ def main() -> int:
     ap.add_argument("--capture", action="store_true",
                     help="issue 19: capture regions of the example maneuvers (50 starts each)")  # fmt: skip
     ap.add_argument("--replot", type=Path, help="redraw the plots from a --json file into --out")
+    ap.add_argument("--leaps", action="store_true",
+                    help="only Fig. 4.1 and 4.2 (the vertical leaps), both bodies, into --json")  # fmt: skip
     args = ap.parse_args()
+    if args.leaps:
+        res = {"date": datetime.date.today().isoformat()}
+        for body in BODIES:
+            _leap_experiments(body, args.workers, res, {}, {})
+            row, half = res[f"leap_{body}"], res[f"leap05_{body}"]
+            print(f"{body}: achieved {np.round(row['achieved'], 3).tolist()}, landed "
+                  f"{sum(row['landed'])}/10 {row['landed']}; 0.5 m: {half}")  # fmt: skip
+        if args.json is not None:
+            from reactmocap.io import atomic_write_text
+
+            atomic_write_text(args.json, json.dumps(res, indent=1, default=str) + "\n")
+        return 0
     if args.tables:
         build_tables(args.workers, tuple(args.parts.split(",")))
         return 0

@@ -23,7 +23,13 @@ from reactmocap.athletics.bodies import BODIES, Athlete, athlete
 from reactmocap.athletics.land import Landing
 from reactmocap.athletics.leap import Leap, LeapParams
 from reactmocap.athletics.machine import Context
-from reactmocap.athletics.report import fell, joint_peaks, plausibility, standing_balanced
+from reactmocap.athletics.report import (
+    fell,
+    ground_force,
+    joint_peaks,
+    plausibility,
+    standing_balanced,
+)
 from reactmocap.athletics.scene import Slope, add_backpack, athletics_world, stand_angles
 from reactmocap.athletics.sequencer import Sequencer
 from reactmocap.errors import ConfigError, UnknownKeyError
@@ -222,7 +228,9 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     thrust = next((tr.time for tr in seq.transitions if tr.target == "leap.thrust"), None)
     lift = ctx.liftoff_time
     weight = ath.mass * float(np.linalg.norm(world.model.opt.gravity))
-    push = (t >= (thrust or 0.0)) & (t < (lift if lift is not None else -1.0))
+    # the push's ground force, each control tick's mean (report.ground_force)
+    _, force = ground_force(log, ctx.rig.mass, world.model.opt.gravity)
+    push = (t[1:] > (thrust or 0.0)) & (t[:-1] < (lift if lift is not None else -1.0))
     rep: dict[str, Any] = {"effort": s}
     if broad:
         # the jump's length: COM travel (ahead, +X) from standing to where the landing took
@@ -235,9 +243,16 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
         rep["final_distance_m"] = float(log["com"][-1, 0] - log["com"][0, 0])
     else:
         rep["commanded_height_m"] = target
-        rep["achieved_height_m"] = float(log["com"][:, 2].max() - com0) if lift is not None else 0.0
+        # the apex of the flight (lift-off to touchdown), not a later bounce off the landing
+        td = ctx.touchdown_time
+        flight = (t >= (lift if lift is not None else np.inf)) & (
+            t <= (td if td is not None else np.inf)
+        )
+        rep["achieved_height_m"] = (
+            float(log["com"][flight, 2].max() - com0) if flight.any() else 0.0
+        )
     rep["time_to_liftoff_s"] = lift
-    rep["peak_grf_bw"] = float(np.linalg.norm(log["grf"][push], axis=1).max() / weight) \
+    rep["peak_grf_bw"] = float(np.linalg.norm(force[push], axis=1).max() / weight) \
         if push.any() else None  # fmt: skip
     rep["liftoff_pitch_momentum"] = ctx.handover.get("liftoff_pitch_momentum")
     rep.update(_landing(ctx, log, pelvis0))

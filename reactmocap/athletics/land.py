@@ -49,6 +49,15 @@ MAX_SUPPORT = 6.0
 #: fraction of the crouch left at touchdown that the planned stop uses
 PLAN_ROOM = 0.7
 
+#: knee flexion (rad) below which a knee switched off while absorbing is servoed again, the
+#: flexion it is driven to, and how stiffly (m g L N m/rad). Why: a knee is a hinge with an
+#: extension stop, but our ball joint's cone lets a passive, nearly straight knee (a short
+#: flight leaves no time to bend it) buckle backwards under the landing's push (seen to
+#: -1.5 rad; the servo's return then launched the body). A soft stop: at the balance's 3.0 the
+#: example broad-jump maneuver's landing fell.
+KNEE_STOP = 0.0
+KNEE_GUARD = 0.2
+KNEE_GUARD_STIFFNESS = 1.0
 #: a foot within this height (m) of the floor after touchdown carries weight
 STANCE_REACH = 0.02
 
@@ -145,6 +154,7 @@ class Landing(Basis):
         rig = ctx.rig
         bl = BalanceLaw(ctx, BALANCE_GAINS)
         memo: dict[str, float] = {}
+        guard = np.zeros(2, dtype=bool)  # knees held out of hyperextension (knee_stop)
         m = ctx.world.model
         pre = rig.wc.prefix
         hip_joints = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
@@ -210,7 +220,23 @@ class Landing(Basis):
             # the joint rate), and a rigid leg makes the contact spring the body back up
             rig.set_damping(per_joint(ABSORB_DAMPING))
             memo["knee_peak"] = _knee_speed(world, ctx)
+            guard[:] = False
             bl.posture = Posture(leg=_leg_fraction(ctx), lean=p.lean, settle=0.0)
+
+        def knee_stop(t: float) -> None:
+            """Hold a switched-off knee out of hyperextension (see KNEE_STOP): servo it to
+            KNEE_GUARD while below KNEE_STOP, release it once bent past KNEE_GUARD."""
+            flex = rig.knee_flexion()
+            new = (guard | (flex < KNEE_STOP)) & (flex < KNEE_GUARD)
+            if np.array_equal(new, guard):
+                return
+            guard[:] = new
+            stiff = rig.stiffness.copy()
+            stiff[_KNEE] = np.where(new, KNEE_GUARD_STIFFNESS, p.knee_stiffness)
+            rig.set_stiffness(stiff)
+            goal = np.full((NJ, 3), np.nan)
+            goal[np.asarray(_KNEE)[new]] = (KNEE_GUARD, 0.0, 0.0)
+            rig.move(goal, 0.0, t, np.asarray(_KNEE)[new])
 
         def absorb(world: World, t: float) -> None:
             s = ctx.sense(t)
@@ -247,6 +273,8 @@ class Landing(Basis):
                     knee = knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k], length)
                     goal[_KNEE[k]] = (float(knee[0]), 0.0, 0.0)
                 rig.move(goal, 0.0, t, _KNEE)
+            if p.knee_stiffness == 0.0:
+                knee_stop(t)
             memo["knee_peak"] = max(memo["knee_peak"], _knee_speed(world, ctx))
 
         def slowed(world: World, t: float, t_in: float) -> bool:

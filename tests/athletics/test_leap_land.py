@@ -10,6 +10,7 @@ from reactmocap.athletics import run, tables
 from reactmocap.athletics.behaviours import LANDING_LEG
 from reactmocap.athletics.bodies import athlete
 from reactmocap.athletics.land import LandingParams
+from reactmocap.athletics.report import ground_force
 from reactmocap.athletics.scene import stand_angles
 from reactmocap.errors import ConfigError
 
@@ -21,6 +22,25 @@ def test_a_leap_to_30_cm_lands_within_3_cm_and_balanced() -> None:
     # the height is the COM's rise at the apex over standing, from the log itself
     com = r.log["com"][:, 2]
     assert com.max() - com[0] == pytest.approx(r.report["achieved_height_m"])
+
+
+def test_a_short_female_leap_never_bounces_off_its_landing() -> None:
+    # a 0.1 m flight leaves no time to bend the knees; a switched-off straight knee used to
+    # buckle backwards under the landing's push and the servo's return launched the body
+    # (reported as a 4.7 m leap); below the measured range, so run with check_range=False
+    r = run("leap", "female", height=0.1, check_range=False)
+    assert abs(r.report["achieved_height_m"] - 0.1) <= 0.03
+    com = r.log["com"][:, 2]
+    assert com.max() - com[0] < 0.15  # nothing after the touchdown went higher than the leap
+
+
+def test_the_ground_force_of_a_standing_athlete_is_its_weight() -> None:
+    r = run("balance", "female", seconds=1.0)
+    t, force = ground_force(r.log, r.report["mass_kg"], np.array([0.0, 0.0, -9.81]))
+    late = t > 0.5
+    weight = r.report["mass_kg"] * 9.81
+    assert np.abs(force[late, 2].mean() / weight - 1.0) < 0.02
+    assert np.abs(force[late, :2]).max() < 0.05 * weight
 
 
 def test_a_broad_jump_of_1_m_within_5_cm() -> None:
