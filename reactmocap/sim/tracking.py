@@ -144,7 +144,9 @@ def track_clip(
     ``start``). ``root_assist > 0`` adds the NON-PHYSICAL root assist with that kp (only with
     ``"pd"``). ``parts``: the clip's body parts (default: mapped by name). ``on_tick(t,
     seconds)`` reports progress. The whole-body tracker gets the registry's
-    :data:`~reactmocap.sim.controllers.registry.WHOLE_CLIP` options under ``params``. A failure
+    :data:`~reactmocap.sim.controllers.registry.WHOLE_CLIP` options under ``params`` (with
+    ``impacts``, without its trunk rows: they held the chest still where a push needs the waist to
+    give, and the guard stance fell under 150 N sideways). A failure
     is a result, not an exception: a fall ends the run
     there (``stop_on_fall``), a diverging simulation at its last stable frame, and the report's
     ``status`` says which."""
@@ -168,7 +170,10 @@ def track_clip(
         )
     given = {**(params or {}), **{k: v for k, v in (("kp", kp), ("kv", kv)) if v is not None}}
     if set(WHOLE_CLIP) <= set(spec.options):  # a whole clip, not a short window
-        given = {**WHOLE_CLIP, **given}
+        whole = dict(WHOLE_CLIP)
+        if impacts:  # a pushed body needs the hip strategy the trunk rows forbid
+            whole["trunk_weight"] = 0.0
+        given = {**whole, **given}
     resolved = spec.params(given)
     frame = round(start * motion.fps)
     character = build_character(motion, parts, total_mass=total_mass, frame=frame,
