@@ -197,7 +197,7 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
               "predictive": "whole-body + predictive sampling (physical)"}  # fmt: skip
     modes = [(c, 0.0, labels.get(c, c), {}) for c in controllers]
     if "wholebody" in controllers:  # the tracker without the whole-clip options
-        window = {k: 0.0 for k in WHOLE_CLIP}
+        window = {k: None for k in WHOLE_CLIP}  # None: the constructor's defaults
         modes.append(("wholebody", 0.0, "whole-body, window settings (no WHOLE_CLIP)", window))
     modes.append(("pd", assist_gain, f"PD WITH non-physical root assist kp={assist_gain:g}", {}))
     motions = {p: _read_bvh(p) for p in clips}

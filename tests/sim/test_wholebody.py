@@ -257,6 +257,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("pivot_rate", -2.0),
         ("anchor_tau", -0.1),
         ("step_time", float("nan")),
+        ("trunk_weight", -1.0),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -290,3 +291,23 @@ def test_cli_track_controller_choice(
     err = capsys.readouterr().err
     assert "unknown controller 'nope'" in err and "wholebody" in err
     assert not (tmp_path / "nope.json").exists()
+
+
+def test_trunk_rows_keep_the_chest_turning_as_tracked(guard: Motion) -> None:
+    """With the pelvis pushed 8 cm off its target the plan cannot follow every target; with
+    ``trunk_weight`` it keeps the chest's world angular acceleration nearer the one the
+    targets ask (rather than bending the waist to hold the pelvis)."""
+    misses = []
+    for weight in (0.0, 30.0):
+        world, _, wb = _standing(guard, 10, trunk_weight=weight)
+        m, d = world.model, world.data
+        d.qpos[world.characters[0].qpos_adr] += 0.08
+        mujoco.mj_forward(m, d)
+        plan = wb.plan(0.0)
+        chest = int(world.characters[0].body_ids[2])
+        jr = np.zeros((3, m.nv))
+        mujoco.mj_jac(m, d, None, jr, d.xpos[chest], chest)
+        sl = world.characters[0].qvel_slice
+        misses.append(float(np.linalg.norm(jr[:, sl] @ (plan.qacc - plan.desired_qacc))))
+    assert misses[0] > 10.0, misses  # rad/s^2: the offset is big enough to matter
+    assert misses[1] < 0.1 * misses[0], misses

@@ -20,7 +20,7 @@ from scipy.optimize import nnls
 
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
-from reactmocap.sim.character import BALL_JOINTS
+from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.anchoring import AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
@@ -98,6 +98,11 @@ class WholeBodyTracker(AnchoredReference):
             blew up on the synthetic ``sway`` clip, so the default stays critical.
         root_weight: weight of the pelvis rows of ``W`` against 1 for joints (dropped while
             no foot supports: then only momentum moves the pelvis).
+        trunk_weight: weight of three rows holding the chest's world angular acceleration
+            to what the pelvis, waist and back targets together ask (0: none). While the
+            pelvis targets ask more than the feet can give, the program otherwise bends the
+            waist to hold the pelvis (a hip strategy that never comes back): on whole clips
+            the waist drifted ~1 rad in the 0.5-1 s before most falls (``docs/tracking.md``).
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
@@ -155,6 +160,7 @@ class WholeBodyTracker(AnchoredReference):
         kp_joint: float,
         kv_joint: float | None = None,
         root_weight: float = 30.0,
+        trunk_weight: float = 0.0,
         contact_weight: float = 1e4,
         contact_kv: float = 20.0,
         friction: float = 0.7,
@@ -188,7 +194,7 @@ class WholeBodyTracker(AnchoredReference):
         check_params(
             {
                 "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint,
-                "root_weight": root_weight, "contact_weight": contact_weight,
+                "root_weight": root_weight, "trunk_weight": trunk_weight, "contact_weight": contact_weight,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
@@ -222,6 +228,8 @@ class WholeBodyTracker(AnchoredReference):
         self._root_rows = np.eye(6, NV) * self._w_root
         self._free = np.zeros(0, dtype=bool)  # the last NNLS solution's positive coefficients
         self._wj = np.ones(3 * NJ)
+        self._w_trunk = float(trunk_weight)
+        self._chest = int(wc.body_ids[SIM_BODIES.index("chest")])
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
         self.mu = float(friction) * float(world.config.friction)
@@ -418,6 +426,13 @@ class WholeBodyTracker(AnchoredReference):
         tasks: list[tuple[F64, F64]] = []
         if nc:
             tasks.append((self._root_rows, self._w_root * acc_des[:6]))
+            if self._w_trunk:
+                # the chest's world turn as the plan's own targets turn it (pelvis, waist and
+                # back together): without it the least squares spent the waist to hold the
+                # pelvis, and whole clips fell after the waist had drifted ~1 rad
+                mujoco.mj_jac(m, d, None, self._jacr, d.xpos[self._chest], self._chest)
+                jt = self._jacr[:, sl] * self._w_trunk
+                tasks.append((jt, jt @ acc_des))
             # the corners in contact do not move (J_c qdd + Jdot_c qdot = -k_c v_c), so the
             # planned forces are the ones MuJoCo's rigid-ish contact will produce: with only
             # the tangential rows and a soft weight, joint accelerations missed the plan by
