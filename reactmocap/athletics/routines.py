@@ -110,12 +110,15 @@ def somersault(
     fps: float = 60.0,
 ) -> AthleticsResult:
     """A standing somersault (:func:`somersault_maneuver`); ``twist`` (turns) is refused:
-    twisting is not built yet (``docs/athletics.md``)."""
+    the twist is aimed only in the dive (:func:`dive`; ``docs/athletics.md``)."""
     if not math.isfinite(twist):
         raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
     if twist != 0.0:
         raise ConfigError(
-            "twisting somersaults are not built yet (issue 19, thesis 5.2); run without --twist"
+            "twisting somersaults are not built (thesis 5.2): the twist is aimed only in the "
+            "layout back dive (athletics dive --twist 0.5|1); the layout somersault does not "
+            "land and a twist thrown in the tuck or pike did not stop (docs/athletics.md); "
+            "run without --twist"
         )
     if not (math.isfinite(backpack) and backpack >= 0):
         raise ConfigError(f"backpack must be >= 0 kg, got {backpack!r}")

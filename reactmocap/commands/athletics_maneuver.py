@@ -43,7 +43,8 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     s.add_argument("--position", choices=sorted(POSITIONS), default="tuck")
     s.add_argument("--direction", choices=list(DIRECTIONS), default="backward")
     s.add_argument("--twist", type=float, default=0.0,
-                   help="twist turns (not built yet: anything but 0 is refused)")  # fmt: skip
+                   help="twist turns (not built for somersaults: anything but 0 is refused; "
+                   "see dive --twist)")  # fmt: skip
     s.add_argument("--backpack", type=float, default=0.0, help="kg on the chest (thesis 8.5.2)")
     output_args(s, "male", plot=False)
     s.set_defaults(func=_somersault)
