@@ -505,6 +505,8 @@ def run_maneuver(
     if "tumble_peak_rate" in ctx.handover:
         rep["peak_somersault_rate_rad_s"] = ctx.handover["tumble_peak_rate"]
         rep["tumble_min_inertia_kgm2"] = ctx.handover["tumble_min_inertia"]
+    if "tumble_twist_undone" in ctx.handover:  # when the tilt twist's throw was undone
+        rep["twist_undone_s"] = ctx.handover["tumble_twist_undone"]
     if high > 0:  # judged at the water: entry angle, rotation and twist there
         rep.update(entry_report(ctx, high, res.status == "ok"))
         rep["touchdown_s"] = None

@@ -19,8 +19,10 @@ from reactmocap.errors import ConfigError, UnknownKeyError
 __all__ = [
     "DIRECTIONS",
     "DIVE_DIRECTIONS",
+    "DIVE_TWISTS",
     "PLATFORM_MAX",
     "SOMERSAULT_PRESETS",
+    "TWIST_DIVE",
     "dive",
     "dive_maneuver",
     "somersault",
@@ -108,12 +110,15 @@ def somersault(
     fps: float = 60.0,
 ) -> AthleticsResult:
     """A standing somersault (:func:`somersault_maneuver`); ``twist`` (turns) is refused:
-    twisting is not built yet (``docs/athletics.md``)."""
+    the twist is aimed only in the dive (:func:`dive`; ``docs/athletics.md``)."""
     if not math.isfinite(twist):
         raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
     if twist != 0.0:
         raise ConfigError(
-            "twisting somersaults are not built yet (issue 19, thesis 5.2); run without --twist"
+            "twisting somersaults are not built (thesis 5.2): the twist is aimed only in the "
+            "layout back dive (athletics dive --twist 0.5|1); the layout somersault does not "
+            "land and a twist thrown in the tuck or pike did not stop (docs/athletics.md); "
+            "run without --twist"
         )
     if not (math.isfinite(backpack) and backpack >= 0):
         raise ConfigError(f"backpack must be >= 0 kg, got {backpack!r}")
@@ -127,15 +132,30 @@ def somersault(
 #: the dive's tumble lead (rad) per position, tuned by hand on the male body (5 m, 1.5 turns)
 DIVE_LEADS: Mapping[str, float] = MappingProxyType({"pike": 2.0, "tuck": 1.7, "layout": 0.0})
 DIVE_DIRECTIONS = ("backward",)
+#: the twists a dive is built for (turns)
+DIVE_TWISTS = (0.5, 1.0)
+#: the twisting dive (thesis 5.2's tilt twist), tuned by hand on the male body from 5 m: a
+#: back dive in layout (half a somersault, head first), the leap aiming at less spin (-45 kg
+#: m^2/s; at the back somersault's -55 the entry over-rotated to 49 degrees), the arms thrown
+#: 2.0 rad right after lift-off (entry 0.1 s) for the fastest twist; the tumble stays in layout
+#: until the twist is stopped. Tried and not kept: the twist in the 1.5-somersault pike (the
+#: pike's pelvis-to-head line is not its long axis: the tilt and the twist do not stop when the
+#: arms come back, and the somersault lost 110 degrees: entry 125 degrees off)
+TWIST_DIVE: tuple[Mapping[str, float], Mapping[str, float]] = (
+    MappingProxyType({"spin": -45.0}),
+    MappingProxyType({"arm_tilt": 2.0, "entry": 0.1}),
+)
 
 
 def dive_maneuver(
     position: str = "pike", direction: str = "backward", body: str = "male",
-    height: float = 5.0, turns: float = 1.5,
+    height: float = 5.0, turns: float = 1.5, twist: float = 0.0,
 ) -> Maneuver:  # fmt: skip
     """A backward dive of ``turns`` somersaults (1.5: head first) in ``position`` from a
     ``height`` m platform: balance, the back somersault's leap, tumble (aimed at the water),
-    stretch. The tumble's opening predicts with the stretched body's inertia."""
+    stretch. The tumble's opening predicts with the stretched body's inertia. ``twist``
+    (turns, one of :data:`DIVE_TWISTS`) adds :data:`TWIST_DIVE`'s tilt twist, stopped at that
+    many turns; it is built for the layout back dive (``position`` layout, ``turns`` 0.5)."""
     if direction not in DIVE_DIRECTIONS:
         raise UnknownKeyError(
             f"unknown dive direction {direction!r}; built: {list(DIVE_DIRECTIONS)}"
@@ -148,11 +168,20 @@ def dive_maneuver(
         raise ConfigError(f"dive platform height must be 1-{PLATFORM_MAX:g} m, got {height!r}")
     if not (math.isfinite(turns) and turns > 0):
         raise ConfigError(f"dive turns must be > 0, got {turns!r}")
+    _check_twist(twist)
+    if twist and (position != "layout" or turns != 0.5):
+        raise ConfigError(
+            "a twisting dive is built as the layout back dive (position layout, turns 0.5), "
+            f"got position {position!r}, turns {turns!r} (docs/athletics.md)"
+        )
     leap = dict(SOMERSAULT_PRESETS["male"]["backward"][0])
     i_open = round(somersault_inertia(athlete(body), stretch_angles()), 2)
     tumble = {"position": position, "turns": turns, "lead": DIVE_LEADS[position],
               "target_height": -height, "open_inertia": i_open, "latest": 0.3,
               "max_seconds": 5.0}  # fmt: skip
+    if twist:
+        leap.update(TWIST_DIVE[0])
+        tumble.update(TWIST_DIVE[1], twist=twist)
     phases = (
         Phase("balance", "after", {}, 0.3),
         Phase("leap", "liftoff", leap),
@@ -160,30 +189,43 @@ def dive_maneuver(
         Phase("stretch", "never", {}),
     )
     seconds = round(1.7 + math.sqrt(2.0 * (height + 2.0) / 9.81), 1)
-    return Maneuver(f"dive_{direction}_{position}", phases, body, seconds, 0.0, height)
+    name = f"dive_{direction}_{position}" + (f"_twist{twist:g}" if twist else "")
+    return Maneuver(name, phases, body, seconds, 0.0, height)
+
+
+def _check_twist(twist: float) -> None:
+    if not math.isfinite(twist) or (twist and twist not in DIVE_TWISTS):
+        raise ConfigError(
+            f"dive twist must be 0 or one of {list(DIVE_TWISTS)} turns, got {twist!r}"
+        )
 
 
 def dive(
-    position: str = "pike",
+    position: str | None = None,
     direction: str = "backward",
     body: str = "male",
     *,
     height: float = 5.0,
-    turns: float = 1.5,
+    turns: float | None = None,
     twist: float = 0.0,
     on_tick: Callable[[float], None] | None = None,
     fps: float = 60.0,
 ) -> AthleticsResult:
     """A platform dive (:func:`dive_maneuver`). ``landed`` is a clean entry (head first within
     ``dive.ENTRY_TOLERANCE`` of straight down when the COM reaches the water), ``fell`` its
-    opposite. ``twist`` (turns) is refused: twists are not aimed yet (``docs/athletics.md``)."""
-    if not math.isfinite(twist):
-        raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
-    if twist != 0.0:
-        raise ConfigError(
-            "twisting dives are not built yet (issue 19, thesis 5.2); run without --twist"
-        )
-    result = run_maneuver(dive_maneuver(position, direction, body, height, turns),
+    opposite. ``position`` and ``turns`` default to the pike 1.5 somersaults, or with a
+    ``twist`` (turns, :data:`DIVE_TWISTS`) to the layout back dive (half a somersault) that
+    the twist is built for; the report adds ``twist_turns`` (commanded), ``twist_error_deg``
+    (``|twist_deg|`` against it) and ``twist_stopped`` (the throw undone before the entry)."""
+    _check_twist(twist)
+    position = position or ("layout" if twist else "pike")
+    turns = turns if turns is not None else (0.5 if twist else 1.5)
+    result = run_maneuver(dive_maneuver(position, direction, body, height, turns, twist),
                           on_tick=on_tick, fps=fps)  # fmt: skip
-    result.report.update(position=position, direction=direction, turns=turns, twist_turns=0.0)
+    rep = result.report
+    rep.update(position=position, direction=direction, turns=turns, twist_turns=twist)
+    if twist:
+        undone, entry = rep.get("twist_undone_s"), rep.get("entry_s")
+        rep["twist_error_deg"] = abs(rep["twist_deg"]) - 360.0 * twist
+        rep["twist_stopped"] = undone is not None and entry is not None and undone < entry
     return result

@@ -149,6 +149,16 @@ class TumbleParams:
             over the head, the other down and across); the body tilts the other way out of
             the somersault plane and starts to twist. 0: no throw.
         arm_throw: seconds the throw takes.
+        twist: twists (turns, >= 0, in half turns) to stop the tilt twist at; 0: the throw
+            (if any) is held. Each tick after the throw the twist still to come while the
+            asymmetry is undone is predicted as the twist rate now (the pelvis's angular
+            velocity about the pelvis-to-head line) times ``arm_throw / 2`` (the tilt, and
+            with it the rate, falls to zero over the undo); once the twist so far plus that
+            reaches the goal the asymmetry is undone: at a whole turn the arms go back to the
+            position (the body's front-back axis is where it was at the throw, so turning
+            the arms back takes the tilt out), at an odd half turn they go on by another
+            ``arm_tilt`` (the front-back axis is reversed, so the same turn of the trunk
+            needs the opposite arm motion).
         target_height: the COM height (m) the prediction aims at instead (a dive: the water
             surface); None: ``touchdown_height`` of the standing COM.
         open_inertia: the opened body's inertia about the somersault axis (kg m^2) the
@@ -170,6 +180,7 @@ class TumbleParams:
     max_seconds: float = 3.0
     arm_tilt: float = 0.0
     arm_throw: float = 0.15
+    twist: float = 0.0
     target_height: float | None = None
     open_inertia: float | None = None
     extend: float = 0.0
@@ -178,12 +189,16 @@ class TumbleParams:
     def __post_init__(self) -> None:
         position_angles(self.position)  # an unknown position lists the valid ones
         for name in ("turns", "entry", "lead", "touchdown_height", "latest", "max_seconds",
-                     "arm_tilt", "arm_throw", "extend", "extend_lead"):  # fmt: skip
+                     "arm_tilt", "arm_throw", "twist", "extend", "extend_lead"):  # fmt: skip
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"tumble {name} must be a finite number, got {v!r}")
         if self.turns <= 0 or self.entry <= 0 or self.max_seconds <= 0 or self.arm_throw <= 0:
             raise ConfigError("tumble turns, entry, arm_throw and max_seconds must be > 0")
+        if self.twist < 0 or not float(2.0 * self.twist).is_integer():
+            raise ConfigError(f"tumble twist must be >= 0 in half turns, got {self.twist!r}")
+        if self.twist and not self.arm_tilt:
+            raise ConfigError("tumble twist needs an arm throw (arm_tilt != 0) to twist with")
         if not 0.0 <= self.extend <= 1.0:
             raise ConfigError(f"tumble extend must be in [0, 1], got {self.extend!r}")
         if self.open_at is not None and not (math.isfinite(self.open_at) and self.open_at >= 0):
@@ -237,6 +252,9 @@ class Tumble(Basis):
             memo["t0"] = t
             memo.pop("thrown", None)
             memo.pop("extended", None)
+            memo.pop("undone", None)
+            memo["twist0"] = ctx.twist
+            memo["tick"] = t
 
         def control(world: World, t: float) -> None:
             if p.arm_tilt and "thrown" not in memo and t - memo["t0"] >= p.entry:
@@ -245,6 +263,21 @@ class Tumble(Basis):
                 for side in _SHOULDERS:
                     throw[side] = goal[side] + (0.0, p.arm_tilt, 0.0)
                 rig.move(throw, p.arm_throw, t, _SHOULDERS)
+            twist_rate = (ctx.twist - memo["twist0"]) / max(t - memo["tick"], 1e-9)
+            memo["twist0"], memo["tick"] = ctx.twist, t
+            if (p.twist and "undone" not in memo and "thrown" in memo
+                    and t - memo["thrown"] >= p.arm_throw):  # fmt: skip
+                # the twist still to come while the tilt is taken out: about half the
+                # rate now over the undo
+                coming = abs(ctx.twist + twist_rate * 0.5 * p.arm_throw)
+                if coming >= 2.0 * math.pi * p.twist:
+                    memo["undone"] = t
+                    ctx.handover["tumble_twist_undone"] = t
+                    half = not float(p.twist).is_integer()
+                    back = np.full((NJ, 3), np.nan)
+                    for side in _SHOULDERS:
+                        back[side] = goal[side] + (0.0, 2.0 * p.arm_tilt if half else 0.0, 0.0)
+                    rig.move(back, p.arm_throw, t, _SHOULDERS)
             # the rotation the body would still turn, opened now, before its feet touch:
             # the angular momentum about the somersault axis over the open body's inertia,
             # times the time the COM takes to fall to its touchdown height
@@ -273,11 +306,13 @@ class Tumble(Basis):
             ctx.handover["tumble_peak_rate"] = max(peak, rate)
 
         def opened(world: World, t: float, t_in: float) -> bool:
-            del world, t
+            del world
             if p.open_at is not None:
                 return t_in >= p.open_at
             if t_in <= p.entry:
                 return False
+            if p.twist and ("undone" not in memo or t < memo["undone"] + p.arm_throw):
+                return False  # a twist is opened out of only once it is stopped
             want = 2.0 * math.pi * p.turns
             return abs(memo["predicted"]) >= want - p.lead or memo["t_td"] <= p.latest
 

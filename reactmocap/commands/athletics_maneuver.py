@@ -43,7 +43,8 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     s.add_argument("--position", choices=sorted(POSITIONS), default="tuck")
     s.add_argument("--direction", choices=list(DIRECTIONS), default="backward")
     s.add_argument("--twist", type=float, default=0.0,
-                   help="twist turns (not built yet: anything but 0 is refused)")  # fmt: skip
+                   help="twist turns (not built for somersaults: anything but 0 is refused; "
+                   "see dive --twist)")  # fmt: skip
     s.add_argument("--backpack", type=float, default=0.0, help="kg on the chest (thesis 8.5.2)")
     output_args(s, "male", plot=False)
     s.set_defaults(func=_somersault)
@@ -55,13 +56,16 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
         description="A backward dive from a platform, judged at the water (a plane at the "
         "platform's foot): `landed` is a clean, head-first entry.",
     )  # fmt: skip
-    d.add_argument("--position", choices=sorted(POSITIONS), default="pike")
+    d.add_argument("--position", choices=sorted(POSITIONS), default=None,
+                   help="default pike, or layout with --twist")  # fmt: skip
     d.add_argument("--direction", choices=list(DIVE_DIRECTIONS), default="backward")
     d.add_argument("--height", type=float, default=5.0,
                    help=f"platform height over the water (1-{PLATFORM_MAX:g} m; default 5)")  # fmt: skip
-    d.add_argument("--turns", type=float, default=1.5, help="somersaults (1.5: head first)")
+    d.add_argument("--turns", type=float, default=None,
+                   help="somersaults (default 1.5, or 0.5 with --twist: head first)")  # fmt: skip
     d.add_argument("--twist", type=float, default=0.0,
-                   help="twist turns (not built yet: anything but 0 is refused)")  # fmt: skip
+                   help="twist turns: 0, 0.5 or 1 (a tilt twist, built for the layout back "
+                   "dive: --position layout --turns 0.5, the defaults with --twist)")  # fmt: skip
     output_args(d, "male", plot=False)
     d.set_defaults(func=_dive)
 

@@ -71,7 +71,7 @@ def test_bad_files_are_refused_naming_the_field(tmp_path: Path, text: str, field
 def test_every_example_is_valid_and_names_a_maneuver_the_issue_asks_for() -> None:
     names = {p.stem for p in EXAMPLES}
     assert {"back_somersault", "forward_somersault", "vertical_leap", "broad_jump",
-            "dive_pike"} <= names  # fmt: skip
+            "dive_pike", "dive_twist"} <= names  # fmt: skip
     for path in EXAMPLES:
         m = load_maneuver(path)
         assert m.name == path.stem and m.phases[0].controller == "balance"
@@ -86,6 +86,9 @@ def test_each_example_maneuver_runs_and_lands(path: Path) -> None:
         assert abs(r["rotation_deg"] + 360.0) <= 30.0
     elif path.stem == "forward_somersault":
         assert abs(r["rotation_deg"] - 360.0) <= 30.0
+    elif path.stem == "dive_twist":  # half a somersault and one twist, head first
+        assert abs(r["rotation_deg"] + 180.0) <= 30.0 and r["entry_angle_deg"] <= 30.0
+        assert abs(abs(r["twist_deg"]) - 360.0) <= 45.0 and r["flight_momentum_drift"] <= 0.01
     elif path.stem.startswith("dive"):  # 1.5 somersaults: head first into the water
         assert abs(r["rotation_deg"] + 540.0) <= 30.0 and r["entry_angle_deg"] <= 30.0
         assert r["flight_momentum_drift"] <= 0.01
@@ -142,6 +145,45 @@ def test_the_dive_command_enters_head_first_and_a_layout_dive_does_not(tmp_path:
     # the report tells the truth: a layout has too little rotation for 1.5 somersaults
     layout = dive("layout").report
     assert layout["landed"] is False and layout["fell"] is True and layout["entry_angle_deg"] > 30
+
+
+def test_a_dive_with_one_twist_stops_it_within_45_degrees_and_keeps_its_momentum() -> None:
+    # thesis 5.2: the arm throw tilts the body and it twists; undoing the throw when the
+    # predicted twist reaches the goal stops it; the air exerts no torque on the body
+    report = dive(twist=1.0).report
+    assert report["position"] == "layout" and report["twist_turns"] == 1.0
+    assert abs(abs(report["twist_deg"]) - 360.0) <= 45.0
+    assert report["twist_stopped"] is True and report["twist_undone_s"] < report["entry_s"]
+    assert report["flight_momentum_drift"] < 0.01
+    assert report["landed"] is True and report["entry_angle_deg"] <= 30.0
+
+
+def test_a_dive_twist_outside_what_is_built_names_the_range(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(ConfigError, match=r"one of \[0.5, 1.0\] turns, got 2"):
+        dive(twist=2.0)
+    with pytest.raises(ConfigError, match="one of"):
+        dive(twist=-1.0)
+    with pytest.raises(ConfigError, match="layout back dive"):
+        dive("pike", twist=1.0)
+    out = tmp_path / "d.bvh"
+    assert main(["athletics", "dive", "--twist", "1.5", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "0.5, 1.0" in err[0]
+    assert not out.exists()
+
+
+def test_the_dive_command_twists_half_a_turn(tmp_path: Path) -> None:
+    out, rep = tmp_path / "d.bvh", tmp_path / "d.json"
+    assert (
+        main(["athletics", "dive", "--twist", "0.5", "--out", str(out), "--report", str(rep)]) == 0
+    )
+    report = json.loads(rep.read_text())
+    assert report["twist_turns"] == 0.5 and report["turns"] == 0.5
+    assert abs(abs(report["twist_deg"]) - 180.0) <= 45.0
+    assert abs(report["twist_error_deg"]) <= 45.0
+    assert read_bvh(out).num_frames > 100
 
 
 def test_capture_region_runs_perturbed_starts_and_says_where_they_succeed() -> None:
