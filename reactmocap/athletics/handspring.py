@@ -49,10 +49,13 @@ class HandspringParams:
         hips: hip pitch in the air (> 0 extends the legs behind the trunk).
         knees: knee flexion in the air.
         entry: seconds the joints take to reach that shape.
+        give: elbow flexion (rad) the arms take on contact, over ``push_after`` (0: straight
+            struts); the push straightens them again.
         push_after: seconds after the hands touch that the push and snap-down start.
         push: shoulder pitch the push swings the arms to (past the head: < ``arms``).
         snap_hips: hip pitch of the snap-down (< 0 flexes, bringing the legs over).
         snap_trunk: waist and back pitch of the snap-down (> 0 flexes).
+        snap_knees: knee flexion of the snap-down (the legs reach the floor bent, to absorb).
         snap: seconds the push and snap-down take.
         max_seconds: hand over to the landing after this long at the latest.
     """
@@ -63,10 +66,12 @@ class HandspringParams:
     hips: float = 0.2
     knees: float = 0.0
     entry: float = 0.2
+    give: float = 0.0
     push_after: float = 0.05
     push: float = -3.1
     snap_hips: float = -0.8
     snap_trunk: float = 0.2
+    snap_knees: float = 0.0
     snap: float = 0.15
     max_seconds: float = 2.0
 
@@ -143,6 +148,13 @@ class Handspring(Basis):
             memo["contact"] = t
             memo["pushed"] = False
             rig.set_stiffness(per_joint(SUPPORT_STIFFNESS))
+            if p.give > 0:  # the arms give a little on impact, then push
+                goal = np.full((NJ, 3), np.nan)
+                for s in "lr":
+                    goal[joint_index(f"{s}_elbow")] = (p.give, 0.0, 0.0)
+                rig.move(
+                    goal, max(p.push_after, 0.02), t, [joint_index(f"{s}_elbow") for s in "lr"]
+                )
 
         def support(world: World, t: float) -> None:
             del world
@@ -150,7 +162,7 @@ class Handspring(Basis):
             if not memo["pushed"] and t - memo["contact"] >= p.push_after:
                 memo["pushed"] = True
                 rec["push"] = t
-                goal = pose(p.push, p.snap_trunk, p.snap_hips, 0.0, 0.0)
+                goal = pose(p.push, p.snap_trunk, p.snap_hips, p.snap_knees, 0.0)
                 rig.move(goal, p.snap, t, list(range(NJ)))
 
         def hands_on(_w: World, t: float, _t_in: float) -> bool:

@@ -198,11 +198,12 @@ def dive(
 #: the hand support (arched, arms over the head; on contact the shoulders close and the hips
 #: and trunk snap down), the landing and a slow stand-up (docs/athletics.md)
 HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
-    "leap": MappingProxyType({"effort": 0.6, "spin": -110.0, "spin_limit": 1.8,
+    "leap": MappingProxyType({"effort": 0.6, "spin": -110.0, "spin_limit": 1.5,
                               "com_offset": -0.1}),
-    "handspring": MappingProxyType({"push_after": 0.0, "snap_hips": -1.6, "snap_trunk": 0.5,
-                                    "push": -2.5, "snap": 0.12}),
-    "land": MappingProxyType({"delta": -0.1}),
+    "handspring": MappingProxyType({"give": 0.5, "push_after": 0.06, "push": -2.65,
+                                    "snap_hips": -1.2, "snap_trunk": 0.5, "snap_knees": 0.6,
+                                    "snap": 0.1}),
+    "land": MappingProxyType({"delta": -0.45}),
 })  # fmt: skip
 
 
