@@ -1,8 +1,9 @@
 """Composed maneuvers (thesis ch. 8): a maneuver is a sequence of phases, each a basis controller
-from :data:`CONTROLLERS` (``balance``, ``leap``, ``tumble``, ``land``) with its parameters and the
-event that ends it; the sequencer runs them with automatic transitions. A user writes one in a
-TOML file (:func:`load_maneuver`, ``reactmocap athletics maneuver FILE.toml``); the somersaults
-and dives are built-in maneuvers (:mod:`reactmocap.athletics.routines`).
+from :data:`CONTROLLERS` (``balance``, ``leap``, ``tumble``, ``land``, ``stretch``,
+``handspring``) with its parameters and the event that ends it; the sequencer runs them with
+automatic transitions. A user writes one in a TOML file (:func:`load_maneuver`, ``reactmocap
+athletics maneuver FILE.toml``); the somersaults, dives and the back handspring are built-in
+maneuvers (:mod:`reactmocap.athletics.routines`).
 
 A maneuver file::
 
