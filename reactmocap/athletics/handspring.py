@@ -1,14 +1,16 @@
 """The back handspring's hand support (thesis 8.3): the basis controller between the leap and the
 landing. From lift-off the body arches back with the arms thrown over the head; when the hands
-touch the floor (MuJoCo contacts of the hand bodies) the arms become stiff struts, and after
-``push_after`` seconds the shoulders push (the arms swing on past the head) while the hips and
-trunk snap down (flex), turning the legs over toward the floor; it hands over to the landing
-once the hands have left the floor or a foot touches. As in the thesis, the hands are not
+touch the floor (MuJoCo contacts of the hand bodies) the arms become stiff struts that give a
+little at the elbows, and after ``push_after`` seconds they push: the elbows straighten and
+the shoulders close (the arms swing from over the head toward the front) while the hips, trunk
+and knees snap down (flex), turning the legs over toward the floor; the body leaves the hands
+for a second, short flight, and the controller hands over to the landing once the hands are
+off the floor (or a foot touches). As in the thesis, the hands are not
 controlled by feedback: the push comes a set time after contact.
 
 The hand contacts are expected, so they are not a fall: :func:`handspring_report` judges
-``fell`` on every contact but the hands' during this phase (``ctx.handover``), and adds the
-time the hands were on the floor."""
+``fell`` on every contact but the hands' during this phase (``ctx.handover["handspring"]``),
+and adds the time the hands were on the floor during it."""
 
 from __future__ import annotations
 
@@ -52,7 +54,8 @@ class HandspringParams:
         give: elbow flexion (rad) the arms take on contact, over ``push_after`` (0: straight
             struts); the push straightens them again.
         push_after: seconds after the hands touch that the push and snap-down start.
-        push: shoulder pitch the push swings the arms to (past the head: < ``arms``).
+        push: shoulder pitch the push closes the shoulders to (> ``arms``: the arms swing
+            from over the head toward the front).
         snap_hips: hip pitch of the snap-down (< 0 flexes, bringing the legs over).
         snap_trunk: waist and back pitch of the snap-down (> 0 flexes).
         snap_knees: knee flexion of the snap-down (the legs reach the floor bent, to absorb).
@@ -136,7 +139,6 @@ class Handspring(Basis):
 
         def reach_enter(world: World, t: float) -> None:
             del world
-            memo["t0"] = t
             rig.set_stiffness(per_joint(TUMBLE_STIFFNESS))
             rig.support[:] = 0.0
             rig.offset[:] = 0.0
