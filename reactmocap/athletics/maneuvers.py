@@ -1,8 +1,9 @@
 """Composed maneuvers (thesis ch. 8): a maneuver is a sequence of phases, each a basis controller
-from :data:`CONTROLLERS` (``balance``, ``leap``, ``tumble``, ``land``) with its parameters and the
-event that ends it; the sequencer runs them with automatic transitions. A user writes one in a
-TOML file (:func:`load_maneuver`, ``reactmocap athletics maneuver FILE.toml``); the somersaults
-and dives are built-in maneuvers (:mod:`reactmocap.athletics.routines`).
+from :data:`CONTROLLERS` (``balance``, ``leap``, ``tumble``, ``land``, ``stretch``,
+``handspring``) with its parameters and the event that ends it; the sequencer runs them with
+automatic transitions. A user writes one in a TOML file (:func:`load_maneuver`, ``reactmocap
+athletics maneuver FILE.toml``); the somersaults, dives and the back handspring are built-in
+maneuvers (:mod:`reactmocap.athletics.routines`).
 
 A maneuver file::
 
@@ -49,6 +50,7 @@ from reactmocap.athletics.behaviours import (
 )
 from reactmocap.athletics.bodies import BODIES, Athlete, athlete
 from reactmocap.athletics.dive import PLATFORM_MAX, Platform, Stretch, entry_report
+from reactmocap.athletics.handspring import Handspring, HandspringParams, handspring_report
 from reactmocap.athletics.land import Landing, LandingParams
 from reactmocap.athletics.leap import Leap, LeapParams
 from reactmocap.athletics.machine import Basis
@@ -163,6 +165,11 @@ def _build_stretch(phase: Phase, ath: Athlete) -> Basis:
     return Stretch(**phase.params)
 
 
+def _build_handspring(phase: Phase, ath: Athlete) -> Basis:
+    del ath
+    return Handspring(HandspringParams(**phase.params))
+
+
 def _build_land(phase: Phase, ath: Athlete) -> Basis:
     base = tables.landing_params(ath.name, 0.0, after_leap=True)
     if "delta" in phase.params:  # an explicit delta holds at every speed
@@ -190,6 +197,12 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
     "land": BasisSpec(
         "land", "passive landing (ch. 6); ends once it has settled and handed over",
         _kinds(LandingParams, skip=("deltas",)), {"settled": "once the landing has settled"}, _build_land),
+    "handspring": BasisSpec(
+        "handspring", "back handspring's hand support (ch. 8.3): arched with the arms over the "
+        "head until the hands touch, arms as struts, then push and snap down",
+        _kinds(HandspringParams),
+        {"released": "once the hands have left the floor after the push, or a foot touches"},
+        _build_handspring),
     "stretch": BasisSpec(
         "stretch", "straighten with the arms over the head for a dive's entry; holds to the "
         "end", {"seconds": "number"}, {"never": "holds to the end of the run"}, _build_stretch),
@@ -512,6 +525,8 @@ def run_maneuver(
         rep["touchdown_s"] = None
     else:
         rep.update(_landing(ctx, log, pelvis0))
+        if any(p.controller == "handspring" for p in phases):  # the hands' contacts are no fall
+            rep.update(handspring_report(ctx, log, pelvis0))
     rep.update(_plausible(ctx, ath, 0.0, np.inf))
     result = _result(maneuver.name, ath, ctx, seq, res, rep)
     return result

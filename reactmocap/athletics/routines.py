@@ -25,6 +25,9 @@ __all__ = [
     "TWIST_DIVE",
     "dive",
     "dive_maneuver",
+    "HANDSPRING_PRESET",
+    "handspring",
+    "handspring_maneuver",
     "somersault",
     "somersault_maneuver",
 ]
@@ -229,3 +232,52 @@ def dive(
         rep["twist_error_deg"] = abs(rep["twist_deg"]) - 360.0 * twist
         rep["twist_stopped"] = undone is not None and entry is not None and undone < entry
     return result
+
+
+# ---------------------------------------------------------------------------------- handspring
+#: the back handspring (thesis 8.3), tuned by hand on the male body: a leap aiming at a large
+#: backward angular momentum (the hands must reach the floor with the body about inverted),
+#: the hand support (arched, arms over the head; on contact the shoulders close and the hips
+#: and trunk snap down), the landing and a slow stand-up (docs/athletics.md)
+HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
+    "leap": MappingProxyType({"effort": 0.6, "spin": -110.0, "spin_limit": 1.5,
+                              "com_offset": -0.1}),
+    "handspring": MappingProxyType({"give": 0.5, "push_after": 0.06, "push": -2.65,
+                                    "snap_hips": -1.2, "snap_trunk": 0.5, "snap_knees": 0.6,
+                                    "snap": 0.1}),
+    "land": MappingProxyType({"delta": -0.45}),
+})  # fmt: skip
+
+
+def handspring_maneuver(body: str = "male") -> Maneuver:
+    """The back handspring as a maneuver: balance, leap with backward rotation, hand support
+    (:class:`~reactmocap.athletics.handspring.Handspring`), land, balance. Another body than
+    the male one aims its leap at the male's angular momentum scaled by its layout inertia
+    (the same spin rate); that is untuned and its report says what happened."""
+    leap = dict(HANDSPRING_PRESET["leap"])
+    if body != "male":
+        ratio = somersault_inertia(athlete(body), "layout") / somersault_inertia(
+            athlete("male"), "layout"
+        )
+        leap["spin"] = round(leap["spin"] * ratio, 1)
+    phases = (
+        Phase("balance", "after", {}, 0.3),
+        Phase("leap", "liftoff", leap),
+        Phase("handspring", "released", dict(HANDSPRING_PRESET["handspring"])),
+        Phase("land", "settled", dict(HANDSPRING_PRESET["land"])),
+        Phase("balance", "never", {"settle": 2.0}),
+    )
+    return Maneuver("back_handspring", phases, body, 5.0)
+
+
+def handspring(
+    body: str = "male",
+    *,
+    on_tick: Callable[[float], None] | None = None,
+    fps: float = 60.0,
+) -> AthleticsResult:
+    """A standing back handspring (:func:`handspring_maneuver`). The report adds
+    ``hands_contact_s`` (time the hands were on the floor), the hands' first and last contact
+    and the push's time; ``fell`` ignores the hands' own contacts
+    (:func:`~reactmocap.athletics.handspring.handspring_report`)."""
+    return run_maneuver(handspring_maneuver(body), on_tick=on_tick, fps=fps)

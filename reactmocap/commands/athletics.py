@@ -70,7 +70,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     from reactmocap.commands.athletics_maneuver import register_maneuvers
 
-    register_maneuvers(inner)  # maneuver, somersault, dive
+    register_maneuvers(inner)  # maneuver, somersault, dive, handspring
 
     from reactmocap.commands.athletics_bicycle import register as register_bicycle
 

@@ -1,4 +1,5 @@
-"""``athletics maneuver FILE.toml``, ``athletics somersault`` and ``athletics dive``: thin
+"""``athletics maneuver FILE.toml``, ``athletics somersault``, ``athletics dive`` and
+``athletics handspring``: thin
 wrappers over :func:`reactmocap.athletics.maneuvers.run_maneuver`,
 :func:`~reactmocap.athletics.routines.somersault` and :func:`~reactmocap.athletics.routines.dive`
 that write a BVH, a JSON report and
@@ -13,7 +14,7 @@ __all__ = ["register_maneuvers"]
 
 
 def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    """Add ``maneuver``, ``somersault`` and ``dive`` to the ``athletics`` command's
+    """Add ``maneuver``, ``somersault``, ``dive`` and ``handspring`` to the ``athletics`` command's
     sub-commands."""
     from reactmocap.athletics.maneuvers import describe
     from reactmocap.athletics.routines import DIRECTIONS
@@ -69,6 +70,16 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     output_args(d, "male", plot=False)
     d.set_defaults(func=_dive)
 
+    h = inner.add_parser(
+        "handspring", help="back handspring: leap, hands on the floor, push, land (thesis 8.3)",
+        description="A standing back handspring composed of the leap, handspring (hand support), "
+        "land and balance basis controllers. The report adds hands_contact_s (time the hands "
+        "were on the floor); `fell` ignores the hands' own contacts. --out: a BVH file, or a "
+        "folder (anything not ending in .bvh) for back_handspring_BODY.bvh.",
+    )  # fmt: skip
+    output_args(h, "male", plot=False)
+    h.set_defaults(func=_handspring)
+
 
 def _maneuver(args: argparse.Namespace) -> int:
     from reactmocap.athletics.maneuvers import load_maneuver, run_maneuver
@@ -102,6 +113,24 @@ def _dive(args: argparse.Namespace) -> int:
         result = dive(args.position, args.direction, str(args.body), height=args.height,
                       turns=args.turns, twist=args.twist, on_tick=bar.tick, fps=args.fps)  # fmt: skip
     _finish(result, args, args.out or Path(f"{result.behaviour}_{result.body}.bvh"))
+    return 0
+
+
+def _handspring(args: argparse.Namespace) -> int:
+    from reactmocap.athletics.routines import handspring
+    from reactmocap.commands.athletics import _Bar
+
+    with _Bar("handspring") as bar:
+        result = handspring(str(args.body), on_tick=bar.tick, fps=args.fps)
+    name = Path(f"{result.behaviour}_{result.body}.bvh")
+    out: Path | None = args.out
+    if out is None:
+        out = name
+    elif out.suffix.lower() != ".bvh":  # a folder
+        out = out / name
+    _finish(result, args, out)
+    r = result.report
+    print(f"hands on the floor {r['hands_contact_s']:.2f} s")
     return 0
 
 

@@ -71,7 +71,7 @@ def test_bad_files_are_refused_naming_the_field(tmp_path: Path, text: str, field
 def test_every_example_is_valid_and_names_a_maneuver_the_issue_asks_for() -> None:
     names = {p.stem for p in EXAMPLES}
     assert {"back_somersault", "forward_somersault", "vertical_leap", "broad_jump",
-            "dive_pike", "dive_twist"} <= names  # fmt: skip
+            "dive_pike", "dive_twist", "back_handspring"} <= names  # fmt: skip
     for path in EXAMPLES:
         m = load_maneuver(path)
         assert m.name == path.stem and m.phases[0].controller == "balance"
@@ -84,6 +84,9 @@ def test_each_example_maneuver_runs_and_lands(path: Path) -> None:
     assert r["landed"] and not r["fell"]
     if path.stem == "back_somersault":
         assert abs(r["rotation_deg"] + 360.0) <= 30.0
+    elif path.stem == "back_handspring":  # on the hands, and only the hands, then the feet
+        assert abs(r["rotation_deg"] + 360.0) <= 45.0
+        assert r["hands_contact_s"] > 0.05 and r["handspring_other_contacts"] == []
     elif path.stem == "forward_somersault":
         assert abs(r["rotation_deg"] - 360.0) <= 30.0
     elif path.stem == "dive_twist":  # half a somersault and one twist, head first
