@@ -189,6 +189,8 @@ class Backdrop(Basis):
         root = int(m.jnt_bodyid[m.joint(f"{prefix}{BALL_JOINTS[_HIPS[0]]}").id])
         root = int(m.body_rootid[root])
         self.limb_momentum: list[float] = []
+        for j in _SHOULDERS:  # the arms circle past the shoulder's cone limit (for the run)
+            m.jnt_limited[m.joint(f"{prefix}{BALL_JOINTS[j]}").id] = 0
 
         def enter(world: World, t: float) -> None:
             del world
@@ -242,9 +244,6 @@ def backdrop(
     ath = athlete(body)
     world = athletics_world(ath)
     m = world.model
-    wc = world.characters[0]
-    for side in "lr":  # the arms circle past the shoulder's cone limit
-        m.jnt_limited[m.joint(f"{wc.prefix}{side}_shoulder").id] = 0
     world.set_pose(0, ath.standing_qpos(stand_angles(ath), clearance=3.0))
     ctx = Context.make(world, ath, control_every=8)
     # torque-free without a fall to outlast; the servo's units were set with gravity on

@@ -4,10 +4,13 @@ momentum turns the body; the controls (hips alone, arms alone) show the loop is 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
 from reactmocap.athletics.backdrop import Backdrop, backdrop, backdrop_keyframes
+from reactmocap.athletics.maneuvers import load_maneuver, run_maneuver
 from reactmocap.errors import ConfigError, ReactMocapError
 
 
@@ -62,3 +65,31 @@ def test_bad_backdrop_input_is_refused() -> None:
     with pytest.raises(ReactMocapError, match="segment"):
         backdrop("male", segment=0.0)
     assert Backdrop(loops=3, segment=0.4).seconds == pytest.approx(3 * 3 * 0.4)
+
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples/athletics/torque_free/backdrop_drop.toml"
+
+
+def test_the_backdrop_phase_runs_from_toml_in_a_drop() -> None:
+    # a feet-first drop off the platform with no spin: the backdrop turns the body backward
+    # in the air, the forward loop as far forward (the leap's small residual spin is common)
+    m = load_maneuver(EXAMPLE)
+    back = run_maneuver(m).report
+    assert back["status"] == "ok" and back["entry_s"] is not None
+    assert abs(back["liftoff_pitch_momentum"]) < 5.0  # next to none (the tuck's is ~50)
+    assert back["rotation_deg"] <= -40.0
+    bd = m.phases[-1]
+    fwd = replace(
+        m, phases=(*m.phases[:-1], replace(bd, params={**bd.params, "direction": "forward"}))
+    )
+    assert run_maneuver(fwd).report["rotation_deg"] >= 40.0
+
+
+def test_bad_backdrop_phases_are_refused_naming_the_field(tmp_path: Path) -> None:
+    text = EXAMPLE.read_text()
+    for bad, field in (('direction = "backward"', 'direction = "sideways"'),
+                       ("loops = 1,", "loops = 1.5,"), ("loops = 1,", 'loops = "one",')):  # fmt: skip
+        path = tmp_path / "bad.toml"
+        path.write_text(text.replace(bad, field))
+        with pytest.raises(ConfigError, match=r"phase\[3\]\.params"):
+            load_maneuver(path)
