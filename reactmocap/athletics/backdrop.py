@@ -124,7 +124,8 @@ def arm_windmill(
 
 
 _HIPS = [joint_index(f"{s}_hip") for s in "lr"]
-#: hip flexion (rad) of the backdrop's pike (the tumbling pike's, :data:`.tumble.POSITIONS`)
+#: the deepest hip flexion (rad) of the backdrop's pike (the tumbling pike's,
+#: :data:`.tumble.POSITIONS`), also its default depth below the entry pose
 PIKE_HIP = -2.2
 
 
@@ -142,7 +143,8 @@ def backdrop_keyframes(direction: str = "backward", hip: float = PIKE_HIP) -> F6
 class Backdrop(Basis):
     """Frohlich's backdrop (thesis 5.1.1, Fig. 5.4): the arms and hips run ``loops`` times
     through a closed loop of shapes (``keyframes`` of ``[shoulder pitch, hip pitch]``, rad;
-    ``segment`` s from one to the next, smoothstep in between, taken from the pose at entry;
+    ``segment`` s from one to the next, smoothstep in between, taken from the pose at entry,
+    the hips no deeper than :data:`PIKE_HIP`;
     ``handover``: hand over to the next basis controller once done). Every leg of the loop turns
     the body, by different amounts because the inertias differ between the shapes (the arms
     circle while the body is piked, its inertia a third of the layout's), so with zero
@@ -197,6 +199,7 @@ class Backdrop(Basis):
             rig.gravity_compensation = False
             rig.set_stiffness(per_joint({**TUMBLE_STIFFNESS, "shoulder": 0.6, "elbow": 0.3}))
             rig.support[:] = 0.0
+            rig.offset[:] = 0.0  # a leap's last corrections would bend the loop
             memo["t0"] = t
             pose = rig.current_angles()
             # the loop is taken from the pose at entry, so it closes on it (from the standing
@@ -211,7 +214,9 @@ class Backdrop(Basis):
             s, h = memo["start"] + a + (b - a) * float(smoothstep(np.array(x - k)))
             goal = np.full((NJ, 3), np.nan)
             goal[_SHOULDERS] = (s, 0.0, 0.0)
-            goal[_HIPS] = (h, 0.0, 0.0)
+            # no deeper than the tumbling pike, inside the hip's 2.4 rad cone (from a flexed
+            # entry pose an offset would press the hip into its limit)
+            goal[_HIPS] = (max(h, PIKE_HIP), 0.0, 0.0)
             rig.move(goal, 0.0, t, joints)
             # the moving limbs' angular momentum about the whole-body COM (mj_subtreeVel has
             # run): the scale the trunk's counter-momentum must match, the drift's reference
