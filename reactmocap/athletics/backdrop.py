@@ -130,8 +130,8 @@ PIKE_HIP = -2.2
 
 
 def backdrop_keyframes(direction: str = "backward", hip: float = PIKE_HIP) -> F64:
-    """The backdrop's loop of shapes as keyframes ``[shoulder pitch, hip pitch]`` (rad; arms
-    forward/up < 0, hips flexed < 0): pike, circle both arms once (``backward``: up behind the
+    """The backdrop's loop of shapes as keyframes ``[shoulder pitch, hip pitch]`` (rad, from
+    the pose the phase starts in; arms forward/up < 0, hips flexed < 0): pike, circle both arms once (``backward``: up behind the
     back, turning the body backward; ``forward``: up in front), open the hips. The last
     keyframe is the first shape again (the shoulders a full turn on)."""
     if direction not in ("backward", "forward"):

@@ -7,10 +7,11 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from reactmocap.athletics.backdrop import Backdrop, backdrop, backdrop_keyframes
-from reactmocap.athletics.maneuvers import load_maneuver, run_maneuver
+from reactmocap.athletics.maneuvers import Phase, load_maneuver, run_maneuver
 from reactmocap.errors import ConfigError, ReactMocapError
 
 
@@ -72,17 +73,24 @@ EXAMPLE = Path(__file__).resolve().parents[2] / "examples/athletics/torque_free/
 
 def test_the_backdrop_phase_runs_from_toml_in_a_drop() -> None:
     # a feet-first drop off the platform with no spin: the backdrop turns the body backward
-    # in the air, the forward loop as far forward (the leap's small residual spin is common)
+    # in the air (-49.5 deg at the water), the forward loop forward
     m = load_maneuver(EXAMPLE)
     back = run_maneuver(m).report
     assert back["status"] == "ok" and back["entry_s"] is not None
     assert abs(back["liftoff_pitch_momentum"]) < 5.0  # next to none (the tuck's is ~50)
     assert back["rotation_deg"] <= -40.0
+    # the forward loop, handing over when done (exit "done") to the entry's stretch
     bd = m.phases[-1]
-    fwd = replace(
-        m, phases=(*m.phases[:-1], replace(bd, params={**bd.params, "direction": "forward"}))
-    )
-    assert run_maneuver(fwd).report["rotation_deg"] >= 40.0
+    fwd = replace(bd, params={**bd.params, "direction": "forward"}, exit="done")
+    res = run_maneuver(replace(m, phases=(*m.phases[:-1], fwd, Phase("stretch", "never"))))
+    start = next(t for t, _, target in res.transitions if target.startswith("backdrop."))
+    done = next(t for t, _, target in res.transitions if target.startswith("stretch."))
+    assert done - start == pytest.approx(3 * 0.35, abs=0.02)
+    # over the loop itself it turned forward (41 deg; the leap's small backward spin takes some,
+    # and the stretch then turns it back)
+    t, rotation = res.log["t"], res.log["rotation"]
+    turned = math.degrees(rotation[np.searchsorted(t, done)] - rotation[np.searchsorted(t, start)])
+    assert turned >= 30.0
 
 
 def test_bad_backdrop_phases_are_refused_naming_the_field(tmp_path: Path) -> None:
