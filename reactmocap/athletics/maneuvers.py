@@ -1,9 +1,9 @@
 """Composed maneuvers (thesis ch. 8): a maneuver is a sequence of phases, each a basis controller
 from :data:`CONTROLLERS` (``balance``, ``leap``, ``tumble``, ``land``, ``stretch``,
-``handspring``) with its parameters and the event that ends it; the sequencer runs them with
-automatic transitions. A user writes one in a TOML file (:func:`load_maneuver`, ``reactmocap
-athletics maneuver FILE.toml``); the somersaults, dives and the back handspring are built-in
-maneuvers (:mod:`reactmocap.athletics.routines`).
+``handspring``, ``backdrop``) with its parameters and the event that ends it; the sequencer runs
+them with automatic transitions. A user writes one in a TOML file (:func:`load_maneuver`,
+``reactmocap athletics maneuver FILE.toml``); the somersaults, dives and the back handspring
+are built-in maneuvers (:mod:`reactmocap.athletics.routines`).
 
 A maneuver file::
 
@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from reactmocap.athletics import tables
+from reactmocap.athletics.backdrop import Backdrop, backdrop_keyframes
 from reactmocap.athletics.balance import Balance, Posture
 from reactmocap.athletics.behaviours import (
     AthleticsResult,
@@ -170,6 +171,17 @@ def _build_handspring(phase: Phase, ath: Athlete) -> Basis:
     return Handspring(HandspringParams(**phase.params))
 
 
+def _build_backdrop(phase: Phase, ath: Athlete | None = None) -> Basis:
+    del ath
+    p = phase.params
+    keys = backdrop_keyframes(str(p.get("direction", "backward")))
+    loops = p.get("loops", 1.0)
+    if int(loops) != loops:
+        raise ConfigError(f"backdrop loops must be a whole number, got {loops}")
+    segment = float(p.get("segment", 0.5))
+    return Backdrop(keys, segment, int(loops), handover=phase.exit == "done")
+
+
 def _build_land(phase: Phase, ath: Athlete) -> Basis:
     base = tables.landing_params(ath.name, 0.0, after_leap=True)
     if "delta" in phase.params:  # an explicit delta holds at every speed
@@ -203,6 +215,12 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
         _kinds(HandspringParams),
         {"released": "once the hands have left the floor after the push, or a foot touches"},
         _build_handspring),
+    "backdrop": BasisSpec(
+        "backdrop", "Frohlich's torque-free backdrop in the air (5.1.1): pike, circle both arms "
+        "(`direction` backward or forward: the way the body turns), open; `loops` times, "
+        "`segment` s per move", {"direction": "string", "loops": "number", "segment": "number"},
+        {"done": "once the loops are done", "never": "holds the last shape to the end"},
+        _build_backdrop),
     "stretch": BasisSpec(
         "stretch", "straighten with the arms over the head for a dive's entry; holds to the "
         "end", {"seconds": "number"}, {"never": "holds to the end of the run"}, _build_stretch),
@@ -273,7 +291,13 @@ def check_phase(phase: Phase, where: str) -> Phase:
             f"{where}.params.position: unknown position {params['position']!r}; valid "
             f"positions are {sorted(POSITIONS)}"
         )
-    return replace(phase, params=params)
+    checked = replace(phase, params=params)
+    if phase.controller == "backdrop":  # its own checks, named here
+        try:
+            _build_backdrop(checked)
+        except ConfigError as e:
+            raise ConfigError(f"{where}.params: {e}") from e
+    return checked
 
 
 _TOP = {"name": "string", "body": "string", "seconds": "number", "backpack": "number",
