@@ -53,6 +53,18 @@ class ClothSpec:
         self.project = 2
 
 
+#: barycentric points of a triangle where the drawn surface's depth is sampled
+_SURFACE_SAMPLES = np.array(
+    [
+        [0.5, 0.5, 0.0],
+        [0.0, 0.5, 0.5],
+        [0.5, 0.0, 0.5],
+        [1 / 3, 1 / 3, 1 / 3],
+        [2 / 3, 1 / 6, 1 / 6],
+        [1 / 6, 2 / 3, 1 / 6],
+        [1 / 6, 1 / 6, 2 / 3],
+    ]
+)
 _CAPSULE, _SPHERE = int(mujoco.mjtGeom.mjGEOM_CAPSULE), int(mujoco.mjtGeom.mjGEOM_SPHERE)
 #: collision bits of the copies of the runner's bodies in the cloth model (per leg)
 _BITS = {"l_": 4, "r_": 8}
@@ -125,6 +137,8 @@ class Cloth:
         self._pen_n = 0
         self._ticks = 0
         self._over_1cm = 0
+        self.surface_max = 0.0
+        self._surface: list[float] = []
         self.penetration_mean = 0.0
         self.finite = True
         self.frames: list[F64] = []
@@ -285,6 +299,16 @@ class Cloth:
         self._caxis = axes
         self._chalf = np.where(m.geom_type[caps] == _CAPSULE, m.geom_size[caps, 1], 0.0)
         self._crad = m.geom_size[caps, 0] + self.spec.thickness
+        self._cgeom = caps
+        # the drawn surface: each triangle's global vertex ids and its leg's capsules
+        elems, masks = [], []
+        for f in range(m.nflex):
+            adr, num = m.flex_elemdataadr[f], m.flex_elemnum[f]
+            elems.append(m.flex_elem[adr : adr + 3 * num].reshape(-1, 3) + m.flex_vertadr[f])
+            hits = (m.geom_contype[caps] & m.flex_conaffinity[f]) > 0
+            masks.append(np.repeat(hits[None], num, axis=0))
+        self._elems = np.concatenate(elems)
+        self._emask = np.concatenate(masks)[:, None, :]
 
     # ------------------------------------------------------------------ controller
     def reset(self, world: World) -> None:
@@ -413,8 +437,27 @@ class Cloth:
         xfrc[ids] += force
         self._applied = force
 
+    def _surface_depth(self) -> float:
+        """How deep the drawn cloth (its triangles, sampled at the edge midpoints, the
+        centroid and halfway from it to each corner) is inside the body's capsules (m). The
+        contacts do not see a triangle that a limb has gone through between its corners."""
+        m, d = self.model, self.data
+        assert m is not None and d is not None
+        g = self._cgeom
+        pts = np.einsum("sk,ekd->esd", _SURFACE_SAMPLES, d.flexvert_xpos[self._elems])
+        ax = d.geom_xmat[g].reshape(-1, 3, 3)[:, :, 2]
+        rel = pts[:, :, None, :] - d.geom_xpos[g]
+        s = np.clip(np.einsum("esgi,gi->esg", rel, ax), -self._chalf, self._chalf)
+        off = rel - s[..., None] * ax
+        dist = np.sqrt(np.einsum("esgi,esgi->esg", off, off))
+        depth = np.where(self._emask, m.geom_size[g, 0] - dist, 0.0)
+        return max(0.0, float(depth.max()))
+
     def _record(self, t: float) -> None:
         assert self.data is not None
+        depth = self._surface_depth()
+        self.surface_max = max(self.surface_max, depth)
+        self._surface.append(depth)
         pos, quat = self._poses()
         self.frames.append(self.data.flexvert_xpos.copy())
         self.frame_bodies.append(np.concatenate([pos, quat], axis=1))
@@ -422,12 +465,17 @@ class Cloth:
         self._next_frame = t + 1.0 / self.record_fps
 
     def report(self) -> dict[str, float | bool]:
+        surface = self._surface
         return {
             "cloth": True,
             "cloth_feedback": self.feedback,
-            "cloth_penetration_max_m": self.penetration_max,
+            "cloth_penetration_max_m": max(self.penetration_max, self.surface_max),
+            "cloth_contact_depth_max_m": self.penetration_max,
             "cloth_penetration_mean_m": self.penetration_mean,
-            "cloth_ticks_over_1cm": self._over_1cm / max(self._ticks, 1),
+            "cloth_steps_over_1cm": self._over_1cm / max(self._ticks, 1),
+            "cloth_surface_depth_max_m": self.surface_max,
+            "cloth_surface_depth_median_m": float(np.median(surface)) if surface else 0.0,
+            "cloth_frames_over_1cm": float(np.mean(np.array(surface) > 0.01)) if surface else 0.0,
             "cloth_finite": self.finite,
             "cloth_wall_s": self.wall_s,
             "cloth_vertices": int(self.model.nflexvert) if self.model is not None else 0,
