@@ -3,6 +3,7 @@ runner's motion is the same with and without them) unless feedback is asked for.
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -87,8 +88,12 @@ def test_cloth_vertices_are_moved_out_of_the_body() -> None:
     side /= np.linalg.norm(side)
     inside = centre + 0.02 * side
     before = x.copy()
+    drawn = cloth._surface_depth()
     before[v] = inside
     d.qpos[cloth._vq] = (before - p0) @ r0 - cloth._vrest
+    # the drawn surface's depth sees the triangles around the vertex inside the thigh
+    mujoco.mj_fwdPosition(m, d)
+    assert cloth._surface_depth() > max(drawn, 0.02)
     others = d.qpos[cloth._vq].copy()
     cloth._project(pos, rot)
     after = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
