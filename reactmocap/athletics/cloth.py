@@ -2,7 +2,9 @@
 the simulated runner): loose trousers as MuJoCo flex cloth (``flexcomp``, one tube per leg
 hanging from the waist, inextensible edges), in a model of their own where the runner's
 bodies are copies of its collision geoms, set at every cloth step to where the runner's
-bodies are and how fast they move (so the contacts see them move). The cloth collides with them and drapes and swings; by
+bodies are and how fast they move (so the contacts see them move); before each step, cloth
+vertices found inside a body capsule are moved out along its radius (the contacts alone let a
+fast limb drag the cloth into itself). The cloth collides with them and drapes and swings; by
 default nothing acts back on the runner (the paper's one-way coupling), and with
 ``feedback`` the cloth's contact forces are applied to the runner's bodies (one tick late).
 Why a model of its own: ``docs/athletics.md``."""
@@ -32,7 +34,7 @@ class ClothSpec:
 
     def __init__(
         self, rings: int = 9, around: int = 8, slack: float = 0.05, mass: float = 0.4,
-        thickness: float = 0.006, timestep: float = 0.002, hem: float = 1.6,
+        thickness: float = 0.006, timestep: float = 0.008, hem: float = 1.6,
     ) -> None:  # fmt: skip
         if rings < 3 or around < 4:
             raise ConfigError("a cloth tube needs at least 3 rings of 4 points")
@@ -43,12 +45,27 @@ class ClothSpec:
         self.rings, self.around, self.slack, self.mass = rings, around, slack, mass
         self.iterations = 15
         #: stretchy (sweatpants): the edges are soft equality constraints of this time
-        #: constant (s), with damping
-        self.stretch = 0.03
-        self.stretch_damping = 0.002
+        #: constant (s, at least two cloth steps), with damping
+        self.stretch = 0.015
+        self.stretch_damping = 0.001
         self.thickness, self.timestep, self.hem = thickness, timestep, hem
+        #: passes of the vertex projection out of the body's capsules (0: contacts only)
+        self.project = 2
 
 
+#: barycentric points of a triangle where the drawn surface's depth is sampled
+_SURFACE_SAMPLES = np.array(
+    [
+        [0.5, 0.5, 0.0],
+        [0.0, 0.5, 0.5],
+        [0.5, 0.0, 0.5],
+        [1 / 3, 1 / 3, 1 / 3],
+        [2 / 3, 1 / 6, 1 / 6],
+        [1 / 6, 2 / 3, 1 / 6],
+        [1 / 6, 1 / 6, 2 / 3],
+    ]
+)
+_CAPSULE, _SPHERE = int(mujoco.mjtGeom.mjGEOM_CAPSULE), int(mujoco.mjtGeom.mjGEOM_SPHERE)
 #: collision bits of the copies of the runner's bodies in the cloth model (per leg)
 _BITS = {"l_": 4, "r_": 8}
 #: the garments by name: ``pants`` (loose trousers, hem 60% of the way down the shin),
@@ -56,7 +73,7 @@ _BITS = {"l_": 4, "r_": 8}
 #: ``shorts`` (hem above the knee)
 CLOTHES: dict[str, ClothSpec] = {
     "pants": ClothSpec(),
-    "pants-light": ClothSpec(rings=7, around=6, timestep=0.004),
+    "pants-light": ClothSpec(rings=7, around=6),
     "shorts": ClothSpec(rings=6, hem=0.85),
 }
 
@@ -77,9 +94,10 @@ def _geom_xml(m: mujoco.MjModel, g: int, bits: int) -> str:
 
 
 class Cloth:
-    """A garment on character ``character`` of ``world``, as an engine controller: at every
-    tick it steps the cloth over the tick's duration with the copies of the character's bodies
-    carried along at their velocities.
+    """A garment on character ``character`` of ``world``, as an engine controller: every
+    ``control_every`` steps (a multiple of the runner's tick near the cloth's time step) it
+    steps the cloth over that time with the copies of the character's bodies carried along
+    at their velocities, after moving the cloth's vertices out of the body's capsules.
 
     Attributes (after a rollout): ``penetration_max`` and ``penetration_mean`` (m, the
     deepest overlap of cloth and body over the run, and its mean over ticks with contact),
@@ -103,7 +121,10 @@ class Cloth:
         self.spec = spec
         self.feedback = bool(feedback)
         self.character = character
-        self.control_every = control_every
+        # the cloth steps once per its time step: every so many of the runner's ticks
+        self.control_every = control_every * max(
+            1, round(spec.timestep / (control_every * world.timestep))
+        )
         self.record_fps = float(record_fps)
         self.wc = world.characters[character]
         self.model: mujoco.MjModel | None = None
@@ -114,6 +135,10 @@ class Cloth:
         self.penetration_max = 0.0
         self._pen_sum = 0.0
         self._pen_n = 0
+        self._ticks = 0
+        self._over_1cm = 0
+        self.surface_max = 0.0
+        self._surface: list[float] = []
         self.penetration_mean = 0.0
         self.finite = True
         self.frames: list[F64] = []
@@ -204,7 +229,8 @@ class Cloth:
                 f'mass="{0.5 * sp.mass}" rgba="0.2 0.2 0.25 1" '
                 f'point="{" ".join(f"{x:.5f}" for x in local.ravel())}" '
                 f'element="{" ".join(str(x) for x in np.ravel(tris))}">'
-                f'<edge equality="true" solref="{sp.stretch} 1" damping="{sp.stretch_damping}"/>'
+                f'<edge equality="true" solref="{max(sp.stretch, 2 * sp.timestep)} 1" '
+                f'damping="{sp.stretch_damping}"/>'
                 f'<contact contype="0" conaffinity="{affinity}" selfcollide="none" '
                 f'solref="{2 * sp.timestep} 1" solimp="0.99 0.999 0.001"/>'
                 f'<pin id="{" ".join(str(i) for i in range(ring))}"/></flexcomp>'
@@ -236,9 +262,53 @@ class Cloth:
         joints = [int(m.body_jntadr[m.body(f"b{i}").id]) for i in range(len(SIM_BODIES))]
         self._qadr = np.array([m.jnt_qposadr[j] for j in joints])
         self._dadr = np.array([m.jnt_dofadr[j] for j in joints])
+        self._qidx = self._qadr[:, None] + np.arange(7)
+        self._didx = self._dadr[:, None] + np.arange(6)
         mb = self.model.geom_bodyid
         ids = {int(self.model.body(f"b{i}").id): i for i in range(len(SIM_BODIES))}
         self._geom_part = np.array([ids.get(int(b), -1) for b in mb])
+        self._collider_setup()
+
+    def _collider_setup(self) -> None:
+        """What the vertex projection needs: the free vertices' slide-joint addresses and
+        rest offsets in the pelvis copy's frame, the capsules (and the head's sphere, a
+        capsule of no length) in their bodies' frames, and which of them each vertex's
+        trouser leg collides with."""
+        m = self.model
+        assert m is not None
+        b0 = int(m.body("b0").id)
+        hit = np.bitwise_or.reduce(m.flex_conaffinity)
+        kinds = np.isin(m.geom_type, (_CAPSULE, _SPHERE))
+        caps = np.flatnonzero((self._geom_part >= 0) & (m.geom_contype & hit > 0) & kinds)
+        axes = np.zeros((len(caps), 3))
+        for i, g in enumerate(caps):
+            mat = np.zeros(9)
+            mujoco.mju_quat2Mat(mat, m.geom_quat[g])
+            axes[i] = mat.reshape(3, 3)[:, 2]
+        body = m.flex_vertbodyid
+        free = np.flatnonzero(m.body_jntnum[body] == 3)
+        body = body[free]
+        if not (m.body_parentid[body] == b0).all():
+            raise SimulationError("the cloth's vertices are expected to hang from the pelvis")
+        flex = np.searchsorted(m.flex_vertadr, free, side="right") - 1
+        self._vq = m.jnt_qposadr[m.body_jntadr[body]][:, None] + np.arange(3)
+        self._vrest = m.body_pos[body].copy()
+        self._vmask = (m.geom_contype[caps][None] & m.flex_conaffinity[flex][:, None]) > 0
+        self._cpart = self._geom_part[caps]
+        self._cpos = m.geom_pos[caps].copy()
+        self._caxis = axes
+        self._chalf = np.where(m.geom_type[caps] == _CAPSULE, m.geom_size[caps, 1], 0.0)
+        self._crad = m.geom_size[caps, 0] + self.spec.thickness
+        self._cgeom = caps
+        # the drawn surface: each triangle's global vertex ids and its leg's capsules
+        elems, masks = [], []
+        for f in range(m.nflex):
+            adr, num = m.flex_elemdataadr[f], m.flex_elemnum[f]
+            elems.append(m.flex_elem[adr : adr + 3 * num].reshape(-1, 3) + m.flex_vertadr[f])
+            hits = (m.geom_contype[caps] & m.flex_conaffinity[f]) > 0
+            masks.append(np.repeat(hits[None], num, axis=0))
+        self._elems = np.concatenate(elems)
+        self._emask = np.concatenate(masks)[:, None, :]
 
     # ------------------------------------------------------------------ controller
     def reset(self, world: World) -> None:
@@ -253,12 +323,14 @@ class Cloth:
         return d.xpos[ids].copy(), d.xquat[ids].copy()
 
     def _velocities(self) -> tuple[F64, F64]:
-        """World linear velocity of each body's origin and world angular velocity."""
+        """World linear velocity of each body's origin and world angular velocity (from
+        ``cvel``, which holds them about the subtree's centre of mass)."""
         m, d = self.world.model, self.world.data
-        out = np.empty((len(SIM_BODIES), 6))
-        for i, b in enumerate(self.wc.body_ids):
-            mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, int(b), out[i], 0)
-        return out[:, 3:], out[:, :3]
+        ids = self.wc.body_ids
+        cvel = d.cvel[ids]
+        com = d.subtree_com[m.body_rootid[ids]]
+        omega = cvel[:, :3]
+        return cvel[:, 3:] + np.cross(omega, d.xpos[ids] - com), omega
 
     def control(self, world: World, t: float) -> None:
         import time
@@ -273,19 +345,18 @@ class Cloth:
         dt = self.control_every * world.timestep
         n = max(1, round(dt / m.opt.timestep))
         h = dt / n
+        qpos, qvel = self._qidx, self._didx
         for k in range(n):
             # the runner's bodies carried over the tick by their velocities (the contacts
             # see them move, so the cloth is pushed along rather than overlapped)
-            tau = k * h
-            for i in range(len(SIM_BODIES)):
-                qa, da = self._qadr[i], self._dadr[i]
-                d.qpos[qa : qa + 3] = pos[i] + vel[i] * tau
-                q = d.qpos[qa + 3 : qa + 7]
-                q[:] = quat[i]
-                if tau > 0:
-                    mujoco.mju_quatIntegrate(q, local[i], tau)
-                d.qvel[da : da + 3] = vel[i]
-                d.qvel[da + 3 : da + 6] = local[i]
+            d.qpos[qpos[:, :3]] = pos + vel * (k * h)
+            d.qpos[qpos[:, 3:]] = _quat_advance(quat, local, k * h) if k else quat
+            d.qvel[qvel[:, :3]] = vel
+            d.qvel[qvel[:, 3:]] = local
+            if self.spec.project:
+                self._project(
+                    d.qpos[qpos[:, :3]], rot if not k else _quat_mats(d.qpos[qpos[:, 3:]])
+                )
             mujoco.mj_step(m, d)
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
             self.finite = False
@@ -295,48 +366,98 @@ class Cloth:
             self._record(t)
         self.wall_s += time.perf_counter() - wall
 
+    def _project(self, pos: F64, rot: F64) -> None:
+        """Move the free vertices that are inside a body capsule (closer to its axis than
+        its radius and the cloth's thickness) out along the capsule's radius, a few passes
+        for where capsules overlap (behind a bent knee): with the contacts alone, a fast
+        limb drags the cloth into itself, and once through, the cloth stays there."""
+        d = self.data
+        assert d is not None
+        r0, p0 = rot[0], pos[0]
+        part = self._cpart
+        a = np.einsum("gij,gj->gi", rot[part], self._cpos) + pos[part]
+        ax = np.einsum("gij,gj->gi", rot[part], self._caxis)
+        x = (self._vrest + d.qpos[self._vq]) @ r0.T + p0
+        rows = np.arange(len(x))
+        moved = False
+        for _ in range(self.spec.project):
+            rel = x[:, None, :] - a[None]
+            s = np.clip(np.einsum("vgi,gi->vg", rel, ax), -self._chalf, self._chalf)
+            off = rel - s[..., None] * ax[None]
+            dist = np.sqrt(np.einsum("vgi,vgi->vg", off, off))
+            depth = np.where(self._vmask, self._crad - dist, 0.0)
+            g = depth.argmax(axis=1)
+            v = np.flatnonzero(depth[rows, g] > 0)
+            if not v.size:
+                break
+            gv = g[v]
+            x[v] += off[v, gv] * (depth[v, gv] / np.maximum(dist[v, gv], 1e-9))[:, None]
+            moved = True
+        if moved:
+            d.qpos[self._vq] = (x - p0) @ r0 - self._vrest
+
     def _measure(self, world: World) -> None:
         assert self.model is not None and self.data is not None
         m, d = self.model, self.data
-        n = d.ncon
-        deepest = 0.0
-        force = np.zeros((len(SIM_BODIES), 6)) if self.feedback else None
-        f6 = np.zeros(6)
-        for i in range(n):
-            c = d.contact[i]
-            if c.flex[0] < 0 and c.flex[1] < 0:
-                continue
-            g = c.geom[1] if c.flex[0] >= 0 else c.geom[0]
-            part = int(self._geom_part[g]) if g >= 0 else -1
-            if part < 0:
-                continue  # the floor
-            # the contact distance is to the cloth's surface inflated by its thickness: the
-            # cloth itself is inside the body by what is left after that
-            deepest = max(deepest, -float(c.dist) - self.spec.thickness)
-            if force is not None:
-                mujoco.mj_contactForce(m, d, i, f6)
-                fw = c.frame.reshape(3, 3).T @ f6[:3]  # on the second element from the first
-                on_body = fw if c.flex[0] >= 0 else -fw
-                body = self.wc.body_ids[part]
-                arm = c.pos - world.data.xipos[body]
-                force[part, :3] += on_body
-                force[part, 3:] += np.cross(arm, on_body)
-        # the flex vertices' own thickness is part of the contact distance: an overlap
-        # beyond the cloth's half-thickness is the cloth inside the body
+        con = d.contact
+        flex, geom = con.flex, con.geom
+        # cloth-body contacts (the floor's geom has no part)
+        g = np.where(flex[:, 0] >= 0, geom[:, 1], geom[:, 0])
+        mine = (flex.max(axis=1) >= 0) & (g >= 0)
+        mine[mine] = self._geom_part[g[mine]] >= 0
+        # the contact distance is the geometric one between the cloth's triangles inflated
+        # by its thickness and the body geom (no margin): the cloth's mid-surface (what is
+        # drawn) is inside the body by what is left after that
+        dist = con.dist[mine]
+        deepest = max(0.0, float(-dist.min()) - self.spec.thickness) if dist.size else 0.0
         self.penetration_max = max(self.penetration_max, deepest)
+        self._ticks += 1
+        self._over_1cm += deepest > 0.01
         if deepest > 0:
             self._pen_sum += deepest
             self._pen_n += 1
             self.penetration_mean = self._pen_sum / self._pen_n
-        if force is not None:
-            xfrc = world.data.xfrc_applied
-            ids = self.wc.body_ids
-            xfrc[ids] -= self._applied
-            xfrc[ids] += force
-            self._applied = force
+        if not self.feedback:
+            return
+        force = np.zeros((len(SIM_BODIES), 6))
+        f6 = np.zeros(6)
+        for i in np.flatnonzero(mine):
+            c = d.contact[i]
+            mujoco.mj_contactForce(m, d, int(i), f6)
+            fw = c.frame.reshape(3, 3).T @ f6[:3]  # on the second element from the first
+            on_body = fw if c.flex[0] >= 0 else -fw
+            part = int(self._geom_part[g[i]])
+            body = self.wc.body_ids[part]
+            arm = c.pos - world.data.xipos[body]
+            force[part, :3] += on_body
+            force[part, 3:] += np.cross(arm, on_body)
+        xfrc = world.data.xfrc_applied
+        ids = self.wc.body_ids
+        xfrc[ids] -= self._applied
+        xfrc[ids] += force
+        self._applied = force
+
+    def _surface_depth(self) -> float:
+        """How deep the drawn cloth (its triangles, sampled at the edge midpoints, the
+        centroid and halfway from it to each corner) is inside the body's capsules (m). The
+        contacts do not see a triangle that a limb has gone through between its corners."""
+        m, d = self.model, self.data
+        assert m is not None and d is not None
+        g = self._cgeom
+        pts = np.einsum("sk,ekd->esd", _SURFACE_SAMPLES, d.flexvert_xpos[self._elems])
+        ax = d.geom_xmat[g].reshape(-1, 3, 3)[:, :, 2]
+        rel = pts[:, :, None, :] - d.geom_xpos[g]
+        s = np.clip(np.einsum("esgi,gi->esg", rel, ax), -self._chalf, self._chalf)
+        off = rel - s[..., None] * ax
+        dist = np.sqrt(np.einsum("esgi,esgi->esg", off, off))
+        depth = np.where(self._emask, m.geom_size[g, 0] - dist, 0.0)
+        return max(0.0, float(depth.max()))
 
     def _record(self, t: float) -> None:
         assert self.data is not None
+        depth = self._surface_depth()
+        self.surface_max = max(self.surface_max, depth)
+        self._surface.append(depth)
         pos, quat = self._poses()
         self.frames.append(self.data.flexvert_xpos.copy())
         self.frame_bodies.append(np.concatenate([pos, quat], axis=1))
@@ -344,11 +465,17 @@ class Cloth:
         self._next_frame = t + 1.0 / self.record_fps
 
     def report(self) -> dict[str, float | bool]:
+        surface = self._surface
         return {
             "cloth": True,
             "cloth_feedback": self.feedback,
-            "cloth_penetration_max_m": self.penetration_max,
+            "cloth_penetration_max_m": max(self.penetration_max, self.surface_max),
+            "cloth_contact_depth_max_m": self.penetration_max,
             "cloth_penetration_mean_m": self.penetration_mean,
+            "cloth_steps_over_1cm": self._over_1cm / max(self._ticks, 1),
+            "cloth_surface_depth_max_m": self.surface_max,
+            "cloth_surface_depth_median_m": float(np.median(surface)) if surface else 0.0,
+            "cloth_frames_over_1cm": float(np.mean(np.array(surface) > 0.01)) if surface else 0.0,
             "cloth_finite": self.finite,
             "cloth_wall_s": self.wall_s,
             "cloth_vertices": int(self.model.nflexvert) if self.model is not None else 0,
@@ -387,6 +514,28 @@ def render_cloth_video(cloth: Cloth, path: str | Path, size: tuple[int, int] = (
     finally:
         renderer.close()
     return Path(write_video(frames, path, cloth.record_fps))
+
+
+def _quat_advance(quat: F64, local: F64, tau: float) -> F64:
+    """Unit quaternions ``quat`` (B, 4) turned for ``tau`` s at body-frame angular velocities
+    ``local`` (B, 3) (``mju_quatIntegrate`` over many bodies at once)."""
+    w = np.linalg.norm(local, axis=1)
+    half = 0.5 * w * tau
+    axis = local / np.maximum(w, 1e-12)[:, None]
+    dq = np.concatenate([np.cos(half)[:, None], np.sin(half)[:, None] * axis], axis=1)
+    a0, av = quat[:, :1], quat[:, 1:]
+    b0, bv = dq[:, :1], dq[:, 1:]
+    real = a0 * b0 - np.sum(av * bv, axis=1, keepdims=True)
+    out = np.concatenate([real, a0 * bv + b0 * av + np.cross(av, bv)], axis=1)
+    return out / np.linalg.norm(out, axis=1, keepdims=True)
+
+
+def _quat_mats(quat: F64) -> F64:
+    """Rotation matrices ``(B, 3, 3)`` of unit quaternions ``(B, 4)``."""
+    out = np.empty((len(quat), 9))
+    for i, q in enumerate(quat):
+        mujoco.mju_quat2Mat(out[i], q)
+    return out.reshape(-1, 3, 3)
 
 
 def _set_vertices(m: mujoco.MjModel, d: mujoco.MjData, verts: F64) -> None:

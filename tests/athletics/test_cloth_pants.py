@@ -3,6 +3,7 @@ runner's motion is the same with and without them) unless feedback is asked for.
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -57,3 +58,49 @@ def test_cloth_options_are_checked() -> None:
     with pytest.raises(ConfigError, match="slack"):
         ClothSpec(slack=-1.0)
     assert set(CLOTHES) == {"pants", "pants-light", "shorts"}
+
+
+def test_cloth_vertices_are_moved_out_of_the_body() -> None:
+    """The projection puts a cloth vertex found inside the thigh's capsule back on the
+    capsule's surface (radius plus the cloth's thickness) and leaves outside vertices alone."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+
+    world = athletics_world(athlete("male"))
+    cloth = Cloth(world, "pants")
+    assert cloth.control_every * world.timestep == pytest.approx(cloth.spec.timestep)
+    cloth.reset(world)
+    m, d = cloth.model, cloth.data
+    wd = world.data
+    ids = cloth.wc.body_ids
+    pos, rot = wd.xpos[ids].copy(), wd.xmat[ids].reshape(-1, 3, 3).copy()
+    thigh = int(np.flatnonzero(cloth._geom_part == 13)[0])  # r_thigh
+    assert m.geom_type[thigh] == 3
+    centre = d.geom_xpos[thigh].copy()
+    radius = float(m.geom_size[thigh, 0])
+    # the right trouser leg's vertex nearest the thigh's centre, put 2 cm off its axis
+    right = np.flatnonzero(cloth._vmask[:, list(cloth._cpart).index(13)])
+    r0, p0 = rot[0], pos[0]
+    x = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    v = right[np.argmin(np.linalg.norm(x[right] - centre, axis=1))]
+    axis = d.geom_xmat[thigh].reshape(3, 3)[:, 2]
+    side = np.cross(axis, [0.0, 0.0, 1.0])
+    side /= np.linalg.norm(side)
+    inside = centre + 0.02 * side
+    before = x.copy()
+    drawn = cloth._surface_depth()
+    before[v] = inside
+    d.qpos[cloth._vq] = (before - p0) @ r0 - cloth._vrest
+    # the drawn surface's depth sees the triangles around the vertex inside the thigh
+    mujoco.mj_fwdPosition(m, d)
+    assert cloth._surface_depth() > max(drawn, 0.02)
+    others = d.qpos[cloth._vq].copy()
+    cloth._project(pos, rot)
+    after = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    off = after[v] - centre
+    off -= axis * float(off @ axis)
+    assert np.linalg.norm(off) == pytest.approx(radius + cloth.spec.thickness, abs=1e-6)
+    # the trousers are made with slack around the legs: the other vertices stay put, but
+    # for the four the start pose puts inside the forearms and hands (at the hips)
+    moved = np.flatnonzero(np.abs(d.qpos[cloth._vq] - others).max(axis=1) > 1e-9)
+    assert v in moved and len(moved) == 5
