@@ -203,6 +203,23 @@ def _shared_library(shared_mocap_dir: Path, tmp_path: Path) -> Path:
     return lib
 
 
+def _real_kick(
+    library: Path, recipient: str, facing_deg: float, position: tuple[float, float], name: str
+) -> Scenario:
+    # bench_reactions' aim: the real front kick at a real recipient, whole-body trackers
+    from reactmocap.response.scenario import ResponseConfig
+
+    return Scenario(
+        library=library,
+        recipient=CharacterSpec(recipient, start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=facing_deg, position=position),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                attacker_assist=100.0),
+        name=name,
+    )  # fmt: skip
+
+
 def test_a_blend_held_by_contact_still_moves_the_root_smoothly(
     shared_mocap_dir: Path, tmp_path: Path
 ) -> None:
@@ -210,18 +227,10 @@ def test_a_blend_held_by_contact_still_moves_the_root_smoothly(
     # the end of the transition: the blend's root correction (0.5 m) was held to the last
     # frame and jumped there (16.6 m/s); it is now spread over ROOT_BLEND_MIN_S at least
     from reactmocap.response.final import ROOT_BLEND_MIN_S
-    from reactmocap.response.scenario import ResponseConfig
 
-    scenario = Scenario(
-        library=_shared_library(shared_mocap_dir, tmp_path),
-        recipient=CharacterSpec("dataset-1_walk_normal_001", start=0.5),
-        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
-                              facing_deg=164.64459363196647,
-                              position=(2.1888065748710512, 0.1540919325202299)),
-        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
-                                attacker_assist=100.0),
-        name="walk-kick",
-    )  # fmt: skip
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = _real_kick(lib, "dataset-1_walk_normal_001", 164.64459363196647,
+                          (2.1888065748710512, 0.1540919325202299), "walk-kick")  # fmt: skip
     res = run_response(scenario)
     offset = res.report["quality"]["blend_root_offset_max_m"]
     assert offset > 0.3  # the case: a large root correction
@@ -239,19 +248,11 @@ def test_an_unstable_simulation_1_is_reported_not_fatal(
     # the real bow kicked by the real kick (bench_reactions' aim): the whole-body tracker's
     # torques run away in Simulation 1 at 1.2 s; the response stops it there, searches what
     # is left and says so, rather than failing
-    from reactmocap.response.scenario import ResponseConfig
     from reactmocap.response.stages import UNSTABLE_TRIM_S
 
-    scenario = Scenario(
-        library=_shared_library(shared_mocap_dir, tmp_path),
-        recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
-        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
-                              facing_deg=167.42333060441473,
-                              position=(0.9101249775269609, 0.24847072154800792)),
-        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
-                                attacker_assist=100.0),
-        name="bow-kick",
-    )  # fmt: skip
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = _real_kick(lib, "dataset-1_bow_normal_001", 167.42333060441473,
+                          (0.9101249775269609, 0.24847072154800792), "bow-kick")  # fmt: skip
     res = run_response(scenario)
     stopped = [w for w in res.report["warnings"] if w.startswith("Simulation 1 stopped early")]
     assert len(stopped) == 1 and "unstable" in stopped[0]
