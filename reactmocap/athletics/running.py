@@ -588,4 +588,5 @@ class Runner:
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
             angles[list(_HIP), 0], angles[list(_KNEE), 0], self.heading_d, self.cross_track,
+            self.trunk_euler()[0],
         ))  # fmt: skip

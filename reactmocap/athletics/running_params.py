@@ -165,7 +165,8 @@ _AXES = ("attitude_kp", "attitude_kv")
 class RunLog:
     """Per control tick: time, COM, COM velocity, pelvis heading, state index, active leg,
     feet in contact (bit 0 left, bit 1 right), pelvis height, whether anything but the feet
-    touched the floor, hip and knee pitch of both legs; and the touchdown and lift-off
+    touched the floor, hip and knee pitch of both legs, desired heading, cross-track error, the
+    trunk's (chest's) pitch (rad, forward > 0); and the touchdown and lift-off
     events (time, leg, foot position)."""
 
     rows: list[tuple] = field(default_factory=list)
@@ -174,7 +175,7 @@ class RunLog:
 
     def arrays(self) -> dict[str, NDArray]:
         names = ("t", "com", "com_vel", "heading", "state", "active", "feet", "pelvis",
-                 "others", "hip", "knee", "desired_heading", "cross_track")  # fmt: skip
+                 "others", "hip", "knee", "desired_heading", "cross_track", "trunk_pitch")  # fmt: skip
         if not self.rows:
             return {n: np.zeros(0) for n in names}
         cols = list(zip(*self.rows))
