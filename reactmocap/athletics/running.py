@@ -353,6 +353,11 @@ class Runner:
             self.pitch_sum = _clamp(self.pitch_sum + local[1] * dt, -PITCH_SUM, PITCH_SUM)
             gain[1] += self.inertia_unit * k["pitch_integral"] * self.pitch_sum
         torque = axes.T @ gain
+        if k["attitude_ramp"] > 0:
+            # eased in after touchdown: the torque's reaction drives the thigh, and at once
+            # it drove the heel into the ground (11-13 body weights) and it bounced off
+            ease = _clamp((self.world.data.time - self.t_touchdown) / k["attitude_ramp"], 0, 1)
+            torque *= ease * ease * (3.0 - 2.0 * ease)
         if k["attitude_limit"] > 0:
             top = k["attitude_limit"] * self.mass * self.g * self.athlete.leg_length
             size = float(np.linalg.norm(torque))

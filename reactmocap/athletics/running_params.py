@@ -69,6 +69,9 @@ class RunParams:
             the stances (1/s^3, per unit as ``attitude_kp``; 0: none): above 3.5 m/s the
             stance hip alone left the trunk 0.1 rad forward of the desired pitch, and the
             runner tripped at 5 m/s.
+        attitude_ramp: the attitude torque eases in over this long (s) after touchdown (0:
+            at once): its reaction drives the stance thigh, and at once, with the trunk
+            pitched forward, it drove the heel into the ground and it bounced off.
         attitude_limit: the most attitude torque (``m g L`` N m; 0: no limit), above what a
             run holding its feet needs (at most 7 at 5 m/s): after a trip the unlimited
             servo reached 30 kN m and the simulation blew up instead of reporting a fall.
@@ -105,6 +108,7 @@ class RunParams:
     attitude_kv: tuple[float, float, float] = (14.0, 14.0, 5.42)
     pitch_integral: float | Speeds = (0, 0, 150)
     attitude_limit: float | Speeds = 8.0
+    attitude_ramp: float | Speeds = (0, 0, 0.02)
     yaw_grip: float | Speeds = 0.181
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0

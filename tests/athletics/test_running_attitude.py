@@ -40,3 +40,26 @@ def test_the_attitude_torque_stays_within_its_limit() -> None:
     assert free > top
     # cut to the limit (the foot's grip may take a little more off the twist about the leg)
     assert 0.95 * top < limited <= top * (1 + 1e-9)
+
+
+def test_the_attitude_torque_eases_in_after_touchdown() -> None:
+    """At 5 m/s the attitude torque is zero at touchdown, part of it half the ramp later and
+    all of it after the ramp; without the ramp it is whole at once."""
+    res = run_course(5.0, seconds=1.5, fps=10.0)
+    runner = res.runner
+    ramp = runner.k["attitude_ramp"]
+    assert ramp > 0
+    runner.k["pitch"] = 0.5  # an error the servo acts on, well within the limit
+    runner.k["pitch_integral"] = 0.0  # each call would add to the integral
+    now = runner.world.data.time
+
+    def size(since: float) -> float:
+        runner.t_touchdown = now - since
+        return float(np.linalg.norm(runner._attitude_torque(runner.heading_d)))
+
+    full = size(2 * ramp)
+    assert full > 0
+    assert size(0.0) == 0.0
+    assert 0.2 * full < size(0.5 * ramp) < 0.8 * full
+    runner.k["attitude_ramp"] = 0.0
+    assert size(0.0) == full
