@@ -180,9 +180,14 @@ class Polyline:
             d = self.points[-1] - self.points[-2]
             target = p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead
         d = target - p
-        a0, a1 = self.direction_at(s), self.direction_at(s + self.lookahead)
-        turn = (a1 - a0 + math.pi) % (2 * math.pi) - math.pi
-        return math.atan2(d[1], d[0]), turn / self.lookahead, cross
+        # the curvature over the look-ahead: the turn between its two halves' chords (the
+        # segments' own directions turn in steps, and the lean read from them jumped)
+        half = 0.5 * self.lookahead
+        p0, p1, p2 = (self.point_at(s + f * half) for f in (0.0, 1.0, 2.0))
+        c0, c1 = p1 - p0, p2 - p1
+        turn = math.atan2(c0[0] * c1[1] - c0[1] * c1[0], float(c0 @ c1))
+        turn = 0.0 if abs(turn) < 1e-12 else turn  # a straight stretch: no rounding's lean
+        return math.atan2(d[1], d[0]), turn / half, cross
 
 
 def Straight(heading: float = 0.0, start: ArrayLike = (0.0, 0.0)) -> Polyline:

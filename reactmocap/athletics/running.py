@@ -87,6 +87,8 @@ ERROR_CAP = 0.3
 #: runner fell recovering it
 START_SPEED = 3.5
 ACCEL = 1.5
+#: the most the pitch error's integral holds (rad s)
+PITCH_SUM = 0.1
 
 
 class Runner:
@@ -183,6 +185,7 @@ class Runner:
         self.leg_force = 0.0
         self.lo_pitch = [0.0, 0.0]
         self.td_pitch = 0.0
+        self.pitch_sum = 0.0
         self.speed_bias = 0.0
         self.step_start: tuple[float, F64] | None = None
         self.thrust_force = k["thrust"] * self.mass * self.g
@@ -340,11 +343,26 @@ class Runner:
         mujoco.mju_quat2Vel(err, _qmul(want, _qconj(now)), 1.0)  # world rotation vector
         c, s = math.cos(heading), math.sin(heading)
         axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
+        local = axes @ err
         gain = self.inertia_unit * (
-            np.asarray(self.params.attitude_kp) * (axes @ err)
+            np.asarray(self.params.attitude_kp) * local
             - np.asarray(self.params.attitude_kv) * (axes @ d.cvel[self._chest, :3])
         )
+        if k["pitch_integral"] > 0:
+            dt = self.control_every * self.world.timestep
+            self.pitch_sum = _clamp(self.pitch_sum + local[1] * dt, -PITCH_SUM, PITCH_SUM)
+            gain[1] += self.inertia_unit * k["pitch_integral"] * self.pitch_sum
         torque = axes.T @ gain
+        if k["attitude_ramp"] > 0:
+            # eased in after touchdown: the torque's reaction drives the thigh, and at once
+            # it drove the heel into the ground (11-13 body weights) and it bounced off
+            ease = _clamp((self.world.data.time - self.t_touchdown) / k["attitude_ramp"], 0, 1)
+            torque *= ease * ease * (3.0 - 2.0 * ease)
+        if k["attitude_limit"] > 0:
+            top = k["attitude_limit"] * self.mass * self.g * self.athlete.leg_length
+            size = float(np.linalg.norm(torque))
+            if size > top:
+                torque *= top / size
         # the part about the stance thigh's long axis only twists the leg against the foot's
         # grip on the ground: it stays within what the foot can hold, or the leg spins
         leg = self.active
@@ -575,4 +593,5 @@ class Runner:
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
             angles[list(_HIP), 0], angles[list(_KNEE), 0], self.heading_d, self.cross_track,
+            self.trunk_euler()[0],
         ))  # fmt: skip

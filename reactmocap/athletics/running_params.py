@@ -65,6 +65,16 @@ class RunParams:
         pitch: desired forward pitch of the trunk (rad).
         attitude_kp, attitude_kv: the stance hip's attitude servo (roll, pitch, yaw), per
             unit of the body's mass times its leg length squared (1/s^2, 1/s).
+        pitch_integral: the attitude servo's integral gain on the trunk's pitch error over
+            the stances (1/s^3, per unit as ``attitude_kp``; 0: none): above 3.5 m/s the
+            stance hip alone left the trunk 0.1 rad forward of the desired pitch, and the
+            runner tripped at 5 m/s.
+        attitude_ramp: the attitude torque eases in over this long (s) after touchdown (0:
+            at once): its reaction drives the stance thigh, and at once, with the trunk
+            pitched forward, it drove the heel into the ground and it bounced off.
+        attitude_limit: the most attitude torque (``m g L`` N m; 0: no limit), above what a
+            run holding its feet needs (at most 7 at 5 m/s): after a trip the unlimited
+            servo reached 30 kN m and the simulation blew up instead of reporting a fall.
         yaw_grip: the twisting moment a stance foot can hold, in units of its length times
             the vertical ground force (a friction coefficient times the lever).
         knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
@@ -96,6 +106,9 @@ class RunParams:
     pitch: float | Speeds = (0.1207, 0.013, -0.01578)
     attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
     attitude_kv: tuple[float, float, float] = (14.0, 14.0, 5.42)
+    pitch_integral: float | Speeds = (0, 0, 150)
+    attitude_limit: float | Speeds = 8.0
+    attitude_ramp: float | Speeds = (0, 0, 0.02)
     yaw_grip: float | Speeds = 0.181
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
@@ -156,7 +169,8 @@ _AXES = ("attitude_kp", "attitude_kv")
 class RunLog:
     """Per control tick: time, COM, COM velocity, pelvis heading, state index, active leg,
     feet in contact (bit 0 left, bit 1 right), pelvis height, whether anything but the feet
-    touched the floor, hip and knee pitch of both legs; and the touchdown and lift-off
+    touched the floor, hip and knee pitch of both legs, desired heading, cross-track error, the
+    trunk's (chest's) pitch (rad, forward > 0); and the touchdown and lift-off
     events (time, leg, foot position)."""
 
     rows: list[tuple] = field(default_factory=list)
@@ -165,7 +179,7 @@ class RunLog:
 
     def arrays(self) -> dict[str, NDArray]:
         names = ("t", "com", "com_vel", "heading", "state", "active", "feet", "pelvis",
-                 "others", "hip", "knee", "desired_heading", "cross_track")  # fmt: skip
+                 "others", "hip", "knee", "desired_heading", "cross_track", "trunk_pitch")  # fmt: skip
         if not self.rows:
             return {n: np.zeros(0) for n in names}
         cols = list(zip(*self.rows))

@@ -90,6 +90,24 @@ def test_polyline_follows_in_order() -> None:
     assert heading == pytest.approx(0.5) and curvature == 0.0 and cross == pytest.approx(0.0)
 
 
+def test_figure_eight_curvature_is_its_loops() -> None:
+    """Along the eight the curvature read by the steering is +1/R on the first loop and -1/R
+    on the second, to 2%, between the segments' corners as well as at them (a lean read
+    from the segments' own directions jumped by 10-20%)."""
+    eight = figure_eight(10.0)
+    loop = 2 * math.pi * 10.0
+    got = []
+    for s in np.arange(2.0, 2 * loop - 5.0, 0.13):
+        pos = eight.point_at(float(s))
+        _, curvature, _ = eight.steer(pos, 0.0)
+        if 2.0 < s < loop - 5.0:
+            got.append(curvature)
+        elif loop + 2.0 < s:
+            got.append(-curvature)
+    assert len(got) > 500
+    assert np.allclose(got, 0.1, rtol=0.02), (min(got), max(got))
+
+
 def test_facing_turns_at_a_limited_rate() -> None:
     f = Facing([(0.0, 0.0), (1.0, math.pi / 2)], rate=0.5)
     assert f.steer(np.zeros(2), 0.5)[0] == 0.0

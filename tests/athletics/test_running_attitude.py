@@ -1,0 +1,65 @@
+"""The running attitude servo's integral on the trunk's pitch and its torque limit (real
+MuJoCo, the thesis male)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reactmocap.athletics.run_course import run_course
+from reactmocap.athletics.running import RunParams
+
+
+def _pitch_error(params: RunParams) -> float:
+    """Mean trunk pitch minus the desired, over 2-6 s of a 5 m/s run."""
+    res = run_course(5.0, seconds=6.0, fps=10.0, params=params)
+    assert not res.report["fell"], res.report["notes"]
+    log = res.log
+    late = log["t"] >= 2.0
+    return float(np.mean(log["trunk_pitch"][late])) - params.at(5.0)["pitch"]
+
+
+def test_the_pitch_integral_brings_the_trunk_toward_the_desired_pitch() -> None:
+    """At 5 m/s the stance hip's PD alone leaves the trunk pitched forward of the desired;
+    the integral takes at least a third of that off."""
+    without = _pitch_error(RunParams(pitch_integral=0.0))
+    with_integral = _pitch_error(RunParams())
+    assert without > 0.05
+    assert with_integral < (2.0 / 3.0) * without
+
+
+def test_the_attitude_torque_stays_within_its_limit() -> None:
+    """A trunk a radian off its desired pitch asks the servo for more than the limit: the
+    torque is cut to it; without a limit it is not."""
+    res = run_course(3.5, seconds=0.2, fps=10.0)
+    runner = res.runner
+    runner.k["pitch"] = 1.0
+    top = runner.k["attitude_limit"] * runner.mass * runner.g * runner.athlete.leg_length
+    limited = float(np.linalg.norm(runner._attitude_torque(runner.heading_d)))
+    runner.k["attitude_limit"] = 0.0
+    free = float(np.linalg.norm(runner._attitude_torque(runner.heading_d)))
+    assert free > top
+    # cut to the limit (the foot's grip may take a little more off the twist about the leg)
+    assert 0.95 * top < limited <= top * (1 + 1e-9)
+
+
+def test_the_attitude_torque_eases_in_after_touchdown() -> None:
+    """At 5 m/s the attitude torque is zero at touchdown, part of it half the ramp later and
+    all of it after the ramp; without the ramp it is whole at once."""
+    res = run_course(5.0, seconds=1.5, fps=10.0)
+    runner = res.runner
+    ramp = runner.k["attitude_ramp"]
+    assert ramp > 0
+    runner.k["pitch"] = 0.5  # an error the servo acts on, well within the limit
+    runner.k["pitch_integral"] = 0.0  # each call would add to the integral
+    now = runner.world.data.time
+
+    def size(since: float) -> float:
+        runner.t_touchdown = now - since
+        return float(np.linalg.norm(runner._attitude_torque(runner.heading_d)))
+
+    full = size(2 * ramp)
+    assert full > 0
+    assert size(0.0) == 0.0
+    assert 0.2 * full < size(0.5 * ramp) < 0.8 * full
+    runner.k["attitude_ramp"] = 0.0
+    assert size(0.0) == full
