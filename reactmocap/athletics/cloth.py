@@ -12,6 +12,7 @@ Why a model of its own: ``docs/athletics.md``."""
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 
 import mujoco
@@ -19,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, ReactMocapError, SimulationError
+from reactmocap.rotations import quat_exp, quat_mul, quat_normalize, quat_to_matrix
 from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.world import World
 
@@ -333,8 +335,6 @@ class Cloth:
         return cvel[:, 3:] + np.cross(omega, d.xpos[ids] - com), omega
 
     def control(self, world: World, t: float) -> None:
-        import time
-
         assert self.model is not None and self.data is not None
         wall = time.perf_counter()
         m, d = self.model, self.data
@@ -350,12 +350,14 @@ class Cloth:
             # the runner's bodies carried over the tick by their velocities (the contacts
             # see them move, so the cloth is pushed along rather than overlapped)
             d.qpos[qpos[:, :3]] = pos + vel * (k * h)
-            d.qpos[qpos[:, 3:]] = _quat_advance(quat, local, k * h) if k else quat
+            d.qpos[qpos[:, 3:]] = (
+                quat_normalize(quat_mul(quat, quat_exp(local * (k * h)))) if k else quat
+            )
             d.qvel[qvel[:, :3]] = vel
             d.qvel[qvel[:, 3:]] = local
             if self.spec.project:
                 self._project(
-                    d.qpos[qpos[:, :3]], rot if not k else _quat_mats(d.qpos[qpos[:, 3:]])
+                    d.qpos[qpos[:, :3]], rot if not k else quat_to_matrix(d.qpos[qpos[:, 3:]])
                 )
             mujoco.mj_step(m, d)
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
@@ -514,28 +516,6 @@ def render_cloth_video(cloth: Cloth, path: str | Path, size: tuple[int, int] = (
     finally:
         renderer.close()
     return Path(write_video(frames, path, cloth.record_fps))
-
-
-def _quat_advance(quat: F64, local: F64, tau: float) -> F64:
-    """Unit quaternions ``quat`` (B, 4) turned for ``tau`` s at body-frame angular velocities
-    ``local`` (B, 3) (``mju_quatIntegrate`` over many bodies at once)."""
-    w = np.linalg.norm(local, axis=1)
-    half = 0.5 * w * tau
-    axis = local / np.maximum(w, 1e-12)[:, None]
-    dq = np.concatenate([np.cos(half)[:, None], np.sin(half)[:, None] * axis], axis=1)
-    a0, av = quat[:, :1], quat[:, 1:]
-    b0, bv = dq[:, :1], dq[:, 1:]
-    real = a0 * b0 - np.sum(av * bv, axis=1, keepdims=True)
-    out = np.concatenate([real, a0 * bv + b0 * av + np.cross(av, bv)], axis=1)
-    return out / np.linalg.norm(out, axis=1, keepdims=True)
-
-
-def _quat_mats(quat: F64) -> F64:
-    """Rotation matrices ``(B, 3, 3)`` of unit quaternions ``(B, 4)``."""
-    out = np.empty((len(quat), 9))
-    for i, q in enumerate(quat):
-        mujoco.mju_quat2Mat(out[i], q)
-    return out.reshape(-1, 3, 3)
 
 
 def _set_vertices(m: mujoco.MjModel, d: mujoco.MjData, verts: F64) -> None:
