@@ -156,18 +156,13 @@ def _longest(values: list[float], ok: list[bool]) -> tuple[float, float] | None:
 
 def _drop_for_com(body: str, com_height: float) -> float:
     """Sole clearance that puts the landing pose's COM at ``com_height`` m (thesis ch. 6)."""
-    import mujoco
-
     from reactmocap.athletics.behaviours import LANDING_LEG
     from reactmocap.athletics.bodies import athlete
     from reactmocap.athletics.scene import stand_angles
 
     ath = athlete(body)
     q = ath.standing_qpos(stand_angles(ath, LANDING_LEG), clearance=0.0)
-    data = mujoco.MjData(ath.character.model)
-    data.qpos[:] = q
-    mujoco.mj_forward(ath.character.model, data)
-    return round(com_height - float(data.subtree_com[1][2]), 3)
+    return round(com_height - float(ath.com_of(q)[2]), 3)
 
 
 # ---------------------------------------------------------------------------------- searches

@@ -251,6 +251,16 @@ class Athlete:
         q[2] += clearance - float(corners[..., 2].min())
         return q
 
+    def com_of(self, qpos: F64) -> F64:
+        """World centre of mass ``(3,)`` of the whole body at ``qpos`` (a setup-time query:
+        it makes its own MjData)."""
+        model = self.character.model
+        data = mujoco.MjData(model)
+        data.qpos[:] = qpos
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        return data.subtree_com[1].copy()
+
 
 def _sole_geoms(character: Character) -> NDArray[np.int64]:
     """Geom ids (in the character's own model) of the left and right sole boxes."""

@@ -39,7 +39,6 @@ from reactmocap.athletics.vault_setup import (
     HORSE,
     Apparatus,
     VaultParams,
-    _com_of,
     vault_athlete,
     vault_start,
     vault_world,
@@ -177,7 +176,7 @@ def vault(
     log = VaultLog()
     basis = Vault(p, log)
     # the COM's standing height: the tumbling controller's touchdown height is a fraction of it
-    ctx.standing_com = float(_com_of(ath, ath.standing_qpos(np.zeros((NJ, 3))))[2])
+    ctx.standing_com = float(ath.com_of(ath.standing_qpos(np.zeros((NJ, 3))))[2])
     tumble = Tumble(TumbleParams(position=p.position2, turns=p.turns2,
                                  touchdown_height=p.touchdown_com))  # fmt: skip
     stand = Balance(Posture(leg=p.stand_leg, settle=p.stand_settle))

@@ -259,7 +259,7 @@ def vault_start(ath: Athlete, p: VaultParams) -> tuple[F64, F64]:
         angles[_J[f"{s}_ankle"]] = (-0.2, 0.0, 0.0)
         angles[_J[f"{s}_shoulder"]] = (p.arms_board, 0.0, 0.0)
     q = ath.standing_qpos(angles, pitch=-0.1, clearance=p.start_clearance + BOARD.top)
-    com = _com_of(ath, q)
+    com = ath.com_of(q)
     q[0] += p.start_x - com[0]
     v = np.zeros(6 + 3 * NJ)
     v[0] = p.approach_vx
@@ -269,12 +269,3 @@ def vault_start(ath: Athlete, p: VaultParams) -> tuple[F64, F64]:
     mujoco.mju_quat2Mat(rot, q[3:7])
     v[3:6] = rot.reshape(3, 3).T @ np.array([0.0, p.approach_spin, 0.0])
     return q, v
-
-
-def _com_of(ath: Athlete, q: F64) -> F64:
-    m = ath.character.model
-    d = mujoco.MjData(m)
-    d.qpos[:] = q
-    mujoco.mj_kinematics(m, d)
-    mujoco.mj_comPos(m, d)
-    return d.subtree_com[1].copy()

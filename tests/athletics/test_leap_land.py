@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 import pytest
 
@@ -88,10 +87,7 @@ def _drop_for_com_height(body: str, com_height: float) -> float:
     """Sole clearance that puts the landing pose's COM at ``com_height`` (thesis ch. 6)."""
     ath = athlete(body)
     q = ath.standing_qpos(stand_angles(ath, LANDING_LEG), clearance=0.0)
-    data = mujoco.MjData(ath.character.model)
-    data.qpos[:] = q
-    mujoco.mj_forward(ath.character.model, data)
-    return com_height - float(data.subtree_com[1][2])
+    return com_height - float(ath.com_of(q)[2])
 
 
 def test_a_forward_landing_at_2_m_per_s_lands_with_the_delta_table(
