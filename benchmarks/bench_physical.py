@@ -1,12 +1,13 @@
 """The physical response mode against the paper's blend, on the facing sweep (prints figures).
 
-    python benchmarks/bench_physical.py [--directions 36] [--sweep examples/sweep_facing.toml]
+    python benchmarks/bench_physical.py [--directions 36] [--degs 0,90] [--sweep ...toml]
 
 Every direction of the sweep runs in both modes in the same process, alternating, so the time
 ratio is measured under the same load. Per direction: whether the run finished, whether the
 body landed on the found clip within the tolerances, the final blend's root offset and largest
-joint correction, and the time per response. The targets (issue 16): 100% finish, median root
-offset <= 0.02 m, 95th-percentile joint correction <= 0.1 rad, median time <= 3x the blend's.
+joint correction, the impulse the recipient took, and the time per response. The targets
+(issue 16): 100% finish, median root offset <= 0.02 m, 95th-percentile joint correction
+<= 0.1 rad, median time <= 3x the blend's.
 """
 
 from __future__ import annotations
@@ -29,14 +30,19 @@ ROOT = Path(__file__).resolve().parents[1]
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--directions", type=int, default=36)
+    ap.add_argument("--degs", help="facing directions to run (comma list, degrees) instead of "
+                    "--directions evenly spaced ones")  # fmt: skip
     ap.add_argument("--sweep", type=Path, default=ROOT / "examples" / "sweep_facing.toml")
     args = ap.parse_args()
+    if args.degs:
+        degs = [float(d) for d in args.degs.split(",")]
+    else:
+        degs = [360.0 * k / args.directions for k in range(args.directions)]
     base = load_sweep(args.sweep).points()[0].scenario
     cache = LibraryCache()
     run_response(base, cache)  # warm the library cache outside the timings
     rows: dict[str, list[dict]] = {"blend": [], "physical": []}
-    for k in range(args.directions):
-        deg = 360.0 * k / args.directions
+    for deg in degs:
         for mode in ("blend", "physical"):
             sc = replace(base, recipient=replace(base.recipient, facing_deg=deg),
                          response=replace(base.response, mode=mode))  # fmt: skip
@@ -53,7 +59,8 @@ def main() -> None:
             print(f"facing {deg:5.1f} {mode:8s} {rep['matched']['clip'][:14]:14s} "
                   f"landed {tr['landed_on_clip']!s:5s} root {q['blend_root_offset_max_m']:.3f} m "
                   f"joint {q['blend_joint_correction_max_rad']:.3f} rad "
-                  f"disp {q['reaction_displacement_m']:.2f} m tr {q['transition_s']:.2f} s "
+                  f"disp {q['reaction_displacement_m']:.2f} m "
+                  f"imp {q['contact_impulse_Ns']:.0f} N s tr {q['transition_s']:.2f} s "
                   f"fell {q['fell']!s:5s} {wall:.2f} s")  # fmt: skip
     for mode, rs in rows.items():
         done = [r for r in rs if not r["failed"]]
