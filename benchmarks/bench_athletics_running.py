@@ -6,8 +6,9 @@ Sections:
 * ``--speeds``: 30 s runs at 2.5-5 m/s in steps of 0.5 and 4.25, 4.75: falls, mean speed, RMS stride-speed
   error, cadence, stride, real-time factor (goal: no falls, error <= 0.15 m/s, >= 2x real
   time).
-* ``--paths``: a circle of radius 10 m and a figure eight of 10 m loops: RMS cross-track error
-  (goal <= 0.3 m).
+* ``--paths``: a circle of radius 10 m (``--seconds``) and a figure eight of 10 m loops
+  (``--eight-seconds``, 60: once round, 126 m): RMS cross-track error (goal <= 0.3 m) and
+  how far along the path the runner got.
 * ``--phase``: the hip-knee phase plot (Fig. 6) of a run at the shared run clip's speed beside
   the clip's, and their cadence and stride (goal: within 10%); writes the figure.
 * ``--push``: the largest sideways impulse on the chest (over 0.1 s) the runner survives.
@@ -69,14 +70,18 @@ def speeds(seconds: float) -> None:
     print(f"\nmedian real-time factor without cloth: {np.median(rtf):.2f}x\n")
 
 
-def paths(seconds: float, speed: float) -> None:
-    print(f"## Path following ({seconds:g} s at {speed:g} m/s)\n")
-    print("| path | fell | RMS cross-track error (m) | stride speed RMS error (m/s) |")
-    print("|---|---|---|---|")
-    for spec in ("circle:10", "eight:10"):
-        r = run_course(speed, seconds=seconds, path=spec, fps=10.0).report
+def paths(seconds: float, speed: float, eight_seconds: float) -> None:
+    print(f"## Path following (at {speed:g} m/s)\n")
+    print("| path | seconds | fell | RMS cross-track error (m) | stride speed RMS error (m/s) "
+          "| along the path (m) |")  # fmt: skip
+    print("|---|---|---|---|---|---|")
+    for spec, secs in (("circle:10", seconds), ("eight:10", eight_seconds)):
+        r = run_course(speed, seconds=secs, path=spec, fps=10.0).report
         fell = f"at {r['fell_at_s']:.1f} s" if r["fell"] and r.get("fell_at_s") else _fmt(r["fell"])
-        print(f"| {spec} | {fell} | {_fmt(r['path_error_m'])} | {_fmt(r['speed_error_m_s'])} |")
+        along = (f"{r['path_progress_m']:.1f} of {r['path_length_m']:.1f}"
+                 if r.get("path_progress_m") is not None else "-")  # fmt: skip
+        print(f"| {spec} | {secs:g} | {fell} | {_fmt(r['path_error_m'])} | "
+              f"{_fmt(r['speed_error_m_s'])} | {along} |")  # fmt: skip
     print()
 
 
@@ -331,6 +336,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="the vault's landing with each landing value moved by 2%%")  # fmt: skip
     ap.add_argument("--seconds", type=float, default=30.0, help="length of the speed runs")
     ap.add_argument("--path-speed", type=float, default=2.5, help="speed of the path runs")
+    ap.add_argument(
+        "--eight-seconds",
+        type=float,
+        default=60.0,
+        help="length of the figure-eight run (60 s: once round the 10 m loops)",
+    )
     ap.add_argument("--figures", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--tune-speed", type=float, help="search the runner's values at a speed")
     ap.add_argument("--tune-vault", action="store_true", help="search the vault's values")
@@ -348,7 +359,7 @@ def main(argv: list[str] | None = None) -> int:
     if every or args.speeds:
         speeds(args.seconds)
     if every or args.paths:
-        paths(30.0, args.path_speed)
+        paths(30.0, args.path_speed, args.eight_seconds)
     if every or args.phase:
         phase(args.figures)
     if every or args.push:

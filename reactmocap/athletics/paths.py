@@ -127,11 +127,14 @@ class Polyline:
         self.cum = np.concatenate([[0.0], np.cumsum(self.len)])
         self.closed = closed
         self.lookahead = float(lookahead)
-        self.index = 0
         self.total = float(self.cum[-1])
+        self.reset()
 
     def reset(self) -> None:
         self.index = 0
+        #: how far along the path the runner has got (m), laps of a closed path counted
+        self.progress = 0.0
+        self._laps = 0
 
     def _closest(self, p: F64) -> tuple[int, float, float]:
         """Segment, arc length and signed distance of the closest point, searched a window
@@ -174,7 +177,10 @@ class Polyline:
         del t
         p = np.asarray(pos[:2], dtype=np.float64)
         i, s, cross = self._closest(p)
+        if self.closed and i < self.index - len(self.len) // 2:
+            self._laps += 1  # past the closing point into the next lap
         self.index = i
+        self.progress = s + self._laps * self.total
         target = self.point_at(s + self.lookahead)
         if not self.closed and s + self.lookahead > self.total:  # past the end: straight on
             d = self.points[-1] - self.points[-2]

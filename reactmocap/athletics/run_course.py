@@ -139,6 +139,9 @@ def run_course(
         "path": path if isinstance(path, str) else type(path).__name__,
     }  # fmt: skip
     report.update(run_metrics(log, runner.log.touchdowns, speed, standing))
+    # how far along a path the runner got (whether a figure eight was run through)
+    report["path_progress_m"] = course.progress if isinstance(course, Polyline) else None
+    report["path_length_m"] = course.total if isinstance(course, Polyline) else None
     if res.status != "ok":
         report["fell"] = True
         report["reason"] = res.reason

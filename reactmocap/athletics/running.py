@@ -358,8 +358,13 @@ class Runner:
             # it drove the heel into the ground (11-13 body weights) and it bounced off
             ease = _clamp((self.world.data.time - self.t_touchdown) / k["attitude_ramp"], 0, 1)
             torque *= ease * ease * (3.0 - 2.0 * ease)
-        if k["attitude_limit"] > 0:
-            top = k["attitude_limit"] * self.mass * self.g * self.athlete.leg_length
+        limit = k["attitude_limit"]
+        if k["touchdown_limit"] > 0 and self.machine.current.name in ("loading", "heel"):
+            # until the ball is down: at once a large torque drove the heel into the ground
+            # and the foot bounced off (the turning runner's falls at 2.5 m/s)
+            limit = min(limit, k["touchdown_limit"]) if limit > 0 else k["touchdown_limit"]
+        if limit > 0:
+            top = limit * self.mass * self.g * self.athlete.leg_length
             size = float(np.linalg.norm(torque))
             if size > top:
                 torque *= top / size

@@ -75,6 +75,12 @@ class RunParams:
         attitude_limit: the most attitude torque (``m g L`` N m; 0: no limit), above what a
             run holding its feet needs (at most 7 at 5 m/s): after a trip the unlimited
             servo reached 30 kN m and the simulation blew up instead of reporting a fall.
+        touchdown_limit: the most attitude torque (``m g L`` N m) from touchdown until the
+            ball is down (the loading and heel states; 0: ``attitude_limit`` only). A touchdown with the trunk pitched
+            forward after a flight that rotated it (0.3-0.4 rad) met 7-8 ``m g L`` at once;
+            its reaction on the stance thigh drove the heel into the ground (12-13 body
+            weights) and the foot bounced off, which is how the turning runner at 2.5 m/s
+            fell. In a traced eight the touchdowns that did not bounce met 1.1-3.4.
         yaw_grip: the twisting moment a stance foot can hold, in units of its length times
             the vertical ground force (a friction coefficient times the lever).
         knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
@@ -109,6 +115,7 @@ class RunParams:
     pitch_integral: float | Speeds = (0, 0, 150)
     attitude_limit: float | Speeds = 8.0
     attitude_ramp: float | Speeds = (0, 0, 0.02)
+    touchdown_limit: float | Speeds = (4.0, 4.0, 8.0)
     yaw_grip: float | Speeds = 0.181
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0

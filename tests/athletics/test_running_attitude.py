@@ -63,3 +63,27 @@ def test_the_attitude_torque_eases_in_after_touchdown() -> None:
     assert 0.2 * full < size(0.5 * ramp) < 0.8 * full
     runner.k["attitude_ramp"] = 0.0
     assert size(0.0) == full
+
+
+def test_the_touchdown_limit_caps_the_torque_until_the_ball_is_down() -> None:
+    """At 2.5 m/s a trunk half a radian off its pitch asks for more than the touchdown limit:
+    in the loading and heel states the torque is cut to it, once the ball is down only to
+    the (larger) attitude limit."""
+    res = run_course(2.5, seconds=0.2, fps=10.0)
+    runner = res.runner
+    k = runner.k
+    assert 0 < k["touchdown_limit"] < k["attitude_limit"]
+    k["pitch"] = -0.5  # the trunk well behind its desired pitch
+    unit = runner.mass * runner.g * runner.athlete.leg_length
+    states = runner.machine._by_name
+
+    def size(state: str) -> float:
+        runner.machine.current = states[state]
+        return float(np.linalg.norm(runner._attitude_torque(runner.heading_d))) / unit
+
+    assert size("toe") > 1.2 * k["touchdown_limit"]
+    for state in ("loading", "heel"):
+        assert size(state) <= k["touchdown_limit"] * (1 + 1e-9)
+        assert size(state) > 0.9 * k["touchdown_limit"]
+    k["touchdown_limit"] = 0.0  # off: the attitude limit alone
+    assert size("loading") == size("toe")

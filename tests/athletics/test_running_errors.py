@@ -113,3 +113,15 @@ def test_facing_turns_at_a_limited_rate() -> None:
     assert f.steer(np.zeros(2), 0.5)[0] == 0.0
     h1, curv, cross = f.steer(np.zeros(2), 1.5)
     assert h1 == pytest.approx(0.5) and curv == pytest.approx(0.5) and math.isnan(cross)
+
+
+def test_path_progress_counts_the_laps_of_a_closed_path() -> None:
+    """Following the eight's points in order, the progress grows by the path's length each
+    lap (the closing point does not reset it)."""
+    eight = figure_eight(5.0)
+    pts = eight.points[::3]
+    for p in np.vstack([pts, pts, pts[:10]]):
+        eight.steer(p, 0.0)
+    assert eight.progress == pytest.approx(2 * eight.total + float(eight.cum[27]), abs=0.5)
+    eight.reset()
+    assert eight.progress == 0.0
