@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from reactmocap.commands import output_file
 from reactmocap.errors import ConfigError
 from reactmocap.progress import Progress
 
@@ -56,10 +57,10 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
                            help=f"{par.help} ({unit}; default {default})")  # fmt: skip
         if name == "balance":
             p.add_argument("--com-offset", help="desired COM offset X,Y (m) from the support")
-        p.add_argument("--out", type=Path, help="BVH of the motion (default: NAME_BODY.bvh)")
-        p.add_argument("--report", type=Path, help="JSON report")
-        p.add_argument("--plot", type=Path, help="PNG of COM height and ground force")
-        p.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
+        p.add_argument("--out", type=output_file, help="BVH of the motion (default: NAME_BODY.bvh)")
+        p.add_argument("--report", type=output_file, help="JSON report")
+        p.add_argument("--plot", type=output_file, help="PNG of COM height and ground force")
+        p.add_argument("--video", type=output_file, help="MP4 (or GIF) of the motion")
         p.add_argument("--fps", type=float, default=60.0, help="BVH frame rate")
         p.add_argument("--any-range", action="store_true",
                        help="run outside the measured supported range (reported honestly)")  # fmt: skip

@@ -10,6 +10,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from reactmocap.commands import output_file
 from reactmocap.commands.athletics import _Bar
 from reactmocap.errors import ConfigError
 
@@ -52,9 +53,9 @@ def _common(p: argparse.ArgumentParser, out: str) -> None:
     p.add_argument("--body", default="male", help="male, female or a BVH file (CLIP.bvh)")
     p.add_argument("--out", type=Path, default=Path(out),
                    help=f"folder for rider{{k}}.bvh and bicycle{{k}}.bvh (default {out}/)")  # fmt: skip
-    p.add_argument("--report", type=Path, help="JSON report")
-    p.add_argument("--plot", type=Path, help="PNG: top-view paths, speed and heading")
-    p.add_argument("--video", type=Path, help="MP4 (or GIF) of the ride")
+    p.add_argument("--report", type=output_file, help="JSON report")
+    p.add_argument("--plot", type=output_file, help="PNG: top-view paths, speed and heading")
+    p.add_argument("--video", type=output_file, help="MP4 (or GIF) of the ride")
     p.add_argument("--fps", type=float, default=30.0, help="BVH frame rate (default 30)")
 
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from reactmocap.commands import output_file
+
 __all__ = ["register_maneuvers"]
 
 
@@ -31,7 +33,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     m.add_argument("--out", type=Path, required=True,
                    help="folder for NAME.bvh and NAME.json (the report)")  # fmt: skip
     m.add_argument("--body", help="male, female or a BVH file (default: the file's body)")
-    m.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
+    m.add_argument("--video", type=output_file, help="MP4 (or GIF) of the motion")
     m.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
     m.set_defaults(func=_maneuver)
 

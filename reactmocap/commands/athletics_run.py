@@ -14,6 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from reactmocap.commands import output_file
 from reactmocap.errors import ConfigError
 
 __all__ = ["register_run"]
@@ -58,11 +59,11 @@ def register_run(inner: argparse._SubParsersAction) -> None:  # type: ignore[typ
 def output_args(p: argparse.ArgumentParser, body: str, *, plot: bool = True) -> None:
     """The athletics commands' body and output options."""
     p.add_argument("--body", default=body, help=f"male, female or a BVH file (default {body})")
-    p.add_argument("--out", type=Path, help="BVH of the motion (default: NAME_BODY.bvh)")
-    p.add_argument("--report", type=Path, help="JSON report")
+    p.add_argument("--out", type=output_file, help="BVH of the motion (default: NAME_BODY.bvh)")
+    p.add_argument("--report", type=output_file, help="JSON report")
     if plot:
-        p.add_argument("--plot", type=Path, help="PNG figure")
-    p.add_argument("--video", type=Path, help="MP4 (or GIF) of the motion")
+        p.add_argument("--plot", type=output_file, help="PNG figure")
+    p.add_argument("--video", type=output_file, help="MP4 (or GIF) of the motion")
     p.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
 
 

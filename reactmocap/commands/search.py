@@ -8,6 +8,7 @@ import math
 import time
 from pathlib import Path
 
+from reactmocap.commands import output_file
 from reactmocap.errors import ReactMocapError, SearchError
 
 __all__ = ["register"]
@@ -29,7 +30,9 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     b = ssub.add_parser("build", help="index every window of a clip library")
     b.add_argument("library", type=Path, metavar="LIBRARY_DIR")
-    b.add_argument("--out", type=Path, required=True, metavar="INDEX", help="index file (.npz)")
+    b.add_argument(
+        "--out", type=output_file, required=True, metavar="INDEX", help="index file (.npz)"
+    )
     b.add_argument("--mirror", action="store_true", help="also index left/right mirrored clips")
     b.add_argument("--fps", type=float, default=None, help="index rate (default 30)")
     b.add_argument("--duration", type=float, default=None, help="window length in s (default 0.3)")

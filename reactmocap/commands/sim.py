@@ -10,6 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from reactmocap.commands import output_file
 from reactmocap.errors import ConfigError
 from reactmocap.progress import Progress
 
@@ -21,8 +22,8 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     track.add_argument("clip", type=Path, help="input BVH")
     track.add_argument("--start", type=float, default=0.0, help="clip time to start at (s)")
     track.add_argument("--seconds", type=float, help="how long to track (default: to the end)")
-    track.add_argument("--out", type=Path, help="simulated motion as BVH")
-    track.add_argument("--report", type=Path, help="JSON report")
+    track.add_argument("--out", type=output_file, help="simulated motion as BVH")
+    track.add_argument("--report", type=output_file, help="JSON report")
     _common(track)
     track.set_defaults(func=_track)
 
@@ -37,8 +38,8 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     )
     push.add_argument("--duration", type=float, default=0.1, help="push duration (s)")
     push.add_argument("--seconds", type=float, help="how long to simulate after the start")
-    push.add_argument("--out", type=Path, required=True, help="simulated motion as BVH")
-    push.add_argument("--report", type=Path, help="JSON report")
+    push.add_argument("--out", type=output_file, required=True, help="simulated motion as BVH")
+    push.add_argument("--report", type=output_file, help="JSON report")
     _common(push)
     push.set_defaults(func=_push)
     _register_feasibility(sub)
@@ -56,7 +57,7 @@ def _register_feasibility(sub: argparse._SubParsersAction) -> None:  # type: ign
     )
     feas.add_argument("--min-seconds", type=float, default=0.1, help="shortest stretch to list (s)")
     feas.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
-    feas.add_argument("--report", type=Path, help="JSON report")
+    feas.add_argument("--report", type=output_file, help="JSON report")
     feas.set_defaults(func=_feasibility)
 
 

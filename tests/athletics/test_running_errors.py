@@ -20,6 +20,7 @@ from reactmocap.athletics.run_course import run_course
 from reactmocap.athletics.running import SPEED_RANGE, RunParams, check_speed
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError, ReactMocapError
+from tests.conftest import SYNTHETIC
 
 
 @pytest.mark.parametrize("speed", [2.4, 5.1, -1.0, float("nan"), 0.0])
@@ -125,3 +126,24 @@ def test_path_progress_counts_the_laps_of_a_closed_path() -> None:
     assert eight.progress == pytest.approx(2 * eight.total + float(eight.cum[27]), abs=0.5)
     eight.reset()
     assert eight.progress == 0.0
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["athletics", "run", "--speed", "3", "--out", "{dir}"],
+        ["athletics", "leap", "--height", "0.3", "--plot", "{dir}/"],
+        ["track", str(SYNTHETIC / "guard.bvh"), "--report", "{dir}"],
+    ],
+)
+def test_an_output_file_option_given_a_folder_is_refused_before_running(
+    argv: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # before: the run simulated for its whole length and then crashed in os.replace
+    args = [a.replace("{dir}", str(tmp_path)) for a in argv]
+    with pytest.raises(SystemExit) as exc:
+        main(args)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "is a folder" in err and str(tmp_path) in err
+    assert list(tmp_path.iterdir()) == []
