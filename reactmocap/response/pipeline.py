@@ -164,8 +164,8 @@ def _report(
         warnings.append(
             f"physical mode: the body did not reach the found clip within {cfg.land_within} s "
             f"(pelvis {gap[0]:.2f} m, root {gap[1]:.2f} rad, a joint {gap[2]:.2f} rad off; "
-            f"tolerances {cfg.land_position} m, {cfg.land_angle} rad, {cfg.land_joint} rad): "
-            "the blend closed the rest"
+            f"tolerances {cfg.land_position} m, {cfg.land_angle} rad, {cfg.land_joint} rad, "
+            "where it came closest): the blend closed the rest"
         )
     return {
         "scenario": scenario.name,

@@ -425,12 +425,16 @@ PHYSICAL_TRACKERS = ("wholebody", "predictive")
 class _Landing:
     """The physical mode's stop condition: from ``after`` s into the rollout, the recipient is
     within the landing tolerances of the desired path ``q`` (qpos per control tick, ``rate``
-    Hz from the rollout's start); ``at`` is then that time (None until it is)."""
+    Hz from the rollout's start); ``at`` is then that time (None until it is). Until then it
+    keeps the check where the body came closest (``best``: the largest gap over its
+    tolerance smallest): a body that never lands lands there, not wherever it has drifted (or
+    fallen) to when the time is up."""
 
     def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float) -> None:
         self.cfg, self.q, self.rate, self.after = cfg, q, rate, after
         self.at: float | None = None
         self.gap = np.full(3, np.inf)  # the last check's pelvis (m), root and joint (rad) gaps
+        self.best = (np.inf, after, self.gap)  # (largest gap / tolerance, time, gaps)
 
     def __call__(self, world: World, t: float) -> str | None:
         if t < self.after - 1e-9:
@@ -442,7 +446,10 @@ class _Landing:
         )
         self.gap = np.array([np.linalg.norm(cur[:3] - want[:3]), turn[0], turn[1:].max()])
         cfg = self.cfg
-        if np.all(self.gap <= (cfg.land_position, cfg.land_angle, cfg.land_joint)):
+        score = float(np.max(self.gap / (cfg.land_position, cfg.land_angle, cfg.land_joint)))
+        if score < self.best[0]:
+            self.best = (score, t, self.gap)
+        if score <= 1.0:
             self.at = t
             return "landed on the found clip"
         return None
@@ -527,9 +534,15 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     landed, on_clip, gap = cont.time, True, (0.0, 0.0, 0.0)
     if landing is not None:
         on_clip = landing.at is not None
-        # a simulation that went unstable before the match still lands no earlier than it
-        landed = max(cont.time, rewind + (res.duration if landing.at is None else landing.at))
-        gap = (float(landing.gap[0]), float(landing.gap[1]), float(landing.gap[2]))
+        # not landed: where the body came closest (a simulation that went unstable before the
+        # match still lands no earlier than it)
+        _, at, last = landing.best
+        if landing.at is not None:
+            at, last = landing.at, landing.gap
+        elif not np.isfinite(last).all():  # never checked (unstable before the match)
+            at, last = res.duration, landing.gap
+        landed = max(cont.time, rewind + min(at, res.duration))
+        gap = (float(last[0]), float(last[1]), float(last[2]))
     unstable = res.reason if res.status == "unstable" else None
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
                                 res.contact_log, release, landed, on_clip, gap,
