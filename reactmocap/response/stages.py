@@ -5,7 +5,7 @@ the recipient clip at ``recipient.start``; outputs are at the recipient clip's f
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
 
@@ -348,6 +348,8 @@ class Continuation:
     time: float
     found: Motion
     found_clip: Motion
+    #: the next-best continuations on other clips, best first (``land_tries - 1`` at most)
+    alternatives: tuple[Continuation, ...] = ()
 
 
 def search_continuation(
@@ -396,10 +398,24 @@ def search_continuation(
     best, best_start = next((r for r in results
                              if not _runs_into(cast, cfg, r[0], contact.rewind + r[1] / q_fps)),
                             results[0])  # fmt: skip
-    candidates = index.top_k(query, best_start, n=cfg.top_k, parts=parts)
-    found_clip = cast.library[best.clip]
-    found = found_clip.transformed(best.yaw, best.translation).replace(name=best.clip)
-    return Continuation(best, candidates, contact.rewind + best_start / q_fps, found, found_clip)
+
+    def continuation(r: SearchResult, start: int) -> Continuation:
+        found_clip = cast.library[r.clip]
+        found = found_clip.transformed(r.yaw, r.translation).replace(name=r.clip)
+        return Continuation(r, index.top_k(query, start, n=cfg.top_k, parts=parts),
+                            contact.rewind + start / q_fps, found, found_clip)  # fmt: skip
+
+    others: list[Continuation] = []
+    if cfg.mode == "physical":  # the next-best window of each other clip, for land_tries
+        seen = {best.clip}
+        for r, s in results:
+            if len(others) >= cfg.land_tries - 1:
+                break
+            if r.clip in seen or _runs_into(cast, cfg, r, contact.rewind + s / q_fps):
+                continue
+            seen.add(r.clip)
+            others.append(continuation(r, s))
+    return replace(continuation(best, best_start), alternatives=tuple(others))
 
 
 def _runs_into(cast: Cast, cfg: ResponseConfig, r: SearchResult, at: float) -> bool:
