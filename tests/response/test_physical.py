@@ -83,3 +83,32 @@ def test_a_body_that_never_lands_lands_where_it_came_closest() -> None:
     score, at, gap = landing.best
     assert at == 0.3  # not the last check (0.4 s), nor the one before ``after``
     assert gap[2] == pytest.approx(0.15, abs=1e-6) and score == pytest.approx(1.5, abs=1e-5)
+
+
+def _score(report: dict, sc: Scenario) -> float:
+    gap = report["transition"]["landing_gap"]
+    cfg = sc.response
+    return max(gap["pelvis_m"] / cfg.land_position, gap["root_rad"] / cfg.land_angle,
+               gap["joint_rad"] / cfg.land_joint)  # fmt: skip
+
+
+def test_a_body_that_does_not_land_tries_other_clips_and_keeps_the_closest() -> None:
+    from reactmocap.response import stages
+
+    sc = _physical("front_kick")
+    one = run_response(sc, CACHE).report
+    if one["transition"]["landed_on_clip"]:
+        pytest.skip("the kick now lands physically on the nearest window")
+    tries = replace(sc, response=replace(sc.response, land_tries=3))
+    cast = stages.cast(tries, CACHE)
+    contact = stages.estimate_contact(tries, cast)
+    cont = stages.search_continuation(tries, cast, contact, stages.naive_simulation(tries, cast,
+                                                                                    contact))  # fmt: skip
+    others = [c.best.clip for c in cont.alternatives]
+    assert cont.best.clip == one["matched"]["clip"]  # the nearest window still comes first
+    assert 1 <= len(others) <= 2 and len({cont.best.clip, *others}) == len(others) + 1, others
+    three = run_response(tries, CACHE).report
+    assert three["matched"]["clip"] in {cont.best.clip, *others}
+    assert _score(three, tries) <= _score(one, sc) + 1e-12
+    if three["matched"]["clip"] != one["matched"]["clip"]:  # it switched: it landed closer
+        assert _score(three, tries) < _score(one, sc)
