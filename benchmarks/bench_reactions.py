@@ -1,6 +1,7 @@
 """Reactions that react: the figures of the reaction targets (prints them).
 
     python benchmarks/bench_reactions.py [--skip facing examples real] [--directions 36]
+        [--recipients ...] [--mode physical|blend]
 
 1. Facing sweep (``examples/sweep_facing.toml``, the front kick from every direction): the share
    of directions whose reaction displacement is >= 0.10 m within 45 deg of the contact impulse,
@@ -11,9 +12,10 @@
    kick (its first kick aimed at the recipient's pelvis) and pushed at the chest from 4
    directions, on a library of the shared clips plus the synthetic reactions (retargeted):
    runs without warnings, the deepest overlap of the output animations, timing. These run the
-   whole-body tracker in both simulations (the paper's PD servo cannot keep a walking body up)
-   and hold the kicker on its clip's path with the NON-PHYSICAL root assist until it first
-   touches (the shared kick's spins need 3-15x the moment a foot can give).
+   physical mode (:data:`REAL`; ``--mode blend`` for the paper's blend) with the whole-body
+   tracker in both simulations (the paper's PD servo cannot keep a walking body up) and hold
+   the kicker on its clip's path with the NON-PHYSICAL root assist until it first touches (the
+   shared kick's spins need 3-15x the moment a foot can give).
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from reactmocap.library.bvh import read_bvh
 from reactmocap.library.placement import heading, place
 from reactmocap.response.pipeline import LibraryCache, run_response
 from reactmocap.response.scenario import (
+    MODES,
     AttackerSpec,
     CharacterSpec,
     ImpactSpec,
@@ -44,8 +47,14 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 SHARED = ROOT.parent / "shared" / "mocap" / "bandai-namco-1"
 SYNTHETIC = ROOT / "data" / "synthetic_clips"
+#: the real recipients run in the physical mode: Simulation 2 tracks the found clip past the
+#: match until the body is within reach of it (the pelvis 0.25 m, the root and every joint 0.5
+#: rad: inside what the final blend may correct without a warning), for 1 s at most, and lands
+#: there or where it came closest; the blend then closes only that gap. A body that does not
+#: land tries the search's next-best windows of two other clips, and the closest wins
 REAL = ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
-                      attacker_assist=100.0)  # fmt: skip
+                      attacker_assist=100.0, mode="physical", land_position=0.25,
+                      land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3)  # fmt: skip
 RECIPIENTS = ("walk_normal_001", "walk_normal_002", "walk-back", "walk-left", "walk-right",
               "run_normal_001", "bow_normal_001", "respond_normal_001")  # fmt: skip
 
@@ -159,7 +168,7 @@ HELD_OUT = ("walk-right", "respond_normal_001")
 
 
 def real_scenarios(
-    lib: Path, keys: tuple[str, ...] = RECIPIENTS
+    lib: Path, keys: tuple[str, ...] = RECIPIENTS, cfg: ResponseConfig = REAL
 ) -> list[tuple[str, str, Scenario]]:
     """``(recipient, label, scenario)`` of the real-recipient runs: each recipient kicked by
     the shared kick and pushed at the chest from 4 directions."""
@@ -178,7 +187,7 @@ def real_scenarios(
         gaps = [_gap(a, rec, clip, kick) for _, a in options]
         hit, att = options[next((i for i, g in enumerate(gaps) if g >= 0.7),
                                 int(np.argmax(gaps)))]  # fmt: skip
-        out.append((key, "kick", Scenario(lib, rec, attacker=att, response=REAL,
+        out.append((key, "kick", Scenario(lib, rec, attacker=att, response=cfg,
                                           name=f"{key}-kick")))  # fmt: skip
         parts = map_body_parts(m.skeleton)
         placed = place(m, parts, round(start * m.fps), 0.0, (0.0, 0.0))
@@ -189,7 +198,7 @@ def real_scenarios(
             force = (250.0 * np.cos(d), 250.0 * np.sin(d), 0.0)
             imp = ImpactSpec("chest", force, hit, 0.2, (0.0, 0.0, 0.0))
             out.append((key, f"push {label}",
-                        Scenario(lib, rec, impact=imp, response=REAL, name=f"{key}-{label}")))  # fmt: skip
+                        Scenario(lib, rec, impact=imp, response=cfg, name=f"{key}-{label}")))  # fmt: skip
     return out
 
 
@@ -211,14 +220,17 @@ def _summary(title: str, rows: list[dict | None]) -> None:
           f"by kind {count}; median displacement {disp:.2f} m")  # fmt: skip
 
 
-def real(cache: LibraryCache, keys: tuple[str, ...] = RECIPIENTS) -> None:
+def real(cache: LibraryCache, keys: tuple[str, ...] = RECIPIENTS, cfg: ResponseConfig = REAL
+         ) -> None:  # fmt: skip
     if not SHARED.is_dir():
         print(f"\n(no shared mocap at {SHARED}: real recipients skipped)")
         return
     lib = _library()
-    print("\n## real recipients (shared clips + synthetic reactions as the library)")
+    print(
+        f"\n## real recipients (shared clips + synthetic reactions as the library), {cfg.mode} mode"
+    )
     rows: dict[str, list[dict | None]] = {}
-    for key, label, sc in real_scenarios(lib, keys):
+    for key, label, sc in real_scenarios(lib, keys, cfg):
         t = time.perf_counter()
         try:
             rep = run_response(sc, cache).report
@@ -249,6 +261,8 @@ def main() -> None:
         choices=RECIPIENTS,
         help="the real recipients to run (all by default)",
     )
+    ap.add_argument("--mode", choices=MODES, default=REAL.mode,
+                    help=f"the real recipients' response mode ({REAL.mode} by default)")  # fmt: skip
     args = ap.parse_args()
     cache = LibraryCache()
     if "examples" not in args.skip:
@@ -256,7 +270,7 @@ def main() -> None:
     if "facing" not in args.skip:
         facing(args.directions, cache)
     if "real" not in args.skip:
-        real(cache, tuple(args.recipients))
+        real(cache, tuple(args.recipients), replace(REAL, mode=args.mode))
 
 
 if __name__ == "__main__":

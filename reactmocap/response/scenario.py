@@ -118,6 +118,11 @@ class ResponseConfig:
     land_angle: float = 0.17
     land_joint: float = 0.1
     land_within: float = 1.5
+    #: physical mode: when the body does not land, Simulation 2 runs again toward the search's
+    #: next-best windows of other clips, up to ``land_tries`` continuations in all, and the one
+    #: the body came closest to (its landing gap over the tolerances) wins: a continuation the
+    #: body can reach rather than the nearest window to Simulation 1
+    land_tries: int = 1
 
 
 @dataclass(frozen=True)

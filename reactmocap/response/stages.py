@@ -5,7 +5,7 @@ the recipient clip at ``recipient.start``; outputs are at the recipient clip's f
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
 
@@ -348,6 +348,8 @@ class Continuation:
     time: float
     found: Motion
     found_clip: Motion
+    #: the next-best continuations on other clips, best first (``land_tries - 1`` at most)
+    alternatives: tuple[Continuation, ...] = ()
 
 
 def search_continuation(
@@ -396,10 +398,24 @@ def search_continuation(
     best, best_start = next((r for r in results
                              if not _runs_into(cast, cfg, r[0], contact.rewind + r[1] / q_fps)),
                             results[0])  # fmt: skip
-    candidates = index.top_k(query, best_start, n=cfg.top_k, parts=parts)
-    found_clip = cast.library[best.clip]
-    found = found_clip.transformed(best.yaw, best.translation).replace(name=best.clip)
-    return Continuation(best, candidates, contact.rewind + best_start / q_fps, found, found_clip)
+
+    def continuation(r: SearchResult, start: int) -> Continuation:
+        found_clip = cast.library[r.clip]
+        found = found_clip.transformed(r.yaw, r.translation).replace(name=r.clip)
+        return Continuation(r, index.top_k(query, start, n=cfg.top_k, parts=parts),
+                            contact.rewind + start / q_fps, found, found_clip)  # fmt: skip
+
+    others: list[Continuation] = []
+    if cfg.mode == "physical":  # the next-best window of each other clip, for land_tries
+        seen = {best.clip}
+        for r, s in results:
+            if len(others) >= cfg.land_tries - 1:
+                break
+            if r.clip in seen or _runs_into(cast, cfg, r, contact.rewind + s / q_fps):
+                continue
+            seen.add(r.clip)
+            others.append(continuation(r, s))
+    return replace(continuation(best, best_start), alternatives=tuple(others))
 
 
 def _runs_into(cast: Cast, cfg: ResponseConfig, r: SearchResult, at: float) -> bool:
@@ -425,12 +441,16 @@ PHYSICAL_TRACKERS = ("wholebody", "predictive")
 class _Landing:
     """The physical mode's stop condition: from ``after`` s into the rollout, the recipient is
     within the landing tolerances of the desired path ``q`` (qpos per control tick, ``rate``
-    Hz from the rollout's start); ``at`` is then that time (None until it is)."""
+    Hz from the rollout's start); ``at`` is then that time (None until it is). Until then it
+    keeps the check where the body came closest (``best``: the largest gap over its
+    tolerance smallest): a body that never lands lands there, not wherever it has drifted (or
+    fallen) to when the time is up."""
 
     def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float) -> None:
         self.cfg, self.q, self.rate, self.after = cfg, q, rate, after
         self.at: float | None = None
         self.gap = np.full(3, np.inf)  # the last check's pelvis (m), root and joint (rad) gaps
+        self.best = (np.inf, after, self.gap)  # (largest gap / tolerance, time, gaps)
 
     def __call__(self, world: World, t: float) -> str | None:
         if t < self.after - 1e-9:
@@ -442,7 +462,10 @@ class _Landing:
         )
         self.gap = np.array([np.linalg.norm(cur[:3] - want[:3]), turn[0], turn[1:].max()])
         cfg = self.cfg
-        if np.all(self.gap <= (cfg.land_position, cfg.land_angle, cfg.land_joint)):
+        score = float(np.max(self.gap / (cfg.land_position, cfg.land_angle, cfg.land_joint)))
+        if score < self.best[0]:
+            self.best = (score, t, self.gap)
+        if score <= 1.0:
             self.at = t
             return "landed on the found clip"
         return None
@@ -527,9 +550,15 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     landed, on_clip, gap = cont.time, True, (0.0, 0.0, 0.0)
     if landing is not None:
         on_clip = landing.at is not None
-        # a simulation that went unstable before the match still lands no earlier than it
-        landed = max(cont.time, rewind + (res.duration if landing.at is None else landing.at))
-        gap = (float(landing.gap[0]), float(landing.gap[1]), float(landing.gap[2]))
+        # not landed: where the body came closest (a simulation that went unstable before the
+        # match still lands no earlier than it)
+        _, at, last = landing.best
+        if landing.at is not None:
+            at, last = landing.at, landing.gap
+        elif not np.isfinite(last).all():  # never checked (unstable before the match)
+            at, last = res.duration, landing.gap
+        landed = max(cont.time, rewind + min(at, res.duration))
+        gap = (float(last[0]), float(last[1]), float(last[2]))
     unstable = res.reason if res.status == "unstable" else None
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
                                 res.contact_log, release, landed, on_clip, gap,

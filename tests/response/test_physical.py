@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from reactmocap.errors import ConfigError
@@ -56,3 +57,58 @@ def test_an_unknown_mode_is_a_clear_error() -> None:
             "impact": {}, "response": {"mode": "ragdoll"}}  # fmt: skip
     with pytest.raises(ConfigError, match=r"\[response\]\.mode: expected one of"):
         parse_scenario(data, source="s.toml")
+
+
+def test_a_body_that_never_lands_lands_where_it_came_closest() -> None:
+    # a real World on the light push's recipient, its qpos set off the desired path by a turn
+    # of one joint at each check: far, near (still outside the 0.1 rad tolerance), far again
+    from reactmocap.response import stages
+    from reactmocap.rotations import quat_mul
+    from reactmocap.sim.world import World
+
+    sc = _physical("light_push")
+    cast = stages.cast(sc, CACHE)
+    rec = cast.recipient
+    q = rec.character.qpos_from_motion(rec.motion)
+    world = World([rec.character])
+    span = world.characters[0].qpos_slice
+    landing = stages._Landing(sc.response, q, rec.motion.fps, after=0.1)
+    for t, angle in ((0.05, 0.01), (0.2, 0.8), (0.3, 0.15), (0.4, 0.6)):
+        want = q[int(round(t * rec.motion.fps))].copy()
+        turn = np.array([np.cos(angle / 2), np.sin(angle / 2), 0.0, 0.0])
+        want[7:11] = quat_mul(want[7:11], turn)  # the first joint after the free root
+        world.data.qpos[span] = want
+        assert landing(world, t) is None  # never within the tolerances
+    assert landing.at is None
+    score, at, gap = landing.best
+    assert at == 0.3  # not the last check (0.4 s), nor the one before ``after``
+    assert gap[2] == pytest.approx(0.15, abs=1e-6) and score == pytest.approx(1.5, abs=1e-5)
+
+
+def _score(report: dict, sc: Scenario) -> float:
+    gap = report["transition"]["landing_gap"]
+    cfg = sc.response
+    return max(gap["pelvis_m"] / cfg.land_position, gap["root_rad"] / cfg.land_angle,
+               gap["joint_rad"] / cfg.land_joint)  # fmt: skip
+
+
+def test_a_body_that_does_not_land_tries_other_clips_and_keeps_the_closest() -> None:
+    from reactmocap.response import stages
+
+    sc = _physical("front_kick")
+    one = run_response(sc, CACHE).report
+    if one["transition"]["landed_on_clip"]:
+        pytest.skip("the kick now lands physically on the nearest window")
+    tries = replace(sc, response=replace(sc.response, land_tries=3))
+    cast = stages.cast(tries, CACHE)
+    contact = stages.estimate_contact(tries, cast)
+    cont = stages.search_continuation(tries, cast, contact, stages.naive_simulation(tries, cast,
+                                                                                    contact))  # fmt: skip
+    others = [c.best.clip for c in cont.alternatives]
+    assert cont.best.clip == one["matched"]["clip"]  # the nearest window still comes first
+    assert 1 <= len(others) <= 2 and len({cont.best.clip, *others}) == len(others) + 1, others
+    three = run_response(tries, CACHE).report
+    assert three["matched"]["clip"] in {cont.best.clip, *others}
+    assert _score(three, tries) <= _score(one, sc) + 1e-12
+    if three["matched"]["clip"] != one["matched"]["clip"]:  # it switched: it landed closer
+        assert _score(three, tries) < _score(one, sc)
