@@ -150,7 +150,7 @@ LANDING_DELTAS: dict[Any, Any] = {
     ),
 }
 SUPPORTED: dict[Any, Any] = {
-    ("leap", "height"): {"male": (0.0857, 0.9987), "female": (0.4089, 0.8726)},
+    ("leap", "height"): {"male": (0.0857, 0.9987), "female": (0.0706, 0.7588)},
     ("broad-jump", "distance"): {"male": (0.4524, 1.3568), "female": (0.3624, 0.9691)},
     ("land", "drop"): {"male": (0.0, 2.2), "female": (0.0, 2.5)},
     ("land", "vx"): {"male": (-2.0, 3.0), "female": (-1.0, 2.0)},
