@@ -5,6 +5,7 @@ the thesis-style plots and a JSON of every figure.
     python benchmarks/bench_athletics.py --tables      # rebuild the tables and supported ranges
     python benchmarks/bench_athletics.py --out docs/athletics   # the experiments and plots
     python benchmarks/bench_athletics.py --leaps --json leaps.json   # Fig. 4.1 and 4.2 only
+        (into an existing results.json: replaces its leap entries only; --out redraws the two plots)
     python benchmarks/bench_athletics.py --capture --json docs/athletics/capture.json  # issue 19
 
 ``--workers N`` runs simulations in N processes (the figures do not depend on it).
@@ -393,6 +394,34 @@ def capture(workers: int, starts: int = 50) -> dict[str, Any]:
     return out
 
 
+def _leaps_only(workers: int, path: Path | None, out: Path | None) -> int:
+    """``--leaps``: Fig. 4.1 and 4.2 only. An existing ``--json`` file keeps its other
+    figures (its ``leap_*`` entries are replaced and dated ``leaps_date``); ``--out`` redraws
+    those two plots."""
+    today = datetime.date.today().isoformat()
+    res: dict[str, Any] = {}
+    grf_curves: dict[str, Any] = {}
+    for body in BODIES:
+        _leap_experiments(body, workers, res, {}, grf_curves)
+        row, half = res[f"leap_{body}"], res[f"leap05_{body}"]
+        print(f"{body}: achieved {np.round(row['achieved'], 3).tolist()}, landed "
+              f"{sum(row['landed'])}/10 {row['landed']}; 0.5 m: {half}")  # fmt: skip
+    if out is not None:
+        panels = {b: (res[f"leap_{b}"]["commanded"], res[f"leap_{b}"]["achieved"]) for b in BODIES}
+        out.mkdir(parents=True, exist_ok=True)
+        commanded_plot(panels, out / "fig4_1_vertical_leap.png", quantity="height")
+        series_plot(grf_curves, out / "fig4_2_ground_force.png", xlabel="time (s)",
+                    ylabel="vertical GRF (body weights)", title="Leaps, ground reaction force")  # fmt: skip
+    if path is not None:
+        from reactmocap.io import atomic_write_text
+
+        full = json.loads(path.read_text()) if path.exists() else {"date": today}
+        full.update(res)
+        full["leaps_date"] = today
+        atomic_write_text(path, json.dumps(full, indent=1, default=str) + "\n")
+    return 0
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -411,17 +440,7 @@ def main() -> int:
                     help="only Fig. 4.1 and 4.2 (the vertical leaps), both bodies, into --json")  # fmt: skip
     args = ap.parse_args()
     if args.leaps:
-        res = {"date": datetime.date.today().isoformat()}
-        for body in BODIES:
-            _leap_experiments(body, args.workers, res, {}, {})
-            row, half = res[f"leap_{body}"], res[f"leap05_{body}"]
-            print(f"{body}: achieved {np.round(row['achieved'], 3).tolist()}, landed "
-                  f"{sum(row['landed'])}/10 {row['landed']}; 0.5 m: {half}")  # fmt: skip
-        if args.json is not None:
-            from reactmocap.io import atomic_write_text
-
-            atomic_write_text(args.json, json.dumps(res, indent=1, default=str) + "\n")
-        return 0
+        return _leaps_only(args.workers, args.json, args.out)
     if args.tables:
         build_tables(args.workers, tuple(args.parts.split(",")))
         return 0

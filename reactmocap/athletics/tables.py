@@ -26,6 +26,7 @@ __all__ = [
     "LEAP_LANDING_TABLE",
     "LEAP_TABLES",
     "SUPPORTED",
+    "VERTICAL_LANDING",
     "broad_params",
     "effort_for",
     "landing_delta",
@@ -39,8 +40,11 @@ def leap_params(s: float) -> LeapParams:
     """The vertical leap at effort ``s``: a deeper crouch and stiffer push as ``s`` grows (the
     thesis's Table 4.1 walks crouch height and torso pitch the same way)."""
     s = float(np.clip(s, 0.0, 1.0))
+    # the landing takes over at lift-off, not at the apex: its knees then reach their ready
+    # bend before touchdown (from the apex, a 0.3 m leap's landing had 0.25 s and touched
+    # down with the knees at 0.4 rad of 0.6; the female bounced off them)
     return LeapParams(leg=0.85 - 0.2 * s, pitch=0.0, lean=0.5, stiffness=0.1 + 0.9 * s,
-                      spin_gain=20.0)  # fmt: skip
+                      spin_gain=20.0, handover="liftoff")  # fmt: skip
 
 
 def broad_params(s: float) -> LeapParams:
@@ -64,10 +68,22 @@ LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType
 #: the landing's capture-point lead per body (tuned like the thesis's per-body deltas; a BVH
 #: body gets the landing's default)
 LANDING_LEADS: Mapping[str, float] = MappingProxyType({"male": 0.5, "female": 1.0})
-#: bodies whose landings after a leap use the delta table (measured on drops): the male's
+#: bodies whose landings after a broad jump use the delta table (measured on drops; vertical
+#: leaps use VERTICAL_LANDING where the body has one): the male's
 #: broad jumps landed 3 of 6 with it against 1 without; the female's fell in all 6 (her
 #: broad-jump landings want a delta near 0 where her drops want -0.12 at the same speed)
 LEAP_LANDING_TABLE: frozenset[str] = frozenset({"male"})
+#: the landing after a vertical leap, per body: (capture-point lead, foot-servo delta m), a
+#: constant delta (no table). Measured over the ten Fig. 4.1 commands (0.1-1.0 m, landed of 10,
+#: 2026-12-02): male delta -0.04 (the table's) / -0.01 / +0.04: 9 / 10 / 4; female (lead 0.5)
+#: -0.07 / -0.05 / -0.04 / -0.01: 8 / 10 / 10 / 7, and 1 with her drops' lead of 1.0 (a
+#: vertical leap drifts back at 0.15-0.6 m/s, and her drops' lead put the feet so far behind
+#: that the shins leaned 0.7 rad at touchdown and the ankles threw her back up once the
+#: landing stiffened). Her -0.05 over -0.04: on the leap table's 41 efforts it lands
+#: 0.07-0.76 m unbroken, where -0.04 lost the 0.39 m leap (range 0.41-0.87 m)
+VERTICAL_LANDING: Mapping[str, tuple[float, float]] = MappingProxyType(
+    {"male": (0.5, -0.01), "female": (0.5, -0.05)}
+)
 #: (behaviour, parameter) -> body -> (low, high): the measured supported range
 SUPPORTED: Mapping[tuple[str, str], Mapping[str, tuple[float, float]]] = MappingProxyType(
     measured.SUPPORTED
@@ -91,10 +107,16 @@ def landing_delta(table: tuple[tuple[float, float], ...], velocity: float) -> fl
     return float(np.interp(velocity, v, d))
 
 
-def landing_params(body: str, velocity: float, after_leap: bool = False) -> LandingParams:
+def landing_params(
+    body: str, velocity: float, after_leap: bool = False, vertical: bool = False
+) -> LandingParams:
     """The landing controller's parameters for a body and a horizontal velocity (m/s); the
     delta table goes with them (interpolated in the air) unless ``after_leap`` and the body
-    is not in :data:`LEAP_LANDING_TABLE`."""
+    is not in :data:`LEAP_LANDING_TABLE`. ``vertical``: after a vertical leap, the body's
+    :data:`VERTICAL_LANDING` where it has one."""
+    if vertical and body in VERTICAL_LANDING:
+        lead, delta = VERTICAL_LANDING[body]
+        return LandingParams(lead=lead, delta=delta)
     lead = LANDING_LEADS.get(body, LandingParams().lead)
     table = tuple(LANDING_DELTAS.get(body, ()))
     if after_leap and body not in LEAP_LANDING_TABLE:

@@ -33,6 +33,22 @@ def test_a_short_female_leap_never_bounces_off_its_landing() -> None:
     assert com.max() - com[0] < 0.15  # nothing after the touchdown went higher than the leap
 
 
+def test_vertical_leaps_land_with_the_ready_bend(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The landing takes over at lift-off, so its knees are bent ready at touchdown, and
+    places the feet by the vertical leap's own lead and delta. With her drops' landing (the
+    capture-point lead of 1.0) the female's half-metre leap falls."""
+    r = run("leap", "female", height=0.5, check_range=False)
+    assert r.report["landed"] and not r.report["fell"]
+    reach = next(t for t, _, target in r.transitions if target == "land.reach")
+    assert reach - r.report["time_to_liftoff_s"] < 0.02
+    m = run("leap", "male", height=0.2, check_range=False)  # fell before: feet too far back
+    assert m.report["landed"] and not m.report["fell"]
+    monkeypatch.setattr(tables, "VERTICAL_LANDING", {})
+    r0 = run("leap", "female", height=0.5, check_range=False)
+    assert abs(r0.report["achieved_height_m"] - r.report["achieved_height_m"]) < 0.01
+    assert not r0.report["landed"]
+
+
 def test_the_ground_force_of_a_standing_athlete_is_its_weight() -> None:
     r = run("balance", "female", seconds=1.0)
     t, force = ground_force(r.log, r.report["mass_kg"], np.array([0.0, 0.0, -9.81]))
