@@ -103,11 +103,11 @@ class WholeBodyTracker(AnchoredReference):
             pelvis targets ask more than the feet can give, the program otherwise bends the
             waist to hold the pelvis (a hip strategy that never comes back): on whole clips
             the waist drifted ~1 rad in the 0.5-1 s before most falls (``docs/tracking.md``).
-        trunk_give, trunk_band: once an external force has acted on the character
-            (``xfrc_applied``, e.g. a push), the trunk rows are off while the mocap stands
-            (both feet planted for ``step_time``) and the simulated capture point is more
-            than ``trunk_band`` m from the mocap's, and come back linearly over
-            ``trunk_give`` s after (0: they never give). Held, they kept the chest still where
+        trunk_give, trunk_band: while the mocap stands (both feet planted for
+            ``step_time``), the trunk rows are off while an external force acts on the
+            character (``xfrc_applied``, e.g. a push) and, after one, while the simulated
+            capture point is more than ``trunk_band`` m from the mocap's; they come back
+            linearly over ``trunk_give`` s after (0: they never give). Held, they kept the chest still where
             a standing body needs the hip strategy (a guard stance fell under 150 N
             sideways); a walk keeps them (it fell under smaller pushes without them).
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
@@ -514,13 +514,13 @@ class WholeBodyTracker(AnchoredReference):
         )  # fmt: skip
 
     def _trunk_weight(self, t: float) -> float:
-        """The trunk rows' weight at ``t``: off once an external force has acted, while the
-        mocap stands on both feet and the capture point is more than ``trunk_band`` m from
-        the mocap's; back linearly over ``trunk_give`` s after."""
+        """The trunk rows' weight at ``t``: while the mocap stands, off while an external force
+        acts and, after one, while the capture point is more than ``trunk_band`` m from the
+        mocap's; back linearly over ``trunk_give`` s after."""
         if not (self._w_trunk and self._give):
             return self._w_trunk
-        if not self._pushed:
-            self._pushed = bool(self.world.data.xfrc_applied[self.wc.body_ids].any())
+        pushing = bool(self.world.data.xfrc_applied[self.wc.body_ids].any())
+        self._pushed |= pushing
         i = self.clock.nearest(t)
         # standing: both feet planted for a balance step's time, as for balance steps (a
         # walk's double support is shorter; a walk kept its trunk rows, its figures dropped
@@ -528,7 +528,7 @@ class WholeBodyTracker(AnchoredReference):
         if self._pushed and self.path.planted[i : i + self._stand_frames].all():
             xi, omega = self.capture_point()
             c, v, _ = self.com_reference(t)
-            if np.linalg.norm(xi - c[:2] - v[:2] / omega) > self._give_band:
+            if pushing or np.linalg.norm(xi - c[:2] - v[:2] / omega) > self._give_band:
                 self._back_from = t
         return self._w_trunk * min(1.0, max(0.0, t - self._back_from) / self._give)
 
