@@ -151,8 +151,8 @@ def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:
     d = world.data
     spec = controller_spec("wholebody")
     wb = WholeBodyTracker(world, 0, guard, 0.0, kp_joint=1000.0, trunk_weight=30.0,
-                          trunk_give=0.5, servo_kv=float(spec.defaults["servo_kv"]),
-                          control_every=4)  # fmt: skip
+                          trunk_give=0.5, kp_root_pushed=30.0,
+                          servo_kv=float(spec.defaults["servo_kv"]), control_every=4)  # fmt: skip
     wb.reset(world)
     root = world.characters[0].qvel_slice.start
     d.qvel[root + 1] = 1.0  # the body moving sideways: its capture point ~0.3 m off
@@ -170,3 +170,25 @@ def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:
     assert wb._trunk_weight(1.0) == 30.0
     d.xfrc_applied[chest, 0] = 150.0  # off while a push acts, the capture point not yet off
     assert wb._trunk_weight(1.05) == 0.0
+    assert (wb.kp[:3] == 100.0).all()  # a standing body keeps its pelvis servo
+
+
+def test_a_pushed_step_softens_the_pelvis_servo(step_forward: Motion) -> None:
+    """A push while the mocap steps keeps the trunk rows and sets ``kp_root_pushed``; a reset
+    brings the built gains back."""
+    step = step_forward
+    world = World(build_character(step, frame=0))
+    world.set_from_motion(0, step, 0)
+    spec = controller_spec("wholebody")
+    wb = WholeBodyTracker(world, 0, step, 0.0, kp_joint=1000.0, trunk_weight=30.0,
+                          trunk_give=0.5, kp_root_pushed=30.0,
+                          servo_kv=float(spec.defaults["servo_kv"]), control_every=4)  # fmt: skip
+    wb.reset(world)
+    stepping = ~np.array([wb.path.planted[i : i + wb._stand_frames].all()
+                          for i in range(wb.path.num_frames)])  # fmt: skip
+    t = float(np.flatnonzero(stepping)[0]) / wb.path.fps
+    world.data.xfrc_applied[world.characters[0].body_id("chest"), 0] = 150.0
+    assert wb._trunk_weight(t) == 30.0
+    np.testing.assert_allclose(wb.kp[:3], 30.0)
+    wb.reset(world)
+    np.testing.assert_allclose(wb.kp[:3], 100.0)

@@ -110,6 +110,8 @@ class WholeBodyTracker(AnchoredReference):
             linearly over ``trunk_give`` s after (0: they never give). Held, they kept the chest still where
             a standing body needs the hip strategy (a guard stance fell under 150 N
             sideways); a walk keeps them (it fell under smaller pushes without them).
+        kp_root_pushed: with ``trunk_give``, a push that starts while the mocap does not stand
+            sets ``kp_root`` to this for the rest of the rollout (0: unchanged).
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
@@ -170,6 +172,7 @@ class WholeBodyTracker(AnchoredReference):
         trunk_weight: float = 0.0,
         trunk_give: float = 0.0,
         trunk_band: float = 0.1,
+        kp_root_pushed: float = 0.0,
         contact_weight: float = 1e4,
         contact_kv: float = 20.0,
         friction: float = 0.7,
@@ -205,6 +208,7 @@ class WholeBodyTracker(AnchoredReference):
                 "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint,
                 "root_weight": root_weight, "trunk_weight": trunk_weight, "contact_weight": contact_weight,
                 "trunk_give": trunk_give, "trunk_band": trunk_band,
+                "kp_root_pushed": kp_root_pushed,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
@@ -241,6 +245,7 @@ class WholeBodyTracker(AnchoredReference):
         self._w_trunk = float(trunk_weight)
         self._give = float(trunk_give)
         self._give_band = float(trunk_band)
+        self._kp_root_pushed = float(kp_root_pushed)
         self._pushed = False  # an external force has acted on the body
         self._back_from = -np.inf  # the last time they were off
         self._chest = int(wc.body_ids[SIM_BODIES.index("chest")])
@@ -520,12 +525,17 @@ class WholeBodyTracker(AnchoredReference):
         if not (self._w_trunk and self._give):
             return self._w_trunk
         pushing = bool(self.world.data.xfrc_applied[self.wc.body_ids].any())
-        self._pushed |= pushing
         i = self.clock.nearest(t)
         # standing: both feet planted for a balance step's time, as for balance steps (a
         # walk's double support is shorter; a walk kept its trunk rows, its figures dropped
         # where they gave in double support)
-        if self._pushed and self.path.planted[i : i + self._stand_frames].all():
+        standing = bool(self.path.planted[i : i + self._stand_frames].all())
+        if pushing and not self._pushed and not standing and self._kp_root_pushed:
+            # a walk pushed: a softer pelvis servo lets its steps catch it
+            self.kp[:3] = self._kp_root_pushed
+            self.kv[:3] = critical_kv(self._kp_root_pushed)
+        self._pushed |= pushing
+        if self._pushed and standing:
             xi, omega = self.capture_point()
             c, v, _ = self.com_reference(t)
             if pushing or np.linalg.norm(xi - c[:2] - v[:2] / omega) > self._give_band:
@@ -585,16 +595,20 @@ class WholeBodyTracker(AnchoredReference):
         self.kv[:] = self._kv0 * np.sqrt(scale)
 
     def memory(self) -> tuple[object, ...]:
-        return (*super().memory(), self._pushed, self._back_from)
+        return (*super().memory(), self._pushed, self._back_from, self.kp[:3].copy(),
+                self.kv[:3].copy())  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
-        super().restore(memory[:-2])
-        self._pushed = bool(memory[-2])
-        self._back_from = float(memory[-1])  # type: ignore[arg-type]
+        super().restore(memory[:-4])
+        self._pushed = bool(memory[-4])
+        self._back_from = float(memory[-3])  # type: ignore[arg-type]
+        self.kp[:3], self.kv[:3] = memory[-2], memory[-1]
 
     def reset(self, world: World) -> None:
         self.reset_ground(world)
         self._pushed, self._back_from = False, -np.inf
+        if self._kp_root_pushed:  # the pelvis servo as built
+            self.kp[:3], self.kv[:3] = self._kp0[:3], self._kv0[:3]
         servo = world.servo
         servo.enable(self.character, on=True)
         servo.set_gains(0.0, self.servo_kv, self.character)
