@@ -89,10 +89,12 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
         # a clip that falls unpushed in the window measures the tracker, not the push
         print(f"{name} falls unpushed within {args.after} s after {at} s: choose another clip")
         return [float("nan")] * 8
+    dirs = [k for k in range(8) if LABELS[k] in args.dirs]
     jobs = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.max_force,
-             args.steps) for k in range(8)]  # fmt: skip
+             args.steps) for k in dirs]  # fmt: skip
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-        return list(pool.map(largest, jobs))
+        found = dict(zip(dirs, pool.map(largest, jobs)))
+    return [found.get(k, float("nan")) for k in range(8)]
 
 
 def _label(params: dict[str, Any]) -> str:
@@ -115,6 +117,8 @@ def plot(out: Path, runs: list[dict[str, Any]]) -> None:
         ax.set_title(title, pad=14)
     for run in runs:
         for ax, key in zip(axes, ("standing", "walking")):
+            if key not in run:
+                continue
             forces = np.array(run[key]["max_force_n"])
             ax.plot(ang, ring(forces), "o-", label=f"{run[key]['clip']}, {_label(run['params'])}")
     axes[0].plot(ang, ring(np.array(WOOTEN_STANDING_N)), "--",
@@ -136,6 +140,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--steps", type=int, default=6, help="bisection halvings")
     ap.add_argument("--params", default="{}", help="controller parameters (JSON)")
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--only", choices=("standing", "walking"), help="measure one clip only")
+    ap.add_argument("--dirs", nargs="+", choices=LABELS, default=list(LABELS),
+                    help="directions to measure (the others print nan)")  # fmt: skip
     ap.add_argument("--json", type=Path, help="write the figures here")
     ap.add_argument("--plot", type=Path, help="write the polar plot (PNG) here")
     ap.add_argument("--overlay", type=Path, nargs="*", default=[],
@@ -152,6 +159,8 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     out: dict[str, Any] = {"labels": LABELS, "params": json.loads(args.params)}
     for key, dur in (("standing", 0.25), ("walking", 0.2)):
+        if args.only and key != args.only:
+            continue
         name, at = getattr(args, key).split(":")
         t0 = time.perf_counter()
         forces = measure(name, float(at), dur, args)

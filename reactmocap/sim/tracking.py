@@ -18,7 +18,6 @@ from reactmocap.metrics import FALL_FRACTION
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.sim.character import SIM_PARENTS, build_character
 from reactmocap.sim.controllers.registry import (
-    NOT_PUSHED,
     WHOLE_CLIP,
     build,
     controller_spec,
@@ -149,9 +148,8 @@ def track_clip(
     ``start``). ``root_assist > 0`` adds the NON-PHYSICAL root assist with that kp (only with
     ``"pd"``). ``parts``: the clip's body parts (default: mapped by name). ``on_tick(t,
     seconds)`` reports progress. The whole-body tracker gets the registry's
-    :data:`~reactmocap.sim.controllers.registry.WHOLE_CLIP` options under ``params`` (with
-    ``impacts``, without those in ``NOT_PUSHED``: the trunk rows held the chest still where a push
-    needs the waist to give, and the guard stance fell under 150 N sideways). A failure
+    :data:`~reactmocap.sim.controllers.registry.WHOLE_CLIP` options under ``params`` (their
+    trunk rows give after a push while the clip stands: ``trunk_give``). A failure
     is a result, not an exception: a fall ends the run
     there (``stop_on_fall``), a diverging simulation at its last stable frame, and the report's
     ``status`` says which."""
@@ -175,9 +173,7 @@ def track_clip(
         )
     given = {**(params or {}), **{k: v for k, v in (("kp", kp), ("kv", kv)) if v is not None}}
     if set(WHOLE_CLIP) <= set(spec.options):  # a whole clip, not a short window
-        # a pushed body needs the hip strategy the trunk rows forbid
-        given = {**{k: v for k, v in WHOLE_CLIP.items() if not (impacts and k in NOT_PUSHED)},
-                 **given}  # fmt: skip
+        given = {**WHOLE_CLIP, **given}
     resolved = spec.params(given)
     frame = round(start * motion.fps)
     character = build_character(motion, parts, total_mass=total_mass, frame=frame,

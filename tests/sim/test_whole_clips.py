@@ -138,3 +138,57 @@ def test_a_sliding_foot_is_not_planted(guard: Motion) -> None:
     assert path.planted[0].all() and still.planted.all()
     assert not glide.planted[2:-2].any()
     assert glide.sole is not None and glide.sole.shape == (20, 2, 3)
+
+
+def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:
+    """The whole-clip trunk rows keep their weight while nothing pushes (even with the capture
+    point off), are off while a push acts and until the capture point is back near the
+    standing mocap's, and come back over ``trunk_give`` after."""
+    import mujoco
+
+    world = World(build_character(guard, frame=0))
+    world.set_from_motion(0, guard, 0)
+    d = world.data
+    spec = controller_spec("wholebody")
+    wb = WholeBodyTracker(world, 0, guard, 0.0, kp_joint=1000.0, trunk_weight=30.0,
+                          trunk_give=0.5, kp_root_pushed=30.0,
+                          servo_kv=float(spec.defaults["servo_kv"]), control_every=4)  # fmt: skip
+    wb.reset(world)
+    root = world.characters[0].qvel_slice.start
+    d.qvel[root + 1] = 1.0  # the body moving sideways: its capture point ~0.3 m off
+    mujoco.mj_forward(world.model, d)
+    assert wb._trunk_weight(0.0) == 30.0  # a drift, not a push
+    chest = world.characters[0].body_id("chest")
+    d.xfrc_applied[chest, 1] = 150.0
+    assert wb._trunk_weight(0.05) == 0.0
+    d.xfrc_applied[chest] = 0.0
+    assert wb._trunk_weight(0.1) == 0.0  # the push is over, the capture point still off
+    d.qvel[:] = 0.0
+    mujoco.mj_forward(world.model, d)
+    assert wb._trunk_weight(0.15) == pytest.approx(30.0 * 0.05 / 0.5)
+    assert wb._trunk_weight(0.5) == pytest.approx(30.0 * 0.4 / 0.5)
+    assert wb._trunk_weight(1.0) == 30.0
+    d.xfrc_applied[chest, 0] = 150.0  # off while a push acts, the capture point not yet off
+    assert wb._trunk_weight(1.05) == 0.0
+    assert (wb.kp[:3] == 100.0).all()  # a standing body keeps its pelvis servo
+
+
+def test_a_pushed_step_softens_the_pelvis_servo(step_forward: Motion) -> None:
+    """A push while the mocap steps keeps the trunk rows and sets ``kp_root_pushed``; a reset
+    brings the built gains back."""
+    step = step_forward
+    world = World(build_character(step, frame=0))
+    world.set_from_motion(0, step, 0)
+    spec = controller_spec("wholebody")
+    wb = WholeBodyTracker(world, 0, step, 0.0, kp_joint=1000.0, trunk_weight=30.0,
+                          trunk_give=0.5, kp_root_pushed=30.0,
+                          servo_kv=float(spec.defaults["servo_kv"]), control_every=4)  # fmt: skip
+    wb.reset(world)
+    stepping = ~np.array([wb.path.planted[i : i + wb._stand_frames].all()
+                          for i in range(wb.path.num_frames)])  # fmt: skip
+    t = float(np.flatnonzero(stepping)[0]) / wb.path.fps
+    world.data.xfrc_applied[world.characters[0].body_id("chest"), 0] = 150.0
+    assert wb._trunk_weight(t) == 30.0
+    np.testing.assert_allclose(wb.kp[:3], 30.0)
+    wb.reset(world)
+    np.testing.assert_allclose(wb.kp[:3], 100.0)

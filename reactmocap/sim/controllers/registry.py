@@ -23,7 +23,6 @@ from reactmocap.sim.world import World
 
 __all__ = [
     "CONTROLLERS",
-    "NOT_PUSHED",
     "WHOLE_CLIP",
     "ControllerSpec",
     "Factory",
@@ -146,18 +145,17 @@ _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: ``docs/tracking.md``): corners within 3 mm support, a foot skimming the floor faster than
 #: 0.5 m/s is not planted, a heel raised 2 cm is let go, the ground path re-anchored to the
 #: feet (0.1 s), the targets keeping the capture point 5 cm inside them (0.1 s) and the chest's
-#: world turn held as tracked (weight 30, as the pelvis), the pelvis position servo at half
-#: stiffness (50 1/s^2). Without them
+#: world turn held as tracked (weight 30, as the pelvis; after a push they give while the mocap
+#: stands and the capture point is off, back over 0.5 s: the hip strategy a standing body
+#: needs), the pelvis position servo at half stiffness (50 1/s^2; 30 once a walk is pushed).
+#: Without them
 #: the tracker follows the captured world path, as the 1 s benchmark windows, predictive
 #: sampling and the response pipeline's physical mode expect.
 WHOLE_CLIP: Mapping[str, Param] = MappingProxyType(
     {"touch": 0.003, "slide_speed": 0.5, "roll_band": 0.02, "anchor_tau": 0.1, "balance_tau": 0.1,
-     "balance_margin": 0.05, "trunk_weight": 30.0, "kp_root": 50.0}
+     "balance_margin": 0.05, "trunk_weight": 30.0, "trunk_give": 0.5, "kp_root": 50.0,
+     "kp_root_pushed": 30.0}
 )  # fmt: skip
-#: the :data:`WHOLE_CLIP` options left at the constructor's defaults under a push: they hold
-#: the trunk and soften the pelvis against slow drift, where a push needs the waist to give
-#: (``docs/tracking.md``)
-NOT_PUSHED: tuple[str, ...] = ("trunk_weight", "kp_root")
 
 _REGISTRY: dict[str, ControllerSpec] = {
     "pd": ControllerSpec(

@@ -103,6 +103,15 @@ class WholeBodyTracker(AnchoredReference):
             pelvis targets ask more than the feet can give, the program otherwise bends the
             waist to hold the pelvis (a hip strategy that never comes back): on whole clips
             the waist drifted ~1 rad in the 0.5-1 s before most falls (``docs/tracking.md``).
+        trunk_give, trunk_band: while the mocap stands (both feet planted for
+            ``step_time``), the trunk rows are off while an external force acts on the
+            character (``xfrc_applied``, e.g. a push) and, after one, while the simulated
+            capture point is more than ``trunk_band`` m from the mocap's; they come back
+            linearly over ``trunk_give`` s after (0: they never give). Held, they kept the chest still where
+            a standing body needs the hip strategy (a guard stance fell under 150 N
+            sideways); a walk keeps them (it fell under smaller pushes without them).
+        kp_root_pushed: with ``trunk_give``, a push that starts while the mocap does not stand
+            sets ``kp_root`` to this for the rest of the rollout (0: unchanged).
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
@@ -161,6 +170,9 @@ class WholeBodyTracker(AnchoredReference):
         kv_joint: float | None = None,
         root_weight: float = 30.0,
         trunk_weight: float = 0.0,
+        trunk_give: float = 0.0,
+        trunk_band: float = 0.1,
+        kp_root_pushed: float = 0.0,
         contact_weight: float = 1e4,
         contact_kv: float = 20.0,
         friction: float = 0.7,
@@ -195,6 +207,8 @@ class WholeBodyTracker(AnchoredReference):
             {
                 "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint,
                 "root_weight": root_weight, "trunk_weight": trunk_weight, "contact_weight": contact_weight,
+                "trunk_give": trunk_give, "trunk_band": trunk_band,
+                "kp_root_pushed": kp_root_pushed,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
@@ -229,6 +243,11 @@ class WholeBodyTracker(AnchoredReference):
         self._free = np.zeros(0, dtype=bool)  # the last NNLS solution's positive coefficients
         self._wj = np.ones(3 * NJ)
         self._w_trunk = float(trunk_weight)
+        self._give = float(trunk_give)
+        self._give_band = float(trunk_band)
+        self._kp_root_pushed = float(kp_root_pushed)
+        self._pushed = False  # an external force has acted on the body
+        self._back_from = -np.inf  # the last time they were off
         self._chest = int(wc.body_ids[SIM_BODIES.index("chest")])
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
@@ -278,6 +297,7 @@ class WholeBodyTracker(AnchoredReference):
             step_margin=step_margin, step_time=step_time, step_height=step_height,
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
         )  # fmt: skip
+        self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
         self.kp_swing = float(kp_swing)
         self.kv_swing = critical_kv(kp_swing)
@@ -426,12 +446,13 @@ class WholeBodyTracker(AnchoredReference):
         tasks: list[tuple[F64, F64]] = []
         if nc:
             tasks.append((self._root_rows, self._w_root * acc_des[:6]))
-            if self._w_trunk:
+            w_trunk = self._trunk_weight(t)
+            if w_trunk:
                 # the chest's world turn as the plan's own targets turn it (pelvis, waist and
                 # back together): without it the least squares spent the waist to hold the
                 # pelvis, and whole clips fell after the waist had drifted ~1 rad
                 mujoco.mj_jac(m, d, None, self._jacr, d.xpos[self._chest], self._chest)
-                jt = self._jacr[:, sl] * self._w_trunk
+                jt = self._jacr[:, sl] * w_trunk
                 tasks.append((jt, jt @ acc_des))
             # the corners in contact do not move (J_c qdd + Jdot_c qdot = -k_c v_c), so the
             # planned forces are the ones MuJoCo's rigid-ish contact will produce: with only
@@ -497,6 +518,30 @@ class WholeBodyTracker(AnchoredReference):
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
 
+    def _trunk_weight(self, t: float) -> float:
+        """The trunk rows' weight at ``t``: while the mocap stands, off while an external force
+        acts and, after one, while the capture point is more than ``trunk_band`` m from the
+        mocap's; back linearly over ``trunk_give`` s after."""
+        if not (self._w_trunk and self._give):
+            return self._w_trunk
+        pushing = bool(self.world.data.xfrc_applied[self.wc.body_ids].any())
+        i = self.clock.nearest(t)
+        # standing: both feet planted for a balance step's time, as for balance steps (a
+        # walk's double support is shorter; a walk kept its trunk rows, its figures dropped
+        # where they gave in double support)
+        standing = bool(self.path.planted[i : i + self._stand_frames].all())
+        if pushing and not self._pushed and not standing and self._kp_root_pushed:
+            # a walk pushed: a softer pelvis servo lets its steps catch it
+            self.kp[:3] = self._kp_root_pushed
+            self.kv[:3] = critical_kv(self._kp_root_pushed)
+        self._pushed |= pushing
+        if self._pushed and standing:
+            xi, omega = self.capture_point()
+            c, v, _ = self.com_reference(t)
+            if pushing or np.linalg.norm(xi - c[:2] - v[:2] / omega) > self._give_band:
+                self._back_from = t
+        return self._w_trunk * min(1.0, max(0.0, t - self._back_from) / self._give)
+
     def _swing_task(
         self, f: int, v: F64, p_d: F64, v_d: F64, a_d: F64, up_d: F64 | None
     ) -> tuple[F64, F64]:
@@ -549,8 +594,21 @@ class WholeBodyTracker(AnchoredReference):
         self.kp[:] = self._kp0 * scale
         self.kv[:] = self._kv0 * np.sqrt(scale)
 
+    def memory(self) -> tuple[object, ...]:
+        return (*super().memory(), self._pushed, self._back_from, self.kp[:3].copy(),
+                self.kv[:3].copy())  # fmt: skip
+
+    def restore(self, memory: tuple[object, ...]) -> None:
+        super().restore(memory[:-4])
+        self._pushed = bool(memory[-4])
+        self._back_from = float(memory[-3])  # type: ignore[arg-type]
+        self.kp[:3], self.kv[:3] = memory[-2], memory[-1]
+
     def reset(self, world: World) -> None:
         self.reset_ground(world)
+        self._pushed, self._back_from = False, -np.inf
+        if self._kp_root_pushed:  # the pelvis servo as built
+            self.kp[:3], self.kv[:3] = self._kp0[:3], self._kv0[:3]
         servo = world.servo
         servo.enable(self.character, on=True)
         servo.set_gains(0.0, self.servo_kv, self.character)
