@@ -49,6 +49,8 @@ NJ = len(BALL_JOINTS)
 ANKLE_LIMITS = (math.radians(-68.0), math.radians(90.0))
 #: standing hip-to-ankle length as a fraction of the straight leg (a knee slightly unlocked)
 STANDING_LEG = 0.985
+#: a foot whose sole is within this height (m) of the floor carries weight
+STANCE_REACH = 0.02
 _HIP = [joint_index(f"{s}_hip") for s in "lr"]
 _KNEE = [joint_index(f"{s}_knee") for s in "lr"]
 _ANKLE = [joint_index(f"{s}_ankle") for s in "lr"]
@@ -218,10 +220,17 @@ class BalanceLaw:
         self._support(s)
 
     def _level_legs(self, d, desired: F64) -> None:  # type: ignore[no-untyped-def]
-        """Leg by leg (eq. 7.5 per leg): the leg whose ankle stands higher (uphill on a
-        sideways slope) is shortened by the height difference, so the pelvis stays level."""
+        """Leg by leg (eq. 7.5 per leg): the leg whose ankle stands over higher floor (uphill
+        on a sideways slope) is shortened by the height difference, so the pelvis stays level.
+        The floor's height under each ankle, not the ankle's own: a heel or a foot that
+        lifts would otherwise shorten its leg and lengthen the other, lifting it further
+        (on flat floor that loop lifted a foot and launched the body out of a landing's
+        stand-up, docs/athletics.md)."""
         a = self.athlete
-        z = d.xanchor[self.ctx.senses.ankle_joints, 2]
+        s = self.ctx.senses
+        n = s.floor_normal
+        xy = d.xanchor[s.ankle_joints, :2]
+        z = -(xy @ n[:2]) / max(float(n[2]), 1e-6)  # the floor plane's height, up to a constant
         for k in range(2):
             knee = float(desired[_KNEE[k], 0])
             ul, ll = float(a.thigh[k]), float(a.shin[k])
@@ -230,16 +239,22 @@ class BalanceLaw:
             self.ctx.rig.offset[_KNEE[k], 0] = float(knee_for_length(ul, ll, level)[0]) - knee
 
     def _support(self, s) -> None:  # type: ignore[no-untyped-def]
-        """Weight shares of the feet in contact (by where the COM lies between them)."""
+        """Weight shares of the feet that stand (by where the COM lies between them): in
+        contact, or with the sole within :data:`STANCE_REACH` of the floor. A resting sole
+        loses its contacts for a step now and then; taking its share away unloads the leg,
+        which then lifts the foot (seen in the landings' stand-up, docs/athletics.md)."""
         rig = self.ctx.rig
         rig.support[:] = 0.0
-        feet = np.flatnonzero(s.foot_contact)
+        rel = s.sole_corners() - self.ctx.world.data.geom_xpos[s.floor]
+        near = (rel @ s.floor_normal).min(axis=1) < STANCE_REACH
+        feet = np.flatnonzero(s.foot_contact | near)
         if feet.size == 0:
             return
         if feet.size == 1:
             rig.support[feet[0]] = 1.0
             return
-        a, b = s.foot_point[0, :2], s.foot_point[1, :2]
+        pts = np.where(s.foot_contact[:, None], s.foot_point, s.sole_corners().mean(axis=1))
+        a, b = pts[0, :2], pts[1, :2]
         ab = b - a
         w = float(np.clip(np.dot(s.com[:2] - a, ab) / max(float(ab @ ab), 1e-9), 0.0, 1.0))
         rig.support[:] = (1.0 - w, w)
