@@ -49,8 +49,6 @@ NJ = len(BALL_JOINTS)
 ANKLE_LIMITS = (math.radians(-68.0), math.radians(90.0))
 #: standing hip-to-ankle length as a fraction of the straight leg (a knee slightly unlocked)
 STANDING_LEG = 0.985
-#: a foot whose sole is within this height (m) of the floor carries weight
-STANCE_REACH = 0.02
 _HIP = [joint_index(f"{s}_hip") for s in "lr"]
 _KNEE = [joint_index(f"{s}_knee") for s in "lr"]
 _ANKLE = [joint_index(f"{s}_ankle") for s in "lr"]
@@ -239,22 +237,16 @@ class BalanceLaw:
             self.ctx.rig.offset[_KNEE[k], 0] = float(knee_for_length(ul, ll, level)[0]) - knee
 
     def _support(self, s) -> None:  # type: ignore[no-untyped-def]
-        """Weight shares of the feet that stand (by where the COM lies between them): in
-        contact, or with the sole within :data:`STANCE_REACH` of the floor. A resting sole
-        loses its contacts for a step now and then; taking its share away unloads the leg,
-        which then lifts the foot (seen in the landings' stand-up, docs/athletics.md)."""
+        """Weight shares of the feet in contact (by where the COM lies between them)."""
         rig = self.ctx.rig
         rig.support[:] = 0.0
-        rel = s.sole_corners() - self.ctx.world.data.geom_xpos[s.floor]
-        near = (rel @ s.floor_normal).min(axis=1) < STANCE_REACH
-        feet = np.flatnonzero(s.foot_contact | near)
+        feet = np.flatnonzero(s.foot_contact)
         if feet.size == 0:
             return
         if feet.size == 1:
             rig.support[feet[0]] = 1.0
             return
-        pts = np.where(s.foot_contact[:, None], s.foot_point, s.sole_corners().mean(axis=1))
-        a, b = pts[0, :2], pts[1, :2]
+        a, b = s.foot_point[0, :2], s.foot_point[1, :2]
         ab = b - a
         w = float(np.clip(np.dot(s.com[:2] - a, ab) / max(float(ab @ ab), 1e-9), 0.0, 1.0))
         rig.support[:] = (1.0 - w, w)

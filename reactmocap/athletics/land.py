@@ -17,7 +17,6 @@ import numpy as np
 
 from reactmocap.athletics.balance import (
     BALANCE_GAINS,
-    STANCE_REACH,
     BalanceLaw,
     Posture,
     hold_pelvis_and_feet,
@@ -59,6 +58,8 @@ PLAN_ROOM = 0.7
 KNEE_STOP = 0.0
 KNEE_GUARD = 0.2
 KNEE_GUARD_STIFFNESS = 1.0
+#: a foot within this height (m) of the floor after touchdown carries weight
+STANCE_REACH = 0.02
 
 
 @dataclass(frozen=True)
