@@ -218,10 +218,17 @@ class BalanceLaw:
         self._support(s)
 
     def _level_legs(self, d, desired: F64) -> None:  # type: ignore[no-untyped-def]
-        """Leg by leg (eq. 7.5 per leg): the leg whose ankle stands higher (uphill on a
-        sideways slope) is shortened by the height difference, so the pelvis stays level."""
+        """Leg by leg (eq. 7.5 per leg): the leg whose ankle stands over higher floor (uphill
+        on a sideways slope) is shortened by the height difference, so the pelvis stays level.
+        The floor's height under each ankle, not the ankle's own: a heel or a foot that
+        lifts would otherwise shorten its leg and lengthen the other, lifting it further
+        (on flat floor that loop lifted a foot and launched the body out of a landing's
+        stand-up, docs/athletics.md)."""
         a = self.athlete
-        z = d.xanchor[self.ctx.senses.ankle_joints, 2]
+        s = self.ctx.senses
+        n = s.floor_normal
+        xy = d.xanchor[s.ankle_joints, :2]
+        z = -(xy @ n[:2]) / max(float(n[2]), 1e-6)  # the floor plane's height, up to a constant
         for k in range(2):
             knee = float(desired[_KNEE[k], 0])
             ul, ll = float(a.thigh[k]), float(a.shin[k])
