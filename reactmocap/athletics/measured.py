@@ -154,6 +154,9 @@ SUPPORTED: dict[Any, Any] = {
     ("broad-jump", "distance"): {"male": (0.4524, 1.3568), "female": (0.3624, 0.9691)},
     ("land", "drop"): {"male": (0.0, 2.2), "female": (0.0, 2.5)},
     ("land", "vx"): {"male": (-2.0, 3.0), "female": (-1.0, 2.0)},
-    ("balance", "slope"): {"male": (0.0, 0.34033920413889424), "female": (0.0, 0.34033920413889424)},
+    ("balance", "slope"): {
+        "male": (0.0, 0.34033920413889424),
+        "female": (0.0, 0.34033920413889424),
+    },
 }
 MEASURED_ON = "2026-12-02 (bench_athletics.py --tables)"
