@@ -133,7 +133,7 @@ class VaultParams:
     land_delta: float = -0.107
     land_damping: float = 1.2
     land_knee_stiffness: float = 0.0
-    land_restore: float = 0.245
+    land_restore: float = 0.3
     land_lean: float = 0.396
     stand_leg: float = 0.9
     stand_settle: float = 0.5
