@@ -179,8 +179,10 @@ def _landing(ctx: Context, log: dict[str, np.ndarray], standing_pelvis: float) -
     td = ctx.touchdown_time
     weight = ctx.athlete.mass * float(np.linalg.norm(ctx.world.model.opt.gravity))
     t = log["t"]
-    grf = np.linalg.norm(log["grf"], axis=1) / weight
-    after = t >= (td if td is not None else np.inf)
+    # the tick-mean force from the momentum, as peak_grf_bw (report.ground_force says why)
+    tf, force = ground_force(log, ctx.rig.mass, ctx.world.model.opt.gravity)
+    grf = np.linalg.norm(force, axis=1) / weight
+    after = tf >= (td if td is not None else np.inf)
     went_down = fell(ctx, standing_pelvis)
     end = float(t[-1]) if t.size else 0.0
     landed = (td is not None and not went_down and end >= td + LANDED_AFTER - 1e-6

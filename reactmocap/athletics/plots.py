@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from reactmocap.athletics.report import ground_force
 from reactmocap.io import save_png
 from reactmocap.response.plots import _pyplot
 
@@ -31,7 +32,9 @@ def run_plot(result, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 5), dpi=100, sharex=True)
     a1.plot(t, log["com"][:, 2], "k-", lw=1.5)
     a1.set_ylabel("COM height (m)")
-    a2.plot(t, log["grf"][:, 2] / weight, "b-", lw=1.0)
+    # the tick-mean force from the momentum, as the report's peak_grf_bw (not a sampled contact)
+    tf, force = ground_force(log, result.report["mass_kg"], np.array([0.0, 0.0, -9.81]))
+    a2.plot(tf, force[:, 2] / weight, "b-", lw=1.0)
     a2.set_ylabel("vertical GRF (BW)")
     a2.set_xlabel("time (s)")
     for time, _src, dst in result.transitions:

@@ -78,6 +78,13 @@ def test_flight_conserves_angular_momentum() -> None:
 def test_a_half_metre_drop_lands() -> None:
     r = run("land", "male", drop=0.5)
     assert r.report["landed"] and not r.report["fell"]
+    # the landing's peak is the tick-mean ground force after touchdown, as the push-off's
+    # peak_grf_bw (once a sampled contact force, which read a chattering contact wrongly)
+    t, force = ground_force(r.log, r.report["mass_kg"], np.array([0.0, 0.0, -9.81]))
+    after = t >= r.report["touchdown_s"]
+    peak = np.linalg.norm(force[after], axis=1).max() / (r.report["mass_kg"] * 9.81)
+    assert r.report["landing_peak_grf_bw"] == pytest.approx(peak, rel=0.02)
+    assert 2.0 < r.report["landing_peak_grf_bw"] < 40.0
 
 
 def test_a_3_metre_drop_is_never_a_success() -> None:
