@@ -91,16 +91,18 @@ def _geom_xml(m: mujoco.MjModel, g: int, bits: int) -> str:
                                                           "cylinder": 2}.get(kind, 3)])  # fmt: skip
     pos = " ".join(f"{x:.5f}" for x in m.geom_pos[g])
     quat = " ".join(f"{x:.6f}" for x in m.geom_quat[g])
-    xml = (f'<geom type="{kind}" size="{size}" pos="{pos}" quat="{quat}" contype="{bits}" '
-           f'conaffinity="0" density="0" rgba="0.35 0.55 0.85 1"/>')  # fmt: skip
+
+    def geom(kind: str, rgba: str) -> str:
+        return (f'<geom type="{kind}" size="{size}" pos="{pos}" quat="{quat}" contype="{bits}" '
+                f'conaffinity="0" density="0" rgba="{rgba}"/>')  # fmt: skip
+
+    xml = geom(kind, "0.35 0.55 0.85 1")
     if kind == "capsule":
         # an invisible cylinder twin: MuJoCo 4.0.0's capsule-triangle test only finds a
         # capsule's end over a triangle or a triangle's corner in the capsule, so a limb
         # lying across a triangle (corners outside) makes no contact; the cylinder goes
         # through the general convex test, which finds it (the capsule keeps the ends)
-        xml += xml.replace('type="capsule"', 'type="cylinder"').replace(
-            'rgba="0.35 0.55 0.85 1"', 'rgba="0 0 0 0"'
-        )
+        xml += geom("cylinder", "0 0 0 0")
     return xml
 
 

@@ -157,19 +157,19 @@ def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:
     root = world.characters[0].qvel_slice.start
     d.qvel[root + 1] = 1.0  # the body moving sideways: its capture point ~0.3 m off
     mujoco.mj_forward(world.model, d)
-    assert wb._trunk_weight(0.0) == 30.0  # a drift, not a push
+    assert wb._push_response(0.0) == 30.0  # a drift, not a push
     chest = world.characters[0].body_id("chest")
     d.xfrc_applied[chest, 1] = 150.0
-    assert wb._trunk_weight(0.05) == 0.0
+    assert wb._push_response(0.05) == 0.0
     d.xfrc_applied[chest] = 0.0
-    assert wb._trunk_weight(0.1) == 0.0  # the push is over, the capture point still off
+    assert wb._push_response(0.1) == 0.0  # the push is over, the capture point still off
     d.qvel[:] = 0.0
     mujoco.mj_forward(world.model, d)
-    assert wb._trunk_weight(0.15) == pytest.approx(30.0 * 0.05 / 0.5)
-    assert wb._trunk_weight(0.5) == pytest.approx(30.0 * 0.4 / 0.5)
-    assert wb._trunk_weight(1.0) == 30.0
+    assert wb._push_response(0.15) == pytest.approx(30.0 * 0.05 / 0.5)
+    assert wb._push_response(0.5) == pytest.approx(30.0 * 0.4 / 0.5)
+    assert wb._push_response(1.0) == 30.0
     d.xfrc_applied[chest, 0] = 150.0  # off while a push acts, the capture point not yet off
-    assert wb._trunk_weight(1.05) == 0.0
+    assert wb._push_response(1.05) == 0.0
     assert (wb.kp[:3] == 100.0).all()  # a standing body keeps its pelvis servo
 
 
@@ -188,7 +188,7 @@ def test_a_pushed_step_softens_the_pelvis_servo(step_forward: Motion) -> None:
                           for i in range(wb.path.num_frames)])  # fmt: skip
     t = float(np.flatnonzero(stepping)[0]) / wb.path.fps
     world.data.xfrc_applied[world.characters[0].body_id("chest"), 0] = 150.0
-    assert wb._trunk_weight(t) == 30.0
+    assert wb._push_response(t) == 30.0
     np.testing.assert_allclose(wb.kp[:3], 30.0)
     wb.reset(world)
     np.testing.assert_allclose(wb.kp[:3], 100.0)

@@ -247,6 +247,7 @@ class WholeBodyTracker(AnchoredReference):
         self._give_band = float(trunk_band)
         self._kp_root_pushed = float(kp_root_pushed)
         self._pushed = False  # an external force has acted on the body
+        self._xfrc = np.zeros((len(wc.body_ids), 6))
         self._back_from = -np.inf  # the last time they were off
         self._chest = int(wc.body_ids[SIM_BODIES.index("chest")])
         self.sqrt_wc = float(np.sqrt(contact_weight))
@@ -446,7 +447,7 @@ class WholeBodyTracker(AnchoredReference):
         tasks: list[tuple[F64, F64]] = []
         if nc:
             tasks.append((self._root_rows, self._w_root * acc_des[:6]))
-            w_trunk = self._trunk_weight(t)
+            w_trunk = self._push_response(t)
             if w_trunk:
                 # the chest's world turn as the plan's own targets turn it (pelvis, waist and
                 # back together): without it the least squares spent the waist to hold the
@@ -518,13 +519,16 @@ class WholeBodyTracker(AnchoredReference):
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
 
-    def _trunk_weight(self, t: float) -> float:
-        """The trunk rows' weight at ``t``: while the mocap stands, off while an external force
-        acts and, after one, while the capture point is more than ``trunk_band`` m from the
-        mocap's; back linearly over ``trunk_give`` s after."""
+    def _push_response(self, t: float) -> float:
+        """Follows pushes and returns the trunk rows' weight at ``t``: while the mocap stands,
+        off while an external force acts and, after one, while the capture point is more than
+        ``trunk_band`` m from the mocap's; back linearly over ``trunk_give`` s after. A walk
+        pushed gets the softer pelvis servo (``kp_root_pushed``)."""
         if not (self._w_trunk and self._give):
             return self._w_trunk
-        pushing = bool(self.world.data.xfrc_applied[self.wc.body_ids].any())
+        # into a buffer: this runs every control tick
+        np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
+        pushing = bool(self._xfrc.any())
         i = self.clock.nearest(t)
         # standing: both feet planted for a balance step's time, as for balance steps (a
         # walk's double support is shorter; a walk kept its trunk rows, its figures dropped
