@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -199,12 +200,14 @@ def _controller(
     ref: Motion | F64,
     start: float,
     fps: float,
+    options: dict[str, Any] | None = None,
 ) -> Controller:
-    """A registered controller with the scenario's ``[response]`` gains (``None``: its own)."""
+    """A registered controller with the scenario's ``[response]`` gains (``None``: its own)
+    and ``options``."""
     path = reference_path(world, c, ref, fps=fps) if isinstance(ref, np.ndarray) else ref
     gains = {k: v for k, v in (("kp", cfg.kp), ("kv", cfg.kv))
              if k in controller_spec(name).defaults}  # fmt: skip
-    return build(name, world, path, gains, character=c, start=start)
+    return build(name, world, path, {**gains, **(options or {})}, character=c, start=start)
 
 
 @dataclass(frozen=True)
@@ -523,7 +526,11 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     every = int(controller_spec(name).defaults["control_every"] or 1)
     yields = yields_to(cfg, naive.impulse)
     q, rate = _recipient_path(cast, cfg, rewind, seconds, every, naive.impact_time, yields, cont)
-    recipient = _controller(name, cfg, world, 0, q, 0.0, rate)
+    # the physical mode's body keeps its balance through a hit its ankles cannot take (it gives
+    # way above the hips only): yielding whole, it is still off balance when the found clip
+    # starts and falls from it (docs/benchmarks.md)
+    options = {"hold_balance": True} if physical else None
+    recipient = _controller(name, cfg, world, 0, q, 0.0, rate, options)
     if yields and isinstance(recipient, GainScalable):
         recipient = Scheduled(recipient, yield_schedule(cfg, naive.impact_time - rewind))
     ctrls = [recipient]

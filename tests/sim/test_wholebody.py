@@ -9,6 +9,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.motion import Motion
@@ -23,7 +24,7 @@ from reactmocap.sim import (
     rollout,
     track_clip,
 )
-from reactmocap.sim.character import PATCH_GEOM_GROUP
+from reactmocap.sim.character import BALL_JOINTS, PATCH_GEOM_GROUP
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "mocap"
 
@@ -311,3 +312,41 @@ def test_trunk_rows_keep_the_chest_turning_as_tracked(guard: Motion) -> None:
         misses.append(float(np.linalg.norm(jr[:, sl] @ (plan.qacc - plan.desired_qacc))))
     assert misses[0] > 10.0, misses  # rad/s^2: the offset is big enough to matter
     assert misses[1] < 0.1 * misses[0], misses
+
+
+def test_hold_balance_keeps_the_pelvis_and_legs_stiff_once_the_capture_point_leaves_the_feet(
+    guard: Motion,
+) -> None:
+    # the body set off its reference at the pelvis, a knee and an elbow, standing still or
+    # thrown forward at 2 m/s (its capture point ~0.6 m ahead of the feet); the desired
+    # accelerations of one control tick at full gains or yielding to 10%
+    frame = 10
+    t = frame / guard.fps
+    rows = {j: 6 + 3 * BALL_JOINTS.index(j) + np.arange(3) for j in ("l_knee", "l_elbow")}
+
+    def desired(speed: float, scale: float, **kw: bool) -> NDArray[np.float64]:
+        world = World(build_character(guard, frame=frame))
+        world.set_from_motion(0, guard, frame)
+        wc = world.characters[0]
+        world.data.qvel[wc.qvel_slice] = 0.0
+        world.data.qvel[wc.qvel_slice.start] = speed
+        world.data.qpos[wc.qpos_slice.start] += 0.05
+        for joint in ("l_knee", "l_elbow"):
+            k = wc.qpos_slice.start + 7 + 4 * BALL_JOINTS.index(joint)
+            world.data.qpos[k : k + 4] = [np.cos(0.1), np.sin(0.1), 0.0, 0.0]
+        mujoco.mj_forward(world.model, world.data)
+        wb = _tracker(world, guard, t, **kw)  # type: ignore[arg-type]
+        wb.scale_gains(scale)
+        wb.control(world, t)
+        assert wb.last_plan is not None
+        return wb.last_plan.desired_qacc
+
+    thrown = {"full": desired(2.0, 1.0), "low": desired(2.0, 0.1),
+              "held": desired(2.0, 0.1, hold_balance=True)}  # fmt: skip
+    for r in (np.arange(6), rows["l_knee"]):  # the pelvis and the knee keep their gains
+        np.testing.assert_allclose(thrown["held"][r], thrown["full"][r])
+        assert not np.allclose(thrown["low"][r], thrown["full"][r])
+    np.testing.assert_allclose(thrown["held"][rows["l_elbow"]], thrown["low"][rows["l_elbow"]])
+    assert not np.allclose(thrown["held"][rows["l_elbow"]], thrown["full"][rows["l_elbow"]])
+    # standing still, the capture point is over the feet: everything yields
+    np.testing.assert_allclose(desired(0.0, 0.1, hold_balance=True), desired(0.0, 0.1))

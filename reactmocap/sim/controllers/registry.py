@@ -107,6 +107,7 @@ def _predictive(
     tracker = WholeBodyTracker(
         world, c, ref, start, kp_joint=wb["kp"], kv_joint=wb["kv"],
         servo_kv=wb["servo_kv"], control_every=wb["control_every"],
+        hold_balance=p.pop("hold_balance", False),
     )  # fmt: skip
     return PredictiveTracker(tracker, **p)
 
@@ -169,7 +170,8 @@ _REGISTRY: dict[str, ControllerSpec] = {
         "the feet)", _WHOLEBODY, _wholebody, _options(WholeBodyTracker)),
     "predictive": ControllerSpec(
         "predictive", "the whole-body tracker steered by predictive sampling (looks 0.5 s "
-        "ahead; ~40x slower)", _WHOLEBODY, _predictive, _options(PredictiveTracker)),
+        "ahead; ~40x slower)", _WHOLEBODY, _predictive,
+        (*_options(PredictiveTracker), "hold_balance")),
     "passive": ControllerSpec(
         "passive", "no control: the servo off, joint damping and limits only (a ragdoll)",
         {"control_every": 10}, _passive),

@@ -23,6 +23,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.anchoring import AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
+from reactmocap.sim.controllers.stepping import outside_distance
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
@@ -148,6 +149,11 @@ class WholeBodyTracker(AnchoredReference):
             ``place_deadband`` m from the mocap's, the foot lands ``place_gain`` times that
             error (at most 0.4 m) from the mocap's landing (0: off; see ``docs/tracking.md``).
         servo_kv: the servo's damping (1/s).
+        hold_balance: once the simulated capture point leaves the feet on the floor (a hit
+            the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
+            the rollout, whatever :meth:`scale_gains` asks: the body gives way above the hips
+            and keeps its balance (the response's physical mode; a lighter hit yields whole;
+            ``docs/benchmarks.md``).
 
     The constructor's defaults are the short-window tracker (the captured world path, every
     touching corner, any foot near the floor; chosen on the benchmark's 1 s windows);
@@ -197,6 +203,7 @@ class WholeBodyTracker(AnchoredReference):
         place_gain: float = 0.0,
         place_deadband: float = 0.15,
         place_height: float = 0.03,
+        hold_balance: bool = False,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -218,7 +225,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height,
-                "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint,
+                "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
         servo = world.servo
@@ -306,6 +313,10 @@ class WholeBodyTracker(AnchoredReference):
             [BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"
         ]
         self._leg_rows = [np.concatenate([3 * k + np.arange(3) for k in leg]) for leg in legs]
+        self._hold_balance = bool(hold_balance)
+        self._stance_rows = np.r_[np.arange(6), 6 + np.concatenate(self._leg_rows)]
+        self._holding = False  # hold_balance has taken hold
+        self._scale = 1.0  # the last scale_gains
         self.release()
 
     # ------------------------------------------------------------------ control
@@ -594,23 +605,41 @@ class WholeBodyTracker(AnchoredReference):
         return x
 
     def scale_gains(self, scale: float) -> None:
-        """The tracking gains (joints and pelvis) times ``scale``, damping times its root."""
+        """The tracking gains (joints and pelvis; not the pelvis and legs once
+        ``hold_balance`` holds them) times ``scale``, damping times its root."""
+        self._scale = float(scale)
         self.kp[:] = self._kp0 * scale
         self.kv[:] = self._kv0 * np.sqrt(scale)
+        if self._holding:
+            r = self._stance_rows
+            self.kp[r], self.kv[r] = self._kp0[r], self._kv0[r]
+
+    def _check_balance(self, t: float) -> None:
+        """``hold_balance``: hold the pelvis and leg rows once the simulated capture point is
+        outside the feet on the floor."""
+        feet = [f for f in self._footprint(t) if len(f)]
+        if not feet:
+            return
+        xi, _ = self.capture_point()
+        if outside_distance(xi, np.concatenate(feet)) > 0.0:
+            self._holding = True
+            self.scale_gains(self._scale)
 
     def memory(self) -> tuple[object, ...]:
         return (*super().memory(), self._pushed, self._back_from, self.kp[:3].copy(),
-                self.kv[:3].copy())  # fmt: skip
+                self.kv[:3].copy(), self._holding, self._scale)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
-        super().restore(memory[:-4])
-        self._pushed = bool(memory[-4])
-        self._back_from = float(memory[-3])  # type: ignore[arg-type]
-        self.kp[:3], self.kv[:3] = memory[-2], memory[-1]
+        super().restore(memory[:-6])
+        self._pushed = bool(memory[-6])
+        self._back_from = float(memory[-5])  # type: ignore[arg-type]
+        self.kp[:3], self.kv[:3] = memory[-4], memory[-3]
+        self._holding, self._scale = bool(memory[-2]), float(memory[-1])  # type: ignore[arg-type]
 
     def reset(self, world: World) -> None:
         self.reset_ground(world)
         self._pushed, self._back_from = False, -np.inf
+        self._holding = False
         if self._kp_root_pushed:  # the pelvis servo as built
             self.kp[:3], self.kv[:3] = self._kp0[:3], self._kv0[:3]
         servo = world.servo
@@ -630,6 +659,8 @@ class WholeBodyTracker(AnchoredReference):
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(patch[f]))
         self.update_ground(t)
+        if self._hold_balance and not self._holding:
+            self._check_balance(t)
         plan = self.plan(t)
         self.last_plan = plan
         # the servo (damping only by default) keeps acting between ticks; at the tick the
