@@ -542,6 +542,7 @@ class Cloth:
             "cloth_steps_over_1cm": self._over_1cm / max(self._ticks, 1),
             "cloth_surface_depth_max_m": self.surface_max,
             "cloth_surface_depth_median_m": float(np.median(surface)) if surface else 0.0,
+            "cloth_surface_depth_p95_m": float(np.percentile(surface, 95)) if surface else 0.0,
             "cloth_frames_over_1cm": float(np.mean(np.array(surface) > 0.01)) if surface else 0.0,
             "cloth_finite": self.finite,
             "cloth_wall_s": self.wall_s,
