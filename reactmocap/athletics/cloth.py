@@ -63,6 +63,8 @@ class ClothSpec:
         #: the projection also stops a moved vertex moving into the body (its velocity
         #: along the surface normal is raised to the body surface's)
         self.project_velocity = True
+        #: how far a free vertex may go from where it was made on the leg (m; 0: anywhere)
+        self.tether = 0.05
 
 
 #: barycentric points of a triangle where the drawn surface's depth is sampled
@@ -297,6 +299,38 @@ class Cloth:
         self._geom_part = np.array([ids.get(int(b), -1) for b in mb])
         self._collider_setup()
 
+    def _tether_setup(self, free: NDArray[np.intp], flex: NDArray[np.intp]) -> None:
+        """Where each free vertex was made, carried by the pelvis, thigh and shin copies
+        (blended near the hip and the knee by its ring's place down the leg)."""
+        m, d = self.model, self.data
+        assert m is not None and d is not None
+        ring = (free - m.flex_vertadr[flex]) // self.spec.around
+        u = np.linspace(0.0, self.spec.hem, self.spec.rings)[ring]
+        w_pelvis = np.clip((0.4 - u) / 0.4, 0.0, 1.0)
+        w_shin = np.clip((u - 0.8) / 0.4, 0.0, 1.0)
+        self._tw = np.column_stack([w_pelvis, 1.0 - w_pelvis - w_shin, w_shin])
+        sides = np.array(["l", "r"])[flex]
+        parts = np.zeros((len(free), 3), dtype=np.intp)
+        for j, name in ((1, "thigh"), (2, "shin")):
+            parts[:, j] = [SIM_BODIES.index(f"{sd}_{name}") for sd in sides]
+        self._tparts = parts
+        b = np.array([m.body(f"b{i}").id for i in range(len(SIM_BODIES))])[parts]
+        x = d.flexvert_xpos[free]
+        self._tlocal = np.einsum("vjki,vjk->vji", d.xmat[b].reshape(*b.shape, 3, 3),
+                                 x[:, None] - d.xpos[b])  # fmt: skip
+
+    def _tether(self, x: F64, pos: F64, rot: F64) -> None:
+        """Keep each free vertex within ``spec.tether`` of where it was made on the leg
+        (NvCloth's "max distance" constraint): a loose tube cannot then fall across the limb
+        it hangs around, which neither the contacts nor the projection undo."""
+        p = self._tparts
+        home = np.einsum("vj,vjki,vji->vk", self._tw, rot[p], self._tlocal)
+        home += np.einsum("vj,vjk->vk", self._tw, pos[p])
+        off = x - home
+        dist = np.linalg.norm(off, axis=1)
+        far = dist > self.spec.tether
+        x[far] = home[far] + off[far] * (self.spec.tether / dist[far])[:, None]
+
     def _collider_setup(self) -> None:
         """What the vertex projection needs: the free vertices' slide-joint addresses and
         rest offsets in the pelvis copy's frame, the capsules (and the head's sphere, a
@@ -321,6 +355,7 @@ class Cloth:
             raise SimulationError("the cloth's vertices are expected to hang from the pelvis")
         flex = np.searchsorted(m.flex_vertadr, free, side="right") - 1
         self._vq = m.jnt_qposadr[m.body_jntadr[body]][:, None] + np.arange(3)
+        self._tether_setup(free, flex)
         self._vd = m.jnt_dofadr[m.body_jntadr[body]][:, None] + np.arange(3)
         self._vrest = m.body_pos[body].copy()
         self._vmask = (m.geom_contype[caps][None] & affinity[flex][:, None]) > 0
@@ -413,6 +448,8 @@ class Cloth:
         a = np.einsum("gij,gj->gi", rot[part], self._cpos) + pos[part]
         ax = np.einsum("gij,gj->gi", rot[part], self._caxis)
         x = (self._vrest + d.qpos[self._vq]) @ r0.T + p0
+        if self.spec.tether > 0:
+            self._tether(x, pos, rot)
         # later passes look only at the vertices the one before moved (the others are out)
         v = np.arange(len(x))
         moved: list[NDArray[np.intp]] = []
@@ -434,7 +471,7 @@ class Cloth:
             moved.append(v)
             normals.append(normal)
             caps.append(g)
-        if not moved:
+        if not moved and self.spec.tether <= 0:
             return
         d.qpos[self._vq] = (x - p0) @ r0 - self._vrest
         if velocity is None:

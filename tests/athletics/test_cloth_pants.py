@@ -159,12 +159,14 @@ def test_a_moved_vertex_stops_moving_into_the_limb() -> None:
     """With the bodies' velocities, the projection also takes away a moved vertex's velocity
     into the limb relative to the limb's surface (here the thigh moving forward at 1 m/s and
     the vertex going in at 2 m/s), keeps its sliding along the limb, and leaves a vertex
-    moving out of the limb alone."""
+    moving out of the limb alone (the tether off: it would pull the vertex home first)."""
     from reactmocap.athletics.bodies import athlete
     from reactmocap.athletics.scene import athletics_world
 
     world = athletics_world(athlete("male"))
-    cloth = Cloth(world, "pants")
+    spec = ClothSpec()
+    spec.tether = 0.0
+    cloth = Cloth(world, spec)
     cloth.reset(world)
     m, d = cloth.model, cloth.data
     wd = world.data
@@ -200,3 +202,31 @@ def test_a_moved_vertex_stops_moving_into_the_limb() -> None:
     cloth._project(pos, rot)
     np.testing.assert_array_equal(d.qvel, before)
     assert not np.array_equal(d.qpos, q)
+
+
+def test_a_vertex_is_kept_near_where_it_was_made_on_the_leg() -> None:
+    """The tether pulls a cloth vertex that has gone 20 cm from its place on the leg (out in
+    the air, in no capsule) back to the tether's length from it, and leaves the others, all
+    where they were made, alone."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+
+    world = athletics_world(athlete("male"))
+    cloth = Cloth(world, "pants")
+    cloth.reset(world)
+    d = cloth.data
+    ids = cloth.wc.body_ids
+    pos, rot = world.data.xpos[ids].copy(), world.data.xmat[ids].reshape(-1, 3, 3).copy()
+    r0, p0 = rot[0], pos[0]
+    made = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    v = int(np.argmax(made[:, 2]))  # a vertex of the top free ring
+    x = made.copy()
+    x[v] += [0.0, 0.0, 0.2]  # straight up, above the hips
+    d.qpos[cloth._vq] = (x - p0) @ r0 - cloth._vrest
+    cloth._project(pos, rot)
+    after = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    assert np.linalg.norm(after[v] - made[v]) == pytest.approx(cloth.spec.tether, abs=1e-9)
+    others = np.arange(len(made)) != v
+    moved = np.linalg.norm(after[others] - made[others], axis=1) > 1e-9
+    # the start pose puts four vertices inside the forearms and hands (at the hips)
+    assert moved.sum() == 4
