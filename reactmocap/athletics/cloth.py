@@ -3,10 +3,11 @@ the simulated runner): loose trousers as MuJoCo flex cloth (``flexcomp``, one tu
 hanging from the waist, inextensible edges), in a model of their own where the runner's
 bodies are copies of its collision geoms, set at every cloth step to where the runner's
 bodies are and how fast they move (so the contacts see them move); before each step, cloth
-vertices found inside a body capsule are moved out along its radius (the contacts alone let a
-fast limb drag the cloth into itself). The cloth collides with them and drapes and swings; by
-default nothing acts back on the runner (the paper's one-way coupling), and with
-``feedback`` the cloth's contact forces are applied to the runner's bodies (one tick late).
+vertices found inside a body capsule are moved out along its radius and stopped from moving
+further in (the contacts alone let a fast limb drag the cloth into itself). The cloth
+collides with them and drapes and swings; by default nothing acts back on the runner (the
+paper's one-way coupling), and with ``feedback`` the cloth's contact forces are applied to
+the runner's bodies (one tick late).
 Why a model of its own: ``docs/athletics.md``."""
 
 from __future__ import annotations
@@ -46,6 +47,12 @@ class ClothSpec:
                 raise ConfigError(f"cloth {name} must be > 0, got {v!r}")
         self.rings, self.around, self.slack, self.mass = rings, around, slack, mass
         self.iterations = 15
+        #: the cloth-body contacts' time constant (s): under MuJoCo's safe minimum of two
+        #: steps (its ``refsafe`` check is off in the cloth model), so a fast limb is stopped
+        #: within a step
+        self.contact_time = 0.006
+        #: CG's line-search iterations (MuJoCo's default 50): 5 does as well here, cheaper
+        self.ls_iterations = 5
         #: stretchy (sweatpants): the edges are soft equality constraints of this time
         #: constant (s, at least two cloth steps), with damping
         self.stretch = 0.015
@@ -53,6 +60,11 @@ class ClothSpec:
         self.thickness, self.timestep, self.hem = thickness, timestep, hem
         #: passes of the vertex projection out of the body's capsules (0: contacts only)
         self.project = 2
+        #: the projection also stops a moved vertex moving into the body (its velocity
+        #: along the surface normal is raised to the body surface's)
+        self.project_velocity = True
+        #: how far a free vertex may go from where it was made on the leg (m; 0: anywhere)
+        self.tether = 0.05
 
 
 #: barycentric points of a triangle where the drawn surface's depth is sampled
@@ -158,6 +170,7 @@ class Cloth:
         self.frame_bodies: list[F64] = []
         self.frame_times: list[float] = []
         self.wall_s = 0.0
+        self.cpu_s = 0.0
         self._next_frame = 0.0
         self._applied = np.zeros((len(SIM_BODIES), 6))
 
@@ -225,12 +238,15 @@ class Cloth:
         sp = self.spec
         ring = sp.around
         flexes = []
+        # the body parts each trouser leg meets (the contacts' and the projection's)
+        self._affinity: list[int] = []
         for side in ("l", "r"):
             pts = self._tube(side).reshape(-1, 3)
             # each trouser leg meets its own leg and the trunk and arms; the two legs of the
             # trousers do not squeeze between the thighs (there is no crotch), and the
             # waistband is sewn to the pelvis (pinned), so the pelvis is left out
             affinity = _BITS[side + "_"] | 2
+            self._affinity.append(affinity)
             local = (pts - pos0) @ rot0  # in the pelvis frame
             tris = []
             for j in range(sp.rings - 1):
@@ -245,7 +261,7 @@ class Cloth:
                 f'<edge equality="true" solref="{max(sp.stretch, 2 * sp.timestep)} 1" '
                 f'damping="{sp.stretch_damping}"/>'
                 f'<contact contype="0" conaffinity="{affinity}" selfcollide="none" '
-                f'solref="{2 * sp.timestep} 1" solimp="0.99 0.999 0.001"/>'
+                f'solref="{sp.contact_time} 1" solimp="0.99 0.999 0.001"/>'
                 f'<pin id="{" ".join(str(i) for i in range(ring))}"/></flexcomp>'
             )
         parts = []
@@ -259,7 +275,8 @@ class Cloth:
                          f"{geoms}{extra}</body>")  # fmt: skip
         xml = (
             f'<mujoco><option timestep="{sp.timestep}" solver="CG" iterations="{sp.iterations}" '
-            'integrator="implicitfast" gravity="0 0 -9.81"/>'
+            f'ls_iterations="{sp.ls_iterations}" '
+            'integrator="implicitfast" gravity="0 0 -9.81"><flag refsafe="disable"/></option>'
             '<visual><global offwidth="640" offheight="480"/></visual>'
             '<worldbody><light pos="0 0 6" dir="0 0 -1" directional="true"/>'
             '<geom name="floor" type="plane" size="0 0 0.05" rgba="0.82 0.84 0.86 1" '
@@ -282,6 +299,38 @@ class Cloth:
         self._geom_part = np.array([ids.get(int(b), -1) for b in mb])
         self._collider_setup()
 
+    def _tether_setup(self, free: NDArray[np.intp], flex: NDArray[np.intp]) -> None:
+        """Where each free vertex was made, carried by the pelvis, thigh and shin copies
+        (blended near the hip and the knee by its ring's place down the leg)."""
+        m, d = self.model, self.data
+        assert m is not None and d is not None
+        ring = (free - m.flex_vertadr[flex]) // self.spec.around
+        u = np.linspace(0.0, self.spec.hem, self.spec.rings)[ring]
+        w_pelvis = np.clip((0.4 - u) / 0.4, 0.0, 1.0)
+        w_shin = np.clip((u - 0.8) / 0.4, 0.0, 1.0)
+        self._tw = np.column_stack([w_pelvis, 1.0 - w_pelvis - w_shin, w_shin])
+        sides = np.array(["l", "r"])[flex]
+        parts = np.zeros((len(free), 3), dtype=np.intp)
+        for j, name in ((1, "thigh"), (2, "shin")):
+            parts[:, j] = [SIM_BODIES.index(f"{sd}_{name}") for sd in sides]
+        self._tparts = parts
+        b = np.array([m.body(f"b{i}").id for i in range(len(SIM_BODIES))])[parts]
+        x = d.flexvert_xpos[free]
+        self._tlocal = np.einsum("vjki,vjk->vji", d.xmat[b].reshape(*b.shape, 3, 3),
+                                 x[:, None] - d.xpos[b])  # fmt: skip
+
+    def _tether(self, x: F64, pos: F64, rot: F64) -> None:
+        """Keep each free vertex within ``spec.tether`` of where it was made on the leg
+        (NvCloth's "max distance" constraint): a loose tube cannot then fall across the limb
+        it hangs around, which neither the contacts nor the projection undo."""
+        p = self._tparts
+        home = np.einsum("vj,vjki,vji->vk", self._tw, rot[p], self._tlocal)
+        home += np.einsum("vj,vjk->vk", self._tw, pos[p])
+        off = x - home
+        dist = np.linalg.norm(off, axis=1)
+        far = dist > self.spec.tether
+        x[far] = home[far] + off[far] * (self.spec.tether / dist[far])[:, None]
+
     def _collider_setup(self) -> None:
         """What the vertex projection needs: the free vertices' slide-joint addresses and
         rest offsets in the pelvis copy's frame, the capsules (and the head's sphere, a
@@ -290,7 +339,8 @@ class Cloth:
         m = self.model
         assert m is not None
         b0 = int(m.body("b0").id)
-        hit = np.bitwise_or.reduce(m.flex_conaffinity)
+        affinity = np.array(self._affinity)
+        hit = np.bitwise_or.reduce(affinity)
         kinds = np.isin(m.geom_type, (_CAPSULE, _SPHERE))
         caps = np.flatnonzero((self._geom_part >= 0) & (m.geom_contype & hit > 0) & kinds)
         axes = np.zeros((len(caps), 3))
@@ -305,23 +355,23 @@ class Cloth:
             raise SimulationError("the cloth's vertices are expected to hang from the pelvis")
         flex = np.searchsorted(m.flex_vertadr, free, side="right") - 1
         self._vq = m.jnt_qposadr[m.body_jntadr[body]][:, None] + np.arange(3)
+        self._tether_setup(free, flex)
+        self._vd = m.jnt_dofadr[m.body_jntadr[body]][:, None] + np.arange(3)
         self._vrest = m.body_pos[body].copy()
-        self._vmask = (m.geom_contype[caps][None] & m.flex_conaffinity[flex][:, None]) > 0
+        self._vmask = (m.geom_contype[caps][None] & affinity[flex][:, None]) > 0
         self._cpart = self._geom_part[caps]
         self._cpos = m.geom_pos[caps].copy()
         self._caxis = axes
         self._chalf = np.where(m.geom_type[caps] == _CAPSULE, m.geom_size[caps, 1], 0.0)
         self._crad = m.geom_size[caps, 0] + self.spec.thickness
         self._cgeom = caps
-        # the drawn surface: each triangle's global vertex ids and its leg's capsules
-        elems, masks = [], []
+        # the drawn surface: each trouser leg's triangles (global vertex ids) and the capsules
+        # that leg meets (only those pairs are measured)
+        self._surface_sets: list[tuple[NDArray[np.intp], NDArray[np.intp]]] = []
         for f in range(m.nflex):
             adr, num = m.flex_elemdataadr[f], m.flex_elemnum[f]
-            elems.append(m.flex_elem[adr : adr + 3 * num].reshape(-1, 3) + m.flex_vertadr[f])
-            hits = (m.geom_contype[caps] & m.flex_conaffinity[f]) > 0
-            masks.append(np.repeat(hits[None], num, axis=0))
-        self._elems = np.concatenate(elems)
-        self._emask = np.concatenate(masks)[:, None, :]
+            elems = m.flex_elem[adr : adr + 3 * num].reshape(-1, 3) + m.flex_vertadr[f]
+            self._surface_sets.append((elems, np.flatnonzero(m.geom_contype[caps] & affinity[f])))
 
     # ------------------------------------------------------------------ controller
     def reset(self, world: World) -> None:
@@ -347,7 +397,7 @@ class Cloth:
 
     def control(self, world: World, t: float) -> None:
         assert self.model is not None and self.data is not None
-        wall = time.perf_counter()
+        wall, cpu = time.perf_counter(), time.process_time()
         m, d = self.model, self.data
         pos, quat = self._poses()
         vel, omega = self._velocities()
@@ -368,7 +418,9 @@ class Cloth:
             d.qvel[qvel[:, 3:]] = local
             if self.spec.project:
                 self._project(
-                    d.qpos[qpos[:, :3]], rot if not k else quat_to_matrix(d.qpos[qpos[:, 3:]])
+                    d.qpos[qpos[:, :3]],
+                    rot if not k else quat_to_matrix(d.qpos[qpos[:, 3:]]),
+                    (vel, omega) if self.spec.project_velocity else None,
                 )
             mujoco.mj_step(m, d)
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
@@ -378,12 +430,17 @@ class Cloth:
         if t + 1e-9 >= self._next_frame:
             self._record(t)
         self.wall_s += time.perf_counter() - wall
+        self.cpu_s += time.process_time() - cpu
 
-    def _project(self, pos: F64, rot: F64) -> None:
+    def _project(self, pos: F64, rot: F64, velocity: tuple[F64, F64] | None = None) -> None:
         """Move the free vertices that are inside a body capsule (closer to its axis than
         its radius and the cloth's thickness) out along the capsule's radius, a few passes
         for where capsules overlap (behind a bent knee): with the contacts alone, a fast
-        limb drags the cloth into itself, and once through, the cloth stays there."""
+        limb drags the cloth into itself, and once through, the cloth stays there. With
+        ``velocity`` (the bodies' world linear velocities at their origins and angular
+        velocities) a moved vertex also stops moving into the body: its velocity along the
+        capsule's outward normal is raised to the body surface's there (what the soft contacts
+        take several steps to do; its sliding along the surface is kept)."""
         d = self.data
         assert d is not None
         r0, p0 = rot[0], pos[0]
@@ -391,23 +448,44 @@ class Cloth:
         a = np.einsum("gij,gj->gi", rot[part], self._cpos) + pos[part]
         ax = np.einsum("gij,gj->gi", rot[part], self._caxis)
         x = (self._vrest + d.qpos[self._vq]) @ r0.T + p0
-        rows = np.arange(len(x))
-        moved = False
+        if self.spec.tether > 0:
+            self._tether(x, pos, rot)
+        # later passes look only at the vertices the one before moved (the others are out)
+        v = np.arange(len(x))
+        moved: list[NDArray[np.intp]] = []
+        normals: list[F64] = []
+        caps: list[NDArray[np.intp]] = []
         for _ in range(self.spec.project):
-            rel = x[:, None, :] - a[None]
+            rel = x[v, None, :] - a[None]
             s = np.clip(np.einsum("vgi,gi->vg", rel, ax), -self._chalf, self._chalf)
             off = rel - s[..., None] * ax[None]
             dist = np.sqrt(np.einsum("vgi,vgi->vg", off, off))
-            depth = np.where(self._vmask, self._crad - dist, 0.0)
+            depth = np.where(self._vmask[v], self._crad - dist, 0.0)
             g = depth.argmax(axis=1)
-            v = np.flatnonzero(depth[rows, g] > 0)
-            if not v.size:
+            k = np.flatnonzero(depth[np.arange(len(v)), g] > 0)
+            if not k.size:
                 break
-            gv = g[v]
-            x[v] += off[v, gv] * (depth[v, gv] / np.maximum(dist[v, gv], 1e-9))[:, None]
-            moved = True
-        if moved:
-            d.qpos[self._vq] = (x - p0) @ r0 - self._vrest
+            v, g = v[k], g[k]
+            normal = off[k, g] / np.maximum(dist[k, g], 1e-9)[:, None]
+            x[v] += normal * depth[k, g][:, None]
+            moved.append(v)
+            normals.append(normal)
+            caps.append(g)
+        if not moved and self.spec.tether <= 0:
+            return
+        d.qpos[self._vq] = (x - p0) @ r0 - self._vrest
+        if velocity is None:
+            return
+        vel, omega = velocity
+        qv = self._vd
+        # the vertices' world velocities: the pelvis copy's motion and their slide joints
+        xv = vel[0] + np.cross(omega[0], x - p0) + d.qvel[qv] @ r0.T
+        for v, normal, g in zip(moved, normals, caps):
+            b = part[g]
+            rel = xv[v] - (vel[b] + np.cross(omega[b], x[v] - pos[b]))
+            vn = np.einsum("vi,vi->v", rel, normal)
+            xv[v] -= np.minimum(vn, 0.0)[:, None] * normal
+        d.qvel[qv] = (xv - vel[0] - np.cross(omega[0], x - p0)) @ r0
 
     def _measure(self, world: World) -> None:
         assert self.model is not None and self.data is not None
@@ -456,15 +534,28 @@ class Cloth:
         contacts do not see a triangle that a limb has gone through between its corners."""
         m, d = self.model, self.data
         assert m is not None and d is not None
-        g = self._cgeom
-        pts = np.einsum("sk,ekd->esd", _SURFACE_SAMPLES, d.flexvert_xpos[self._elems])
-        ax = d.geom_xmat[g].reshape(-1, 3, 3)[:, :, 2]
-        rel = pts[:, :, None, :] - d.geom_xpos[g]
-        s = np.clip(np.einsum("esgi,gi->esg", rel, ax), -self._chalf, self._chalf)
-        off = rel - s[..., None] * ax
-        dist = np.sqrt(np.einsum("esgi,esgi->esg", off, off))
-        depth = np.where(self._emask, m.geom_size[g, 0] - dist, 0.0)
-        return max(0.0, float(depth.max()))
+        deepest = 0.0
+        for elems, c in self._surface_sets:
+            g = self._cgeom[c]
+            half = self._chalf[c]
+            radius = m.geom_size[g, 0]
+            corners = d.flexvert_xpos[elems]
+            # only the (triangle, capsule) pairs near enough for the triangle to reach in
+            centre = corners.mean(axis=1)
+            reach = np.linalg.norm(corners - centre[:, None], axis=2).max(axis=1)
+            ax = d.geom_xmat[g].reshape(-1, 3, 3)[:, :, 2]
+            rel = centre[:, None, :] - d.geom_xpos[g]
+            s = np.clip(np.einsum("egi,gi->eg", rel, ax), -half, half)
+            near = np.linalg.norm(rel - s[..., None] * ax, axis=2) < radius + reach[:, None]
+            e, k = np.nonzero(near)
+            if not e.size:
+                continue
+            pts = np.einsum("sk,ekd->esd", _SURFACE_SAMPLES, corners[e])
+            rel = pts - d.geom_xpos[g[k]][:, None]
+            s = np.clip(np.einsum("esi,ei->es", rel, ax[k]), -half[k, None], half[k, None])
+            dist = np.linalg.norm(rel - s[..., None] * ax[k][:, None], axis=2)
+            deepest = max(deepest, float((radius[k, None] - dist).max()))
+        return deepest
 
     def _record(self, t: float) -> None:
         assert self.data is not None
@@ -488,9 +579,11 @@ class Cloth:
             "cloth_steps_over_1cm": self._over_1cm / max(self._ticks, 1),
             "cloth_surface_depth_max_m": self.surface_max,
             "cloth_surface_depth_median_m": float(np.median(surface)) if surface else 0.0,
+            "cloth_surface_depth_p95_m": float(np.percentile(surface, 95)) if surface else 0.0,
             "cloth_frames_over_1cm": float(np.mean(np.array(surface) > 0.01)) if surface else 0.0,
             "cloth_finite": self.finite,
             "cloth_wall_s": self.wall_s,
+            "cloth_cpu_s": self.cpu_s,
             "cloth_vertices": int(self.model.nflexvert) if self.model is not None else 0,
         }
 

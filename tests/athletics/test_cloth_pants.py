@@ -153,3 +153,80 @@ def test_a_limb_across_a_triangle_touches_it() -> None:
     mine = np.isin(con.geom, geoms).any(axis=1) & (con.flex == flex).any(axis=1)
     assert (con.elem[mine] == e).any()
     assert con.dist[mine].min() < -0.02
+
+
+def test_a_moved_vertex_stops_moving_into_the_limb() -> None:
+    """With the bodies' velocities, the projection also takes away a moved vertex's velocity
+    into the limb relative to the limb's surface (here the thigh moving forward at 1 m/s and
+    the vertex going in at 2 m/s), keeps its sliding along the limb, and leaves a vertex
+    moving out of the limb alone (the tether off: it would pull the vertex home first)."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+
+    world = athletics_world(athlete("male"))
+    spec = ClothSpec()
+    spec.tether = 0.0
+    cloth = Cloth(world, spec)
+    cloth.reset(world)
+    m, d = cloth.model, cloth.data
+    wd = world.data
+    ids = cloth.wc.body_ids
+    pos, rot = wd.xpos[ids].copy(), wd.xmat[ids].reshape(-1, 3, 3).copy()
+    part = 13  # r_thigh
+    thigh = int(np.flatnonzero(cloth._geom_part == part)[0])
+    assert m.geom_type[thigh] == mujoco.mjtGeom.mjGEOM_CAPSULE
+    centre = d.geom_xpos[thigh].copy()
+    axis = d.geom_xmat[thigh].reshape(3, 3)[:, 2]
+    side = np.cross(axis, [0.0, 0.0, 1.0])
+    side /= np.linalg.norm(side)
+    r0, p0 = rot[0], pos[0]
+    x = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    right = np.flatnonzero(cloth._vmask[:, list(cloth._cpart).index(part)])
+    v = right[np.argmin(np.linalg.norm(x[right] - centre, axis=1))]
+    x[v] = centre + 0.02 * side
+    d.qpos[cloth._vq] = (x - p0) @ r0 - cloth._vrest
+    vel, omega = np.zeros((len(ids), 3)), np.zeros((len(ids), 3))
+    vel[part] = [1.0, 0.0, 0.0]
+    q, qv = d.qpos.copy(), d.qvel.copy()
+    for inward, expected in ((-2.0, 0.0), (0.5, 0.5)):
+        d.qpos[:], d.qvel[:] = q, qv
+        moving = vel[part] + inward * side + 0.5 * axis
+        d.qvel[cloth._vd[v]] = moving @ r0  # the pelvis copy is still: world = r0 @ local
+        cloth._project(pos, rot, (vel, omega))
+        after = r0 @ d.qvel[cloth._vd[v]]
+        np.testing.assert_allclose(after, vel[part] + expected * side + 0.5 * axis, atol=1e-9)
+    # without the velocities only the position is projected
+    d.qpos[:], d.qvel[:] = q, qv
+    d.qvel[cloth._vd[v]] = (vel[part] - 2.0 * side) @ r0
+    before = d.qvel.copy()
+    cloth._project(pos, rot)
+    np.testing.assert_array_equal(d.qvel, before)
+    assert not np.array_equal(d.qpos, q)
+
+
+def test_a_vertex_is_kept_near_where_it_was_made_on_the_leg() -> None:
+    """The tether pulls a cloth vertex that has gone 20 cm from its place on the leg (out in
+    the air, in no capsule) back to the tether's length from it, and leaves the others, all
+    where they were made, alone."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+
+    world = athletics_world(athlete("male"))
+    cloth = Cloth(world, "pants")
+    cloth.reset(world)
+    d = cloth.data
+    ids = cloth.wc.body_ids
+    pos, rot = world.data.xpos[ids].copy(), world.data.xmat[ids].reshape(-1, 3, 3).copy()
+    r0, p0 = rot[0], pos[0]
+    made = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    v = int(np.argmax(made[:, 2]))  # a vertex of the top free ring
+    x = made.copy()
+    x[v] += [0.0, 0.0, 0.2]  # straight up, above the hips
+    d.qpos[cloth._vq] = (x - p0) @ r0 - cloth._vrest
+    cloth._project(pos, rot)
+    after = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    assert np.linalg.norm(after[v] - made[v]) == pytest.approx(cloth.spec.tether, abs=1e-9)
+    others = np.arange(len(made)) != v
+    moved = np.linalg.norm(after[others] - made[others], axis=1) > 1e-9
+    # the start pose puts four vertices inside the forearms and hands (at the hips)
+    assert moved.sum() == 4
