@@ -97,7 +97,7 @@ class RunParams:
         turn_lead: on a curve, eqs. 1-2's desired velocity is turned into it by ``turn_lead
             * v * kappa`` (s; the velocity a moment ahead): the turn's feed-forward.
         path_integral: the facing is turned by this gain times the curvature times the
-            integral of the cross-track error times the curvature (1/s per 1/m^2; 0: none),
+            integral of the cross-track error times the curvature (m/s; 0: none),
             which takes out the steady offset a curve leaves.
         lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
