@@ -89,6 +89,10 @@ START_SPEED = 3.5
 ACCEL = 1.5
 #: the most the pitch error's integral holds (rad s)
 PITCH_SUM = 0.1
+#: the path correction integrates from this time on (s; the start from the set pose strays)
+PATH_AFTER = 3.0
+#: the most the path correction's integral (cross-track times curvature) holds (s)
+PATH_SUM = 5.0
 
 
 class Runner:
@@ -186,6 +190,7 @@ class Runner:
         self.lo_pitch = [0.0, 0.0]
         self.td_pitch = 0.0
         self.pitch_sum = 0.0
+        self.path_sum = 0.0
         self.speed_bias = 0.0
         self.step_start: tuple[float, F64] | None = None
         self.thrust_force = k["thrust"] * self.mass * self.g
@@ -254,7 +259,11 @@ class Runner:
         s = self.senses
         v = s.com_vel[:2]
         hd = self.heading_d
-        vd = self.speed * np.array([math.cos(hd), math.sin(hd)])
+        # on a curve the desired velocity is the one a moment ahead, turned into the curve
+        # (the centripetal acceleration's feed-forward): without it the velocity lagged the
+        # facing by up to 0.1 rad and the stances were irregular
+        lead = hd + k["turn_lead"] * self.speed * self.curvature
+        vd = self.speed * np.array([math.cos(lead), math.sin(lead)])
         ts, lf = self.stance_estimate, self.foot_length
         x_hh = 0.5 * (ts * v[0] - math.cos(heading) * lf) + k["speed_gain"] * (v[0] - vd[0])
         y_hh = 0.5 * (ts * v[1] - math.sin(heading) * lf) + k["speed_gain"] * (v[1] - vd[1])
@@ -487,7 +496,12 @@ class Runner:
     def _enter_flight(self, world: World, t: float) -> None:
         del world
         if self.machine.transitions:  # lift-off (not the first tick): swap the legs
-            self.stance_estimate = _clamp(t - self.t_touchdown, 0.12, 0.4)
+            # smoothed: in turns the stance varies step to step and feeds the next placement
+            last = _clamp(t - self.t_touchdown, 0.12, 0.4)
+            blend = self.k["stance_blend"]
+            if blend < 1:
+                last = self.stance_estimate + blend * (last - self.stance_estimate)
+            self.stance_estimate = last
             self.log.liftoffs.append((t, self.active))
             self.active = 1 - self.active
         h = self.heading()
@@ -548,6 +562,15 @@ class Runner:
         s.update(t)
         self._contacts()
         want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
+        if self.k["path_integral"] > 0 and math.isfinite(self.cross_track) and t >= PATH_AFTER:
+            # the steady offset a curve leaves (pure pursuit's chord, the feed-forward's lead)
+            # grows with the curvature and flips with it: integrated and applied in proportion
+            # to the curvature, it carries over a figure eight's reversal (a plain integral
+            # of the error was wrong-signed there and the runner fell)
+            dt = self.control_every * world.timestep
+            kap = self.curvature
+            self.path_sum = _clamp(self.path_sum + self.cross_track * kap * dt, -PATH_SUM, PATH_SUM)
+            want -= self.k["path_integral"] * self.path_sum * kap
         # the facing turns at a limited rate whatever the course asks (an abrupt change of
         # facing throws the runner down)
         if self._steered:

@@ -46,6 +46,9 @@ class RunParams:
     Args:
         stance_time: first estimate of the stance duration ``t_s`` (eqs. 1-2); later steps
             use the previous stance's.
+        stance_blend: how far each lift-off moves ``t_s`` toward the stance just ended (1:
+            all the way, eqs. 1-2's own). 0.3 at 2.5 m/s: in turns the stances varied by
+            0.03 s step to step, each feeding the next placement, and the turning runner fell.
         speed_gain: ``k`` of eqs. 1-2, the velocity-error gain (s).
         speed_integral: per step, the placement's slow correction (m) per m/s of the last
             step's speed error, capped at 0.3 m/s (0: eqs. 1-2 alone). Set by hand, not by
@@ -91,12 +94,18 @@ class RunParams:
         arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
         elbow: elbow flexion (rad).
         turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
+        turn_lead: on a curve, eqs. 1-2's desired velocity is turned into it by ``turn_lead
+            * v * kappa`` (s; the velocity a moment ahead): the turn's feed-forward.
+        path_integral: the facing is turned by this gain times the curvature times the
+            integral of the cross-track error times the curvature (m/s; 0: none),
+            which takes out the steady offset a curve leaves.
         lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
+    stance_blend: float | Speeds = (0.3, 1.0, 1.0)
     speed_gain: float | Speeds = (0.1914, 0.0835, 0.08567)
     speed_integral: float | Speeds = (0, 0, 0.03)
     touchdown_leg: float | Speeds = (0.93, 0.948, 0.9475)
@@ -126,6 +135,8 @@ class RunParams:
     arm_offset: float | Speeds = 0.05
     elbow: float | Speeds = 1.4
     turn_rate: float | Speeds = 0.35
+    turn_lead: float | Speeds = (0.1, 0, 0)
+    path_integral: float | Speeds = (5.0, 0, 0)
     lean: float | Speeds = 1.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
@@ -153,6 +164,10 @@ class RunParams:
                 raise ConfigError(f"touchdown_leg must be in (0.5, 1], got {self.touchdown_leg}")
             if r["stance_time"] <= 0 or r["smoothing"] < 0 or r["leg_stiffness"] <= 0:
                 raise ConfigError("stance_time and leg_stiffness must be > 0, smoothing >= 0")
+            if not 0.0 < r["stance_blend"] <= 1.0:
+                raise ConfigError(f"stance_blend must be in (0, 1], got {self.stance_blend}")
+            if r["path_integral"] < 0:
+                raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
 
     def at(self, speed: float) -> dict[str, float]:
         """Every scalar tuning value at ``speed`` (triples interpolated, clamped to the
