@@ -202,8 +202,9 @@ def _controller(
 ) -> Controller:
     """A registered controller with the scenario's ``[response]`` gains (``None``: its own)."""
     path = reference_path(world, c, ref, fps=fps) if isinstance(ref, np.ndarray) else ref
-    gains = {k: v for k, v in (("kp", cfg.kp), ("kv", cfg.kv))
-             if k in controller_spec(name).defaults}  # fmt: skip
+    spec = controller_spec(name)
+    gains = {k: v for k, v in (("kp", cfg.kp), ("kv", cfg.kv), ("torque_limit", cfg.torque_limit))
+             if k in spec.defaults or k in spec.options}  # fmt: skip
     return build(name, world, path, gains, character=c, start=start)
 
 

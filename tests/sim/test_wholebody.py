@@ -258,6 +258,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("anchor_tau", -0.1),
         ("step_time", float("nan")),
         ("trunk_weight", -1.0),
+        ("torque_limit", -100.0),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -311,3 +312,20 @@ def test_trunk_rows_keep_the_chest_turning_as_tracked(guard: Motion) -> None:
         misses.append(float(np.linalg.norm(jr[:, sl] @ (plan.qacc - plan.desired_qacc))))
     assert misses[0] > 10.0, misses  # rad/s^2: the offset is big enough to matter
     assert misses[1] < 0.1 * misses[0], misses
+
+
+def test_torque_limit_bounds_every_joint_torque_the_plan_applies(step_forward: Motion) -> None:
+    # the plan's torques reach the body as the servo's feed-forward, which no actuator limit
+    # clips; with ``torque_limit`` each ball joint's total torque at a tick stays within it
+    limit = 40.0
+    world, servo, wb = _standing(step_forward, 20, torque_limit=limit)
+    asked = []
+    for k in range(40):  # 20 control ticks
+        t = k * wb.control_every * world.timestep
+        wb.control(world, t)
+        asked.append(np.linalg.norm(wb.last_plan.torques, axis=1).max())  # type: ignore[union-attr]
+        applied = wb._ff + servo.torques(0)
+        assert np.linalg.norm(applied, axis=1).max() <= limit * (1 + 1e-9)
+        servo.step(wb.control_every)
+    # the plan asked for more than the limit: the bound did something
+    assert max(asked) > 2 * limit
