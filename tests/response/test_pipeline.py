@@ -20,6 +20,7 @@ from reactmocap.response.pipeline import run_response, run_scenario
 from reactmocap.response.scenario import (
     AttackerSpec,
     CharacterSpec,
+    ImpactSpec,
     Scenario,
     load_scenario,
 )
@@ -283,6 +284,31 @@ def test_a_torque_limit_keeps_the_kicked_bow_stable(shared_mocap_dir: Path, tmp_
     res = run_response(scenario)
     assert not [w for w in res.report["warnings"] if "stopped early" in w]
     assert res.sim1.duration > 1.3
+    assert res.report["quality"]["reaction_displacement_m"] > 0.05
+
+
+def test_a_search_whose_nearest_windows_are_all_the_own_clip_looks_further(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real bow pushed from behind (bench_reactions' push, physical mode with the torque
+    # limit): the 4 nearest windows of every search start are the bow itself, which a real hit
+    # rules out; the response failed ("no library window continues the response") and now
+    # looks OWN_CLIP_DEPTH windows down each start's ranking
+    from reactmocap.response.scenario import ResponseConfig
+
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = Scenario(
+        library=lib,
+        recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
+        impact=ImpactSpec("chest", (249.99920660413557, 0.629839108608112, 0.0), 1.0, 0.2),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                mode="physical", land_position=0.25, land_angle=0.5,
+                                land_joint=0.5, land_within=1.0, land_tries=3,
+                                torque_limit=1000.0),
+        name="bow-push-back",
+    )  # fmt: skip
+    res = run_response(scenario)
+    assert res.matched.clip != "dataset-1_bow_normal_001"
     assert res.report["quality"]["reaction_displacement_m"] > 0.05
 
 
