@@ -203,7 +203,8 @@ def _seams(i_imp: int, i_end: int, before: Motion | None) -> list[int]:
 def _limb_root(body: int) -> int:
     """The first body of the chain whose blend an overlap of ``body`` delays: a leg from its
     thigh; anything above the pelvis from the waist (holding an arm alone still lets the
-    blended trunk carry it into the other character)."""
+    blended trunk carry it into the other character). Either also holds the pelvis's turn,
+    which swings a held leg as much as the trunk."""
     name = SIM_BODIES[body]
     if name == "pelvis":
         return body
@@ -228,7 +229,7 @@ def _blend_later(cast: Cast, hit: NDArray[np.bool_], start: F64) -> F64 | None:
         parent = int(anchors[SIM_PARENTS[root]]) if root > 0 else -1
         above = [j for j in skel.chain(a) if parent < 0 or j not in skel.chain(parent)]
         joints = above + [j for j in range(skel.num_joints) if a in skel.chain(j)]
-        if SIM_BODIES[root] == "waist":  # the pelvis's turn carries the trunk too
+        if SIM_BODIES[root] != "pelvis":  # the pelvis's turn carries the trunk and legs too
             joints += skel.chain(int(anchors[0]))
         last = int(np.flatnonzero(hit[:, b])[-1]) + 2
         out[joints] = np.maximum(out[joints], last)

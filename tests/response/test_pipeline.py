@@ -312,6 +312,33 @@ def test_a_search_whose_nearest_windows_are_all_the_own_clip_looks_further(
     assert res.report["quality"]["reaction_displacement_m"] > 0.05
 
 
+def test_a_leg_the_blend_turns_into_the_attacker_is_held_with_the_pelvis(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real walk-right kicked (bench_reactions' aim, physical mode, torque limit): the body
+    # did not land (0.6 m, 1.4 rad off), and the blend's turn of the pelvis swung the left
+    # shin 6 cm into the kicker while the shin's own joints were held; a leg's overlap now
+    # holds the pelvis's turn too, as an arm's holds the trunk's
+    from reactmocap.response.scenario import ResponseConfig
+
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = Scenario(
+        library=lib,
+        recipient=CharacterSpec("dataset-1_walk-right_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=162.95691247341688,
+                              position=(2.0136727200528957, 0.0003111082439202495)),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                attacker_assist=100.0, mode="physical", land_position=0.25,
+                                land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3,
+                                torque_limit=1000.0),
+        name="walk-right-kick",
+    )  # fmt: skip
+    res = run_response(scenario)
+    assert res.report["quality"]["blend_root_offset_max_m"] > 0.3  # the case: a large correction
+    assert res.report["quality"]["character_overlap_max_m"] <= 0.02
+
+
 def test_an_unstable_simulation_1_is_reported_not_fatal(
     shared_mocap_dir: Path, tmp_path: Path
 ) -> None:
