@@ -51,10 +51,13 @@ SYNTHETIC = ROOT / "data" / "synthetic_clips"
 #: match until the body is within reach of it (the pelvis 0.25 m, the root and every joint 0.5
 #: rad: inside what the final blend may correct without a warning), for 1 s at most, and lands
 #: there or where it came closest; the blend then closes only that gap. A body that does not
-#: land tries the search's next-best windows of two other clips, and the closest wins
+#: land tries the search's next-best windows of two other clips, and the closest wins. The
+#: whole-body plan's joint torques are bounded at 1 kN m (``torque_limit``): unbounded, the bow
+#: kicked asked 41 kN m at a hip and Simulation 1 blew up
 REAL = ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
                       attacker_assist=100.0, mode="physical", land_position=0.25,
-                      land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3)  # fmt: skip
+                      land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3,
+                      torque_limit=1000.0)  # fmt: skip
 RECIPIENTS = ("walk_normal_001", "walk_normal_002", "walk-back", "walk-left", "walk-right",
               "run_normal_001", "bow_normal_001", "respond_normal_001")  # fmt: skip
 

@@ -34,6 +34,9 @@ F64 = NDArray[np.float64]
 #: the shortest span (s) over which the final blend moves the root (a contact that delays the
 #: root's correction cannot squeeze it into fewer frames)
 ROOT_BLEND_MIN_S = 0.2
+#: how many times the attacker's blend back to its clip may double its length to move no joint
+#: faster than its clip's fastest
+BLEND_BACK_TRIES = 5
 
 
 def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
@@ -58,8 +61,9 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
                      shift: F64, release: float, speed: float) -> Motion:  # fmt: skip
     """The attacker's output: its clip until the rewind, its simulation (moved by the
     recipient's blend ``shift`` at ``shift_times``, held after) until ``release``, then
-    blended back to its clip over ``attacker_blend`` or longer: no faster than half its
-    clip's fastest joint ``speed`` (m/s)."""
+    blended back to its clip over ``attacker_blend`` or longer: the straight-line gap closed at
+    no more than half its clip's fastest joint ``speed`` (m/s), and the blend lengthened until
+    no joint moves faster than ``speed``."""
     assert sim2.attacker is not None
     afps = att.motion.fps
     t = np.arange(0, int(np.floor(duration * afps)) + 1) / afps
@@ -76,8 +80,16 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     gap = float(np.linalg.norm(sim.slice(i, i + 1).global_positions()[0]
                                - own.slice(i, i + 1).global_positions()[0], axis=1).max())  # fmt: skip
     span = max(cfg.attacker_blend, gap / max(0.5 * speed, 1e-9))
-    w = np.where(t < contact.rewind, 1.0, np.clip((t - release) / span, 0, 1))
-    return ground_root(blend_poses(sim, own, w), att.parts).replace(name="attacker")
+    for _ in range(BLEND_BACK_TRIES):
+        w = np.where(t < contact.rewind, 1.0, np.clip((t - release) / span, 0, 1))
+        out = ground_root(blend_poses(sim, own, w), att.parts).replace(name="attacker")
+        # the gap above is a straight line, but the blend turns every joint along its arc, and
+        # a clip that spins while the simulation stands turns that arc by whole turns: the
+        # blend is lengthened until it moves no joint faster than the capture does
+        if joint_speed_max_m_s(out.slice(i)) <= speed:
+            break
+        span *= 2.0
+    return out
 
 
 @dataclass(frozen=True)
@@ -191,7 +203,8 @@ def _seams(i_imp: int, i_end: int, before: Motion | None) -> list[int]:
 def _limb_root(body: int) -> int:
     """The first body of the chain whose blend an overlap of ``body`` delays: a leg from its
     thigh; anything above the pelvis from the waist (holding an arm alone still lets the
-    blended trunk carry it into the other character)."""
+    blended trunk carry it into the other character). Either also holds the pelvis's turn,
+    which swings a held leg as much as the trunk."""
     name = SIM_BODIES[body]
     if name == "pelvis":
         return body
@@ -216,7 +229,7 @@ def _blend_later(cast: Cast, hit: NDArray[np.bool_], start: F64) -> F64 | None:
         parent = int(anchors[SIM_PARENTS[root]]) if root > 0 else -1
         above = [j for j in skel.chain(a) if parent < 0 or j not in skel.chain(parent)]
         joints = above + [j for j in range(skel.num_joints) if a in skel.chain(j)]
-        if SIM_BODIES[root] == "waist":  # the pelvis's turn carries the trunk too
+        if SIM_BODIES[root] != "pelvis":  # the pelvis's turn carries the trunk and legs too
             joints += skel.chain(int(anchors[0]))
         last = int(np.flatnonzero(hit[:, b])[-1]) + 2
         out[joints] = np.maximum(out[joints], last)

@@ -75,6 +75,9 @@ class ResponseConfig:
     #: controller's own default (the registry's table; ``pd``: kp 4000, kv critical)
     kp: float | None = None
     kv: float | None = None
+    #: the largest joint torque (N m) of the controllers that plan torques (``wholebody``,
+    #: through the servo's feed-forward, which nothing else limits); 0: none
+    torque_limit: float = 0.0
     friction_sim1: float = 1.0
     friction_sim2: float = 0.5
     #: Simulation 1: ``yielding`` (the recipient gives way to the hit with its stiffness cut to
@@ -226,7 +229,7 @@ class _Reader:
                                   "contact_shift_max", "attacker_follow", "attacker_blend",
                                   "friction_sim1", "friction_sim2", "kv", "yield_gain",
                                   "react_impulse", "active_min", "own_clip_margin", "attacker_assist",
-                                  "yield_recover", "land_within"}  # fmt: skip
+                                  "yield_recover", "land_within", "torque_limit"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
                                     "total_mass", "land_position", "land_angle",
                                     "land_joint"}  # fmt: skip

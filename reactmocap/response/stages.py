@@ -140,6 +140,11 @@ def cast(scenario: Scenario, cache: LibraryCache) -> Cast:
     return Cast(recipient, attacker, library, index)
 
 
+#: how far down each start's ranking the search looks for a window that is not the recipient's
+#: own clip, when the first 4 of every start are
+OWN_CLIP_DEPTH = 16
+
+
 @dataclass(frozen=True)
 class ContactEstimate:
     """When the hit lands (scenario seconds), which bodies, and the last mocap frame before it,
@@ -205,8 +210,9 @@ def _controller(
     """A registered controller with the scenario's ``[response]`` gains (``None``: its own)
     and ``options``."""
     path = reference_path(world, c, ref, fps=fps) if isinstance(ref, np.ndarray) else ref
-    gains = {k: v for k, v in (("kp", cfg.kp), ("kv", cfg.kv))
-             if k in controller_spec(name).defaults}  # fmt: skip
+    spec = controller_spec(name)
+    gains = {k: v for k, v in (("kp", cfg.kp), ("kv", cfg.kv), ("torque_limit", cfg.torque_limit))
+             if k in spec.defaults or k in spec.options}  # fmt: skip
     return build(name, world, path, {**gains, **(options or {})}, character=c, start=start)
 
 
@@ -386,13 +392,20 @@ def search_continuation(
         own = rec.clock0 + contact.rewind + start / q_fps
         return not (hit and r.clip == rec.clip.name and abs(r.time - own) < cfg.own_clip_margin)
 
-    results = []
-    for s in starts.tolist():
-        r: SearchResult | None = index.query(query, s, parts=parts)
-        if r is not None and not allowed(r, s):
-            r = next((c for c in index.top_k(query, s, n=4, parts=parts) if allowed(c, s)), None)
-        if r is not None:
-            results.append((r, s))
+    def search(deeper: int) -> list[tuple[SearchResult, int]]:
+        found = []
+        for s in starts.tolist():
+            r: SearchResult | None = index.query(query, s, parts=parts)
+            if r is not None and not allowed(r, s):
+                r = next((c for c in index.top_k(query, s, n=deeper, parts=parts)
+                          if allowed(c, s)), None)  # fmt: skip
+            if r is not None:
+                found.append((r, s))
+        return found
+
+    # the runners-up of each start, further down when the nearest are all the own clip (the
+    # real bow pushed from behind matched only its own bow in the first 4)
+    results = search(4) or search(OWN_CLIP_DEPTH)
     if not results:
         raise SearchError("no library window continues the response (only the recipient's own "
                           "clip matched, and a real hit rules it out)")  # fmt: skip

@@ -14,11 +14,13 @@ from reactmocap.cli import main
 from reactmocap.errors import ReactMocapError
 from reactmocap.library.bodyparts import map_body_parts
 from reactmocap.library.bvh import read_bvh
+from reactmocap.metrics import joint_speed_max_m_s
 from reactmocap.response import outputs
 from reactmocap.response.pipeline import run_response, run_scenario
 from reactmocap.response.scenario import (
     AttackerSpec,
     CharacterSpec,
+    ImpactSpec,
     Scenario,
     load_scenario,
 )
@@ -240,6 +242,101 @@ def test_a_blend_held_by_contact_still_moves_the_root_smoothly(
     # the correction adds at most offset / ROOT_BLEND_MIN_S to the simulated body's own speed
     assert speed.max() < 2.5 + offset / ROOT_BLEND_MIN_S, speed.max()
     assert res.report["quality"]["attacker_speed_ratio"] <= 1.5
+
+
+def test_the_attacker_blends_back_to_a_spinning_clip_no_faster_than_it(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real walk backwards kicked from behind (bench_reactions' aim, its physical mode):
+    # the kick clip spins while the attacker's simulation has stopped, so blending back over
+    # the straight-line gap turned the toes 1.61x faster than the capture ever moves them;
+    # the blend back is now lengthened until no joint outruns the clip
+    from reactmocap.response.scenario import ResponseConfig
+
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = Scenario(
+        library=lib,
+        recipient=CharacterSpec("dataset-1_walk-back_normal_001", start=0.1),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=1.5833333333333335,
+                              facing_deg=372.77788526938275,
+                              position=(-1.3014127488540825, -0.2353328567744819)),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                attacker_assist=100.0, mode="physical", land_position=0.25,
+                                land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3),
+        name="walk-back-kick",
+    )  # fmt: skip
+    res = run_response(scenario)
+    assert res.attacker is not None
+    release = res.report["transition"]["end"]  # the attacker is on its own from about here
+    out = res.attacker.slice(int(np.ceil(release * res.attacker.fps)))
+    clip_speed = joint_speed_max_m_s(read_bvh(next(shared_mocap_dir.glob("*kick_normal_001.bvh"))))
+    assert joint_speed_max_m_s(out) <= clip_speed * (1 + 1e-9)
+    assert res.report["quality"]["attacker_speed_ratio"] <= 1.5
+
+
+def test_a_torque_limit_keeps_the_kicked_bow_stable(shared_mocap_dir: Path, tmp_path: Path) -> None:
+    # the case below: the whole-body plan asks 41 kN m at a hip before Simulation 1 blows up;
+    # with ``torque_limit`` (the plan's feed-forward bounded per joint) it runs to its end
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = _real_kick(lib, "dataset-1_bow_normal_001", 167.42333060441473,
+                          (0.9101249775269609, 0.24847072154800792), "bow-kick")  # fmt: skip
+    scenario = replace(scenario, response=replace(scenario.response, torque_limit=1000.0))
+    res = run_response(scenario)
+    assert not [w for w in res.report["warnings"] if "stopped early" in w]
+    assert res.sim1.duration > 1.3
+    assert res.report["quality"]["reaction_displacement_m"] > 0.05
+
+
+def test_a_search_whose_nearest_windows_are_all_the_own_clip_looks_further(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real bow pushed from behind (bench_reactions' push, physical mode with the torque
+    # limit): the 4 nearest windows of every search start are the bow itself, which a real hit
+    # rules out; the response failed ("no library window continues the response") and now
+    # looks OWN_CLIP_DEPTH windows down each start's ranking
+    from reactmocap.response.scenario import ResponseConfig
+
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = Scenario(
+        library=lib,
+        recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
+        impact=ImpactSpec("chest", (249.99920660413557, 0.629839108608112, 0.0), 1.0, 0.2),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                mode="physical", land_position=0.25, land_angle=0.5,
+                                land_joint=0.5, land_within=1.0, land_tries=3,
+                                torque_limit=1000.0),
+        name="bow-push-back",
+    )  # fmt: skip
+    res = run_response(scenario)
+    assert res.matched.clip != "dataset-1_bow_normal_001"
+    assert res.report["quality"]["reaction_displacement_m"] > 0.05
+
+
+def test_a_leg_the_blend_turns_into_the_attacker_is_held_with_the_pelvis(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real walk-right kicked (bench_reactions' aim, physical mode, torque limit): the body
+    # did not land (0.6 m, 1.4 rad off), and the blend's turn of the pelvis swung the left
+    # shin 6 cm into the kicker while the shin's own joints were held; a leg's overlap now
+    # holds the pelvis's turn too, as an arm's holds the trunk's
+    from reactmocap.response.scenario import ResponseConfig
+
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = Scenario(
+        library=lib,
+        recipient=CharacterSpec("dataset-1_walk-right_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=162.95691247341688,
+                              position=(2.0136727200528957, 0.0003111082439202495)),
+        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                                attacker_assist=100.0, mode="physical", land_position=0.25,
+                                land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3,
+                                torque_limit=1000.0),
+        name="walk-right-kick",
+    )  # fmt: skip
+    res = run_response(scenario)
+    assert res.report["quality"]["blend_root_offset_max_m"] > 0.3  # the case: a large correction
+    assert res.report["quality"]["character_overlap_max_m"] <= 0.02
 
 
 def test_an_unstable_simulation_1_is_reported_not_fatal(

@@ -57,6 +57,10 @@ def test_good_scenario_and_defaults(tmp_path: Path) -> None:
         (("force = [-350, 0, 0]", "force = [1, 2]"), r"\[impact\].force: expected a list of 3"),
         (("duration = 0.1", "duration = -1"), r"\[impact\].duration: expected a number > 0"),
         (("reaction_delay = 0.12", "reaction_delay = true"), r"reaction_delay: expected a number"),
+        (
+            ("reaction_delay = 0.12", "reaction_delay = 0.12\ntorque_limit = -5"),
+            r"\[response\].torque_limit: expected a number >= 0",
+        ),
         (('clip = "guard"', ""), r"\[recipient\]: missing required key\(s\) \['clip'\]"),
         (('library = "', 'library = "/nonexistent/'), r"library: .* not found"),
         (("[response]", "[responce]"), r"top level: unknown key\(s\) \['responce'\]"),

@@ -259,6 +259,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("anchor_tau", -0.1),
         ("step_time", float("nan")),
         ("trunk_weight", -1.0),
+        ("torque_limit", -100.0),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -350,3 +351,20 @@ def test_hold_balance_keeps_the_pelvis_and_legs_stiff_once_the_capture_point_lea
     assert not np.allclose(thrown["held"][rows["l_elbow"]], thrown["full"][rows["l_elbow"]])
     # standing still, the capture point is over the feet: everything yields
     np.testing.assert_allclose(desired(0.0, 0.1, hold_balance=True), desired(0.0, 0.1))
+
+
+def test_torque_limit_bounds_every_joint_torque_the_plan_applies(step_forward: Motion) -> None:
+    # the plan's torques reach the body as the servo's feed-forward, which no actuator limit
+    # clips; with ``torque_limit`` each ball joint's total torque at a tick stays within it
+    limit = 40.0
+    world, servo, wb = _standing(step_forward, 20, torque_limit=limit)
+    asked = []
+    for k in range(40):  # 20 control ticks
+        t = k * wb.control_every * world.timestep
+        wb.control(world, t)
+        asked.append(np.linalg.norm(wb.last_plan.torques, axis=1).max())  # type: ignore[union-attr]
+        applied = wb._ff + servo.torques(0)
+        assert np.linalg.norm(applied, axis=1).max() <= limit * (1 + 1e-9)
+        servo.step(wb.control_every)
+    # the plan asked for more than the limit: the bound did something
+    assert max(asked) > 2 * limit

@@ -148,6 +148,10 @@ class WholeBodyTracker(AnchoredReference):
             above ``place_height``) and the simulated capture point is more than
             ``place_deadband`` m from the mocap's, the foot lands ``place_gain`` times that
             error (at most 0.4 m) from the mocap's landing (0: off; see ``docs/tracking.md``).
+        torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
+            joint's torque; 0: none). The plan's torques come as feed-forward, which the
+            servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
+            at a hip blew up (the bow kicked, ``docs/benchmarks.md``).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -204,6 +208,7 @@ class WholeBodyTracker(AnchoredReference):
         place_deadband: float = 0.15,
         place_height: float = 0.03,
         hold_balance: bool = False,
+        torque_limit: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -224,7 +229,7 @@ class WholeBodyTracker(AnchoredReference):
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
-                "place_height": place_height,
+                "place_height": place_height, "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -235,6 +240,7 @@ class WholeBodyTracker(AnchoredReference):
         self.servo = servo
         self.servo_kv = float(servo_kv)
         self.control_every = int(control_every)
+        self.torque_limit = float(torque_limit)
         wc = world.characters[character]
         self.wc = wc
         kvj = critical_kv(kp_joint) if kv_joint is None else float(kv_joint)
@@ -664,5 +670,9 @@ class WholeBodyTracker(AnchoredReference):
         plan = self.plan(t)
         self.last_plan = plan
         # the servo (damping only by default) keeps acting between ticks; at the tick the
-        # total joint torque is the plan's
-        self._ff[:] = plan.torques - self.servo.torques(self.character)
+        # total joint torque is the plan's (within ``torque_limit``)
+        tau = plan.torques
+        if self.torque_limit > 0:
+            norm = np.linalg.norm(tau, axis=1, keepdims=True)
+            tau = tau * np.minimum(1.0, self.torque_limit / np.maximum(norm, 1e-12))
+        self._ff[:] = tau - self.servo.torques(self.character)
