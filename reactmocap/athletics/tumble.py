@@ -162,7 +162,9 @@ class TumbleParams:
         target_height: the COM height (m) the prediction aims at instead (a dive: the water
             surface); None: ``touchdown_height`` of the standing COM.
         open_inertia: the opened body's inertia about the somersault axis (kg m^2) the
-            prediction uses; None: the landing pose's (:data:`LANDING_POSE`).
+            prediction uses; None: the landing pose's (:data:`LANDING_POSE`). When it is
+            below the position's own (the layout), the prediction falls through the flight
+            and the tumble opens once it has come down to ``turns`` (+ ``lead``) instead.
         extend: fraction (0-1) of the way from the position to the landing pose that the
             hips and knees extend before the opening (thesis 8.5.1: in the forward somersault
             they extend slightly in the air before the landing controller takes over, so the
@@ -232,6 +234,9 @@ class Tumble(Basis):
             for side in "lr":
                 landing[joint_index(f"{side}_{key}")] = val
         i_open = p.open_inertia or somersault_inertia(ctx.athlete, landing)
+        # a position that turns slower than the opened body (the layout): the prediction falls
+        # as the flight goes on, so it opens once the prediction has come down to the turn
+        slower = somersault_inertia(ctx.athlete, goal) > i_open
         legs = [joint_index(f"{side}_{j}") for side in "lr" for j in ("hip", "knee")]
         extended = np.full((NJ, 3), np.nan)
         extended[legs] = goal[legs] + p.extend * (landing[legs] - goal[legs])
@@ -314,6 +319,8 @@ class Tumble(Basis):
             if p.twist and ("undone" not in memo or t < memo["undone"] + p.arm_throw):
                 return False  # a twist is opened out of only once it is stopped
             want = 2.0 * math.pi * p.turns
+            if slower:
+                return abs(memo["predicted"]) <= want + p.lead or memo["t_td"] <= p.latest
             return abs(memo["predicted"]) >= want - p.lead or memo["t_td"] <= p.latest
 
         exits: list[tuple[Event, str]] = [(opened, NEXT), (after(p.max_seconds), NEXT)]
