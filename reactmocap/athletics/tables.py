@@ -107,7 +107,7 @@ VERTICAL_LANDING: Mapping[str, tuple[float, float]] = MappingProxyType(
 BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = MappingProxyType(
     {
         "male": (0.5, ((1.12, 0.04), (1.35, 0.02), (1.47, -0.02), (1.69, -0.02), (1.78, -0.02))),
-        "female": (0.5, ((0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
+        "female": (0.5, ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
     }
 )
 #: seconds over which a broad jump's landing rights the trunk (LandingParams.pitch_ease):
