@@ -106,7 +106,10 @@ VERTICAL_LANDING: Mapping[str, tuple[float, float]] = MappingProxyType(
 #: (/tmp sweep of ``run("broad-jump", body, effort=s)``; docs/athletics.md)
 BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = MappingProxyType(
     {
-        "male": (0.5, ((1.12, 0.04), (1.35, 0.02), (1.47, -0.02), (1.69, -0.02), (1.78, -0.02))),
+        "male": (
+            0.5,
+            ((0.66, 0.1), (1.12, 0.04), (1.35, 0.02), (1.47, -0.02), (1.69, -0.02), (1.78, -0.02)),
+        ),
         "female": (0.5, ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
     }
 )
