@@ -83,10 +83,10 @@ LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType
 #: the landing's capture-point lead per body (tuned like the thesis's per-body deltas; a BVH
 #: body gets the landing's default)
 LANDING_LEADS: Mapping[str, float] = MappingProxyType({"male": 0.5, "female": 1.0})
-#: bodies whose landings after a broad jump use the delta table (measured on drops; vertical
-#: leaps use VERTICAL_LANDING where the body has one): the male's
-#: broad jumps landed 3 of 6 with it against 1 without; the female's fell in all 6 (her
-#: broad-jump landings want a delta near 0 where her drops want -0.12 at the same speed)
+#: bodies whose landings after a leap (``after_leap``: the maneuver files' landings) use the
+#: drops' delta table (vertical leaps use VERTICAL_LANDING, broad jumps BROAD_LANDING where
+#: the body has one). Chosen when broad jumps still used it: the male's landed 3 of 6 with it
+#: against 1 without; the female's fell in all 6
 LEAP_LANDING_TABLE: frozenset[str] = frozenset({"male"})
 #: the landing after a vertical leap, per body: (capture-point lead, foot-servo delta m), a
 #: constant delta (no table). Measured over the ten Fig. 4.1 commands (0.1-1.0 m, landed of 10,
