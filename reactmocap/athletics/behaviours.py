@@ -201,7 +201,6 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     key = "distance" if broad else "height"
     target = float(p[key])
     table = (tables.BROAD_TABLES if broad else tables.LEAP_TABLES).get(ath.name)
-    path = tables.broad_params if broad else tables.leap_params
     if p.get("effort") is not None:
         s = float(p["effort"])
     elif table:
@@ -211,13 +210,14 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
             f"no {'broad-jump' if broad else 'leap'} table for body {ath.name!r}: pass effort "
             "(0-1) or build one with reactmocap.athletics.tables / bench_athletics.py --tables"
         )
-    params = path(s)
+    params = tables.broad_params(s, ath.name) if broad else tables.leap_params(s)
     if p.get("spin") is not None:
         from dataclasses import replace
 
         params = replace(params, spin=float(p["spin"]))
     world = athletics_world(ath, backpack=float(p.get("backpack") or 0.0))
-    landing = tables.landing_params(ath.name, 0.0, after_leap=True, vertical=not broad)
+    landing = tables.landing_params(ath.name, 0.0, after_leap=True, vertical=not broad,
+                                    broad=broad)  # fmt: skip
     bases = [Balance(Posture(), seconds=LEAD_IN), Leap(params), Landing(landing),
              Balance(STAND_UP)]  # fmt: skip
     # the run lasts until well after touchdown: the flight time of the expected height

@@ -87,6 +87,10 @@ class LandingParams:
             (thesis Table 6.1), interpolated on the velocity sensed in the air, so that a
             landing after a broad jump gets its own speed's delta; empty: ``delta`` at every
             speed.
+        pitch_ease: seconds over which the absorption's pelvis pitch goes from where it was
+            at touchdown to the upright (``lean``) target; 0: the target at once. A broad
+            jump lands with the trunk pitched far forward, and righting it at once drove the
+            hips' extension into the floor and threw the body back up.
     """
 
     knee: float = 0.6
@@ -101,6 +105,7 @@ class LandingParams:
     lean: float = 0.5
     knee_stiffness: float = 0.0
     deltas: tuple[tuple[float, float], ...] = ()
+    pitch_ease: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -115,10 +120,13 @@ class LandingParams:
             "toes",
             "lean",
             "knee_stiffness",
+            "pitch_ease",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
+        if self.pitch_ease < 0:
+            raise ConfigError(f"landing pitch_ease must be >= 0 s, got {self.pitch_ease}")
         for row in self.deltas:
             if len(row) != 2 or not all(
                 isinstance(x, (int, float)) and math.isfinite(x) for x in row
@@ -222,6 +230,8 @@ class Landing(Basis):
             memo["knee_peak"] = _knee_speed(world, ctx)
             guard[:] = False
             bl.posture = Posture(leg=_leg_fraction(ctx), lean=p.lean, settle=0.0)
+            memo["t_touch"] = t
+            memo["pitch_touch"] = bl.pelvis_pitch() - bl._lean()
 
         def knee_stop(t: float) -> None:
             """Hold a switched-off knee out of hyperextension (see KNEE_STOP): servo it to
@@ -242,7 +252,10 @@ class Landing(Basis):
             s = ctx.sense(t)
             # passive, as the thesis's: feet flat, pelvis upright (leaning as the knees bend),
             # no COM servo (its ankle torques would push the body back off the ground)
-            hold_pelvis_and_feet(ctx, world.data, bl._lean(), s.heading(), t)
+            ease = 0.0
+            if p.pitch_ease > 0:
+                ease = max(0.0, 1.0 - (t - memo["t_touch"]) / p.pitch_ease) * memo["pitch_touch"]
+            hold_pelvis_and_feet(ctx, world.data, ease + bl._lean(), s.heading(), t)
             rig.offset[:] = 0.0
             _stance_support(ctx)
             damp = rig.damping.copy()

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from types import MappingProxyType
 
 import numpy as np
@@ -20,6 +21,9 @@ from reactmocap.athletics.leap import BROAD_TIMING, LeapParams
 from reactmocap.errors import ConfigError
 
 __all__ = [
+    "BROAD_LANDING",
+    "BROAD_PITCH_EASE",
+    "BROAD_SPIN",
     "BROAD_TABLES",
     "LANDING_DELTAS",
     "LANDING_LEADS",
@@ -47,12 +51,23 @@ def leap_params(s: float) -> LeapParams:
                       spin_gain=20.0, handover="liftoff")  # fmt: skip
 
 
-def broad_params(s: float) -> LeapParams:
-    """The standing broad jump at effort ``s``: crouch, COM ahead of the feet, arm swing."""
+def broad_params(s: float, body: str | None = None) -> LeapParams:
+    """The standing broad jump at effort ``s``: crouch, COM ahead of the feet, arm swing;
+    the take-off's backward angular momentum is the body's :data:`BROAD_SPIN`."""
     s = float(np.clip(s, 0.0, 1.0))
+    spin = BROAD_SPIN.get(body or "", DEFAULT_BROAD_SPIN)
     return LeapParams(leg=0.8 - 0.15 * s, pitch=0.3, lean=0.0, com_offset=0.12 + 0.1 * s,
                       stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
-                      arms=-1.8 - 1.0 * s, broad=True, spin=-5.0, spin_gain=40.0, hold=0.1)  # fmt: skip
+                      arms=-1.8 - 1.0 * s, broad=True, spin=spin, spin_gain=40.0, hold=0.1)  # fmt: skip
+
+
+#: the broad jump's take-off pitch momentum (kg m^2/s, backward < 0)
+DEFAULT_BROAD_SPIN = -5.0
+#: per body (measured 2026-12-02, efforts 0.1/0.2/0.45/0.7): the female (m L^2 under half
+#: the male's, so the same momentum is a larger rotation) with -5 touched down from a low jump
+#: with the feet 0.13 m behind the COM after a 0.1 s flight and fell forward; with -1 her
+#: 0.35 and 0.43 m jumps land (-2: 0.43 m only; -3: none)
+BROAD_SPIN: Mapping[str, float] = MappingProxyType({"female": -1.0})
 
 
 #: (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
@@ -68,10 +83,10 @@ LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType
 #: the landing's capture-point lead per body (tuned like the thesis's per-body deltas; a BVH
 #: body gets the landing's default)
 LANDING_LEADS: Mapping[str, float] = MappingProxyType({"male": 0.5, "female": 1.0})
-#: bodies whose landings after a broad jump use the delta table (measured on drops; vertical
-#: leaps use VERTICAL_LANDING where the body has one): the male's
-#: broad jumps landed 3 of 6 with it against 1 without; the female's fell in all 6 (her
-#: broad-jump landings want a delta near 0 where her drops want -0.12 at the same speed)
+#: bodies whose landings after a leap (``after_leap``: the maneuver files' landings) use the
+#: drops' delta table (vertical leaps use VERTICAL_LANDING, broad jumps BROAD_LANDING where
+#: the body has one). Chosen when broad jumps still used it: the male's landed 3 of 6 with it
+#: against 1 without; the female's fell in all 6
 LEAP_LANDING_TABLE: frozenset[str] = frozenset({"male"})
 #: the landing after a vertical leap, per body: (capture-point lead, foot-servo delta m), a
 #: constant delta (no table). Measured over the ten Fig. 4.1 commands (0.1-1.0 m, landed of 10,
@@ -84,6 +99,24 @@ LEAP_LANDING_TABLE: frozenset[str] = frozenset({"male"})
 VERTICAL_LANDING: Mapping[str, tuple[float, float]] = MappingProxyType(
     {"male": (0.5, -0.01), "female": (0.5, -0.05)}
 )
+#: the landing after a broad jump, per body: (capture-point lead, ((touchdown speed m/s,
+#: foot-servo delta m), ...)), thesis Table 6.1 measured on broad jumps, not drops (a broad
+#: jump lands lower, with the trunk pitched forward). Each row: the middle of the deltas that
+#: landed (0.04 m grid, lead 0.5, pitch_ease BROAD_PITCH_EASE) at one effort, 2026-12-02
+#: (/tmp sweep of ``run("broad-jump", body, effort=s)``; docs/athletics.md)
+BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = MappingProxyType(
+    {
+        "male": (
+            0.5,
+            ((0.66, 0.1), (1.12, 0.04), (1.35, 0.02), (1.47, -0.02), (1.69, -0.02), (1.78, -0.02)),
+        ),
+        "female": (0.5, ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
+    }
+)
+#: seconds over which a broad jump's landing rights the trunk (LandingParams.pitch_ease):
+#: righting it at once threw the male's 0.96 m and the female's 0.67 m jumps back up off
+#: their legs (the hips' extension pushed into the floor)
+BROAD_PITCH_EASE = 0.3
 #: (behaviour, parameter) -> body -> (low, high): the measured supported range
 SUPPORTED: Mapping[tuple[str, str], Mapping[str, tuple[float, float]]] = MappingProxyType(
     measured.SUPPORTED
@@ -108,12 +141,24 @@ def landing_delta(table: tuple[tuple[float, float], ...], velocity: float) -> fl
 
 
 def landing_params(
-    body: str, velocity: float, after_leap: bool = False, vertical: bool = False
+    body: str,
+    velocity: float,
+    after_leap: bool = False,
+    vertical: bool = False,
+    broad: bool = False,
 ) -> LandingParams:
     """The landing controller's parameters for a body and a horizontal velocity (m/s); the
     delta table goes with them (interpolated in the air) unless ``after_leap`` and the body
     is not in :data:`LEAP_LANDING_TABLE`. ``vertical``: after a vertical leap, the body's
-    :data:`VERTICAL_LANDING` where it has one."""
+    :data:`VERTICAL_LANDING` where it has one; ``broad``: after a broad jump, the body's
+    :data:`BROAD_LANDING` where it has one, and the trunk righted over
+    :data:`BROAD_PITCH_EASE`."""
+    if broad:
+        base = landing_params(body, velocity, after_leap=True)
+        if body in BROAD_LANDING:
+            lead, table = BROAD_LANDING[body]
+            base = LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
+        return replace(base, pitch_ease=BROAD_PITCH_EASE)
     if vertical and body in VERTICAL_LANDING:
         lead, delta = VERTICAL_LANDING[body]
         return LandingParams(lead=lead, delta=delta)

@@ -63,6 +63,25 @@ def test_a_broad_jump_of_1_m_within_5_cm() -> None:
     assert abs(r.report["achieved_distance_m"] - 1.0) <= 0.05
 
 
+def test_broad_jumps_land_with_the_trunk_righted_slowly(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A broad jump lands with the trunk pitched forward; the landing rights it over
+    BROAD_PITCH_EASE s. Righted at once, the hips' extension pushes into the floor and
+    throws the body back up off its legs: the same jumps fall."""
+    f = run("broad-jump", "female", effort=0.45, check_range=False)
+    m = run("broad-jump", "male", effort=0.6, check_range=False)
+    for r in (f, m):
+        assert r.report["landed"] and not r.report["fell"]
+    assert f.report["achieved_distance_m"] > 0.6 and m.report["achieved_distance_m"] > 0.9
+    monkeypatch.setattr(tables, "BROAD_PITCH_EASE", 0.0)
+    f0 = run("broad-jump", "female", effort=0.45, check_range=False)
+    assert f0.report["fell"] and not f0.report["landed"]
+
+
+def test_landing_pitch_ease_must_not_be_negative() -> None:
+    with pytest.raises(ConfigError, match="pitch_ease"):
+        LandingParams(pitch_ease=-0.1)
+
+
 def test_flight_conserves_angular_momentum() -> None:
     # a leap with pitch momentum; in the air only internal torques act
     r = run("leap", "male", effort=0.4, spin=15.0)
