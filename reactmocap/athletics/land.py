@@ -91,6 +91,10 @@ class LandingParams:
             at touchdown to the upright (``lean``) target; 0: the target at once. A broad
             jump lands with the trunk pitched far forward, and righting it at once drove the
             hips' extension into the floor and threw the body back up.
+        swing_cap: the most the placement swings a leg from under its hip, as the sine of the
+            swing (the foot at most ``swing_cap`` leg lengths ahead of or behind the hip). A fast
+            backward landing (the female back handspring) needs the feet farther behind
+            than the default allows.
     """
 
     knee: float = 0.6
@@ -106,6 +110,7 @@ class LandingParams:
     knee_stiffness: float = 0.0
     deltas: tuple[tuple[float, float], ...] = ()
     pitch_ease: float = 0.0
+    swing_cap: float = 0.9
 
     def __post_init__(self) -> None:
         for name in (
@@ -127,6 +132,8 @@ class LandingParams:
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
         if self.pitch_ease < 0:
             raise ConfigError(f"landing pitch_ease must be >= 0 s, got {self.pitch_ease}")
+        if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
+            raise ConfigError(f"landing swing_cap must be in (0, 1), got {self.swing_cap!r}")
         for row in self.deltas:
             if len(row) != 2 or not all(
                 isinstance(x, (int, float)) and math.isfinite(x) for x in row
@@ -207,7 +214,9 @@ class Landing(Basis):
                 hip = d.xanchor[hip_joints[k]]
                 length = float(np.linalg.norm(hip - d.xanchor[ankle_joints[k]]))
                 ahead = float(s.local(s.com - hip, h)[0]) + want[0]
-                swing = math.asin(float(np.clip(ahead / max(length, 0.2), -0.9, 0.9)))
+                swing = math.asin(
+                    float(np.clip(ahead / max(length, 0.2), -p.swing_cap, p.swing_cap))
+                )
                 geom = float(knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k],
                                              length)[1])  # fmt: skip
                 goal[_HIP[k]] = (-swing + geom - servo[0] - pelvis, servo[1], 0.0)

@@ -25,6 +25,7 @@ __all__ = [
     "TWIST_DIVE",
     "dive",
     "dive_maneuver",
+    "HANDSPRING_BODY_PRESET",
     "HANDSPRING_PRESET",
     "handspring",
     "handspring_maneuver",
@@ -255,15 +256,32 @@ HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
                                     "snap": 0.1}),
     "land": MappingProxyType({"delta": -0.45}),
 })  # fmt: skip
+#: a body's own replacements for the male preset's leap and landing parameters. The female
+#: (hand-tuned 2026-12-02, narrow: docs/athletics.md) leaps harder with more hip feedback,
+#: and lands on feet placed farther behind her (the hip swing allowed past asin 0.9) with
+#: stiffer, more damped knees, which stop the legs bouncing her back into the air
+HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, float]]] = MappingProxyType({
+    "female": MappingProxyType({
+        "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 2.0}),
+        "land": MappingProxyType({"delta": -0.6, "swing_cap": 0.97, "knee_stiffness": 1.0,
+                                  "damping": 2.0}),
+    }),
+})  # fmt: skip
 
 
 def handspring_maneuver(body: str = "male") -> Maneuver:
     """The back handspring as a maneuver: balance, leap with backward rotation, hand support
-    (:class:`~reactmocap.athletics.handspring.Handspring`), land, balance. Another body than
+    (:class:`~reactmocap.athletics.handspring.Handspring`), land, balance. A body with a
+    :data:`HANDSPRING_BODY_PRESET` entry gets its own leap and landing; any other body than
     the male one aims its leap at the male's angular momentum scaled by its layout inertia
     (the same spin rate); that is untuned and its report says what happened."""
     leap = dict(HANDSPRING_PRESET["leap"])
-    if body != "male":
+    land = dict(HANDSPRING_PRESET["land"])
+    own = HANDSPRING_BODY_PRESET.get(body)
+    if own is not None:
+        leap.update(own.get("leap", {}))
+        land.update(own.get("land", {}))
+    elif body != "male":
         ratio = somersault_inertia(athlete(body), "layout") / somersault_inertia(
             athlete("male"), "layout"
         )
@@ -272,7 +290,7 @@ def handspring_maneuver(body: str = "male") -> Maneuver:
         Phase("balance", "after", {}, 0.3),
         Phase("leap", "liftoff", leap),
         Phase("handspring", "released", dict(HANDSPRING_PRESET["handspring"])),
-        Phase("land", "settled", dict(HANDSPRING_PRESET["land"])),
+        Phase("land", "settled", land),
         Phase("balance", "never", {"settle": 2.0}),
     )
     return Maneuver("back_handspring", phases, body, 5.0)

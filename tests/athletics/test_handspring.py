@@ -6,13 +6,15 @@ run's own log."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from reactmocap.athletics.handspring import HandspringParams
-from reactmocap.athletics.maneuvers import load_maneuver
+from reactmocap.athletics.land import LandingParams
+from reactmocap.athletics.maneuvers import load_maneuver, run_maneuver
 from reactmocap.athletics.routines import handspring, handspring_maneuver
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError
@@ -32,6 +34,9 @@ def test_bad_handspring_parameters_are_config_errors() -> None:
         HandspringParams(snap=0.0)
     with pytest.raises(ConfigError, match="push"):
         HandspringParams(push=float("nan"))
+    for cap in (0.0, 1.0, float("nan")):
+        with pytest.raises(ConfigError, match="swing_cap"):
+            LandingParams(swing_cap=cap)
 
 
 def test_the_hands_carry_the_body_past_inverted_and_the_report_matches_the_log() -> None:
@@ -72,3 +77,21 @@ def test_the_handspring_command_writes_bvh_and_report_to_a_folder(tmp_path: Path
     assert KEYS <= set(report) and report["hands_contact_s"] > 0.0
     assert isinstance(report["landed"], bool) and isinstance(report["fell"], bool)
     assert read_bvh(out / "back_handspring_male.bvh").num_frames > 50
+
+
+def test_the_female_handspring_lands_on_feet_placed_past_the_default_hip_swing() -> None:
+    r = handspring("female", fps=10.0)
+    rep, log = r.report, r.log
+    assert rep["status"] == "ok" and rep["body"] == "female"
+    assert rep["rotation_at_hands_deg"] < -150.0 and rep["handspring_other_contacts"] == []
+    assert rep["landed"] is True and rep["fell"] is False
+    assert abs(rep["rotation_deg"] + 360.0) <= 45.0
+    assert log["feet"][-1] > 0
+    # the same preset with the landing's hip swing held at the default cap falls
+    m = handspring_maneuver("female")
+    phases = tuple(
+        replace(ph, params={**ph.params, "swing_cap": 0.9}) if ph.controller == "land" else ph
+        for ph in m.phases
+    )
+    capped = run_maneuver(replace(m, phases=phases), fps=10.0).report
+    assert capped["landed"] is False and capped["fell"] is True
