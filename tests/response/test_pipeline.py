@@ -21,6 +21,7 @@ from reactmocap.response.scenario import (
     AttackerSpec,
     CharacterSpec,
     ImpactSpec,
+    ResponseConfig,
     Scenario,
     load_scenario,
 )
@@ -205,12 +206,18 @@ def _shared_library(shared_mocap_dir: Path, tmp_path: Path) -> Path:
     return lib
 
 
+def _bench_physical(**kw: Any) -> ResponseConfig:
+    """bench_reactions' real recipients: whole-body trackers, the physical mode landing
+    within 0.25 m / 0.5 rad in 1 s, three tries."""
+    return ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                          mode="physical", land_position=0.25, land_angle=0.5, land_joint=0.5,
+                          land_within=1.0, land_tries=3, **kw)  # fmt: skip
+
+
 def _real_kick(
     library: Path, recipient: str, facing_deg: float, position: tuple[float, float], name: str
 ) -> Scenario:
     # bench_reactions' aim: the real front kick at a real recipient, whole-body trackers
-    from reactmocap.response.scenario import ResponseConfig
-
     return Scenario(
         library=library,
         recipient=CharacterSpec(recipient, start=0.5),
@@ -251,8 +258,6 @@ def test_the_attacker_blends_back_to_a_spinning_clip_no_faster_than_it(
     # the kick clip spins while the attacker's simulation has stopped, so blending back over
     # the straight-line gap turned the toes 1.61x faster than the capture ever moves them;
     # the blend back is now lengthened until no joint outruns the clip
-    from reactmocap.response.scenario import ResponseConfig
-
     lib = _shared_library(shared_mocap_dir, tmp_path)
     scenario = Scenario(
         library=lib,
@@ -260,9 +265,7 @@ def test_the_attacker_blends_back_to_a_spinning_clip_no_faster_than_it(
         attacker=AttackerSpec("dataset-1_kick_normal_001", start=1.5833333333333335,
                               facing_deg=372.77788526938275,
                               position=(-1.3014127488540825, -0.2353328567744819)),
-        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
-                                attacker_assist=100.0, mode="physical", land_position=0.25,
-                                land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3),
+        response=_bench_physical(attacker_assist=100.0),
         name="walk-back-kick",
     )  # fmt: skip
     res = run_response(scenario)
@@ -294,17 +297,12 @@ def test_a_search_whose_nearest_windows_are_all_the_own_clip_looks_further(
     # limit): the 4 nearest windows of every search start are the bow itself, which a real hit
     # rules out; the response failed ("no library window continues the response") and now
     # looks OWN_CLIP_DEPTH windows down each start's ranking
-    from reactmocap.response.scenario import ResponseConfig
-
     lib = _shared_library(shared_mocap_dir, tmp_path)
     scenario = Scenario(
         library=lib,
         recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
         impact=ImpactSpec("chest", (249.99920660413557, 0.629839108608112, 0.0), 1.0, 0.2),
-        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
-                                mode="physical", land_position=0.25, land_angle=0.5,
-                                land_joint=0.5, land_within=1.0, land_tries=3,
-                                torque_limit=1000.0),
+        response=_bench_physical(torque_limit=1000.0),
         name="bow-push-back",
     )  # fmt: skip
     res = run_response(scenario)
@@ -319,8 +317,6 @@ def test_a_leg_the_blend_turns_into_the_attacker_is_held_with_the_pelvis(
     # did not land (0.6 m, 1.4 rad off), and the blend's turn of the pelvis swung the left
     # shin 6 cm into the kicker while the shin's own joints were held; a leg's overlap now
     # holds the pelvis's turn too, as an arm's holds the trunk's
-    from reactmocap.response.scenario import ResponseConfig
-
     lib = _shared_library(shared_mocap_dir, tmp_path)
     scenario = Scenario(
         library=lib,
@@ -328,10 +324,7 @@ def test_a_leg_the_blend_turns_into_the_attacker_is_held_with_the_pelvis(
         attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
                               facing_deg=162.95691247341688,
                               position=(2.0136727200528957, 0.0003111082439202495)),
-        response=ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
-                                attacker_assist=100.0, mode="physical", land_position=0.25,
-                                land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3,
-                                torque_limit=1000.0),
+        response=_bench_physical(attacker_assist=100.0, torque_limit=1000.0),
         name="walk-right-kick",
     )  # fmt: skip
     res = run_response(scenario)
