@@ -43,6 +43,14 @@ class SearchWeights:
     * ``support_height``: hands and pelvis count as ground support when they are within this many
       metres of the lowest mapped body part at the query's first frame (a fallen character);
       the feet always count.
+    * ``stance_mismatch``: added to ``D`` for each foot whose ground contact at the window's first
+      frame differs between query and library window (counted in the support position term), so
+      a continuation standing on the other foot, or flying where the body stands, pays for the
+      blend that would drag the feet there. A foot is in contact when it is at most
+      ``contact_height`` m above the ground and moves horizontally at most ``contact_speed`` m/s
+      (from the first two window frames). 0 (the default) turns the cost off: the KD embedding
+      does not hold the term, so with it on the indexed search misses the exact optimum more
+      often (``docs/benchmarks.md``, "Reactions that react", the stance-mismatch cost).
     * ``feature_set``: key into :data:`reactmocap.search.features.FEATURE_SETS`.
     """
 
@@ -55,6 +63,9 @@ class SearchWeights:
     support_orientation: float = 0.25
     support_height: float = 0.25
     window_floor: float = 0.0
+    stance_mismatch: float = 0.0
+    contact_height: float = 0.15
+    contact_speed: float = 0.5
 
     def __post_init__(self) -> None:
         from reactmocap.search.features import get_feature_set
@@ -69,6 +80,7 @@ class SearchWeights:
             (
                 "trunk_position", "trunk_orientation", "limb_position", "limb_orientation",
                 "support_position", "support_orientation", "support_height", "window_floor",
+                "stance_mismatch", "contact_height", "contact_speed",
             ),
         )  # fmt: skip
         if self.window_floor > 1:
@@ -167,9 +179,17 @@ def _from_dict(cls: type[_T], data: dict[str, Any]) -> _T:
     return cls(**data)
 
 
+_STANCE_FIELDS = ("stance_mismatch", "contact_height", "contact_speed")
+
+
 def settings_hash(weights: SearchWeights, window: WindowConfig, mirror: bool) -> str:
+    w = weights.to_dict()
+    if weights.stance_mismatch == 0:
+        # the stance term off changes nothing: indexes saved before it existed stay valid
+        for k in _STANCE_FIELDS:
+            del w[k]
     blob = json.dumps(
-        {"weights": weights.to_dict(), "window": window.to_dict(), "mirror": bool(mirror)},
+        {"weights": w, "window": window.to_dict(), "mirror": bool(mirror)},
         sort_keys=True,
     )
     return hashlib.sha256(blob.encode()).hexdigest()

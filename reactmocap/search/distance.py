@@ -24,6 +24,7 @@ __all__ = [
     "group_matrix",
     "localize",
     "select_support",
+    "StanceCost",
     "window_distances",
 ]
 
@@ -51,6 +52,41 @@ class QueryWindow:
     support: int  # index into the feature set's parts
     support_part: str
     com: F64  # (3,) at the first frame, world
+
+
+@dataclass(frozen=True)
+class StanceCost:
+    """The stance-mismatch term (``SearchWeights.stance_mismatch``): ``weight`` per foot whose
+    contact at the window's first frame differs from the query's."""
+
+    feet: NDArray[np.int64]  # indices into the feature set's parts
+    weight: float
+    height: float  # m above the ground
+    step: float  # m of horizontal travel between the first two window frames
+
+    @classmethod
+    def of(cls, feature_set: FeatureSet, weights: SearchWeights, fps: float) -> StanceCost | None:
+        if weights.stance_mismatch <= 0:
+            return None
+        feet = [
+            feature_set.parts.index(p) for p in feature_set.support_always if p in feature_set.parts
+        ]
+        if not feet:
+            return None
+        return cls(np.asarray(feet, dtype=np.int64), float(weights.stance_mismatch),
+                   float(weights.contact_height), float(weights.contact_speed) / fps)  # fmt: skip
+
+    def contacts(self, p0: NDArray[np.floating], p1: NDArray[np.floating]) -> NDArray[np.bool_]:
+        """``(..., F)`` feet in contact from their positions at two consecutive frames
+        ``(..., F, 3)`` (horizontal travel is the same in any yaw frame)."""
+        travel = np.hypot(p1[..., 0] - p0[..., 0], p1[..., 1] - p0[..., 1])
+        return np.asarray((p0[..., 2] <= self.height) & (travel <= self.step))
+
+    def cost(self, positions: F32, starts: NDArray[np.int64], query: QueryWindow) -> F64:
+        """``(C,)`` mismatch cost of the windows starting at ``starts``."""
+        lib = self.contacts(positions[starts][:, self.feet], positions[starts + 1][:, self.feet])
+        q = self.contacts(query.positions[0, self.feet], query.positions[1, self.feet])
+        return self.weight * np.count_nonzero(lib != q[None], axis=1).astype(np.float64)
 
 
 def localize(
@@ -188,6 +224,7 @@ def window_distances(
     groups: F64 | None = None,
     offsets: NDArray[np.int64] | None = None,
     precise: bool = True,
+    stance: StanceCost | None = None,
 ) -> tuple[F64, F64 | None]:
     """``D`` between ``query`` and the library windows starting at ``starts``.
 
@@ -196,7 +233,8 @@ def window_distances(
     ``precise=False`` computes the same quantities in a cheaper form that loses precision near
     zero (about 1e-3 rad in ``d_theta``), which is fine for pre-ranking only.
     Returns ``(D (C,), breakdown (C, 6) or None)``; the breakdown (when ``groups`` is given)
-    follows :data:`BREAKDOWN_TERMS` and sums to ``D``.
+    follows :data:`BREAKDOWN_TERMS` and sums to ``D``; ``stance``'s cost, when given, is in
+    ``D`` and in the support position term.
     """
     if offsets is None:
         offsets = np.arange(query.positions.shape[0])
@@ -249,9 +287,14 @@ def window_distances(
     sp = np.einsum("clp,l->cp", dpos, wi).astype(np.float64)  # per part, time-weighted
     sa = np.einsum("clp,l->cp", dang, wi).astype(np.float64)
     total = sp @ wp + sa @ wq
+    extra = None if stance is None else stance.cost(positions, starts, query)
+    if extra is not None:
+        total = total + extra
     if groups is None:
         return total, None
     bp = (sp * wp[None]) @ groups  # (C, 3)
+    if extra is not None:
+        bp[:, 2] += extra
     ba = (sa * wq[None]) @ groups
     br = np.stack([bp[:, 0], ba[:, 0], bp[:, 1], ba[:, 1], bp[:, 2], ba[:, 2]], axis=1)
     return total, br

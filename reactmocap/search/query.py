@@ -20,6 +20,7 @@ from reactmocap.search.build import EmbeddingWeights, embedding_weights, rate_st
 from reactmocap.search.config import SearchWeights, WindowConfig
 from reactmocap.search.distance import (
     QueryWindow,
+    StanceCost,
     body_weights,
     embed_local,
     embedding_frame_weights,
@@ -79,6 +80,7 @@ class QueryConstants:
     wp: F64  # (P, P): row s = position weight per part when part s is the support body
     wq: F64  # (P, P): the same for orientation
     groups: F64  # (P, P, 3): row s = group_matrix with support s
+    stance: StanceCost | None  # the stance-mismatch term, None when its weight is 0
 
     @classmethod
     def of(cls, weights: SearchWeights, window: WindowConfig) -> QueryConstants:
@@ -98,6 +100,7 @@ class QueryConstants:
             wp=np.stack([w[0] for w in per_support]),
             wq=np.stack([w[1] for w in per_support]),
             groups=np.stack([group_matrix(fs, s) for s in range(len(fs.parts))]),
+            stance=StanceCost.of(fs, weights, window.fps),
         )
         shared = (c.window_weights, c.coarse_offsets, c.coarse_weights, c.wp, c.wq, c.groups)
         for a in (*c.embedding, *shared):
@@ -231,7 +234,7 @@ def _distances(
         index.positions, index.orientations, index.heading, index.origin, starts, qw,
         c.coarse_weights if coarse else c.window_weights, c.wp[s], c.wq[s],
         c.groups[s] if breakdown else None, c.coarse_offsets if coarse else None,
-        precise=(not coarse) if precise is None else precise,
+        precise=(not coarse) if precise is None else precise, stance=c.stance,
     )  # fmt: skip
 
 

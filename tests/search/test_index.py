@@ -24,6 +24,7 @@ from reactmocap.search import (
     prepare_query,
     search_window,
 )
+from reactmocap.search.config import settings_hash
 from reactmocap.search.query import distances
 from reactmocap.search.types import DEFAULT_K
 
@@ -355,3 +356,34 @@ def test_an_explicit_query_cache(synth_index: MotionIndex, synth_clips: dict[str
     )
     cache.clear()
     assert synth_index.top_k(m, 12, n=2, cache=cache) == synth_index.top_k(m, 12, n=2)
+
+
+def test_a_stance_mismatch_costs_each_foot_whose_contact_differs(
+    synth_clips: dict[str, Motion],
+) -> None:
+    """``stance_mismatch`` adds its weight to ``D`` once per foot planted in one window and not
+    in the other (issue 15: a continuation on the other foot drags the feet in the blend)."""
+    w = 0.7
+    off = MotionIndex.build(synth_clips, SearchWeights(stance_mismatch=0.0), WindowConfig())
+    on = MotionIndex.build(synth_clips, SearchWeights(stance_mismatch=w), WindowConfig())
+    m = synth_clips["side_kick"]  # index frame 20: the right foot kicks, the left is planted
+
+    def starts(index: MotionIndex, clip: str, frames: list[int]) -> np.ndarray:
+        return np.asarray(frames, dtype=np.int64) + index.clip_offsets[index.clip_index(clip)]
+
+    def extra(clip: str, frames: list[int]) -> np.ndarray:
+        d_on, br = distances(on, prepare_query(on, m, 40), starts(on, clip, frames), breakdown=True)
+        d_off, _ = distances(off, prepare_query(off, m, 40), starts(off, clip, frames))
+        assert br is not None
+        np.testing.assert_allclose(br.sum(axis=1), d_on, rtol=1e-6)  # the breakdown holds it
+        return d_on - d_off
+
+    ci = on.clip_index("guard")
+    guard = list(range(0, int(np.diff(on.clip_offsets)[ci]) - on.length, 7))
+    np.testing.assert_allclose(extra("guard", guard), w, atol=1e-5)  # both feet planted there
+    np.testing.assert_allclose(extra("side_kick", [20, 25]), 0.0, atol=1e-5)  # the same stance
+    np.testing.assert_allclose(extra("side_kick", [5]), 2 * w, atol=1e-5)  # left up, right down
+    # with the term off, indexes saved before it existed keep their settings hash
+    no_term = SearchWeights(stance_mismatch=0.0, contact_height=0.3)
+    assert settings_hash(no_term, WindowConfig(), False) == off.settings_hash
+    assert on.settings_hash != off.settings_hash
