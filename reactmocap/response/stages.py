@@ -392,10 +392,14 @@ def search_continuation(
         own = rec.clock0 + contact.rewind + start / q_fps
         return not (hit and r.clip == rec.clip.name and abs(r.time - own) < cfg.own_clip_margin)
 
+    nearest: list[tuple[SearchResult | None, int]] = [
+        (index.query(query, s, parts=parts), s) for s in starts.tolist()
+    ]
+
     def search(deeper: int) -> list[tuple[SearchResult, int]]:
         found = []
-        for s in starts.tolist():
-            r: SearchResult | None = index.query(query, s, parts=parts)
+        for first, s in nearest:
+            r = first
             if r is not None and not allowed(r, s):
                 r = next((c for c in index.top_k(query, s, n=deeper, parts=parts)
                           if allowed(c, s)), None)  # fmt: skip
