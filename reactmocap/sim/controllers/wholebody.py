@@ -671,8 +671,9 @@ class WholeBodyTracker(AnchoredReference):
         self.last_plan = plan
         # the servo (damping only by default) keeps acting between ticks; at the tick the
         # total joint torque is the plan's (within ``torque_limit``)
-        tau = plan.torques
-        if self.torque_limit > 0:
-            norm = np.linalg.norm(tau, axis=1, keepdims=True)
-            tau = tau * np.minimum(1.0, self.torque_limit / np.maximum(norm, 1e-12))
-        self._ff[:] = tau - self.servo.torques(self.character)
+        self._ff[:] = plan.torques
+        if self.torque_limit > 0:  # each joint's torque scaled down to the limit, in place
+            scale = np.linalg.norm(self._ff, axis=1, keepdims=True)
+            np.divide(self.torque_limit, np.maximum(scale, 1e-12, out=scale), out=scale)
+            self._ff *= np.minimum(scale, 1.0, out=scale)
+        self._ff -= self.servo.torques(self.character)
