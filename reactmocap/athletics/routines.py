@@ -129,8 +129,9 @@ def somersault(
         raise ConfigError(
             "twisting somersaults are not built (thesis 5.2): the twist is aimed only in the "
             "layout back dive (athletics dive --twist 0.5|1); a twist thrown in the tuck or "
-            "pike did not stop, and the layout somersault is held only until the landing's "
-            "reach, 0.6 s into the flight (docs/athletics.md); run without --twist"
+            "pike did not stop, in the layout a half twist cannot be stopped (the arms' undo "
+            "runs into the shoulders' cones) and a full one stops at best 0.26 s before touchdown, "
+            "too late to land (docs/athletics.md); run without --twist"
         )
     if not (math.isfinite(backpack) and backpack >= 0):
         raise ConfigError(f"backpack must be >= 0 kg, got {backpack!r}")
