@@ -1,6 +1,6 @@
 """Cloth driven by the runner (Hodgins et al. 1995, "Secondary motions": sweatpants driven by
 the simulated runner): loose trousers as MuJoCo flex cloth (``flexcomp``, one tube per leg
-hanging from the waist, inextensible edges), in a model of their own where the runner's
+sewn to the pelvis at the waist, inextensible edges), in a model of their own where the runner's
 bodies are copies of its collision geoms, set at every cloth step to where the runner's
 bodies are and how fast they move (so the contacts see them move); before each step, cloth
 vertices found inside a body capsule are moved out along its radius and stopped from moving
@@ -20,6 +20,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from reactmocap.athletics.rider_kinematics import _cross
 from reactmocap.errors import ConfigError, ReactMocapError, SimulationError
 from reactmocap.rotations import quat_exp, quat_mul, quat_normalize, quat_to_matrix
 from reactmocap.sim.bodies import SIM_BODIES
@@ -226,9 +227,6 @@ class Cloth:
     def _build(self) -> None:
         m, d = self.world.model, self.world.data
         wc = self.wc
-        root = wc.body_ids[0]
-        rot0 = d.xmat[root].reshape(3, 3)
-        pos0 = d.xpos[root]
         patches = set(wc.patch_ids.tolist())
         bodies = []
         for i, b in enumerate(wc.body_ids):
@@ -244,10 +242,9 @@ class Cloth:
             pts = self._tube(side).reshape(-1, 3)
             # each trouser leg meets its own leg and the trunk and arms; the two legs of the
             # trousers do not squeeze between the thighs (there is no crotch), and the
-            # waistband is sewn to the pelvis (pinned), so the pelvis is left out
+            # waistband is sewn to the pelvis (carried by it), so the pelvis is left out
             affinity = _BITS[side + "_"] | 2
             self._affinity.append(affinity)
-            local = (pts - pos0) @ rot0  # in the pelvis frame
             tris = []
             for j in range(sp.rings - 1):
                 for i in range(ring):
@@ -256,23 +253,21 @@ class Cloth:
             flexes.append(
                 f'<flexcomp name="{side}_leg" type="direct" dim="2" radius="{sp.thickness}" '
                 f'mass="{0.5 * sp.mass}" rgba="0.2 0.2 0.25 1" '
-                f'point="{" ".join(f"{x:.5f}" for x in local.ravel())}" '
+                f'point="{" ".join(f"{x:.5f}" for x in pts.ravel())}" '
                 f'element="{" ".join(str(x) for x in np.ravel(tris))}">'
                 f'<edge equality="true" solref="{max(sp.stretch, 2 * sp.timestep)} 1" '
                 f'damping="{sp.stretch_damping}"/>'
                 f'<contact contype="0" conaffinity="{affinity}" selfcollide="none" '
-                f'solref="{sp.contact_time} 1" solimp="0.99 0.999 0.001"/>'
-                f'<pin id="{" ".join(str(i) for i in range(ring))}"/></flexcomp>'
+                f'solref="{sp.contact_time} 1" solimp="0.99 0.999 0.001"/></flexcomp>'
             )
         parts = []
         for i, geoms in bodies:
-            extra = "".join(flexes) if i == 0 else ""
             pos = " ".join(map(str, d.xpos[wc.body_ids[i]]))
             quat = " ".join(map(str, d.xquat[wc.body_ids[i]]))
             # heavy and weightless: the cloth barely moves it, and it is set each step
             parts.append(f'<body name="b{i}" pos="{pos}" quat="{quat}" gravcomp="1"><freejoint/>'
                          '<inertial pos="0 0 0" mass="1000" diaginertia="10 10 10"/>'
-                         f"{geoms}{extra}</body>")  # fmt: skip
+                         f"{geoms}</body>")  # fmt: skip
         xml = (
             f'<mujoco><option timestep="{sp.timestep}" solver="CG" iterations="{sp.iterations}" '
             f'ls_iterations="{sp.ls_iterations}" '
@@ -280,7 +275,7 @@ class Cloth:
             '<visual><global offwidth="640" offheight="480"/></visual>'
             '<worldbody><light pos="0 0 6" dir="0 0 -1" directional="true"/>'
             '<geom name="floor" type="plane" size="0 0 0.05" rgba="0.82 0.84 0.86 1" '
-            'contype="16" conaffinity="0"/>' + "".join(parts) + "</worldbody></mujoco>"
+            'contype="16" conaffinity="0"/>' + "".join(parts + flexes) + "</worldbody></mujoco>"
         )
         try:
             self.model = mujoco.MjModel.from_xml_string(xml)
@@ -324,20 +319,21 @@ class Cloth:
         (NvCloth's "max distance" constraint): a loose tube cannot then fall across the limb
         it hangs around, which neither the contacts nor the projection undo."""
         p = self._tparts
-        home = np.einsum("vj,vjki,vji->vk", self._tw, rot[p], self._tlocal)
-        home += np.einsum("vj,vjk->vk", self._tw, pos[p])
+        # each part's point (rot @ local + pos), then their blend
+        home = np.einsum("vjki,vji->vjk", rot[p], self._tlocal) + pos[p]
+        home = np.einsum("vj,vjk->vk", self._tw, home)
         off = x - home
-        dist = np.linalg.norm(off, axis=1)
-        far = dist > self.spec.tether
+        dist = np.sqrt(np.einsum("vi,vi->v", off, off))
+        far = np.flatnonzero(dist > self.spec.tether)
         x[far] = home[far] + off[far] * (self.spec.tether / dist[far])[:, None]
 
     def _collider_setup(self) -> None:
-        """What the vertex projection needs: the free vertices' slide-joint addresses and
-        rest offsets in the pelvis copy's frame, the capsules (and the head's sphere, a
-        capsule of no length) in their bodies' frames, and which of them each vertex's
-        trouser leg collides with."""
-        m = self.model
-        assert m is not None
+        """What the vertex projection needs: the vertices' slide-joint addresses and rest
+        positions (world), the waistband's place on the pelvis copy, the capsules (and the
+        head's sphere, a capsule of no length) in their bodies' frames, and which of them each
+        vertex's trouser leg collides with."""
+        m, d = self.model, self.data
+        assert m is not None and d is not None
         b0 = int(m.body("b0").id)
         affinity = np.array(self._affinity)
         hit = np.bitwise_or.reduce(affinity)
@@ -351,14 +347,23 @@ class Cloth:
         body = m.flex_vertbodyid
         free = np.flatnonzero(m.body_jntnum[body] == 3)
         body = body[free]
-        if not (m.body_parentid[body] == b0).all():
-            raise SimulationError("the cloth's vertices are expected to hang from the pelvis")
+        # the vertices are particles in the world (not children of the pelvis copy: coupled
+        # to its free joint, every vertex's rows of the mass matrix and the constraint
+        # Jacobian carried its 6 dofs: MuJoCo's step was about 1.3x dearer in a run)
+        if len(free) != m.nflexvert or not (m.body_parentid[body] == 0).all():
+            raise SimulationError("the cloth's vertices are expected to be free in the world")
         flex = np.searchsorted(m.flex_vertadr, free, side="right") - 1
+        # the waistband (each tube's first ring) is sewn to the pelvis: carried by its copy
+        self._pin = np.flatnonzero(free - m.flex_vertadr[flex] < self.spec.around)
+        r0 = d.xmat[b0].reshape(3, 3)
+        self._pin_local = (d.flexvert_xpos[free[self._pin]] - d.xpos[b0]) @ r0
         self._vq = m.jnt_qposadr[m.body_jntadr[body]][:, None] + np.arange(3)
         self._tether_setup(free, flex)
         self._vd = m.jnt_dofadr[m.body_jntadr[body]][:, None] + np.arange(3)
+        self._vall = np.arange(len(free))
         self._vrest = m.body_pos[body].copy()
         self._vmask = (m.geom_contype[caps][None] & affinity[flex][:, None]) > 0
+        self._vmask[self._pin] = False  # the waistband is never projected
         self._cpart = self._geom_part[caps]
         self._cpos = m.geom_pos[caps].copy()
         self._caxis = axes
@@ -378,6 +383,12 @@ class Cloth:
         del world
         self._reset_record()
         self._build()
+        # the cloth starts moving with the pelvis, as if it had been worn before
+        assert self.data is not None
+        pos, _ = self._poses()
+        vel, omega = self._velocities()
+        x = self._vrest + self.data.qpos[self._vq]
+        self.data.qvel[self._vd] = vel[0] + _cross(omega[0], x - pos[0])
         self._record(0.0)
 
     def _poses(self) -> tuple[F64, F64]:
@@ -393,7 +404,7 @@ class Cloth:
         cvel = d.cvel[ids]
         com = d.subtree_com[m.body_rootid[ids]]
         omega = cvel[:, :3]
-        return cvel[:, 3:] + np.cross(omega, d.xpos[ids] - com), omega
+        return cvel[:, 3:] + _cross(omega, d.xpos[ids] - com), omega
 
     def control(self, world: World, t: float) -> None:
         assert self.model is not None and self.data is not None
@@ -416,12 +427,11 @@ class Cloth:
             )
             d.qvel[qvel[:, :3]] = vel
             d.qvel[qvel[:, 3:]] = local
+            now = d.qpos[qpos[:, :3]]
+            rot_k = rot if not k else quat_to_matrix(d.qpos[qpos[:, 3:]])
+            self._sew(now[0], rot_k[0], vel[0], omega[0])
             if self.spec.project:
-                self._project(
-                    d.qpos[qpos[:, :3]],
-                    rot if not k else quat_to_matrix(d.qpos[qpos[:, 3:]]),
-                    (vel, omega) if self.spec.project_velocity else None,
-                )
+                self._project(now, rot_k, (vel, omega) if self.spec.project_velocity else None)
             mujoco.mj_step(m, d)
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
             self.finite = False
@@ -443,53 +453,63 @@ class Cloth:
         take several steps to do; its sliding along the surface is kept)."""
         d = self.data
         assert d is not None
-        r0, p0 = rot[0], pos[0]
         part = self._cpart
         a = np.einsum("gij,gj->gi", rot[part], self._cpos) + pos[part]
         ax = np.einsum("gij,gj->gi", rot[part], self._caxis)
-        x = (self._vrest + d.qpos[self._vq]) @ r0.T + p0
+        x = self._vrest + d.qpos[self._vq]
         if self.spec.tether > 0:
             self._tether(x, pos, rot)
         # later passes look only at the vertices the one before moved (the others are out)
-        v = np.arange(len(x))
+        v = self._vall
+        lo, hi, crad = -self._chalf, self._chalf, self._crad
         moved: list[NDArray[np.intp]] = []
         normals: list[F64] = []
         caps: list[NDArray[np.intp]] = []
         for _ in range(self.spec.project):
-            rel = x[v, None, :] - a[None]
-            s = np.clip(np.einsum("vgi,gi->vg", rel, ax), -self._chalf, self._chalf)
-            off = rel - s[..., None] * ax[None]
-            dist = np.sqrt(np.einsum("vgi,vgi->vg", off, off))
-            depth = np.where(self._vmask[v], self._crad - dist, 0.0)
+            rel = x[v, None, :] - a
+            s = np.minimum(np.maximum(np.einsum("vgi,gi->vg", rel, ax), lo), hi)
+            rel -= s[..., None] * ax
+            dist = np.sqrt(np.einsum("vgi,vgi->vg", rel, rel))
+            depth = (crad - dist) * self._vmask[v]
             g = depth.argmax(axis=1)
-            k = np.flatnonzero(depth[np.arange(len(v)), g] > 0)
+            rows = np.arange(len(v))
+            k = np.flatnonzero(depth[rows, g] > 0)
             if not k.size:
                 break
             v, g = v[k], g[k]
-            normal = off[k, g] / np.maximum(dist[k, g], 1e-9)[:, None]
+            normal = rel[k, g] / np.maximum(dist[k, g], 1e-9)[:, None]
             x[v] += normal * depth[k, g][:, None]
             moved.append(v)
             normals.append(normal)
             caps.append(g)
         if not moved and self.spec.tether <= 0:
             return
-        d.qpos[self._vq] = (x - p0) @ r0 - self._vrest
-        if velocity is None:
+        d.qpos[self._vq] = x - self._vrest
+        if velocity is None or not moved:
             return
         vel, omega = velocity
         qv = self._vd
-        # the vertices' world velocities: the pelvis copy's motion and their slide joints
-        xv = vel[0] + np.cross(omega[0], x - p0) + d.qvel[qv] @ r0.T
-        for v, normal, g in zip(moved, normals, caps):
+        for w, normal, g in zip(moved, normals, caps):
             b = part[g]
-            rel = xv[v] - (vel[b] + np.cross(omega[b], x[v] - pos[b]))
+            rel = d.qvel[qv[w]] - (vel[b] + _cross(omega[b], x[w] - pos[b]))
             vn = np.einsum("vi,vi->v", rel, normal)
-            xv[v] -= np.minimum(vn, 0.0)[:, None] * normal
-        d.qvel[qv] = (xv - vel[0] - np.cross(omega[0], x - p0)) @ r0
+            d.qvel[qv[w]] -= np.minimum(vn, 0.0)[:, None] * normal
+
+    def _sew(self, pos: F64, rot: F64, vel: F64, omega: F64) -> None:
+        """The waistband where the pelvis has it, moving with it (``pos``, ``rot``, ``vel``
+        and ``omega`` the pelvis copy's)."""
+        d = self.data
+        assert d is not None
+        arm = self._pin_local @ rot.T
+        d.qpos[self._vq[self._pin]] = arm + pos - self._vrest[self._pin]
+        d.qvel[self._vd[self._pin]] = vel + _cross(omega, arm)
 
     def _measure(self, world: World) -> None:
         assert self.model is not None and self.data is not None
         m, d = self.model, self.data
+        self._ticks += 1
+        if not d.ncon and not self.feedback:
+            return
         con = d.contact
         flex, geom = con.flex, con.geom
         # cloth-body contacts (the floor's geom has no part)
@@ -502,7 +522,6 @@ class Cloth:
         dist = con.dist[mine]
         deepest = max(0.0, float(-dist.min()) - self.spec.thickness) if dist.size else 0.0
         self.penetration_max = max(self.penetration_max, deepest)
-        self._ticks += 1
         self._over_1cm += deepest > 0.01
         if deepest > 0:
             self._pen_sum += deepest
@@ -542,18 +561,23 @@ class Cloth:
             corners = d.flexvert_xpos[elems]
             # only the (triangle, capsule) pairs near enough for the triangle to reach in
             centre = corners.mean(axis=1)
-            reach = np.linalg.norm(corners - centre[:, None], axis=2).max(axis=1)
-            ax = d.geom_xmat[g].reshape(-1, 3, 3)[:, :, 2]
+            spoke = corners - centre[:, None]
+            reach = np.sqrt(np.einsum("eki,eki->ek", spoke, spoke).max(axis=1))
+            ax = d.geom_xmat[g][:, 2::3]
             rel = centre[:, None, :] - d.geom_xpos[g]
-            s = np.clip(np.einsum("egi,gi->eg", rel, ax), -half, half)
-            near = np.linalg.norm(rel - s[..., None] * ax, axis=2) < radius + reach[:, None]
+            s = np.minimum(np.maximum(np.einsum("egi,gi->eg", rel, ax), -half), half)
+            rel -= s[..., None] * ax
+            near = np.einsum("egi,egi->eg", rel, rel) < (radius + reach[:, None]) ** 2
             e, k = np.nonzero(near)
             if not e.size:
                 continue
             pts = np.einsum("sk,ekd->esd", _SURFACE_SAMPLES, corners[e])
             rel = pts - d.geom_xpos[g[k]][:, None]
-            s = np.clip(np.einsum("esi,ei->es", rel, ax[k]), -half[k, None], half[k, None])
-            dist = np.linalg.norm(rel - s[..., None] * ax[k][:, None], axis=2)
+            axk = ax[k]
+            s = np.minimum(np.maximum(np.einsum("esi,ei->es", rel, axk), -half[k, None]),
+                           half[k, None])  # fmt: skip
+            rel -= s[..., None] * axk[:, None]
+            dist = np.sqrt(np.einsum("esi,esi->es", rel, rel))
             deepest = max(deepest, float((radius[k, None] - dist).max()))
         return deepest
 

@@ -80,8 +80,7 @@ def test_cloth_vertices_are_moved_out_of_the_body() -> None:
     radius = float(m.geom_size[thigh, 0])
     # the right trouser leg's vertex nearest the thigh's centre, put 2 cm off its axis
     right = np.flatnonzero(cloth._vmask[:, list(cloth._cpart).index(13)])
-    r0, p0 = rot[0], pos[0]
-    x = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    x = cloth._vrest + d.qpos[cloth._vq]
     v = right[np.argmin(np.linalg.norm(x[right] - centre, axis=1))]
     axis = d.geom_xmat[thigh].reshape(3, 3)[:, 2]
     side = np.cross(axis, [0.0, 0.0, 1.0])
@@ -90,13 +89,13 @@ def test_cloth_vertices_are_moved_out_of_the_body() -> None:
     before = x.copy()
     drawn = cloth._surface_depth()
     before[v] = inside
-    d.qpos[cloth._vq] = (before - p0) @ r0 - cloth._vrest
+    d.qpos[cloth._vq] = before - cloth._vrest
     # the drawn surface's depth sees the triangles around the vertex inside the thigh
     mujoco.mj_fwdPosition(m, d)
     assert cloth._surface_depth() > max(drawn, 0.02)
     others = d.qpos[cloth._vq].copy()
     cloth._project(pos, rot)
-    after = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    after = cloth._vrest + d.qpos[cloth._vq]
     off = after[v] - centre
     off -= axis * float(off @ axis)
     assert np.linalg.norm(off) == pytest.approx(radius + cloth.spec.thickness, abs=1e-6)
@@ -179,25 +178,24 @@ def test_a_moved_vertex_stops_moving_into_the_limb() -> None:
     axis = d.geom_xmat[thigh].reshape(3, 3)[:, 2]
     side = np.cross(axis, [0.0, 0.0, 1.0])
     side /= np.linalg.norm(side)
-    r0, p0 = rot[0], pos[0]
-    x = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    x = cloth._vrest + d.qpos[cloth._vq]
     right = np.flatnonzero(cloth._vmask[:, list(cloth._cpart).index(part)])
     v = right[np.argmin(np.linalg.norm(x[right] - centre, axis=1))]
     x[v] = centre + 0.02 * side
-    d.qpos[cloth._vq] = (x - p0) @ r0 - cloth._vrest
+    d.qpos[cloth._vq] = x - cloth._vrest
     vel, omega = np.zeros((len(ids), 3)), np.zeros((len(ids), 3))
     vel[part] = [1.0, 0.0, 0.0]
     q, qv = d.qpos.copy(), d.qvel.copy()
     for inward, expected in ((-2.0, 0.0), (0.5, 0.5)):
         d.qpos[:], d.qvel[:] = q, qv
         moving = vel[part] + inward * side + 0.5 * axis
-        d.qvel[cloth._vd[v]] = moving @ r0  # the pelvis copy is still: world = r0 @ local
+        d.qvel[cloth._vd[v]] = moving  # the vertices are particles in the world
         cloth._project(pos, rot, (vel, omega))
-        after = r0 @ d.qvel[cloth._vd[v]]
+        after = d.qvel[cloth._vd[v]]
         np.testing.assert_allclose(after, vel[part] + expected * side + 0.5 * axis, atol=1e-9)
     # without the velocities only the position is projected
     d.qpos[:], d.qvel[:] = q, qv
-    d.qvel[cloth._vd[v]] = (vel[part] - 2.0 * side) @ r0
+    d.qvel[cloth._vd[v]] = vel[part] - 2.0 * side
     before = d.qvel.copy()
     cloth._project(pos, rot)
     np.testing.assert_array_equal(d.qvel, before)
@@ -217,16 +215,48 @@ def test_a_vertex_is_kept_near_where_it_was_made_on_the_leg() -> None:
     d = cloth.data
     ids = cloth.wc.body_ids
     pos, rot = world.data.xpos[ids].copy(), world.data.xmat[ids].reshape(-1, 3, 3).copy()
-    r0, p0 = rot[0], pos[0]
-    made = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    made = cloth._vrest + d.qpos[cloth._vq]
     v = int(np.argmax(made[:, 2]))  # a vertex of the top free ring
     x = made.copy()
     x[v] += [0.0, 0.0, 0.2]  # straight up, above the hips
-    d.qpos[cloth._vq] = (x - p0) @ r0 - cloth._vrest
+    d.qpos[cloth._vq] = x - cloth._vrest
     cloth._project(pos, rot)
-    after = (cloth._vrest + d.qpos[cloth._vq]) @ r0.T + p0
+    after = cloth._vrest + d.qpos[cloth._vq]
     assert np.linalg.norm(after[v] - made[v]) == pytest.approx(cloth.spec.tether, abs=1e-9)
     others = np.arange(len(made)) != v
     moved = np.linalg.norm(after[others] - made[others], axis=1) > 1e-9
     # the start pose puts four vertices inside the forearms and hands (at the hips)
     assert moved.sum() == 4
+
+
+def test_the_waistband_moves_with_the_pelvis() -> None:
+    """The cloth's vertices are particles in the world; the waistband (each tube's top ring)
+    is sewn to the pelvis: with the runner's body moved 10 cm forward and turned 0.3 rad about
+    the vertical, and the pelvis moving (1 m/s forward, 2 rad/s about the vertical), each
+    cloth step starts with the waistband where the pelvis now has it and moving with it; the
+    rest of the cloth is left where it was."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+
+    world = athletics_world(athlete("male"))
+    cloth = Cloth(world, "pants")
+    cloth.reset(world)
+    d = cloth.data
+    wd = world.data
+    pelvis = cloth.wc.body_ids[0]
+    r0, p0 = wd.xmat[pelvis].reshape(3, 3).copy(), wd.xpos[pelvis].copy()
+    made = cloth._vrest + d.qpos[cloth._vq]
+    band = cloth._pin
+    local = (made[band] - p0) @ r0
+    assert len(band) == 2 * cloth.spec.around
+    turn = np.array([[np.cos(0.3), -np.sin(0.3), 0.0], [np.sin(0.3), np.cos(0.3), 0.0],
+                     [0.0, 0.0, 1.0]])  # fmt: skip
+    r1, p1 = turn @ r0, p0 + [0.1, 0.0, 0.0]
+    vel, omega = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 2.0])
+    cloth._sew(p1, r1, vel, omega)
+    now = cloth._vrest + d.qpos[cloth._vq]
+    arm = local @ r1.T
+    np.testing.assert_allclose(now[band], arm + p1, atol=1e-12)
+    np.testing.assert_allclose(d.qvel[cloth._vd[band]], vel + np.cross(omega, arm), atol=1e-12)
+    others = np.setdiff1d(np.arange(len(now)), band)
+    np.testing.assert_array_equal(now[others], made[others])
