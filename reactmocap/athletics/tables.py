@@ -21,6 +21,7 @@ from reactmocap.athletics.leap import BROAD_TIMING, LeapParams
 from reactmocap.errors import ConfigError
 
 __all__ = [
+    "BROAD_ARMS",
     "BROAD_LANDING",
     "BROAD_PITCH_EASE",
     "BROAD_SPIN",
@@ -113,6 +114,13 @@ BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = Map
         "female": (0.5, ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
     }
 )
+#: the shoulder pitch (rad, > 0 behind the trunk) a broad jump's landing swings the arms to
+#: in the air, per body (LandingParams.arms; others keep its -0.6, in front). Why: the take-off
+#: leaves the arms overhead, and swinging them forward-down and on behind the trunk turns the
+#: rest of the body back (angular momentum is conserved in the air), so the trunk touches
+#: down less pitched forward. Female, 2026-12-02: with 0.6 her 0.65 m command (effort 0.42,
+#: trunk 57 deg forward at touchdown against 62) lands where it fell (docs/athletics.md)
+BROAD_ARMS: Mapping[str, float] = MappingProxyType({"female": 1.0})
 #: seconds over which a broad jump's landing rights the trunk (LandingParams.pitch_ease):
 #: righting it at once threw the male's 0.96 m and the female's 0.67 m jumps back up off
 #: their legs (the hips' extension pushed into the floor)
@@ -151,14 +159,15 @@ def landing_params(
     delta table goes with them (interpolated in the air) unless ``after_leap`` and the body
     is not in :data:`LEAP_LANDING_TABLE`. ``vertical``: after a vertical leap, the body's
     :data:`VERTICAL_LANDING` where it has one; ``broad``: after a broad jump, the body's
-    :data:`BROAD_LANDING` where it has one, and the trunk righted over
-    :data:`BROAD_PITCH_EASE`."""
+    :data:`BROAD_LANDING` where it has one, the arms swung to :data:`BROAD_ARMS` in the air
+    where it has one, and the trunk righted over :data:`BROAD_PITCH_EASE`."""
     if broad:
         base = landing_params(body, velocity, after_leap=True)
         if body in BROAD_LANDING:
             lead, table = BROAD_LANDING[body]
             base = LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
-        return replace(base, pitch_ease=BROAD_PITCH_EASE)
+        arms = BROAD_ARMS.get(body, base.arms)
+        return replace(base, pitch_ease=BROAD_PITCH_EASE, arms=arms)
     if vertical and body in VERTICAL_LANDING:
         lead, delta = VERTICAL_LANDING[body]
         return LandingParams(lead=lead, delta=delta)
