@@ -11,7 +11,9 @@ measured table (:mod:`reactmocap.athletics.tables`)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -83,7 +85,7 @@ COP_RANGE = (-0.08, 0.15)
 #: backward take-off (-3.4 / -1.3 at 0.5 m). Female over the ten Fig. 4.1 commands: 0 landed
 #: 6, -1.3 landed 7; male -3.4 lost the 0.1 m leap that -2 lands (2026-12-02)
 COM_PUSH_LEG = 0.6
-COM_PUSH_SPIN = {"male": -2.0, "female": -1.3}
+COM_PUSH_SPIN: Mapping[str, float] = MappingProxyType({"male": -2.0, "female": -1.3})
 #: the "com" push's horizontal COM servo through the ankles (rad/m, rad s/m; the balance's)
 ANKLE_KP, ANKLE_KV = 2.0, 0.5
 #: stiffness in the air (the legs only position themselves)
@@ -147,10 +149,10 @@ class LeapParams:
             raise ConfigError("leap timing, crouch and ankle gain must be > 0")
         if self.push not in PUSHES:
             raise ConfigError(f"leap push must be one of {list(PUSHES)}, got {self.push!r}")
-        if not 0.0 < self.rise <= 2.0 or self.push_ramp < 0:
+        if not 0.0 < self.rise <= 2.0 or self.push_ramp < 0 or self.push_limit <= 1.0:
             raise ConfigError(
-                f"leap rise must be in (0, 2] m and push_ramp >= 0, got {self.rise}, "
-                f"{self.push_ramp}"
+                f"leap rise must be in (0, 2] m, push_ramp >= 0 and push_limit > 1 BW, got "
+                f"{self.rise}, {self.push_ramp}, {self.push_limit}"
             )
         if self.handover not in HANDOVERS:
             raise ConfigError(

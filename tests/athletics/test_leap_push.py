@@ -38,6 +38,8 @@ def test_push_choices_are_checked() -> None:
         LeapParams(push="spring")
     with pytest.raises(ConfigError, match="rise"):
         LeapParams(push="com", rise=0.0)
+    with pytest.raises(ConfigError, match="push_limit"):
+        LeapParams(push="com", push_limit=0.5)
 
 
 def test_com_push_leaves_the_broad_jump_alone() -> None:
