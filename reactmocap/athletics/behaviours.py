@@ -21,7 +21,7 @@ from reactmocap.athletics import tables
 from reactmocap.athletics.balance import STANDING_LEG, Balance, Posture
 from reactmocap.athletics.bodies import BODIES, Athlete, athlete
 from reactmocap.athletics.land import Landing
-from reactmocap.athletics.leap import Leap, LeapParams
+from reactmocap.athletics.leap import PUSHES, Leap, LeapParams, com_push
 from reactmocap.athletics.machine import Context
 from reactmocap.athletics.report import (
     fell,
@@ -65,6 +65,8 @@ class Param:
     help: str
     angle: bool = False
     minimum: float | None = None
+    #: a text parameter's valid values (a number otherwise)
+    choices: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -211,6 +213,14 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
             "(0-1) or build one with reactmocap.athletics.tables / bench_athletics.py --tables"
         )
     params = tables.broad_params(s, ath.name) if broad else tables.leap_params(s)
+    if not broad and p.get("push") == "com":
+        # the COM push plans the commanded rise itself; an effort asks for the timed push's
+        # height at that effort (its table), or 0.1-1.0 m without a table
+        rise = target
+        if p.get("effort") is not None:
+            rise = (float(np.interp(s, [r[0] for r in table], [r[1] for r in table]))
+                    if table else 0.1 + 0.9 * float(np.clip(s, 0.0, 1.0)))  # fmt: skip
+        params = com_push(params, max(rise, 0.05), ath.name)
     if p.get("spin") is not None:
         from dataclasses import replace
 
@@ -234,6 +244,8 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     _, force = ground_force(log, ctx.rig.mass, world.model.opt.gravity)
     push = (t[1:] > (thrust or 0.0)) & (t[:-1] < (lift if lift is not None else -1.0))
     rep: dict[str, Any] = {"effort": s}
+    if not broad:
+        rep["push"] = params.push
     if broad:
         # the jump's length: COM travel (ahead, +X) from standing to where the landing took
         # the speed off (the landing's recovery starts), or 0.3 s after touchdown
@@ -376,6 +388,8 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
         (Param("height", None, "m", "commanded COM rise at the apex over standing"),
          Param("effort", None, "", "leap effort 0-1 instead of a height (no table needed)"),
          Param("spin", None, "kg m^2/s", "take-off angular momentum (pitch) to aim for"),
+         Param("push", None, "", "push-off: 'timed' (the thesis's, default) or 'com' (a "
+               "servo on the COM, ground force planned)", choices=PUSHES),
          _BACKPACK, _FPS),
         lambda a, p, cb: _run_leap(a, p, cb), ("height",)),
     "broad-jump": Behaviour(
@@ -414,7 +428,10 @@ def _params(b: Behaviour, given: Mapping[str, Any], check_range: bool, body: str
     out: dict[str, Any] = {}
     for p in b.params:
         v = given.get(p.name, p.default)
-        if v is not None:
+        if p.choices:
+            if v is not None and v not in p.choices:
+                raise ConfigError(f"{b.name} {p.name} must be one of {list(p.choices)}, got {v!r}")
+        elif v is not None:
             try:
                 v = float(v)
             except (TypeError, ValueError):
@@ -425,7 +442,7 @@ def _params(b: Behaviour, given: Mapping[str, Any], check_range: bool, body: str
                 raise ConfigError(f"{b.name} {p.name} must be >= {p.minimum} {p.unit}, got {v}")
         out[p.name] = v
     needed = [p.name for p in b.params if p.default is None and out[p.name] is None
-              and p.name not in ("effort", "spin", "pelvis_height")]  # fmt: skip
+              and p.name not in ("effort", "spin", "pelvis_height", "push")]  # fmt: skip
     if b.name in ("leap", "broad-jump") and out.get("effort") is not None:
         needed = []
         out["height" if b.name == "leap" else "distance"] = out.get(

@@ -11,12 +11,19 @@ measured table (:mod:`reactmocap.athletics.tables`)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
-from reactmocap.athletics.balance import BALANCE_GAINS, BalanceLaw, Posture
+from reactmocap.athletics.balance import (
+    BALANCE_GAINS,
+    BalanceLaw,
+    Posture,
+    hold_pelvis_and_feet,
+)
 from reactmocap.athletics.machine import NEXT, Basis, Context, apex, law, liftoff
 from reactmocap.athletics.rig import joint_index, per_joint
 from reactmocap.athletics.senses import Senses
@@ -25,7 +32,19 @@ from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import Event, State, after
 from reactmocap.sim.world import World
 
-__all__ = ["BROAD_TIMING", "HANDOVERS", "LEAP_STIFFNESS", "VERTICAL_TIMING", "Leap", "LeapParams"]
+__all__ = [
+    "BROAD_TIMING",
+    "COM_PUSH_LEG",
+    "COM_PUSH_SPIN",
+    "COM_PUSH_STIFFNESS",
+    "HANDOVERS",
+    "LEAP_STIFFNESS",
+    "PUSHES",
+    "VERTICAL_TIMING",
+    "Leap",
+    "LeapParams",
+    "com_push",
+]
 
 NJ = len(BALL_JOINTS)
 #: seconds to full extension of hip, knee and ankle (section 4.1 and 4.2)
@@ -44,6 +63,31 @@ LEAP_STIFFNESS = {
 }  # fmt: skip
 #: when a leap may hand over to the next basis controller (see LeapParams.handover)
 HANDOVERS = ("auto", "apex", "liftoff")
+#: how a vertical leap pushes off (see LeapParams.push)
+PUSHES = ("timed", "com")
+#: joint stiffness during the "com" push (units of m g L N m/rad): the hips hold the pelvis's
+#: pitch and the ankles the feet flat, the knees are free (the push is the feed-forward). Soft:
+#: a stiff servo's damping (critical, against the joints' speed) took the push's force once
+#: the legs extended fast (hips and ankles at 6 and 3: the feet left at 2.6 m/s, knees at 0.8)
+COM_PUSH_STIFFNESS = {
+    "waist": 3.0, "back": 3.0, "neck": 0.3, "shoulder": 0.6, "elbow": 0.15, "wrist": 0.05,
+    "hip": 1.0, "knee": 0.0, "ankle": 1.0,
+}  # fmt: skip
+#: a "com" push whose plan needs more than push_limit may ask this much over its plan
+PUSH_HEADROOM = 1.1
+#: the "com" push's centre of pressure: metres ahead per unit of pitch momentum error (in
+#: m L^2 rad/s) and its range about the sole centres (m)
+COP_GAIN = 2.0
+COP_RANGE = (-0.08, 0.15)
+#: the "com" push's crouch (leg fraction; trunk upright: a leaning trunk's hip torque made
+#: most of the force, beyond the feed-forward's reach) and its take-off pitch momentum
+#: (kg m^2/s) per body: the landing after a vertical leap is tuned for the timed push's
+#: backward take-off (-3.4 / -1.3 at 0.5 m). Female over the ten Fig. 4.1 commands: 0 landed
+#: 6, -1.3 landed 7; male -3.4 lost the 0.1 m leap that -2 lands (2026-12-02)
+COM_PUSH_LEG = 0.6
+COM_PUSH_SPIN: Mapping[str, float] = MappingProxyType({"male": -2.0, "female": -1.3})
+#: the "com" push's horizontal COM servo through the ankles (rad/m, rad s/m; the balance's)
+ANKLE_KP, ANKLE_KV = 2.0, 0.5
 #: stiffness in the air (the legs only position themselves)
 FLIGHT_STIFFNESS = {
     "waist": 2.0, "back": 2.0, "neck": 0.3, "shoulder": 0.3, "elbow": 0.15, "wrist": 0.05,
@@ -77,22 +121,53 @@ class LeapParams:
     handover: str = "auto"
     #: the largest hip offset (rad) the angular-momentum feedback may make
     spin_limit: float = 0.6
+    #: how a vertical leap pushes off: ``"timed"`` (the thesis's: hips, knees and ankles
+    #: extend on fixed timing under stiff servos) or ``"com"`` (a servo on the COM's height and
+    #: vertical speed along a planned constant acceleration, its ground force fed forward
+    #: through the legs; the broad jump always pushes ``"timed"``)
+    push: str = "timed"
+    #: the "com" push's planned apex COM rise over standing (m)
+    rise: float = 0.5
+    #: the "com" push ends with the COM this far (m) above its standing height (< 0: below)
+    push_end: float = -0.03
+    #: the "com" push's largest planned ground force (body weights)
+    push_limit: float = 3.0
+    #: seconds over which the "com" push's acceleration comes in
+    push_ramp: float = 0.1
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
                 self.hold, *self.timing, self.ankle_gain, self.ankle_extension, self.liftoff_hip,
                 self.stiffness, self.lean,
-                self.spin, self.spin_gain, self.spin_limit]  # fmt: skip
+                self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
+                self.push_ramp, self.push_limit]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.3 <= self.leg <= 1.0:
             raise ConfigError(f"leap crouch leg fraction must be in [0.3, 1.0], got {self.leg}")
         if min(self.timing) <= 0 or self.crouch <= 0 or self.hold < 0 or self.ankle_gain <= 0:
             raise ConfigError("leap timing, crouch and ankle gain must be > 0")
+        if self.push not in PUSHES:
+            raise ConfigError(f"leap push must be one of {list(PUSHES)}, got {self.push!r}")
+        if not 0.0 < self.rise <= 2.0 or self.push_ramp < 0 or self.push_limit <= 1.0:
+            raise ConfigError(
+                f"leap rise must be in (0, 2] m, push_ramp >= 0 and push_limit > 1 BW, got "
+                f"{self.rise}, {self.push_ramp}, {self.push_limit}"
+            )
         if self.handover not in HANDOVERS:
             raise ConfigError(
                 f"leap handover must be one of {list(HANDOVERS)}, got {self.handover!r}"
             )
+
+
+def com_push(params: LeapParams, rise: float, body: str | None = None) -> LeapParams:
+    """``params`` with the "com" push to a planned apex rise (m): its crouch (upright trunk,
+    :data:`COM_PUSH_LEG`) and the body's take-off pitch momentum (:data:`COM_PUSH_SPIN`, 0 for
+    a body without one). A broad jump is returned unchanged (it always pushes "timed")."""
+    if params.broad:
+        return params
+    return replace(params, push="com", rise=rise, leg=COM_PUSH_LEG, lean=0.0, pitch=0.0,
+                   spin_gain=0.0, spin=COM_PUSH_SPIN.get(body or "", 0.0))  # fmt: skip
 
 
 def pitch_momentum(world: World, s: Senses) -> float:
@@ -174,6 +249,116 @@ class Leap(Basis):
                 for j in (joint_index("l_hip"), joint_index("r_hip")):
                     ctx.rig.offset[j, 0] = off
 
+        g = float(np.linalg.norm(ctx.world.model.opt.gravity))
+
+        def com_thrust(world: World, t: float) -> None:
+            # plan: from rest, the COM's acceleration ramps in over push_ramp, then stays
+            # constant until the COM has the lift-off speed of the commanded rise, reached
+            # push_end above standing (the COM is ballistic after lift-off)
+            s = ctx.sense(t)
+            rig = ctx.rig
+            rig.move(rig.desired(t) + rig.offset, 0.0, t)
+            rig.offset[:] = 0.0
+            memo["stiff0"] = rig.stiffness.copy()
+            memo["stiff1"] = per_joint(COM_PUSH_STIFFNESS)
+            # the balance's joint damping off the legs: at the push's joint speeds (10 rad/s)
+            # it took the legs' extension
+            rig.set_damping(per_joint({"waist": 0.1, "back": 0.1}))
+            memo.pop("ramp", None)
+            z0 = float(s.com[2])
+            memo["z0"] = z0
+            memo["pitch0"] = p.pitch + p.lean * float(np.mean(rig.knee_flexion()))
+            z_stand = ctx.standing_com if ctx.standing_com is not None else memo["z_stand"]
+            z_end = z_stand + p.push_end
+            v_end = math.sqrt(2.0 * g * max(p.rise - p.push_end, 0.01))
+            memo.pop("az_prev", None)
+            memo.update(gain=1.0, t_thrust=t, t_prev=t, v_end=v_end, pushing=True, z_end=z_end,
+                        z_stand=z_stand, acc=v_end**2 / (2.0 * max(z_end - z0, 0.05)),
+                        com0=s.com.copy())  # fmt: skip
+            goal = np.full((NJ, 3), np.nan)
+            dur = v_end / memo["acc"]
+            arms = [joint_index(f"{k}_shoulder") for k in "lr"]
+            goal[arms] = (p.arms, 0.0, 0.0)
+            for j in ("waist", "back"):
+                goal[joint_index(j)] = 0.0
+            rig.move(goal, dur, t, [*arms, joint_index("waist"), joint_index("back")])
+
+        knees = [joint_index(f"{k}_knee") for k in "lr"]
+        ankles = [joint_index(f"{k}_ankle") for k in "lr"]
+        hips = [joint_index(f"{k}_hip") for k in "lr"]
+
+        def com_push(world: World, t: float) -> None:
+            s = ctx.sense(t)
+            rig = ctx.rig
+            tau = t - memo["t_thrust"]
+            if memo.get("ramp", -1.0) < 1.0:
+                ramp = min(1.0, tau / STIFFNESS_RAMP)
+                memo["ramp"] = ramp
+                rig.set_stiffness(memo["stiff0"] + ramp * (memo["stiff1"] - memo["stiff0"]))
+            dt = t - memo["t_prev"]
+            memo["t_prev"] = t
+            h = s.heading()
+            # the pelvis goes from the crouch's lean to upright over the planned push
+            frac = 1.0 - min(1.0, tau * memo["acc"] / memo["v_end"]) ** 2
+            pitch = frac * memo["pitch0"]
+            hold_pelvis_and_feet(ctx, world.data, pitch, h, t)
+            # the COM kept over the feet as the balance servo does: ankle (and half as much,
+            # opposite, hip) pitch offsets from the horizontal COM error
+            err = s.local(memo["com0"] - s.com, h)[0]
+            dx = float(np.clip(ANKLE_KP * err - ANKLE_KV * s.local(s.com_vel, h)[0], -0.35, 0.35))
+            rig.offset[:] = 0.0
+            for j in ankles:
+                rig.offset[j, 0] = -dx
+            for j in hips:
+                rig.offset[j, 0] = 0.5 * dx
+            # the knees' targets follow them while their stiffness ramps out
+            now = rig.current_angles()
+            goal = np.full((NJ, 3), np.nan)
+            goal[knees] = now[knees]
+            rig.move(goal, 0.0, t, knees)
+            bl._support(s)
+            if not memo["pushing"]:
+                rig.support_point = None
+                rig.support[:] = 0.0
+                return
+            # the constant acceleration that brings the COM from where it is to the lift-off
+            # speed at the push's end (a feedback: a lag asks for more, a lead for less)
+            z, vz = float(s.com[2]), float(s.com_vel[2])
+            v_need = math.sqrt(2.0 * g * max(p.rise - (z - memo["z_stand"]), 0.0))
+            if vz >= v_need:
+                memo["pushing"] = False  # the apex is reached ballistically: stop pushing
+                rig.support[:] = 0.0
+                return
+            az = (memo["v_end"] ** 2 - vz * abs(vz)) / (2.0 * max(memo["z_end"] - z, 0.02))
+            ramp = min(1.0, tau / p.push_ramp) if p.push_ramp > 0 else 1.0
+            plan = 1.0 + memo["acc"] / g
+            top = p.push_limit if plan <= p.push_limit else PUSH_HEADROOM * plan
+            az = float(np.clip(ramp * az, -g, top * g - g))
+            # the legs' feed-forward does not make its force one to one (the trunk and the
+            # legs' own inertia add or take some): scale it by the last tick's measured
+            # ground force (from the COM's momentum) against the one asked for
+            if "az_prev" in memo and dt > 0:
+                made = (vz - memo["vz_last"]) / dt + g
+                want = memo["az_prev"] + g
+                if made > 0.2 * g:
+                    gain = memo["gain"] * math.sqrt(want / made)
+                    memo["gain"] = float(np.clip(gain, 0.3, 3.0))
+            memo["az_prev"], memo["vz_last"] = az, vz
+            force = np.array([0.0, 0.0, (g + max(az, -g)) * memo["gain"]])
+            size = float(np.linalg.norm(force))
+            rig.support_scale = size / g
+            rig.support_dir = force / max(size, 1e-9)
+            # the force acts on each foot under the COM (not through the ankle, where it
+            # passed behind the COM and pitched the body forward), moved ahead or back by the
+            # whole-body pitch momentum's error: the centre of pressure steers the momentum
+            fwd = np.array([math.cos(h), math.sin(h), 0.0])
+            mid = s.corners.mean(axis=1)  # (2, 3) sole centres
+            err_l = (pitch_momentum(world, s) - p.spin) / (
+                ctx.athlete.mass * ctx.athlete.leg_length**2
+            )
+            ahead = np.clip((s.com - mid) @ fwd + COP_GAIN * err_l, *COP_RANGE)
+            rig.support_point = mid + ahead[:, None] * fwd
+
         def flight(world: World, t: float) -> None:
             s = ctx.sense(t)
             ctx.handover["liftoff_pitch_momentum"] = pitch_momentum(world, s)
@@ -181,17 +366,19 @@ class Leap(Basis):
             ctx.rig.support[:] = 0.0
             ctx.rig.support_scale = 1.0
             ctx.rig.support_dir = None
+            ctx.rig.support_point = None
 
         at_apex = p.handover == "apex" or (p.handover == "auto" and not p.broad)
         flight_exit: Event = apex(ctx) if at_apex else after(0.0)
+        com = p.push == "com" and not p.broad
         return [
             State(
                 "crouch", law(bl.control, every), crouch, ((after(p.crouch + p.hold), "thrust"),)
             ),
             State(
                 "thrust",
-                law(push, every),
-                thrust,
+                law(com_push, every) if com else law(push, every),
+                com_thrust if com else thrust,
                 ((liftoff(ctx), "flight"), (after(THRUST_TIMEOUT), "flight")),
             ),
             State("flight", None, flight, ((flight_exit, NEXT),)),

@@ -126,6 +126,8 @@ class Rig:
         self.support_scale = 1.0
         #: direction (world, unit) of that ground force; None: against gravity
         self.support_dir: F64 | None = None
+        #: where on each foot (world, ``(2, 3)``) that force acts; None: through the ankle
+        self.support_point: F64 | None = None
         self._ankles = [self._balls[joint_index(f"{s}_ankle")] for s in "lr"]
         self._knees = [joint_index(f"{s}_knee") for s in "lr"]
         self._knee_qpos = np.concatenate(
@@ -149,6 +151,7 @@ class Rig:
         self.support[:] = 0.0
         self.support_scale = 1.0
         self.support_dir = None
+        self.support_point = None
 
     def release(self) -> None:
         """Give the model its joint damping back (call when the rig's rollout ends)."""
@@ -256,6 +259,7 @@ class Rig:
         for k in np.flatnonzero(self.support > 0):
             up = self._up if self.support_dir is None else self.support_dir
             force = self.support[k] * self.support_scale * self._weight_n * up
-            mujoco.mj_jac(m, d, self._jacp, None, d.xanchor[self._ankles[k]], self._feet[k])
+            at = d.xanchor[self._ankles[k]] if self.support_point is None else self.support_point[k]
+            mujoco.mj_jac(m, d, self._jacp, None, at, self._feet[k])
             cols = self._leg_cols[k]
             flat[cols - self.wc.ball_dof_start] -= self._jacp[:, cols].T @ force
