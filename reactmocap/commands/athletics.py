@@ -55,6 +55,10 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
             default = par.default if par.default is None or not deg else math.degrees(par.default)
             p.add_argument(flag, type=float, default=None,
                            help=f"{par.help} ({unit}; default {default})")  # fmt: skip
+        if name == "leap":
+            push = params["push"]
+            p.add_argument("--push", dest="push_off", choices=list(push.choices or ()),
+                           default=None, help=f"{push.help} (default timed)")  # fmt: skip
         if name == "balance":
             p.add_argument("--com-offset", help="desired COM offset X,Y (m) from the support")
         p.add_argument("--out", type=output_file, help="BVH of the motion (default: NAME_BODY.bvh)")
@@ -86,6 +90,8 @@ def _run(args: argparse.Namespace) -> int:
         v = getattr(args, flag.lstrip("-").replace("-", "_"))
         if v is not None:
             params[key] = math.radians(v) if deg else v
+    if getattr(args, "push_off", None):
+        params["push"] = args.push_off
     if getattr(args, "com_offset", None):
         try:
             x, y = (float(v) for v in args.com_offset.split(","))
