@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 from collections import OrderedDict
+from collections.abc import Callable
 from pathlib import Path
 from typing import Generic, TypeVar
 
@@ -13,7 +14,7 @@ import numpy as np
 
 from reactmocap import __version__
 from reactmocap.errors import LibraryError, ReactMocapError
-from reactmocap.library.bodyparts import BodyPartMap, parts_for
+from reactmocap.library.bodyparts import parts_for
 from reactmocap.library.clip_library import (
     ClipLibrary,
     ClipLoadFailure,
@@ -80,13 +81,15 @@ class LibraryCache:
         self,
         key: tuple[str, ...],
         lib: ClipLibrary,
-        clips: dict[str, Motion],
-        parts: dict[str, BodyPartMap],
+        make_clips: Callable[[], dict[str, Motion]],
+        rules: Path | None,
         skipped: list[ClipLoadFailure],
     ) -> tuple[ClipLibrary, MotionIndex]:
         hit = self._indexes.get(key)
         if hit is not None:
             return hit
+        clips = make_clips()  # retargeting only on a miss: the key already says what it gives
+        parts = {n: parts_for(m.skeleton, rules) for n, m in clips.items()}
         digest = hashlib.sha256("\0".join(key).encode()).hexdigest()[:16]  # stable across runs
         index_path = default_cache_dir().parent / "indexes" / f"{digest}.npz"
         index = MotionIndex.load_or_build(index_path, clips, SearchWeights(), WindowConfig(),
@@ -105,8 +108,9 @@ def prepare_library(
     """A clip library (loaded unless given) and its search index (cached on disk, keyed by
     content, by ``skeleton_of``'s skeleton and the body-part ``rules``). Clips whose skeleton no
     rule maps are skipped and listed in the returned library's ``failures``. With
-    ``skeleton_of``, clips on other skeletons are retargeted onto it (each side's reference
-    pose is frame 0 of its alphabetically first clip)."""
+    ``skeleton_of``, clips on other skeletons are retargeted onto it (the source side's reference
+    pose is frame 0 of its alphabetically first clip, the target's frame 0 of ``skeleton_of``,
+    so the key then holds ``skeleton_of``'s content too)."""
     lib = load_library(path) if lib is None else lib
     clips: dict[str, Motion] = {}
     skipped: list[ClipLoadFailure] = []
@@ -122,17 +126,34 @@ def prepare_library(
                            f"({skipped[0].reason})")  # fmt: skip
     target = ""
     if skeleton_of is not None:
-        clips = _retargeted(clips, skeleton_of, rules)
         sk = skeleton_of.skeleton
         target = hashlib.sha256(
             ("\0".join(sk.names) + repr(np.round(sk.offsets, 6).tolist())).encode()
         ).hexdigest()[:12]
+        if any(not m.skeleton.same_structure(sk) for m in clips.values()):
+            # retargeted clips depend on the recipient's clip (its frame 0 sets the anatomical
+            # frames, its lowest feet the soles), not only on its skeleton: keyed on the
+            # skeleton alone, the cache gave every recipient the clips retargeted for the first
+            # one in the process, so a response depended on what ran before it
+            target += "/" + _motion_digest(skeleton_of)
     rules_key = hashlib.sha256(Path(rules).read_bytes()).hexdigest()[:12] if rules else ""
     # the code versions are part of the key: an index written by older search code is not reused
     key = (str(Path(path).resolve()), ",".join(sorted(clips)) + lib.fingerprint(),
            f"{__version__}/{INDEX_FORMAT_VERSION}/retarget{RETARGET_VERSION}/{target}/{rules_key}")  # fmt: skip
-    parts = {n: parts_for(m.skeleton, rules) for n, m in clips.items()}
-    return (cache or LibraryCache(1))._index(key, lib, clips, parts, skipped)
+
+    def make() -> dict[str, Motion]:
+        return clips if skeleton_of is None else _retargeted(clips, skeleton_of, rules)
+
+    return (cache or LibraryCache(1))._index(key, lib, make, rules, skipped)
+
+
+def _motion_digest(motion: Motion) -> str:
+    """Content hash of a motion's arrays (what a retargeting onto it reads)."""
+    h = hashlib.sha256(np.float64(motion.fps).tobytes())
+    for a in (motion.root_positions, motion.rotations, motion.translations):
+        if a is not None:
+            h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    return h.hexdigest()[:12]
 
 
 def _retargeted(

@@ -12,12 +12,14 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.linalg
+from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, SearchError
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.search.config import SearchWeights, WindowConfig, settings_hash
 from reactmocap.search.distance import (
+    StanceCost,
     body_weights,
     embed_local,
     embedding_body_weights,
@@ -128,11 +130,17 @@ def _embed_starts(fr: _Frames, starts: I64, ew: EmbeddingWeights) -> F32:
 
 
 def _unique_starts(
-    fr: _Frames, clip_offsets: I64, weights: SearchWeights, window: WindowConfig
+    fr: _Frames,
+    clip_offsets: I64,
+    weights: SearchWeights,
+    window: WindowConfig,
+    planted: NDArray[np.bool_] | None = None,
 ) -> tuple[I64, I64, I64]:
     """Kept window starts and their refinement intervals (inclusive), clip by clip: a start is
     kept whenever the pose path length since the last kept one crosses another multiple of
-    ``window.unique_tolerance``, and at least every ``window.max_gap`` seconds."""
+    ``window.unique_tolerance``, at least every ``window.max_gap`` seconds, and (with
+    ``planted``, ``(N, F)`` feet in contact per frame) wherever a foot's contact changes, so
+    that each kept start's contacts hold until the next one."""
     wp, wq = body_weights(get_feature_set(weights.feature_set), weights, None)
     step = frame_pose_steps(fr.positions, fr.orientations, fr.heading, fr.origin, wp, wq)
     kept_list, lo_list, hi_list = [], [], []
@@ -149,6 +157,9 @@ def _unique_starts(
             local = np.flatnonzero(np.diff(bucket, prepend=-1) != 0)
         else:
             local = np.arange(m)
+        if planted is not None:
+            seg = planted[a : a + m]
+            local = np.union1d(local, np.flatnonzero(np.any(seg[1:] != seg[:-1], axis=1)) + 1)
         ends = np.append(local, m)
         fill = [np.arange(x + gap, y, gap) for x, y in itertools.pairwise(ends) if y - x > gap]
         if fill:
@@ -256,7 +267,9 @@ def build_index(
         progress(f"features: {len(names)} clips, {offsets[-1]} frames at {fps:g} fps")
 
     ew = embedding_weights(weights, window)
-    kept, lo, hi = _unique_starts(fr, offsets, weights, window)
+    stance = StanceCost.of(get_feature_set(weights.feature_set), weights, fps)
+    planted = None if stance is None else stance.frame_contacts(fr.positions)
+    kept, lo, hi = _unique_starts(fr, offsets, weights, window, planted)
     mean, comps, explained, de = _fit_pca(
         fr, kept, ew, window.pca_dims, np.random.default_rng(seed)
     )
@@ -264,6 +277,8 @@ def build_index(
     for i in range(0, kept.size, _CHUNK):
         e = _embed_starts(fr, kept[i : i + _CHUNK], ew)
         proj[i : i + e.shape[0]] = (e - mean) @ comps
+    if stance is not None and planted is not None:
+        proj = np.concatenate([proj, stance.columns(planted[kept])], axis=1)
     nvalid = int(valid_starts(offsets, L).size)
     if progress:
         progress(

@@ -82,6 +82,27 @@ class StanceCost:
         travel = np.hypot(p1[..., 0] - p0[..., 0], p1[..., 1] - p0[..., 1])
         return np.asarray((p0[..., 2] <= self.height) & (travel <= self.step))
 
+    def frame_contacts(self, positions: NDArray[np.floating]) -> NDArray[np.bool_]:
+        """``(N, F)`` feet in contact at each frame of ``(N, P, 3)`` positions (from the frame
+        and the next: what a window starting there counts; the last frame counts as lifted)."""
+        out = np.zeros((positions.shape[0], self.feet.size), dtype=bool)
+        out[:-1] = self.contacts(positions[:-1, self.feet], positions[1:, self.feet])
+        return out
+
+    def columns(self, flags: NDArray[np.bool_]) -> F32:
+        """KD-embedding columns of contact flags ``(..., F)``: ``sqrt(weight) / 2`` per foot in
+        contact, after the PCA (which would drop them), so the embedding holds the term and
+        the KD-tree proposes the windows it favours. A quarter of the weight per differing foot
+        in the squared embedding distance had the best recall against brute force on the
+        synthetic library (95-96%; the full weight 92-95%, twice it 87%; recall without the
+        columns 60%: ``docs/benchmarks.md``)."""
+        return (0.5 * np.sqrt(self.weight) * flags).astype(np.float32)
+
+    def query_columns(self, query: QueryWindow) -> F32:
+        """``(F,)`` the query's KD-embedding columns."""
+        return self.columns(self.contacts(query.positions[0, self.feet],
+                                          query.positions[1, self.feet]))  # fmt: skip
+
     def cost(self, positions: F32, starts: NDArray[np.int64], query: QueryWindow) -> F64:
         """``(C,)`` mismatch cost of the windows starting at ``starts``."""
         lib = self.contacts(positions[starts][:, self.feet], positions[starts + 1][:, self.feet])

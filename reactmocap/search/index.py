@@ -18,7 +18,7 @@ from reactmocap.errors import SearchError
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.search.config import SearchWeights, WindowConfig
-from reactmocap.search.distance import QueryWindow
+from reactmocap.search.distance import QueryWindow, StanceCost
 from reactmocap.search.features import FeatureSet, get_feature_set
 from reactmocap.search.types import (
     DEFAULT_EXACT,
@@ -137,6 +137,12 @@ class MotionIndex:
     def fingerprint(self) -> str:
         return hashlib.sha256(f"{self.library_hash}|{self.settings_hash}".encode()).hexdigest()
 
+    def _stance_columns(self) -> int:
+        """Columns after the PCA dimensions in :attr:`embedding`: each foot's contact
+        (``SearchWeights.stance_mismatch``; none when it is 0)."""
+        stance = StanceCost.of(self.feature_set, self.weights, self.window.fps)
+        return 0 if stance is None else int(stance.feet.size)
+
     def nbytes(self) -> int:
         return int(sum(getattr(self, a).nbytes for a in ARRAYS))
 
@@ -174,7 +180,7 @@ class MotionIndex:
             (self.kept.ndim == 1 and self.interval_lo.shape == (K,), "kept"),
             (self.interval_hi.shape == (K,), "intervals"),
             (self.pca_components.ndim == 2 and self.pca_components.shape[0] == de, "pca"),
-            (self.embedding.shape == (K, dims), "embedding"),
+            (self.embedding.shape == (K, dims + self._stance_columns()), "embedding"),
         ]  # fmt: skip
         bad = [name for ok, name in checks if not ok]
         if not bad:

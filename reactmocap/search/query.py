@@ -256,11 +256,13 @@ def distances(
     return _distances(index, qw, c, starts, breakdown, coarse, precise)
 
 
-def _embed_query(index: MotionIndex, qw: QueryWindow, ew: EmbeddingWeights) -> F32:
+def _embed_query(index: MotionIndex, qw: QueryWindow, c: QueryConstants) -> F32:
+    ew = c.embedding
     e = embed_local(
         qw.positions[None, ew.offsets], qw.orientations[None, ew.offsets], ew.frames, ew.wp, ew.wq
     )
-    return ((e - index.pca_mean) @ index.pca_components)[0]
+    out = ((e - index.pca_mean) @ index.pca_components)[0]
+    return out if c.stance is None else np.concatenate([out, c.stance.query_columns(qw)])
 
 
 def search_window(
@@ -295,7 +297,7 @@ def search_window(
             f"(got n={n}, k={k}, refine={refine}, exact={exact})"
         )
     c = (cache or DEFAULT_CACHE).constants(index.weights, index.window)
-    e = _embed_query(index, qw, c.embedding)
+    e = _embed_query(index, qw, c)
     k = min(k, index.num_indexed)
     _, rows = index.tree.query(e, k=k)
     rows = np.atleast_1d(np.asarray(rows, dtype=np.int64))

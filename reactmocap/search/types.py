@@ -28,7 +28,8 @@ __all__ = [
 ]
 
 #: version of the saved index; bumped whenever the stored features or embedding change
-FORMAT_VERSION = 2  # 2: centre of mass from the one mass-fraction table
+#: 2: centre of mass from the one mass-fraction table; 3: the feet's contacts in the embedding
+FORMAT_VERSION = 3
 MIRROR_SUFFIX = "_mirror"
 #: windows embedded (or localised) per batch: bounds the temporary arrays
 _CHUNK = 4096

@@ -192,7 +192,9 @@ def test_simulation_2_fills_the_joints_it_does_not_simulate_from_what_it_was_ask
     # only what the physics did not follow
     from reactmocap.response import final, stages
 
-    sc = load_scenario(EXAMPLES / "medium_push.toml")
+    # a found clip whose head and toes end away from the old clip's (the medium push's
+    # step_back_2 ends with them as the old clip holds them, so the test could not fail there)
+    sc = load_scenario(EXAMPLES / "heavy_push_fall.toml")
     cast = stages.cast(sc, CACHE)
     contact = stages.estimate_contact(sc, cast)
     naive = stages.naive_simulation(sc, cast, contact)
@@ -216,3 +218,29 @@ def test_simulation_2_fills_the_joints_it_does_not_simulate_from_what_it_was_ask
     # and the final blend leaves them as asked
     rel = np.abs(np.sum(out.simulated.rotations[:, free] * out.blended.rotations[:, free], -1))
     assert rel.min() > 1 - 1e-6
+
+
+def test_the_retargeted_library_does_not_depend_on_the_recipient_before(tmp_path: Path) -> None:
+    # two recipients on one skeleton, posed differently at frame 0 (which sets the anatomical
+    # frames of a retargeting onto them): the second must get the library retargeted for
+    # itself, as it does alone, not the first one's from the shared cache
+    from reactmocap.response.pipeline import prepare_library
+    from tests.fixtures.one_spine import one_spine
+
+    clips = synthetic_clips(60.0)
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    for name in ("guard", "fall_backward"):
+        (lib / f"{name}.bvh").symlink_to(SYNTHETIC / f"{name}.bvh")
+    first = one_spine(clips["guard"])
+    kick = one_spine(clips["front_kick"])
+    second = kick.slice(kick.num_frames // 2, None)  # mid-kick at its frame 0
+    assert first.skeleton == second.skeleton
+    shared = LibraryCache()
+    before, _ = prepare_library(lib, first, cache=shared)
+    after, index = prepare_library(lib, second, cache=shared)
+    alone, _ = prepare_library(lib, second, cache=LibraryCache())
+    fall = [m["fall_backward"].rotations for m in (before, after, alone)]
+    assert not np.allclose(fall[0], fall[2], atol=1e-3)  # the two recipients' retargets differ
+    np.testing.assert_array_equal(fall[1], fall[2])
+    assert index is not prepare_library(lib, first, cache=shared)[1]
