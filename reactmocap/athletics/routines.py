@@ -49,11 +49,14 @@ __all__ = [
 #: (thesis 8.5.1: without it the legs are still folded at touchdown and the landing sinks the
 #: pelvis below the fall line), and lands with the feet 40 cm ahead of the capture point to
 #: stop the forward spin (landed at 35-45 cm; at 30 cm the crouch sank too deep). The back
-#: layout (inertia 18.5 kg m^2 against the tuck's 4.7) needs the leap at effort 0.8 aiming at
-#: -90 kg m^2/s with the hips allowed 1.5 rad (it gets -75.9, 1.0 m of COM rise); it holds the
+#: layout (inertia 18.5 kg m^2 against the tuck's 4.7) needs the leap at effort 0.9 aiming at
+#: -90 kg m^2/s with the hips allowed 1.5 rad (it gets -77.0, 1.2 m of COM rise); it holds the
 #: layout until the rotation predicted for the landing's reach (which pikes the body to put the
-#: feet under it: predicted at 7.5 kg m^2) comes down to the turn, and lands with the knees bent
-#: 1.0 rad, the feet 21 cm behind the capture point (landed at 20-22 cm, not 18 or 24).
+#: feet under it: predicted at 8.0 kg m^2) comes down to the turn, and lands with the knees bent
+#: 1.0 rad, the feet 13 cm behind the capture point (landed at 12-13 cm, not 15 or 17). At
+#: effort 0.8 (before 2026-12-02) the opening sat at the edge where the reach, opened short of
+#: inverted, folds the body into a deep pike and turns it over: perturbed starts, a little
+#: short of the nominal's momentum, opened a few degrees earlier and over-rotated by 200.
 SOMERSAULT_PRESETS: Mapping[
     str, Mapping[str, tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]]
 ] = MappingProxyType({
@@ -63,9 +66,9 @@ SOMERSAULT_PRESETS: Mapping[
         "backward/pike": (MappingProxyType({"effort": 0.6, "spin": -66.0, "spin_limit": 1.3}),
                           MappingProxyType({"lead": 3.4}),
                           MappingProxyType({"delta": -0.15, "knee": 1.0})),
-        "backward/layout": (MappingProxyType({"effort": 0.8, "spin": -90.0, "spin_limit": 1.5}),
-                            MappingProxyType({"lead": 0.0, "open_inertia": 7.5}),
-                            MappingProxyType({"delta": -0.21, "knee": 1.0})),
+        "backward/layout": (MappingProxyType({"effort": 0.9, "spin": -90.0, "spin_limit": 1.5}),
+                            MappingProxyType({"lead": 0.0, "open_inertia": 8.0}),
+                            MappingProxyType({"delta": -0.13, "knee": 1.0})),
         "forward": (MappingProxyType({"effort": 1.0, "spin": 60.0, "spin_limit": 1.0,
                                       "com_offset": 0.08, "arms_back": -2.8, "arms": 0.0}),
                     MappingProxyType({"lead": 0.0, "latest": 0.0, "extend": 0.6,

@@ -3,6 +3,7 @@ on the simulated motion."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -10,7 +11,7 @@ import pytest
 
 from reactmocap.athletics import athlete
 from reactmocap.athletics.backdrop import arm_windmill
-from reactmocap.athletics.maneuvers import run_maneuver
+from reactmocap.athletics.maneuvers import Perturbation, run_maneuver
 from reactmocap.athletics.report import FALL_HEIGHT
 from reactmocap.athletics.routines import somersault, somersault_maneuver
 from reactmocap.athletics.tumble import POSITIONS, TumbleParams, somersault_inertia
@@ -156,3 +157,20 @@ def test_the_back_pike_lands_on_more_momentum_than_the_tuck(back_tuck) -> None: 
     # the pike's larger inertia (Fig. 5.2) needs a larger take-off momentum for the same turn
     assert r["liftoff_pitch_momentum"] < back_tuck.report["liftoff_pitch_momentum"] - 5.0
     assert r["tumble_min_inertia_kgm2"] > back_tuck.report["tumble_min_inertia_kgm2"] + 0.5
+
+
+def test_perturbed_back_layouts_open_past_inverted_and_land() -> None:
+    """Starts 2 and 10 of the capture region at a tenth (seed 0). With the leap at effort 0.8
+    and the opening predicted at 7.5 kg m^2 (before 2026-12-02 07:00) both fell: start 2 took
+    off with a little less momentum than the nominal, opened short of inverted, and the
+    landing's reach folded it into a deep pike that touched down at -514 deg. The higher leap
+    opens them past inverted: they touch down near -300 deg and land."""
+    rng = np.random.default_rng(0)
+    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
+             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
+    starts = [Perturbation.sample(rng, **tenth) for _ in range(11)]
+    m = somersault_maneuver("layout")
+    for i in (2, 10):
+        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
+        assert -330.0 < r["rotation_at_touchdown_deg"] < -280.0, (i, r["rotation_at_touchdown_deg"])
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
