@@ -126,9 +126,11 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     # the blend corrects the simulation toward what it was asked to do, which ends exactly on
     # the found clip: it then corrects only the tracking error, not the whole way to the clip
     found = desired_motion(cast, cfg, times, naive.impact_time, yields_to(cfg, naive.impulse), cont)
+    # the found clip's time at the landing (time-warped by the physical mode's landing phase)
+    on = cont.best.time + (sim2.landed - cont.time) + sim2.landing_phase
     if cfg.mode == "physical":  # close only the gap left at the landing, spread over the blend
-        found = _with_end_gap(simulated, found)
-    on = cont.best.time + (sim2.landed - cont.time)  # the found clip's time at the landing
+        end = grounded(cont.found.sample([on])) if sim2.landing_phase else found
+        found = _with_end_gap(simulated, end)
     tail_n = int(np.floor(max(0.0, min(cfg.tail, cont.found.duration - on)) * fps))
     tail = (grounded(cont.found.sample(on + np.arange(1, tail_n + 1) / fps))
             if tail_n > 0 else None)  # fmt: skip

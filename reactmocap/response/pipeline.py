@@ -219,6 +219,7 @@ def _report(
             "mode": cfg.mode,
             "landed_on_clip": sim2.on_clip,
             "landing_gap": dict(zip(("pelvis_m", "root_rad", "joint_rad"), sim2.landing_gap)),
+            "landing_phase_s": sim2.landing_phase,
         },
         "timings_s": timings,
         "steps": {"sim1": naive.steps, "sim2": sim2.steps},

@@ -121,6 +121,11 @@ class ResponseConfig:
     land_angle: float = 0.17
     land_joint: float = 0.1
     land_within: float = 1.5
+    #: physical mode: the landing check also compares the body with the found clip up to this
+    #: many seconds ahead of or behind the path (a time warp: a hit body follows the clip a
+    #: little late or early); it lands on the nearest frame, and the found clip plays on from
+    #: there (0: the path's own frame only)
+    land_warp: float = 0.2
     #: physical mode: when the body does not land, Simulation 2 runs again toward the search's
     #: next-best windows of other clips, up to ``land_tries`` continuations in all, and the one
     #: the body came closest to (its landing gap over the tolerances) wins: a continuation the
@@ -229,7 +234,8 @@ class _Reader:
                                   "contact_shift_max", "attacker_follow", "attacker_blend",
                                   "friction_sim1", "friction_sim2", "kv", "yield_gain",
                                   "react_impulse", "active_min", "own_clip_margin", "attacker_assist",
-                                  "yield_recover", "land_within", "torque_limit"}  # fmt: skip
+                                  "yield_recover", "land_within", "land_warp",
+                                  "torque_limit"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
                                     "total_mass", "land_position", "land_angle",
                                     "land_joint"}  # fmt: skip

@@ -464,27 +464,53 @@ class _Landing:
     Hz from the rollout's start); ``at`` is then that time (None until it is). Until then it
     keeps the check where the body came closest (``best``: the largest gap over its
     tolerance smallest): a body that never lands lands there, not wherever it has drifted (or
-    fallen) to when the time is up."""
+    fallen) to when the time is up.
 
-    def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float) -> None:
+    ``clip`` (the found clip's qpos per tick, ``pad`` ticks before the rollout's start and
+    after its end) and ``offsets`` (ticks) time-warp the check: the body is compared with the
+    found clip ``offsets`` ticks ahead of (or behind) the path too, and lands on the nearest
+    (``phase``, s; the smallest shift among equals). A hit body that follows the clip late or
+    early is on it, at another frame; the blend then lands on that frame."""
+
+    def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float,
+                 clip: F64 | None = None, offsets: NDArray[np.int64] | None = None,
+                 pad: int = 0) -> None:  # fmt: skip
         self.cfg, self.q, self.rate, self.after = cfg, q, rate, after
+        self.tol = np.array([cfg.land_position, cfg.land_angle, cfg.land_joint])
+        self.clip, self.pad = clip, pad
+        # the path itself first, then the shifts by size: argmin keeps the smallest among equals
+        offs = np.zeros(1, np.int64) if offsets is None else np.asarray(offsets, np.int64)
+        self.offsets = offs[np.argsort(np.abs(offs), kind="stable")]
         self.at: float | None = None
         self.gap = np.full(3, np.inf)  # the last check's pelvis (m), root and joint (rad) gaps
-        self.best = (np.inf, after, self.gap)  # (largest gap / tolerance, time, gaps)
+        self.phase = 0.0  # the last check's time shift onto the found clip (s)
+        self.best = (np.inf, after, self.gap, 0.0)  # (largest gap / tolerance, time, gaps, phase)
 
     def __call__(self, world: World, t: float) -> str | None:
         if t < self.after - 1e-9:
             return None
-        want = self.q[min(int(round(t * self.rate)), len(self.q) - 1)]
+        i = min(int(round(t * self.rate)), len(self.q) - 1)
+        if self.clip is None or self.offsets.size == 1:
+            want, offs = self.q[i][None], self.offsets[:1]
+        else:  # shifts that stay within the found clip's frames (``clip``'s non-NaN rows)
+            rows = i + self.pad + self.offsets
+            ok = (rows >= 0) & (rows < len(self.clip))
+            rows, offs = rows[ok], self.offsets[ok]
+            ok = np.isfinite(self.clip[rows, 0])
+            rows, offs = rows[ok], offs[ok]
+            want = np.concatenate([self.q[i][None], self.clip[rows[offs != 0]]])
+            offs = np.concatenate([[0], offs[offs != 0]])
         cur = world.data.qpos[world.characters[0].qpos_slice]
-        turn = np.linalg.norm(
-            quat_log(quat_mul(quat_conj(want[3:].reshape(-1, 4)), cur[3:].reshape(-1, 4))), axis=1
-        )
-        self.gap = np.array([np.linalg.norm(cur[:3] - want[:3]), turn[0], turn[1:].max()])
-        cfg = self.cfg
-        score = float(np.max(self.gap / (cfg.land_position, cfg.land_angle, cfg.land_joint)))
+        m = len(want)
+        rel = quat_mul(quat_conj(want[:, 3:].reshape(m, -1, 4)), cur[3:].reshape(1, -1, 4))
+        turn = np.linalg.norm(quat_log(rel), axis=-1)
+        gaps = np.stack([np.linalg.norm(want[:, :3] - cur[:3], axis=1), turn[:, 0],
+                         turn[:, 1:].max(axis=1)], axis=1)  # fmt: skip
+        scores = (gaps / self.tol).max(axis=1)
+        k = int(np.argmin(scores))
+        score, self.gap, self.phase = float(scores[k]), gaps[k], float(offs[k]) / self.rate
         if score < self.best[0]:
-            self.best = (score, t, self.gap)
+            self.best = (score, t, self.gap, self.phase)
         if score <= 1.0:
             self.at = t
             return "landed on the found clip"
@@ -515,6 +541,9 @@ class TransitionSimulation:
     #: physical mode: why Simulation 2 stopped early (it went unstable), else None; it ends at
     #: its last stable frame and the blend closes the rest
     unstable: str | None = None
+    #: physical mode: the time shift (s) onto the found clip at the landing (``land_warp``):
+    #: the blend lands on the found clip's frame that much later than the path's
+    landing_phase: float = 0.0
 
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
@@ -550,12 +579,19 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     recipient = _controller(name, cfg, world, 0, q, 0.0, rate, options)
     if yields and isinstance(recipient, GainScalable):
         recipient = Scheduled(recipient, yield_schedule(cfg, naive.impact_time - rewind))
+    landing = None
+    if physical:
+        pad = int(round(cfg.land_warp * rate))
+        ticks = rewind + np.arange(-pad, len(q) + pad) / rate
+        clip = _found_path(cast, cont, ticks) if pad else None
+        step = max(1, int(round(rate * LAND_WARP_STEP)))
+        offsets = np.arange(-(pad // step), pad // step + 1) * step
+        landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind, clip, offsets, pad)
     ctrls = [recipient]
     fps = [cast.recipient.motion.fps]
     if cast.attacker is not None:
         ctrls += _attacker(world, cast, cfg, rewind)
         fps.append(cast.attacker.motion.fps)
-    landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind) if physical else None
     # the joints the body does not simulate (toes, clavicles, the head below a neck body) take
     # what Simulation 2 was asked to do, not the old clip: the final blend then corrects only
     # what the physics did not follow
@@ -571,22 +607,38 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
     assert res.contact_log is not None
-    landed, on_clip, gap = cont.time, True, (0.0, 0.0, 0.0)
+    landed, on_clip, gap, phase = cont.time, True, (0.0, 0.0, 0.0), 0.0
     if landing is not None:
         on_clip = landing.at is not None
         # not landed: where the body came closest (a simulation that went unstable before the
         # match still lands no earlier than it)
-        _, at, last = landing.best
+        _, at, last, phase = landing.best
         if landing.at is not None:
-            at, last = landing.at, landing.gap
+            at, last, phase = landing.at, landing.gap, landing.phase
         elif not np.isfinite(last).all():  # never checked (unstable before the match)
-            at, last = res.duration, landing.gap
+            at, last, phase = res.duration, landing.gap, 0.0
         landed = max(cont.time, rewind + min(at, res.duration))
         gap = (float(last[0]), float(last[1]), float(last[2]))
     unstable = res.reason if res.status == "unstable" else None
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
                                 res.contact_log, release, landed, on_clip, gap,
-                                unstable)  # fmt: skip
+                                unstable, phase)  # fmt: skip
+
+
+#: the physical mode's time-warped landing check compares the body with the found clip at
+#: shifts this many seconds apart (within ``land_warp``)
+LAND_WARP_STEP = 0.01
+
+
+def _found_path(cast: Cast, cont: Continuation, times: F64) -> F64:
+    """The found clip's qpos at scenario ``times`` (played from the match as in
+    :func:`desired_motion`); NaN rows where ``times`` fall outside the clip."""
+    rec = cast.recipient
+    clip_t = cont.best.time + (np.asarray(times, dtype=np.float64) - cont.time)
+    found = ground_root(cont.found.sample(clip_t), rec.parts, turn=False)
+    q = rec.character.qpos_from_motion(found)
+    q[(clip_t < 0.0) | (clip_t > cont.found.duration)] = np.nan
+    return q
 
 
 def _output_end(cfg: ResponseConfig, cont: Continuation, landed: float | None = None) -> float:

@@ -36,6 +36,7 @@ def test_a_push_lands_physically_and_the_blend_corrects_only_the_small_gap() -> 
     assert q["blend_root_offset_max_m"] <= 0.02, q
     assert q["blend_joint_correction_max_rad"] <= 0.1 + 1e-9, q
     assert q["reaction_displacement_m"] >= 0.10  # a reaction, not the own clip played on
+    assert abs(tr["landing_phase_s"]) <= sc.response.land_warp + 1e-9
     assert not physical["warnings"]
     # the same fields as the blend mode, so regress can compare the two
     assert set(q) == set(blend["quality"])
@@ -80,9 +81,41 @@ def test_a_body_that_never_lands_lands_where_it_came_closest() -> None:
         world.data.qpos[span] = want
         assert landing(world, t) is None  # never within the tolerances
     assert landing.at is None
-    score, at, gap = landing.best
+    score, at, gap, phase = landing.best
     assert at == 0.3  # not the last check (0.4 s), nor the one before ``after``
     assert gap[2] == pytest.approx(0.15, abs=1e-6) and score == pytest.approx(1.5, abs=1e-5)
+    assert phase == 0.0  # no time warp asked
+
+
+def test_a_body_on_the_clip_but_late_lands_on_its_frame_with_the_time_warp() -> None:
+    # a real World with the body posed on a stepping clip 0.1 s behind the path: off the path's
+    # own frame by more than the tolerances, on the clip's earlier frame exactly
+    from reactmocap.response import stages
+    from reactmocap.sim.world import World
+
+    sc = _physical("light_push")
+    cfg = sc.response
+    cast = stages.cast(sc, CACHE)
+    rec = cast.recipient
+    clip = cast.library["step_right"]
+    q = rec.character.qpos_from_motion(clip)
+    rate = clip.fps
+    world = World([rec.character])
+    lag = int(round(0.1 * rate))
+    t = 0.6
+    i = int(round(t * rate))
+    world.data.qpos[world.characters[0].qpos_slice] = q[i - lag]
+    plain = stages._Landing(cfg, q, rate, after=0.0)
+    assert plain(world, t) is None and plain.at is None  # the path's own frame: not landed
+    assert plain.best[0] > 1.0
+    pad = int(round(cfg.land_warp * rate))
+    assert lag < pad
+    padded = np.vstack([np.full((pad, q.shape[1]), np.nan), q, np.full((pad, q.shape[1]), np.nan)])
+    warped = stages._Landing(cfg, q, rate, after=0.0, clip=padded,
+                             offsets=np.arange(-pad, pad + 1), pad=pad)  # fmt: skip
+    assert warped(world, t) == "landed on the found clip"
+    assert warped.at == t and warped.phase == pytest.approx(-lag / rate)
+    assert np.all(warped.gap < 1e-6), warped.gap
 
 
 def _score(report: dict, sc: Scenario) -> float:
