@@ -34,6 +34,7 @@ from reactmocap.sim.world import World
 __all__ = [
     "ANKLE_LIMITS",
     "BALANCE_GAINS",
+    "STANDING_GAINS",
     "STANDING_LEG",
     "Balance",
     "BalanceGains",
@@ -108,6 +109,10 @@ class BalanceGains:
     kp: float = 2.0
     kv: float = 0.5
     max_offset: float = 0.35
+    #: COM target moved uphill by these times the floor's gradient (m; heading frame, along
+    #: and across the feet): sideways, the feet slide downhill first; along them a shift
+    #: downhill (< 0) measured better (docs/athletics.md)
+    uphill: tuple[float, float] = (0.0, 0.0)
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
         ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
@@ -115,6 +120,10 @@ class BalanceGains:
     damping: tuple[tuple[str, float], ...] = (
         ("waist", 0.1), ("back", 0.1), ("hip", 0.15), ("knee", 0.15), ("ankle", 0.2),
     )  # fmt: skip
+
+    def __post_init__(self) -> None:
+        if len(self.uphill) != 2 or not all(math.isfinite(v) for v in self.uphill):
+            raise ConfigError(f"balance uphill must be 2 finite numbers, got {self.uphill!r}")
 
     def stiffness_array(self) -> F64:
         return per_joint(dict(self.stiffness))
@@ -124,6 +133,11 @@ class BalanceGains:
 
 
 BALANCE_GAINS = BalanceGains()
+#: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
+#: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
+#: sideways slope balanced 19.5 -> 23.5-25.5 deg, docs/athletics.md); on flat floor as
+#: :data:`BALANCE_GAINS`
+STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07))
 
 
 class BalanceLaw:
@@ -197,6 +211,11 @@ class BalanceLaw:
         target = centre.copy()
         target[0] += c * off[0] - sn * off[1]
         target[1] += sn * off[0] + c * off[1]
+        if any(g.uphill):
+            n = s.floor_normal
+            up = s.local(-n / max(float(n[2]), 1e-6), h) * g.uphill  # gradient, heading frame
+            target[0] += c * up[0] - sn * up[1]
+            target[1] += sn * up[0] + c * up[1]
         self.com_target = target
         err = s.local(target - s.com, h)
         vel = s.local(s.com_vel, h)

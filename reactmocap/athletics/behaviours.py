@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from reactmocap.athletics import tables
-from reactmocap.athletics.balance import STANDING_LEG, Balance, Posture
+from reactmocap.athletics.balance import STANDING_GAINS, STANDING_LEG, Balance, Posture
 from reactmocap.athletics.bodies import BODIES, Athlete, athlete
 from reactmocap.athletics.land import Landing
 from reactmocap.athletics.leap import PUSHES, Leap, LeapParams, com_push
@@ -331,7 +331,8 @@ def _run_balance(
         impacts = (Impact("chest", force=force, start=float(p["push_time"]) + ramp,
                           duration=float(p["push_duration"])),)  # fmt: skip
     seconds = float(p["seconds"]) + ramp
-    ctx, seq, res = _simulate(ath, world, [Balance(posture)], seconds, behaviour="balance",
+    stand = Balance(posture, gains=STANDING_GAINS)  # the COM target moves uphill on a slope
+    ctx, seq, res = _simulate(ath, world, [stand], seconds, behaviour="balance",
                               impacts=impacts, extra=tuple(extra), on_tick=on_tick, fps=p["fps"])  # fmt: skip
     log = ctx.log.arrays()
     _, pelvis0 = _standing(ctx)

@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import run
+from reactmocap.athletics.balance import BalanceGains
+from reactmocap.errors import ConfigError
 
 
 def test_a_50_newton_push_is_recovered() -> None:
@@ -44,3 +46,14 @@ def test_balance_on_a_slope_and_with_a_backpack() -> None:
     assert r.report["balanced"]
     r = run("balance", "female", seconds=2.0, backpack=4.0)
     assert r.report["balanced"] and r.report["mass_kg"] == pytest.approx(53.3, abs=0.01)
+
+
+def test_the_com_target_moves_uphill_on_a_sideways_slope() -> None:
+    # the balance command's STANDING_GAINS: with the thesis's target (the support centre) she
+    # slid downhill and fell from 19.5 deg on (2026-12-02); now she stands on 23 deg
+    r = run(
+        "balance", "female", seconds=3.0, slope=math.radians(23.0), slope_dir=math.radians(90.0)
+    )
+    assert r.report["balanced"] and not r.report["fell"]
+    with pytest.raises(ConfigError):
+        BalanceGains(uphill=(0.0, math.nan))
