@@ -101,13 +101,24 @@ LEAP_LANDING_TABLE: frozenset[str] = frozenset({"male"})
 VERTICAL_LANDING: Mapping[str, tuple[float, float]] = MappingProxyType(
     {"male": (0.5, -0.01), "female": (0.5, -0.05)}
 )
-#: the landing after a "com" push's vertical leap (LeapParams.push), per body, as
-#: VERTICAL_LANDING (a body without one uses that): its take-off is upright (pitch momentum 0 to
-#: +2 kg m^2/s against the timed push's -3.4). Over the ten Fig. 4.1 commands (0.1-1.0 m,
-#: landed of 10, lead 0.5, 2026-12-02): male delta -0.04 / -0.01 / 0.0 / +0.01 / +0.02: 6 / 9 /
-#: 10 / 9 / 9 (lead 0.4 with 0.0: 10; 0.6: 9). The female has none: no lead/delta reached 8
-#: (docs/athletics.md)
-VERTICAL_LANDING_COM: Mapping[str, tuple[float, float]] = MappingProxyType({"male": (0.5, 0.0)})
+#: the landing after a "com" push's vertical leap (LeapParams.push), per body, as BROAD_LANDING:
+#: (capture-point lead, ((horizontal speed m/s, foot-servo delta m), ...)), the delta
+#: interpolated on the speed sensed in the air (a body without one uses VERTICAL_LANDING). Its
+#: take-off is upright (pitch momentum about 0 to +2 kg m^2/s against the timed push's -3.4)
+#: and drifts back faster the higher the leap (female -0.19 m/s at 0.1 m to -0.47 at 1.0 m).
+#: Over the ten Fig. 4.1 commands (0.1-1.0 m, landed of 10, lead 0.5, 2026-12-02): male
+#: constant delta -0.04 / -0.01 / 0.0 / +0.01 / +0.02: 6 / 9 / 10 / 9 / 9; female constant
+#: -0.07 / -0.05 / -0.01: 6 / 7 / 3 (her 0.1 m leap landed only with -0.1, her 1.0 m only with
+#: 0.0 to +0.04), this table 9 (the 0.9 m leap falls: it drifts back as fast as the 0.8 m
+#: one, -0.40 m/s, and landed only with deltas the 0.8 m one fell with)
+VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = (
+    MappingProxyType(
+        {
+            "male": (0.5, ((0.0, 0.0),)),
+            "female": (0.5, ((-0.47, 0.0), (-0.43, -0.05), (-0.21, -0.05), (-0.19, -0.1))),
+        }
+    )
+)
 #: the landing after a broad jump, per body: (capture-point lead, ((touchdown speed m/s,
 #: foot-servo delta m), ...)), thesis Table 6.1 measured on broad jumps, not drops (a broad
 #: jump lands lower, with the trunk pitched forward). Each row: the middle of the deltas that
@@ -179,8 +190,8 @@ def landing_params(
         arms = BROAD_ARMS.get(body, base.arms)
         return replace(base, pitch_ease=BROAD_PITCH_EASE, arms=arms)
     if vertical and push == "com" and body in VERTICAL_LANDING_COM:
-        lead, delta = VERTICAL_LANDING_COM[body]
-        return LandingParams(lead=lead, delta=delta)
+        lead, table = VERTICAL_LANDING_COM[body]
+        return LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
     if vertical and body in VERTICAL_LANDING:
         lead, delta = VERTICAL_LANDING[body]
         return LandingParams(lead=lead, delta=delta)

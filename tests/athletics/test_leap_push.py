@@ -52,9 +52,9 @@ def test_com_push_leaves_the_broad_jump_alone() -> None:
 def test_the_com_push_lands_on_its_own_landing_setting(monkeypatch: pytest.MonkeyPatch) -> None:
     """The male's 0.9 m "com" leap (upright take-off) lands with VERTICAL_LANDING_COM's delta
     and falls with the timed push's VERTICAL_LANDING (its feet placed too far back)."""
-    assert tables.landing_params("male", 0.0, vertical=True, push="com").delta == pytest.approx(
-        tables.VERTICAL_LANDING_COM["male"][1]
-    )
+    lp = tables.landing_params("female", 0.0, vertical=True, push="com")
+    assert lp.deltas == tables.VERTICAL_LANDING_COM["female"][1]
+    assert lp.delta_at(-0.47) == pytest.approx(0.0) and lp.delta_at(-0.3) == pytest.approx(-0.05)
     r = run("leap", "male", height=0.9, push="com", check_range=False)
     assert r.report["landed"] and not r.report["fell"]
     assert abs(r.report["achieved_height_m"] - 0.9) <= 0.03
