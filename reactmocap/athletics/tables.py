@@ -32,6 +32,7 @@ __all__ = [
     "LEAP_TABLES",
     "SUPPORTED",
     "VERTICAL_LANDING",
+    "VERTICAL_LANDING_COM",
     "broad_params",
     "effort_for",
     "landing_delta",
@@ -100,6 +101,24 @@ LEAP_LANDING_TABLE: frozenset[str] = frozenset({"male"})
 VERTICAL_LANDING: Mapping[str, tuple[float, float]] = MappingProxyType(
     {"male": (0.5, -0.01), "female": (0.5, -0.05)}
 )
+#: the landing after a "com" push's vertical leap (LeapParams.push), per body, as BROAD_LANDING:
+#: (capture-point lead, ((horizontal speed m/s, foot-servo delta m), ...)), the delta
+#: interpolated on the speed sensed in the air (a body without one uses VERTICAL_LANDING). Its
+#: take-off is upright (pitch momentum about 0 to +2 kg m^2/s against the timed push's -3.4)
+#: and drifts back faster the higher the leap (female -0.19 m/s at 0.1 m to -0.47 at 1.0 m).
+#: Over the ten Fig. 4.1 commands (0.1-1.0 m, landed of 10, lead 0.5, 2026-12-02): male
+#: constant delta -0.04 / -0.01 / 0.0 / +0.01 / +0.02: 6 / 9 / 10 / 9 / 9; female constant
+#: -0.07 / -0.05 / -0.01: 6 / 7 / 3 (her 0.1 m leap landed only with -0.1, her 1.0 m only with
+#: 0.0 to +0.04), this table 9 (the 0.9 m leap falls: it drifts back as fast as the 0.8 m
+#: one, -0.40 m/s, and landed only with deltas the 0.8 m one fell with)
+VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = (
+    MappingProxyType(
+        {
+            "male": (0.5, ((0.0, 0.0),)),
+            "female": (0.5, ((-0.47, 0.0), (-0.43, -0.05), (-0.21, -0.05), (-0.19, -0.1))),
+        }
+    )
+)
 #: the landing after a broad jump, per body: (capture-point lead, ((touchdown speed m/s,
 #: foot-servo delta m), ...)), thesis Table 6.1 measured on broad jumps, not drops (a broad
 #: jump lands lower, with the trunk pitched forward). Each row: the middle of the deltas that
@@ -154,13 +173,15 @@ def landing_params(
     after_leap: bool = False,
     vertical: bool = False,
     broad: bool = False,
+    push: str = "timed",
 ) -> LandingParams:
     """The landing controller's parameters for a body and a horizontal velocity (m/s); the
     delta table goes with them (interpolated in the air) unless ``after_leap`` and the body
     is not in :data:`LEAP_LANDING_TABLE`. ``vertical``: after a vertical leap, the body's
     :data:`VERTICAL_LANDING` where it has one; ``broad``: after a broad jump, the body's
     :data:`BROAD_LANDING` where it has one, the arms swung to :data:`BROAD_ARMS` in the air
-    where it has one, and the trunk righted over :data:`BROAD_PITCH_EASE`."""
+    where it has one, and the trunk righted over :data:`BROAD_PITCH_EASE`. ``push``: the
+    vertical leap's push-off (``"com"``: the body's :data:`VERTICAL_LANDING_COM` first)."""
     if broad:
         base = landing_params(body, velocity, after_leap=True)
         if body in BROAD_LANDING:
@@ -168,6 +189,9 @@ def landing_params(
             base = LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
         arms = BROAD_ARMS.get(body, base.arms)
         return replace(base, pitch_ease=BROAD_PITCH_EASE, arms=arms)
+    if vertical and push == "com" and body in VERTICAL_LANDING_COM:
+        lead, table = VERTICAL_LANDING_COM[body]
+        return LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
     if vertical and body in VERTICAL_LANDING:
         lead, delta = VERTICAL_LANDING[body]
         return LandingParams(lead=lead, delta=delta)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from reactmocap.athletics import run
+from reactmocap.athletics import run, tables
 from reactmocap.athletics.leap import LeapParams, com_push
 from reactmocap.athletics.report import ground_force
 from reactmocap.errors import ConfigError
@@ -47,3 +47,18 @@ def test_com_push_leaves_the_broad_jump_alone() -> None:
     assert com_push(broad, 0.5, "male") is broad
     vertical = com_push(LeapParams(), 0.4, "male")
     assert vertical.push == "com" and vertical.rise == 0.4
+
+
+def test_the_com_push_lands_on_its_own_landing_setting(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The male's 0.9 m "com" leap (upright take-off) lands with VERTICAL_LANDING_COM's delta
+    and falls with the timed push's VERTICAL_LANDING (its feet placed too far back)."""
+    lp = tables.landing_params("female", 0.0, vertical=True, push="com")
+    assert lp.deltas == tables.VERTICAL_LANDING_COM["female"][1]
+    assert lp.delta_at(-0.47) == pytest.approx(0.0) and lp.delta_at(-0.3) == pytest.approx(-0.05)
+    r = run("leap", "male", height=0.9, push="com", check_range=False)
+    assert r.report["landed"] and not r.report["fell"]
+    assert abs(r.report["achieved_height_m"] - 0.9) <= 0.03
+    monkeypatch.setattr(tables, "VERTICAL_LANDING_COM", {})
+    r0 = run("leap", "male", height=0.9, push="com", check_range=False)
+    assert abs(r0.report["achieved_height_m"] - r.report["achieved_height_m"]) < 0.01
+    assert not r0.report["landed"]
