@@ -37,9 +37,20 @@ def _start(sweep: Path, out: Path) -> subprocess.Popen[str]:
         "--workers",
         "1",
     ]
+    # the sweep must get Ctrl-C's default handling even when this process ignores SIGINT (an
+    # ignored signal stays ignored across exec, and Python then installs no KeyboardInterrupt)
     return subprocess.Popen(
-        cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        cmd,
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_default_sigint,
     )
+
+
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _run_until(proc: subprocess.Popen[str], jsonl: Path, rows: int, sig: int) -> None:
@@ -93,8 +104,8 @@ def test_killed_sweep_resumes_with_exact_rows(warm_cache, write_sweep, tmp_path:
     # 2. SIGINT (Ctrl-C): finished rows kept, results.csv rewritten from them, exit 130
     proc = _start(sweep, out)
     _run_until(proc, jsonl, first + 2, signal.SIGINT)
-    _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130, err
+    out_text, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, (err, out_text, signal.getsignal(signal.SIGINT))
     assert f"{first} already done" in err and "interrupted" in err and "Traceback" not in err
     second = [json.loads(ln) for ln in _lines(jsonl)]  # every line whole, torn one gone
     assert first + 2 <= len(second) < N
