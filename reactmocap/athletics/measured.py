@@ -174,7 +174,7 @@ SUPPORTED: dict[Any, Any] = {
     ("leap", "height"): {"male": (0.0857, 0.9987), "female": (0.0706, 0.7588)},
     ("broad-jump", "distance"): {"male": (0.4589, 1.4143), "female": (0.2877, 1.2846)},
     ("land", "drop"): {"male": (0.0, 2.2), "female": (0.0, 2.5)},
-    ("land", "vx"): {"male": (-2.0, 3.0), "female": (-1.0, 2.0)},
+    ("land", "vx"): {"male": (-2.0, 3.0), "female": (-1.0, 3.0)},
     ("balance", "slope"): {
         "male": (0.0, 0.41015237421866746),
         "female": (0.0, 0.44505895925855404),

@@ -27,6 +27,7 @@ __all__ = [
     "BROAD_SPIN",
     "BROAD_TABLES",
     "LANDING_DELTAS",
+    "LANDING_DELTAS_FAST",
     "LANDING_LEADS",
     "LEAP_LANDING_TABLE",
     "LEAP_TABLES",
@@ -81,6 +82,15 @@ BROAD_TABLES: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
 #: (horizontal velocity m/s, foot-servo delta m), thesis Table 6.1 rebuilt
 LANDING_DELTAS: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
     measured.LANDING_DELTAS
+)
+#: faster rows of Table 6.1 per body, (horizontal velocity m/s, foot-servo delta m), used
+#: above the measured table's fastest row (a rebuild that reaches these speeds supersedes
+#: them). Female, COM 1.25 m up, lead 1.0, 2026-12-02: the middle of the deltas that landed on
+#: a 0.01 m grid (2.25: -0.48..-0.44; 2.5: -0.54..-0.50; 2.75: -0.62..-0.57; 3.0:
+#: -0.67..-0.63), where the 0.02 m rebuild grid (-0.5..0.3 m, 0.5 m/s steps) stops short of
+#: them; with the 2.0 m/s row's -0.38 held she fell at every speed above 2.0 m/s
+LANDING_DELTAS_FAST: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    {"female": ((2.25, -0.46), (2.5, -0.52), (2.75, -0.595), (3.0, -0.65))}
 )
 #: the landing's capture-point lead per body (tuned like the thesis's per-body deltas; a BVH
 #: body gets the landing's default)
@@ -196,10 +206,19 @@ def landing_params(
         lead, delta = VERTICAL_LANDING[body]
         return LandingParams(lead=lead, delta=delta)
     lead = LANDING_LEADS.get(body, LandingParams().lead)
-    table = tuple(LANDING_DELTAS.get(body, ()))
+    table = _with_fast_rows(tuple(LANDING_DELTAS.get(body, ())), LANDING_DELTAS_FAST.get(body, ()))
     if after_leap and body not in LEAP_LANDING_TABLE:
         table = ()
     return LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
+
+
+def _with_fast_rows(
+    table: tuple[tuple[float, float], ...], fast: tuple[tuple[float, float], ...]
+) -> tuple[tuple[float, float], ...]:
+    """The measured delta table with the :data:`LANDING_DELTAS_FAST` rows faster than its
+    fastest row appended."""
+    top = max((v for v, _ in table), default=-math.inf)
+    return table + tuple(r for r in fast if r[0] > top)
 
 
 def supported_range(behaviour: str, param: str, body: str) -> tuple[float, float] | None:

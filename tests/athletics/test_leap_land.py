@@ -173,6 +173,38 @@ def test_a_forward_landing_at_2_m_per_s_lands_with_the_delta_table(
     assert r0.report["fell"] and not r0.report["landed"]
 
 
+@pytest.mark.parametrize("vx", [2.5, 3.0])
+def test_the_female_lands_at_2_5_and_3_m_per_s_with_the_fast_rows(
+    monkeypatch: pytest.MonkeyPatch, vx: float
+) -> None:
+    """Thesis ch. 6 (-1.0 to 3.0 m/s, COM 1.25 m up) on the female: her measured delta table
+    ends at 2.0 m/s, and held at its -0.38 m she fell at every faster speed; the fast rows
+    (``tables.LANDING_DELTAS_FAST``) put her feet where she lands."""
+    drop = _drop_for_com_height("female", 1.25)
+    r = run("land", "female", drop=drop, vx=vx)  # inside her supported range now
+    assert r.report["landed"] and not r.report["fell"]
+    lp = tables.landing_params("female", vx)
+    assert lp.delta < tables.landing_params("female", 2.0).delta - 0.05  # farther ahead
+    assert r.report["foot_servo_delta_m"] == pytest.approx(lp.delta_at(vx))
+    assert r.log["com"][-1, 0] - r.log["com"][0, 0] > 0.5
+    assert abs(r.log["offset"][-1]) < 0.05
+    # without the fast rows the same landing falls
+    monkeypatch.setattr(tables, "LANDING_DELTAS_FAST", {})
+    r0 = run("land", "female", drop=drop, vx=vx)
+    assert r0.report["fell"] and not r0.report["landed"]
+
+
+def test_the_fast_rows_only_extend_the_measured_table(monkeypatch: pytest.MonkeyPatch) -> None:
+    fast = tables.LANDING_DELTAS_FAST["female"]
+    rows = tables.landing_params("female", 0.0).deltas
+    assert rows[-len(fast) :] == fast
+    assert [v for v, _ in rows] == sorted(v for v, _ in rows)
+    assert tables.landing_params("male", 0.0).deltas == tuple(tables.LANDING_DELTAS["male"])
+    # a rebuilt table that reaches their speeds supersedes them
+    monkeypatch.setattr(tables, "LANDING_DELTAS", {"female": ((0.0, -0.04), (2.5, -0.3))})
+    assert tables.landing_params("female", 0.0).deltas == ((0.0, -0.04), (2.5, -0.3), *fast[-2:])
+
+
 def test_landing_deltas_are_validated_and_interpolated() -> None:
     lp = LandingParams(delta=0.1, deltas=((0.0, -0.04), (1.0, 0.06)))
     assert lp.delta_at(0.5) == pytest.approx(0.01)
