@@ -111,7 +111,7 @@ def build_tables(
 
 #: the landing delta table's grid (thesis Table 6.1): horizontal velocities (m/s), deltas (m)
 DELTA_VELOCITIES = np.round(np.arange(-1.0, 3.01, 0.5), 2)
-DELTA_GRID = np.round(np.arange(-0.5, 0.31, 0.02), 2)
+DELTA_GRID = np.round(np.arange(-0.8, 0.31, 0.02), 2)  # her 3 m/s window is near -0.65
 
 
 def _land_with_delta(job: tuple[str, float, float, float]) -> bool:
