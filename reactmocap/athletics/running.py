@@ -87,6 +87,11 @@ ERROR_CAP = 0.3
 #: runner fell recovering it
 START_SPEED = 3.5
 ACCEL = 1.5
+#: the thrust also stops once the body's rise slows by this much (m/s) below its peak: when the
+#: toe phase began at the bottom of the stance the take-off speed was never reached, and the
+#: thrust, tilting forward as the leg swept back, pushed on to lift-off (+0.26 m/s forward,
+#: a long flight, a hard landing far ahead of the body: the slow-cadence gaits' falls)
+THRUST_DROP = 0.02
 #: the most the pitch error's integral holds (rad s)
 PITCH_SUM = 0.1
 #: the path correction integrates from this time on (s; the start from the set pose strays)
@@ -195,6 +200,7 @@ class Runner:
         self.step_start: tuple[float, F64] | None = None
         self.thrust_force = k["thrust"] * self.mass * self.g
         self.released = False
+        self.vz_peak = -math.inf
         self.steps = 0
 
     def reset(self, world: World) -> None:
@@ -512,6 +518,7 @@ class Runner:
         del world
         self.t_touchdown = t
         self.released = False
+        self.vz_peak = -math.inf
         leg = self.active
         d = self.world.data
         self.td_pitch = self._pitch(self._thighs[1 - leg], _THIGH[1 - leg], self.heading())
@@ -554,7 +561,9 @@ class Runner:
         del world, t
         if not self.released and self.machine.current.name in ("toe", "unloading"):
             # the thrust stops once the body rises at the take-off speed wanted
-            self.released = float(self.senses.com_vel[2]) >= self.k["takeoff_vz"]
+            vz = float(self.senses.com_vel[2])
+            self.released = vz >= self.k["takeoff_vz"] or vz < self.vz_peak - THRUST_DROP
+            self.vz_peak = max(self.vz_peak, vz)
 
     # ------------------------------------------------------------------ tick
     def control(self, world: World, t: float) -> None:
