@@ -87,11 +87,6 @@ ERROR_CAP = 0.3
 #: runner fell recovering it
 START_SPEED = 3.5
 ACCEL = 1.5
-#: the thrust also stops once the body's rise slows by this much (m/s) below its peak: when the
-#: toe phase began at the bottom of the stance the take-off speed was never reached, and the
-#: thrust, tilting forward as the leg swept back, pushed on to lift-off (+0.26 m/s forward,
-#: a long flight, a hard landing far ahead of the body: the slow-cadence gaits' falls)
-THRUST_DROP = 0.02
 #: the most the pitch error's integral holds (rad s)
 PITCH_SUM = 0.1
 #: the path correction integrates from this time on (s; the start from the set pose strays)
@@ -560,9 +555,11 @@ class Runner:
     def _stance(self, world: World, t: float) -> None:
         del world, t
         if not self.released and self.machine.current.name in ("toe", "unloading"):
-            # the thrust stops once the body rises at the take-off speed wanted
+            # the thrust stops once the body rises at the take-off speed wanted, or once its
+            # rise slows (the take-off speed out of reach: pushing on to lift-off drove the
+            # body forward into a long flight and a hard landing far ahead)
             vz = float(self.senses.com_vel[2])
-            self.released = vz >= self.k["takeoff_vz"] or vz < self.vz_peak - THRUST_DROP
+            self.released = vz >= self.k["takeoff_vz"] or vz < self.vz_peak - self.k["thrust_drop"]
             self.vz_peak = max(self.vz_peak, vz)
 
     # ------------------------------------------------------------------ tick
