@@ -195,6 +195,7 @@ class Runner:
         self.step_start: tuple[float, F64] | None = None
         self.thrust_force = k["thrust"] * self.mass * self.g
         self.released = False
+        self.vz_peak = -math.inf
         self.steps = 0
 
     def reset(self, world: World) -> None:
@@ -512,6 +513,7 @@ class Runner:
         del world
         self.t_touchdown = t
         self.released = False
+        self.vz_peak = -math.inf
         leg = self.active
         d = self.world.data
         self.td_pitch = self._pitch(self._thighs[1 - leg], _THIGH[1 - leg], self.heading())
@@ -553,8 +555,12 @@ class Runner:
     def _stance(self, world: World, t: float) -> None:
         del world, t
         if not self.released and self.machine.current.name in ("toe", "unloading"):
-            # the thrust stops once the body rises at the take-off speed wanted
-            self.released = float(self.senses.com_vel[2]) >= self.k["takeoff_vz"]
+            # the thrust stops once the body rises at the take-off speed wanted, or once its
+            # rise slows (the take-off speed out of reach: pushing on to lift-off drove the
+            # body forward into a long flight and a hard landing far ahead)
+            vz = float(self.senses.com_vel[2])
+            self.released = vz >= self.k["takeoff_vz"] or vz < self.vz_peak - self.k["thrust_drop"]
+            self.vz_peak = max(self.vz_peak, vz)
 
     # ------------------------------------------------------------------ tick
     def control(self, world: World, t: float) -> None:

@@ -63,6 +63,12 @@ class RunParams:
             damping ratio.
         thrust: the toe phase's extra leg force (body weights), until the body rises at
             ``takeoff_vz`` (m/s).
+        thrust_drop: the thrust also stops once the body's vertical speed falls this far (m/s)
+            below its peak in the push: when the toe phase began at the bottom of the stance the
+            take-off speed was never reached, and the thrust, tilted forward as the leg swept
+            back, pushed on to lift-off (+0.26 m/s forward, a long flight, a landing with the
+            foot 0.2 m ahead: how the slow-cadence gaits fell). Off from 4 m/s (10: never
+            reached), where the gaits were tuned without it.
         toe_fraction: the heel-and-toe phase ends at this fraction of the expected stance
             (the paper: 30-50% by speed).
         pitch: desired forward pitch of the trunk (rad).
@@ -117,6 +123,7 @@ class RunParams:
     leg_damping: float | Speeds = (0.08527, 0.04, 0.06971)
     thrust: float | Speeds = (1.683, 1.71, 1.716)
     takeoff_vz: float | Speeds = (0.5575, 0.517, 0.5806)
+    thrust_drop: float | Speeds = (0.02, 0.02, 10.0)
     toe_fraction: float | Speeds = (0.3849, 0.42, 0.3199)
     pitch: float | Speeds = (0.1207, 0.013, -0.01578)
     attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
@@ -166,6 +173,8 @@ class RunParams:
                 raise ConfigError("stance_time and leg_stiffness must be > 0, smoothing >= 0")
             if not 0.0 < r["stance_blend"] <= 1.0:
                 raise ConfigError(f"stance_blend must be in (0, 1], got {self.stance_blend}")
+            if r["thrust_drop"] <= 0:
+                raise ConfigError(f"thrust_drop must be > 0, got {self.thrust_drop}")
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
 

@@ -87,3 +87,29 @@ def test_the_touchdown_limit_caps_the_torque_until_the_ball_is_down() -> None:
         assert size(state) > 0.9 * k["touchdown_limit"]
     k["touchdown_limit"] = 0.0  # off: the attitude limit alone
     assert size("loading") == size("toe")
+
+
+def test_the_thrust_stops_at_the_take_off_speed_or_once_the_rise_slows() -> None:
+    """In the toe phase the thrust is on while the body's rise speeds up below the take-off
+    speed; it stops at the take-off speed, or once the rise falls ``thrust_drop`` below its
+    peak (a push that cannot reach the take-off speed); above 4 m/s the drop is off."""
+    res = run_course(2.5, seconds=0.2, fps=10.0)
+    runner = res.runner
+    k = runner.k
+    runner.machine.current = runner.machine._by_name["toe"]
+    vz = runner.senses.com_vel
+
+    def push(*speeds: float) -> bool:
+        runner.released, runner.vz_peak = False, -np.inf
+        for v in speeds:
+            vz[2] = v
+            runner._stance(runner.world, 0.0)
+        return bool(runner.released)
+
+    top, drop = k["takeoff_vz"], k["thrust_drop"]
+    assert 0 < drop < 0.2 * top
+    assert not push(0.0, 0.3 * top, 0.6 * top, 0.9 * top)
+    assert push(0.0, 0.5 * top, top)
+    assert not push(0.0, 0.5 * top, 0.5 * top - 0.5 * drop)  # a small dip: still on
+    assert push(0.0, 0.5 * top, 0.5 * top - 2.0 * drop)
+    assert RunParams().at(4.0)["thrust_drop"] > 2.0  # off where the fast gaits were tuned

@@ -54,6 +54,8 @@ def test_run_params_are_checked() -> None:
         RunParams(stance_blend=(0.0, 1.0, 1.0))
     with pytest.raises(ConfigError, match="path_integral"):
         RunParams(path_integral=-1.0)
+    with pytest.raises(ConfigError, match="thrust_drop"):
+        RunParams(thrust_drop=0.0)
     p = RunParams(thrust=(1.0, 2.0, 4.0))
     assert p.at(2.5)["thrust"] == 1.0 and p.at(3.0)["thrust"] == pytest.approx(1.5)
     assert p.at(4.25)["thrust"] == pytest.approx(3.0) and p.at(9.0)["thrust"] == 4.0
