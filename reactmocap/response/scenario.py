@@ -126,6 +126,10 @@ class ResponseConfig:
     #: little late or early); it lands on the nearest frame, and the found clip plays on from
     #: there (0: the path's own frame only)
     land_warp: float = 0.2
+    #: physical mode: from the match on, Simulation 2's whole-body tracker holds the joints
+    #: this many times stiffer (damping times its root; 1: as built), so the hit body settles
+    #: onto the found clip's pose before it drifts off it (``docs/benchmarks.md``)
+    land_stiffness: float = 6.0
     #: physical mode: when the body does not land, Simulation 2 runs again toward the search's
     #: next-best windows of other clips, up to ``land_tries`` continuations in all, and the one
     #: the body came closest to (its landing gap over the tolerances) wins: a continuation the
@@ -238,7 +242,7 @@ class _Reader:
                                   "torque_limit"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
                                     "total_mass", "land_position", "land_angle",
-                                    "land_joint"}  # fmt: skip
+                                    "land_joint", "land_stiffness"}  # fmt: skip
                 kwargs[name] = self.number(
                     where, value, positive=positive, min_=0.0 if nonneg else None
                 )

@@ -36,6 +36,7 @@ from reactmocap.sim.controllers import (
     build,
 )
 from reactmocap.sim.controllers.registry import controller_spec
+from reactmocap.sim.controllers.wholebody import WholeBodyTracker
 from reactmocap.sim.impacts import Impact, first_contact, overlap_depths
 from reactmocap.sim.reference import reference_path
 from reactmocap.sim.rollout import ContactLog, rollout
@@ -576,7 +577,7 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     # way above the hips only): yielding whole, it is still off balance when the found clip
     # starts and falls from it (docs/benchmarks.md)
     options = {"hold_balance": True} if physical else None
-    recipient = _controller(name, cfg, world, 0, q, 0.0, rate, options)
+    recipient = tracker = _controller(name, cfg, world, 0, q, 0.0, rate, options)
     if yields and isinstance(recipient, GainScalable):
         recipient = Scheduled(recipient, yield_schedule(cfg, naive.impact_time - rewind))
     landing = None
@@ -587,6 +588,8 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         step = max(1, int(round(rate * LAND_WARP_STEP)))
         offsets = np.arange(-(pad // step), pad // step + 1) * step
         landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind, clip, offsets, pad)
+        if cfg.land_stiffness != 1.0 and isinstance(tracker, WholeBodyTracker):
+            recipient = _StiffenFrom(recipient, tracker, landing.after, cfg.land_stiffness)
     ctrls = [recipient]
     fps = [cast.recipient.motion.fps]
     if cast.attacker is not None:
@@ -623,6 +626,27 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
                                 res.contact_log, release, landed, on_clip, gap,
                                 unstable, phase)  # fmt: skip
+
+
+class _StiffenFrom:
+    """``inner`` (driving ``tracker``) with ``tracker``'s joints ``factor`` times stiffer from
+    rollout time ``at`` on (the physical mode's ``land_stiffness``, from the match)."""
+
+    def __init__(self, inner: Controller, tracker: WholeBodyTracker, at: float,
+                 factor: float) -> None:  # fmt: skip
+        self.inner, self.tracker, self.at, self.factor = inner, tracker, at, factor
+        self.control_every = inner.control_every
+        self._done = False
+
+    def reset(self, world: World) -> None:
+        self.inner.reset(world)
+        self._done = False
+
+    def control(self, world: World, t: float) -> None:
+        if not self._done and t >= self.at - 1e-9:
+            self.tracker.stiffen_joints(self.factor)
+            self._done = True
+        self.inner.control(world, t)
 
 
 #: the physical mode's time-warped landing check compares the body with the found clip at

@@ -145,3 +145,29 @@ def test_a_body_that_does_not_land_tries_other_clips_and_keeps_the_closest() -> 
     assert _score(three, tries) <= _score(one, sc) + 1e-12
     if three["matched"]["clip"] != one["matched"]["clip"]:  # it switched: it landed closer
         assert _score(three, tries) < _score(one, sc)
+
+
+def test_stiffening_from_the_match_lands_a_kick_that_does_not_land_without_it() -> None:
+    # the facing sweep's kick from 240 deg (the found clip `step_right`): with the joints as
+    # built the body comes within 1.5 tolerances 0.15 s after the match and drifts off;
+    # held stiffer from the match on (`land_stiffness`), it settles onto the clip
+    from reactmocap.batch import load_sweep
+
+    base = load_sweep(EXAMPLES / "sweep_facing.toml").points()[0].scenario
+    sc = replace(base, recipient=replace(base.recipient, facing_deg=240.0),
+                 response=replace(base.response, mode="physical"))  # fmt: skip
+    assert sc.response.land_stiffness > 1.0
+    stiff = run_response(sc, CACHE).report
+    built = run_response(replace(sc, response=replace(sc.response, land_stiffness=1.0)),
+                         CACHE).report  # fmt: skip
+    assert stiff["matched"]["clip"] == built["matched"]["clip"]  # the same search
+    assert not built["transition"]["landed_on_clip"]
+    assert stiff["transition"]["landed_on_clip"], stiff["transition"]
+    assert _score(stiff, sc) <= 1.0 < _score(built, sc)
+
+
+def test_a_land_stiffness_that_is_not_positive_is_a_clear_error() -> None:
+    data = {"library": str(REPO / "data" / "synthetic_clips"), "recipient": {"clip": "guard"},
+            "impact": {}, "response": {"mode": "physical", "land_stiffness": 0.0}}  # fmt: skip
+    with pytest.raises(ConfigError, match=r"\[response\]\.land_stiffness"):
+        parse_scenario(data, source="s.toml")

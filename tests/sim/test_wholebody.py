@@ -368,3 +368,37 @@ def test_torque_limit_bounds_every_joint_torque_the_plan_applies(step_forward: M
         servo.step(wb.control_every)
     # the plan asked for more than the limit: the bound did something
     assert max(asked) > 2 * limit
+
+
+def test_stiffen_joints_stiffens_the_joint_rows_only_and_reset_undoes_it(guard: Motion) -> None:
+    # the response's physical mode stiffens the hit body's joints from the match on
+    frame = 10
+    world = World(build_character(guard, frame=frame))
+    world.set_from_motion(0, guard, frame)
+    wc = world.characters[0]
+    world.data.qpos[wc.qpos_slice.start] += 0.05  # the pelvis and a knee off the reference
+    k = wc.qpos_slice.start + 7 + 4 * BALL_JOINTS.index("l_knee")
+    world.data.qpos[k : k + 4] = [np.cos(0.1), np.sin(0.1), 0.0, 0.0]
+    mujoco.mj_forward(world.model, world.data)
+    wb = _tracker(world, guard, frame / guard.fps)
+    kp, kv = wb.kp.copy(), wb.kv.copy()
+    wb.control(world, frame / guard.fps)
+    assert wb.last_plan is not None
+    before = wb.last_plan.desired_qacc.copy()
+    wb.stiffen_joints(4.0)
+    np.testing.assert_allclose(wb.kp[6:], 4.0 * kp[6:])
+    np.testing.assert_allclose(wb.kv[6:], 2.0 * kv[6:])
+    np.testing.assert_array_equal(wb.kp[:6], kp[:6])
+    wb.control(world, frame / guard.fps)
+    after = wb.last_plan.desired_qacc
+    knee = 6 + 3 * BALL_JOINTS.index("l_knee") + np.arange(3)
+    np.testing.assert_allclose(after[:6], before[:6])  # the pelvis rows as built
+    assert np.abs(after[knee]).max() > 2.0 * np.abs(before[knee]).max()
+    wb.scale_gains(0.5)  # a gain schedule scales the stiffened gains
+    np.testing.assert_allclose(wb.kp[6:], 2.0 * kp[6:])
+    wb.reset(world)
+    wb.scale_gains(1.0)
+    np.testing.assert_allclose(wb.kp, kp)
+    np.testing.assert_allclose(wb.kv, kv)
+    with pytest.raises(ConfigError, match="factor must be > 0"):
+        wb.stiffen_joints(0.0)

@@ -323,6 +323,7 @@ class WholeBodyTracker(AnchoredReference):
         self._stance_rows = np.r_[np.arange(6), 6 + np.concatenate(self._leg_rows)]
         self._holding = False  # hold_balance has taken hold
         self._scale = 1.0  # the last scale_gains
+        self._stiffness = 1.0  # the last stiffen_joints
         self.release()
 
     # ------------------------------------------------------------------ control
@@ -620,6 +621,19 @@ class WholeBodyTracker(AnchoredReference):
             r = self._stance_rows
             self.kp[r], self.kv[r] = self._kp0[r], self._kv0[r]
 
+    def stiffen_joints(self, factor: float) -> None:
+        """The joints' stiffness as built times ``factor`` (damping times its root) from the
+        next tick, under any :meth:`scale_gains`; the pelvis rows keep theirs. The response's
+        physical mode stiffens a hit body from the match on, so that it settles onto the found
+        clip's pose before drifting off it (``docs/benchmarks.md``); :meth:`reset` undoes it."""
+        if not (np.isfinite(factor) and factor > 0.0):
+            raise ConfigError(f"stiffen_joints: factor must be > 0, got {factor!r}")
+        ratio = float(factor) / self._stiffness
+        self._stiffness = float(factor)
+        self._kp0[6:] *= ratio
+        self._kv0[6:] *= np.sqrt(ratio)
+        self.scale_gains(self._scale)
+
     def _check_balance(self, t: float) -> None:
         """``hold_balance``: hold the pelvis and leg rows once the simulated capture point is
         outside the feet on the floor."""
@@ -646,6 +660,8 @@ class WholeBodyTracker(AnchoredReference):
         self.reset_ground(world)
         self._pushed, self._back_from = False, -np.inf
         self._holding = False
+        if self._stiffness != 1.0:
+            self.stiffen_joints(1.0)
         if self._kp_root_pushed:  # the pelvis servo as built
             self.kp[:3], self.kv[:3] = self._kp0[:3], self._kv0[:3]
         servo = world.servo
