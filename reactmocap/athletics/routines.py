@@ -93,7 +93,7 @@ DIRECTIONS = ("backward", "forward")
 #: touchdown. So the leap makes more somersault momentum than the untwisted layout's (effort
 #: 1.0, aimed at -95 kg m^2/s with the hips allowed 2.0 rad: it gets -94.5, against -77):
 #: the body turns faster through the twist and the reach (at -79 the touchdown came at -275
-#: deg, at -100 at -315..-331: both fell), and lands with the feet 12 cm behind the capture
+#: deg, at -99 at -311..-331: both fell), and lands with the feet 12 cm behind the capture
 #: point (landed at 11-13 cm, fell at 14-15). Narrow: docs/athletics.md.
 TWIST_SOMERSAULT_PRESETS: Mapping[
     str, Mapping[str, Mapping[float, tuple[Mapping[str, float], Mapping[str, float],
