@@ -23,6 +23,7 @@ __all__ = [
     "PLATFORM_MAX",
     "SOMERSAULT_PRESETS",
     "TWIST_DIVE",
+    "TWIST_SOMERSAULT_PRESETS",
     "dive",
     "dive_maneuver",
     "HANDSPRING_BODY_PRESET",
@@ -81,14 +82,63 @@ SOMERSAULT_PRESETS: Mapping[
     }),
 })  # fmt: skip
 DIRECTIONS = ("backward", "forward")
+#: the twisting somersaults built (thesis 5.2's tilt twist, initiated in the air), tuned by
+#: hand (2026-12-02, docs/athletics.md): body -> ``direction/position`` -> twist turns ->
+#: (leap, tumble, landing parameters). The male back layout with one twist: the arms are
+#: thrown 1.8 rad the same way about the body's front-back axis 0.05 s after lift-off (over
+#: 0.08 s) and brought back once the predicted twist reaches the full turn, which takes the
+#: tilt out and stops the twist (a half twist cannot be stopped this way: its undo runs past
+#: the shoulders' cones). The twist costs the layout's flight its opening: the tumble opens
+#: only once the throw is undone (its lead 1.5 rad already asks to open by then), 0.3 s before
+#: touchdown. So the leap makes more somersault momentum than the untwisted layout's (effort
+#: 1.0, aimed at -95 kg m^2/s with the hips allowed 2.0 rad: it gets -94.5, against -77):
+#: the body turns faster through the twist and the reach (at -79 the touchdown came at -275
+#: deg, at -99 at -311..-331: both fell), and lands with the feet 12 cm behind the capture
+#: point (landed at 11-13 cm, fell at 14-15). Narrow: docs/athletics.md.
+TWIST_SOMERSAULT_PRESETS: Mapping[
+    str, Mapping[str, Mapping[float, tuple[Mapping[str, float], Mapping[str, float],
+                                           Mapping[str, float]]]]
+] = MappingProxyType({
+    "male": MappingProxyType({
+        "backward/layout": MappingProxyType({
+            1.0: (MappingProxyType({"effort": 1.0, "spin": -95.0, "spin_limit": 2.0}),
+                  MappingProxyType({"lead": 1.5, "open_inertia": 8.0, "arm_tilt": 1.8,
+                                    "entry": 0.05, "arm_throw": 0.08, "twist": 1.0}),
+                  MappingProxyType({"delta": -0.12, "knee": 1.0})),
+        }),
+    }),
+})  # fmt: skip
+
+
+def _twist_preset(
+    position: str, direction: str, body: str, twist: float
+) -> tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]:
+    """The :data:`TWIST_SOMERSAULT_PRESETS` entry, or a :class:`ConfigError` saying why the
+    combination is not built."""
+    if not math.isfinite(twist):
+        raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
+    preset = TWIST_SOMERSAULT_PRESETS.get(body, {}).get(f"{direction}/{position}", {}).get(twist)
+    if preset is None:
+        raise ConfigError(
+            f"a twisting somersault is built only as the male back layout with one twist "
+            f"(--position layout --direction backward --twist 1), got body {body!r}, direction "
+            f"{direction!r}, position {position!r}, twist {twist!r} (thesis 5.2): a half twist "
+            "cannot be stopped (the arms' undo runs into the shoulders' cones), a twist thrown "
+            "in the tuck or pike did not stop, and no other body or direction is tuned "
+            "(docs/athletics.md)"
+        )
+    return preset
 
 
 def somersault_maneuver(
-    position: str = "tuck", direction: str = "backward", body: str = "male", backpack: float = 0.0
-) -> Maneuver:
+    position: str = "tuck", direction: str = "backward", body: str = "male",
+    backpack: float = 0.0, twist: float = 0.0,
+) -> Maneuver:  # fmt: skip
     """The standing somersault (thesis 8.4-8.5) as a maneuver: balance, leap with rotation,
     tumble in ``position``, land, balance. Uses the male preset for a body or direction that
-    has none of its own; such runs are untuned and their reports say what happened."""
+    has none of its own; such runs are untuned and their reports say what happened. ``twist``
+    (turns) uses :data:`TWIST_SOMERSAULT_PRESETS`; a combination with no entry there is
+    refused (:class:`ConfigError`, with the reason)."""
     if direction not in DIRECTIONS:
         raise UnknownKeyError(
             f"unknown somersault direction {direction!r}; valid directions are {list(DIRECTIONS)}"
@@ -97,10 +147,13 @@ def somersault_maneuver(
         raise UnknownKeyError(
             f"unknown somersault position {position!r}; valid positions are {sorted(POSITIONS)}"
         )
-    presets = SOMERSAULT_PRESETS.get(body, SOMERSAULT_PRESETS["male"])
-    if direction not in presets:
-        presets = SOMERSAULT_PRESETS["male"]
-    leap, tumble, land = presets.get(f"{direction}/{position}", presets[direction])
+    if twist:
+        leap, tumble, land = _twist_preset(position, direction, body, twist)
+    else:
+        presets = SOMERSAULT_PRESETS.get(body, SOMERSAULT_PRESETS["male"])
+        if direction not in presets:
+            presets = SOMERSAULT_PRESETS["male"]
+        leap, tumble, land = presets.get(f"{direction}/{position}", presets[direction])
     phases = (
         Phase("balance", "after", {}, 0.3),
         Phase("leap", "liftoff", dict(leap)),
@@ -110,7 +163,7 @@ def somersault_maneuver(
         # the COM forward off the feet after most perturbed landings (docs/athletics.md)
         Phase("balance", "never", {"settle": 2.0}),
     )
-    name = f"{direction}_somersault_{position}"
+    name = f"{direction}_somersault_{position}" + (f"_twist{twist:g}" if twist else "")
     return Maneuver(name, phases, body, 5.5, backpack)
 
 
@@ -124,23 +177,21 @@ def somersault(
     on_tick: Callable[[float], None] | None = None,
     fps: float = 60.0,
 ) -> AthleticsResult:
-    """A standing somersault (:func:`somersault_maneuver`); ``twist`` (turns) is refused:
-    the twist is aimed only in the dive (:func:`dive`; ``docs/athletics.md``)."""
-    if not math.isfinite(twist):
-        raise ConfigError(f"twist must be a finite number of turns, got {twist!r}")
-    if twist != 0.0:
-        raise ConfigError(
-            "twisting somersaults are not built (thesis 5.2): the twist is aimed only in the "
-            "layout back dive (athletics dive --twist 0.5|1); a twist thrown in the tuck or "
-            "pike did not stop, in the layout a half twist cannot be stopped (the arms' undo "
-            "runs into the shoulders' cones) and a full one stops at best 0.26 s before touchdown, "
-            "too late to land (docs/athletics.md); run without --twist"
-        )
+    """A standing somersault (:func:`somersault_maneuver`). ``twist`` (turns) is built only
+    where :data:`TWIST_SOMERSAULT_PRESETS` has an entry (the male back layout with one twist);
+    anything else is refused with the reason. With a twist the report adds
+    ``twist_error_deg`` (``|twist_deg|`` against the commanded turns) and ``twist_stopped``
+    (the throw undone before touchdown)."""
     if not (math.isfinite(backpack) and backpack >= 0):
         raise ConfigError(f"backpack must be >= 0 kg, got {backpack!r}")
-    m = somersault_maneuver(position, direction, body, backpack)
+    m = somersault_maneuver(position, direction, body, backpack, twist)
     result = run_maneuver(m, on_tick=on_tick, fps=fps)
-    result.report.update(position=position, direction=direction, twist_turns=0.0)
+    rep = result.report
+    rep.update(position=position, direction=direction, twist_turns=twist)
+    if twist:
+        undone, td = rep.get("twist_undone_s"), rep.get("touchdown_s")
+        rep["twist_error_deg"] = abs(rep["twist_deg"]) - 360.0 * twist
+        rep["twist_stopped"] = undone is not None and td is not None and undone < td
     return result
 
 

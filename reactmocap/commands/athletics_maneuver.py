@@ -40,14 +40,15 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     s = inner.add_parser(
         "somersault", help="standing somersault: leap, tumble, land, balance (thesis 8.4-8.5)",
         description="A standing somersault composed of the leap, tumble, land and balance basis "
-        "controllers. Tuned: the backward tuck (male, female); the other combinations run untuned "
-        "and their reports say what happened.",
+        "controllers. Tuned: the backward tuck (male, female), the backward pike and layout (male; "
+        "the layout also with --twist 1) and the forward tuck (male); the other combinations run "
+        "untuned and their reports say what happened.",
     )  # fmt: skip
     s.add_argument("--position", choices=sorted(POSITIONS), default="tuck")
     s.add_argument("--direction", choices=list(DIRECTIONS), default="backward")
     s.add_argument("--twist", type=float, default=0.0,
-                   help="twist turns (not built for somersaults: anything but 0 is refused; "
-                   "see dive --twist)")  # fmt: skip
+                   help="twist turns: 0, or 1 for the male back layout (--position layout; a "
+                   "tilt twist, thesis 5.2); anything else is refused with the reason")  # fmt: skip
     s.add_argument("--backpack", type=float, default=0.0, help="kg on the chest (thesis 8.5.2)")
     output_args(s, "male", plot=False)
     s.set_defaults(func=_somersault)

@@ -92,6 +92,9 @@ def test_each_example_maneuver_runs_and_lands(path: Path) -> None:
     assert r["landed"] and not r["fell"]
     if path.stem in ("back_somersault", "back_layout"):
         assert abs(r["rotation_deg"] + 360.0) <= 30.0
+    elif path.stem == "back_somersault_full_twist":  # one somersault, one twist
+        assert abs(r["rotation_deg"] + 360.0) <= 30.0
+        assert abs(abs(r["twist_deg"]) - 360.0) <= 45.0
     elif path.stem.startswith("back_handspring"):  # on the hands, and only the hands, then the feet
         assert abs(r["rotation_deg"] + 360.0) <= 45.0
         assert r["hands_contact_s"] > 0.05 and r["handspring_other_contacts"] == []
@@ -133,14 +136,29 @@ def test_somersault_refuses_what_is_not_built(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "s.bvh"
-    assert main(["athletics", "somersault", "--twist", "1", "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("reactmocap: error:") and "twist" in err[0]
-    assert not out.exists()
+    # a twist is built only as the male back layout with one twist: the tuck (the default
+    # position), a half twist and the female body are refused with the reason
+    for extra in ([], ["--position", "layout", "--twist", "0.5"],
+                  ["--position", "layout", "--body", "female"]):  # fmt: skip
+        args = ["athletics", "somersault", "--twist", "1", *extra, "--out", str(out)]
+        assert main(args) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("reactmocap: error:") and "twist" in err[0]
+        assert "layout" in err[0] and not out.exists()
     with pytest.raises(UnknownKeyError, match="valid positions"):
         somersault("straddle")
     with pytest.raises(UnknownKeyError, match="valid directions"):
         somersault("tuck", "sideways")
+
+
+def test_the_full_twist_example_is_the_routines_preset() -> None:
+    # the example file and `somersault --position layout --twist 1` run the same phases
+    path = EXAMPLES[[p.stem for p in EXAMPLES].index("back_somersault_full_twist")]
+    ex, built = load_maneuver(path), somersault_maneuver("layout", twist=1.0)
+    assert [(p.controller, p.exit, dict(p.params), p.seconds) for p in ex.phases] == [
+        (p.controller, p.exit, dict(p.params), p.seconds) for p in built.phases
+    ]
+    assert (ex.body, ex.seconds) == (built.body, built.seconds)
 
 
 def test_the_dive_command_enters_head_first_and_a_layout_dive_does_not(tmp_path: Path) -> None:

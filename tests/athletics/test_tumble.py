@@ -94,6 +94,24 @@ def test_the_back_layout_somersault_turns_360_and_lands() -> None:
     assert r["flight_momentum_drift"] <= 0.01
 
 
+def test_the_back_layout_with_one_twist_twists_360_and_lands() -> None:
+    # thesis 5.2's tilt twist in the standing back layout (issue 19): the arms' throw twists
+    # the body and their return stops it at a full turn; the tumble opens only after that, so
+    # the leap takes off with more momentum than the untwisted layout's (-77 kg m^2/s: at -79
+    # the body touched down at -275 deg and fell). Refused before 2026-12-02
+    res = somersault("layout", "backward", "male", twist=1.0)
+    r = res.report
+    assert r["status"] == "ok" and r["landed"] and not r["fell"]
+    assert abs(r["rotation_deg"] + 360.0) <= 30.0
+    assert r["twist_turns"] == 1.0 and abs(r["twist_error_deg"]) <= 45.0
+    assert abs(abs(r["twist_at_touchdown_deg"]) - 360.0) <= 45.0
+    assert r["twist_stopped"] and r["liftoff_pitch_momentum"] < -85.0
+    opened = next(t for t, frm, _ in res.transitions if frm == "tumble.tumble")
+    assert r["twist_undone_s"] < opened < r["touchdown_s"]
+    # the arms' throw and return within the flight: 1.4% drift measured (the dive's: < 1%)
+    assert r["flight_momentum_drift"] <= 0.02
+
+
 def _layout_flight(arm_tilt: float) -> tuple[float, dict]:  # type: ignore[type-arg]
     """The twist (deg) when the tumble opens (the layout held until then) and the report."""
     m = somersault_maneuver("layout")
