@@ -90,15 +90,17 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
             break
     sim2 = timed("blend", final.settle, scenario, cast, contact, naive, cont, sim2)
     out = timed("blend", final.blend, scenario, cast, contact, naive, cont, sim2)
-    for alt in cont.alternatives if scenario.response.mode == "blend" else ():
+    tries = cont.alternatives if scenario.response.mode == "blend" else ()
+    score = _blend_score(cast, out) if tries else (False, 0.0)
+    for alt in tries:
         # the blend mode's land_tries: a continuation whose final blend corrects less wins
-        if _blend_score(cast, out) <= 1.0:
+        if score <= (False, 1.0):
             break
         other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, alt)
         other = timed("blend", final.settle, scenario, cast, contact, naive, alt, other)
         blended = timed("blend", final.blend, scenario, cast, contact, naive, alt, other)
-        if _blend_score(cast, blended) < _blend_score(cast, out):
-            cont, sim2, out = alt, other, blended
+        if (s := _blend_score(cast, blended)) < score:
+            cont, sim2, out, score = alt, other, blended, s
     timings["total"] = time.perf_counter() - t_all
     report = _report(scenario, cast, contact, naive, cont, sim2, out, timings)
     rec = cast.recipient
@@ -134,14 +136,21 @@ def _landing_score(scenario: Scenario, sim2: stages.TransitionSimulation) -> flo
     return float(np.max(np.asarray(sim2.landing_gap) / tol))
 
 
-def _blend_score(cast: stages.Cast, out: final.Blend) -> float:
-    """How much the final blend corrects Simulation 2: its largest joint turn and root offset
-    over their warning thresholds (<= 1: within both)."""
+def _blend_score(cast: stages.Cast, out: final.Blend) -> tuple[bool, float]:
+    """How much the final blend corrects Simulation 2: whether the output overlaps the
+    attacker beyond its warning threshold (first: a continuation that overlaps never wins over
+    one that does not), then its largest joint turn and root offset over their warning
+    thresholds (<= 1: within both)."""
     parts = cast.recipient.parts
-    return max(qm.blend_joint_correction_max_rad(out.simulated, out.blended)
-               / qm.WARN_JOINT_CORRECTION_RAD,
-               qm.blend_root_offset_max_m(out.simulated, out.blended, parts)
-               / qm.WARN_ROOT_OFFSET_M)  # fmt: skip
+    overlap = False
+    if out.attacker is not None:
+        rec = out.recipient
+        att = out.attacker.sample(rec.times).replace(fps=rec.fps)
+        overlap = bool(overlap_depths(cast.pair, [rec, att]).max() > qm.WARN_OVERLAP_M)
+    return overlap, max(qm.blend_joint_correction_max_rad(out.simulated, out.blended)
+                        / qm.WARN_JOINT_CORRECTION_RAD,
+                        qm.blend_root_offset_max_m(out.simulated, out.blended, parts)
+                        / qm.WARN_ROOT_OFFSET_M)  # fmt: skip
 
 
 def _report(
