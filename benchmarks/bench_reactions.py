@@ -53,11 +53,14 @@ SYNTHETIC = ROOT / "data" / "synthetic_clips"
 #: there or where it came closest; the blend then closes only that gap. A body that does not
 #: land tries the search's next-best windows of two other clips, and the closest wins. The
 #: whole-body plan's joint torques are bounded at 1 kN m (``torque_limit``): unbounded, the bow
-#: kicked asked 41 kN m at a hip and Simulation 1 blew up
+#: kicked asked 41 kN m at a hip and Simulation 1 blew up. In the blend mode (``--mode
+#: blend``) Simulation 2 runs on 0.5 s past the match and the final blend lands where it
+#: corrects least (``blend_settle``), and a final blend that would warn tries the search's
+#: next-best windows of two other clips (``land_tries``), the least corrected winning
 REAL = ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
                       attacker_assist=100.0, mode="physical", land_position=0.25,
                       land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3,
-                      torque_limit=1000.0)  # fmt: skip
+                      torque_limit=1000.0, blend_settle=0.5)  # fmt: skip
 RECIPIENTS = ("walk_normal_001", "walk_normal_002", "walk-back", "walk-left", "walk-right",
               "run_normal_001", "bow_normal_001", "respond_normal_001")  # fmt: skip
 

@@ -3,14 +3,20 @@ output around the recipient's (see :mod:`reactmocap.response.stages` for the one
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import ground_root
-from reactmocap.metrics import joint_speed_max_m_s
+from reactmocap.metrics import (
+    WARN_JOINT_CORRECTION_RAD,
+    WARN_ROOT_OFFSET_M,
+    blend_joint_correction_max_rad,
+    blend_root_offset_max_m,
+    joint_speed_max_m_s,
+)
 from reactmocap.response.blend import blend_poses, final_blend
 from reactmocap.response.footlock import lock_feet
 from reactmocap.response.scenario import ResponseConfig, Scenario
@@ -28,7 +34,7 @@ from reactmocap.rotations import quat_conj, quat_mul
 from reactmocap.sim.bodies import SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.impacts import overlap_depths
 
-__all__ = ["Blend", "blend"]
+__all__ = ["Blend", "blend", "settle"]
 
 F64 = NDArray[np.float64]
 #: the shortest span (s) over which the final blend moves the root (a contact that delays the
@@ -37,6 +43,8 @@ ROOT_BLEND_MIN_S = 0.2
 #: how many times the attacker's blend back to its clip may double its length to move no joint
 #: faster than its clip's fastest
 BLEND_BACK_TRIES = 5
+#: the blend mode's ``blend_settle`` tries a landing every this many seconds past the match
+SETTLE_STEP_S = 0.05
 
 
 def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
@@ -175,6 +183,41 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
             break
         held = float(out_t[after][late[-1]]) + 1.0 / fps
     return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
+
+
+def settle(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
+           cont: Continuation, sim2: TransitionSimulation) -> TransitionSimulation:  # fmt: skip
+    """The blend mode's landing with ``blend_settle``: Simulation 2 ran on along the found clip
+    past the match, and the final blend lands on the frame (from the match on, every
+    :data:`SETTLE_STEP_S`) where it corrects least: its largest joint turn and pelvis shift
+    (the foot lock's included; not the holds of limbs touching the attacker), each over its
+    warning threshold; the smallest of the larger wins, the earliest among equals. ``sim2``
+    unchanged otherwise (the paper: the match time)."""
+    cfg = scenario.response
+    rec = cast.recipient
+    fps = rec.motion.fps
+    i_imp = int(np.ceil(naive.impact_time * fps - 1e-9))
+    i_match = int(round(cont.time * fps))
+    i_last = min(int(np.floor((contact.rewind + sim2.motion.duration) * fps + 1e-9)),
+                 int(np.floor((cont.time + cfg.blend_settle) * fps + 1e-9)))  # fmt: skip
+    if cfg.mode != "blend" or i_last <= i_match or i_match <= i_imp:
+        return sim2
+    times = np.arange(i_imp, i_last + 1) / fps
+    simulated = ground_root(sim2.motion.sample(times - contact.rewind), rec.parts, turn=False)
+    # what the blend corrects toward: exactly as in :func:`blend`
+    found = desired_motion(cast, cfg, times, naive.impact_time, yields_to(cfg, naive.impulse), cont)
+    best, landed = np.inf, i_match
+    step = max(1, int(round(SETTLE_STEP_S * fps)))
+    for end in range(i_match - i_imp, times.size, step):
+        sim, out = simulated.slice(0, end + 1), final_blend(simulated.slice(0, end + 1),
+                                                            found.slice(0, end + 1))  # fmt: skip
+        if cfg.foot_lock:
+            out = lock_feet(out, rec.parts)
+        score = max(blend_joint_correction_max_rad(sim, out) / WARN_JOINT_CORRECTION_RAD,
+                    blend_root_offset_max_m(sim, out, rec.parts) / WARN_ROOT_OFFSET_M)  # fmt: skip
+        if score < best - 1e-9:
+            best, landed = score, i_imp + end
+    return replace(sim2, landed=landed / fps)
 
 
 def _with_end_gap(simulated: Motion, target: Motion) -> Motion:

@@ -88,7 +88,19 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
             cont, sim2 = alt, other
         if sim2.on_clip:
             break
+    sim2 = timed("blend", final.settle, scenario, cast, contact, naive, cont, sim2)
     out = timed("blend", final.blend, scenario, cast, contact, naive, cont, sim2)
+    tries = cont.alternatives if scenario.response.mode == "blend" else ()
+    score = _blend_score(cast, out) if tries else (False, 0.0)
+    for alt in tries:
+        # the blend mode's land_tries: a continuation whose final blend corrects less wins
+        if score <= (False, 1.0):
+            break
+        other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, alt)
+        other = timed("blend", final.settle, scenario, cast, contact, naive, alt, other)
+        blended = timed("blend", final.blend, scenario, cast, contact, naive, alt, other)
+        if (s := _blend_score(cast, blended)) < score:
+            cont, sim2, out, score = alt, other, blended, s
     timings["total"] = time.perf_counter() - t_all
     report = _report(scenario, cast, contact, naive, cont, sim2, out, timings)
     rec = cast.recipient
@@ -122,6 +134,23 @@ def _landing_score(scenario: Scenario, sim2: stages.TransitionSimulation) -> flo
         return np.inf
     tol = (cfg.land_position, cfg.land_angle, cfg.land_joint)
     return float(np.max(np.asarray(sim2.landing_gap) / tol))
+
+
+def _blend_score(cast: stages.Cast, out: final.Blend) -> tuple[bool, float]:
+    """How much the final blend corrects Simulation 2: whether the output overlaps the
+    attacker beyond its warning threshold (first: a continuation that overlaps never wins over
+    one that does not), then its largest joint turn and root offset over their warning
+    thresholds (<= 1: within both)."""
+    parts = cast.recipient.parts
+    overlap = False
+    if out.attacker is not None:
+        rec = out.recipient
+        att = out.attacker.sample(rec.times).replace(fps=rec.fps)
+        overlap = bool(overlap_depths(cast.pair, [rec, att]).max() > qm.WARN_OVERLAP_M)
+    return overlap, max(qm.blend_joint_correction_max_rad(out.simulated, out.blended)
+                        / qm.WARN_JOINT_CORRECTION_RAD,
+                        qm.blend_root_offset_max_m(out.simulated, out.blended, parts)
+                        / qm.WARN_ROOT_OFFSET_M)  # fmt: skip
 
 
 def _report(

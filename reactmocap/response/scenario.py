@@ -133,8 +133,16 @@ class ResponseConfig:
     #: physical mode: when the body does not land, Simulation 2 runs again toward the search's
     #: next-best windows of other clips, up to ``land_tries`` continuations in all, and the one
     #: the body came closest to (its landing gap over the tolerances) wins: a continuation the
-    #: body can reach rather than the nearest window to Simulation 1
+    #: body can reach rather than the nearest window to Simulation 1. Blend mode: the same
+    #: when the final blend would turn a joint or move the root beyond the warning thresholds,
+    #: and the continuation whose final blend corrects least (over those thresholds) wins
     land_tries: int = 1
+    #: blend mode: Simulation 2 tracks the found clip up to this many seconds past the match,
+    #: and the final blend lands where the body came closest to it (the landing check's score
+    #: over ``land_position``, ``land_angle``, ``land_joint``; stopping once within them): the
+    #: blend then corrects the smallest tracking gap in that span, not the gap at the match
+    #: (0: at the match, the paper)
+    blend_settle: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -238,7 +246,7 @@ class _Reader:
                                   "contact_shift_max", "attacker_follow", "attacker_blend",
                                   "friction_sim1", "friction_sim2", "kv", "yield_gain",
                                   "react_impulse", "active_min", "own_clip_margin", "attacker_assist",
-                                  "yield_recover", "land_within", "land_warp",
+                                  "yield_recover", "land_within", "land_warp", "blend_settle",
                                   "torque_limit"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
                                     "total_mass", "land_position", "land_angle",

@@ -427,7 +427,7 @@ def search_continuation(
                             contact.rewind + start / q_fps, found, found_clip)  # fmt: skip
 
     others: list[Continuation] = []
-    if cfg.mode == "physical":  # the next-best window of each other clip, for land_tries
+    if cfg.land_tries > 1:  # the next-best window of each other clip, for land_tries
         seen = {best.clip}
         for r, s in results:
             if len(others) >= cfg.land_tries - 1:
@@ -557,8 +557,11 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     rewind = contact.rewind
     end = cont.time
     physical = cfg.mode == "physical"
-    if physical:  # no further than the found clip goes
-        end += max(0.0, min(cfg.land_within, cont.found.duration - cont.best.time))
+    left = cont.found.duration - cont.best.time  # no further than the found clip goes
+    if physical:
+        end += max(0.0, min(cfg.land_within, left))
+    else:  # the blend mode's landing may be chosen up to blend_settle s later (final.settle)
+        end += max(0.0, min(cfg.blend_settle, left))
     release = 0.0
     if cast.attacker is not None:
         release = max(naive.impact_time + cfg.attacker_follow,
