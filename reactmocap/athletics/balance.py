@@ -113,6 +113,12 @@ class BalanceGains:
     #: and across the feet): sideways, the feet slide downhill first; along them a shift
     #: downhill (< 0) measured better (docs/athletics.md)
     uphill: tuple[float, float] = (0.0, 0.0)
+    #: on a sideways slope, the sideways offset's multiples on the ankles' and the hips' roll
+    #: (level floor: the thesis's 1 and -0.5), blended in over the first :data:`SIDE_SLOPE`
+    #: of gradient: an ankle roll offset tips each foot onto its downhill edge, and a foot on
+    #: one edge creeps downhill in MuJoCo's soft contact at half the friction cone
+    #: (docs/athletics.md); ``None``: the thesis's everywhere
+    side_roll: tuple[float, float] | None = None
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
         ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
@@ -122,8 +128,10 @@ class BalanceGains:
     )  # fmt: skip
 
     def __post_init__(self) -> None:
-        if len(self.uphill) != 2 or not all(math.isfinite(v) for v in self.uphill):
-            raise ConfigError(f"balance uphill must be 2 finite numbers, got {self.uphill!r}")
+        for name in ("uphill", "side_roll"):
+            v = getattr(self, name)
+            if v is not None and (len(v) != 2 or not all(math.isfinite(x) for x in v)):
+                raise ConfigError(f"balance {name} must be 2 finite numbers, got {v!r}")
 
     def stiffness_array(self) -> F64:
         return per_joint(dict(self.stiffness))
@@ -132,12 +140,15 @@ class BalanceGains:
         return per_joint(dict(self.damping))
 
 
+#: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
+SIDE_SLOPE = 0.2
 BALANCE_GAINS = BalanceGains()
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
-#: sideways slope balanced 19.5 -> 23.5-25.5 deg, docs/athletics.md); on flat floor as
-#: :data:`BALANCE_GAINS`
-STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07))
+#: sideways slope balanced 19.5 -> 23.5-25.5 deg, docs/athletics.md), and on a sideways
+#: slope the sideways offset on the hips, not the ankles (23.5-25.5 -> 30-33.5 deg); on
+#: flat floor as :data:`BALANCE_GAINS`
+STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0))
 
 
 class BalanceLaw:
@@ -211,11 +222,16 @@ class BalanceLaw:
         target = centre.copy()
         target[0] += c * off[0] - sn * off[1]
         target[1] += sn * off[0] + c * off[1]
-        if any(g.uphill):
+        roll = (1.0, -0.5)
+        if any(g.uphill) or g.side_roll is not None:
             n = s.floor_normal
-            up = s.local(-n / max(float(n[2]), 1e-6), h) * g.uphill  # gradient, heading frame
+            grad = s.local(-n / max(float(n[2]), 1e-6), h)  # the floor's gradient, heading frame
+            up = grad * g.uphill
             target[0] += c * up[0] - sn * up[1]
             target[1] += sn * up[0] + c * up[1]
+            if g.side_roll is not None:
+                w = min(abs(float(grad[1])) / SIDE_SLOPE, 1.0)
+                roll = (1.0 + w * (g.side_roll[0] - 1.0), -0.5 + w * (g.side_roll[1] + 0.5))
         self.com_target = target
         err = s.local(target - s.com, h)
         vel = s.local(s.com_vel, h)
@@ -225,9 +241,9 @@ class BalanceLaw:
         rig.offset[:] = 0.0
         for k in range(2):
             rig.offset[_ANKLE[k], 0] = -delta[0]
-            rig.offset[_ANKLE[k], 1] = delta[1]
+            rig.offset[_ANKLE[k], 1] = roll[0] * delta[1]
             rig.offset[_HIP[k], 0] = 0.5 * delta[0]
-            rig.offset[_HIP[k], 1] = -0.5 * delta[1]
+            rig.offset[_HIP[k], 1] = roll[1] * delta[1]
         lo, hi = ANKLE_LIMITS
         desired = rig.desired(t)
         for k in range(2):

@@ -176,8 +176,8 @@ SUPPORTED: dict[Any, Any] = {
     ("land", "drop"): {"male": (0.0, 2.2), "female": (0.0, 2.5)},
     ("land", "vx"): {"male": (-2.0, 3.0), "female": (-1.0, 3.0)},
     ("balance", "slope"): {
-        "male": (0.0, 0.41015237421866746),
-        "female": (0.0, 0.44505895925855404),
+        "male": (0.0, 0.5235987755982988),
+        "female": (0.0, 0.5846852994181004),
     },
 }
 MEASURED_ON = "2026-12-02 (bench_athletics.py --tables)"

@@ -57,3 +57,22 @@ def test_the_com_target_moves_uphill_on_a_sideways_slope() -> None:
     assert r.report["balanced"] and not r.report["fell"]
     with pytest.raises(ConfigError):
         BalanceGains(uphill=(0.0, math.nan))
+
+
+def test_on_a_sideways_slope_the_hips_shift_the_weight_and_the_feet_stay_flat() -> None:
+    # STANDING_GAINS.side_roll: the thesis's ankle roll offset tipped the feet onto their
+    # downhill edges and they crept downhill, 6-8 cm/s at 24.5 deg (0.35 m in the run), and
+    # the male fell from 24 deg on (2026-12-02); with the sideways offset on the hips he stands
+    # on 27 deg and his feet creep 2-4 cm/s (0.14-0.18 m in the run)
+    r = run(
+        "balance", "male", check_range=False, seconds=3.0, slope=math.radians(27.0),
+        slope_dir=math.radians(90.0),
+    )  # fmt: skip
+    assert r.report["balanced"] and not r.report["fell"]
+    world = r.rollout.world
+    ankles = [world.model.joint(f"a/{s}_ankle").id for s in "lr"]
+    # the feet start at y = +-0.088 m (across the slope, -y downhill)
+    slid = np.array([0.088, -0.088]) - world.data.xanchor[ankles, 1]
+    assert slid.max() < 0.25
+    with pytest.raises(ConfigError):
+        BalanceGains(side_roll=(math.inf, 0.0))
