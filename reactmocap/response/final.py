@@ -45,6 +45,10 @@ ROOT_BLEND_MIN_S = 0.2
 BLEND_BACK_TRIES = 5
 #: the blend mode's ``blend_settle`` tries a landing every this many seconds past the match
 SETTLE_STEP_S = 0.05
+#: physical mode: the attacker steps aside until the two overlap by no more than this (m) ...
+ASIDE_MARGIN_M = 0.005
+#: ... re-measured this many times (each adds the depth still left)
+ASIDE_TRIES = 12
 
 
 def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
@@ -81,6 +85,11 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     if shift_times.size:
         moved = np.stack([np.interp(t, shift_times, shift[:, k]) for k in range(3)], axis=1)
         moved[t < shift_times[0]] = 0.0
+        if cfg.mode == "physical":
+            # the recipient's per-joint blend can squeeze its correction into a few frames (the
+            # run kicked: its hit body 22.9 m/s); the attacker follows it no faster than half
+            # its clip's fastest joint speed, as the blend back does
+            moved = _rate_limited(moved, 0.5 * speed / afps)
         sim = sim.replace(root_positions=sim.root_positions + moved)
     # back to the clip no faster than the capture moves: the blend adds (gap / duration) to
     # the joints' speed, kept within half the clip's fastest joint speed
@@ -98,6 +107,62 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
             break
         span *= 2.0
     return out
+
+
+def _rate_limited(path: F64, step: float) -> F64:
+    """``path`` ``(n, 3)`` followed by a point that moves at most ``step`` per frame (it keeps
+    catching up after ``path`` stops)."""
+    out = path.copy()
+    for k in range(1, len(out)):  # sequential by nature: each frame starts from the last
+        d = path[k] - out[k - 1]
+        n = float(np.linalg.norm(d))
+        out[k] = out[k - 1] + (d * (step / n) if n > step else d)
+    return out
+
+
+def _step_aside(cast: Cast, recipient: Motion, attacker: Motion, impact: float,
+                speed: float) -> Motion:  # fmt: skip
+    """``attacker`` moved aside horizontally (away from the recipient's pelvis where they first
+    overlap) until the recipient's output no longer runs into it: the offset it needs at each
+    overlapping frame is reached beforehand at no more than a quarter of its clip's fastest
+    joint ``speed`` and kept after (the recipient stays where it stood). The physical mode's
+    tail (the found clip after the landing) walks or falls onto an attacker that its
+    simulation left standing or lying there (docs/benchmarks.md)."""
+    fps = recipient.fps
+    t = recipient.times
+    ta = attacker.times
+    need = np.zeros(t.size)
+    offset = np.zeros(t.size)
+    direction: F64 | None = None
+    pelvis = cast.recipient.parts.joint_of("pelvis")
+    apelvis = cast.attacker.parts.joint_of("pelvis") if cast.attacker is not None else 0
+    moved = attacker
+    for _ in range(ASIDE_TRIES):
+        depth = overlap_depths(cast.pair, [recipient, moved.sample(t).replace(fps=fps)])
+        depth[t < impact] = 0.0  # before the hit the two are apart by construction
+        bad = depth > ASIDE_MARGIN_M
+        if not bad.any():
+            break
+        if direction is None:
+            k = int(np.argmax(bad))
+            d = (moved.sample([t[k]]).global_positions()[0, apelvis]
+                 - recipient.global_positions()[k, pelvis])  # fmt: skip
+            d[2] = 0.0
+            n = float(np.linalg.norm(d))
+            direction = d / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
+        # at least the offset it already has there, plus the depth still left
+        need = np.where(bad, np.maximum(need, offset + depth + ASIDE_MARGIN_M), need)
+        # the offset at each frame: the largest of every later need reached at the step-aside
+        # speed, and of every earlier one (kept)
+        v = 0.25 * speed
+        ahead = t[None, :] - t[:, None]  # [this frame i, frame j]: t_j - t_i
+        reach = need[None, :] - v * np.maximum(ahead, 0.0)
+        offset = np.maximum(reach.max(axis=1), 0.0)
+        off_a = np.interp(ta, t, offset)
+        off_a[ta < impact] = 0.0
+        moved = attacker.replace(root_positions=attacker.root_positions
+                                 + off_a[:, None] * direction[None])  # fmt: skip
+    return moved
 
 
 @dataclass(frozen=True)
@@ -182,6 +247,8 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
         if late.size == 0:
             break
         held = float(out_t[after][late[-1]]) + 1.0 / fps
+    if cfg.mode == "physical" and cast.attacker is not None and attacker is not None:
+        attacker = _step_aside(cast, recipient, attacker, naive.impact_time, speed)
     return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
 
 

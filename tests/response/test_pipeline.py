@@ -332,6 +332,42 @@ def test_a_leg_the_blend_turns_into_the_attacker_is_held_with_the_pelvis(
     assert res.report["quality"]["character_overlap_max_m"] <= 0.02
 
 
+@pytest.mark.parametrize(
+    ("recipient", "start", "attacker"),
+    [
+        ("dataset-1_walk-left_normal_001", 0.5,
+         AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                      facing_deg=171.62535275062777,
+                      position=(2.0532632057903535, 0.6267587902974016))),
+        ("dataset-1_run_normal_001", 0.1,
+         AttackerSpec("dataset-1_kick_normal_001", start=1.6833333333333333,
+                      facing_deg=207.03765069334506,
+                      position=(1.422719565513337, 0.2043343482184246))),
+    ],
+    ids=["walk-left", "run"],
+)  # fmt: skip
+def test_the_kicked_recipients_tail_does_not_run_into_the_attacker(
+    shared_mocap_dir: Path, tmp_path: Path, recipient: str, start: float, attacker: AttackerSpec
+) -> None:
+    # bench_reactions' kicked walk-left and run (physical mode): the found clip's tail walked
+    # (11.6 cm) or fell (16.0 cm) onto the attacker its simulation left standing or lying
+    # there, and the run's attacker, carried with the recipient's blend, moved 2.29x faster
+    # than its clip; it now follows that blend no faster than its clip and steps aside
+    lib = _shared_library(shared_mocap_dir, tmp_path)
+    scenario = Scenario(
+        library=lib,
+        recipient=CharacterSpec(recipient, start=start),
+        attacker=attacker,
+        response=_bench_physical(attacker_assist=100.0, torque_limit=1000.0),
+        name="kicked",
+    )
+    res = run_response(scenario)
+    q = res.report["quality"]
+    assert q["contact_impulse_Ns"] > 50.0  # the case: a real hit
+    assert q["character_overlap_max_m"] <= 0.02
+    assert q["attacker_speed_ratio"] <= 1.5
+
+
 def test_an_unstable_simulation_1_is_reported_not_fatal(
     shared_mocap_dir: Path, tmp_path: Path
 ) -> None:
