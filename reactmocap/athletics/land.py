@@ -22,9 +22,11 @@ from reactmocap.athletics.balance import (
     hold_pelvis_and_feet,
     knee_for_length,
 )
+from reactmocap.athletics.bodies import EULER_ORDER
 from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
 from reactmocap.athletics.rig import joint_index, per_joint
 from reactmocap.errors import ConfigError
+from reactmocap.rotations import quat_conj, quat_from_euler, quat_from_yaw, quat_mul, quat_to_euler
 from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import State, after
 from reactmocap.sim.world import World
@@ -95,6 +97,13 @@ class LandingParams:
             swing (the foot at most ``swing_cap`` leg lengths ahead of or behind the hip). A fast
             backward landing (the female back handspring) needs the feet farther behind
             than the default allows.
+        aim_sideways: the hips' roll (the legs' sideways aim) from the pelvis's whole
+            orientation (pitch, roll and yaw), so the pair of feet lands under the sideways
+            capture point (the eq. 6.1 servo stays on top as a correction); the hips' pitch is
+            as without it. Off (the default), the roll is the servo alone, with the pelvis's
+            own roll not taken out: a back tuck from a perturbed start touched down with the
+            pelvis rolled up to 16 degrees, the feet up to 7 cm to the side of the COM and
+            6-8 cm apart fore-aft, and stood on one foot after the landing.
     """
 
     knee: float = 0.6
@@ -111,6 +120,7 @@ class LandingParams:
     deltas: tuple[tuple[float, float], ...] = ()
     pitch_ease: float = 0.0
     swing_cap: float = 0.9
+    aim_sideways: bool = False
 
     def __post_init__(self) -> None:
         for name in (
@@ -210,8 +220,11 @@ class Landing(Basis):
             # (it turns freely in the air with the body's angular momentum)
             pelvis = bl.pelvis_pitch()
             goal = np.full((NJ, 3), np.nan)
+            thighs = np.zeros((2, 3))  # aim_sideways: each thigh's pitch and roll in the world
+            hips = d.xanchor[hip_joints]
+            middle = s.local(s.com - hips.mean(axis=0), h)
             for k in range(2):
-                hip = d.xanchor[hip_joints[k]]
+                hip = hips[k]
                 length = float(np.linalg.norm(hip - d.xanchor[ankle_joints[k]]))
                 ahead = float(s.local(s.com - hip, h)[0]) + want[0]
                 swing = math.asin(
@@ -220,6 +233,10 @@ class Landing(Basis):
                 geom = float(knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k],
                                              length)[1])  # fmt: skip
                 goal[_HIP[k]] = (-swing + geom - servo[0] - pelvis, servo[1], 0.0)
+                side = float(np.clip((middle[1] + want[1]) / max(length, 0.2), -0.5, 0.5))
+                thighs[k] = (-swing + geom - servo[0], math.asin(side) + servo[1], 0.0)
+            if p.aim_sideways:  # the roll from the pelvis's whole orientation; pitch as above
+                goal[_HIP, 1] = _hips_for_thighs(ctx, d, thighs, h)[:, 1]
             rig.move(goal, 0.0, t, _HIP)
             rig.offset[:] = 0.0
             for k in range(2):
@@ -335,6 +352,16 @@ class Landing(Basis):
                   ((settled, "done"), (after(1.0), "done"))),
             State("done", law(bl.control, every), done, ((after(0.0), NEXT),)),
         ]  # fmt: skip
+
+
+def _hips_for_thighs(ctx: Context, d, thighs: np.ndarray, heading: float) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """``(2, 3)`` hip angles that give the thighs the world ``thighs`` ``(2, 3)`` (anatomical
+    pitch, roll, yaw in the heading frame) from where the pelvis is now, in all three axes."""
+    pelvis = quat_mul(d.xquat[ctx.senses.root], quat_conj(ctx.athlete.neutral[0]))
+    want = quat_mul(quat_from_yaw(heading)[None], quat_from_euler(thighs, EULER_ORDER))
+    eul = quat_to_euler(quat_mul(quat_conj(pelvis)[None], want), EULER_ORDER)
+    eul[:, 2] = 0.0  # the hips' yaw targets stay 0, as elsewhere
+    return eul
 
 
 def _stance_support(ctx: Context) -> None:

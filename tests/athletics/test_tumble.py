@@ -192,3 +192,25 @@ def test_perturbed_back_layouts_open_past_inverted_and_land() -> None:
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
         assert -330.0 < r["rotation_at_touchdown_deg"] < -280.0, (i, r["rotation_at_touchdown_deg"])
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+
+
+def test_perturbed_back_tucks_land_with_the_legs_aimed_sideways() -> None:
+    """Starts 0 and 5 of the capture region at full size (seed 0). Both fell with the legs'
+    roll from the foot servo alone: start 0 touched down with the pelvis rolled 16 degrees and
+    the feet 7 cm to the side of the COM, stood on one foot and fell sideways; start 5 stood on
+    one foot and turned on backward. With the hips' roll taken from the pelvis's whole
+    orientation (``aim_sideways``, the preset since 2026-12-02) both land on both feet."""
+    rng = np.random.default_rng(0)
+    full = {"joint_sd": math.radians(3.0), "pitch_sd": math.radians(2.0),
+            "velocity_sd": 0.05, "spin_sd": 0.1}  # fmt: skip
+    starts = [Perturbation.sample(rng, **full) for _ in range(6)]
+    m = somersault_maneuver()
+    assert m.phases[3].params["aim_sideways"] is True
+    for i in (0, 5):
+        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+    # the same landing without the sideways aim: start 0 falls
+    land = replace(m.phases[3], params={**m.phases[3].params, "aim_sideways": False})
+    off = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
+    r = run_maneuver(off, perturbation=starts[0], fps=10.0).report
+    assert r["fell"] and not r["landed"]
