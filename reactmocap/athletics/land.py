@@ -104,6 +104,17 @@ class LandingParams:
             own roll not taken out: a back tuck from a perturbed start touched down with the
             pelvis rolled up to 16 degrees, the feet up to 7 cm to the side of the COM and
             6-8 cm apart fore-aft, and stood on one foot after the landing.
+        fall_gain: how much nearer (m) the feet go per m/s of horizontal speed and per metre
+            that the fall exceeds ``fall_ref`` (s/m); 0: off (the deltas hold for one drop
+            height only). The fall is predicted as the reach begins: the soles' clearance
+            plus the rise still to come, ``vz^2 / (2 g)`` if rising (the COM's apex less its
+            height over the soles, so a backpack's higher COM does not read as a longer
+            fall); it sets the touchdown's vertical speed. Why: a harder touchdown makes a
+            larger landing force, whose horizontal part along the leg takes the horizontal
+            speed off sooner, so the feet must land nearer the COM (the female at 2.5 m/s:
+            the window of deltas that land moved from -0.47 m to -0.52 and -0.57 m with the
+            COM 1.15, 1.25, 1.35 m up).
+        fall_ref: the fall (m) the deltas were measured at (``fall_gain``'s zero).
     """
 
     knee: float = 0.6
@@ -121,6 +132,8 @@ class LandingParams:
     pitch_ease: float = 0.0
     swing_cap: float = 0.9
     aim_sideways: bool = False
+    fall_gain: float = 0.0
+    fall_ref: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -136,6 +149,8 @@ class LandingParams:
             "lean",
             "knee_stiffness",
             "pitch_ease",
+            "fall_gain",
+            "fall_ref",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -186,7 +201,6 @@ class Landing(Basis):
         ankle_joints = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]
 
         def reach_enter(world: World, t: float) -> None:
-            del world
             rig.set_stiffness(per_joint(LANDING_STIFFNESS))
             rig.set_damping(per_joint({"knee": 0.1, "hip": 0.1, "ankle": 0.05}))
             rig.support[:] = 0.0
@@ -198,6 +212,13 @@ class Landing(Basis):
                 goal[joint_index(j)] = 0.0
             moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
             rig.move(goal, 0.2, t, moving)
+            memo["fall"] = p.fall_ref
+            if p.fall_gain:  # the fall predicted now, in the landing pose (see fall_gain)
+                sn = ctx.sense(t)
+                soles = (sn.sole_corners() - world.data.geom_xpos[sn.floor]) @ sn.floor_normal
+                up = max(float(sn.com_vel @ sn.floor_normal), 0.0)
+                g = float(np.linalg.norm(world.model.opt.gravity))
+                memo["fall"] = max(float(soles.min()), 0.0) + up * up / (2.0 * g)
 
         def reach(world: World, t: float) -> None:
             s = ctx.sense(t)
@@ -212,6 +233,7 @@ class Landing(Basis):
             g = float(np.linalg.norm(world.model.opt.gravity))
             lead = p.lead * math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
             want = np.array([lead * v[0] + p.delta_at(float(v[0])), lead * v[1]])
+            want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
             # eq. 6.1 as a correction on top of the geometric placement below
             x = s.local(feet - s.com, h)
             xd = s.local(fvel - s.com_vel, h)

@@ -28,6 +28,7 @@ __all__ = [
     "BROAD_TABLES",
     "LANDING_DELTAS",
     "LANDING_DELTAS_FAST",
+    "LANDING_FALL",
     "LANDING_LEADS",
     "LEAP_LANDING_TABLE",
     "LEAP_TABLES",
@@ -95,6 +96,14 @@ LANDING_DELTAS_FAST: Mapping[str, tuple[tuple[float, float], ...]] = MappingProx
 #: the landing's capture-point lead per body (tuned like the thesis's per-body deltas; a BVH
 #: body gets the landing's default)
 LANDING_LEADS: Mapping[str, float] = MappingProxyType({"male": 0.5, "female": 1.0})
+#: the drops' placement by the fall, per body: (fall_ref m, fall_gain s/m), see
+#: LandingParams.fall_gain; used by the ``land`` behaviour's drops only (leaps, broad jumps, the
+#: maneuver files' landings and the vault keep it off). fall_ref: the delta tables' drop, the
+#: sole clearance that puts the landing pose's COM 1.25 m up (thesis ch. 6), so those drops
+#: are placed as before; gains from the windows at 2.5 m/s from COM 1.15 / 1.35 m, 2026-12-02
+LANDING_FALL: Mapping[str, tuple[float, float]] = MappingProxyType(
+    {"male": (0.273, 0.12), "female": (0.393, 0.2)}
+)
 #: bodies whose landings after a leap (``after_leap``: the maneuver files' landings) use the
 #: drops' delta table (vertical leaps use VERTICAL_LANDING, broad jumps BROAD_LANDING where
 #: the body has one). Chosen when broad jumps still used it: the male's landed 3 of 6 with it
@@ -209,7 +218,9 @@ def landing_params(
     table = _with_fast_rows(tuple(LANDING_DELTAS.get(body, ())), LANDING_DELTAS_FAST.get(body, ()))
     if after_leap and body not in LEAP_LANDING_TABLE:
         table = ()
-    return LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
+    fall_ref, fall_gain = LANDING_FALL.get(body, (0.0, 0.0)) if not after_leap else (0.0, 0.0)
+    return LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table,
+                         fall_gain=fall_gain, fall_ref=fall_ref)  # fmt: skip
 
 
 def _with_fast_rows(

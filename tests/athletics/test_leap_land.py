@@ -212,3 +212,30 @@ def test_landing_deltas_are_validated_and_interpolated() -> None:
     assert LandingParams(delta=0.1).delta_at(3.0) == pytest.approx(0.1)
     with pytest.raises(ConfigError, match="deltas"):
         LandingParams(deltas=((0.0, float("nan")),))
+
+
+def test_the_female_lands_fast_from_a_higher_drop_by_its_fall(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Issue 18: the delta table was measured from COM 1.25 m up, and its windows (0.04 m wide)
+    belong to that fall: from COM 1.35 m up she fell at 2.5 m/s. The placement scaled by the
+    fall predicted in the air (``tables.LANDING_FALL``) puts her feet nearer after the longer fall."""
+    drop = _drop_for_com_height("female", 1.35)
+    r = run("land", "female", drop=drop, vx=2.5, check_range=False)
+    assert r.report["landed"] and not r.report["fell"]
+    assert abs(r.log["offset"][-1]) < 0.05
+    monkeypatch.setattr(tables, "LANDING_FALL", {})
+    r0 = run("land", "female", drop=drop, vx=2.5, check_range=False)
+    assert r0.report["fell"] and not r0.report["landed"]
+
+
+def test_the_fall_placement_is_for_drops_only() -> None:
+    lp = tables.landing_params("female", 2.5)
+    assert lp.fall_gain > 0 and lp.fall_ref == pytest.approx(
+        _drop_for_com_height("female", 1.25), abs=1e-3
+    )
+    for kw in ({"after_leap": True}, {"vertical": True}, {"broad": True}):
+        assert tables.landing_params("female", 1.0, **kw).fall_gain == 0.0  # type: ignore[arg-type]
+    assert LandingParams().fall_gain == 0.0
+    with pytest.raises(ConfigError, match="fall_gain"):
+        LandingParams(fall_gain=float("inf"))
