@@ -348,11 +348,13 @@ def _vault_score(rep: dict, landing: bool) -> float:
 
 
 def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | None = None,
-               out: Path | None = None) -> None:  # fmt: skip
+               out: Path | None = None, sample: int = 0) -> None:  # fmt: skip
     """The vault's random search: ``keys`` "all" (every value, scored on Table 1 and the
     landing) or "pre" (:data:`_VAULT_PRE_SPACE`, from the defaults, several values at once;
     with ``seconds`` short of the landing, scored on Table 1 and clearing the horse only).
-    Each new best is printed and, with ``out``, written there as JSON."""
+    With ``sample``, first that many points of a Latin hypercube over the whole box (scipy's
+    ``qmc``), the search then starting from the best of them and the defaults. Each run and
+    each new best is printed and, with ``out``, the best written there as JSON."""
     from reactmocap.athletics.vault import VaultParams, vault
 
     space = {
@@ -396,6 +398,14 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
     rng = np.random.default_rng(seed)
     base = VaultParams()
     best = {k: float(getattr(base, k)) for k in space}
+    if sample:
+        from scipy.stats import qmc
+
+        lo, hi = (np.array([space[k][i] for k in space]) for i in (0, 1))
+        pts = qmc.scale(qmc.LatinHypercube(d=len(space), seed=seed).random(sample), lo, hi)
+        scored = [(score(best), best)]
+        scored += [(score(x), x) for x in (dict(zip(space, map(float, p))) for p in pts)]
+        best = min(scored, key=lambda jx: jx[0])[1]
     best = _random_search(score, space, best, iterations, rng, tries=4,
                           changed=(1, 5) if keys == "all" else (2, 7), sigma_max=3.0)  # fmt: skip
     print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
@@ -423,6 +433,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--vault-seconds", type=float,
                     help="--tune-vault: seconds per run (short of the landing: Table 1 only)")  # fmt: skip
     ap.add_argument("--tune-out", type=Path, help="--tune-vault: the best so far (JSON)")
+    ap.add_argument("--vault-sample", type=int, default=0,
+                    help="--tune-vault: Latin-hypercube points over the box before the search")  # fmt: skip
     ap.add_argument("--iterations", type=int, default=30)
     ap.add_argument("--cloth-repeats", type=int, default=3,
                     help="alternating runs with and without cloth per garment")  # fmt: skip
@@ -433,7 +445,14 @@ def main(argv: list[str] | None = None) -> int:
         tune_speed(args.tune_speed, args.iterations, 6.0, args.seed)
         return 0
     if args.tune_vault:
-        tune_vault(args.iterations, args.seed, args.vault_keys, args.vault_seconds, args.tune_out)
+        tune_vault(
+            args.iterations,
+            args.seed,
+            args.vault_keys,
+            args.vault_seconds,
+            args.tune_out,
+            args.vault_sample,
+        )
         return 0
     every = args.all
     if every or args.speeds:

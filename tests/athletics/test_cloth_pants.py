@@ -67,7 +67,9 @@ def test_cloth_vertices_are_moved_out_of_the_body() -> None:
     from reactmocap.athletics.scene import athletics_world
 
     world = athletics_world(athlete("male"))
-    cloth = Cloth(world, "pants")
+    spec = ClothSpec()
+    spec.project = 2  # the projection is off by default
+    cloth = Cloth(world, spec)
     assert cloth.control_every * world.timestep == pytest.approx(cloth.spec.timestep)
     cloth.reset(world)
     m, d = cloth.model, cloth.data
@@ -176,6 +178,7 @@ def test_a_moved_vertex_stops_moving_into_the_limb() -> None:
     world = athletics_world(athlete("male"))
     spec = ClothSpec()
     spec.tether = 0.0
+    spec.project = 2
     cloth = Cloth(world, spec)
     cloth.reset(world)
     m, d = cloth.model, cloth.data
