@@ -47,9 +47,9 @@ class ClothSpec:
             if not (math.isfinite(v) and v > 0):
                 raise ConfigError(f"cloth {name} must be > 0, got {v!r}")
         self.rings, self.around, self.slack, self.mass = rings, around, slack, mass
-        #: the cloth model's solver: PGS, 3 iterations (CG with 15 left the edges stretched
-        #: ~40% across a bent knee, and its triangles cut into the thigh: at 3 m/s 9% of the
-        #: frames over 1 cm; PGS at 3 iterations costs about the same and holds them)
+        #: the cloth model's solver: PGS, 3 iterations (with CG at 15 the triangles near the
+        #: knee cut into the thigh at 3 m/s, 9% of the frames over 1 cm; PGS costs about the
+        #: same and holds them out: docs/athletics.md)
         self.solver = "PGS"
         self.iterations = 3
         #: the cloth-body contacts' time constant (s): under MuJoCo's safe minimum of two
