@@ -348,13 +348,14 @@ def _vault_score(rep: dict, landing: bool) -> float:
 
 
 def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | None = None,
-               out: Path | None = None, sample: int = 0) -> None:  # fmt: skip
+               out: Path | None = None, sample: int = 0, start: Path | None = None) -> None:  # fmt: skip
     """The vault's random search: ``keys`` "all" (every value, scored on Table 1 and the
     landing) or "pre" (:data:`_VAULT_PRE_SPACE`, from the defaults, several values at once;
     with ``seconds`` short of the landing, scored on Table 1 and clearing the horse only).
     With ``sample``, first that many points of a Latin hypercube over the whole box (scipy's
     ``qmc``), the search then starting from the best of them and the defaults. Each run and
-    each new best is printed and, with ``out``, the best written there as JSON."""
+    each new best is printed and, with ``out``, the best written there as JSON; ``start``
+    (such a file) starts the search from its values instead of the defaults."""
     from reactmocap.athletics.vault import VaultParams, vault
 
     space = {
@@ -398,6 +399,8 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
     rng = np.random.default_rng(seed)
     base = VaultParams()
     best = {k: float(getattr(base, k)) for k in space}
+    if start is not None:
+        best.update({k: float(v) for k, v in json.loads(start.read_text())["params"].items()})
     if sample:
         from scipy.stats import qmc
 
@@ -433,6 +436,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--vault-seconds", type=float,
                     help="--tune-vault: seconds per run (short of the landing: Table 1 only)")  # fmt: skip
     ap.add_argument("--tune-out", type=Path, help="--tune-vault: the best so far (JSON)")
+    ap.add_argument("--tune-from", type=Path, help="--tune-vault: start from a --tune-out file")
     ap.add_argument("--vault-sample", type=int, default=0,
                     help="--tune-vault: Latin-hypercube points over the box before the search")  # fmt: skip
     ap.add_argument("--iterations", type=int, default=30)
@@ -452,6 +456,7 @@ def main(argv: list[str] | None = None) -> int:
             args.vault_seconds,
             args.tune_out,
             args.vault_sample,
+            args.tune_from,
         )
         return 0
     every = args.all
