@@ -17,7 +17,7 @@ Sections:
 * ``--vault-sensitivity``: the vault with each second-flight and landing value 2% lower and
   2% higher (20 runs): how many land.
 * ``--cloth``: the same run with and without trousers: penetration and the slow-down ratio
-  (goal: <= 1 cm, <= 1.5x).
+  (goal: <= 1 cm, <= 1.5x); the trousers' penetration at 3 and 4 m/s too.
 * ``--tune-speed S`` and ``--tune-vault``: the searches that found the defaults (a (1+3)
   evolution strategy; slow: an hour or more on two cores).
 """
@@ -188,7 +188,8 @@ def vault_sensitivity(step: float = 0.02) -> None:
     print(f"\nlanded in {landed} of {2 * len(VAULT_LANDING_KEYS)} runs\n")
 
 
-def cloth(seconds: float, speed: float, repeats: int = 3) -> None:
+def cloth(seconds: float, speed: float, repeats: int = 3,
+          other_speeds: tuple[float, ...] = (3.0, 4.0)) -> None:  # fmt: skip
     print(f"## Cloth ({seconds:g} s at {speed:g} m/s, the same run with and without; wall "
           f"and CPU times the median of {repeats} alternating runs)\n")  # fmt: skip
     # "in-run": a dressed run's CPU time over the same less the cloth's own (``cloth_cpu_s``),
@@ -221,6 +222,17 @@ def cloth(seconds: float, speed: float, repeats: int = 3) -> None:
               f"{np.median(cpu):.2f}x | {np.median(inrun):.2f}x ({min(inrun):.2f}-"
               f"{max(inrun):.2f}) | {_fmt(same)} |", flush=True)  # fmt: skip
     print(f"\nbare run: median {np.median(bare_walls):.1f} s wall for {seconds:g} s\n")
+    # the penetration at the issue's other speeds (one dressed run each)
+    print("| pants at (m/s) | contact depth max (cm) | drawn surface max (cm) | p95 (cm) | "
+          "frames > 1 cm | fell |")  # fmt: skip
+    print("|---|---|---|---|---|---|")
+    for v in other_speeds:
+        r = run_course(v, seconds=seconds, cloth="pants", fps=30.0).report
+        print(f"| {v:g} | {100 * r['cloth_contact_depth_max_m']:.2f} | "
+              f"{100 * r['cloth_surface_depth_max_m']:.2f} | "
+              f"{100 * r['cloth_surface_depth_p95_m']:.2f} | "
+              f"{100 * r['cloth_frames_over_1cm']:.1f}% | {_fmt(r['fell'])} |", flush=True)  # fmt: skip
+    print()
 
 
 # ------------------------------------------------------------------------------ the searches
@@ -294,8 +306,57 @@ def _random_search(score: Callable[[dict[str, float]], float],
     return best
 
 
-def tune_vault(iterations: int, seed: int) -> None:
-    from reactmocap.athletics.vault import TABLE1, VaultParams, vault
+#: the vault's values before the horse's lift-off (``--tune-vault --vault-keys pre``): the
+#: approach, the hurdle's pose, the board, the push, the first flight, the hands' aim and the
+#: shoulders on the horse and just after (the second flight's arm drive makes most of the
+#: horse contact: docs/athletics.md)
+_VAULT_PRE_SPACE = {
+    "approach_vx": (6.2, 7.2, 0.08), "approach_vz": (-1.5, -0.75, 0.06),
+    "approach_spin": (-1.0, 3.0, 0.3), "start_pitch": (-0.4, 0.2, 0.04),
+    "start_x": (-0.7, 0.0, 0.04), "block": (-0.9, 0.1, 0.05),
+    "knee_touchdown": (0.0, 0.8, 0.04), "knee_stiffness": (4.0, 16.0, 0.8),
+    "push_stiffness": (8.0, 32.0, 1.2), "push_hip": (-0.6, 0.3, 0.05),
+    "arms_push": (-3.1, -1.6, 0.1), "arms_board": (-3.1, -1.6, 0.1),
+    "board_stiffness": (32000, 60000, 2000), "board_damping": (150, 600, 30),
+    "horse_distance": (1.3, 2.0, 0.04), "hand_target": (-0.15, 0.15, 0.02),
+    "pike": (-0.3, 0.5, 0.05), "flight_stiffness": (1.0, 8.0, 0.4),
+    "horse_push": (0.0, 1.5, 0.1), "arms_flight2": (-3.1, -1.6, 0.1),
+}  # fmt: skip
+
+
+def _vault_score(rep: dict, landing: bool) -> float:
+    """Table 1 (each row outside the human range 1 + how far out in spans, each row's
+    distance from the mean a little), clearing the horse and, with ``landing``, how long she
+    stayed up after touchdown and whether she landed."""
+    from reactmocap.athletics.vault import TABLE1
+
+    j = 0.0
+    for row in TABLE1:
+        v = rep["table1"][row.key]
+        if v is None:
+            j += 3.0
+            continue
+        span = row.high - row.low
+        out = max(row.low - v, v - row.high, 0.0) / span
+        j += (1.0 if out > 0 else 0.0) + 2.0 * out + 0.3 * abs(v - row.mean) / span
+    j += 3.0 * (not rep["cleared"])
+    if landing:
+        # the landing: how long she stayed up after touchdown (to the run's end: landed)
+        up = min(rep["up_after_touchdown_s"], 3.0) / 3.0
+        j += 6.0 * (1.0 - up) + 2.0 * (not rep["landed"])
+    return j
+
+
+def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | None = None,
+               out: Path | None = None, sample: int = 0, start: Path | None = None) -> None:  # fmt: skip
+    """The vault's random search: ``keys`` "all" (every value, scored on Table 1 and the
+    landing) or "pre" (:data:`_VAULT_PRE_SPACE`, from the defaults, several values at once;
+    with ``seconds`` short of the landing, scored on Table 1 and clearing the horse only).
+    With ``sample``, first that many points of a Latin hypercube over the whole box (scipy's
+    ``qmc``), the search then starting from the best of them and the defaults. Each run and
+    each new best is printed and, with ``out``, the best written there as JSON; ``start``
+    (such a file) starts the search from its values instead of the defaults."""
+    from reactmocap.athletics.vault import VaultParams, vault
 
     space = {
         "board_stiffness": (15000, 120000, 8000), "board_damping": (0, 1500, 100),
@@ -311,27 +372,45 @@ def tune_vault(iterations: int, seed: int) -> None:
         "land_restore": (0.0, 0.5, 0.04), "land_lean": (0.0, 1.2, 0.1),
         "mat_solref": (0.01, 0.08, 0.006), "stand_leg": (0.7, 1.0, 0.03),
         "stand_settle": (0.2, 1.5, 0.1),
-    }  # fmt: skip
+    } if keys == "all" else _VAULT_PRE_SPACE  # fmt: skip
+    landing = seconds is None
+    best_j = math.inf
 
     def score(x: dict[str, float]) -> float:
-        rep = vault(params=dataclasses.replace(VaultParams(), **x)).report
-        j = 0.0
-        for row in TABLE1:
-            v = rep["table1"][row.key]
-            if v is None:
-                j += 3.0
-                continue
-            span = row.high - row.low
-            j += 2.0 * max(row.low - v, v - row.high, 0.0) / span + 0.3 * abs(v - row.mean) / span
-        # the landing: how long she stayed up after touchdown (to the run's end: landed)
-        up = min(rep["up_after_touchdown_s"], 3.0) / 3.0
-        return j + 3.0 * (not rep["cleared"]) + 6.0 * (1.0 - up) + 2.0 * (not rep["landed"])
+        nonlocal best_j
+        rep = vault(params=dataclasses.replace(VaultParams(), **x), seconds=seconds).report
+        j = _vault_score(rep, landing)
+        t1 = rep["table1"]
+        print(f"  run: {j:.3f}, {rep['table1_inside']}/16 inside, horse contact "
+              f"{t1['horse_contact_s'] or 0:.3f} s, board lift-off vz {t1['board_liftoff_vz_m_s'] or 0:.2f}"
+              f" m/s, cleared {rep['cleared']}", flush=True)  # fmt: skip
+        if j < best_j:
+            best_j = j
+            print(f"  best {j:.3f}: {rep['table1_inside']}/16 inside, outside "
+                  f"{rep['table1_outside']}, cleared {rep['cleared']}, landed {rep['landed']}",
+                  flush=True)  # fmt: skip
+            if out is not None:
+                tmp = out.with_suffix(".tmp")
+                tmp.write_text(json.dumps({"score": j, "params": x, "report": rep}, indent=1,
+                                          default=str))  # fmt: skip
+                tmp.replace(out)
+        return j
 
     rng = np.random.default_rng(seed)
     base = VaultParams()
     best = {k: float(getattr(base, k)) for k in space}
-    best = _random_search(score, space, best, iterations, rng, tries=4, changed=(1, 5),
-                          sigma_max=3.0)  # fmt: skip
+    if start is not None:
+        best.update({k: float(v) for k, v in json.loads(start.read_text())["params"].items()})
+    if sample:
+        from scipy.stats import qmc
+
+        lo, hi = (np.array([space[k][i] for k in space]) for i in (0, 1))
+        pts = qmc.scale(qmc.LatinHypercube(d=len(space), seed=seed).random(sample), lo, hi)
+        scored = [(score(best), best)]
+        scored += [(score(x), x) for x in (dict(zip(space, map(float, p))) for p in pts)]
+        best = min(scored, key=lambda jx: jx[0])[1]
+    best = _random_search(score, space, best, iterations, rng, tries=4,
+                          changed=(1, 5) if keys == "all" else (2, 7), sigma_max=3.0)  # fmt: skip
     print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
 
 
@@ -352,6 +431,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--figures", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--tune-speed", type=float, help="search the runner's values at a speed")
     ap.add_argument("--tune-vault", action="store_true", help="search the vault's values")
+    ap.add_argument("--vault-keys", choices=("all", "pre"), default="all",
+                    help="--tune-vault: every value, or those before the horse's lift-off")  # fmt: skip
+    ap.add_argument("--vault-seconds", type=float,
+                    help="--tune-vault: seconds per run (short of the landing: Table 1 only)")  # fmt: skip
+    ap.add_argument("--tune-out", type=Path, help="--tune-vault: the best so far (JSON)")
+    ap.add_argument("--tune-from", type=Path, help="--tune-vault: start from a --tune-out file")
+    ap.add_argument("--vault-sample", type=int, default=0,
+                    help="--tune-vault: Latin-hypercube points over the box before the search")  # fmt: skip
     ap.add_argument("--iterations", type=int, default=30)
     ap.add_argument("--cloth-repeats", type=int, default=3,
                     help="alternating runs with and without cloth per garment")  # fmt: skip
@@ -362,7 +449,15 @@ def main(argv: list[str] | None = None) -> int:
         tune_speed(args.tune_speed, args.iterations, 6.0, args.seed)
         return 0
     if args.tune_vault:
-        tune_vault(args.iterations, args.seed)
+        tune_vault(
+            args.iterations,
+            args.seed,
+            args.vault_keys,
+            args.vault_seconds,
+            args.tune_out,
+            args.vault_sample,
+            args.tune_from,
+        )
         return 0
     every = args.all
     if every or args.speeds:

@@ -61,6 +61,8 @@ class VaultParams:
         start_clearance: height of the soles over the board at the start (m).
         start_x: the COM's position along the run at the start, from the board's centre (m).
         block: hip flexion at board touchdown (rad; the feet ahead: "blocking").
+        start_pitch: the body's pitch at the start (rad, < 0 leaning back: the board
+            touchdown's lean).
         knee_touchdown: knee flexion at board touchdown (rad).
         knee_stiffness: knee and hip stiffness on the board (units of m g L).
         push_stiffness: stiffness of the extension at the board's deepest (units of m g L).
@@ -109,6 +111,7 @@ class VaultParams:
     start_clearance: float = 0.02
     start_x: float = -0.3523
     block: float = -0.6745
+    start_pitch: float = -0.1
     knee_touchdown: float = 0.2449
     knee_stiffness: float = 12.0
     push_stiffness: float = 20.0
@@ -258,7 +261,7 @@ def vault_start(ath: Athlete, p: VaultParams) -> tuple[F64, F64]:
         angles[_J[f"{s}_knee"]] = (p.knee_touchdown, 0.0, 0.0)
         angles[_J[f"{s}_ankle"]] = (-0.2, 0.0, 0.0)
         angles[_J[f"{s}_shoulder"]] = (p.arms_board, 0.0, 0.0)
-    q = ath.standing_qpos(angles, pitch=-0.1, clearance=p.start_clearance + BOARD.top)
+    q = ath.standing_qpos(angles, pitch=p.start_pitch, clearance=p.start_clearance + BOARD.top)
     com = ath.com_of(q)
     q[0] += p.start_x - com[0]
     v = np.zeros(6 + 3 * NJ)

@@ -46,6 +46,17 @@ def test_cloth_does_not_act_on_the_runner(dressed) -> None:  # type: ignore[no-u
     assert np.array_equal(bare.rollout.qpos, dressed.rollout.qpos)
 
 
+def test_the_drawn_cloth_stays_out_of_the_legs_at_3_m_s() -> None:
+    """At 3 m/s (the knees bend most) the drawn cloth's 95th-percentile depth inside the body
+    over the first 1.2 s is under 1 cm, and at most 1 frame in 20 has a point over 1 cm in
+    (2026-12-02: 0.64 cm and 1 frame of 30; with the old CG solver at 15 iterations 1.14 cm
+    and 3 of 30)."""
+    rep = run_course(3.0, seconds=SECONDS, cloth="pants", fps=30.0).report
+    assert rep["status"] == "ok" and rep["cloth_finite"] is True
+    assert 0 < rep["cloth_surface_depth_p95_m"] < 0.01
+    assert rep["cloth_frames_over_1cm"] <= 0.05
+
+
 def test_cloth_options_are_checked() -> None:
     from reactmocap.athletics.bodies import athlete
     from reactmocap.athletics.scene import athletics_world
@@ -67,7 +78,9 @@ def test_cloth_vertices_are_moved_out_of_the_body() -> None:
     from reactmocap.athletics.scene import athletics_world
 
     world = athletics_world(athlete("male"))
-    cloth = Cloth(world, "pants")
+    spec = ClothSpec()
+    spec.project = 2  # the projection is off by default
+    cloth = Cloth(world, spec)
     assert cloth.control_every * world.timestep == pytest.approx(cloth.spec.timestep)
     cloth.reset(world)
     m, d = cloth.model, cloth.data
@@ -99,28 +112,35 @@ def test_cloth_vertices_are_moved_out_of_the_body() -> None:
     off = after[v] - centre
     off -= axis * float(off @ axis)
     assert np.linalg.norm(off) == pytest.approx(radius + cloth.spec.thickness, abs=1e-6)
-    # the trousers are made with slack around the legs: the other vertices stay put, but
-    # for the four the start pose puts inside the forearms and hands (at the hips)
+    # the trousers are made with slack around the legs: the other vertices stay put (the
+    # four the start pose puts inside the forearms and hands, at the hips, too: by default
+    # the arms are only measured against the cloth, not collided with it)
     moved = np.flatnonzero(np.abs(d.qpos[cloth._vq] - others).max(axis=1) > 1e-9)
-    assert v in moved and len(moved) == 5
+    assert list(moved) == [v]
 
 
-def test_a_limb_across_a_triangle_touches_it() -> None:
+@pytest.mark.parametrize("collide_arms", [True, False])
+def test_a_limb_across_a_triangle_touches_it(collide_arms: bool) -> None:
     """A limb through the middle of a cloth triangle whose corners are all outside it makes a
     contact with that triangle (MuJoCo's capsule-triangle test alone misses it; the cloth
-    model's cylinder twins of the capsules find it)."""
+    model's cylinder twins of the capsules find it). The limb is a hand: without
+    ``collide_arms`` (the default) it makes no contact but the drawn surface's depth still
+    measures it."""
     from reactmocap.athletics.bodies import athlete
     from reactmocap.athletics.scene import athletics_world
     from reactmocap.sim.bodies import SIM_BODIES
 
     world = athletics_world(athlete("male"))
-    cloth = Cloth(world, "pants")
+    spec = ClothSpec()
+    spec.collide_arms = collide_arms
+    cloth = Cloth(world, spec)
     cloth.reset(world)
     m, d = cloth.model, cloth.data
     part = SIM_BODIES.index("r_hand")
     geoms = np.flatnonzero(cloth._geom_part == part)
     cap = int(geoms[m.geom_type[geoms] == mujoco.mjtGeom.mjGEOM_CAPSULE][0])
-    flex = int(np.flatnonzero(m.flex_conaffinity & m.geom_contype[cap])[0])
+    flex = 1  # the right trouser leg
+    assert bool(m.flex_conaffinity[flex] & m.geom_contype[cap]) == collide_arms
     # the right trouser leg's triangle whose corners are farthest from its centroid
     adr, num = m.flex_elemdataadr[flex], m.flex_elemnum[flex]
     tris = m.flex_elem[adr : adr + 3 * num].reshape(-1, 3) + m.flex_vertadr[flex]
@@ -150,6 +170,10 @@ def test_a_limb_across_a_triangle_touches_it() -> None:
     assert np.allclose(d.geom_xpos[cap], centroid[e])
     con = d.contact
     mine = np.isin(con.geom, geoms).any(axis=1) & (con.flex == flex).any(axis=1)
+    assert cloth._surface_depth() > 0.02
+    if not collide_arms:
+        assert not mine.any()
+        return
     assert (con.elem[mine] == e).any()
     assert con.dist[mine].min() < -0.02
 
@@ -165,6 +189,7 @@ def test_a_moved_vertex_stops_moving_into_the_limb() -> None:
     world = athletics_world(athlete("male"))
     spec = ClothSpec()
     spec.tether = 0.0
+    spec.project = 2
     cloth = Cloth(world, spec)
     cloth.reset(world)
     m, d = cloth.model, cloth.data
@@ -225,8 +250,9 @@ def test_a_vertex_is_kept_near_where_it_was_made_on_the_leg() -> None:
     assert np.linalg.norm(after[v] - made[v]) == pytest.approx(cloth.spec.tether, abs=1e-9)
     others = np.arange(len(made)) != v
     moved = np.linalg.norm(after[others] - made[others], axis=1) > 1e-9
-    # the start pose puts four vertices inside the forearms and hands (at the hips)
-    assert moved.sum() == 4
+    # (the four the start pose puts inside the forearms and hands, at the hips, too: the
+    # arms are only measured against the cloth by default)
+    assert moved.sum() == 0
 
 
 def test_the_waistband_moves_with_the_pelvis() -> None:
