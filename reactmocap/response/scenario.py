@@ -138,10 +138,10 @@ class ResponseConfig:
     #: and the continuation whose final blend corrects least (over those thresholds) wins
     land_tries: int = 1
     #: blend mode: Simulation 2 tracks the found clip up to this many seconds past the match,
-    #: and the final blend lands where the body came closest to it (the landing check's score
-    #: over ``land_position``, ``land_angle``, ``land_joint``; stopping once within them): the
-    #: blend then corrects the smallest tracking gap in that span, not the gap at the match
-    #: (0: at the match, the paper)
+    #: and the final blend lands on the frame where it corrects least (``final.settle``: its
+    #: largest joint turn and pelvis shift, each over its warning threshold), not at the match
+    #: (0: at the match, the paper). Off by default, like ``land_tries``: on the examples
+    #: both together cost 1.3-2.1x the pre-issue-15 time (``docs/benchmarks.md``)
     blend_settle: float = 0.0
 
 
