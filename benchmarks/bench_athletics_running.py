@@ -28,6 +28,7 @@ import argparse
 import dataclasses
 import json
 import math
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -221,7 +222,10 @@ def cloth(seconds: float, speed: float, repeats: int = 3,
               f"{100 * r['cloth_frames_over_1cm']:.0f}% | {np.median(ratios):.2f}x | "
               f"{np.median(cpu):.2f}x | {np.median(inrun):.2f}x ({min(inrun):.2f}-"
               f"{max(inrun):.2f}) | {_fmt(same)} |", flush=True)  # fmt: skip
-    print(f"\nbare run: median {np.median(bare_walls):.1f} s wall for {seconds:g} s\n")
+    # the machine's load (other jobs move the ratios: say what it was)
+    load = " / ".join(f"{x:.2f}" for x in os.getloadavg())
+    print(f"\nbare run: median {np.median(bare_walls):.1f} s wall for {seconds:g} s; load average "
+          f"(1/5/15 min) at the end: {load}\n")  # fmt: skip
     # the penetration at the other speeds (one dressed run each)
     print("| pants at (m/s) | contact depth max (cm) | drawn surface max (cm) | p95 (cm) | "
           "frames > 1 cm | fell |")  # fmt: skip
