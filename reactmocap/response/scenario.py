@@ -140,9 +140,9 @@ class ResponseConfig:
     #: blend mode: Simulation 2 tracks the found clip up to this many seconds past the match,
     #: and the final blend lands on the frame where it corrects least (``final.settle``: its
     #: largest joint turn and pelvis shift, each over its warning threshold), not at the match
-    #: (0: at the match, the paper). Off by default, like ``land_tries``: on the examples
-    #: both together cost 1.3-2.1x the pre-issue-15 time (``docs/benchmarks.md``)
-    blend_settle: float = 0.0
+    #: (0: at the match, the paper). Only where the final blend at the match would warn (joint
+    #: turn or root shift over the thresholds): Simulation 2 then runs again, this much longer
+    blend_settle: float = 0.5
 
 
 @dataclass(frozen=True)

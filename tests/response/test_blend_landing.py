@@ -36,20 +36,33 @@ def _score(report: dict) -> float:
 
 
 def test_the_blend_mode_settles_where_the_final_blend_corrects_least() -> None:
-    # the front kick's body still lags the found sway clip at the match (0.43 rad); it is
-    # closer to it a little later, and the blend lands there
-    at_match = run_response(_blend("front_kick"), CACHE).report
-    settled = run_response(_blend("front_kick", blend_settle=0.5), CACHE).report
+    # the heavy push's blend at the match turns a joint 0.67 rad (over the warning threshold);
+    # Simulation 2 runs on, and the blend lands later, where it corrects less
+    at_match = run_response(_blend("heavy_push_fall", blend_settle=0.0), CACHE).report
+    settled = run_response(_blend("heavy_push_fall", blend_settle=0.5), CACHE).report
     tr = settled["transition"]
     assert tr["match"] == at_match["transition"]["match"]  # the same search, the same match
     assert at_match["transition"]["end"] == at_match["transition"]["match"]  # the paper
+    assert _score(at_match) > 1.0, at_match["quality"]  # the case: the match's blend warns
     assert tr["match"] < tr["end"] <= tr["match"] + 0.5 + 1e-9
     assert _score(settled) < _score(at_match) - 0.05, (settled["quality"], at_match["quality"])
     assert settled["quality"]["transition_s"] > at_match["quality"]["transition_s"]
     # a settle too short to reach the next candidate frame keeps the match
-    short = run_response(_blend("front_kick", blend_settle=0.01), CACHE).report
+    short = run_response(_blend("heavy_push_fall", blend_settle=0.01), CACHE).report
     assert short["transition"]["end"] == short["transition"]["match"]
     assert _score(short) == _score(at_match)
+
+
+def test_the_blend_mode_lands_at_the_match_when_its_blend_would_not_warn() -> None:
+    # the front kick's blend at the match turns 0.43 rad, within the threshold: no later
+    # landing is searched, and Simulation 2 stops where it does without blend_settle
+    at_match = run_response(_blend("front_kick", blend_settle=0.0), CACHE)
+    lazy = run_response(_blend("front_kick", blend_settle=0.5), CACHE)
+    assert _score(at_match.report) <= 1.0, at_match.report["quality"]
+    tr = lazy.report["transition"]
+    assert tr["end"] == tr["match"] == at_match.report["transition"]["end"]
+    assert lazy.sim2.num_frames == at_match.sim2.num_frames
+    assert _score(lazy.report) == _score(at_match.report)
 
 
 def test_the_blend_mode_tries_other_clips_when_its_final_blend_would_warn(
