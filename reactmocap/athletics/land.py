@@ -244,7 +244,8 @@ class Landing(Basis):
             goal = np.full((NJ, 3), np.nan)
             thighs = np.zeros((2, 3))  # aim_sideways: each thigh's pitch and roll in the world
             hips = d.xanchor[hip_joints]
-            middle = s.local(s.com - hips.mean(axis=0), h)
+            if p.aim_sideways:
+                middle = s.local(s.com - hips.mean(axis=0), h)
             for k in range(2):
                 hip = hips[k]
                 length = float(np.linalg.norm(hip - d.xanchor[ankle_joints[k]]))
@@ -255,8 +256,9 @@ class Landing(Basis):
                 geom = float(knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k],
                                              length)[1])  # fmt: skip
                 goal[_HIP[k]] = (-swing + geom - servo[0] - pelvis, servo[1], 0.0)
-                side = float(np.clip((middle[1] + want[1]) / max(length, 0.2), -0.5, 0.5))
-                thighs[k] = (-swing + geom - servo[0], math.asin(side) + servo[1], 0.0)
+                if p.aim_sideways:
+                    side = float(np.clip((middle[1] + want[1]) / max(length, 0.2), -0.5, 0.5))
+                    thighs[k] = (-swing + geom - servo[0], math.asin(side) + servo[1], 0.0)
             if p.aim_sideways:  # the roll from the pelvis's whole orientation; pitch as above
                 goal[_HIP, 1] = _hips_for_thighs(ctx, d, thighs, h)[:, 1]
             rig.move(goal, 0.0, t, _HIP)

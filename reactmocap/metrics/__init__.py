@@ -18,6 +18,7 @@ __all__ = [
     "WARN_JOINT_CORRECTION_RAD",
     "WARN_OVERLAP_M",
     "WARN_ROOT_OFFSET_M",
+    "blend_correction_over_warning",
     "blend_joint_correction_max_rad",
     "direction_error_deg",
     "blend_root_offset_max_m",
@@ -172,3 +173,10 @@ WARN_OVERLAP_M = 0.02
 WARN_ROOT_OFFSET_M = 0.3
 WARN_JOINT_CORRECTION_RAD = 0.6
 WARN_ATTACKER_SPEED_RATIO = 1.5
+
+
+def blend_correction_over_warning(simulated: Motion, blended: Motion, parts: BodyPartMap) -> float:
+    """The final blend's largest joint turn and root offset, each over its warning threshold,
+    the larger of the two (<= 1: the blend warns of neither)."""
+    return max(blend_joint_correction_max_rad(simulated, blended) / WARN_JOINT_CORRECTION_RAD,
+               blend_root_offset_max_m(simulated, blended, parts) / WARN_ROOT_OFFSET_M)  # fmt: skip

@@ -10,13 +10,7 @@ from numpy.typing import NDArray
 
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import ground_root
-from reactmocap.metrics import (
-    WARN_JOINT_CORRECTION_RAD,
-    WARN_ROOT_OFFSET_M,
-    blend_joint_correction_max_rad,
-    blend_root_offset_max_m,
-    joint_speed_max_m_s,
-)
+from reactmocap.metrics import blend_correction_over_warning, joint_speed_max_m_s
 from reactmocap.response.blend import blend_poses, final_blend
 from reactmocap.response.footlock import lock_feet
 from reactmocap.response.scenario import ResponseConfig, Scenario
@@ -137,6 +131,8 @@ def _step_aside(cast: Cast, recipient: Motion, attacker: Motion, impact: float,
     pelvis = cast.recipient.parts.joint_of("pelvis")
     apelvis = cast.attacker.parts.joint_of("pelvis") if cast.attacker is not None else 0
     moved = attacker
+    v = 0.25 * speed
+    ahead = np.maximum(t[None, :] - t[:, None], 0.0)  # [this frame i, frame j]: t_j - t_i, >= 0
     for _ in range(ASIDE_TRIES):
         depth = overlap_depths(cast.pair, [recipient, moved.sample(t).replace(fps=fps)])
         depth[t < impact] = 0.0  # before the hit the two are apart by construction
@@ -154,9 +150,7 @@ def _step_aside(cast: Cast, recipient: Motion, attacker: Motion, impact: float,
         need = np.where(bad, np.maximum(need, offset + depth + ASIDE_MARGIN_M), need)
         # the offset at each frame: the largest of every later need reached at the step-aside
         # speed, and of every earlier one (kept)
-        v = 0.25 * speed
-        ahead = t[None, :] - t[:, None]  # [this frame i, frame j]: t_j - t_i
-        reach = need[None, :] - v * np.maximum(ahead, 0.0)
+        reach = need[None, :] - v * ahead
         offset = np.maximum(reach.max(axis=1), 0.0)
         off_a = np.interp(ta, t, offset)
         off_a[ta < impact] = 0.0
@@ -280,8 +274,7 @@ def settle(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naiv
                                                             found.slice(0, end + 1))  # fmt: skip
         if cfg.foot_lock:
             out = lock_feet(out, rec.parts)
-        score = max(blend_joint_correction_max_rad(sim, out) / WARN_JOINT_CORRECTION_RAD,
-                    blend_root_offset_max_m(sim, out, rec.parts) / WARN_ROOT_OFFSET_M)  # fmt: skip
+        score = blend_correction_over_warning(sim, out, rec.parts)
         if score < best - 1e-9:
             best, landed = score, i_imp + end
     return replace(sim2, landed=landed / fps)

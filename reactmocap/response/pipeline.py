@@ -159,10 +159,7 @@ def _blend_score(cast: stages.Cast, out: final.Blend) -> tuple[bool, float]:
         rec = out.recipient
         att = out.attacker.sample(rec.times).replace(fps=rec.fps)
         overlap = bool(overlap_depths(cast.pair, [rec, att]).max() > qm.WARN_OVERLAP_M)
-    return overlap, max(qm.blend_joint_correction_max_rad(out.simulated, out.blended)
-                        / qm.WARN_JOINT_CORRECTION_RAD,
-                        qm.blend_root_offset_max_m(out.simulated, out.blended, parts)
-                        / qm.WARN_ROOT_OFFSET_M)  # fmt: skip
+    return overlap, qm.blend_correction_over_warning(out.simulated, out.blended, parts)
 
 
 def _report(
