@@ -4,8 +4,9 @@
 
 Every direction of the sweep runs in both modes in the same process, alternating, so the time
 ratio is measured under the same load. Per direction: whether the run finished, whether the
-body landed on the found clip within the tolerances, the final blend's root offset and largest
-joint correction, the impulse the recipient took, and the time per response. The targets
+body landed on the found clip within the tolerances, the final blend's root offset, largest
+joint correction (the skeleton's joints) and root turn, the impulse the recipient took, and the
+time per response. The targets
 (issue 16): 100% finish, median root offset <= 0.02 m, 95th-percentile joint correction
 <= 0.1 rad, median time <= 3x the blend's.
 """
@@ -59,6 +60,7 @@ def main() -> None:
             print(f"facing {deg:5.1f} {mode:8s} {rep['matched']['clip'][:14]:14s} "
                   f"landed {tr['landed_on_clip']!s:5s} root {q['blend_root_offset_max_m']:.3f} m "
                   f"joint {q['blend_joint_correction_max_rad']:.3f} rad "
+                  f"root turn {q['blend_root_turn_max_rad']:.3f} rad "
                   f"disp {q['reaction_displacement_m']:.2f} m "
                   f"imp {q['contact_impulse_Ns']:.0f} N s tr {q['transition_s']:.2f} s "
                   f"fell {q['fell']!s:5s} {wall:.2f} s")  # fmt: skip
@@ -69,10 +71,12 @@ def main() -> None:
             continue
         root = [r["blend_root_offset_max_m"] for r in done]
         joint = [r["blend_joint_correction_max_rad"] for r in done]
+        turn = [r["blend_root_turn_max_rad"] for r in done]
         print(f"{mode.upper()}: finished {len(done)}/{len(rs)}; landed on the clip "
               f"{sum(r['landed_on_clip'] for r in done)}/{len(rs)}; median root offset "
               f"{statistics.median(root):.3f} m; p95 joint correction "
-              f"{float(np.percentile(joint, 95)):.3f} rad; median time "
+              f"{float(np.percentile(joint, 95)):.3f} rad; p95 root turn "
+              f"{float(np.percentile(turn, 95)):.3f} rad; median time "
               f"{statistics.median(r['wall'] for r in done):.2f} s")  # fmt: skip
     pairs = [(b["wall"], p["wall"]) for b, p in zip(rows["blend"], rows["physical"], strict=True)
              if not b["failed"] and not p["failed"]]  # fmt: skip

@@ -214,6 +214,7 @@ def _summary(title: str, rows: list[dict | None]) -> None:
     over = max((r["quality"]["character_overlap_max_m"] for r in done), default=0.0)
     kinds = {
         "joint": "turns a joint",
+        "root turn": "turns the root",
         "root": "moves the root",
         "overlap": "overlap by",
         "speed": "attacker moves",

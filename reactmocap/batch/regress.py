@@ -72,6 +72,7 @@ DEFAULT_TOLERANCES: dict[str, Tolerance] = {
     "match_distance": Tolerance(0.01, 0.05),
     "blend_root_offset_max_m": Tolerance(0.005, 0.10),
     "blend_joint_correction_max_rad": Tolerance(0.02, 0.10),
+    "blend_root_turn_max_rad": Tolerance(0.02, 0.10),
     "stitch_velocity_jump_rad_s": Tolerance(0.25, 0.10),
     "foot_skate_m": Tolerance(0.01, 0.10),
     "penetration_max_m": Tolerance(0.005, 0.10),

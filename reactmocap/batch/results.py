@@ -42,6 +42,7 @@ QUALITY_METRICS = (
     "match_distance",
     "blend_root_offset_max_m",
     "blend_joint_correction_max_rad",
+    "blend_root_turn_max_rad",
     "stitch_velocity_jump_rad_s",
     "foot_skate_m",
     "penetration_max_m",

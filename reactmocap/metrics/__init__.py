@@ -18,10 +18,12 @@ __all__ = [
     "WARN_JOINT_CORRECTION_RAD",
     "WARN_OVERLAP_M",
     "WARN_ROOT_OFFSET_M",
+    "WARN_ROOT_TURN_RAD",
     "blend_correction_over_warning",
     "blend_joint_correction_max_rad",
     "direction_error_deg",
     "blend_root_offset_max_m",
+    "blend_root_turn_max_rad",
     "fell",
     "foot_skate_m",
     "intended_fall",
@@ -54,10 +56,23 @@ def blend_root_offset_max_m(simulated: Motion, blended: Motion, parts: BodyPartM
     return float(np.max(np.linalg.norm(d, axis=-1)))
 
 
-def blend_joint_correction_max_rad(simulated: Motion, blended: Motion) -> float:
-    """Largest local joint rotation (rad) the final blend applied, over frames and joints."""
+def _blend_turns(simulated: Motion, blended: Motion) -> NDArray[np.float64]:
+    """``(T, J)`` local rotation (rad) the final blend applied to each joint (joint 0: the
+    root's orientation in the world)."""
     rel = quat_mul(quat_conj(simulated.rotations), blended.rotations)
-    return float(np.max(np.linalg.norm(quat_log(rel), axis=-1)))
+    return np.linalg.norm(quat_log(rel), axis=-1)
+
+
+def blend_joint_correction_max_rad(simulated: Motion, blended: Motion) -> float:
+    """Largest local rotation (rad) the final blend applied to a joint of the skeleton, over
+    frames; the root's orientation is :func:`blend_root_turn_max_rad`."""
+    return float(np.max(_blend_turns(simulated, blended)[:, 1:], initial=0.0))
+
+
+def blend_root_turn_max_rad(simulated: Motion, blended: Motion) -> float:
+    """Largest turn (rad) of the root's world orientation the final blend applied, over
+    frames: with :func:`blend_root_offset_max_m`, how far the whole body was moved."""
+    return float(np.max(_blend_turns(simulated, blended)[:, 0]))
 
 
 def stitch_velocity_jump_rad_s(motion: Motion, seams: Sequence[int]) -> float:
@@ -172,11 +187,16 @@ def speed_ratio(output: Motion, source: Motion) -> float:
 WARN_OVERLAP_M = 0.02
 WARN_ROOT_OFFSET_M = 0.3
 WARN_JOINT_CORRECTION_RAD = 0.6
+#: the root's turn warns where a joint's does (before the two were separate fields, one number
+#: covered both)
+WARN_ROOT_TURN_RAD = WARN_JOINT_CORRECTION_RAD
 WARN_ATTACKER_SPEED_RATIO = 1.5
 
 
 def blend_correction_over_warning(simulated: Motion, blended: Motion, parts: BodyPartMap) -> float:
-    """The final blend's largest joint turn and root offset, each over its warning threshold,
-    the larger of the two (<= 1: the blend warns of neither)."""
-    return max(blend_joint_correction_max_rad(simulated, blended) / WARN_JOINT_CORRECTION_RAD,
+    """The final blend's largest joint turn, root turn and root offset, each over its warning
+    threshold, the largest of the three (<= 1: the blend warns of none)."""
+    turns = _blend_turns(simulated, blended)
+    return max(float(np.max(turns[:, 1:], initial=0.0)) / WARN_JOINT_CORRECTION_RAD,
+               float(np.max(turns[:, 0])) / WARN_ROOT_TURN_RAD,
                blend_root_offset_max_m(simulated, blended, parts) / WARN_ROOT_OFFSET_M)  # fmt: skip

@@ -192,6 +192,7 @@ def _report(
         "blend_joint_correction_max_rad": qm.blend_joint_correction_max_rad(
             out.simulated, out.blended
         ),
+        "blend_root_turn_max_rad": qm.blend_root_turn_max_rad(out.simulated, out.blended),
         "stitch_velocity_jump_rad_s": qm.stitch_velocity_jump_rad_s(out.recipient, out.seams),
         "foot_skate_m": qm.foot_skate_m(out.recipient, parts),
         "penetration_max_m": qm.penetration_max_m(out.recipient),
@@ -289,6 +290,9 @@ def _warnings(
     if q["blend_joint_correction_max_rad"] > qm.WARN_JOINT_CORRECTION_RAD:
         out.append(f"the final blend turns a joint by {q['blend_joint_correction_max_rad']:.2f} "
                    f"rad (more than {qm.WARN_JOINT_CORRECTION_RAD})")  # fmt: skip
+    if q["blend_root_turn_max_rad"] > qm.WARN_ROOT_TURN_RAD:
+        out.append(f"the final blend turns the root by {q['blend_root_turn_max_rad']:.2f} rad "
+                   f"(more than {qm.WARN_ROOT_TURN_RAD})")  # fmt: skip
     ratio = q["attacker_speed_ratio"]
     if ratio is not None and ratio > qm.WARN_ATTACKER_SPEED_RATIO:
         out.append(f"the attacker moves a joint {ratio:.2f}x faster than its clip ever does "

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from reactmocap import metrics
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_exp
+from reactmocap.rotations import quat_exp, quat_mul
 from tests.library.test_motion import NAMES, random_motion
 
 
@@ -57,3 +58,24 @@ def test_stitch_jump_and_blend_corrections() -> None:
     assert metrics.blend_joint_correction_max_rad(m, m) < 1e-7
     shifted = m.transformed(0.0, (0.2, 0.0))
     assert abs(metrics.blend_root_offset_max_m(m, shifted, parts_for(m)) - 0.2) < 1e-12
+
+
+def test_the_roots_turn_is_its_own_field_not_a_joints_correction() -> None:
+    m = random_motion(t=30, fps=30)
+    turned = m.transformed(0.15, (0.0, 0.0))  # the whole body turned 0.15 rad about the vertical
+    assert metrics.blend_root_turn_max_rad(m, turned) == pytest.approx(0.15, abs=1e-9)
+    assert metrics.blend_joint_correction_max_rad(m, turned) < 1e-7  # no joint was bent
+    rot = m.rotations.copy()
+    rot[5:, 2] = quat_mul(rot[5:, 2], quat_exp(np.array([0.0, 0.4, 0.0])))
+    bent = m.replace(rotations=rot)
+    assert metrics.blend_joint_correction_max_rad(m, bent) == pytest.approx(0.4, abs=1e-9)
+    assert metrics.blend_root_turn_max_rad(m, bent) < 1e-7
+    # a large root turn still counts against the warning threshold
+    rot = m.rotations.copy()
+    rot[:, 0] = quat_mul(quat_exp(np.array([0.0, 0.0, 0.9])), rot[:, 0])  # turned in place
+    far = m.replace(rotations=rot)
+    parts = parts_for(m)
+    assert metrics.blend_root_offset_max_m(m, far, parts) < 1e-9
+    assert metrics.blend_correction_over_warning(m, far, parts) == pytest.approx(
+        0.9 / metrics.WARN_ROOT_TURN_RAD, abs=1e-6
+    )

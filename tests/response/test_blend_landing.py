@@ -32,6 +32,7 @@ def _score(report: dict) -> float:
     """The final blend's correction over the warning thresholds (<= 1: no warning)."""
     q = report["quality"]
     return max(q["blend_joint_correction_max_rad"] / qm.WARN_JOINT_CORRECTION_RAD,
+               q["blend_root_turn_max_rad"] / qm.WARN_ROOT_TURN_RAD,
                q["blend_root_offset_max_m"] / qm.WARN_ROOT_OFFSET_M)  # fmt: skip
 
 
