@@ -171,3 +171,50 @@ def test_a_land_stiffness_that_is_not_positive_is_a_clear_error() -> None:
             "impact": {}, "response": {"mode": "physical", "land_stiffness": 0.0}}  # fmt: skip
     with pytest.raises(ConfigError, match=r"\[response\]\.land_stiffness"):
         parse_scenario(data, source="s.toml")
+
+
+def _facing(deg: float, mode: str) -> Scenario:
+    from reactmocap.batch import load_sweep
+
+    base = load_sweep(EXAMPLES / "sweep_facing.toml").points()[0].scenario
+    return replace(base, recipient=replace(base.recipient, facing_deg=deg),
+                   response=replace(base.response, mode=mode))  # fmt: skip
+
+
+def test_a_landed_kick_reports_the_roots_turn_apart_from_the_joints() -> None:
+    # the sweep's kick from 240 deg lands with the root turned 0.15 rad off the clip (within
+    # land_angle) and every joint within land_joint: the final blend turns no joint of the
+    # skeleton by more than 0.1 rad, and the root's turn is its own field
+    sc = _facing(240.0, "physical")
+    rep = run_response(sc, CACHE).report
+    tr, q = rep["transition"], rep["quality"]
+    assert tr["landed_on_clip"], tr
+    gap = tr["landing_gap"]
+    assert q["blend_joint_correction_max_rad"] <= sc.response.land_joint + 1e-9, q
+    assert q["blend_root_turn_max_rad"] == pytest.approx(gap["root_rad"], abs=0.02), (q, gap)
+    assert 0.1 < q["blend_root_turn_max_rad"] <= sc.response.land_angle + 1e-9, q
+    assert q["blend_root_offset_max_m"] <= sc.response.land_position + 1e-9, q
+    assert not rep["warnings"], rep["warnings"]
+
+
+def test_a_kick_lands_physically_with_at_most_2_cm_of_root_correction() -> None:
+    # issue 16's test: the sweep's kick from 80 deg (found clip `step_left`) lands, and the
+    # final blend moves the root at most 2 cm and turns no joint more than 0.1 rad
+    rep = run_response(_facing(80.0, "physical"), CACHE).report
+    tr, q = rep["transition"], rep["quality"]
+    assert tr["landed_on_clip"], tr
+    assert q["contact_impulse_Ns"] > 20.0  # a real kick, not a graze
+    assert q["blend_root_offset_max_m"] <= 0.02, q
+    assert q["blend_joint_correction_max_rad"] <= 0.1, q
+    assert q["blend_root_turn_max_rad"] <= 0.17, q
+
+
+def test_a_large_root_turn_still_warns() -> None:
+    # the blend mode on the sweep's kick from 300 deg: the final blend turns the root by more
+    # than the warning threshold, and the report says so in its own words
+    from reactmocap import metrics as qm
+
+    rep = run_response(_facing(300.0, "blend"), CACHE).report
+    q = rep["quality"]
+    assert q["blend_root_turn_max_rad"] > qm.WARN_ROOT_TURN_RAD, q
+    assert any("turns the root" in w for w in rep["warnings"]), rep["warnings"]
