@@ -37,7 +37,7 @@ def _score(report: dict) -> float:
 
 
 def test_the_blend_mode_settles_where_the_final_blend_corrects_least() -> None:
-    # the heavy push's blend at the match turns a joint 0.67 rad (over the warning threshold);
+    # the heavy push's blend at the match turns the root 0.67 rad (over the warning threshold);
     # Simulation 2 runs on, and the blend lands later, where it corrects less
     at_match = run_response(_blend("heavy_push_fall", blend_settle=0.0), CACHE).report
     settled = run_response(_blend("heavy_push_fall", blend_settle=0.5), CACHE).report
