@@ -162,14 +162,26 @@ VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]
 #: jump lands lower, with the trunk pitched forward). Each row: the middle of the deltas that
 #: landed (0.04 m grid, lead 0.5, pitch_ease BROAD_PITCH_EASE) at one effort, 2026-12-02
 #: (/tmp sweep of ``run("broad-jump", body, effort=s)``; docs/athletics.md). The male's rows
-#: from 1.68 m/s: efforts 0.7-1.0 of his deeper crouch (BROAD_CROUCH), 0.025 m grid, his arms
-#: swung behind (BROAD_ARMS): landed -0.075..0, -0.125..-0.05, -0.05 only, -0.225..-0.15 m
+#: from 1.68 m/s: efforts 0.7 / 0.8 / 0.875 / 0.9 / 0.925 / 1.0 of his deeper crouch
+#: (BROAD_CROUCH), 0.025 m grid, his arms swung behind (BROAD_ARMS): landed -0.075..0,
+#: -0.125..-0.05, -0.125..-0.075, -0.05 only, -0.15 and -0.1, -0.225..-0.15 m (the 0.9 take-off
+#: pitches forward, +2 kg m^2/s, where its neighbours' pitch back: its window is apart; the
+#: 0.925 row is the lower of its two, not their middle, which fell)
 BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = MappingProxyType(
     {
         "male": (
             0.5,
-            ((0.66, 0.1), (1.12, 0.04), (1.35, 0.02), (1.68, -0.04), (2.01, -0.09), (2.34, -0.05),
-             (2.9, -0.19)),
+            (
+                (0.66, 0.1),
+                (1.12, 0.04),
+                (1.35, 0.02),
+                (1.68, -0.04),
+                (2.01, -0.09),
+                (2.29, -0.1),
+                (2.34, -0.05),
+                (2.48, -0.15),
+                (2.9, -0.19),
+            ),
         ),
         "female": (0.5, ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
     }
