@@ -22,6 +22,7 @@ from reactmocap.errors import ConfigError
 
 __all__ = [
     "BROAD_ARMS",
+    "BROAD_CROUCH",
     "BROAD_LANDING",
     "BROAD_PITCH_EASE",
     "BROAD_SPIN",
@@ -60,9 +61,27 @@ def broad_params(s: float, body: str | None = None) -> LeapParams:
     the take-off's backward angular momentum is the body's :data:`BROAD_SPIN`."""
     s = float(np.clip(s, 0.0, 1.0))
     spin = BROAD_SPIN.get(body or "", DEFAULT_BROAD_SPIN)
-    return LeapParams(leg=0.8 - 0.15 * s, pitch=0.3, lean=0.0, com_offset=0.12 + 0.1 * s,
+    knots = np.array(BROAD_CROUCH.get(body or "", DEFAULT_BROAD_CROUCH)).T
+    leg, pitch = (float(np.interp(s, knots[0], k)) for k in knots[1:])
+    return LeapParams(leg=leg, pitch=pitch, lean=0.0, com_offset=0.12 + 0.1 * s,
                       stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
                       arms=-1.8 - 1.0 * s, broad=True, spin=spin, spin_gain=40.0, hold=0.1)  # fmt: skip
+
+
+#: the broad jump's crouch along the effort: knots (effort s, hip-to-ankle leg fraction,
+#: torso pitch rad), interpolated
+DEFAULT_BROAD_CROUCH = ((0.0, 0.8, 0.3), (1.0, 0.65, 0.3))
+#: per body. The thesis's longest jumps crouch much deeper (its Table 4.2, male hip height
+#: 0.72 / 0.68 / 0.50 m for 0.38 / 1.16 / 2.12 m): the push's path sets the take-off speed.
+#: Male, 2026-12-02: the default path's effort 1.0 (leg 0.65) took off at 2.7 m/s (1.95
+#: across, 1.93 up) for a 1.41 m leap; leg 0.45 with the trunk pitched 0.6 rad takes off at
+#: 4.3 m/s (2.9 across, 3.2 up) and lands 2.39 m. The trunk pitch grows with the crouch: at
+#: leg 0.5 with 0.3 rad the push passed behind the COM (pitch momentum +13.6 kg m^2/s at
+#: lift-off, where the spin feedback asks -5) and the landing pitched face down. Efforts up
+#: to 0.6 keep the default path (their landings were measured on it)
+BROAD_CROUCH: Mapping[str, tuple[tuple[float, float, float], ...]] = MappingProxyType(
+    {"male": ((0.0, 0.8, 0.3), (0.6, 0.71, 0.3), (1.0, 0.45, 0.6))}
+)
 
 
 #: the broad jump's take-off pitch momentum (kg m^2/s, backward < 0)
@@ -142,12 +161,27 @@ VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]
 #: foot-servo delta m), ...)), thesis Table 6.1 measured on broad jumps, not drops (a broad
 #: jump lands lower, with the trunk pitched forward). Each row: the middle of the deltas that
 #: landed (0.04 m grid, lead 0.5, pitch_ease BROAD_PITCH_EASE) at one effort, 2026-12-02
-#: (/tmp sweep of ``run("broad-jump", body, effort=s)``; docs/athletics.md)
+#: (/tmp sweep of ``run("broad-jump", body, effort=s)``; docs/athletics.md). The male's rows
+#: from 1.68 m/s: efforts 0.7 / 0.8 / 0.875 / 0.9 / 0.925 / 1.0 of his deeper crouch
+#: (BROAD_CROUCH), 0.025 m grid, his arms swung behind (BROAD_ARMS): landed -0.075..0,
+#: -0.125..-0.05, -0.125..-0.075, -0.05 only, -0.15 and -0.1, -0.225..-0.15 m (the 0.9 take-off
+#: pitches forward, +2 kg m^2/s, where its neighbours' pitch back: its window is apart; the
+#: 0.925 row is the lower of its two, not their middle, which fell)
 BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = MappingProxyType(
     {
         "male": (
             0.5,
-            ((0.66, 0.1), (1.12, 0.04), (1.35, 0.02), (1.47, -0.02), (1.69, -0.02), (1.78, -0.02)),
+            (
+                (0.66, 0.1),
+                (1.12, 0.04),
+                (1.35, 0.02),
+                (1.68, -0.04),
+                (2.01, -0.09),
+                (2.29, -0.1),
+                (2.34, -0.05),
+                (2.48, -0.15),
+                (2.9, -0.19),
+            ),
         ),
         "female": (0.5, ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
     }
@@ -158,7 +192,9 @@ BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = Map
 #: rest of the body back (angular momentum is conserved in the air), so the trunk touches
 #: down less pitched forward. Female, 2026-12-02: with 0.6 her 0.65 m command (effort 0.42,
 #: trunk 57 deg forward at touchdown against 62) lands where it fell (docs/athletics.md)
-BROAD_ARMS: Mapping[str, float] = MappingProxyType({"female": 1.0})
+#: Male (2026-12-02): for his deeper crouch's fast jumps (1.7-2.9 m/s; docs/athletics.md);
+#: his jumps at efforts 0-0.6 land with it at their table deltas as before
+BROAD_ARMS: Mapping[str, float] = MappingProxyType({"female": 1.0, "male": 1.0})
 #: seconds over which a broad jump's landing rights the trunk (LandingParams.pitch_ease):
 #: righting it at once threw the male's 0.96 m and the female's 0.67 m jumps back up off
 #: their legs (the hips' extension pushed into the floor)
