@@ -163,9 +163,9 @@ def test_a_limb_across_a_triangle_touches_it(collide_arms: bool) -> None:
     rot = target @ local.reshape(3, 3).T
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, rot.ravel())
-    qa = cloth._qadr[part]
-    d.qpos[qa : qa + 3] = centroid[e] - rot @ m.geom_pos[cap]
-    d.qpos[qa + 3 : qa + 7] = quat
+    bodies = np.concatenate([d.xpos[cloth._copies], d.xquat[cloth._copies]], axis=1)
+    bodies[part] = np.concatenate([centroid[e] - rot @ m.geom_pos[cap], quat])
+    cloth._place(d, bodies)
     mujoco.mj_fwdPosition(m, d)
     assert np.allclose(d.geom_xpos[cap], centroid[e])
     con = d.contact
@@ -286,3 +286,24 @@ def test_the_waistband_moves_with_the_pelvis() -> None:
     np.testing.assert_allclose(d.qvel[cloth._vd[band]], vel + np.cross(omega, arm), atol=1e-12)
     others = np.setdiff1d(np.arange(len(now)), band)
     np.testing.assert_array_equal(now[others], made[others])
+
+
+def test_a_cloth_state_gone_bad_is_reported_after_mujocos_reset() -> None:
+    """A vertex's velocity gone NaN: MuJoCo's step warns and resets the cloth's model (its
+    state finite again, the trousers back where they were made), and the cloth says so
+    instead of carrying on from the reset."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+    from reactmocap.errors import SimulationError
+
+    world = athletics_world(athlete("male"))
+    cloth = Cloth(world, "pants")
+    cloth.reset(world)
+    d = cloth.data
+    v = int(np.setdiff1d(np.arange(len(cloth._vrest)), cloth._pin)[-1])  # not the waistband
+    d.qvel[cloth._vd[v]] = np.nan
+    with pytest.raises(SimulationError, match="non-finite"):
+        cloth.control(world, 0.0)
+    assert cloth.finite is False
+    assert d.warning[mujoco.mjtWarning.mjWARN_BADQVEL].number > 0
+    assert np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()  # what MuJoCo left
