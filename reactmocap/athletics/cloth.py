@@ -96,8 +96,8 @@ _CAPSULE, _SPHERE = int(mujoco.mjtGeom.mjGEOM_CAPSULE), int(mujoco.mjtGeom.mjGEO
 _BITS = {"l_": 4, "r_": 8}
 _TRUNK, _LOOSE = 2, 32
 #: MuJoCo's warnings of a state gone bad (it then resets the cloth's model)
-_BAD = tuple(int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
-                              mujoco.mjtWarning.mjWARN_BADQACC))  # fmt: skip
+_BAD = np.array([mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                 mujoco.mjtWarning.mjWARN_BADQACC], dtype=np.intp)  # fmt: skip
 
 
 def _body_bits(name: str) -> int:
@@ -178,6 +178,7 @@ class Cloth:
         )
         self.record_fps = float(record_fps)
         self.wc = world.characters[character]
+        self._roots = world.model.body_rootid[self.wc.body_ids]
         self.model: mujoco.MjModel | None = None
         self.data: mujoco.MjData | None = None
         self._reset_record()
@@ -461,7 +462,7 @@ class Cloth:
         # the cloth starts moving with the pelvis, as if it had been worn before
         assert self.data is not None
         pos, _ = self._poses()
-        vel, omega = self._velocities()
+        vel, omega = self._velocities(pos)
         x = self._vrest + self._xq
         self._xv[:] = vel[0] + _cross(omega[0], x - pos[0])
         self._record(0.0)
@@ -469,24 +470,22 @@ class Cloth:
     def _poses(self) -> tuple[F64, F64]:
         d = self.world.data
         ids = self.wc.body_ids
-        return d.xpos[ids].copy(), d.xquat[ids].copy()
+        return d.xpos[ids], d.xquat[ids]  # (copies: indexed by an array)
 
-    def _velocities(self) -> tuple[F64, F64]:
-        """World linear velocity of each body's origin and world angular velocity (from
-        ``cvel``, which holds them about the subtree's centre of mass)."""
-        m, d = self.world.model, self.world.data
-        ids = self.wc.body_ids
-        cvel = d.cvel[ids]
-        com = d.subtree_com[m.body_rootid[ids]]
+    def _velocities(self, pos: F64) -> tuple[F64, F64]:
+        """World linear velocity of each body's origin (at ``pos``) and world angular
+        velocity (from ``cvel``, which holds them about the subtree's centre of mass)."""
+        d = self.world.data
+        cvel = d.cvel[self.wc.body_ids]
         omega = cvel[:, :3]
-        return cvel[:, 3:] + _cross(omega, d.xpos[ids] - com), omega
+        return cvel[:, 3:] + _cross(omega, pos - d.subtree_com[self._roots]), omega
 
     def control(self, world: World, t: float) -> None:
         assert self.model is not None and self.data is not None
         wall, cpu = time.perf_counter(), time.process_time()
         m, d = self.model, self.data
         pos, quat = self._poses()
-        vel, omega = self._velocities()
+        vel, omega = self._velocities(pos)
         rot = world.data.xmat[self.wc.body_ids].reshape(-1, 3, 3)
         local = np.einsum("bji,bj->bi", rot, omega)
         dt = self.control_every * world.timestep
@@ -514,8 +513,7 @@ class Cloth:
             mujoco.mj_step(m, d)
         # MuJoCo resets a model whose state or acceleration went bad (and warns): its state
         # is finite again then; a sum is non-finite when an element is (cheaper than isfinite)
-        bad = sum(d.warning[w].number for w in _BAD)
-        if bad or not math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum())):
+        if d.warning.number[_BAD].any() or not math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum())):
             self.finite = False
             raise SimulationError(f"the cloth went non-finite at t = {t:.3f} s")
         self._measure(world)
@@ -592,7 +590,7 @@ class Cloth:
         d = self.data
         assert d is not None
         arm = self._pin_local @ rot.T
-        self._xq[self._pin] = arm + pos - self._vrest[self._pin]
+        self._xq[self._pin] = arm + (pos - self._vrest[self._pin])
         self._xv[self._pin] = vel + _cross(omega, arm)
 
     def _measure(self, world: World) -> None:
