@@ -376,6 +376,7 @@ class Cloth:
         self._stack = np.zeros((4 * nb, 3))
         self._home = np.zeros((len(free), 3))
         self._off = np.zeros((len(free), 3))
+        self._scale = np.zeros(len(free))
 
     def _tether(self, x: F64, pos: F64, rot: F64) -> None:
         """Keep each free vertex within ``spec.tether`` of where it was made on the leg
@@ -386,10 +387,13 @@ class Cloth:
         self._stack[3 * nb :] = pos
         home = np.matmul(self._tmat, self._stack, out=self._home)
         off = np.subtract(x, home, out=self._off)
-        dist2 = np.einsum("vi,vi->v", off, off)
-        far = np.flatnonzero(dist2 > self.spec.tether**2)
-        if far.size:
-            x[far] = home[far] + off[far] * (self.spec.tether / np.sqrt(dist2[far]))[:, None]
+        # each offset scaled to the tether's length where it is longer (by 1 elsewhere)
+        scale = np.einsum("vi,vi->v", off, off, out=self._scale)
+        np.maximum(scale, self.spec.tether**2, out=scale)
+        np.sqrt(scale, out=scale)
+        np.divide(self.spec.tether, scale, out=scale)
+        np.multiply(off, scale[:, None], out=off)
+        np.add(home, off, out=x)
 
     def _collider_setup(self) -> None:
         """What the vertex projection needs: the vertices' slide-joint addresses and rest
@@ -436,6 +440,10 @@ class Cloth:
         self._x = np.zeros_like(self._vrest)
         self._vmask = (m.geom_contype[caps][None] & affinity[flex][:, None]) > 0
         self._vmask[self._pin] = False  # the waistband is never projected
+        self._pin_rest = self._vrest[self._pin]
+        self._spin = np.zeros((3, 3))
+        self._sew_frame = np.zeros((3, 6))
+        self._arm = np.zeros((len(self._pin), 6))
         self._cpart = self._geom_part[caps]
         self._cpos = m.geom_pos[caps].copy()
         self._caxis = axes
@@ -589,11 +597,18 @@ class Cloth:
     def _sew(self, pos: F64, rot: F64, vel: F64, omega: F64) -> None:
         """The waistband where the pelvis has it, moving with it (``pos``, ``rot``, ``vel``
         and ``omega`` the pelvis copy's)."""
-        d = self.data
-        assert d is not None
-        arm = self._pin_local @ rot.T
-        self._xq[self._pin] = arm + (pos - self._vrest[self._pin])
-        self._xv[self._pin] = vel + _cross(omega, arm)
+        # the ring's points and their velocities about the pelvis in one product:
+        # local @ [R^T | (W R)^T], W the cross-product matrix of omega (d/dt R = W R)
+        w = self._spin
+        w[0, 1], w[1, 0] = -omega[2], omega[2]
+        w[0, 2], w[2, 0] = omega[1], -omega[1]
+        w[1, 2], w[2, 1] = -omega[0], omega[0]
+        frame = self._sew_frame
+        frame[:, :3] = rot.T
+        np.matmul(rot.T, w.T, out=frame[:, 3:])
+        arm = np.matmul(self._pin_local, frame, out=self._arm)
+        self._xq[self._pin] = arm[:, :3] + (pos - self._pin_rest)
+        self._xv[self._pin] = arm[:, 3:] + vel
 
     def _measure(self, world: World) -> None:
         assert self.model is not None and self.data is not None
