@@ -309,3 +309,36 @@ def test_a_cloth_state_gone_bad_is_reported_after_mujocos_reset() -> None:
     assert cloth.finite is False
     assert d.warning[mujoco.mjtWarning.mjWARN_BADQVEL].number > 0
     assert np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()  # what MuJoCo left
+
+
+@pytest.mark.parametrize("collide_arms", [False, True])
+def test_only_the_copies_the_cloth_meets_have_joints(collide_arms: bool) -> None:
+    """The copies of the legs and the trunk (and of the head and arms with ``collide_arms``)
+    move by free joints, so the contacts see their velocities; the others (the pelvis, and
+    the head and arms by default) are mocap bodies without dofs, set where the runner has
+    them each cloth step."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+    from reactmocap.sim.bodies import SIM_BODIES
+
+    world = athletics_world(athlete("male"))
+    spec = ClothSpec()
+    spec.collide_arms = collide_arms
+    cloth = Cloth(world, spec)
+    cloth.reset(world)
+    m, d = cloth.model, cloth.data
+    legs_trunk = [n for n in SIM_BODIES if n.endswith(("thigh", "shin", "foot", "waist", "chest"))]
+    arms_head = [n for n in SIM_BODIES if n != "pelvis" and n not in legs_trunk]
+    moving = len(legs_trunk) + (len(arms_head) if collide_arms else 0)
+    assert m.nv == 6 * moving + 3 * m.nflexvert
+    assert m.nmocap == len(SIM_BODIES) - moving
+    # after a cloth step the mocap copies are where the runner's bodies are, the others
+    # carried a step on by their velocities (at the start pose, well under a millimetre)
+    wd = world.data
+    wd.qpos[0] += 0.1  # the runner moved 10 cm forward
+    mujoco.mj_forward(world.model, wd)
+    cloth.control(world, 0.0)
+    mujoco.mj_kinematics(m, d)
+    body = wd.xpos[cloth.wc.body_ids]
+    np.testing.assert_array_equal(d.xpos[cloth._copies[cloth._mocap]], body[cloth._mocap])
+    np.testing.assert_allclose(d.xpos[cloth._copies], body, atol=1e-3)
