@@ -351,16 +351,15 @@ class Cloth:
         u = np.linspace(0.0, self.spec.hem, self.spec.rings)[ring]
         w_pelvis = np.clip((0.4 - u) / 0.4, 0.0, 1.0)
         w_shin = np.clip((u - 0.8) / 0.4, 0.0, 1.0)
-        self._tw = np.column_stack([w_pelvis, 1.0 - w_pelvis - w_shin, w_shin])
+        weight = np.column_stack([w_pelvis, 1.0 - w_pelvis - w_shin, w_shin])
         sides = np.array(["l", "r"])[flex]
         parts = np.zeros((len(free), 3), dtype=np.intp)
         for j, name in ((1, "thigh"), (2, "shin")):
             parts[:, j] = [SIM_BODIES.index(f"{sd}_{name}") for sd in sides]
-        self._tparts = parts
         b = np.array([m.body(f"b{i}").id for i in range(len(SIM_BODIES))])[parts]
         x = d.flexvert_xpos[free]
-        self._tlocal = np.einsum("vjki,vjk->vji", d.xmat[b].reshape(*b.shape, 3, 3),
-                                 x[:, None] - d.xpos[b])  # fmt: skip
+        local = np.einsum("vjki,vjk->vji", d.xmat[b].reshape(*b.shape, 3, 3),
+                          x[:, None] - d.xpos[b])  # fmt: skip
         # home = sum_j w_j (R_pj local_j + pos_pj), one product with the stacked bodies'
         # transposed rotations and positions (``_stack``): a row of weighted local points
         # per body and the weights
@@ -370,8 +369,8 @@ class Cloth:
         for j in range(3):
             p = parts[:, j]
             for i in range(3):
-                np.add.at(mat, (rows, 3 * p + i), self._tw[:, j] * self._tlocal[:, j, i])
-            np.add.at(mat, (rows, 3 * nb + p), self._tw[:, j])
+                np.add.at(mat, (rows, 3 * p + i), weight[:, j] * local[:, j, i])
+            np.add.at(mat, (rows, 3 * nb + p), weight[:, j])
         self._tmat = mat
         self._stack = np.zeros((4 * nb, 3))
         self._home = np.zeros((len(free), 3))
@@ -550,8 +549,6 @@ class Cloth:
         velocities) a moved vertex also stops moving into the body: its velocity along the
         capsule's outward normal is raised to the body surface's there (what the soft contacts
         take several steps to do; its sliding along the surface is kept)."""
-        d = self.data
-        assert d is not None
         part = self._cpart
         x = np.add(self._vrest, self._xq, out=self._x)
         if self.spec.tether > 0:
