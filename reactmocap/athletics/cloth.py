@@ -37,7 +37,7 @@ class ClothSpec:
     model's time step (s) and where the hem is (0 the waist, 1 the knee, 2 the ankle)."""
 
     def __init__(
-        self, rings: int = 9, around: int = 8, slack: float = 0.05, mass: float = 0.4,
+        self, rings: int = 7, around: int = 7, slack: float = 0.05, mass: float = 0.4,
         thickness: float = 0.006, timestep: float = 0.008, hem: float = 1.6,
     ) -> None:  # fmt: skip
         if rings < 3 or around < 4:
@@ -95,6 +95,9 @@ _CAPSULE, _SPHERE = int(mujoco.mjtGeom.mjGEOM_CAPSULE), int(mujoco.mjtGeom.mjGEO
 #: the cloth, and collided with it only with ``ClothSpec.collide_arms``)
 _BITS = {"l_": 4, "r_": 8}
 _TRUNK, _LOOSE = 2, 32
+#: MuJoCo's warnings of a state gone bad (it then resets the cloth's model)
+_BAD = np.array([mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                 mujoco.mjtWarning.mjWARN_BADQACC], dtype=np.intp)  # fmt: skip
 
 
 def _body_bits(name: str) -> int:
@@ -105,13 +108,14 @@ def _body_bits(name: str) -> int:
     return _TRUNK if name in ("waist", "chest") else _LOOSE
 
 
-#: the garments by name: ``pants`` (loose trousers, hem 60% of the way down the shin),
-#: ``pants-light`` (the same with fewer points and 4 ms steps: cheaper, coarser) and
+#: the garments by name: ``pants`` (loose trousers, 7 rings of 7 points, hem 60% of the way
+#: down the shin; 9 rings of 8 before 2026-12-02: 20% dearer for no less penetration),
+#: ``pants-light`` (the same with 6 points around instead of 7: cheaper, coarser) and
 #: ``shorts`` (hem above the knee)
 CLOTHES: dict[str, ClothSpec] = {
     "pants": ClothSpec(),
     "pants-light": ClothSpec(rings=7, around=6),
-    "shorts": ClothSpec(rings=6, hem=0.85),
+    "shorts": ClothSpec(rings=6, around=8, hem=0.85),
 }
 
 
@@ -175,6 +179,7 @@ class Cloth:
         )
         self.record_fps = float(record_fps)
         self.wc = world.characters[character]
+        self._roots = world.model.body_rootid[self.wc.body_ids]
         self.model: mujoco.MjModel | None = None
         self.data: mujoco.MjData | None = None
         self._reset_record()
@@ -284,9 +289,18 @@ class Cloth:
                 f'solref="{sp.contact_time} 1" solimp="0.99 0.999 0.001"/></flexcomp>'
             )
         parts = []
+        hit = np.bitwise_or.reduce(self._affinity)
+        # the copies the cloth collides with move by free joints (the contacts see their
+        # velocities); the others (the pelvis, and the head and arms unless collided) are
+        # mocap bodies: no dofs in the cloth's mass matrix and constraint Jacobian
+        self._moving = np.array([bool(_body_bits(n) & hit) for n in SIM_BODIES])
         for i, geoms in bodies:
             pos = " ".join(map(str, d.xpos[wc.body_ids[i]]))
             quat = " ".join(map(str, d.xquat[wc.body_ids[i]]))
+            if not self._moving[i]:
+                parts.append(f'<body name="b{i}" pos="{pos}" quat="{quat}" mocap="true">'
+                             f"{geoms}</body>")  # fmt: skip
+                continue
             # heavy and weightless: the cloth barely moves it, and it is set each step
             parts.append(f'<body name="b{i}" pos="{pos}" quat="{quat}" gravcomp="1"><freejoint/>'
                          '<inertial pos="0 0 0" mass="1000" diaginertia="10 10 10"/>'
@@ -308,12 +322,21 @@ class Cloth:
             raise SimulationError(f"MuJoCo could not compile the cloth: {exc}") from exc
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
-        m = self.model
-        joints = [int(m.body_jntadr[m.body(f"b{i}").id]) for i in range(len(SIM_BODIES))]
-        self._qadr = np.array([m.jnt_qposadr[j] for j in joints])
-        self._dadr = np.array([m.jnt_dofadr[j] for j in joints])
-        self._qidx = self._qadr[:, None] + np.arange(7)
-        self._didx = self._dadr[:, None] + np.arange(6)
+        m, d = self.model, self.data
+        copies = np.array([m.body(f"b{i}").id for i in range(len(SIM_BODIES))])
+        self._copies = copies
+        self._mocap = np.flatnonzero(~self._moving)
+        self._free_parts = np.flatnonzero(self._moving)
+        joints = m.body_jntadr[copies[self._free_parts]]
+        # the free copies' qpos and qvel (first in the model, in order): views the steps write
+        nfree = len(joints)
+        if not (np.array_equal(m.jnt_qposadr[joints], 7 * np.arange(nfree))
+                and np.array_equal(m.jnt_dofadr[joints], 6 * np.arange(nfree))
+                and np.array_equal(m.body_mocapid[copies[self._mocap]],
+                                   np.arange(len(self._mocap)))):  # fmt: skip
+            raise SimulationError("the cloth model's body copies are not laid out as expected")
+        self._qbody = d.qpos[: 7 * nfree].reshape(nfree, 7)
+        self._vbody = d.qvel[: 6 * nfree].reshape(nfree, 6)
         mb = self.model.geom_bodyid
         ids = {int(self.model.body(f"b{i}").id): i for i in range(len(SIM_BODIES))}
         self._geom_part = np.array([ids.get(int(b), -1) for b in mb])
@@ -328,29 +351,48 @@ class Cloth:
         u = np.linspace(0.0, self.spec.hem, self.spec.rings)[ring]
         w_pelvis = np.clip((0.4 - u) / 0.4, 0.0, 1.0)
         w_shin = np.clip((u - 0.8) / 0.4, 0.0, 1.0)
-        self._tw = np.column_stack([w_pelvis, 1.0 - w_pelvis - w_shin, w_shin])
+        weight = np.column_stack([w_pelvis, 1.0 - w_pelvis - w_shin, w_shin])
         sides = np.array(["l", "r"])[flex]
         parts = np.zeros((len(free), 3), dtype=np.intp)
         for j, name in ((1, "thigh"), (2, "shin")):
             parts[:, j] = [SIM_BODIES.index(f"{sd}_{name}") for sd in sides]
-        self._tparts = parts
         b = np.array([m.body(f"b{i}").id for i in range(len(SIM_BODIES))])[parts]
         x = d.flexvert_xpos[free]
-        self._tlocal = np.einsum("vjki,vjk->vji", d.xmat[b].reshape(*b.shape, 3, 3),
-                                 x[:, None] - d.xpos[b])  # fmt: skip
+        local = np.einsum("vjki,vjk->vji", d.xmat[b].reshape(*b.shape, 3, 3),
+                          x[:, None] - d.xpos[b])  # fmt: skip
+        # home = sum_j w_j (R_pj local_j + pos_pj), one product with the stacked bodies'
+        # transposed rotations and positions (``_stack``): a row of weighted local points
+        # per body and the weights
+        nb = len(SIM_BODIES)
+        mat = np.zeros((len(free), 4 * nb))
+        rows = np.arange(len(free))
+        for j in range(3):
+            p = parts[:, j]
+            for i in range(3):
+                np.add.at(mat, (rows, 3 * p + i), weight[:, j] * local[:, j, i])
+            np.add.at(mat, (rows, 3 * nb + p), weight[:, j])
+        self._tmat = mat
+        self._stack = np.zeros((4 * nb, 3))
+        self._home = np.zeros((len(free), 3))
+        self._off = np.zeros((len(free), 3))
+        self._scale = np.zeros(len(free))
 
     def _tether(self, x: F64, pos: F64, rot: F64) -> None:
         """Keep each free vertex within ``spec.tether`` of where it was made on the leg
         (NvCloth's "max distance" constraint): a loose tube cannot then fall across the limb
         it hangs around, which neither the contacts nor the projection undo."""
-        p = self._tparts
-        # each part's point (rot @ local + pos), then their blend
-        home = np.einsum("vjki,vji->vjk", rot[p], self._tlocal) + pos[p]
-        home = np.einsum("vj,vjk->vk", self._tw, home)
-        off = x - home
-        dist = np.sqrt(np.einsum("vi,vi->v", off, off))
-        far = np.flatnonzero(dist > self.spec.tether)
-        x[far] = home[far] + off[far] * (self.spec.tether / dist[far])[:, None]
+        nb = len(rot)
+        self._stack[: 3 * nb].reshape(nb, 3, 3)[:] = rot.transpose(0, 2, 1)
+        self._stack[3 * nb :] = pos
+        home = np.matmul(self._tmat, self._stack, out=self._home)
+        off = np.subtract(x, home, out=self._off)
+        # each offset scaled to the tether's length where it is longer (by 1 elsewhere)
+        scale = np.einsum("vi,vi->v", off, off, out=self._scale)
+        np.maximum(scale, self.spec.tether**2, out=scale)
+        np.sqrt(scale, out=scale)
+        np.divide(self.spec.tether, scale, out=scale)
+        np.multiply(off, scale[:, None], out=off)
+        np.add(home, off, out=x)
 
     def _collider_setup(self) -> None:
         """What the vertex projection needs: the vertices' slide-joint addresses and rest
@@ -387,8 +429,20 @@ class Cloth:
         self._vd = m.jnt_dofadr[m.body_jntadr[body]][:, None] + np.arange(3)
         self._vall = np.arange(len(free))
         self._vrest = m.body_pos[body].copy()
+        # the vertices' qpos and qvel (after the free copies', in order): views
+        q0, v0 = 7 * len(self._free_parts), 6 * len(self._free_parts)
+        if not (np.array_equal(self._vq.ravel(), q0 + np.arange(self._vq.size))
+                and np.array_equal(self._vd.ravel(), v0 + np.arange(self._vd.size))):  # fmt: skip
+            raise SimulationError("the cloth's vertices are not laid out as expected")
+        self._xq = d.qpos[q0 : q0 + self._vq.size].reshape(-1, 3)
+        self._xv = d.qvel[v0 : v0 + self._vd.size].reshape(-1, 3)
+        self._x = np.zeros_like(self._vrest)
         self._vmask = (m.geom_contype[caps][None] & affinity[flex][:, None]) > 0
         self._vmask[self._pin] = False  # the waistband is never projected
+        self._pin_rest = self._vrest[self._pin]
+        self._spin = np.zeros((3, 3))
+        self._sew_frame = np.zeros((3, 6))
+        self._arm = np.zeros((len(self._pin), 6))
         self._cpart = self._geom_part[caps]
         self._cpos = m.geom_pos[caps].copy()
         self._caxis = axes
@@ -416,54 +470,59 @@ class Cloth:
         # the cloth starts moving with the pelvis, as if it had been worn before
         assert self.data is not None
         pos, _ = self._poses()
-        vel, omega = self._velocities()
-        x = self._vrest + self.data.qpos[self._vq]
-        self.data.qvel[self._vd] = vel[0] + _cross(omega[0], x - pos[0])
+        vel, omega = self._velocities(pos)
+        x = self._vrest + self._xq
+        self._xv[:] = vel[0] + _cross(omega[0], x - pos[0])
         self._record(0.0)
 
     def _poses(self) -> tuple[F64, F64]:
         d = self.world.data
         ids = self.wc.body_ids
-        return d.xpos[ids].copy(), d.xquat[ids].copy()
+        return d.xpos[ids], d.xquat[ids]  # (copies: indexed by an array)
 
-    def _velocities(self) -> tuple[F64, F64]:
-        """World linear velocity of each body's origin and world angular velocity (from
-        ``cvel``, which holds them about the subtree's centre of mass)."""
-        m, d = self.world.model, self.world.data
-        ids = self.wc.body_ids
-        cvel = d.cvel[ids]
-        com = d.subtree_com[m.body_rootid[ids]]
+    def _velocities(self, pos: F64) -> tuple[F64, F64]:
+        """World linear velocity of each body's origin (at ``pos``) and world angular
+        velocity (from ``cvel``, which holds them about the subtree's centre of mass)."""
+        d = self.world.data
+        cvel = d.cvel[self.wc.body_ids]
         omega = cvel[:, :3]
-        return cvel[:, 3:] + _cross(omega, d.xpos[ids] - com), omega
+        return cvel[:, 3:] + _cross(omega, pos - d.subtree_com[self._roots]), omega
 
     def control(self, world: World, t: float) -> None:
         assert self.model is not None and self.data is not None
         wall, cpu = time.perf_counter(), time.process_time()
         m, d = self.model, self.data
         pos, quat = self._poses()
-        vel, omega = self._velocities()
+        vel, omega = self._velocities(pos)
         rot = world.data.xmat[self.wc.body_ids].reshape(-1, 3, 3)
         local = np.einsum("bji,bj->bi", rot, omega)
         dt = self.control_every * world.timestep
         n = max(1, round(dt / m.opt.timestep))
         h = dt / n
-        qpos, qvel = self._qidx, self._didx
+        free, mocap = self._free_parts, self._mocap
+        self._vbody[:, :3] = vel[free]
+        self._vbody[:, 3:] = local[free]
         for k in range(n):
             # the runner's bodies carried over the tick by their velocities (the contacts
             # see them move, so the cloth is pushed along rather than overlapped)
-            d.qpos[qpos[:, :3]] = pos + vel * (k * h)
-            d.qpos[qpos[:, 3:]] = (
-                quat_normalize(quat_mul(quat, quat_exp(local * (k * h)))) if k else quat
-            )
-            d.qvel[qvel[:, :3]] = vel
-            d.qvel[qvel[:, 3:]] = local
-            now = d.qpos[qpos[:, :3]]
-            rot_k = rot if not k else quat_to_matrix(d.qpos[qpos[:, 3:]])
-            self._sew(now[0], rot_k[0], vel[0], omega[0])
+            if k:
+                pos_k = pos + vel * (k * h)
+                quat_k = quat_normalize(quat_mul(quat, quat_exp(local * (k * h))))
+                rot_k = quat_to_matrix(quat_k)
+            else:
+                pos_k, quat_k, rot_k = pos, quat, rot
+            self._qbody[:, :3] = pos_k[free]
+            self._qbody[:, 3:] = quat_k[free]
+            d.mocap_pos[:] = pos_k[mocap]
+            d.mocap_quat[:] = quat_k[mocap]
+            self._sew(pos_k[0], rot_k[0], vel[0], omega[0])
             if self.spec.project or self.spec.tether > 0:
-                self._project(now, rot_k, (vel, omega) if self.spec.project_velocity else None)
+                self._project(pos_k, rot_k, (vel, omega) if self.spec.project_velocity else None)
             mujoco.mj_step(m, d)
-        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
+        # MuJoCo resets a model whose state or acceleration went bad (and warns): its state
+        # is finite again then; a sum is non-finite when an element is (cheaper than isfinite)
+        total = float(d.qpos.sum()) + float(d.qvel.sum())
+        if d.warning.number[_BAD].any() or not math.isfinite(total):
             self.finite = False
             raise SimulationError(f"the cloth went non-finite at t = {t:.3f} s")
         self._measure(world)
@@ -471,6 +530,15 @@ class Cloth:
             self._record(t)
         self.wall_s += time.perf_counter() - wall
         self.cpu_s += time.process_time() - cpu
+
+    def _place(self, d: mujoco.MjData, bodies: F64) -> None:
+        """Put the body copies in ``d`` (this cloth's model's data) at poses ``bodies``
+        ``(16, 7)`` (position, quaternion): the free ones by their joints, the others as
+        mocap bodies."""
+        free, mocap = self._free_parts, self._mocap
+        d.qpos[: 7 * len(free)] = bodies[free].ravel()
+        d.mocap_pos[:] = bodies[mocap, :3]
+        d.mocap_quat[:] = bodies[mocap, 3:]
 
     def _project(self, pos: F64, rot: F64, velocity: tuple[F64, F64] | None = None) -> None:
         """Move the free vertices that are inside a body capsule (closer to its axis than
@@ -481,14 +549,13 @@ class Cloth:
         velocities) a moved vertex also stops moving into the body: its velocity along the
         capsule's outward normal is raised to the body surface's there (what the soft contacts
         take several steps to do; its sliding along the surface is kept)."""
-        d = self.data
-        assert d is not None
         part = self._cpart
-        a = np.einsum("gij,gj->gi", rot[part], self._cpos) + pos[part]
-        ax = np.einsum("gij,gj->gi", rot[part], self._caxis)
-        x = self._vrest + d.qpos[self._vq]
+        x = np.add(self._vrest, self._xq, out=self._x)
         if self.spec.tether > 0:
             self._tether(x, pos, rot)
+        if self.spec.project:
+            a = np.einsum("gij,gj->gi", rot[part], self._cpos) + pos[part]
+            ax = np.einsum("gij,gj->gi", rot[part], self._caxis)
         # later passes look only at the vertices the one before moved (the others are out)
         v = self._vall
         lo, hi, crad = -self._chalf, self._chalf, self._crad
@@ -514,25 +581,31 @@ class Cloth:
             caps.append(g)
         if not moved and self.spec.tether <= 0:
             return
-        d.qpos[self._vq] = x - self._vrest
+        np.subtract(x, self._vrest, out=self._xq)
         if velocity is None or not moved:
             return
         vel, omega = velocity
-        qv = self._vd
         for w, normal, g in zip(moved, normals, caps):
             b = part[g]
-            rel = d.qvel[qv[w]] - (vel[b] + _cross(omega[b], x[w] - pos[b]))
+            rel = self._xv[w] - (vel[b] + _cross(omega[b], x[w] - pos[b]))
             vn = np.einsum("vi,vi->v", rel, normal)
-            d.qvel[qv[w]] -= np.minimum(vn, 0.0)[:, None] * normal
+            self._xv[w] -= np.minimum(vn, 0.0)[:, None] * normal
 
     def _sew(self, pos: F64, rot: F64, vel: F64, omega: F64) -> None:
         """The waistband where the pelvis has it, moving with it (``pos``, ``rot``, ``vel``
         and ``omega`` the pelvis copy's)."""
-        d = self.data
-        assert d is not None
-        arm = self._pin_local @ rot.T
-        d.qpos[self._vq[self._pin]] = arm + pos - self._vrest[self._pin]
-        d.qvel[self._vd[self._pin]] = vel + _cross(omega, arm)
+        # the ring's points and their velocities about the pelvis in one product:
+        # local @ [R^T | (W R)^T], W the cross-product matrix of omega (d/dt R = W R)
+        w = self._spin
+        w[0, 1], w[1, 0] = -omega[2], omega[2]
+        w[0, 2], w[2, 0] = omega[1], -omega[1]
+        w[1, 2], w[2, 1] = -omega[0], omega[0]
+        frame = self._sew_frame
+        frame[:, :3] = rot.T
+        np.matmul(rot.T, w.T, out=frame[:, 3:])
+        arm = np.matmul(self._pin_local, frame, out=self._arm)
+        self._xq[self._pin] = arm[:, :3] + (pos - self._pin_rest)
+        self._xv[self._pin] = arm[:, 3:] + vel
 
     def _measure(self, world: World) -> None:
         assert self.model is not None and self.data is not None
@@ -541,11 +614,11 @@ class Cloth:
         if not d.ncon and not self.feedback:
             return
         con = d.contact
-        flex, geom = con.flex, con.geom
-        # cloth-body contacts (the floor's geom has no part)
-        g = np.where(flex[:, 0] >= 0, geom[:, 1], geom[:, 0])
-        mine = (flex.max(axis=1) >= 0) & (g >= 0)
-        mine[mine] = self._geom_part[g[mine]] >= 0
+        # cloth-body contacts: the body's geom is the contact's one geom (the flex's side is
+        # -1; the copies and the floor collide with nothing but the cloth), the floor has
+        # no part
+        g = con.geom.max(axis=1)
+        mine = self._geom_part[g] >= 0
         # the contact distance is the geometric one between the cloth's triangles inflated
         # by its thickness and the body geom (no margin): the cloth's mid-surface (what is
         # drawn) is inside the body by what is left after that
@@ -657,9 +730,7 @@ def render_cloth_video(cloth: Cloth, path: str | Path, size: tuple[int, int] = (
     frames = np.empty((len(cloth.frames), height, width, 3), dtype=np.uint8)
     try:
         for i, (verts, bodies) in enumerate(zip(cloth.frames, cloth.frame_bodies)):
-            for k in range(len(SIM_BODIES)):
-                qa = cloth._qadr[k]
-                d.qpos[qa : qa + 7] = bodies[k]
+            cloth._place(d, bodies)
             mujoco.mj_kinematics(m, d)
             # the flex vertices as recorded (they are bodies with slide joints: set them by
             # their world positions through the free-vertex qpos)

@@ -24,7 +24,9 @@ def test_cloth_never_goes_non_finite(dressed) -> None:  # type: ignore[no-untype
     assert rep["status"] == "ok", rep.get("reason")
     assert rep["cloth_finite"] is True
     frames = np.array(dressed.cloth.frames)
-    assert frames.shape[0] >= 30 and frames.shape[1] == rep["cloth_vertices"] > 100
+    pants = CLOTHES["pants"]
+    assert frames.shape[0] >= 30
+    assert frames.shape[1] == rep["cloth_vertices"] == 2 * pants.rings * pants.around
     assert np.isfinite(frames).all()
     assert np.isfinite(dressed.cloth.data.qvel).all()
 
@@ -163,9 +165,9 @@ def test_a_limb_across_a_triangle_touches_it(collide_arms: bool) -> None:
     rot = target @ local.reshape(3, 3).T
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, rot.ravel())
-    qa = cloth._qadr[part]
-    d.qpos[qa : qa + 3] = centroid[e] - rot @ m.geom_pos[cap]
-    d.qpos[qa + 3 : qa + 7] = quat
+    bodies = np.concatenate([d.xpos[cloth._copies], d.xquat[cloth._copies]], axis=1)
+    bodies[part] = np.concatenate([centroid[e] - rot @ m.geom_pos[cap], quat])
+    cloth._place(d, bodies)
     mujoco.mj_fwdPosition(m, d)
     assert np.allclose(d.geom_xpos[cap], centroid[e])
     con = d.contact
@@ -286,3 +288,57 @@ def test_the_waistband_moves_with_the_pelvis() -> None:
     np.testing.assert_allclose(d.qvel[cloth._vd[band]], vel + np.cross(omega, arm), atol=1e-12)
     others = np.setdiff1d(np.arange(len(now)), band)
     np.testing.assert_array_equal(now[others], made[others])
+
+
+def test_a_cloth_state_gone_bad_is_reported_after_mujocos_reset() -> None:
+    """A vertex's velocity gone NaN: MuJoCo's step warns and resets the cloth's model (its
+    state finite again, the trousers back where they were made), and the cloth says so
+    instead of carrying on from the reset."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+    from reactmocap.errors import SimulationError
+
+    world = athletics_world(athlete("male"))
+    cloth = Cloth(world, "pants")
+    cloth.reset(world)
+    d = cloth.data
+    v = int(np.setdiff1d(np.arange(len(cloth._vrest)), cloth._pin)[-1])  # not the waistband
+    d.qvel[cloth._vd[v]] = np.nan
+    with pytest.raises(SimulationError, match="non-finite"):
+        cloth.control(world, 0.0)
+    assert cloth.finite is False
+    assert d.warning[mujoco.mjtWarning.mjWARN_BADQVEL].number > 0
+    assert np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()  # what MuJoCo left
+
+
+@pytest.mark.parametrize("collide_arms", [False, True])
+def test_only_the_copies_the_cloth_meets_have_joints(collide_arms: bool) -> None:
+    """The copies of the legs and the trunk (and of the head and arms with ``collide_arms``)
+    move by free joints, so the contacts see their velocities; the others (the pelvis, and
+    the head and arms by default) are mocap bodies without dofs, set where the runner has
+    them each cloth step."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+    from reactmocap.sim.bodies import SIM_BODIES
+
+    world = athletics_world(athlete("male"))
+    spec = ClothSpec()
+    spec.collide_arms = collide_arms
+    cloth = Cloth(world, spec)
+    cloth.reset(world)
+    m, d = cloth.model, cloth.data
+    legs_trunk = [n for n in SIM_BODIES if n.endswith(("thigh", "shin", "foot", "waist", "chest"))]
+    arms_head = [n for n in SIM_BODIES if n != "pelvis" and n not in legs_trunk]
+    moving = len(legs_trunk) + (len(arms_head) if collide_arms else 0)
+    assert m.nv == 6 * moving + 3 * m.nflexvert
+    assert m.nmocap == len(SIM_BODIES) - moving
+    # after a cloth step the mocap copies are where the runner's bodies are, the others
+    # carried a step on by their velocities (at the start pose, well under a millimetre)
+    wd = world.data
+    wd.qpos[0] += 0.1  # the runner moved 10 cm forward
+    mujoco.mj_forward(world.model, wd)
+    cloth.control(world, 0.0)
+    mujoco.mj_kinematics(m, d)
+    body = wd.xpos[cloth.wc.body_ids]
+    np.testing.assert_array_equal(d.xpos[cloth._copies[cloth._mocap]], body[cloth._mocap])
+    np.testing.assert_allclose(d.xpos[cloth._copies], body, atol=1e-3)
