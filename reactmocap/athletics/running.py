@@ -428,9 +428,6 @@ class Runner:
         damp = 2.0 * k["leg_damping"] * math.sqrt(stiff * self.mass)
         force = stiff * (self.leg_rest - length) - damp * rate
         state = self.machine.current.name
-        if state in ("toe", "unloading") and self.k["pushoff"] > 0:
-            # the push-off extends the leg past its touchdown length
-            force += stiff * (self._pushoff_length() - self.leg_rest)
         if state in ("toe", "unloading") and not self.released:
             force += self.thrust_force
         force = max(force, 0.0)
@@ -444,12 +441,6 @@ class Runner:
         # the knee's and ankle's servos keep no pitch stiffness of their own
         for j in (_KNEE[leg], _ANKLE[leg]):
             self.targets[j, 0] = self.goal[j, 0] = angles[j, 0]
-
-    def _pushoff_length(self) -> float:
-        """The leg's length (m) the push-off extends the stance leg to."""
-        leg = self.active
-        straight = self.athlete.thigh[leg] + self.athlete.shin[leg]
-        return min(self.leg_rest + self.k["pushoff"] * straight, 0.999 * straight)
 
     # ------------------------------------------------------------------ states
     def _states(self) -> list[State]:
@@ -471,8 +462,6 @@ class Runner:
             return t - self.t_touchdown >= self.k["toe_fraction"] * self.stance_estimate
 
         def knee_extended(_w: World, _t: float, t_in: float) -> bool:
-            if self.k["pushoff"] > 0:
-                return t_in > 0.02 and self.leg_prev >= self._pushoff_length() - 0.005
             knee = self._joint_pitch(_KNEE[self.active])
             return t_in > 0.02 and knee <= self.knee_td + 0.05
 

@@ -69,10 +69,6 @@ class RunParams:
             back, pushed on to lift-off (+0.26 m/s forward, a long flight, a landing with the
             foot 0.2 m ahead: how the slow-cadence gaits fell). Off from 4 m/s (10: never
             reached), where the gaits were tuned without it.
-        pushoff: from the toe phase on, the spring's rest length is the touchdown length plus
-            this much (fraction of the straight leg, at most a straight leg), and the toe phase
-            ends once the leg is that long (0: off, the rest length stays the touchdown length
-            and the toe phase ends once the knee is back at its touchdown bend).
         toe_fraction: the heel-and-toe phase ends at this fraction of the expected stance
             (the paper: 30-50% by speed).
         pitch: desired forward pitch of the trunk (rad).
@@ -128,7 +124,6 @@ class RunParams:
     thrust: float | Speeds = (1.683, 1.71, 1.716)
     takeoff_vz: float | Speeds = (0.5575, 0.517, 0.5806)
     thrust_drop: float | Speeds = (0.02, 0.02, 10.0)
-    pushoff: float | Speeds = 0.0
     toe_fraction: float | Speeds = (0.3849, 0.42, 0.3199)
     pitch: float | Speeds = (0.1207, 0.013, -0.01578)
     attitude_kp: tuple[float, float, float] = (208.7, 208.7, 17.9)
@@ -180,8 +175,6 @@ class RunParams:
                 raise ConfigError(f"stance_blend must be in (0, 1], got {self.stance_blend}")
             if r["thrust_drop"] <= 0:
                 raise ConfigError(f"thrust_drop must be > 0, got {self.thrust_drop}")
-            if not 0.0 <= r["pushoff"] <= 0.5:
-                raise ConfigError(f"pushoff must be in [0, 0.5], got {self.pushoff}")
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
 
