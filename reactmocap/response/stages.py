@@ -178,12 +178,17 @@ def estimate_contact(scenario: Scenario, cast: Cast) -> ContactEstimate:
                            scenario.impact.body)  # fmt: skip
 
 
-def _world(cast: Cast, cfg: ResponseConfig, recipient_friction: float) -> World:
-    """The simulations' world: the attacker always on ``friction_sim1`` (its strike should not
-    depend on the pass), the recipient on ``recipient_friction``."""
+#: the bodies whose friction Simulation 2 lowers (the paper lowers it "to allow foot slippage")
+FEET = ("l_foot", "r_foot")
+
+
+def _world(cast: Cast, cfg: ResponseConfig, feet_friction: float) -> World:
+    """The simulations' world on ``friction_sim1``, the recipient's feet on ``feet_friction``.
+    Only the feet: a body lying on the floor on Simulation 2's lower friction slid 0.3 m past
+    where Simulation 1's lay, where the search placed the found clip (``heavy_push_fall``)."""
     world = World([a.character for a in cast.actors],
                   WorldConfig(friction=cfg.friction_sim1, timestep=cfg.timestep))  # fmt: skip
-    world.set_friction(recipient_friction, character=0)
+    world.set_friction(feet_friction, character=0, bodies=FEET)
     return world
 
 
