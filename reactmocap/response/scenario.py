@@ -79,6 +79,9 @@ class ResponseConfig:
     #: through the servo's feed-forward, which nothing else limits); 0: none
     torque_limit: float = 0.0
     friction_sim1: float = 1.0
+    #: Simulation 2's friction on the recipient's limbs (the paper's 0.5 "to allow foot
+    #: slippage"); its trunk keeps ``friction_sim1``, so a fallen body does not slide off where
+    #: Simulation 1's lay, where the search placed the found clip
     friction_sim2: float = 0.5
     #: Simulation 1: ``yielding`` (the recipient gives way to the hit with its stiffness cut to
     #: ``yield_gain`` for the reaction delay, holding its pose at impact, then recovers over

@@ -37,6 +37,7 @@ from reactmocap.sim.controllers import (
 )
 from reactmocap.sim.controllers.registry import controller_spec
 from reactmocap.sim.controllers.wholebody import WholeBodyTracker
+from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.impacts import Impact, first_contact, overlap_depths
 from reactmocap.sim.reference import reference_path
 from reactmocap.sim.rollout import ContactLog, rollout
@@ -178,17 +179,19 @@ def estimate_contact(scenario: Scenario, cast: Cast) -> ContactEstimate:
                            scenario.impact.body)  # fmt: skip
 
 
-#: the bodies whose friction Simulation 2 lowers (the paper lowers it "to allow foot slippage")
-FEET = ("l_foot", "r_foot")
+#: the recipient's bodies on Simulation 2's lower friction: the limbs, which it lets slip into
+#: the found clip's pose (the paper lowers it "to allow foot slippage"); the trunk keeps
+#: Simulation 1's, so a body lying on the floor stays where Simulation 1's lay, where the search
+#: placed the found clip (on the whole body, the heavy push's slid 0.3 m further)
+LIMBS = tuple(b for b in SIM_BODIES if b not in ("pelvis", "waist", "chest", "head"))
 
 
-def _world(cast: Cast, cfg: ResponseConfig, feet_friction: float) -> World:
-    """The simulations' world on ``friction_sim1``, the recipient's feet on ``feet_friction``.
-    Only the feet: a body lying on the floor on Simulation 2's lower friction slid 0.3 m past
-    where Simulation 1's lay, where the search placed the found clip (``heavy_push_fall``)."""
+def _world(cast: Cast, cfg: ResponseConfig, limb_friction: float) -> World:
+    """The simulations' world on ``friction_sim1``, the recipient's :data:`LIMBS` on
+    ``limb_friction`` (the attacker's strike should not depend on the pass)."""
     world = World([a.character for a in cast.actors],
                   WorldConfig(friction=cfg.friction_sim1, timestep=cfg.timestep))  # fmt: skip
-    world.set_friction(feet_friction, character=0, bodies=FEET)
+    world.set_friction(limb_friction, character=0, bodies=LIMBS)
     return world
 
 

@@ -187,9 +187,9 @@ def test_bad_inputs_get_clear_errors(tmp_path: Path, capsys: pytest.CaptureFixtu
         run_response(missing, CACHE)
 
 
-def test_simulation_2_lowers_the_friction_of_the_feet_only() -> None:
-    # the paper lowers Simulation 2's friction "to allow foot slippage"; lowered on the whole
-    # body, the heavy push's fallen body slid on along the floor 0.28 m past where Simulation
+def test_simulation_2_lowers_the_friction_of_the_limbs_only() -> None:
+    # the paper lowers Simulation 2's friction "to allow foot slippage"; lowered on the trunk
+    # too, the heavy push's fallen body slid on along the floor 0.28 m past where Simulation
     # 1's lay (where the search placed the found clip) and the final blend moved the root 0.31 m
     from reactmocap import metrics as qm
     from reactmocap.response import stages
@@ -200,10 +200,10 @@ def test_simulation_2_lowers_the_friction_of_the_feet_only() -> None:
     world = stages._world(cast, cfg, cfg.friction_sim2)
     mu = world.model.geom_friction[:, 0]
     own = world.characters[0].geom_ids
-    feet = np.isin(world.geom_body[own], [SIM_BODIES.index(b) for b in stages.FEET])
-    assert feet.any() and (~feet).any()
-    assert np.all(mu[own[feet]] == cfg.friction_sim2)
-    assert np.all(mu[own[~feet]] == cfg.friction_sim1)
+    limbs = np.isin(world.geom_body[own], [SIM_BODIES.index(b) for b in stages.LIMBS])
+    assert limbs.any() and (~limbs).any()
+    assert np.all(mu[own[limbs]] == cfg.friction_sim2)
+    assert np.all(mu[own[~limbs]] == cfg.friction_sim1)
     with pytest.raises(ConfigError, match="bodies"):
         world.set_friction(0.5, character=0, bodies=("l_paw",))
     contact = stages.estimate_contact(sc, cast)
