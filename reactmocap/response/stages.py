@@ -25,6 +25,7 @@ from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_sc
 from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.search import MotionIndex, SearchResult
+from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.character import Character, build_character
 from reactmocap.sim.controllers import (
     Controller,
@@ -37,7 +38,6 @@ from reactmocap.sim.controllers import (
 )
 from reactmocap.sim.controllers.registry import controller_spec
 from reactmocap.sim.controllers.wholebody import WholeBodyTracker
-from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.impacts import Impact, first_contact, overlap_depths
 from reactmocap.sim.reference import reference_path
 from reactmocap.sim.rollout import ContactLog, rollout
