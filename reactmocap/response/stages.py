@@ -5,7 +5,8 @@ the recipient clip at ``recipient.start``; outputs are at the recipient clip's f
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
 from typing import Any
@@ -366,8 +367,15 @@ class Continuation:
     time: float
     found: Motion
     found_clip: Motion
-    #: the next-best continuations on other clips, best first (``land_tries - 1`` at most)
-    alternatives: tuple[Continuation, ...] = ()
+    #: builds :attr:`alternatives` (on first use: most responses never need them)
+    others: Callable[[], tuple[Continuation, ...]] | None = field(default=None, repr=False,
+                                                                   compare=False)  # fmt: skip
+
+    @cached_property
+    def alternatives(self) -> tuple[Continuation, ...]:
+        """The next-best continuations on other clips, best first (``land_tries - 1`` at
+        most)."""
+        return self.others() if self.others is not None else ()
 
 
 def search_continuation(
@@ -434,8 +442,9 @@ def search_continuation(
         return Continuation(r, index.top_k(query, start, n=cfg.top_k, parts=parts),
                             contact.rewind + start / q_fps, found, found_clip)  # fmt: skip
 
-    others: list[Continuation] = []
-    if cfg.land_tries > 1:  # the next-best window of each other clip, for land_tries
+    def alternatives() -> tuple[Continuation, ...]:
+        # the next-best window of each other clip, for land_tries
+        others: list[Continuation] = []
         seen = {best.clip}
         for r, s in results:
             if len(others) >= cfg.land_tries - 1:
@@ -444,7 +453,10 @@ def search_continuation(
                 continue
             seen.add(r.clip)
             others.append(continuation(r, s))
-    return replace(continuation(best, best_start), alternatives=tuple(others))
+        return tuple(others)
+
+    return replace(continuation(best, best_start),
+                   others=alternatives if cfg.land_tries > 1 else None)  # fmt: skip
 
 
 def _runs_into(cast: Cast, cfg: ResponseConfig, r: SearchResult, at: float) -> bool:
