@@ -571,8 +571,8 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
                           naive: NaiveSimulation, cont: Continuation) -> TransitionSimulation:  # fmt: skip
     """Simulation 2 (the recipient's limbs on ``friction_sim2``) from the same start and
     impact: the recipient follows the desired path to the found clip with ``sim2_controller``,
-    yielding through the reaction delay as in Simulation 1 (the passive response), then recovering (the active).
-    In the ``physical`` mode it runs on along the found clip until the body lands on it."""
+    yielding through the reaction delay as in Simulation 1 (the passive response), then
+    recovering (the active). In the ``physical`` mode it runs on along the found clip until the body lands on it."""
     cfg = scenario.response
     rewind = contact.rewind
     end = cont.time
