@@ -94,7 +94,7 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
         if sim2.on_clip:
             break
     out = timed("blend", final.blend, scenario, cast, contact, naive, cont, sim2)
-    tries = cont.alternatives if cfg.mode == "blend" else ()
+    tries = cfg.mode == "blend" and cfg.land_tries > 1
     score = _blend_score(cast, out) if tries or settles else (False, 0.0)
     if settles and score > (False, 1.0):
         # Simulation 2 runs again, on past the match (a rollout cannot be resumed: its
@@ -104,8 +104,9 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
         blended = timed("blend", final.blend, scenario, cast, contact, naive, cont, later)
         if (s := _blend_score(cast, blended)) < score:
             sim2, out, score = later, blended, s
-    for alt in tries:
+    for alt in cont.alternatives if tries and score > (False, 1.0) else ():
         # the blend mode's land_tries: a continuation whose final blend corrects less wins
+        # (the alternatives are searched only here, where the final blend would warn)
         if score <= (False, 1.0):
             break
         other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, alt)

@@ -79,6 +79,9 @@ class ResponseConfig:
     #: through the servo's feed-forward, which nothing else limits); 0: none
     torque_limit: float = 0.0
     friction_sim1: float = 1.0
+    #: Simulation 2's friction on the recipient's limbs (the paper's 0.5 "to allow foot
+    #: slippage"); its trunk keeps ``friction_sim1``, so a fallen body does not slide off where
+    #: Simulation 1's lay, where the search placed the found clip
     friction_sim2: float = 0.5
     #: Simulation 1: ``yielding`` (the recipient gives way to the hit with its stiffness cut to
     #: ``yield_gain`` for the reaction delay, holding its pose at impact, then recovers over
@@ -135,8 +138,9 @@ class ResponseConfig:
     #: the body came closest to (its landing gap over the tolerances) wins: a continuation the
     #: body can reach rather than the nearest window to Simulation 1. Blend mode: the same
     #: when the final blend would turn a joint or move the root beyond the warning thresholds,
-    #: and the continuation whose final blend corrects least (over those thresholds) wins
-    land_tries: int = 1
+    #: and the continuation whose final blend corrects least (over those thresholds) wins.
+    #: Either way the others are searched and simulated only where the first would warn
+    land_tries: int = 3
     #: blend mode: Simulation 2 tracks the found clip up to this many seconds past the match,
     #: and the final blend lands on the frame where it corrects least (``final.settle``: its
     #: largest joint turn and pelvis shift, each over its warning threshold), not at the match

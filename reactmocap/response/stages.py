@@ -5,7 +5,8 @@ the recipient clip at ``recipient.start``; outputs are at the recipient clip's f
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,7 @@ from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_sc
 from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
 from reactmocap.search import MotionIndex, SearchResult
+from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.character import Character, build_character
 from reactmocap.sim.controllers import (
     Controller,
@@ -178,12 +180,19 @@ def estimate_contact(scenario: Scenario, cast: Cast) -> ContactEstimate:
                            scenario.impact.body)  # fmt: skip
 
 
-def _world(cast: Cast, cfg: ResponseConfig, recipient_friction: float) -> World:
-    """The simulations' world: the attacker always on ``friction_sim1`` (its strike should not
-    depend on the pass), the recipient on ``recipient_friction``."""
+#: the recipient's bodies on Simulation 2's lower friction: the limbs, which it lets slip into
+#: the found clip's pose (the paper lowers it "to allow foot slippage"); the trunk keeps
+#: Simulation 1's, so a body lying on the floor stays where Simulation 1's lay, where the search
+#: placed the found clip (on the whole body, the heavy push's slid 0.3 m further)
+LIMBS = tuple(b for b in SIM_BODIES if b not in ("pelvis", "waist", "chest", "head"))
+
+
+def _world(cast: Cast, cfg: ResponseConfig, limb_friction: float) -> World:
+    """The simulations' world on ``friction_sim1``, the recipient's :data:`LIMBS` on
+    ``limb_friction`` (the attacker's strike should not depend on the pass)."""
     world = World([a.character for a in cast.actors],
                   WorldConfig(friction=cfg.friction_sim1, timestep=cfg.timestep))  # fmt: skip
-    world.set_friction(recipient_friction, character=0)
+    world.set_friction(limb_friction, character=0, bodies=LIMBS)
     return world
 
 
@@ -358,8 +367,15 @@ class Continuation:
     time: float
     found: Motion
     found_clip: Motion
-    #: the next-best continuations on other clips, best first (``land_tries - 1`` at most)
-    alternatives: tuple[Continuation, ...] = ()
+    #: builds :attr:`alternatives` (on first use: most responses never need them)
+    others: Callable[[], tuple[Continuation, ...]] | None = field(default=None, repr=False,
+                                                                   compare=False)  # fmt: skip
+
+    @cached_property
+    def alternatives(self) -> tuple[Continuation, ...]:
+        """The next-best continuations on other clips, best first (``land_tries - 1`` at
+        most)."""
+        return self.others() if self.others is not None else ()
 
 
 def search_continuation(
@@ -426,8 +442,9 @@ def search_continuation(
         return Continuation(r, index.top_k(query, start, n=cfg.top_k, parts=parts),
                             contact.rewind + start / q_fps, found, found_clip)  # fmt: skip
 
-    others: list[Continuation] = []
-    if cfg.land_tries > 1:  # the next-best window of each other clip, for land_tries
+    def alternatives() -> tuple[Continuation, ...]:
+        # the next-best window of each other clip, for land_tries
+        others: list[Continuation] = []
         seen = {best.clip}
         for r, s in results:
             if len(others) >= cfg.land_tries - 1:
@@ -436,7 +453,10 @@ def search_continuation(
                 continue
             seen.add(r.clip)
             others.append(continuation(r, s))
-    return replace(continuation(best, best_start), alternatives=tuple(others))
+        return tuple(others)
+
+    return replace(continuation(best, best_start),
+                   others=alternatives if cfg.land_tries > 1 else None)  # fmt: skip
 
 
 def _runs_into(cast: Cast, cfg: ResponseConfig, r: SearchResult, at: float) -> bool:
@@ -549,10 +569,10 @@ class TransitionSimulation:
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
                           naive: NaiveSimulation, cont: Continuation) -> TransitionSimulation:  # fmt: skip
-    """Simulation 2 (friction ``friction_sim2``) from the same start and impact: the recipient
-    follows the desired path to the found clip with ``sim2_controller``, yielding through the
-    reaction delay as in Simulation 1 (the passive response), then recovering (the active).
-    In the ``physical`` mode it runs on along the found clip until the body lands on it."""
+    """Simulation 2 (the recipient's limbs on ``friction_sim2``) from the same start and
+    impact: the recipient follows the desired path to the found clip with ``sim2_controller``,
+    yielding through the reaction delay as in Simulation 1 (the passive response), then
+    recovering (the active). In the ``physical`` mode it runs on along the found clip until the body lands on it."""
     cfg = scenario.response
     rewind = contact.rewind
     end = cont.time

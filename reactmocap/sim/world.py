@@ -354,17 +354,27 @@ class World:
         """``(2,)`` whether each foot (left, right) currently touches through its patch."""
         return self.model.geom_contype[self.characters[character].patch_ids] != 0
 
-    def set_friction(self, mu: float, character: int | None = None) -> None:
-        """Sliding friction coefficient of every contact, or of one character's contacts.
-        MuJoCo takes the larger of two geoms' coefficients, so the floor keeps the smallest
-        any character has and each character's geoms carry its own."""
+    def set_friction(
+        self, mu: float, character: int | None = None, bodies: tuple[str, ...] | None = None
+    ) -> None:
+        """Sliding friction coefficient of every contact, or of one character's contacts (only
+        those of its ``bodies``, names of SIM_BODIES, when given). MuJoCo takes the larger of
+        two geoms' coefficients, so the floor keeps the smallest any character has and each
+        character's geoms carry its own."""
         if not (np.isfinite(mu) and mu >= 0):
             raise ConfigError(f"friction must be >= 0, got {mu!r}")
         m = self.model
         if character is None:
             m.geom_friction[:, 0] = mu
             return
-        m.geom_friction[self.characters[character].geom_ids, 0] = mu
+        geoms = self.characters[character].geom_ids
+        if bodies is not None:
+            unknown = sorted(set(bodies) - set(SIM_BODIES))
+            if unknown:
+                raise ConfigError(f"bodies: unknown {unknown}; expected names of {SIM_BODIES}")
+            picked = [SIM_BODIES.index(b) for b in bodies]
+            geoms = geoms[np.isin(self.geom_body[geoms], picked)]
+        m.geom_friction[geoms, 0] = mu
         floor = m.geom("floor").id
         m.geom_friction[floor, 0] = min(
             float(m.geom_friction[wc.geom_ids, 0].min()) for wc in self.characters

@@ -77,7 +77,7 @@ def test_the_blend_mode_tries_other_clips_when_its_final_blend_would_warn(
     for f in [*shared_mocap_dir.glob("*.bvh"), *SYNTHETIC.glob("*.bvh")]:
         (lib / f.name).symlink_to(f)
     cfg = ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
-                         torque_limit=1000.0)  # fmt: skip
+                         torque_limit=1000.0, land_tries=1)  # fmt: skip
     sc = Scenario(
         library=lib,
         recipient=CharacterSpec("dataset-1_walk_normal_001", start=0.5),

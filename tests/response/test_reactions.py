@@ -23,6 +23,7 @@ from reactmocap.response.scenario import (
     load_scenario,
     parse_scenario,
 )
+from reactmocap.sim.bodies import SIM_BODIES
 from tests.conftest import REPO, SYNTHETIC
 from tests.fixtures.one_spine import dummy_root, write_one_spine
 
@@ -184,6 +185,39 @@ def test_bad_inputs_get_clear_errors(tmp_path: Path, capsys: pytest.CaptureFixtu
     missing = sc.with_changes(recipient=CharacterSpec("nowhere.bvh"))
     with pytest.raises(ConfigError, match="nowhere.bvh"):
         run_response(missing, CACHE)
+
+
+def test_simulation_2_lowers_the_friction_of_the_limbs_only() -> None:
+    # the paper lowers Simulation 2's friction "to allow foot slippage"; lowered on the trunk
+    # too, the heavy push's fallen body slid on along the floor 0.28 m past where Simulation
+    # 1's lay (where the search placed the found clip) and the final blend moved the root 0.31 m
+    from reactmocap import metrics as qm
+    from reactmocap.response import stages
+
+    sc = load_scenario(EXAMPLES / "heavy_push_fall.toml")
+    cfg = sc.response
+    cast = stages.cast(sc, CACHE)
+    world = stages._world(cast, cfg, cfg.friction_sim2)
+    mu = world.model.geom_friction[:, 0]
+    own = world.characters[0].geom_ids
+    limbs = np.isin(world.geom_body[own], [SIM_BODIES.index(b) for b in stages.LIMBS])
+    assert limbs.any() and (~limbs).any()
+    assert np.all(mu[own[limbs]] == cfg.friction_sim2)
+    assert np.all(mu[own[~limbs]] == cfg.friction_sim1)
+    with pytest.raises(ConfigError, match="bodies"):
+        world.set_friction(0.5, character=0, bodies=("l_paw",))
+    contact = stages.estimate_contact(sc, cast)
+    naive = stages.naive_simulation(sc, cast, contact)
+    cont = stages.search_continuation(sc, cast, contact, naive)
+    sim2 = stages.transition_simulation(sc, cast, contact, naive, cont)
+    pelvis = cast.recipient.parts.joint_of("pelvis")
+    at = [cont.time - contact.rewind]
+    lay = [m.sample(at).global_positions()[0, pelvis, :2] for m in (naive.motion, sim2.motion)]
+    assert naive.motion.sample(at).global_positions()[0, pelvis, 2] < 0.3  # lying: the case
+    assert np.linalg.norm(lay[0] - lay[1]) < 0.15, lay  # 0.28 m on the lowered whole body
+    report = run_response(sc, CACHE).report
+    assert report["quality"]["blend_root_offset_max_m"] <= qm.WARN_ROOT_OFFSET_M
+    assert report["warnings"] == []
 
 
 def test_simulation_2_fills_the_joints_it_does_not_simulate_from_what_it_was_asked() -> None:
