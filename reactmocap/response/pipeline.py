@@ -208,6 +208,11 @@ def _report(
             if out.attacker is not None and cast.attacker is not None
             else None
         ),
+        "attacker_foot_skate_m": (
+            qm.foot_skate_m(out.attacker, cast.attacker.parts)
+            if out.attacker is not None and cast.attacker is not None
+            else None
+        ),
     }
     warnings = _warnings(scenario, cast, contact, naive, cont, quality)
     if naive.unstable is not None:
