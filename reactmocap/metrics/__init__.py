@@ -14,6 +14,7 @@ from reactmocap.rotations import quat_conj, quat_log, quat_mul
 
 __all__ = [
     "REACTION_WINDOW_S",
+    "WARN_ATTACKER_FOOT_SKATE_M",
     "WARN_ATTACKER_SPEED_RATIO",
     "WARN_JOINT_CORRECTION_RAD",
     "WARN_OVERLAP_M",
@@ -196,6 +197,9 @@ WARN_JOINT_CORRECTION_RAD = 0.6
 #: covered both)
 WARN_ROOT_TURN_RAD = WARN_JOINT_CORRECTION_RAD
 WARN_ATTACKER_SPEED_RATIO = 1.5
+#: the attacker's ``foot_skate_m`` warns above the recipient's own in 9 of 10 runs of the
+#: real-recipient benchmark (p90 0.32-0.34 m in both modes, 2026-12-02; docs/benchmarks.md)
+WARN_ATTACKER_FOOT_SKATE_M = 0.3
 
 
 def blend_correction_over_warning(simulated: Motion, blended: Motion, parts: BodyPartMap) -> float:
