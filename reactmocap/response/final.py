@@ -262,7 +262,7 @@ def _side_steps(motion: Motion, parts: BodyPartMap, offset: F64, direction: F64,
     for f, side in enumerate(("l", "r")):
         frames = np.flatnonzero(rest[:, f] | (lift[:, f] > 0.0))
         goals[side] = (frames, goal[frames, f])
-    return place_ankles(moved, parts, goals)
+    return place_ankles(moved, parts, goals, keep_bend=True)
 
 
 @dataclass(frozen=True)

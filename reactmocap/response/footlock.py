@@ -99,10 +99,12 @@ def lock_feet(motion: Motion, parts: BodyPartMap) -> Motion:
 
 
 def place_ankles(motion: Motion, parts: BodyPartMap,
-                 goals: Mapping[str, tuple[NDArray[np.int64], F64]]) -> Motion:  # fmt: skip
+                 goals: Mapping[str, tuple[NDArray[np.int64], F64]],
+                 keep_bend: bool = False) -> Motion:  # fmt: skip
     """``motion`` with each leg's ankle (``goals`` by side, ``"l"``/``"r"``: frames and their
     goals ``(n, 3)``) moved onto its goal by turning the hip and knee (two-bone IK, the knee
-    in its current bending plane, the foot keeping its world turn; a goal out of reach is
+    in the plane of its bend toward the goal, or with ``keep_bend`` the bend's direction from
+    its hip-ankle line kept; the foot keeping its world turn; a goal out of reach is
     approached along the line to it). Legs whose knee is not the hip's child or whose ankle
     is not the knee's child are left as they are."""
     skel = motion.skeleton
@@ -119,10 +121,14 @@ def place_ankles(motion: Motion, parts: BodyPartMap,
         lb = np.linalg.norm(a - k, axis=-1)
         c = np.clip(np.linalg.norm(goal - h, axis=-1), np.abs(la - lb) + 1e-6, la + lb - 1e-6)
         u = _unit(goal - h)
-        # the knee bends the way it bent (its offset from the hip-ankle line, made
-        # perpendicular to the new one: a goal passing under the hip does not flip it)
-        u0 = _unit(a - h)
-        bend = (k - h) - u0 * np.sum((k - h) * u0, axis=-1, keepdims=True)
+        bend = k - h
+        if keep_bend:
+            # the knee bends the way it bent (its offset from the hip-ankle line, made
+            # perpendicular to the new one): a goal far from the ankle, passing under the hip,
+            # does not flip it
+            u0 = _unit(a - h)
+            bend = bend - u0 * np.sum(bend * u0, axis=-1, keepdims=True)
+        # knee stays in the plane of the bend
         v = _unit(bend - u * np.sum(bend * u, axis=-1, keepdims=True))
         cos_a = np.clip((la**2 + c**2 - lb**2) / (2 * la * c), -1.0, 1.0)
         knee_new = h + la[:, None] * (cos_a[:, None] * u + np.sqrt(1 - cos_a**2)[:, None] * v)
