@@ -198,16 +198,12 @@ def _side_steps(motion: Motion, parts: BodyPartMap, offset: F64, direction: F64,
     steps = max(2, int(round(STEP_S * fps)))
     foot = np.zeros((n, 2))  # each foot's offset along ``direction``
     lift = np.zeros((n, 2))
-    # frames to the next plant and the end of that plant, per foot
-    nxt_on = np.full((n, 2), n - 1)
-    nxt_off = np.full((n, 2), n - 1)
-    for f in range(2):  # sequential: each frame looks at the next
-        on = off = n - 1
-        for i in range(n - 1, -1, -1):
-            if down[i, f]:
-                on = i
-                off = off if i + 1 < n and down[i + 1, f] else i
-            nxt_on[i, f], nxt_off[i, f] = on, off
+    # each frame's next planted frame and the last frame of that plant, per foot
+    frame = np.arange(n)[:, None]
+    nxt_on = np.minimum.accumulate(np.where(down, frame, n - 1)[::-1])[::-1]
+    ends = down & ~np.concatenate([down[1:], np.zeros((1, 2), dtype=bool)])
+    nxt_end = np.minimum.accumulate(np.where(ends, frame, n - 1)[::-1])[::-1]
+    nxt_off = np.take_along_axis(nxt_end, nxt_on, axis=0)
     first = int(moving[0])
     order = np.argsort(-(ankles[first, :, :2] @ direction[:2]))  # the leading foot first
     left = np.zeros(2, dtype=int)  # frames left of each foot's own step
@@ -243,24 +239,23 @@ def _side_steps(motion: Motion, parts: BodyPartMap, offset: F64, direction: F64,
     # a foot the root left further than the leg reaches: the root crouches (a straight leg's
     # knee has no bending plane for the IK)
     pos = moved.global_positions()
-    hips = pos[:, [parts.joint_of(f"{s}_thigh") for s in ("l", "r")]]
-    legs = (np.linalg.norm(pos[:, [parts.joint_of(f"{s}_shin") for s in ("l", "r")]] - hips,
-                           axis=-1)
-            + np.linalg.norm(ankles - pos[:, [parts.joint_of(f"{s}_shin") for s in ("l", "r")]],
-                             axis=-1))  # fmt: skip
-    flat = np.linalg.norm((goal - hips)[..., :2], axis=-1)
+    hips, knees = (pos[:, [parts.joint_of(f"{s}_{p}") for s in ("l", "r")]]
+                   for p in ("thigh", "shin"))  # fmt: skip
+    carried = ankles + offset[:, None, None] * direction  # the feet moved with the root
+    legs = np.linalg.norm(knees - hips, axis=-1) + np.linalg.norm(carried - knees, axis=-1)
     # (or its stretch in the clip: a foot left where it was needs no crouch)
-    reach = np.maximum(
-        LEG_REACH * legs,
-        np.linalg.norm(ankles - (hips - offset[:, None, None] * direction), axis=-1),
-    )
+    reach = np.maximum(LEG_REACH * legs, np.linalg.norm(carried - hips, axis=-1))
+    flat = np.linalg.norm((goal - hips)[..., :2], axis=-1)
     up = np.sqrt(np.maximum(reach**2 - flat**2, 0.0))
     drop = np.where(rest | (lift > 0.0), (hips[..., 2] - goal[..., 2]) - up, 0.0).max(axis=1)
+    # each frame's crouch reached beforehand and left afterwards no faster than ``rate``
+    span_s = np.abs(frame - frame.T)
+    drop = np.maximum((drop[None, :] - rate * span_s).max(axis=1), 0.0)
     moved = moved.replace(root_positions=moved.root_positions
-                          - np.maximum(drop, 0.0)[:, None] * np.array([0.0, 0.0, 1.0]))  # fmt: skip
+                          - drop[:, None] * np.array([0.0, 0.0, 1.0]))  # fmt: skip
     goals = {}
     for f, side in enumerate(("l", "r")):
-        frames = np.flatnonzero(rest[:, f] | (lift[:, f] > 0.0))
+        frames = np.flatnonzero(rest[:, f] | (lift[:, f] > 0.0) | (drop > 0.0))
         goals[side] = (frames, goal[frames, f])
     return place_ankles(moved, parts, goals, keep_bend=True)
 

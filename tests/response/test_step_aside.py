@@ -46,11 +46,11 @@ def test_the_attacker_steps_aside_on_planted_feet(
     speed = qm.joint_speed_max_m_s(m)
     out = final._side_steps(m, parts, offset, side, speed)
     feet = [parts.joint_of(f"{s}_foot") for s in ("l", "r")]
-    assert _added_travel(m, out, feet) <= 0.03
+    assert _added_travel(m, out, feet) <= 0.01
     moved = out.root_positions - m.root_positions
     assert moved[-1, 1] == pytest.approx(0.5) and np.abs(moved[:, 0]).max() < 1e-9
     assert qm.speed_ratio(out, m) <= 1.5
-    assert qm.foot_skate_m(out, parts) <= qm.foot_skate_m(m, parts) + 0.03
+    assert qm.foot_skate_m(out, parts) <= qm.foot_skate_m(m, parts) + 0.05
     # the feet went along: at least one foot stepped the whole way
     shift = (out.global_positions()[-1, feet] - m.global_positions()[-1, feet])[:, 1]
     assert shift.max() == pytest.approx(0.5, abs=0.01)
