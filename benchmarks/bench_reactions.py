@@ -72,6 +72,7 @@ def _row(name: str, rep: dict) -> str:
         f"dir {q['reaction_direction_error_deg']:5.1f} deg J {q['contact_impulse_Ns']:5.1f} Ns "
         f"peak {rep['impact']['peak_force_N']:6.0f} N tr {q['transition_s']:.2f} s "
         f"overlap {q['character_overlap_max_m']:.3f} m fell {q['fell']!s:5s} "
+        f"skate {q['foot_skate_m']:.2f}/{q['attacker_foot_skate_m'] or 0.0:.2f} m "
         f"warn {len(rep['warnings'])} {rep['timings_s']['total']:.2f} s"
     )
 
@@ -218,6 +219,7 @@ def _summary(title: str, rows: list[dict | None]) -> None:
         "root": "moves the root",
         "overlap": "overlap by",
         "speed": "attacker moves",
+        "attacker skate": "attacker's planted feet",
         "physical": "physical mode",
     }
     count = {k: sum(any(v in w for w in r["warnings"]) for r in done) for k, v in kinds.items()}

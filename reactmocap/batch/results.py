@@ -54,6 +54,7 @@ QUALITY_METRICS = (
     "contact_impulse_Ns",
     "character_overlap_max_m",
     "attacker_speed_ratio",
+    "attacker_foot_skate_m",
     "warnings",
 )
 TIMING_STAGES = ("scan", "sim1", "search", "sim2", "blend", "total")

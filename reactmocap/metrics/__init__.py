@@ -14,6 +14,7 @@ from reactmocap.rotations import quat_conj, quat_log, quat_mul
 
 __all__ = [
     "REACTION_WINDOW_S",
+    "WARN_ATTACKER_FOOT_SKATE_M",
     "WARN_ATTACKER_SPEED_RATIO",
     "WARN_JOINT_CORRECTION_RAD",
     "WARN_OVERLAP_M",
@@ -30,6 +31,7 @@ __all__ = [
     "joint_speed_max_m_s",
     "match_distance",
     "penetration_max_m",
+    "planted",
     "reaction_displacement",
     "speed_ratio",
     "stitch_velocity_jump_rad_s",
@@ -95,19 +97,23 @@ def _foot_points(motion: Motion, parts: BodyPartMap) -> np.ndarray:
     return motion.global_positions()[:, idx]
 
 
-def foot_skate_m(motion: Motion, parts: BodyPartMap) -> float:
-    """Horizontal travel (m) of the foot and toe joints while planted, summed over the motion.
+def planted(points: NDArray[np.float64], fps: float) -> NDArray[np.bool_]:
+    """``(T - 1, P)`` whether each point of ``points`` ``(T, P, 3)`` is planted on each frame
+    pair: within ``PLANT_HEIGHT_M`` of its lowest height in the motion on both frames and
+    moving slower than ``PLANT_SPEED_M_S``."""
+    low = points[..., 2] <= points[..., 2].min(axis=0) + PLANT_HEIGHT_M
+    step = np.linalg.norm(np.diff(points[..., :2], axis=0), axis=-1)
+    return np.asarray(low[1:] & low[:-1] & (step * fps < PLANT_SPEED_M_S))
 
-    A point is planted on a frame pair when it is within ``PLANT_HEIGHT_M`` of its lowest height
-    in the motion on both frames and moving slower than ``PLANT_SPEED_M_S``.
-    """
+
+def foot_skate_m(motion: Motion, parts: BodyPartMap) -> float:
+    """Horizontal travel (m) of the foot and toe joints while :func:`planted`, summed over the
+    motion (a point sliding faster than ``PLANT_SPEED_M_S`` counts as moving, not skating)."""
     p = _foot_points(motion, parts)
     if p.shape[0] < 2:
         return 0.0
-    low = p[..., 2] <= p[..., 2].min(axis=0) + PLANT_HEIGHT_M
     step = np.linalg.norm(np.diff(p[..., :2], axis=0), axis=-1)
-    planted = low[1:] & low[:-1] & (step * motion.fps < PLANT_SPEED_M_S)
-    return float(np.sum(step[planted]))
+    return float(np.sum(step[planted(p, motion.fps)]))
 
 
 def penetration_max_m(motion: Motion) -> float:
@@ -191,6 +197,9 @@ WARN_JOINT_CORRECTION_RAD = 0.6
 #: covered both)
 WARN_ROOT_TURN_RAD = WARN_JOINT_CORRECTION_RAD
 WARN_ATTACKER_SPEED_RATIO = 1.5
+#: the attacker's ``foot_skate_m`` warns above the recipient's own in 9 of 10 runs of the
+#: real-recipient benchmark (p90 0.32-0.34 m in both modes, 2026-12-02; docs/benchmarks.md)
+WARN_ATTACKER_FOOT_SKATE_M = 0.3
 
 
 def blend_correction_over_warning(simulated: Motion, blended: Motion, parts: BodyPartMap) -> float:

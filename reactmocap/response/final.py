@@ -8,11 +8,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
+from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import ground_root
-from reactmocap.metrics import blend_correction_over_warning, joint_speed_max_m_s
+from reactmocap.metrics import blend_correction_over_warning, joint_speed_max_m_s, planted
 from reactmocap.response.blend import blend_poses, final_blend
-from reactmocap.response.footlock import lock_feet
+from reactmocap.response.footlock import lock_feet, place_ankles
 from reactmocap.response.scenario import ResponseConfig, Scenario
 from reactmocap.response.stages import (
     Actor,
@@ -43,6 +44,14 @@ SETTLE_STEP_S = 0.05
 ASIDE_MARGIN_M = 0.005
 #: ... re-measured this many times (each adds the depth still left)
 ASIDE_TRIES = 12
+#: the step aside is taken in steps: a planted foot steps (lifted ``STEP_LIFT_M``, over
+#: ``STEP_S``) once the root will be more than ``STEP_M`` past it by the step's end; the root
+#: moves no faster than a step per step time (a person's side step: ~0.25-0.4 m in ~0.3 s)
+STEP_M = 0.25
+STEP_S = 0.3
+STEP_LIFT_M = 0.06
+#: ... and the root crouches so that no leg stretches past this share of its length
+LEG_REACH = 0.97
 
 
 def _clear_of(cast: Cast, recipient: Motion, impact: float) -> float:
@@ -117,11 +126,13 @@ def _rate_limited(path: F64, step: float) -> F64:
 def _step_aside(cast: Cast, recipient: Motion, attacker: Motion, impact: float,
                 speed: float) -> Motion:  # fmt: skip
     """``attacker`` moved aside horizontally (away from the recipient's pelvis where they first
-    overlap) until the recipient's output no longer runs into it: the offset it needs at each
-    overlapping frame is reached beforehand at no more than a quarter of its clip's fastest
-    joint ``speed`` and kept after (the recipient stays where it stood). The physical mode's
-    tail (the found clip after the landing) walks or falls onto an attacker that its
-    simulation left standing or lying there (docs/benchmarks.md)."""
+    overlap) until the recipient's output no longer runs into it: the offset its root needs at
+    each overlapping frame is reached beforehand at no more than a quarter of its clip's
+    fastest joint ``speed`` nor a side step's pace (``STEP_M`` per ``STEP_S``) and kept after
+    (the recipient stays where it stood); its feet follow in steps (:func:`_side_steps`). The
+    physical mode's tail (the found clip after the landing) walks or falls onto an attacker
+    that its simulation left standing or lying there (docs/benchmarks.md)."""
+    assert cast.attacker is not None
     fps = recipient.fps
     t = recipient.times
     ta = attacker.times
@@ -129,9 +140,10 @@ def _step_aside(cast: Cast, recipient: Motion, attacker: Motion, impact: float,
     offset = np.zeros(t.size)
     direction: F64 | None = None
     pelvis = cast.recipient.parts.joint_of("pelvis")
-    apelvis = cast.attacker.parts.joint_of("pelvis") if cast.attacker is not None else 0
+    aparts = cast.attacker.parts
+    apelvis = aparts.joint_of("pelvis")
     moved = attacker
-    v = 0.25 * speed
+    v = min(0.25 * speed, STEP_M / STEP_S)
     ahead = np.maximum(t[None, :] - t[:, None], 0.0)  # [this frame i, frame j]: t_j - t_i, >= 0
     for _ in range(ASIDE_TRIES):
         depth = overlap_depths(cast.pair, [recipient, moved.sample(t).replace(fps=fps)])
@@ -154,9 +166,98 @@ def _step_aside(cast: Cast, recipient: Motion, attacker: Motion, impact: float,
         offset = np.maximum(reach.max(axis=1), 0.0)
         off_a = np.interp(ta, t, offset)
         off_a[ta < impact] = 0.0
-        moved = attacker.replace(root_positions=attacker.root_positions
-                                 + off_a[:, None] * direction[None])  # fmt: skip
+        moved = _side_steps(attacker, aparts, off_a, direction, speed)
     return moved
+
+
+def _side_steps(motion: Motion, parts: BodyPartMap, offset: F64, direction: F64,
+                speed: float) -> Motion:  # fmt: skip
+    """``motion`` with its root moved by ``offset`` ``(T,)`` (m, nondecreasing) along
+    ``direction`` and its feet following in steps, each planted foot (as
+    :func:`reactmocap.metrics.planted` finds them in ``motion``) held where it stands: a foot
+    in the air in ``motion`` moves on to where the root will be at the end of its next stance
+    (two step times ahead at most); a planted foot the root leaves more than ``STEP_M``
+    behind steps (lifted ``STEP_LIFT_M``) to where the root will be two step times later, at
+    most ``2 * STEP_M``, over ``STEP_S`` or longer: its foot no faster than half the clip's
+    fastest joint ``speed`` (m/s), as the attacker's blend back; the foot further along
+    ``direction`` first, one foot at a time. The legs bend to their feet
+    (:func:`place_ankles`)."""
+    fps = motion.fps
+    n = motion.num_frames
+    feet = [parts.joint_of(f"{s}_foot") for s in ("l", "r")]
+    ankles = motion.global_positions()[:, feet]
+    pairs = planted(ankles, fps)
+    down = np.zeros((n, 2), dtype=bool)  # a frame is planted where a planted pair touches it
+    down[:-1] |= pairs
+    down[1:] |= pairs
+    moved = motion.replace(root_positions=motion.root_positions
+                           + offset[:, None] * direction[None])  # fmt: skip
+    moving = np.flatnonzero(offset > 0.0)
+    if moving.size == 0:
+        return moved
+    steps = max(2, int(round(STEP_S * fps)))
+    foot = np.zeros((n, 2))  # each foot's offset along ``direction``
+    lift = np.zeros((n, 2))
+    # each frame's next planted frame and the last frame of that plant, per foot
+    frame = np.arange(n)[:, None]
+    nxt_on = np.minimum.accumulate(np.where(down, frame, n - 1)[::-1])[::-1]
+    ends = down & ~np.concatenate([down[1:], np.zeros((1, 2), dtype=bool)])
+    nxt_end = np.minimum.accumulate(np.where(ends, frame, n - 1)[::-1])[::-1]
+    nxt_off = np.take_along_axis(nxt_end, nxt_on, axis=0)
+    first = int(moving[0])
+    order = np.argsort(-(ankles[first, :, :2] @ direction[:2]))  # the leading foot first
+    left = np.zeros(2, dtype=int)  # frames left of each foot's own step
+    span = np.zeros((2, 2))  # each own step's start and end offsets
+    length = np.full(2, steps)  # and its frames
+    rate = 0.5 * speed / fps  # a foot in the air moves on no faster than the blend back
+    for i in range(first, n):  # sequential: each frame starts from the last
+        foot[i] = foot[i - 1] if i > 0 else 0.0
+        for f in order:
+            g = 1 - f
+            if left[f] > 0:
+                # lift, move (in the middle half, the foot off the ground), plant
+                s = 1.0 - (left[f] - 1) / length[f]
+                h = min(max(2.0 * s - 0.5, 0.0), 1.0)
+                foot[i, f] = span[f, 0] + (span[f, 1] - span[f, 0]) * h * h * (3.0 - 2.0 * h)
+                lift[i, f] = STEP_LIFT_M * np.sin(np.pi * s)
+                left[f] -= 1
+            elif not down[i, f]:  # in the air in the clip: on to its next plant
+                land = int(nxt_on[i, f])
+                goal = min(offset[min(int(nxt_off[i, f]), land + 2 * steps)],
+                           offset[land] + STEP_M)  # fmt: skip
+                foot[i, f] += np.clip((goal - foot[i, f]) / max(land - i, 1), -rate, rate)
+            elif (offset[min(i + steps, n - 1)] - foot[i, f] > STEP_M and left[g] == 0
+                  and down[i, g]):  # fmt: skip
+                span[f] = foot[i, f], min(offset[min(i + 2 * steps, n - 1)],
+                                          foot[i, f] + 2.0 * STEP_M)  # fmt: skip
+                # a smoothstep over half the step peaks at 3x the step's mean speed
+                slow = 3.0 * (span[f, 1] - span[f, 0]) / max(0.5 * speed, 1e-9) * fps
+                left[f] = length[f] = max(steps, int(np.ceil(slow)))
+    rest = np.abs(foot - offset[:, None]) > 1e-6
+    goal = ankles + foot[..., None] * direction
+    goal[..., 2] += lift
+    # a foot the root left further than the leg reaches: the root crouches (a straight leg's
+    # knee has no bending plane for the IK)
+    pos = moved.global_positions()
+    hips, knees = (pos[:, [parts.joint_of(f"{s}_{p}") for s in ("l", "r")]]
+                   for p in ("thigh", "shin"))  # fmt: skip
+    carried = ankles + offset[:, None, None] * direction  # the feet moved with the root
+    legs = np.linalg.norm(knees - hips, axis=-1) + np.linalg.norm(carried - knees, axis=-1)
+    # (or its stretch in the clip: a foot left where it was needs no crouch)
+    reach = np.maximum(LEG_REACH * legs, np.linalg.norm(carried - hips, axis=-1))
+    flat = np.linalg.norm((goal - hips)[..., :2], axis=-1)
+    up = np.sqrt(np.maximum(reach**2 - flat**2, 0.0))
+    drop = np.where(rest | (lift > 0.0), (hips[..., 2] - goal[..., 2]) - up, 0.0).max(axis=1)
+    # each frame's crouch reached beforehand and left afterwards no faster than ``rate``
+    span_s = np.abs(frame - frame.T)
+    drop = np.maximum((drop[None, :] - rate * span_s).max(axis=1), 0.0)
+    moved = moved.replace(root_positions=moved.root_positions
+                          - drop[:, None] * np.array([0.0, 0.0, 1.0]))  # fmt: skip
+    goals = {}
+    for f, side in enumerate(("l", "r")):
+        frames = np.flatnonzero(rest[:, f] | (lift[:, f] > 0.0) | (drop > 0.0))
+        goals[side] = (frames, goal[frames, f])
+    return place_ankles(moved, parts, goals, keep_bend=True)
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,8 @@ no listed library does IK on BVH skeletons, and two-bone IK is a few closed-form
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -19,7 +21,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.metrics import PLANT_HEIGHT_M, PLANT_SPEED_M_S
 from reactmocap.rotations import quat_conj, quat_mul, quat_normalize, quat_rotate
 
-__all__ = ["lock_feet"]
+__all__ = ["lock_feet", "place_ankles"]
 
 F64 = NDArray[np.float64]
 #: plants whose ankle drifts less than this (m) are left alone
@@ -83,29 +85,51 @@ def lock_feet(motion: Motion, parts: BodyPartMap) -> Motion:
     knee is not the hip's child or whose ankle is not the knee's child are left as they are."""
     if motion.num_frames < 3:
         return motion
+    pos = motion.global_positions()
+    goals = {}
+    for side in ("l", "r"):
+        a = pos[:, parts.joint_of(f"{side}_foot")]
+        target_xy, w = _targets(a, motion.fps)
+        frames = np.flatnonzero(w > 0)
+        if frames.size:
+            goal = a[frames].copy()
+            goal[:, :2] += w[frames, None] * (target_xy[frames] - a[frames, :2])
+            goals[side] = (frames, goal)
+    return place_ankles(motion, parts, goals)
+
+
+def place_ankles(motion: Motion, parts: BodyPartMap,
+                 goals: Mapping[str, tuple[NDArray[np.int64], F64]],
+                 keep_bend: bool = False) -> Motion:  # fmt: skip
+    """``motion`` with each leg's ankle (``goals`` by side, ``"l"``/``"r"``: frames and their
+    goals ``(n, 3)``) moved onto its goal by turning the hip and knee (two-bone IK, the knee
+    in the plane of its bend toward the goal, or with ``keep_bend`` the bend's direction from
+    its hip-ankle line kept; the foot keeping its world turn; a goal out of reach is
+    approached along the line to it). Legs whose knee is not the hip's child or whose ankle
+    is not the knee's child are left as they are."""
     skel = motion.skeleton
     pos, rot = motion.forward_kinematics()
     local = np.array(motion.rotations)
     changed = False
-    for side in ("l", "r"):
+    for side, (frames, goal) in goals.items():
         hip, knee, ankle = (parts.joint_of(f"{side}_{p}") for p in ("thigh", "shin", "foot"))
-        if skel.parents[knee] != hip or skel.parents[ankle] != knee:
-            continue
-        target_xy, w = _targets(pos[:, ankle], motion.fps)
-        frames = np.flatnonzero(w > 0)
-        if frames.size == 0:
+        if skel.parents[knee] != hip or skel.parents[ankle] != knee or frames.size == 0:
             continue
         changed = True
         h, k, a = pos[frames, hip], pos[frames, knee], pos[frames, ankle]
-        goal = a.copy()
-        goal[:, :2] = a[:, :2] + w[frames, None] * (target_xy[frames] - a[:, :2])
         la = np.linalg.norm(k - h, axis=-1)
         lb = np.linalg.norm(a - k, axis=-1)
         c = np.clip(np.linalg.norm(goal - h, axis=-1), np.abs(la - lb) + 1e-6, la + lb - 1e-6)
         u = _unit(goal - h)
-        # knee stays in the plane of the current bend
-        kv = (k - h) - u * np.sum((k - h) * u, axis=-1, keepdims=True)
-        v = _unit(kv)
+        bend = k - h
+        if keep_bend:
+            # the knee bends the way it bent (its offset from the hip-ankle line, made
+            # perpendicular to the new one): a goal far from the ankle, passing under the hip,
+            # does not flip it
+            u0 = _unit(a - h)
+            bend = bend - u0 * np.sum(bend * u0, axis=-1, keepdims=True)
+        # knee stays in the plane of the bend
+        v = _unit(bend - u * np.sum(bend * u, axis=-1, keepdims=True))
         cos_a = np.clip((la**2 + c**2 - lb**2) / (2 * la * c), -1.0, 1.0)
         knee_new = h + la[:, None] * (cos_a[:, None] * u + np.sqrt(1 - cos_a**2)[:, None] * v)
         # hip: turn the thigh onto the new knee; knee: turn the shin onto the goal

@@ -209,6 +209,11 @@ def _report(
             if out.attacker is not None and cast.attacker is not None
             else None
         ),
+        "attacker_foot_skate_m": (
+            qm.foot_skate_m(out.attacker, cast.attacker.parts)
+            if out.attacker is not None and cast.attacker is not None
+            else None
+        ),
     }
     warnings = _warnings(scenario, cast, contact, naive, cont, quality)
     if naive.unstable is not None:
@@ -298,6 +303,10 @@ def _warnings(
     if ratio is not None and ratio > qm.WARN_ATTACKER_SPEED_RATIO:
         out.append(f"the attacker moves a joint {ratio:.2f}x faster than its clip ever does "
                    f"(more than {qm.WARN_ATTACKER_SPEED_RATIO}x)")  # fmt: skip
+    skate = q["attacker_foot_skate_m"]
+    if skate is not None and skate > qm.WARN_ATTACKER_FOOT_SKATE_M:
+        out.append(f"the attacker's planted feet slide {skate:.2f} m in all (more than "
+                   f"{qm.WARN_ATTACKER_FOOT_SKATE_M} m)")  # fmt: skip
     if cast.attacker is not None and contact.time <= 0.0:
         out.append("the characters already touch when the scenario starts (place them apart)")
     if cast.attacker is not None and naive.contacts.empty:

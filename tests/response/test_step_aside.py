@@ -1,0 +1,81 @@
+"""The physical mode's attacker steps aside from the recipient's tail in steps: its planted
+feet stay where they stand (``final._side_steps``), and the report measures and warns of the
+attacker's foot skate."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reactmocap import metrics as qm
+from reactmocap.library.bodyparts import map_body_parts
+from reactmocap.library.bvh import read_bvh
+from reactmocap.library.motion import Motion
+from reactmocap.library.placement import ground_root
+from reactmocap.response import final
+
+
+def _added_travel(before: Motion, after: Motion, feet: list[int]) -> float:
+    """Horizontal travel (m) that ``after`` adds to the feet planted in ``before`` (as
+    :func:`reactmocap.metrics.planted` finds them) while they stay on the ground."""
+    a = before.global_positions()[:, feet]
+    b = after.global_positions()[:, feet]
+    low = np.abs(b - a)[..., 2] < qm.PLANT_HEIGHT_M
+    on = qm.planted(a, before.fps) & low[1:] & low[:-1]
+    return float(np.linalg.norm(np.diff((b - a)[..., :2], axis=0), axis=-1)[on].sum())
+
+
+@pytest.mark.parametrize(
+    ("clip", "start", "stop"),
+    [("walk_normal_001", 0.5, 3.0), ("bow_normal_001", 0.0, 3.0), ("kick_normal_001", 0.0, 2.0)],
+)
+def test_the_attacker_steps_aside_on_planted_feet(
+    shared_mocap_dir: Path, clip: str, start: float, stop: float
+) -> None:
+    # a real walk, a real bow (standing) and the real kick moved 0.5 m sideways at a side
+    # step's pace: the whole-body slide this replaced dragged their planted feet 0.47, 1.0 and
+    # 1.0 m (and foot_skate_m, which counts no foot faster than 0.5 m/s, missed it)
+    m = read_bvh(shared_mocap_dir / f"dataset-1_{clip}.bvh")
+    parts = map_body_parts(m.skeleton)
+    m = ground_root(m.slice(round(start * m.fps), round(stop * m.fps)), parts)
+    offset = np.clip((m.times - 0.3) * final.STEP_M / final.STEP_S, 0.0, 0.5)
+    side = np.array([0.0, 1.0, 0.0])
+    speed = qm.joint_speed_max_m_s(m)
+    out = final._side_steps(m, parts, offset, side, speed)
+    feet = [parts.joint_of(f"{s}_foot") for s in ("l", "r")]
+    assert _added_travel(m, out, feet) <= 0.01
+    moved = out.root_positions - m.root_positions
+    assert moved[-1, 1] == pytest.approx(0.5) and np.abs(moved[:, 0]).max() < 1e-9
+    assert qm.speed_ratio(out, m) <= 1.5
+    assert qm.foot_skate_m(out, parts) <= qm.foot_skate_m(m, parts) + 0.05
+    # the feet went along: at least one foot stepped the whole way
+    shift = (out.global_positions()[-1, feet] - m.global_positions()[-1, feet])[:, 1]
+    assert shift.max() == pytest.approx(0.5, abs=0.01)
+
+
+def test_an_attacker_whose_feet_slide_is_reported_and_warned(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # bench_reactions' real bow kicked by the real kick, blend mode: the kicker's simulated
+    # feet slide 0.47 m while planted (its step aside never runs in this mode)
+    from reactmocap.response.pipeline import run_response
+    from reactmocap.response.scenario import AttackerSpec, CharacterSpec, Scenario
+    from tests.response.test_pipeline import _bench_physical, _shared_library
+
+    scenario = Scenario(
+        library=_shared_library(shared_mocap_dir, tmp_path),
+        recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=167.42333060441473,
+                              position=(0.9101249775269609, 0.24847072154800792)),
+        response=replace(_bench_physical(attacker_assist=100.0, torque_limit=1000.0,
+                                         blend_settle=0.5), mode="blend"),
+        name="bow-kick",
+    )  # fmt: skip
+    rep = run_response(scenario).report
+    skate = rep["quality"]["attacker_foot_skate_m"]
+    assert skate > qm.WARN_ATTACKER_FOOT_SKATE_M
+    assert f"the attacker's planted feet slide {skate:.2f} m" in " ".join(rep["warnings"])
