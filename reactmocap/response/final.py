@@ -109,6 +109,13 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
         if joint_speed_max_m_s(out.slice(i)) <= speed:
             break
         span *= 2.0
+    # the blend back slides the root under planted feet (0.3-0.4 m in the examples' punch and
+    # push from behind): they are pinned as the recipient's are; the clip before the rewind,
+    # and the ends, stay exact
+    j = int(np.searchsorted(t, contact.rewind))
+    if t.size - j >= 3:
+        locked = lock_feet(out.slice(j), att.parts)
+        out = out.replace(rotations=np.concatenate([out.rotations[:j], locked.rotations]))
     return out
 
 
