@@ -119,11 +119,6 @@ class BalanceGains:
     #: one edge creeps downhill in MuJoCo's soft contact at half the friction cone
     #: (docs/athletics.md); ``None``: the thesis's everywhere
     side_roll: tuple[float, float] | None = None
-    #: rad of ankle pitch offset taken back per metre that a supporting foot rolls off the
-    #: floor in the offset's direction (its heel above its toes when the ankles push the
-    #: toes down, or the toes above the heel): the ankles push only as hard as the foot can
-    #: carry; 0: off (the thesis's)
-    roll_guard: float = 0.0
     #: fraction of a foot's height over the floor (its lowest sole corner, above the other
     #: foot's) by which its leg is lengthened and the other shortened (half each), while the
     #: other foot stands: a perturbed start can leave one foot hanging, and nothing else in
@@ -150,15 +145,11 @@ class BalanceGains:
         return per_joint(dict(self.damping))
 
 
-#: how far (m) a supporting foot's heel may stand above its toes, or they above it, before
-#: :attr:`BalanceGains.roll_guard` takes the ankle offset back: a flat foot's corners sit a
-#: few millimetres apart in the soft contact
-ROLL_SLACK = 0.005
 #: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
 SIDE_SLOPE = 0.2
-#: the balance law in the leaps, landings and maneuvers: a hanging foot brought down to the
-#: floor and the ankles held to what the feet can carry (perturbed starts, docs/athletics.md)
-BALANCE_GAINS = BalanceGains(roll_guard=10.0, reach_floor=1.0)
+#: the balance law in the leaps, landings and maneuvers: a hanging foot is brought down to the
+#: floor (a perturbed start, docs/athletics.md)
+BALANCE_GAINS = BalanceGains(reach_floor=1.0)
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
 #: sideways slope balanced 19.5 -> 23.5-25.5 deg, docs/athletics.md), and on a sideways
@@ -260,8 +251,6 @@ class BalanceLaw:
             rig.offset[_ANKLE[k], 1] = roll[0] * delta[1]
             rig.offset[_HIP[k], 0] = 0.5 * delta[0]
             rig.offset[_HIP[k], 1] = roll[1] * delta[1]
-        if g.roll_guard > 0:
-            self._guard_roll(s, h)
         lo, hi = ANKLE_LIMITS
         desired = rig.desired(t)
         for k in range(2):
@@ -269,28 +258,6 @@ class BalanceLaw:
             rig.offset[_ANKLE[k], 0] += float(np.clip(total, lo, hi)) - total
         self._level_legs(d, desired)
         self._support(s)
-
-    def _guard_roll(self, s, heading: float) -> None:  # type: ignore[no-untyped-def]
-        """Take back each supporting foot's ankle pitch offset by how far the foot has rolled
-        off the floor in the offset's direction (:attr:`BalanceGains.roll_guard`): past what
-        the foot can carry, the offset lifts the heel (or the toes) instead of moving the
-        body, and a foot on its toes then holds the COM at the edge of the support."""
-        rig = self.ctx.rig
-        corners = s.sole_corners()  # (2, 4, 3)
-        height = (corners - self.ctx.world.data.geom_xpos[s.floor]) @ s.floor_normal
-        along = s.local(corners, heading)[..., 0]  # (2, 4) forward in the heading frame
-        order = np.argsort(along, axis=1)
-        rows = np.arange(2)[:, None]
-        back = height[rows, order[:, :2]].mean(axis=1)
-        front = height[rows, order[:, 2:]].mean(axis=1)
-        # > 0: on the toes; a flat foot's corners differ by the contact's give (a few mm)
-        heel_up = (back - front) * s.foot_contact
-        heel_up = np.sign(heel_up) * np.maximum(np.abs(heel_up) - ROLL_SLACK, 0.0)
-        off = rig.offset[_ANKLE, 0]
-        take = self.gains.roll_guard * np.where(off > 0, np.maximum(heel_up, 0.0),
-                                                np.minimum(heel_up, 0.0))  # fmt: skip
-        rig.offset[_ANKLE, 0] = np.where(off > 0, np.maximum(off - take, 0.0),
-                                         np.minimum(off - take, 0.0))  # fmt: skip
 
     def _level_legs(self, d, desired: F64) -> None:  # type: ignore[no-untyped-def]
         """Leg by leg (eq. 7.5 per leg): the leg whose ankle stands over higher floor (uphill

@@ -1,0 +1,81 @@
+"""Perturbed starts (issue 19's capture regions): the balance law brings a hanging foot down
+and keeps a foot off its toes, and the vertical leap maneuver lands with the vertical leap's
+own landing. Starts from ``capture_region``'s full-size distribution, seed 0."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from reactmocap.athletics import tables
+from reactmocap.athletics.balance import BALANCE_GAINS, Balance, BalanceGains, Posture
+from reactmocap.athletics.behaviours import _simulate
+from reactmocap.athletics.bodies import athlete
+from reactmocap.athletics.maneuvers import Perturbation, load_maneuver, run_maneuver
+from reactmocap.athletics.scene import athletics_world
+
+VERTICAL_LEAP = (
+    Path(__file__).resolve().parents[2] / "examples/athletics/maneuvers/vertical_leap.toml"
+)
+FULL = {"joint_sd": math.radians(3.0), "pitch_sd": math.radians(2.0), "velocity_sd": 0.05,
+        "spin_sd": 0.1}  # fmt: skip
+
+
+def _starts(n: int) -> list[Perturbation]:
+    rng = np.random.default_rng(0)
+    return [Perturbation.sample(rng, **FULL) for _ in range(n)]
+
+
+def _stand(start: Perturbation, gains: BalanceGains, seconds: float = 1.2):  # type: ignore[no-untyped-def]
+    ath = athlete("male")
+    world = athletics_world(ath)
+    start.apply(world, ath)
+    ctx, _, _ = _simulate(ath, world, [Balance(Posture(), gains=gains)], seconds,
+                          behaviour="stand", fps=10.0)  # fmt: skip
+    return ctx
+
+
+def test_a_hanging_foot_is_brought_down_to_the_floor() -> None:
+    """Start 12 puts one foot a few millimetres up; without ``reach_floor`` it hangs there
+    for the whole 1.2 s (the leveling sees flat floor under both ankles)."""
+    start = _starts(13)[12]
+    feet = _stand(start, BALANCE_GAINS).log.arrays()
+    without = _stand(start, replace(BALANCE_GAINS, reach_floor=0.0)).log.arrays()
+    late = feet["t"] > 0.8
+    assert feet["feet"][late].min() == 2
+    assert without["feet"][late].max() == 1
+
+
+def test_the_ankles_bring_a_foot_down_off_its_toes() -> None:
+    """Start 14 begins with the COM over the toes: without ``roll_guard`` the ankles' push
+    holds the heels up (several cm) and the COM at the toes' edge for the whole 1.2 s."""
+    start = _starts(15)[14]
+    for gains, guarded in ((BALANCE_GAINS, True), (replace(BALANCE_GAINS, roll_guard=0.0), False)):
+        ctx = _stand(start, gains)
+        s = ctx.senses
+        height = (s.sole_corners() - ctx.world.data.geom_xpos[s.floor]) @ s.floor_normal
+        offset = ctx.log.offsets[-1]
+        if guarded:
+            assert height.max() < 0.015 and offset < 0.06
+        else:
+            assert height.max() > 0.03 and offset > 0.15
+
+
+def test_the_vertical_leap_lands_with_the_vertical_leaps_own_delta() -> None:
+    """Start 3 takes off with almost no pitch momentum (-0.3 kg m^2/s; the nominal -2): with
+    the drops' delta (-0.04) its feet land 9 cm behind the COM and it falls forward off its
+    toes; with the vertical leap's (-0.01) it lands."""
+    m = load_maneuver(VERTICAL_LEAP)
+    land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
+    assert m.phases[land].params["delta"] == tables.VERTICAL_LANDING["male"][1]
+    start = _starts(4)[3]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    phases = list(m.phases)
+    phases[land] = dataclasses.replace(phases[land], params={})
+    old = run_maneuver(dataclasses.replace(m, phases=tuple(phases)), perturbation=start, fps=10.0)
+    assert old.report["fell"]
