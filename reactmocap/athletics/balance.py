@@ -34,6 +34,7 @@ from reactmocap.sim.world import World
 __all__ = [
     "ANKLE_LIMITS",
     "BALANCE_GAINS",
+    "CROUCH_GAINS",
     "STANDING_GAINS",
     "STANDING_LEG",
     "Balance",
@@ -119,10 +120,10 @@ class BalanceGains:
     #: one edge creeps downhill in MuJoCo's soft contact at half the friction cone
     #: (docs/athletics.md); ``None``: the thesis's everywhere
     side_roll: tuple[float, float] | None = None
-    #: fraction of a foot's height over the floor (its lowest sole corner, above the other
-    #: foot's) by which its leg is lengthened and the other shortened (half each), while the
-    #: other foot stands: a perturbed start can leave one foot hanging, and nothing else in
-    #: the law brings it down; 0: off
+    #: while one foot stands and the other is out of contact: the fraction of the hanging
+    #: foot's height over the floor (its lowest sole corner) by which its leg is lengthened
+    #: and the other shortened (half each, as on a slope); a perturbed start can leave one
+    #: foot hanging, and nothing else in the law brings it down; 0: off
     reach_floor: float = 0.0
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
@@ -147,9 +148,10 @@ class BalanceGains:
 
 #: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
 SIDE_SLOPE = 0.2
-#: the balance law in the leaps, landings and maneuvers: a hanging foot is brought down to the
-#: floor (a perturbed start, docs/athletics.md)
-BALANCE_GAINS = BalanceGains(reach_floor=1.0)
+BALANCE_GAINS = BalanceGains()
+#: the leap's crouch: a hanging foot is brought down to the floor before the push (a perturbed
+#: start stood on one foot until it; docs/athletics.md, issue 19)
+CROUCH_GAINS = BalanceGains(reach_floor=1.0)
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
 #: sideways slope balanced 19.5 -> 23.5-25.5 deg, docs/athletics.md), and on a sideways

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from reactmocap.athletics.balance import (
-    BALANCE_GAINS,
+    CROUCH_GAINS,
     BalanceLaw,
     Posture,
     hold_pelvis_and_feet,
@@ -189,7 +189,7 @@ class Leap(Basis):
 
     def states(self, ctx: Context) -> list[State]:
         p = self.params
-        bl = BalanceLaw(ctx, BALANCE_GAINS)
+        bl = BalanceLaw(ctx, CROUCH_GAINS)
         every = ctx.control_every
         memo: dict[str, Any] = {}
 

@@ -1,5 +1,5 @@
-"""Perturbed starts (issue 19's capture regions): the balance law brings a hanging foot down,
-and the vertical leap maneuver lands with the vertical leap's own landing. Starts from
+"""Perturbed starts (issue 19's capture regions): the leap's crouch brings a hanging foot
+down, and the vertical leap maneuver lands with the vertical leap's own landing. Starts from
 ``capture_region``'s full-size distribution, seed 0."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from reactmocap.athletics import tables
-from reactmocap.athletics.balance import BALANCE_GAINS, Balance, BalanceGains, Posture
+from reactmocap.athletics.balance import CROUCH_GAINS, Balance, BalanceGains, Posture
 from reactmocap.athletics.behaviours import _simulate
 from reactmocap.athletics.bodies import athlete
 from reactmocap.athletics.maneuvers import Perturbation, load_maneuver, run_maneuver
@@ -40,11 +40,12 @@ def _stand(start: Perturbation, gains: BalanceGains, seconds: float = 1.2):  # t
 
 
 def test_a_hanging_foot_is_brought_down_to_the_floor() -> None:
-    """Start 12 leaves one foot a few millimetres up: without ``reach_floor`` it hangs there
-    for the whole 1.2 s (the leveling sees flat floor under both ankles)."""
+    """Start 12 leaves one foot a few millimetres up: the leap's crouch law brings it down;
+    without ``reach_floor`` it hangs there for the whole 1.2 s (the leveling sees flat floor
+    under both ankles)."""
     start = _starts(13)[12]
-    feet = _stand(start, BALANCE_GAINS).log.arrays()
-    without = _stand(start, replace(BALANCE_GAINS, reach_floor=0.0)).log.arrays()
+    feet = _stand(start, CROUCH_GAINS).log.arrays()
+    without = _stand(start, replace(CROUCH_GAINS, reach_floor=0.0)).log.arrays()
     late = feet["t"] > 0.8
     assert feet["feet"][late].mean() > 1.5
     assert without["feet"][late].max() == 1
