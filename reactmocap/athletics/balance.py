@@ -149,8 +149,8 @@ class BalanceGains:
 #: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
 SIDE_SLOPE = 0.2
 BALANCE_GAINS = BalanceGains()
-#: the leap's crouch: a hanging foot is brought down to the floor before the push (a perturbed
-#: start stood on one foot until it; docs/athletics.md, issue 19)
+#: the vertical leap's crouch: a hanging foot is brought down to the floor before the push (a
+#: perturbed start stood on one foot until it; docs/athletics.md, issue 19)
 CROUCH_GAINS = BalanceGains(reach_floor=1.0)
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the

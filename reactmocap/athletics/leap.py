@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from reactmocap.athletics.balance import (
+    BALANCE_GAINS,
     CROUCH_GAINS,
     BalanceLaw,
     Posture,
@@ -189,7 +190,9 @@ class Leap(Basis):
 
     def states(self, ctx: Context) -> list[State]:
         p = self.params
-        bl = BalanceLaw(ctx, CROUCH_GAINS)
+        # a broad jump's crouch leans far over the toes: bringing a foot that lost its
+        # contacts down there made the female's 0.65 jump fall (docs/athletics.md)
+        bl = BalanceLaw(ctx, BALANCE_GAINS if p.broad else CROUCH_GAINS)
         every = ctx.control_every
         memo: dict[str, Any] = {}
 
