@@ -34,7 +34,6 @@ from reactmocap.sim.world import World
 __all__ = [
     "ANKLE_LIMITS",
     "BALANCE_GAINS",
-    "CROUCH_GAINS",
     "STANDING_GAINS",
     "STANDING_LEG",
     "Balance",
@@ -120,11 +119,6 @@ class BalanceGains:
     #: one edge creeps downhill in MuJoCo's soft contact at half the friction cone
     #: (docs/athletics.md); ``None``: the thesis's everywhere
     side_roll: tuple[float, float] | None = None
-    #: while one foot stands and the other is out of contact: the fraction of the hanging
-    #: foot's height over the floor (its lowest sole corner) by which its leg is lengthened
-    #: and the other shortened (half each, as on a slope); a perturbed start can leave one
-    #: foot hanging, and nothing else in the law brings it down; 0: off
-    reach_floor: float = 0.0
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
         ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
@@ -149,9 +143,6 @@ class BalanceGains:
 #: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
 SIDE_SLOPE = 0.2
 BALANCE_GAINS = BalanceGains()
-#: the vertical leap's crouch: a hanging foot is brought down to the floor before the push (a
-#: perturbed start stood on one foot until it; docs/athletics.md, issue 19)
-CROUCH_GAINS = BalanceGains(reach_floor=1.0)
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
 #: sideways slope balanced 19.5 -> 23.5-25.5 deg, docs/athletics.md), and on a sideways
@@ -273,9 +264,6 @@ class BalanceLaw:
         n = s.floor_normal
         xy = d.xanchor[s.ankle_joints, :2]
         z = -(xy @ n[:2]) / max(float(n[2]), 1e-6)  # the floor plane's height, up to a constant
-        if self.gains.reach_floor > 0 and s.foot_contact.any():  # a foot hangs beside one
-            lowest = ((s.sole_corners() - d.geom_xpos[s.floor]) @ n).min(axis=1)
-            z = z - self.gains.reach_floor * np.where(s.foot_contact, 0.0, lowest)
         for k in range(2):
             knee = float(desired[_KNEE[k], 0])
             ul, ll = float(a.thigh[k]), float(a.shin[k])

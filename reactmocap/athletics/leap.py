@@ -20,7 +20,6 @@ import numpy as np
 
 from reactmocap.athletics.balance import (
     BALANCE_GAINS,
-    CROUCH_GAINS,
     BalanceLaw,
     Posture,
     hold_pelvis_and_feet,
@@ -190,9 +189,7 @@ class Leap(Basis):
 
     def states(self, ctx: Context) -> list[State]:
         p = self.params
-        # a broad jump's crouch leans far over the toes: bringing a foot that lost its
-        # contacts down there made the female's 0.65 jump fall (docs/athletics.md)
-        bl = BalanceLaw(ctx, BALANCE_GAINS if p.broad else CROUCH_GAINS)
+        bl = BalanceLaw(ctx, BALANCE_GAINS)
         every = ctx.control_every
         memo: dict[str, Any] = {}
 
