@@ -86,7 +86,10 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     sim = ground_root(sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration)),
                       att.parts, turn=False)  # fmt: skip
     if shift_times.size:
-        moved = np.stack([np.interp(t, shift_times, shift[:, k]) for k in range(3)], axis=1)
+        # horizontal only: a blend that lifts a fallen recipient onto a standing clip carried
+        # the attacker lying on the floor 0.8-1.2 m up with it (the real walk-left kicked)
+        moved = np.zeros((t.size, 3))
+        moved[:, :2] = np.stack([np.interp(t, shift_times, shift[:, k]) for k in range(2)], axis=1)
         moved[t < shift_times[0]] = 0.0
         if cfg.mode == "physical":
             # the recipient's per-joint blend can squeeze its correction into a few frames (the
