@@ -10,6 +10,7 @@ import pytest
 from reactmocap.athletics.cloth import CLOTHES, Cloth, ClothSpec
 from reactmocap.athletics.run_course import run_course
 from reactmocap.errors import ConfigError
+from reactmocap.sim.world import World
 
 SECONDS = 1.2
 
@@ -17,6 +18,19 @@ SECONDS = 1.2
 @pytest.fixture(scope="module")
 def dressed():  # type: ignore[no-untyped-def]
     return run_course(3.5, seconds=SECONDS, cloth="pants", fps=30.0)
+
+
+def _dressed_male(collide_arms: bool) -> tuple[World, Cloth]:
+    """The thesis male's world and default pants reset onto his standing pose."""
+    from reactmocap.athletics.bodies import athlete
+    from reactmocap.athletics.scene import athletics_world
+
+    world = athletics_world(athlete("male"))
+    spec = ClothSpec()
+    spec.collide_arms = collide_arms
+    cloth = Cloth(world, spec)
+    cloth.reset(world)
+    return world, cloth
 
 
 def test_cloth_never_goes_non_finite(dressed) -> None:  # type: ignore[no-untyped-def]
@@ -128,15 +142,9 @@ def test_a_limb_across_a_triangle_touches_it(collide_arms: bool) -> None:
     model's cylinder twins of the capsules find it). The limb is a hand: without
     ``collide_arms`` (the default) it makes no contact but the drawn surface's depth still
     measures it."""
-    from reactmocap.athletics.bodies import athlete
-    from reactmocap.athletics.scene import athletics_world
     from reactmocap.sim.bodies import SIM_BODIES
 
-    world = athletics_world(athlete("male"))
-    spec = ClothSpec()
-    spec.collide_arms = collide_arms
-    cloth = Cloth(world, spec)
-    cloth.reset(world)
+    _, cloth = _dressed_male(collide_arms)
     m, d = cloth.model, cloth.data
     part = SIM_BODIES.index("r_hand")
     geoms = np.flatnonzero(cloth._geom_part == part)
@@ -317,15 +325,9 @@ def test_only_the_copies_the_cloth_meets_have_joints(collide_arms: bool) -> None
     move by free joints, so the contacts see their velocities; the others (the pelvis, and
     the head and arms by default) are mocap bodies without dofs, set where the runner has
     them each cloth step."""
-    from reactmocap.athletics.bodies import athlete
-    from reactmocap.athletics.scene import athletics_world
     from reactmocap.sim.bodies import SIM_BODIES
 
-    world = athletics_world(athlete("male"))
-    spec = ClothSpec()
-    spec.collide_arms = collide_arms
-    cloth = Cloth(world, spec)
-    cloth.reset(world)
+    world, cloth = _dressed_male(collide_arms)
     m, d = cloth.model, cloth.data
     legs_trunk = [n for n in SIM_BODIES if n.endswith(("thigh", "shin", "foot", "waist", "chest"))]
     arms_head = [n for n in SIM_BODIES if n != "pelvis" and n not in legs_trunk]
