@@ -35,12 +35,14 @@ F64 = NDArray[np.float64]
 #: the shortest span (s) over which the final blend moves the root (a contact that delays the
 #: root's correction cannot squeeze it into fewer frames)
 ROOT_BLEND_MIN_S = 0.2
+#: MuJoCo's default gravity (m/s^2): the attacker's last simulated pose falls under it
+STANDARD_GRAVITY = 9.81
 #: how many times the attacker's blend back to its clip may double its length to move no joint
 #: faster than its clip's fastest
 BLEND_BACK_TRIES = 5
 #: the blend mode's ``blend_settle`` tries a landing every this many seconds past the match
 SETTLE_STEP_S = 0.05
-#: physical mode: the attacker steps aside until the two overlap by no more than this (m) ...
+#: the attacker steps aside until the two overlap by no more than this (m) ...
 ASIDE_MARGIN_M = 0.005
 #: ... re-measured this many times (each adds the depth still left)
 ASIDE_TRIES = 12
@@ -83,8 +85,9 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     afps = att.motion.fps
     t = np.arange(0, int(np.floor(duration * afps)) + 1) / afps
     own = ground_root(att.motion.sample(t + att.clock0).replace(fps=afps), att.parts, turn=False)
-    sim = ground_root(sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration)),
-                      att.parts, turn=False)  # fmt: skip
+    held = sim2.attacker.sample(np.clip(t - contact.rewind, 0, sim2.attacker.duration))
+    sim = ground_root(_falling_when_held(held, t - contact.rewind - sim2.attacker.duration,
+                                         sim2.attacker, att.parts), att.parts, turn=False)  # fmt: skip
     if shift_times.size:
         # horizontal only: a blend that lifts a fallen recipient onto a standing clip carried
         # the attacker lying on the floor 0.8-1.2 m up with it (the real walk-left kicked)
@@ -122,6 +125,27 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
     return out
 
 
+def _falling_when_held(held: Motion, after: F64, sim: Motion, parts: BodyPartMap) -> Motion:
+    """``held`` (the attacker's simulation sampled at clip times, its last frame held ``after``
+    seconds past its end where positive) with the held frames falling under gravity from the
+    last frame's vertical speed until the body's lowest joint reaches the floor: a simulation
+    that ends with the attacker knocked off its feet would otherwise leave it hanging in the
+    air (the real respond kicked: lying 0.4-0.5 m up from 1.4 s to the end)."""
+    late = after > 0.0
+    if not late.any() or sim.num_frames < 2:
+        return held
+    # a dummy top joint above the pelvis stays on the floor: the body is the rest
+    body = slice(1, None) if parts.joint_of("pelvis") != 0 else slice(None)
+    z = sim.slice(-2).global_positions()[:, body, 2]
+    height = max(float(z[-1].min()), 0.0)
+    vz = float(z[-1].mean() - z[0].mean()) * sim.fps
+    a = after[late]
+    drop = np.clip(-vz * a + 0.5 * STANDARD_GRAVITY * a * a, 0.0, height)
+    root = np.array(held.root_positions)
+    root[late, 2] -= drop
+    return held.replace(root_positions=root)
+
+
 def _rate_limited(path: F64, step: float) -> F64:
     """``path`` ``(n, 3)`` followed by a point that moves at most ``step`` per frame (it keeps
     catching up after ``path`` stops)."""
@@ -140,8 +164,8 @@ def _step_aside(cast: Cast, recipient: Motion, attacker: Motion, impact: float,
     each overlapping frame is reached beforehand at no more than a quarter of its clip's
     fastest joint ``speed`` nor a side step's pace (``STEP_M`` per ``STEP_S``) and kept after
     (the recipient stays where it stood); its feet follow in steps (:func:`_side_steps`). The
-    physical mode's tail (the found clip after the landing) walks or falls onto an attacker
-    that its simulation left standing or lying there (docs/benchmarks.md)."""
+    recipient's tail (the found clip after the landing or the blend) walks or falls onto an
+    attacker that its simulation left standing or lying there (docs/benchmarks.md)."""
     assert cast.attacker is not None
     fps = recipient.fps
     t = recipient.times
@@ -352,7 +376,7 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
         if late.size == 0:
             break
         held = float(out_t[after][late[-1]]) + 1.0 / fps
-    if cfg.mode == "physical" and cast.attacker is not None and attacker is not None:
+    if cast.attacker is not None and attacker is not None:
         attacker = _step_aside(cast, recipient, attacker, naive.impact_time, speed)
     return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
 

@@ -84,3 +84,23 @@ def test_the_attackers_blend_back_keeps_its_planted_feet_and_a_slide_is_warned(
     monkeypatch.setattr(qm, "WARN_ATTACKER_FOOT_SKATE_M", 0.5 * skate)
     rep = run_response(scenario).report
     assert f"the attacker's planted feet slide {skate:.2f} m" in " ".join(rep["warnings"])
+
+
+def test_an_attacker_knocked_off_its_feet_falls_to_the_floor_after_its_simulation() -> None:
+    # Simulation 2 can end with the attacker in the air (the real respond kicked: its kicker
+    # lying 0.4-0.5 m up); its last pose, held after, falls under gravity onto the floor
+    from tests.conftest import SYNTHETIC
+
+    m = read_bvh(SYNTHETIC / "front_kick.bvh")
+    parts = map_body_parts(m.skeleton)
+    sim = m.replace(root_positions=m.root_positions + np.array([0.0, 0.0, 0.5]))  # 0.5 m up
+    lowest = float(sim.slice(-1).global_positions()[0, :, 2].min())
+    after = np.linspace(-0.2, 1.0, 37)  # seconds past the simulation's end
+    held = sim.sample(np.clip(sim.duration + after, 0.0, sim.duration))
+    out = final._falling_when_held(held, after, sim, parts)
+    low = out.global_positions()[..., 2].min(axis=1)
+    assert np.allclose(low[after <= 0.0], lowest)  # the simulation itself is kept
+    fall = np.sqrt(2.0 * lowest / final.STANDARD_GRAVITY)  # from rest: it was held still
+    assert low[after >= fall + 0.05] == pytest.approx(0.0, abs=1e-6)  # then on the floor
+    k = int(np.argmin(np.abs(after - 0.5 * fall)))
+    assert low[k] == pytest.approx(lowest - 0.5 * final.STANDARD_GRAVITY * after[k] ** 2, abs=1e-6)
