@@ -220,6 +220,7 @@ def _summary(title: str, rows: list[dict | None]) -> None:
         "overlap": "overlap by",
         "speed": "attacker moves",
         "attacker skate": "attacker's planted feet",
+        "attacker lift": "attacker's body is",
         "physical": "physical mode",
     }
     count = {k: sum(any(v in w for w in r["warnings"]) for r in done) for k, v in kinds.items()}

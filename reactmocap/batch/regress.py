@@ -84,6 +84,7 @@ DEFAULT_TOLERANCES: dict[str, Tolerance] = {
     "character_overlap_max_m": Tolerance(0.003, 0.10),
     "attacker_speed_ratio": Tolerance(0.05, 0.05),
     "attacker_foot_skate_m": Tolerance(0.01, 0.10),
+    "attacker_lift_m": Tolerance(0.01, 0.10),
     "warnings": Tolerance(0.0, 0.0),  # count per scenario
     "fell": Tolerance(0.05, 0.0),  # rate
     "intended_fall": Tolerance(0.05, 0.0, "both"),  # rate; neither direction is better

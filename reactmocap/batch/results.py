@@ -55,6 +55,7 @@ QUALITY_METRICS = (
     "character_overlap_max_m",
     "attacker_speed_ratio",
     "attacker_foot_skate_m",
+    "attacker_lift_m",
     "warnings",
 )
 TIMING_STAGES = ("scan", "sim1", "search", "sim2", "blend", "total")

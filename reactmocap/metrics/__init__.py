@@ -15,6 +15,7 @@ from reactmocap.rotations import quat_conj, quat_log, quat_mul
 __all__ = [
     "REACTION_WINDOW_S",
     "WARN_ATTACKER_FOOT_SKATE_M",
+    "WARN_ATTACKER_LIFT_M",
     "WARN_ATTACKER_SPEED_RATIO",
     "WARN_JOINT_CORRECTION_RAD",
     "WARN_OVERLAP_M",
@@ -29,6 +30,7 @@ __all__ = [
     "foot_skate_m",
     "intended_fall",
     "joint_speed_max_m_s",
+    "lift_above_source_m",
     "match_distance",
     "penetration_max_m",
     "planted",
@@ -189,6 +191,17 @@ def speed_ratio(output: Motion, source: Motion) -> float:
     return joint_speed_max_m_s(output) / max(joint_speed_max_m_s(source), 1e-9)
 
 
+def lift_above_source_m(output: Motion, source: Motion, parts: BodyPartMap) -> float:
+    """How far (m, >= 0) ``output``'s lowest body joint ever rises above the highest that
+    ``source``'s lowest body joint gets (its jumps and flights): a body held or blended in the
+    air, off the floor, where its capture never is. A dummy top joint above the pelvis (on the
+    floor by construction) is not a body joint."""
+    body = slice(1, None) if parts.joint_of("pelvis") != 0 else slice(None)
+    out = output.global_positions()[:, body, 2].min(axis=1).max()
+    src = source.global_positions()[:, body, 2].min(axis=1).max()
+    return max(float(out - src), 0.0)
+
+
 #: report warnings fire above these (the report's ``warnings`` list; ``respond --strict``)
 WARN_OVERLAP_M = 0.02
 WARN_ROOT_OFFSET_M = 0.3
@@ -200,6 +213,10 @@ WARN_ATTACKER_SPEED_RATIO = 1.5
 #: the attacker's ``foot_skate_m`` warns above the recipient's own in 9 of 10 runs of the
 #: real-recipient benchmark (p90 0.32-0.34 m in both modes, 2026-12-02; docs/benchmarks.md)
 WARN_ATTACKER_FOOT_SKATE_M = 0.3
+#: the attacker's ``lift_above_source_m`` warns above this: a body lying on the floor has its
+#: lowest joint up to ~0.15 m up (half its thickness), so 0.25 m over the clip's highest is off
+#: the floor
+WARN_ATTACKER_LIFT_M = 0.25
 
 
 def blend_correction_over_warning(simulated: Motion, blended: Motion, parts: BodyPartMap) -> float:

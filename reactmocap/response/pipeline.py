@@ -214,6 +214,11 @@ def _report(
             if out.attacker is not None and cast.attacker is not None
             else None
         ),
+        "attacker_lift_m": (
+            qm.lift_above_source_m(out.attacker, cast.attacker.motion, cast.attacker.parts)
+            if out.attacker is not None and cast.attacker is not None
+            else None
+        ),
     }
     warnings = _warnings(scenario, cast, contact, naive, cont, quality)
     if naive.unstable is not None:
@@ -307,6 +312,10 @@ def _warnings(
     if skate is not None and skate > qm.WARN_ATTACKER_FOOT_SKATE_M:
         out.append(f"the attacker's planted feet slide {skate:.2f} m in all (more than "
                    f"{qm.WARN_ATTACKER_FOOT_SKATE_M} m)")  # fmt: skip
+    lift = q["attacker_lift_m"]
+    if lift is not None and lift > qm.WARN_ATTACKER_LIFT_M:
+        out.append(f"the attacker's body is {lift:.2f} m higher off the floor than its clip "
+                   f"ever is (more than {qm.WARN_ATTACKER_LIFT_M} m): held or blended in the air")  # fmt: skip
     if cast.attacker is not None and contact.time <= 0.0:
         out.append("the characters already touch when the scenario starts (place them apart)")
     if cast.attacker is not None and naive.contacts.empty:

@@ -79,3 +79,18 @@ def test_the_roots_turn_is_its_own_field_not_a_joints_correction() -> None:
     assert metrics.blend_correction_over_warning(m, far, parts) == pytest.approx(
         0.9 / metrics.WARN_ROOT_TURN_RAD, abs=1e-6
     )
+
+
+def test_lift_above_source_measures_a_body_held_in_the_air() -> None:
+    from reactmocap.library.bodyparts import map_body_parts
+    from reactmocap.library.bvh import read_bvh
+    from tests.conftest import SYNTHETIC
+
+    m = read_bvh(SYNTHETIC / "front_kick.bvh")
+    parts = map_body_parts(m.skeleton)
+    assert metrics.lift_above_source_m(m, m, parts) == 0.0
+    up = m.root_positions.copy()
+    up[m.num_frames // 2 :, 2] += 0.4  # its second half 0.4 m up
+    assert metrics.lift_above_source_m(m.replace(root_positions=up), m, parts) == pytest.approx(0.4)
+    up[:, 2] -= 0.4  # lowered: never above the clip
+    assert metrics.lift_above_source_m(m.replace(root_positions=up), m, parts) == pytest.approx(0.0)

@@ -80,10 +80,16 @@ def test_the_attackers_blend_back_keeps_its_planted_feet_and_a_slide_is_warned(
     skate = rep["quality"]["attacker_foot_skate_m"]
     assert 0.0 < skate <= 0.2
     assert "the attacker's planted feet slide" not in " ".join(rep["warnings"])
-    # the warning itself, on the same real output with the threshold under its skate
+    lift = rep["quality"]["attacker_lift_m"]
+    assert lift is not None and lift >= 0.0
+    lifted = "higher off the floor than its clip" in " ".join(rep["warnings"])
+    assert lifted == (lift > qm.WARN_ATTACKER_LIFT_M)
+    # the warnings themselves, on the same real output with the thresholds under its figures
     monkeypatch.setattr(qm, "WARN_ATTACKER_FOOT_SKATE_M", 0.5 * skate)
+    monkeypatch.setattr(qm, "WARN_ATTACKER_LIFT_M", lift - 0.01)
     rep = run_response(scenario).report
     assert f"the attacker's planted feet slide {skate:.2f} m" in " ".join(rep["warnings"])
+    assert f"the attacker's body is {lift:.2f} m higher" in " ".join(rep["warnings"])
 
 
 def test_an_attacker_knocked_off_its_feet_falls_to_the_floor_after_its_simulation() -> None:
