@@ -11,7 +11,12 @@ from numpy.typing import NDArray
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import ground_root
-from reactmocap.metrics import blend_correction_over_warning, joint_speed_max_m_s, planted
+from reactmocap.metrics import (
+    FALL_FRACTION,
+    blend_correction_over_warning,
+    joint_speed_max_m_s,
+    planted,
+)
 from reactmocap.response.blend import blend_poses, final_blend
 from reactmocap.response.footlock import lock_feet, place_ankles
 from reactmocap.response.scenario import ResponseConfig, Scenario
@@ -102,6 +107,12 @@ def _attacker_output(cfg: ResponseConfig, att: Actor, contact: ContactEstimate,
         sim = sim.replace(root_positions=sim.root_positions + moved)
     # back to the clip no faster than the capture moves: the blend adds (gap / duration) to
     # the joints' speed, kept within half the clip's fastest joint speed
+    # a kicker its simulation knocked down stays down: blended back to its standing clip it
+    # would rise through the air (no get-up exists; the real respond kicked rose 0.36 m clear)
+    pelvis = att.parts.joint_of("pelvis")
+    standing = float(att.motion.global_positions()[:, pelvis, 2].max())
+    if sim.slice(-1).global_positions()[0, pelvis, 2] < FALL_FRACTION * standing:
+        release = np.inf
     i = min(int(np.searchsorted(t, release)), t.size - 1)
     gap = float(np.linalg.norm(sim.slice(i, i + 1).global_positions()[0]
                                - own.slice(i, i + 1).global_positions()[0], axis=1).max())  # fmt: skip

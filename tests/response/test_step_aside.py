@@ -110,3 +110,30 @@ def test_an_attacker_knocked_off_its_feet_falls_to_the_floor_after_its_simulatio
     assert low[after >= fall + 0.05] == pytest.approx(0.0, abs=1e-6)  # then on the floor
     k = int(np.argmin(np.abs(after - 0.5 * fall)))
     assert low[k] == pytest.approx(lowest - 0.5 * final.STANDARD_GRAVITY * after[k] ** 2, abs=1e-6)
+
+
+def test_a_knocked_down_attacker_stays_down_rather_than_rising_through_the_air(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # bench_reactions' real respond kicked (physical mode): its kicker falls in Simulation 2;
+    # blended back to its standing kick clip it rose through poses with no foot on the floor
+    # (attacker_lift_m 0.37 m); it now stays on the floor where it fell
+    from reactmocap.response.pipeline import run_response
+    from reactmocap.response.scenario import AttackerSpec, CharacterSpec, Scenario
+    from tests.response.test_pipeline import _bench_physical, _shared_library
+
+    scenario = Scenario(
+        library=_shared_library(shared_mocap_dir, tmp_path),
+        recipient=CharacterSpec("dataset-1_respond_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=156.77102981087745,
+                              position=(0.9574638453360457, 0.11494155034128856)),
+        response=_bench_physical(attacker_assist=100.0, torque_limit=1000.0),
+        name="respond-kick",
+    )  # fmt: skip
+    res = run_response(scenario)
+    q = res.report["quality"]
+    assert q["attacker_lift_m"] <= qm.WARN_ATTACKER_LIFT_M
+    parts = map_body_parts(res.attacker.skeleton)
+    pelvis = res.attacker.global_positions()[:, parts.joint_of("pelvis"), 2]
+    assert pelvis[-1] < 0.5 * pelvis[0]  # down at the end, as its simulation left it
