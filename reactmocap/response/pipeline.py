@@ -225,7 +225,8 @@ def _report(
         warnings.append(f"Simulation 1 stopped early ({naive.unstable}): the search used its "
                         f"first {naive.motion.duration:.2f} s")  # fmt: skip
     if sim2.unstable is not None:
-        warnings.append(f"physical mode: Simulation 2 stopped early ({sim2.unstable})")
+        warnings.append(f"Simulation 2 stopped early ({sim2.unstable}): the final blend "
+                        "starts from its last stable frame")  # fmt: skip
     elif not sim2.on_clip:
         gap = sim2.landing_gap
         warnings.append(

@@ -559,7 +559,7 @@ class TransitionSimulation:
     #: physical mode: the pelvis (m), root and largest joint (rad) gaps to the found clip at
     #: the landing (or the simulation's end)
     landing_gap: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    #: physical mode: why Simulation 2 stopped early (it went unstable), else None; it ends at
+    #: why Simulation 2 stopped early (it went unstable), else None; it ends at
     #: its last stable frame and the blend closes the rest
     unstable: str | None = None
     #: physical mode: the time shift (s) onto the found clip at the landing (``land_warp``):
@@ -629,7 +629,7 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         references=[asked] + [a.motion for a in cast.actors[1:]],
         reference_start=[0.0] + [rewind + a.clock0 for a in cast.actors[1:]],
         contact_every=CONTACT_EVERY,
-        stop=landing, on_unstable="stop" if physical else "raise",
+        stop=landing, on_unstable="stop",
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
     assert res.contact_log is not None

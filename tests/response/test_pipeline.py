@@ -372,6 +372,36 @@ def test_the_kicked_recipients_tail_does_not_run_into_the_attacker(
     assert body.min(axis=1).max() <= 0.3
 
 
+def test_an_unstable_simulation_2_is_reported_not_fatal_in_the_blend_mode(
+    shared_mocap_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # with the trunk's orientation weighted 0.75 the search sends the real walk-right kicked
+    # (bench_reactions, blend mode) to a window from which Simulation 2's attacker blows up at
+    # 0.99 s; the blend mode raised SimulationError there, the physical mode stopped and warned
+    from dataclasses import replace
+
+    from reactmocap.response import library_cache
+    from reactmocap.search.config import SearchWeights
+
+    monkeypatch.setattr(library_cache, "SearchWeights",
+                        lambda: SearchWeights(trunk_orientation=0.75))  # fmt: skip
+    scenario = Scenario(
+        library=_shared_library(shared_mocap_dir, tmp_path),
+        recipient=CharacterSpec("dataset-1_walk-right_normal_001", start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=162.95691247341688,
+                              position=(2.0136727200528957, 0.0003111082439202495)),
+        response=replace(_bench_physical(attacker_assist=100.0, torque_limit=1000.0),
+                         mode="blend"),
+        name="walk-right-kick",
+    )  # fmt: skip
+    res = run_response(scenario)
+    stopped = [w for w in res.report["warnings"] if w.startswith("Simulation 2 stopped early")]
+    assert len(stopped) == 1 and "unstable" in stopped[0]
+    assert np.all(np.isfinite(res.recipient.global_positions()))
+    assert res.attacker is not None and np.all(np.isfinite(res.attacker.global_positions()))
+
+
 def test_an_unstable_simulation_1_is_reported_not_fatal(
     shared_mocap_dir: Path, tmp_path: Path
 ) -> None:
