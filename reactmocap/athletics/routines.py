@@ -204,6 +204,9 @@ def somersault(
 #: the dive's tumble lead (rad) per position, tuned by hand on the male body (5 m, 1.5 turns)
 DIVE_LEADS: Mapping[str, float] = MappingProxyType({"pike": 2.0, "tuck": 1.7, "layout": 0.0})
 DIVE_DIRECTIONS = ("backward",)
+#: the pike dive's hip flexion (rad; the pike's own is -2.2): the shallowest pike whose
+#: somersault axis is its largest principal axis, so the turn is stable (TumbleParams.hip)
+DIVE_PIKE_HIP = -2.0
 #: the twists a dive is built for (turns)
 DIVE_TWISTS = (0.5, 1.0)
 #: the twisting dive (thesis 5.2's tilt twist), tuned by hand on the male body from 5 m: a
@@ -251,6 +254,8 @@ def dive_maneuver(
     tumble = {"position": position, "turns": turns, "lead": DIVE_LEADS[position],
               "target_height": -height, "open_inertia": i_open, "latest": 0.3,
               "max_seconds": 5.0}  # fmt: skip
+    if position == "pike":
+        tumble["hip"] = DIVE_PIKE_HIP
     if twist:
         leap.update(TWIST_DIVE[0])
         tumble.update(TWIST_DIVE[1], twist=twist)

@@ -170,6 +170,12 @@ class TumbleParams:
             they extend slightly in the air before the landing controller takes over, so the
             legs are under the body at touchdown); 0: none.
         extend_lead: rotation (rad) before the opening at which that extension starts.
+        hip: the position's hip flexion (rad, anatomical pitch, -2.6..0) instead of its own;
+            None keeps it. The pike's own -2.2 makes the somersault axis the piked body's
+            intermediate principal axis (male 2.07 < 5.94 < 6.10 kg m^2), about which the
+            rotation is unstable: a little cartwheel or twist momentum from the take-off grows
+            into a tilt and a twist (the tuck's is its largest axis). At -2.0 it is the largest
+            (6.28 against 6.00).
     """
 
     position: str = "tuck"
@@ -187,6 +193,7 @@ class TumbleParams:
     open_inertia: float | None = None
     extend: float = 0.0
     extend_lead: float = 0.5
+    hip: float | None = None
 
     def __post_init__(self) -> None:
         position_angles(self.position)  # an unknown position lists the valid ones
@@ -211,6 +218,8 @@ class TumbleParams:
             math.isfinite(self.open_inertia) and self.open_inertia > 0
         ):
             raise ConfigError(f"tumble open_inertia must be > 0, got {self.open_inertia!r}")
+        if self.hip is not None and not (math.isfinite(self.hip) and -2.6 <= self.hip <= 0.0):
+            raise ConfigError(f"tumble hip must be in [-2.6, 0] rad, got {self.hip!r}")
 
 
 class Tumble(Basis):
@@ -229,6 +238,8 @@ class Tumble(Basis):
         every = ctx.control_every
         rig = ctx.rig
         goal = position_angles(p.position)
+        if p.hip is not None:
+            goal[[joint_index(f"{side}_hip") for side in "lr"], 0] = p.hip
         landing = np.zeros((NJ, 3))
         for key, val in LANDING_POSE.items():
             for side in "lr":
