@@ -56,6 +56,10 @@ class ClothSpec:
         #: steps (its ``refsafe`` check is off in the cloth model), so a fast limb is stopped
         #: within a step
         self.contact_time = 0.006
+        #: the cloth-body contacts' margin (m): they act from this far out, so a limb
+        #: swinging into the cloth meets it before the cloth is inside (0 before 2026-12-02,
+        #: 13:30 UTC: the deepest contact 1.09 cm at 3 m/s; docs/athletics.md)
+        self.contact_margin = 0.002
         #: CG's line-search iterations (MuJoCo's default 50; where ``solver`` is CG)
         self.ls_iterations = 5
         #: stretchy (sweatpants): the edges are soft equality constraints of this time
@@ -75,6 +79,10 @@ class ClothSpec:
         self.collide_arms = False
         #: how far a free vertex may go from where it was made on the leg (m; 0: anywhere)
         self.tether = 0.05
+        #: how far outside the thigh's capsule the tether keeps the homes of the rings
+        #: carried by both the thigh and the shin (m; 0: where the blend puts them, which is
+        #: up to 1.7 cm inside the thigh when the knee bends)
+        self.knee_clearance = 0.012
 
 
 #: barycentric points of a triangle where the drawn surface's depth is sampled
@@ -286,7 +294,8 @@ class Cloth:
                 f'<edge equality="true" solref="{max(sp.stretch, 2 * sp.timestep)} 1" '
                 f'damping="{sp.stretch_damping}"/>'
                 f'<contact contype="0" conaffinity="{affinity}" selfcollide="none" '
-                f'solref="{sp.contact_time} 1" solimp="0.99 0.999 0.001"/></flexcomp>'
+                f'solref="{sp.contact_time} 1" solimp="0.99 0.999 0.001" '
+                f'margin="{sp.contact_margin}"/></flexcomp>'
             )
         parts = []
         hit = np.bitwise_or.reduce(self._affinity)
@@ -376,6 +385,21 @@ class Cloth:
         self._home = np.zeros((len(free), 3))
         self._off = np.zeros((len(free), 3))
         self._scale = np.zeros(len(free))
+        # the knee's rings (carried by both the thigh and the shin): their blended homes sink
+        # into the back of the thigh when the knee bends, so they are moved out of its capsule
+        knee = np.flatnonzero((w_shin > 0) & (w_shin < 1))
+        thigh = parts[knee, 1]
+        caps = np.flatnonzero((m.geom_type == _CAPSULE) & (self._geom_part >= 0))
+        cap = caps[np.searchsorted(self._geom_part[caps], thigh)]
+        if not np.array_equal(self._geom_part[cap], thigh):
+            raise SimulationError("a thigh of the cloth model has no capsule")
+        mat = np.zeros((len(cap), 9))
+        for i, g in enumerate(cap):
+            mujoco.mju_quat2Mat(mat[i], m.geom_quat[g])
+        self._knee, self._knee_part = knee, thigh
+        self._knee_pos, self._knee_axis = m.geom_pos[cap].copy(), mat[:, 2::3].copy()
+        self._knee_half = m.geom_size[cap, 1].copy()
+        self._knee_radius = m.geom_size[cap, 0] + self.spec.knee_clearance
 
     def _tether(self, x: F64, pos: F64, rot: F64) -> None:
         """Keep each free vertex within ``spec.tether`` of where it was made on the leg
@@ -385,6 +409,17 @@ class Cloth:
         self._stack[: 3 * nb].reshape(nb, 3, 3)[:] = rot.transpose(0, 2, 1)
         self._stack[3 * nb :] = pos
         home = np.matmul(self._tmat, self._stack, out=self._home)
+        if self.spec.knee_clearance > 0:
+            # the knee rings' homes out of the thigh's capsule, along its radius
+            r, k = rot[self._knee_part], self._knee
+            rel = home[k] - np.einsum("gij,gj->gi", r, self._knee_pos) - pos[self._knee_part]
+            ax = np.einsum("gij,gj->gi", r, self._knee_axis)
+            s = np.clip(np.einsum("gi,gi->g", rel, ax), -self._knee_half, self._knee_half)
+            rel -= s[:, None] * ax
+            dist = np.sqrt(np.einsum("gi,gi->g", rel, rel))
+            home[k] += (
+                rel * (np.maximum(self._knee_radius - dist, 0.0) / np.maximum(dist, 1e-9))[:, None]
+            )
         off = np.subtract(x, home, out=self._off)
         # each offset scaled to the tether's length where it is longer (by 1 elsewhere)
         scale = np.einsum("vi,vi->v", off, off, out=self._scale)
@@ -620,8 +655,9 @@ class Cloth:
         g = con.geom.max(axis=1)
         mine = self._geom_part[g] >= 0
         # the contact distance is the geometric one between the cloth's triangles inflated
-        # by its thickness and the body geom (no margin): the cloth's mid-surface (what is
-        # drawn) is inside the body by what is left after that
+        # by its thickness and the body geom (the margin adds contacts a little apart, whose
+        # distance is positive): the cloth's mid-surface (what is drawn) is inside the body by
+        # what is left after that
         dist = con.dist[mine]
         deepest = max(0.0, float(-dist.min()) - self.spec.thickness) if dist.size else 0.0
         self.penetration_max = max(self.penetration_max, deepest)
