@@ -109,26 +109,6 @@ def test_the_female_broad_jump_swings_the_arms_back_to_land(
     assert trunk_at_touchdown(r) > trunk_at_touchdown(r0) + 0.05
 
 
-def test_a_broad_jump_pitching_forward_lands_by_its_momentum(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    """The male's effort 0.85 takes off pitching forward (+1.7 kg m^2/s where its neighbours
-    pitch back); the landing moves his feet ahead by the momentum sensed in the air
-    (BROAD_LANDING_SPIN) and he lands. With his speed's delta alone he falls."""
-    r = run("broad-jump", "male", effort=0.85, check_range=False)
-    assert r.report["liftoff_pitch_momentum"] > 0.5
-    assert r.report["landed"] and not r.report["fell"]
-    assert r.report["achieved_distance_m"] > 1.7
-    monkeypatch.setattr(tables, "BROAD_LANDING_SPIN", {})
-    r0 = run("broad-jump", "male", effort=0.85, check_range=False)
-    assert r0.report["fell"] and not r0.report["landed"]
-
-
-def test_landing_spin_gain_must_be_finite() -> None:
-    with pytest.raises(ConfigError, match="spin_gain"):
-        LandingParams(spin_gain=float("nan"))
-
-
 def test_landing_pitch_ease_must_not_be_negative() -> None:
     with pytest.raises(ConfigError, match="pitch_ease"):
         LandingParams(pitch_ease=-0.1)
