@@ -23,7 +23,6 @@ from reactmocap.athletics.balance import (
     knee_for_length,
 )
 from reactmocap.athletics.bodies import EULER_ORDER
-from reactmocap.athletics.leap import pitch_momentum
 from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
 from reactmocap.athletics.rig import joint_index, per_joint
 from reactmocap.errors import ConfigError
@@ -116,13 +115,6 @@ class LandingParams:
             the window of deltas that land moved from -0.47 m to -0.52 and -0.57 m with the
             COM 1.15, 1.25, 1.35 m up).
         fall_ref: the fall (m) the deltas were measured at (``fall_gain``'s zero).
-        spin_gain: how much farther ahead (m) the feet go per kg m^2/s of whole-body pitch
-            momentum (> 0 forward) above ``spin_ref``, sensed as the reach begins (it is
-            conserved in the air); 0: off. Why: a broad jump's take-off momentum varies
-            between neighbouring efforts (the male's -4.9 to +2.0 kg m^2/s over efforts
-            0.85-1.0), and one pitching forward lands only with the feet farther ahead than
-            its speed's delta (docs/athletics.md).
-        spin_ref: the pitch momentum (kg m^2/s) the deltas hold for (``spin_gain``'s zero).
     """
 
     knee: float = 0.6
@@ -142,8 +134,6 @@ class LandingParams:
     aim_sideways: bool = False
     fall_gain: float = 0.0
     fall_ref: float = 0.0
-    spin_gain: float = 0.0
-    spin_ref: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -161,8 +151,6 @@ class LandingParams:
             "pitch_ease",
             "fall_gain",
             "fall_ref",
-            "spin_gain",
-            "spin_ref",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -225,9 +213,6 @@ class Landing(Basis):
             moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
             rig.move(goal, 0.2, t, moving)
             memo["fall"] = p.fall_ref
-            memo["spin"] = 0.0
-            if p.spin_gain:  # conserved in the air: sensed once
-                memo["spin"] = p.spin_gain * (pitch_momentum(world, ctx.sense(t)) - p.spin_ref)
             if p.fall_gain:  # the fall predicted now, in the landing pose (see fall_gain)
                 sn = ctx.sense(t)
                 soles = (sn.sole_corners() - world.data.geom_xpos[sn.floor]) @ sn.floor_normal
@@ -249,7 +234,6 @@ class Landing(Basis):
             lead = p.lead * math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
             want = np.array([lead * v[0] + p.delta_at(float(v[0])), lead * v[1]])
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
-            want[0] += memo["spin"]
             # eq. 6.1 as a correction on top of the geometric placement below
             x = s.local(feet - s.com, h)
             xd = s.local(fvel - s.com_vel, h)

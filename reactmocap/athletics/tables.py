@@ -24,7 +24,6 @@ __all__ = [
     "BROAD_ARMS",
     "BROAD_CROUCH",
     "BROAD_LANDING",
-    "BROAD_LANDING_SPIN",
     "BROAD_PITCH_EASE",
     "BROAD_SPIN",
     "BROAD_TABLES",
@@ -165,11 +164,9 @@ VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]
 #: (/tmp sweep of ``run("broad-jump", body, effort=s)``; docs/athletics.md). The male's rows
 #: from 1.68 m/s: efforts 0.7 / 0.8 / 0.875 / 0.9 / 0.925 / 1.0 of his deeper crouch
 #: (BROAD_CROUCH), 0.025 m grid, his arms swung behind (BROAD_ARMS): landed -0.075..0,
-#: -0.125..-0.05, -0.125..-0.075, -0.05 only, -0.15 and -0.1, -0.225..-0.15 m. Since later
-#: on 2026-12-02 the rows from 2.2 m/s hold for a pitch momentum of -3.5 kg m^2/s and
-#: BROAD_LANDING_SPIN moves the feet by the momentum sensed in the air: efforts 0.85 and 0.9
-#: take off pitching forward (+1.7 / +2.0) and landed only at -0.05, their neighbours (-1.4
-#: to -4.9) at -0.175..-0.075 (a row of its own for 0.9 lost efforts 0.898 and 0.9125)
+#: -0.125..-0.05, -0.125..-0.075, -0.05 only, -0.15 and -0.1, -0.225..-0.15 m (the 0.9 take-off
+#: pitches forward, +2 kg m^2/s, where its neighbours' pitch back: its window is apart; the
+#: 0.925 row is the lower of its two, not their middle, which fell)
 BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = MappingProxyType(
     {
         "male": (
@@ -180,20 +177,15 @@ BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = Map
                 (1.35, 0.02),
                 (1.68, -0.04),
                 (2.01, -0.09),
-                (2.2, -0.09),
-                (2.3, -0.115),
-                (2.45, -0.155),
-                (2.9, -0.2),
+                (2.29, -0.1),
+                (2.34, -0.05),
+                (2.48, -0.15),
+                (2.9, -0.19),
             ),
         ),
         "female": (0.5, ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
     }
 )
-#: the broad-jump landing's delta per kg m^2/s of pitch momentum in the air, per body: (gain m
-#: per kg m^2/s, the momentum BROAD_LANDING's rows hold for), LandingParams.spin_gain/spin_ref.
-#: Male, 2026-12-02, efforts 0.8-1.0 in 0.0125 steps: gain 0 (speed only) 14 of 17 landed,
-#: 0.008 17 (0.012: 15, 0.01: worse); docs/athletics.md
-BROAD_LANDING_SPIN: Mapping[str, tuple[float, float]] = MappingProxyType({"male": (0.008, -3.5)})
 #: the shoulder pitch (rad, > 0 behind the trunk) a broad jump's landing swings the arms to
 #: in the air, per body (LandingParams.arms; others keep its -0.6, in front). Why: the take-off
 #: leaves the arms overhead, and swinging them forward-down and on behind the trunk turns the
@@ -249,9 +241,7 @@ def landing_params(
         base = landing_params(body, velocity, after_leap=True)
         if body in BROAD_LANDING:
             lead, table = BROAD_LANDING[body]
-            gain, ref = BROAD_LANDING_SPIN.get(body, (0.0, 0.0))
-            base = LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table,
-                                 spin_gain=gain, spin_ref=ref)  # fmt: skip
+            base = LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
         arms = BROAD_ARMS.get(body, base.arms)
         return replace(base, pitch_ease=BROAD_PITCH_EASE, arms=arms)
     if vertical and push == "com" and body in VERTICAL_LANDING_COM:
