@@ -173,9 +173,10 @@ VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]
 #: (/tmp sweep of ``run("broad-jump", body, effort=s)``; docs/athletics.md). The male's rows
 #: from 1.68 m/s: efforts 0.7 / 0.8 / 0.875 / 0.9 / 0.925 / 1.0 of his deeper crouch
 #: (BROAD_CROUCH), 0.025 m grid, his arms swung behind (BROAD_ARMS): landed -0.075..0,
-#: -0.125..-0.05, -0.125..-0.075, -0.05 only, -0.15 and -0.1, -0.225..-0.15 m (the 0.9 take-off
-#: pitches forward, +2 kg m^2/s, where its neighbours' pitch back: its window is apart; the
-#: 0.925 row is the lower of its two, not their middle, which fell)
+#: -0.125..-0.05, -0.125..-0.075, -0.05 only, -0.15 and -0.1, -0.225..-0.15 m. Since his
+#: take-off spin gain of 20 (BROAD_SPIN_GAIN; no more forward-pitching take-offs) efforts
+#: 0.875 / 0.8875 (2.30 / 2.37 m/s) land at -0.15..-0.1: the rows at 2.25 / 2.3 m/s replace
+#: the 0.9 take-off's own (2.34 m/s, -0.05, when it pitched forward at +2 kg m^2/s)
 BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = MappingProxyType(
     {
         "male": (
@@ -186,8 +187,8 @@ BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = Map
                 (1.35, 0.02),
                 (1.68, -0.04),
                 (2.01, -0.09),
-                (2.29, -0.1),
-                (2.34, -0.05),
+                (2.25, -0.1),
+                (2.3, -0.125),
                 (2.48, -0.15),
                 (2.9, -0.19),
             ),
