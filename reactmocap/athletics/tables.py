@@ -26,6 +26,7 @@ __all__ = [
     "BROAD_LANDING",
     "BROAD_PITCH_EASE",
     "BROAD_SPIN",
+    "BROAD_SPIN_GAIN",
     "BROAD_TABLES",
     "LANDING_DELTAS",
     "LANDING_DELTAS_FAST",
@@ -61,11 +62,12 @@ def broad_params(s: float, body: str | None = None) -> LeapParams:
     the take-off's backward angular momentum is the body's :data:`BROAD_SPIN`."""
     s = float(np.clip(s, 0.0, 1.0))
     spin = BROAD_SPIN.get(body or "", DEFAULT_BROAD_SPIN)
+    spin_gain = BROAD_SPIN_GAIN.get(body or "", DEFAULT_BROAD_SPIN_GAIN)
     knots = np.array(BROAD_CROUCH.get(body or "", DEFAULT_BROAD_CROUCH)).T
     leg, pitch = (float(np.interp(s, knots[0], k)) for k in knots[1:])
     return LeapParams(leg=leg, pitch=pitch, lean=0.0, com_offset=0.12 + 0.1 * s,
                       stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
-                      arms=-1.8 - 1.0 * s, broad=True, spin=spin, spin_gain=40.0, hold=0.1)  # fmt: skip
+                      arms=-1.8 - 1.0 * s, broad=True, spin=spin, spin_gain=spin_gain, hold=0.1)  # fmt: skip
 
 
 #: the broad jump's crouch along the effort: knots (effort s, hip-to-ankle leg fraction,
@@ -91,6 +93,13 @@ DEFAULT_BROAD_SPIN = -5.0
 #: with the feet 0.13 m behind the COM after a 0.1 s flight and fell forward; with -1 her
 #: 0.35 and 0.43 m jumps land (-2: 0.43 m only; -3: none)
 BROAD_SPIN: Mapping[str, float] = MappingProxyType({"female": -1.0})
+#: the take-off spin feedback's gain (LeapParams.spin_gain: hip offset per unit momentum error)
+DEFAULT_BROAD_SPIN_GAIN = 40.0
+#: per body. Male, 2026-12-02: with 40 the feedback hit its limit (spin_limit 0.6 rad) in his
+#: deeper crouch's pushes, and the lift-off momentum jumped between -4.9 and +2.0 kg m^2/s
+#: over efforts 0.85-1.0 (0.4 rad: +2.7 to +5.7, all 17 of efforts 0.8-1.0 fell; 80 or a
+#: 1.0 rad limit: -3.6 to +17); with 20 it stays -1 to -3.4 and the distance grows smoothly
+BROAD_SPIN_GAIN: Mapping[str, float] = MappingProxyType({"male": 20.0})
 
 
 #: (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
@@ -164,9 +173,10 @@ VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]
 #: (/tmp sweep of ``run("broad-jump", body, effort=s)``; docs/athletics.md). The male's rows
 #: from 1.68 m/s: efforts 0.7 / 0.8 / 0.875 / 0.9 / 0.925 / 1.0 of his deeper crouch
 #: (BROAD_CROUCH), 0.025 m grid, his arms swung behind (BROAD_ARMS): landed -0.075..0,
-#: -0.125..-0.05, -0.125..-0.075, -0.05 only, -0.15 and -0.1, -0.225..-0.15 m (the 0.9 take-off
-#: pitches forward, +2 kg m^2/s, where its neighbours' pitch back: its window is apart; the
-#: 0.925 row is the lower of its two, not their middle, which fell)
+#: -0.125..-0.05, -0.125..-0.075, -0.05 only, -0.15 and -0.1, -0.225..-0.15 m. Since his
+#: take-off spin gain of 20 (BROAD_SPIN_GAIN; no more forward-pitching take-offs) efforts
+#: 0.875 / 0.8875 (2.30 / 2.37 m/s) land at -0.15..-0.1: the rows at 2.25 / 2.3 m/s replace
+#: the 0.9 take-off's own (2.34 m/s, -0.05, when it pitched forward at +2 kg m^2/s)
 BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = MappingProxyType(
     {
         "male": (
@@ -177,8 +187,8 @@ BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = Map
                 (1.35, 0.02),
                 (1.68, -0.04),
                 (2.01, -0.09),
-                (2.29, -0.1),
-                (2.34, -0.05),
+                (2.25, -0.1),
+                (2.3, -0.125),
                 (2.48, -0.15),
                 (2.9, -0.19),
             ),

@@ -75,6 +75,19 @@ def test_a_2_2_m_broad_jump_lands_within_5_cm(monkeypatch: pytest.MonkeyPatch) -
     assert r0.report["achieved_distance_m"] < 1.6
 
 
+def test_the_male_2_m_broad_jump_takes_off_pitching_back(monkeypatch: pytest.MonkeyPatch) -> None:
+    """His take-off spin feedback's gain (BROAD_SPIN_GAIN, 20) stays under its limit in his
+    deeper crouch: effort 0.9 (2.01 m) lifts off pitching back and lands. At the default
+    gain of 40 the same push lifts off pitching forward."""
+    r = run("broad-jump", "male", effort=0.9, check_range=False)
+    assert r.report["liftoff_pitch_momentum"] < -1.0
+    assert r.report["landed"] and not r.report["fell"]
+    assert r.report["achieved_distance_m"] > 1.95
+    monkeypatch.setattr(tables, "BROAD_SPIN_GAIN", {})
+    r0 = run("broad-jump", "male", effort=0.9, check_range=False)
+    assert r0.report["liftoff_pitch_momentum"] > 1.0
+
+
 def test_broad_jumps_land_with_the_trunk_righted_slowly(monkeypatch: pytest.MonkeyPatch) -> None:
     """A broad jump lands with the trunk pitched forward; the landing rights it over
     BROAD_PITCH_EASE s. Righted at once, the hips' extension pushes into the floor and
