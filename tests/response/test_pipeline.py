@@ -214,6 +214,21 @@ def _bench_physical(**kw: Any) -> ResponseConfig:
                           land_within=1.0, land_tries=3, **kw)  # fmt: skip
 
 
+def _bench_kick(shared_mocap_dir: Path, tmp_path: Path, recipient: str, facing_deg: float,
+                position: tuple[float, float], mode: str = "physical") -> Scenario:  # fmt: skip
+    """bench_reactions' real kick at a real recipient (its ``REAL`` settings, in ``mode``)."""
+    from dataclasses import replace
+
+    return Scenario(
+        library=_shared_library(shared_mocap_dir, tmp_path),
+        recipient=CharacterSpec(recipient, start=0.5),
+        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
+                              facing_deg=facing_deg, position=position),
+        response=replace(_bench_physical(attacker_assist=100.0, torque_limit=1000.0), mode=mode),
+        name=f"{recipient}-kick",
+    )  # fmt: skip
+
+
 def _real_kick(
     library: Path, recipient: str, facing_deg: float, position: tuple[float, float], name: str
 ) -> Scenario:
@@ -317,16 +332,13 @@ def test_a_leg_the_blend_turns_into_the_attacker_is_held_with_the_pelvis(
     # did not land (0.6 m, 1.4 rad off), and the blend's turn of the pelvis swung the left
     # shin 6 cm into the kicker while the shin's own joints were held; a leg's overlap now
     # holds the pelvis's turn too, as an arm's holds the trunk's
-    lib = _shared_library(shared_mocap_dir, tmp_path)
-    scenario = Scenario(
-        library=lib,
-        recipient=CharacterSpec("dataset-1_walk-right_normal_001", start=0.5),
-        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
-                              facing_deg=162.95691247341688,
-                              position=(2.0136727200528957, 0.0003111082439202495)),
-        response=_bench_physical(attacker_assist=100.0, torque_limit=1000.0),
-        name="walk-right-kick",
-    )  # fmt: skip
+    scenario = _bench_kick(
+        shared_mocap_dir,
+        tmp_path,
+        "dataset-1_walk-right_normal_001",
+        162.95691247341688,
+        (2.0136727200528957, 0.0003111082439202495),
+    )
     res = run_response(scenario)
     assert res.report["quality"]["blend_root_offset_max_m"] > 0.3  # the case: a large correction
     assert res.report["quality"]["character_overlap_max_m"] <= 0.02
@@ -378,23 +390,14 @@ def test_an_unstable_simulation_2_is_reported_not_fatal_in_the_blend_mode(
     # with the trunk's orientation weighted 0.75 the search sends the real walk-right kicked
     # (bench_reactions, blend mode) to a window from which Simulation 2's attacker blows up at
     # 0.99 s; the blend mode raised SimulationError there, the physical mode stopped and warned
-    from dataclasses import replace
-
     from reactmocap.response import library_cache
     from reactmocap.search.config import SearchWeights
 
     monkeypatch.setattr(library_cache, "SearchWeights",
                         lambda: SearchWeights(trunk_orientation=0.75))  # fmt: skip
-    scenario = Scenario(
-        library=_shared_library(shared_mocap_dir, tmp_path),
-        recipient=CharacterSpec("dataset-1_walk-right_normal_001", start=0.5),
-        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
-                              facing_deg=162.95691247341688,
-                              position=(2.0136727200528957, 0.0003111082439202495)),
-        response=replace(_bench_physical(attacker_assist=100.0, torque_limit=1000.0),
-                         mode="blend"),
-        name="walk-right-kick",
-    )  # fmt: skip
+    scenario = _bench_kick(shared_mocap_dir, tmp_path, "dataset-1_walk-right_normal_001",
+                           162.95691247341688, (2.0136727200528957, 0.0003111082439202495),
+                           mode="blend")  # fmt: skip
     res = run_response(scenario)
     stopped = [w for w in res.report["warnings"] if w.startswith("Simulation 2 stopped early")]
     assert len(stopped) == 1 and "unstable" in stopped[0]

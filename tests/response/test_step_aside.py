@@ -4,7 +4,6 @@ attacker's foot skate."""
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -63,19 +62,11 @@ def test_the_attackers_blend_back_keeps_its_planted_feet_and_a_slide_is_warned(
     # from its simulation to its clip slid its planted feet 0.47 m before they were pinned
     # (final._attacker_output's lock_feet)
     from reactmocap.response.pipeline import run_response
-    from reactmocap.response.scenario import AttackerSpec, CharacterSpec, Scenario
-    from tests.response.test_pipeline import _bench_physical, _shared_library
+    from tests.response.test_pipeline import _bench_kick
 
-    scenario = Scenario(
-        library=_shared_library(shared_mocap_dir, tmp_path),
-        recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
-        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
-                              facing_deg=167.42333060441473,
-                              position=(0.9101249775269609, 0.24847072154800792)),
-        response=replace(_bench_physical(attacker_assist=100.0, torque_limit=1000.0,
-                                         blend_settle=0.5), mode="blend"),
-        name="bow-kick",
-    )  # fmt: skip
+    scenario = _bench_kick(shared_mocap_dir, tmp_path, "dataset-1_bow_normal_001",
+                           167.42333060441473, (0.9101249775269609, 0.24847072154800792),
+                           mode="blend")  # fmt: skip
     rep = run_response(scenario).report
     skate = rep["quality"]["attacker_foot_skate_m"]
     assert 0.0 < skate <= 0.2
@@ -119,18 +110,15 @@ def test_a_knocked_down_attacker_stays_down_rather_than_rising_through_the_air(
     # blended back to its standing kick clip it rose through poses with no foot on the floor
     # (attacker_lift_m 0.37 m); it now stays on the floor where it fell
     from reactmocap.response.pipeline import run_response
-    from reactmocap.response.scenario import AttackerSpec, CharacterSpec, Scenario
-    from tests.response.test_pipeline import _bench_physical, _shared_library
+    from tests.response.test_pipeline import _bench_kick
 
-    scenario = Scenario(
-        library=_shared_library(shared_mocap_dir, tmp_path),
-        recipient=CharacterSpec("dataset-1_respond_normal_001", start=0.5),
-        attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
-                              facing_deg=156.77102981087745,
-                              position=(0.9574638453360457, 0.11494155034128856)),
-        response=_bench_physical(attacker_assist=100.0, torque_limit=1000.0),
-        name="respond-kick",
-    )  # fmt: skip
+    scenario = _bench_kick(
+        shared_mocap_dir,
+        tmp_path,
+        "dataset-1_respond_normal_001",
+        156.77102981087745,
+        (0.9574638453360457, 0.11494155034128856),
+    )
     res = run_response(scenario)
     q = res.report["quality"]
     assert q["attacker_lift_m"] <= qm.WARN_ATTACKER_LIFT_M
