@@ -204,21 +204,7 @@ def _report(
         "transition_s": sim2.landed - naive.impact_time,
         "contact_impulse_Ns": float(np.linalg.norm(impulse)),
         "character_overlap_max_m": overlap,
-        "attacker_speed_ratio": (
-            qm.speed_ratio(out.attacker, cast.attacker.motion)
-            if out.attacker is not None and cast.attacker is not None
-            else None
-        ),
-        "attacker_foot_skate_m": (
-            qm.foot_skate_m(out.attacker, cast.attacker.parts)
-            if out.attacker is not None and cast.attacker is not None
-            else None
-        ),
-        "attacker_lift_m": (
-            qm.lift_above_source_m(out.attacker, cast.attacker.motion, cast.attacker.parts)
-            if out.attacker is not None and cast.attacker is not None
-            else None
-        ),
+        **_attacker_quality(cast, out),
     }
     warnings = _warnings(scenario, cast, contact, naive, cont, quality)
     if naive.unstable is not None:
@@ -277,6 +263,18 @@ def _report(
         "quality": quality,
         "config": asdict(cfg),
         "outputs": {},
+    }
+
+
+def _attacker_quality(cast: stages.Cast, out: final.Blend) -> dict[str, float | None]:
+    """The attacker's output against its clip (None without an attacker)."""
+    att = cast.attacker
+    if out.attacker is None or att is None:
+        return dict.fromkeys(("attacker_speed_ratio", "attacker_foot_skate_m", "attacker_lift_m"))
+    return {
+        "attacker_speed_ratio": qm.speed_ratio(out.attacker, att.motion),
+        "attacker_foot_skate_m": qm.foot_skate_m(out.attacker, att.parts),
+        "attacker_lift_m": qm.lift_above_source_m(out.attacker, att.motion, att.parts),
     }
 
 
