@@ -565,7 +565,7 @@ class TransitionSimulation:
     #: physical mode: the time shift (s) onto the found clip at the landing (``land_warp``):
     #: the blend lands on the found clip's frame that much later than the path's
     landing_phase: float = 0.0
-    #: physical mode: the tracker took capture-point balance steps (``land_step_time``)
+    #: physical mode: the tracker took at least one capture-point balance step (``land_step_time``)
     balance_steps: bool = False
 
 
@@ -652,9 +652,10 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         landed = max(cont.time, rewind + min(at, res.duration))
         gap = (float(last[0]), float(last[1]), float(last[2]))
     unstable = res.reason if res.status == "unstable" else None
+    stepped = steps and isinstance(tracker, WholeBodyTracker) and bool(tracker.steps_taken)
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
                                 res.contact_log, release, landed, on_clip, gap,
-                                unstable, phase, steps)  # fmt: skip
+                                unstable, phase, stepped)  # fmt: skip
 
 
 class _StiffenFrom:
