@@ -86,9 +86,14 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     settles = cfg.mode == "blend" and cfg.blend_settle > 0.0
     at_match = replace(scenario, response=replace(cfg, blend_settle=0.0)) if settles else scenario
     sim2 = timed("sim2", stages.transition_simulation, at_match, cast, contact, naive, cont)
-    for alt in cont.alternatives if not sim2.on_clip else ():
-        # the body did not land: a continuation it comes closer to wins (``land_tries``)
-        other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, alt)
+    # the body did not land: the same clip with balance steps (``land_step_time``), then the
+    # search's next-best clips (``land_tries``); the one it comes closest to wins
+    first = cont
+    stepped = cfg.mode == "physical" and cfg.land_step_time > 0
+    retries = () if sim2.on_clip else (first,) * stepped + first.alternatives
+    for alt in retries:
+        other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, alt,
+                      alt is first)  # fmt: skip
         if _landing_score(scenario, other) < _landing_score(scenario, sim2):
             cont, sim2 = alt, other
         if sim2.on_clip:
@@ -257,6 +262,7 @@ def _report(
             "landed_on_clip": sim2.on_clip,
             "landing_gap": dict(zip(("pelvis_m", "root_rad", "joint_rad"), sim2.landing_gap)),
             "landing_phase_s": sim2.landing_phase,
+            "balance_steps": sim2.balance_steps,
         },
         "timings_s": timings,
         "steps": {"sim1": naive.steps, "sim2": sim2.steps},

@@ -133,6 +133,11 @@ class ResponseConfig:
     #: this many times stiffer (damping times its root; 1: as built), so the hit body settles
     #: onto the found clip's pose before it drifts off it (``docs/benchmarks.md``)
     land_stiffness: float = 6.0
+    #: physical mode: a body that does not land is simulated again toward the same found clip
+    #: with the whole-body tracker's capture-point balance steps lasting this many seconds
+    #: (before the search's next-best windows, ``land_tries``), and the closer of the two
+    #: landings wins (0: no such retry)
+    land_step_time: float = 0.2
     #: physical mode: when the body does not land, Simulation 2 runs again toward the search's
     #: next-best windows of other clips, up to ``land_tries`` continuations in all, and the one
     #: the body came closest to (its landing gap over the tolerances) wins: a continuation the
@@ -250,7 +255,7 @@ class _Reader:
                                   "contact_shift_max", "attacker_follow", "attacker_blend",
                                   "friction_sim1", "friction_sim2", "kv", "yield_gain",
                                   "react_impulse", "active_min", "own_clip_margin", "attacker_assist",
-                                  "yield_recover", "land_within", "land_warp", "blend_settle",
+                                  "yield_recover", "land_within", "land_warp", "blend_settle", "land_step_time",
                                   "torque_limit"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
                                     "total_mass", "land_position", "land_angle",

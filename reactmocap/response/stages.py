@@ -565,14 +565,18 @@ class TransitionSimulation:
     #: physical mode: the time shift (s) onto the found clip at the landing (``land_warp``):
     #: the blend lands on the found clip's frame that much later than the path's
     landing_phase: float = 0.0
+    #: physical mode: the tracker took at least one capture-point balance step (``land_step_time``)
+    balance_steps: bool = False
 
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
-                          naive: NaiveSimulation, cont: Continuation) -> TransitionSimulation:  # fmt: skip
+                          naive: NaiveSimulation, cont: Continuation,
+                          steps: bool = False) -> TransitionSimulation:  # fmt: skip
     """Simulation 2 (the recipient's limbs on ``friction_sim2``) from the same start and
     impact: the recipient follows the desired path to the found clip with ``sim2_controller``,
     yielding through the reaction delay as in Simulation 1 (the passive response), then
-    recovering (the active). In the ``physical`` mode it runs on along the found clip until the body lands on it."""
+    recovering (the active). In the ``physical`` mode it runs on along the found clip until the body lands on it,
+    with ``steps`` taking capture-point balance steps of ``land_step_time`` s."""
     cfg = scenario.response
     rewind = contact.rewind
     end = cont.time
@@ -599,7 +603,9 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     # the physical mode's body keeps its balance through a hit its ankles cannot take (it gives
     # way above the hips only): yielding whole, it is still off balance when the found clip
     # starts and falls from it (docs/benchmarks.md)
-    options = {"hold_balance": True} if physical else None
+    options: dict[str, Any] | None = {"hold_balance": True} if physical else None
+    if options is not None and steps:
+        options.update(stepping=True, step_time=cfg.land_step_time)
     recipient = tracker = _controller(name, cfg, world, 0, q, 0.0, rate, options)
     if yields and isinstance(recipient, GainScalable):
         recipient = Scheduled(recipient, yield_schedule(cfg, naive.impact_time - rewind))
@@ -646,9 +652,10 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         landed = max(cont.time, rewind + min(at, res.duration))
         gap = (float(last[0]), float(last[1]), float(last[2]))
     unstable = res.reason if res.status == "unstable" else None
+    stepped = steps and isinstance(tracker, WholeBodyTracker) and bool(tracker.steps_taken)
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
                                 res.contact_log, release, landed, on_clip, gap,
-                                unstable, phase)  # fmt: skip
+                                unstable, phase, stepped)  # fmt: skip
 
 
 class _StiffenFrom:

@@ -219,3 +219,29 @@ def test_a_large_root_turn_still_warns() -> None:
     q = rep["quality"]
     assert q["blend_root_turn_max_rad"] > qm.WARN_ROOT_TURN_RAD, q
     assert any("turns the root" in w for w in rep["warnings"]), rep["warnings"]
+
+
+def test_a_kick_that_does_not_land_lands_when_simulated_again_with_balance_steps() -> None:
+    # the sweep's kick from 210 deg (found clip `step_right`): the body leaves its feet's
+    # support at 0.6-0.8 m/s and falls off the clip after the match; simulated again with
+    # capture-point balance steps (`land_step_time`), it catches itself and lands
+    sc = _facing(210.0, "physical")
+    sc = replace(sc, response=replace(sc.response, land_tries=1))  # the same clip only
+    assert sc.response.land_step_time > 0.0
+    stepped = run_response(sc, CACHE).report
+    flat = run_response(replace(sc, response=replace(sc.response, land_step_time=0.0)),
+                        CACHE).report  # fmt: skip
+    assert stepped["matched"]["clip"] == flat["matched"]["clip"]  # the same search
+    assert not flat["transition"]["landed_on_clip"] and not flat["transition"]["balance_steps"]
+    tr, q = stepped["transition"], stepped["quality"]
+    assert tr["landed_on_clip"] and tr["balance_steps"], tr
+    assert _score(stepped, sc) <= 1.0 < _score(flat, sc)
+    assert q["blend_joint_correction_max_rad"] <= sc.response.land_joint + 1e-9, q
+    assert q["blend_root_offset_max_m"] <= sc.response.land_position + 1e-9, q
+
+
+def test_a_negative_land_step_time_is_a_clear_error() -> None:
+    data = {"library": str(REPO / "data" / "synthetic_clips"), "recipient": {"clip": "guard"},
+            "impact": {}, "response": {"mode": "physical", "land_step_time": -0.1}}  # fmt: skip
+    with pytest.raises(ConfigError, match=r"\[response\]\.land_step_time"):
+        parse_scenario(data, source="s.toml")
