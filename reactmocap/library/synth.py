@@ -371,6 +371,16 @@ def _fall_sideways() -> Clip:
     return c.at(1.9, **lying).hold(4.5, *lying)
 
 
+def _faster(build: Callable[[], Clip], speed: float, duration: float) -> Clip:
+    """Clip ``build`` played ``speed`` times as fast (every key sooner), lasting ``duration``.
+    The simulated bodies the real recipients' pushes knock down reach the floor 0.4-0.7 s after
+    they start to go (the head 1.2-1.4 m -> 0.1-0.2 m); the falls above take 1.4-2.3 s, so a
+    falling body had no fall to match but their lying hold (``docs/benchmarks.md``)."""
+    src, c = build(), Clip(duration)
+    c.keys = {ch: [(t / speed, v) for t, v in keys] for ch, keys in src.keys.items()}
+    return c
+
+
 CLIP_BUILDERS: dict[str, tuple[Callable[[], Clip], str]] = {
     "guard": (_guard, "fighting guard (left foot forward) with a subtle breathing sway; loops"),
     "step_forward": (_step_forward, "guard shuffle step forward 0.3 m (front foot first)"),
@@ -397,6 +407,18 @@ CLIP_BUILDERS: dict[str, tuple[Callable[[], Clip], str]] = {
     "fall_backward": (_fall_backward, "heavy reaction: staggers back, sits down, ends on the back"),
     "fall_forward": (_fall_forward, "heavy reaction: stumbles, drops to the knees, ends prone"),
     "fall_sideways": (_fall_sideways, "heavy reaction: staggers left, ends lying on the left side"),
+    "fall_forward_fast": (
+        lambda: _faster(_fall_forward, 2.0, 3.0),
+        "heavy reaction: fall_forward twice as fast, prone 1.15 s in",
+    ),
+    "fall_backward_fast": (
+        lambda: _faster(_fall_backward, 2.0, 3.0),
+        "heavy reaction: fall_backward twice as fast, on the back 1.15 s in",
+    ),
+    "fall_sideways_fast": (
+        lambda: _faster(_fall_sideways, 2.0, 3.0),
+        "heavy reaction: fall_sideways twice as fast, on the left side 0.95 s in",
+    ),
 }
 CLIP_INFO = {k: v[1] for k, v in CLIP_BUILDERS.items()}
 ATTACK_CLIPS = ("front_kick", "side_kick", "punch", "push")

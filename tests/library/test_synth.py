@@ -21,7 +21,10 @@ from reactmocap.library.synth import (
 from reactmocap.rotations import quat_log
 from tests.conftest import SYNTHETIC
 
-FALLS = ("fall_backward", "fall_forward", "fall_sideways")
+FALLS = (
+    "fall_backward", "fall_forward", "fall_sideways", "fall_backward_fast", "fall_forward_fast",
+    "fall_sideways_fast",
+)  # fmt: skip
 
 # Largest rotation from the rest pose (degrees) per joint; the root is free. A trained kicker's
 # front-kick chamber flexes the hip to about 135-140 degrees with the knee bent.
