@@ -23,7 +23,7 @@ from tests.conftest import SYNTHETIC
 
 FALLS = (
     "fall_backward", "fall_forward", "fall_sideways", "fall_backward_fast", "fall_forward_fast",
-    "fall_sideways_fast",
+    "fall_sideways_fast", "fall_forward_topple",
 )  # fmt: skip
 
 # Largest rotation from the rest pose (degrees) per joint; the root is free. A trained kicker's
