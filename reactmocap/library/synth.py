@@ -371,6 +371,44 @@ def _fall_sideways() -> Clip:
     return c.at(1.9, **lying).hold(4.5, *lying)
 
 
+def _fall_forward_topple() -> Clip:
+    # knocked off balance forward: one catching step, then the body pivots over the planted
+    # feet like a plank (no kneeling), the hands reach for the floor, prone 0.9 s in
+    c = Clip(3.0)
+    c.at(
+        0.08,
+        root=(0.06, 0.0, 0.89), rootrot=(0.0, 12.0, 0.0), Spine=(0.0, 8.0, -8.0),
+        Spine1=(0.0, 6.0, -8.0), Neck=(0.0, -10.0, 8.0), Head=(0.0, -8.0, 8.0),
+        lhand=(0.30, 0.10, -0.10), rhand=(0.30, -0.10, -0.10),
+    )  # fmt: skip
+    c.step("r", 0.05, 0.3, (0.40, -0.13), foot=(-5.0, 0.0, 0.0), h=0.07)
+    c.hold(0.3, "lfoot", "rfoot")
+    c.at(0.3, root=(0.30, 0.0, 0.86), rootrot=(0.0, 25.0, 0.0))
+    c.at(0.3, lhand=(0.40, 0.08, -0.15), rhand=(0.40, -0.08, -0.15))
+    c.at(0.5, root=(0.62, 0.0, 0.68), rootrot=(0.0, 50.0, 0.0), Neck=(0.0, -25.0, 0.0))
+    c.at(0.5, lhand=(0.40, 0.05, -0.35), rhand=(0.40, -0.05, -0.35), Head=(0.0, -15.0, 0.0))
+    c.at(0.6, lfoot=(10.0, 40.0, 0.0), rfoot=(-5.0, 40.0, 0.0))
+    c.at(0.7, root=(0.95, 0.0, 0.38), rootrot=(0.0, 72.0, 0.0))
+    prone: Pose = dict(
+        root=(1.25, 0.0, 0.13), rootrot=(0.0, 88.0, 0.0), Spine=(0.0, -3.0, 0.0),
+        Spine1=(0.0, -3.0, 0.0), Neck=(0.0, -30.0, 0.0), Head=(0.0, -10.0, 0.0),
+        lhand=(0.10, 0.25, -0.05), rhand=(0.10, -0.25, -0.05), lelbow=(-0.3, 1.0, -0.5),
+        relbow=(-0.3, -1.0, -0.5), lknee=(0.0, 0.2, -1.0), rknee=(0.0, -0.2, -1.0),
+        lfoot=(10.0, 65.0, 0.0), rfoot=(-5.0, 65.0, 0.0),
+    )  # fmt: skip
+    return c.at(0.9, **prone).hold(3.0, *prone)
+
+
+def _faster(build: Callable[[], Clip], speed: float, duration: float) -> Clip:
+    """Clip ``build`` played ``speed`` times as fast (every key sooner), lasting ``duration``.
+    The simulated bodies the real recipients' pushes knock down reach the floor 0.4-0.7 s after
+    they start to go (the head 1.2-1.4 m -> 0.1-0.2 m); the falls above take 1.4-2.3 s, so a
+    falling body had no fall to match but their lying hold (``docs/benchmarks.md``)."""
+    src, c = build(), Clip(duration)
+    c.keys = {ch: [(t / speed, v) for t, v in keys] for ch, keys in src.keys.items()}
+    return c
+
+
 CLIP_BUILDERS: dict[str, tuple[Callable[[], Clip], str]] = {
     "guard": (_guard, "fighting guard (left foot forward) with a subtle breathing sway; loops"),
     "step_forward": (_step_forward, "guard shuffle step forward 0.3 m (front foot first)"),
@@ -397,6 +435,22 @@ CLIP_BUILDERS: dict[str, tuple[Callable[[], Clip], str]] = {
     "fall_backward": (_fall_backward, "heavy reaction: staggers back, sits down, ends on the back"),
     "fall_forward": (_fall_forward, "heavy reaction: stumbles, drops to the knees, ends prone"),
     "fall_sideways": (_fall_sideways, "heavy reaction: staggers left, ends lying on the left side"),
+    "fall_forward_topple": (
+        _fall_forward_topple,
+        "heavy reaction: one step, then topples forward over the feet, prone 0.9 s in",
+    ),
+    "fall_forward_fast": (
+        lambda: _faster(_fall_forward, 2.0, 3.0),
+        "heavy reaction: fall_forward twice as fast, prone 1.15 s in",
+    ),
+    "fall_backward_fast": (
+        lambda: _faster(_fall_backward, 2.0, 3.0),
+        "heavy reaction: fall_backward twice as fast, on the back 1.15 s in",
+    ),
+    "fall_sideways_fast": (
+        lambda: _faster(_fall_sideways, 2.0, 3.0),
+        "heavy reaction: fall_sideways twice as fast, on the left side 0.95 s in",
+    ),
 }
 CLIP_INFO = {k: v[1] for k, v in CLIP_BUILDERS.items()}
 ATTACK_CLIPS = ("front_kick", "side_kick", "punch", "push")
