@@ -68,7 +68,8 @@ SOMERSAULT_PRESETS: Mapping[
     "male": MappingProxyType({
         "backward": (MappingProxyType({"effort": 0.6, "spin": -55.0, "spin_limit": 1.0}),
                      MappingProxyType({"lead": 2.8}),
-                     MappingProxyType({"delta": -0.17, "aim_sideways": True})),
+                     MappingProxyType({"delta": -0.17, "aim_sideways": True,
+                                       "spin_aim": True})),
         "backward/pike": (MappingProxyType({"effort": 0.6, "spin": -66.0, "spin_limit": 1.3}),
                           MappingProxyType({"lead": 3.4}),
                           MappingProxyType({"delta": -0.15, "knee": 1.0})),
