@@ -61,7 +61,10 @@ __all__ = [
 #: The back tuck lands with the feet 17 cm behind the capture point and the legs' sideways aim
 #: taken from the pelvis's whole orientation (``aim_sideways``: a perturbed take-off rolls the
 #: body, and feet landing to one side of the COM left it on one foot; since 2026-12-02 its
-#: perturbed starts land 33/50 at full size, from 19, and 50/50 at a tenth, from 41).
+#: perturbed starts land 33/50 at full size, from 19, and 50/50 at a tenth, from 41), and its
+#: reach holds the legs' aim in the world while the body still turns (``spin_aim``: the feet
+#: were still swinging forward at 3-5 m/s when they touched; since 2026-12-02 44/50 at full
+#: size, seed 0).
 SOMERSAULT_PRESETS: Mapping[
     str, Mapping[str, tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]]
 ] = MappingProxyType({
