@@ -46,8 +46,8 @@ class Senses:
         self._own = world.geom_character == character
         self._body = world.geom_body
         self._f6 = np.zeros(6)
-        self._forward = _forward_in_body(athlete)
-        self._left = _forward_in_body(athlete, np.array([0.0, 1.0, 0.0]))
+        self._forward = _axis_in_body(athlete, np.array([1.0, 0.0, 0.0]))
+        self._left = _axis_in_body(athlete, np.array([0.0, 1.0, 0.0]))
         self.time = -1.0
         self.com = np.zeros(3)
         self.com_vel = np.zeros(3)
@@ -174,10 +174,9 @@ class Senses:
         return loc.min(axis=0), loc.max(axis=0)
 
 
-def _forward_in_body(athlete: Athlete, axis: F64 | None = None) -> F64:
-    """The pelvis's anatomical forward (+X of the neutral frame; or ``axis`` of it) in its
-    body frame."""
+def _axis_in_body(athlete: Athlete, axis: F64) -> F64:
+    """An axis of the pelvis's anatomical neutral frame (+X forward, +Y left) in its body
+    frame."""
     from reactmocap.rotations import quat_conj, quat_rotate
 
-    v = np.array([1.0, 0.0, 0.0]) if axis is None else axis
-    return quat_rotate(quat_conj(athlete.neutral[0]), v)
+    return quat_rotate(quat_conj(athlete.neutral[0]), axis)
