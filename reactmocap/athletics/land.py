@@ -104,6 +104,16 @@ class LandingParams:
             own roll not taken out: a back tuck from a perturbed start touched down with the
             pelvis rolled up to 16 degrees, the feet up to 7 cm to the side of the COM and
             6-8 cm apart fore-aft, and stood on one foot after the landing.
+        spin_aim: the reach for a body still turning (a somersault's landing): the legs are
+            aimed in the heading of the pelvis's left-right axis (``Senses.side_heading``;
+            the pelvis's forward axis, the default's heading, flips by half a turn as the
+            body passes the horizontal, which mirrored the placement in mid-reach), and the
+            hips' target is led by the servo's lag (``Rig.lag``) times the pelvis's pitch
+            rate (the target turns with the body, and the servo trailed it by 20-40
+            degrees: the male back tuck's legs were still swinging forward at 3-5 m/s when
+            the feet touched, and a few ms of that decided where they landed). The legs hold
+            their aim in the world and the feet arrive still under the COM. Off (the
+            default): as before.
         fall_gain: how much nearer (m) the feet go per m/s of horizontal speed and per metre
             that the fall exceeds ``fall_ref`` (s/m); 0: off (the deltas hold for one drop
             height only). The fall is predicted as the reach begins: the soles' clearance
@@ -132,6 +142,7 @@ class LandingParams:
     pitch_ease: float = 0.0
     swing_cap: float = 0.9
     aim_sideways: bool = False
+    spin_aim: bool = False
     fall_gain: float = 0.0
     fall_ref: float = 0.0
 
@@ -212,6 +223,7 @@ class Landing(Basis):
                 goal[joint_index(j)] = 0.0
             moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
             rig.move(goal, 0.2, t, moving)
+            memo["lag"] = float(rig.lag(_HIP).mean()) if p.spin_aim else 0.0
             memo["fall"] = p.fall_ref
             if p.fall_gain:  # the fall predicted now, in the landing pose (see fall_gain)
                 sn = ctx.sense(t)
@@ -222,7 +234,7 @@ class Landing(Basis):
 
         def reach(world: World, t: float) -> None:
             s = ctx.sense(t)
-            h = s.heading()
+            h = s.side_heading() if p.spin_aim else s.heading()
             d = world.data
             hold_pelvis_and_feet(ctx, d, 0.0, h, t)  # ankles: feet flat (hips reset below)
             feet = s.sole_corners().mean(axis=(0, 1))  # the middle of the soles
@@ -241,6 +253,8 @@ class Landing(Basis):
             # each leg aimed in the world at its foot's place, whatever the pelvis's pitch
             # (it turns freely in the air with the body's angular momentum)
             pelvis = bl.pelvis_pitch()
+            if p.spin_aim:  # where the pelvis will be when the hips get there (see spin_aim)
+                pelvis += memo["lag"] * float(d.cvel[s.root, :3] @ s.side_axis())
             goal = np.full((NJ, 3), np.nan)
             thighs = np.zeros((2, 3))  # aim_sideways: each thigh's pitch and roll in the world
             hips = d.xanchor[hip_joints]

@@ -102,6 +102,7 @@ class Rig:
         self._accel = np.zeros(NJ, dtype=bool)  # joints on an accelerating (s^2) path
         self.offset = np.zeros((NJ, 3))
         self.stiffness = np.zeros(NJ)
+        self._kp = np.zeros(NJ)  # the servo's kp (1/s^2) per joint, as set_stiffness set it
         self.damping = np.zeros(NJ)
         rows = self.servo.character_indices.index(character) * NJ
         self._ff = self.servo.feedforward[rows : rows + NJ]
@@ -187,7 +188,15 @@ class Rig:
             self.servo.set_gain_scale(
                 self.character, [BALL_JOINTS[i]], k / (SERVO_KP * scale_inertia[i])
             )
+        self._kp[:] = np.where(on, values * self.stiffness_unit / scale_inertia, 0.0)
         self.stiffness[:] = values
+
+    def lag(self, joints: Sequence[int]) -> F64:
+        """Seconds by which each of ``joints`` trails a target that moves at a steady rate
+        (the trailing angle is the rate times this): the servo's ``kv / kp`` at its current
+        stiffness (critical damping: ``2 / sqrt(kp)``); inf for a joint switched off."""
+        kp = self._kp[np.asarray(joints)]
+        return np.where(kp > 0, 2.0 / np.sqrt(np.where(kp > 0, kp, 1.0)), np.inf)
 
     def set_damping(self, values: F64) -> None:
         """Per-joint extra damping ``(15,)`` in units of ``m L sqrt(g L)`` (N m s/rad), added

@@ -46,7 +46,8 @@ class Senses:
         self._own = world.geom_character == character
         self._body = world.geom_body
         self._f6 = np.zeros(6)
-        self._forward = _forward_in_body(athlete)
+        self._forward = _axis_in_body(athlete, np.array([1.0, 0.0, 0.0]))
+        self._left = _axis_in_body(athlete, np.array([0.0, 1.0, 0.0]))
         self.time = -1.0
         self.com = np.zeros(3)
         self.com_vel = np.zeros(3)
@@ -129,6 +130,19 @@ class Senses:
         fwd = d.xmat[self.root].reshape(3, 3) @ self._forward
         return float(np.arctan2(fwd[1], fwd[0]))
 
+    def side_axis(self) -> F64:
+        """The pelvis's anatomical left-right axis (world, unit; left > 0): the axis a
+        somersault turns about."""
+        return self.world.data.xmat[self.root].reshape(3, 3) @ self._left
+
+    def side_heading(self) -> float:
+        """Heading (rad about +Z) of the forward axis a quarter turn from the pelvis's
+        left-right axis. Unlike :meth:`heading` it holds through a somersault: there the
+        pelvis's forward axis passes through the vertical and its heading flips by half a
+        turn."""
+        left = self.side_axis()
+        return float(np.arctan2(-left[0], left[1]))
+
     def local(self, v: F64, heading: float | None = None) -> F64:
         """Horizontal world vector(s) ``v (..., 3)`` in the heading frame (x forward, y left)."""
         h = self.heading() if heading is None else heading
@@ -160,8 +174,9 @@ class Senses:
         return loc.min(axis=0), loc.max(axis=0)
 
 
-def _forward_in_body(athlete: Athlete) -> F64:
-    """The pelvis's anatomical forward (+X of the neutral frame) in its body frame."""
+def _axis_in_body(athlete: Athlete, axis: F64) -> F64:
+    """An axis of the pelvis's anatomical neutral frame (+X forward, +Y left) in its body
+    frame."""
     from reactmocap.rotations import quat_conj, quat_rotate
 
-    return quat_rotate(quat_conj(athlete.neutral[0]), np.array([1.0, 0.0, 0.0]))
+    return quat_rotate(quat_conj(athlete.neutral[0]), axis)

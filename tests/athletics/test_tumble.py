@@ -21,6 +21,8 @@ from reactmocap.athletics.routines import (
     somersault,
     somersault_maneuver,
 )
+from reactmocap.athletics.scene import athletics_world
+from reactmocap.athletics.senses import Senses
 from reactmocap.athletics.tumble import (
     POSITIONS,
     TumbleParams,
@@ -223,11 +225,47 @@ def test_perturbed_back_tucks_land_with_the_legs_aimed_sideways() -> None:
     for i in (0, 5):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
-    # the same landing without the sideways aim: start 0 falls
-    land = replace(m.phases[3], params={**m.phases[3].params, "aim_sideways": False})
+    # the same landing without the sideways aim (and the reach before ``spin_aim``): start 0
+    # falls
+    land = replace(m.phases[3], params={**m.phases[3].params, "aim_sideways": False,
+                                        "spin_aim": False})  # fmt: skip
     off = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
     r = run_maneuver(off, perturbation=starts[0], fps=10.0).report
     assert r["fell"] and not r["landed"]
+
+
+def test_perturbed_back_tucks_land_with_the_legs_holding_their_aim() -> None:
+    """Starts 8 and 9 of the capture region at full size (seed 0) fell with the reach's legs
+    aimed in the pelvis's forward heading (which flips as the body passes the horizontal) and
+    trailing their turning target: the feet swept forward under the body at 3-5 m/s when
+    they touched. With ``spin_aim`` (the preset) the legs hold their aim and both land."""
+    rng = np.random.default_rng(0)
+    full = {"joint_sd": math.radians(3.0), "pitch_sd": math.radians(2.0),
+            "velocity_sd": 0.05, "spin_sd": 0.1}  # fmt: skip
+    starts = [Perturbation.sample(rng, **full) for _ in range(10)]
+    m = somersault_maneuver()
+    assert m.phases[3].params["spin_aim"] is True
+    land = replace(m.phases[3], params={**m.phases[3].params, "spin_aim": False})
+    off = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
+    for i in (8, 9):
+        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+        r = run_maneuver(off, perturbation=starts[i], fps=10.0).report
+        assert r["fell"] and not r["landed"], i
+
+
+def test_the_side_heading_holds_through_a_somersault() -> None:
+    """Pitched past the horizontal, the pelvis's forward axis points back: its heading flips
+    by half a turn; the heading from the left-right axis (the landing's ``spin_aim``) does
+    not."""
+    a = athlete("male")
+    world = athletics_world(a)
+    senses = Senses(world, a)
+    for pitch, flipped in ((0.3, False), (2.2, True), (-2.2, True)):
+        world.set_pose(0, a.standing_qpos(np.zeros((15, 3)), pitch=pitch))
+        turn = abs(math.remainder(senses.heading() - senses.side_heading(), 2.0 * math.pi))
+        assert turn == pytest.approx(math.pi if flipped else 0.0, abs=1e-6), pitch
+        assert abs(math.remainder(senses.side_heading(), 2.0 * math.pi)) < 1e-6
 
 
 @pytest.mark.parametrize("body", ["male", "female"])
