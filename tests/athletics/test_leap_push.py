@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import run, tables
-from reactmocap.athletics.leap import LeapParams, com_push
+from reactmocap.athletics.leap import COM_PUSH_LEGS, LeapParams, com_push
 from reactmocap.athletics.report import ground_force
 from reactmocap.errors import ConfigError
 
@@ -62,3 +62,15 @@ def test_the_com_push_lands_on_its_own_landing_setting(monkeypatch: pytest.Monke
     r0 = run("leap", "male", height=0.9, push="com", check_range=False)
     assert abs(r0.report["achieved_height_m"] - r.report["achieved_height_m"]) < 0.01
     assert not r0.report["landed"]
+
+
+def test_the_female_0_9_m_com_leap_lands_within_3_cm() -> None:
+    """Her com push's hips and ankles at half stiffness (COM_PUSH_LEGS): at 1 and 1 the
+    servo's damping took the force of her fast-straightening legs and her 0.9 m leap fell."""
+    p = com_push(LeapParams(), 0.9, "female")
+    assert (p.push_hip, p.push_ankle) == COM_PUSH_LEGS["female"] == (0.5, 0.5)
+    rep = run("leap", "female", height=0.9, push="com", check_range=False).report
+    assert abs(rep["achieved_height_m"] - 0.9) <= 0.03
+    assert rep["landed"] and not rep["fell"]
+    with pytest.raises(ConfigError, match="push_hip"):
+        LeapParams(push_hip=-1.0)
