@@ -65,13 +65,15 @@ def test_the_com_push_lands_on_its_own_landing_setting(monkeypatch: pytest.Monke
     assert not r0.report["landed"]
 
 
-def test_the_female_0_9_m_com_leap_lands_within_3_cm() -> None:
+@pytest.mark.parametrize("height", [0.1, 0.9])
+def test_the_female_0_1_and_0_9_m_com_leaps_land_within_3_cm(height: float) -> None:
     """Her com push's hips and ankles at half stiffness (COM_PUSH_LEGS): at 1 and 1 the
-    servo's damping took the force of her fast-straightening legs and her 0.9 m leap fell."""
-    p = com_push(LeapParams(), 0.9, "female")
+    servo's damping took the force of her fast-straightening legs and her 0.9 m leap fell;
+    her 0.1 m one (drift -0.21 m/s) lands with VERTICAL_LANDING_COM's -0.1 row at -0.22."""
+    p = com_push(LeapParams(), height, "female")
     assert (p.push_hip, p.push_ankle) == COM_PUSH_LEGS["female"] == (0.5, 0.5)
-    rep = run("leap", "female", height=0.9, push="com", check_range=False).report
-    assert abs(rep["achieved_height_m"] - 0.9) <= 0.03
+    rep = run("leap", "female", height=height, push="com", check_range=False).report
+    assert abs(rep["achieved_height_m"] - height) <= 0.03
     assert rep["landed"] and not rep["fell"]
     with pytest.raises(ConfigError, match="push_hip"):
         LeapParams(push_hip=-1.0)
