@@ -35,6 +35,7 @@ from reactmocap.sim.world import World
 __all__ = [
     "BROAD_TIMING",
     "COM_PUSH_LEG",
+    "COM_PUSH_LEGS",
     "COM_PUSH_SPIN",
     "COM_PUSH_STIFFNESS",
     "HANDOVERS",
@@ -73,6 +74,16 @@ COM_PUSH_STIFFNESS = {
     "waist": 3.0, "back": 3.0, "neck": 0.3, "shoulder": 0.6, "elbow": 0.15, "wrist": 0.05,
     "hip": 1.0, "knee": 0.0, "ankle": 1.0,
 }  # fmt: skip
+#: the "com" push's hip and ankle stiffness per body (LeapParams.push_hip, push_ankle; others
+#: keep COM_PUSH_STIFFNESS's 1 and 1): the servo's critical damping acts on the joints' whole
+#: speed, and at 1 it took the push's force as the legs straightened fast (the feed-forward's
+#: gain rose to its cap of 3 and asks of 1.4-2.2 BW made 0.2-0.4 in the last ticks). Over the
+#: ten Fig. 4.1 commands (max |error|, landed of 10; 2026-12-02): male hip/ankle 1/1 3.4 cm
+#: 10, 0.5/1 1.7 cm 10, 1/0.5 2.7 cm 9, 0.5/0.5 3.6 cm 8; female 1/1 3.6 cm 9, 0.5/1 3.0 cm 8,
+#: 1/0.5 5.3 cm 9, 0.5/0.5 2.9 cm 9 (docs/athletics.md)
+COM_PUSH_LEGS: Mapping[str, tuple[float, float]] = MappingProxyType(
+    {"male": (0.5, 1.0), "female": (0.5, 0.5)}
+)
 #: a "com" push whose plan needs more than push_limit may ask this much over its plan
 PUSH_HEADROOM = 1.1
 #: the "com" push's centre of pressure: metres ahead per unit of pitch momentum error (in
@@ -134,13 +145,16 @@ class LeapParams:
     push_limit: float = 3.0
     #: seconds over which the "com" push's acceleration comes in
     push_ramp: float = 0.1
+    #: the "com" push's hip and ankle stiffness (m g L N m/rad; see COM_PUSH_LEGS)
+    push_hip: float = 1.0
+    push_ankle: float = 1.0
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
                 self.hold, *self.timing, self.ankle_gain, self.ankle_extension, self.liftoff_hip,
                 self.stiffness, self.lean,
                 self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
-                self.push_ramp, self.push_limit]  # fmt: skip
+                self.push_ramp, self.push_limit, self.push_hip, self.push_ankle]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.3 <= self.leg <= 1.0:
@@ -154,6 +168,11 @@ class LeapParams:
                 f"leap rise must be in (0, 2] m, push_ramp >= 0 and push_limit > 1 BW, got "
                 f"{self.rise}, {self.push_ramp}, {self.push_limit}"
             )
+        if not (0.0 <= self.push_hip <= 10.0 and 0.0 <= self.push_ankle <= 10.0):
+            raise ConfigError(
+                f"leap push_hip and push_ankle must be in [0, 10] m g L/rad, got "
+                f"{self.push_hip}, {self.push_ankle}"
+            )
         if self.handover not in HANDOVERS:
             raise ConfigError(
                 f"leap handover must be one of {list(HANDOVERS)}, got {self.handover!r}"
@@ -162,12 +181,15 @@ class LeapParams:
 
 def com_push(params: LeapParams, rise: float, body: str | None = None) -> LeapParams:
     """``params`` with the "com" push to a planned apex rise (m): its crouch (upright trunk,
-    :data:`COM_PUSH_LEG`) and the body's take-off pitch momentum (:data:`COM_PUSH_SPIN`, 0 for
-    a body without one). A broad jump is returned unchanged (it always pushes "timed")."""
+    :data:`COM_PUSH_LEG`), the body's take-off pitch momentum (:data:`COM_PUSH_SPIN`, 0 for
+    a body without one) and its hip and ankle stiffness (:data:`COM_PUSH_LEGS`). A broad jump
+    is returned unchanged (it always pushes "timed")."""
     if params.broad:
         return params
+    hip, ankle = COM_PUSH_LEGS.get(body or "", (1.0, 1.0))
     return replace(params, push="com", rise=rise, leg=COM_PUSH_LEG, lean=0.0, pitch=0.0,
-                   spin_gain=0.0, spin=COM_PUSH_SPIN.get(body or "", 0.0))  # fmt: skip
+                   spin_gain=0.0, spin=COM_PUSH_SPIN.get(body or "", 0.0), push_hip=hip,
+                   push_ankle=ankle)  # fmt: skip
 
 
 def pitch_momentum(world: World, s: Senses) -> float:
@@ -260,7 +282,8 @@ class Leap(Basis):
             rig.move(rig.desired(t) + rig.offset, 0.0, t)
             rig.offset[:] = 0.0
             memo["stiff0"] = rig.stiffness.copy()
-            memo["stiff1"] = per_joint(COM_PUSH_STIFFNESS)
+            memo["stiff1"] = per_joint({**COM_PUSH_STIFFNESS, "hip": p.push_hip,
+                                        "ankle": p.push_ankle})  # fmt: skip
             # the balance's joint damping off the legs: at the push's joint speeds (10 rad/s)
             # it took the legs' extension
             rig.set_damping(per_joint({"waist": 0.1, "back": 0.1}))

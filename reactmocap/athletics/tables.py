@@ -157,12 +157,18 @@ VERTICAL_LANDING: Mapping[str, tuple[float, float]] = MappingProxyType(
 #: constant delta -0.04 / -0.01 / 0.0 / +0.01 / +0.02: 6 / 9 / 10 / 9 / 9; female constant
 #: -0.07 / -0.05 / -0.01: 6 / 7 / 3 (her 0.1 m leap landed only with -0.1, her 1.0 m only with
 #: 0.0 to +0.04), this table 9 (the 0.9 m leap falls: it drifts back as fast as the 0.8 m
-#: one, -0.40 m/s, and landed only with deltas the 0.8 m one fell with)
+#: one, -0.40 m/s, and landed only with deltas the 0.8 m one fell with). Since her push's
+#: softer hips and ankles (leap.COM_PUSH_LEGS) her 0.9 m leap lands and her 0.1 m one (drift
+#: -0.21 m/s) fell with the -0.1 row at -0.19 m/s: with it at -0.22 (-0.05 kept at -0.23) 10
+#: of 10, 0.15-0.85 m in 0.1 steps held out 7 of 8 (0.75 falls; docs/athletics.md). His
+#: constant 0.0 lost his 0.95 m leap, +0.01 his 0.1 m one: 0.0 at his slow drifts (0.1 m:
+#: -0.07 m/s), +0.01 from -0.15 m/s lands 0.1-1.0 m in 0.05 steps and, held out, 0.125 /
+#: 0.325 / 0.525 / 0.725 / 0.925 / 0.975 m
 VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = (
     MappingProxyType(
         {
-            "male": (0.5, ((0.0, 0.0),)),
-            "female": (0.5, ((-0.47, 0.0), (-0.43, -0.05), (-0.21, -0.05), (-0.19, -0.1))),
+            "male": (0.5, ((-0.15, 0.01), (-0.1, 0.0))),
+            "female": (0.5, ((-0.47, 0.0), (-0.43, -0.05), (-0.23, -0.05), (-0.22, -0.1))),
         }
     )
 )
