@@ -83,12 +83,14 @@ class Posture:
         settle: seconds the joints take to reach a new posture (Hermite).
         lean: extra torso pitch per radian of knee flexion beyond standing (a squatting
             person leans forward, which keeps the COM over the feet).
-        plant: bring both feet down flat (a perturbed start): a foot hanging over the floor
-            while the other stands lengthens its leg and shortens the other by half its
-            height each (as the slope leveling), and the COM servo's ankle pitch offset gives
-            way by :data:`PLANT_GAIN` per metre that a standing sole's heel rises above its
-            toes (or they above it) past :data:`PLANT_DEADBAND`; without it an offset past
-            what the foot can push stood the body on its toes or heels.
+        plant: settle a perturbed start onto both feet, flat: the COM target is the middle of
+            both feet, not of those in contact (else a hanging foot stays up and the body
+            leans over the other); a foot hanging over the floor while the other stands
+            lengthens its leg and shortens the other by half its height each (as the slope
+            leveling); and the COM servo's ankle pitch offset gives way by
+            :data:`PLANT_GAIN` per metre that a standing sole's heel rises above its toes (or
+            they above it) past :data:`PLANT_DEADBAND` (an offset past what the foot can
+            push stood the body on its toes or heels).
     """
 
     pitch: float = 0.0
@@ -154,7 +156,7 @@ class BalanceGains:
 #: :attr:`Posture.plant`: the ankle pitch offset given way (rad) per metre of a standing
 #: sole's tilt past the dead band (m)
 PLANT_GAIN = 10.0
-PLANT_DEADBAND = 0.005
+PLANT_DEADBAND = 0.015
 #: what "settled" means for :class:`Balance` (a perturbed start before a leap): each foot
 #: bears this share of the body weight (contact force low-passed over ``tau`` s), the COM
 #: moves slower than ``speed`` (m/s, horizontal) within ``offset`` (m) of the balance's COM
@@ -236,7 +238,7 @@ class BalanceLaw:
         g = self.gains
         h = s.heading()
         self.heading = h
-        centre = s.support_center(h)
+        centre = s.support_center(h, both=self.posture.plant)
         off = np.asarray(self.posture.com_offset)
         c, sn = math.cos(h), math.sin(h)
         target = centre.copy()
