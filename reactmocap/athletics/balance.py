@@ -371,25 +371,25 @@ _X = np.array([1.0, 0.0, 0.0])
 
 def settled(ctx: Context, bl: BalanceLaw) -> Event:
     """Fires once the body stands settled on both feet under ``bl`` (:data:`SETTLED`)."""
-    memo = {"t": -1.0, "since": None, "load": np.zeros(2)}
+    load = np.zeros(2)  # each foot's contact force, low-passed
+    clock = np.array([-1.0, math.nan])  # the last tick, and since when it has been settled
     weight = ctx.senses.mass * float(np.linalg.norm(ctx.world.model.opt.gravity))
 
     def event(_w: World, t: float, _t_in: float) -> bool:
         s = ctx.sense(t)
-        k = min(max(t - memo["t"], 0.0) / SETTLED["tau"], 1.0) if memo["t"] >= 0 else 1.0
-        memo["t"] = t
-        load = memo["load"]
-        load += k * (s.foot_force - load)
+        k = min(max(t - clock[0], 0.0) / SETTLED["tau"], 1.0) if clock[0] >= 0 else 1.0
+        clock[0] = t
+        load[:] += k * (s.foot_force - load)
         h = s.heading()
         ok = (bool(s.foot_contact.all()) and float(load.min()) >= SETTLED["share"] * weight
               and float(np.hypot(*s.com_vel[:2])) < SETTLED["speed"]
               and float(np.hypot(*s.local(bl.com_target - s.com, h))) < SETTLED["offset"])  # fmt: skip
         if not ok:
-            memo["since"] = None
+            clock[1] = math.nan
             return False
-        if memo["since"] is None:
-            memo["since"] = t
-        return t - memo["since"] >= SETTLED["hold"] - 1e-9
+        if math.isnan(clock[1]):
+            clock[1] = t
+        return bool(t - clock[1] >= SETTLED["hold"] - 1e-9)
 
     return event
 

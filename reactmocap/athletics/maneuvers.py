@@ -286,8 +286,10 @@ def check_phase(phase: Phase, where: str) -> Phase:
         phase.seconds is None or not math.isfinite(phase.seconds) or phase.seconds < 0
     ):
         raise ConfigError(f"{where}.exit.seconds: exit 'after' needs seconds >= 0")
-    if phase.exit == "settled" and phase.seconds is not None and not (
-        math.isfinite(phase.seconds) and phase.seconds > 0
+    if (
+        phase.exit == "settled"
+        and phase.seconds is not None
+        and not (math.isfinite(phase.seconds) and phase.seconds > 0)
     ):
         raise ConfigError(f"{where}.exit.seconds: exit 'settled' needs seconds > 0 (the "
                           f"time it may take), got {phase.seconds}")  # fmt: skip
