@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from types import MappingProxyType
 
 import mujoco
 import numpy as np
@@ -28,11 +29,12 @@ from reactmocap.rotations import (
     quat_to_euler,
 )
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.controllers.machine import Event, State
+from reactmocap.sim.controllers.machine import Event, State, after
 from reactmocap.sim.world import World
 
 __all__ = [
     "ANKLE_LIMITS",
+    "SETTLED",
     "BALANCE_GAINS",
     "STANDING_GAINS",
     "STANDING_LEG",
@@ -81,6 +83,14 @@ class Posture:
         settle: seconds the joints take to reach a new posture (Hermite).
         lean: extra torso pitch per radian of knee flexion beyond standing (a squatting
             person leans forward, which keeps the COM over the feet).
+        plant: settle a perturbed start onto both feet, flat: the COM target is the middle of
+            both feet, not of those in contact (else a hanging foot stays up and the body
+            leans over the other); a foot hanging over the floor while the other stands
+            lengthens its leg and shortens the other by half its height each (as the slope
+            leveling); and the COM servo's ankle pitch offset gives way by
+            :data:`PLANT_GAIN` per metre that a standing sole's heel rises above its toes (or
+            they above it) past :data:`PLANT_DEADBAND` (an offset past what the foot can
+            push stood the body on its toes or heels).
     """
 
     pitch: float = 0.0
@@ -89,8 +99,11 @@ class Posture:
     arms: float = 0.0
     settle: float = 0.5
     lean: float = 0.5
+    plant: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.plant, bool):
+            raise ConfigError(f"posture plant must be true or false, got {self.plant!r}")
         for name in ("pitch", "leg", "arms", "settle", "lean"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -140,6 +153,15 @@ class BalanceGains:
         return per_joint(dict(self.damping))
 
 
+#: :attr:`Posture.plant`: the ankle pitch offset given way (rad) per metre of a standing
+#: sole's tilt past the dead band (m)
+PLANT_GAIN = 10.0
+PLANT_DEADBAND = 0.015
+#: what "settled" means for :class:`Balance` (a perturbed start before a leap): each foot
+#: bears this share of the body weight (contact force low-passed over ``tau`` s), the COM
+#: moves slower than ``speed`` (m/s, horizontal) within ``offset`` (m) of the balance's COM
+#: target, all for ``hold`` s in a row
+SETTLED = MappingProxyType({"share": 0.2, "tau": 0.05, "speed": 0.05, "offset": 0.03, "hold": 0.2})
 #: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
 SIDE_SLOPE = 0.2
 BALANCE_GAINS = BalanceGains()
@@ -216,7 +238,7 @@ class BalanceLaw:
         g = self.gains
         h = s.heading()
         self.heading = h
-        centre = s.support_center(h)
+        centre = s.support_center(h, both=self.posture.plant)
         off = np.asarray(self.posture.com_offset)
         c, sn = math.cos(h), math.sin(h)
         target = centre.copy()
@@ -249,21 +271,38 @@ class BalanceLaw:
         for k in range(2):
             total = desired[_ANKLE[k], 0] + rig.offset[_ANKLE[k], 0]
             rig.offset[_ANKLE[k], 0] += float(np.clip(total, lo, hi)) - total
-        self._level_legs(d, desired)
+        hang = self._plant(s, d, h) if self.posture.plant else None
+        self._level_legs(d, desired, hang)
         self._support(s)
 
-    def _level_legs(self, d, desired: F64) -> None:  # type: ignore[no-untyped-def]
+    def _plant(self, s, d, h: float) -> F64:  # type: ignore[no-untyped-def]
+        """:attr:`Posture.plant`'s ankle give (on the rig's offsets); returns each foot's
+        height to bring down (m; 0 unless it hangs while the other stands)."""
+        corners = s.corners
+        fwd = s.local(corners, h)[..., 0]
+        back = np.where(fwd < fwd.mean(axis=1, keepdims=True), 0.5, -0.5)
+        tilt = (back * corners[..., 2]).sum(axis=1)  # heel over toes (m), each foot
+        excess = np.sign(tilt) * np.maximum(np.abs(tilt) - PLANT_DEADBAND, 0.0)
+        self.ctx.rig.offset[_ANKLE, 0] -= PLANT_GAIN * excess * s.foot_contact
+        n = s.floor_normal
+        height = ((corners - d.geom_xpos[s.floor]) @ n).min(axis=1)
+        return np.where(~s.foot_contact & s.foot_contact[::-1], np.maximum(height, 0.0), 0.0)
+
+    def _level_legs(self, d, desired: F64, hang: F64 | None = None) -> None:  # type: ignore[no-untyped-def]
         """Leg by leg (eq. 7.5 per leg): the leg whose ankle stands over higher floor (uphill
         on a sideways slope) is shortened by the height difference, so the pelvis stays level.
         The floor's height under each ankle, not the ankle's own: a heel or a foot that
         lifts would otherwise shorten its leg and lengthen the other, lifting it further
         (on flat floor that loop lifted a foot and launched the body out of a landing's
-        stand-up, docs/athletics.md)."""
+        stand-up, docs/athletics.md). ``hang``: each foot's height over the floor to bring
+        down (:meth:`_plant`), counted as floor that much lower under it."""
         a = self.athlete
         s = self.ctx.senses
         n = s.floor_normal
         xy = d.xanchor[s.ankle_joints, :2]
         z = -(xy @ n[:2]) / max(float(n[2]), 1e-6)  # the floor plane's height, up to a constant
+        if hang is not None:
+            z = z - hang
         for k in range(2):
             knee = float(desired[_KNEE[k], 0])
             ul, ll = float(a.thigh[k]), float(a.shin[k])
@@ -330,9 +369,37 @@ def _flat_feet(foot_now: F64, normal: F64) -> F64:
 _X = np.array([1.0, 0.0, 0.0])
 
 
+def settled(ctx: Context, bl: BalanceLaw) -> Event:
+    """Fires once the body stands settled on both feet under ``bl`` (:data:`SETTLED`)."""
+    load = np.zeros(2)  # each foot's contact force, low-passed
+    clock = np.array([-1.0, math.nan])  # the last tick, and since when it has been settled
+    weight = ctx.senses.mass * float(np.linalg.norm(ctx.world.model.opt.gravity))
+
+    def event(_w: World, t: float, _t_in: float) -> bool:
+        s = ctx.sense(t)
+        k = min(max(t - clock[0], 0.0) / SETTLED["tau"], 1.0) if clock[0] >= 0 else 1.0
+        clock[0] = t
+        load[:] += k * (s.foot_force - load)
+        h = s.heading()
+        ok = (bool(s.foot_contact.all()) and float(load.min()) >= SETTLED["share"] * weight
+              and float(np.hypot(*s.com_vel[:2])) < SETTLED["speed"]
+              and float(np.hypot(*s.local(bl.com_target - s.com, h))) < SETTLED["offset"])  # fmt: skip
+        if not ok:
+            clock[1] = math.nan
+            return False
+        if math.isnan(clock[1]):
+            clock[1] = t
+        return bool(t - clock[1] >= SETTLED["hold"] - 1e-9)
+
+    return event
+
+
 class Balance(Basis):
     """The balance basis controller: settle into ``posture`` and hold it, for ``seconds`` (then
-    hand over) or forever (``None``)."""
+    hand over) or forever (``None``). With ``settle_within`` it hands over once
+    :func:`settled` (the posture's COM target reached, still, on both feet); a body not
+    settled within that many seconds stays in the state ``unsettled`` (the sequence never
+    goes on) and the time is in the hand-over dict (``"unsettled_s"``): a failure."""
 
     name = "balance"
     initial = "hold"
@@ -343,11 +410,15 @@ class Balance(Basis):
         seconds: float | None = None,
         gains: BalanceGains = BALANCE_GAINS,
         until: Event | None = None,
+        settle_within: float | None = None,
     ) -> None:
         self.posture = posture or Posture()
         if seconds is not None and not (math.isfinite(seconds) and seconds >= 0):
             raise ConfigError(f"balance seconds must be >= 0, got {seconds!r}")
+        if settle_within is not None and not (math.isfinite(settle_within) and settle_within > 0):
+            raise ConfigError(f"balance settle_within must be > 0 s, got {settle_within!r}")
         self.seconds = seconds
+        self.settle_within = settle_within
         self.gains = gains
         self.until = until
         self.law: BalanceLaw | None = None
@@ -367,10 +438,18 @@ class Balance(Basis):
         if self.until is not None:
             exits.append((self.until, NEXT))
         if self.seconds is not None:
-            from reactmocap.sim.controllers.machine import after
-
             exits.append((after(self.seconds), NEXT))
-        return [State("hold", law(bl.control, ctx.control_every), enter, tuple(exits))]
+        hold = law(bl.control, ctx.control_every)
+        if self.settle_within is None:
+            return [State("hold", hold, enter, tuple(exits))]
+
+        def timed_out(world: World, t: float) -> None:
+            del world
+            ctx.handover["unsettled_s"] = t
+
+        exits += [(settled(ctx, bl), NEXT), (after(self.settle_within), "unsettled")]
+        return [State("hold", hold, enter, tuple(exits)), State("unsettled", hold, timed_out)]
 
     def with_posture(self, **changes: object) -> Balance:
-        return Balance(replace(self.posture, **changes), self.seconds, self.gains, self.until)  # type: ignore[arg-type]
+        return Balance(replace(self.posture, **changes), self.seconds, self.gains, self.until,  # type: ignore[arg-type]
+                       self.settle_within)  # fmt: skip

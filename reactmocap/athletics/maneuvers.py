@@ -136,7 +136,10 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
     if "com_offset" in p:
         p["com_offset"] = tuple(p["com_offset"])
     seconds = phase.seconds if phase.exit == "after" else None
-    return Balance(Posture(**p), seconds=seconds)
+    within = None
+    if phase.exit == "settled":
+        within = phase.seconds if phase.seconds is not None else SETTLE_WITHIN
+    return Balance(Posture(**p), seconds=seconds, settle_within=within)
 
 
 def _build_leap(phase: Phase, ath: Athlete) -> Basis:
@@ -189,11 +192,16 @@ def _build_land(phase: Phase, ath: Athlete) -> Basis:
     return Landing(replace(base, **phase.params))
 
 
+#: seconds a balance phase ending "settled" may take by default
+SETTLE_WITHIN = 2.0
 _LEAP_KINDS = {"effort": "number", **_kinds(LeapParams, skip=("handover",))}
 CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
     "balance": BasisSpec(
         "balance", "stand balanced in a posture (thesis ch. 7)", _kinds(Posture),
-        {"after": "after `seconds`", "never": "holds to the end of the run"}, _build_balance),
+        {"after": "after `seconds`", "never": "holds to the end of the run",
+         "settled": "once standing still on both feet with the COM over them (a perturbed "
+                    "start); not settled within `seconds` (default 2): the run fails there"},
+        _build_balance),
     "leap": BasisSpec(
         "leap", "crouch and leap (ch. 4); `effort` 0-1 picks the measured leap (broad = true: "
         "the broad jump's), any other parameter overrides it; `spin` (kg m^2/s, pitch, "
@@ -278,6 +286,13 @@ def check_phase(phase: Phase, where: str) -> Phase:
         phase.seconds is None or not math.isfinite(phase.seconds) or phase.seconds < 0
     ):
         raise ConfigError(f"{where}.exit.seconds: exit 'after' needs seconds >= 0")
+    if (
+        phase.exit == "settled"
+        and phase.seconds is not None
+        and not (math.isfinite(phase.seconds) and phase.seconds > 0)
+    ):
+        raise ConfigError(f"{where}.exit.seconds: exit 'settled' needs seconds > 0 (the "
+                          f"time it may take), got {phase.seconds}")  # fmt: skip
     params = {}
     for key, value in phase.params.items():
         if key not in spec.params:
@@ -542,6 +557,8 @@ def run_maneuver(
     if "tumble_peak_rate" in ctx.handover:
         rep["peak_somersault_rate_rad_s"] = ctx.handover["tumble_peak_rate"]
         rep["tumble_min_inertia_kgm2"] = ctx.handover["tumble_min_inertia"]
+    if "unsettled_s" in ctx.handover:  # a balance phase timed out before it settled
+        rep["unsettled_s"] = ctx.handover["unsettled_s"]
     if "tumble_twist_undone" in ctx.handover:  # when the tilt twist's throw was undone
         rep["twist_undone_s"] = ctx.handover["tumble_twist_undone"]
     if high > 0:  # judged at the water: entry angle, rotation and twist there

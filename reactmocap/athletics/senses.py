@@ -153,11 +153,11 @@ class Senses:
     def heading_quat(self, heading: float | None = None) -> F64:
         return quat_from_yaw(self.heading() if heading is None else heading)
 
-    def support_center(self, heading: float | None = None) -> F64:
+    def support_center(self, heading: float | None = None, both: bool = False) -> F64:
         """World point (on the floor) at the middle of the support area's extents in the
-        heading frame: the feet in contact, or both feet when none is."""
+        heading frame: the feet in contact, or both feet when none is (or ``both``)."""
         corners = self.sole_corners()
-        use = self.foot_contact if self.foot_contact.any() else np.ones(2, dtype=bool)
+        use = self.foot_contact if self.foot_contact.any() and not both else np.ones(2, dtype=bool)
         pts = corners[use].reshape(-1, 3)
         loc = self.local(pts, heading)
         mid = 0.5 * (loc.min(axis=0) + loc.max(axis=0))

@@ -1,5 +1,6 @@
 """Perturbed starts (issue 19's capture regions): the vertical leap maneuver lands with the
-vertical leap's own landing. Starts from ``capture_region``'s full-size distribution, seed 0."""
+vertical leap's own landing, and a perturbed start settles onto both feet before the leap.
+Starts from ``capture_region``'s full-size distribution, seed 0."""
 
 from __future__ import annotations
 
@@ -8,9 +9,16 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from reactmocap.athletics import tables
-from reactmocap.athletics.maneuvers import Perturbation, load_maneuver, run_maneuver
+from reactmocap.athletics.maneuvers import (
+    Maneuver,
+    Perturbation,
+    Phase,
+    load_maneuver,
+    run_maneuver,
+)
 
 VERTICAL_LEAP = (
     Path(__file__).resolve().parents[2] / "examples/athletics/maneuvers/vertical_leap.toml"
@@ -27,14 +35,39 @@ def _starts(n: int) -> list[Perturbation]:
 def test_the_vertical_leap_lands_with_the_vertical_leaps_own_delta() -> None:
     """Start 9 takes off with almost no pitch momentum (-0.3 kg m^2/s; the nominal -2): with
     the drops' delta (-0.04) its feet land 9 cm behind the COM and it falls forward off its
-    toes; with the vertical leap's (-0.01) it lands."""
+    toes; with the vertical leap's (-0.01) it lands. The leap 0.3 s into the start, as it
+    was measured (the file now settles the start first)."""
     m = load_maneuver(VERTICAL_LEAP)
     land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
     assert m.phases[land].params["delta"] == tables.VERTICAL_LANDING["male"][1]
+    phases = [Phase("balance", "after", seconds=0.3), *m.phases[1:]]
+    m = dataclasses.replace(m, phases=tuple(phases), seconds=4.0)
     start = _starts(10)[9]
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"]
-    phases = list(m.phases)
     phases[land] = dataclasses.replace(phases[land], params={})
     old = run_maneuver(dataclasses.replace(m, phases=tuple(phases)), perturbation=start, fps=10.0)
     assert old.report["fell"]
+
+
+def _settle(start: Perturbation, plant: bool) -> dict:
+    m = Maneuver("settle", (
+        Phase("balance", "settled", {"plant": plant}, seconds=2.0),
+        Phase("balance", "never"),
+    ), seconds=2.3)  # fmt: skip
+    r = run_maneuver(m, perturbation=start, fps=10.0)
+    return {**r.report, "states": {target for _, _, target in r.transitions}}
+
+
+def test_a_perturbed_start_settles_on_both_feet_before_the_leap() -> None:
+    """Starts 12 and 14 never settle under the plain balance (12 stands on one foot, the
+    other hanging; 14 stands on its toes and falls forward): ``settled`` times out and the
+    run reports it. With ``plant`` both settle onto both feet and hand over."""
+    starts = _starts(15)
+    for i in (12, 14):
+        plain = _settle(starts[i], plant=False)
+        assert plain["unsettled_s"] == pytest.approx(2.0, abs=0.01)
+        assert "balance1.hold" not in plain["states"] and not plain["landed"]
+        planted = _settle(starts[i], plant=True)
+        assert "unsettled_s" not in planted and "balance1.hold" in planted["states"]
+        assert not planted["fell"]
