@@ -23,7 +23,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.anchoring import AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
-from reactmocap.sim.controllers.stepping import clamp_to_support, outside_distance
+from reactmocap.sim.controllers.stepping import outside_distance
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
@@ -113,6 +113,16 @@ class WholeBodyTracker(AnchoredReference):
             sideways); a walk keeps them (it fell under smaller pushes without them).
         kp_root_pushed: with ``trunk_give``, a push that starts while the mocap does not stand
             sets ``kp_root`` to this for the rest of the rollout (0: unchanged).
+        hip_weight, hip_gain, hip_free, hip_margin, hip_back, hip_tilt: a hip strategy after
+            a push while the mocap stands (0: off): while the simulated capture point is
+            within ``hip_margin`` m of the feet's edge or beyond, rows of weight ``hip_weight``
+            ask the ground forces for the centre-of-mass acceleration that brings it back to
+            the mocap's (critically damped at ``hip_gain`` times omega), and the pelvis rows
+            and the waist, back and hip joint rows drop to ``hip_free`` of their weight, so
+            the trunk's turn about the hips lets the ground push the body back further than
+            the feet's centre of pressure could. It fades as the trunk turns ``hip_tilt`` rad
+            (the pelvis, waist and back rotation errors summed) and, once the capture point is
+            back inside, over ``hip_back`` s.
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
@@ -185,9 +195,10 @@ class WholeBodyTracker(AnchoredReference):
         kp_root_pushed: float = 0.0,
         hip_weight: float = 0.0,
         hip_gain: float = 1.0,
-        hip_free: float = 0.1,
+        hip_free: float = 0.3,
         hip_margin: float = 0.03,
         hip_back: float = 0.5,
+        hip_tilt: float = 1.6,
         contact_weight: float = 1e4,
         contact_kv: float = 20.0,
         friction: float = 0.7,
@@ -227,6 +238,7 @@ class WholeBodyTracker(AnchoredReference):
                 "trunk_give": trunk_give, "trunk_band": trunk_band,
                 "kp_root_pushed": kp_root_pushed, "hip_weight": hip_weight, "hip_gain": hip_gain,
                 "hip_free": hip_free, "hip_margin": hip_margin, "hip_back": hip_back,
+                "hip_tilt": hip_tilt,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
@@ -239,10 +251,10 @@ class WholeBodyTracker(AnchoredReference):
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
-        if not 0.0 < hip_free <= 1.0 or (hip_weight and not hip_back):
+        if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
             raise ConfigError(
-                f"hip_free must be in (0, 1] and hip_back > 0 with hip_weight, got hip_free "
-                f"{hip_free!r}, hip_back {hip_back!r}"
+                f"hip_free must be in (0, 1], hip_back and hip_tilt > 0 with hip_weight, got "
+                f"hip_free {hip_free!r}, hip_back {hip_back!r}, hip_tilt {hip_tilt!r}"
             )
         servo = world.servo
         m = world.model
@@ -280,6 +292,7 @@ class WholeBodyTracker(AnchoredReference):
         self._hip_free = float(hip_free)
         self._hip_margin = float(hip_margin)
         self._hip_back = float(hip_back)
+        self._hip_tilt = float(hip_tilt)
         self._hip_from = -np.inf  # the last time the hip strategy was fully on
         self._hip_acc = np.zeros(2)  # the centre of mass's horizontal acceleration it asks
         # the joints whose rows it frees: the trunk turns about the hips
@@ -493,6 +506,11 @@ class WholeBodyTracker(AnchoredReference):
         if nc:
             w_trunk = self._push_response(t)
             hip = self._hip_strength(t)
+            if hip:
+                # bounded: it fades as the trunk (pelvis, waist, back) turns ``hip_tilt`` rad
+                # off the mocap, so the joint rows bring it back before it folds
+                turn = self._dq[sl][3:12].reshape(3, 3)
+                hip *= max(0.0, 1.0 - float(np.linalg.norm(turn, axis=1).sum()) / self._hip_tilt)
             root_rows, root_target = self._root_rows, self._w_root * acc_des[:6]
             if hip:
                 # the pelvis's turn and the trunk's joints freed: their angular momentum
@@ -629,7 +647,7 @@ class WholeBodyTracker(AnchoredReference):
         hip = 1.0 - min(1.0, (t - self._hip_from) / self._hip_back)
         if hip:
             c, v, _ = self.com_reference(t)
-            goal = clamp_to_support(c[:2] + v[:2] / omega, points, self._hip_margin)
+            goal = c[:2] + v[:2] / omega
             vel = self.world.data.subtree_linvel[self._root][:2]
             self._hip_acc[:] = omega * (self._hip_gain * omega * (goal - xi) - vel)
         return hip
