@@ -633,8 +633,8 @@ class WholeBodyTracker(AnchoredReference):
         """The hip strategy (``hip_weight``) after :meth:`_push_response` at ``t``: while a
         pushed body's mocap stands and its capture point is within ``hip_margin`` m of the feet's
         edge or beyond, full (1), back to 0 linearly over ``hip_back`` s after. Sets the centre
-        of mass's horizontal acceleration that brings the capture point back toward the mocap's,
-        held ``hip_margin`` inside the feet (critically damped, ``hip_gain`` times omega)."""
+        of mass's horizontal acceleration that brings the capture point back to the mocap's
+        (critically damped at ``hip_gain`` times omega)."""
         if not (self._w_hip and self._pushed and self._standing):
             return 0.0
         feet = [f for f in self._footprint(t) if len(f)]
