@@ -194,7 +194,7 @@ class WholeBodyTracker(AnchoredReference):
         trunk_band: float = 0.1,
         kp_root_pushed: float = 0.0,
         hip_weight: float = 0.0,
-        hip_gain: float = 1.0,
+        hip_gain: float = 2.0,
         hip_free: float = 0.3,
         hip_margin: float = 0.03,
         hip_back: float = 0.5,
