@@ -52,8 +52,10 @@ def heading(motion: Motion, time_s: float) -> float:
     return float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum()))
 
 
-def survives(job: tuple[str, float, float, float, float, float, dict[str, Any]]) -> bool:
-    name, at, angle, force, duration, after, params = job
+def survives(job: tuple[str, float, float, float, float, float, dict[str, Any], float]) -> bool:
+    """Upright to the window's end; with ``settled`` > 0 also the pelvis within that many m of
+    the mocap's there (a body still tumbling when the window ends is not a recovery)."""
+    name, at, angle, force, duration, after, params, settled = job
     from reactmocap.sim import push_clip
 
     motion = _clip(name)
@@ -63,18 +65,22 @@ def survives(job: tuple[str, float, float, float, float, float, dict[str, Any]])
         motion, time=at, body="chest", force=[force * np.cos(angle), force * np.sin(angle), 0.0],
         duration=duration, start=start, seconds=seconds, params=params,
     )  # fmt: skip
+    if settled > 0 and res.report.status == "ok":
+        return bool(res.errors.root[-1] < settled)
     return res.report.status == "ok"
 
 
-def largest(job: tuple[str, float, float, float, float, dict[str, Any], float, int]) -> float:
+def largest(
+    job: tuple[str, float, float, float, float, dict[str, Any], float, int, float],
+) -> float:
     """Bisection on the force in ``[0, hi]`` (``steps`` halvings)."""
-    name, at, angle, duration, after, params, hi, steps = job
-    if survives((name, at, angle, hi, duration, after, params)):
+    name, at, angle, duration, after, params, hi, steps, settled = job
+    if survives((name, at, angle, hi, duration, after, params, settled)):
         return hi
     lo = 0.0
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
-        if survives((name, at, angle, mid, duration, after, params)):
+        if survives((name, at, angle, mid, duration, after, params, settled)):
             lo = mid
         else:
             hi = mid
@@ -85,13 +91,13 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
     motion = _clip(name)
     yaw = heading(motion, at)
     params = json.loads(args.params)
-    if not survives((name, at, yaw, 0.0, duration, args.after, params)):
+    if not survives((name, at, yaw, 0.0, duration, args.after, params, args.settled)):
         # a clip that falls unpushed in the window measures the tracker, not the push
         print(f"{name} falls unpushed within {args.after} s after {at} s: choose another clip")
         return [float("nan")] * 8
     dirs = [k for k in range(8) if LABELS[k] in args.dirs]
     jobs = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.max_force,
-             args.steps) for k in dirs]  # fmt: skip
+             args.steps, args.settled) for k in dirs]  # fmt: skip
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         found = dict(zip(dirs, pool.map(largest, jobs)))
     return [found.get(k, float("nan")) for k in range(8)]
@@ -139,6 +145,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--max-force", type=float, default=800.0)
     ap.add_argument("--steps", type=int, default=6, help="bisection halvings")
     ap.add_argument("--params", default="{}", help="controller parameters (JSON)")
+    ap.add_argument("--settled", type=float, default=0.0,
+                    help="also require the pelvis within this many m of the mocap's at the "
+                         "window's end (0: upright is enough)")  # fmt: skip
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--only", choices=("standing", "walking"), help="measure one clip only")
     ap.add_argument("--dirs", nargs="+", choices=LABELS, default=list(LABELS),

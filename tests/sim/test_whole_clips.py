@@ -22,6 +22,7 @@ from reactmocap.sim.controllers.stepping import (
 )
 from reactmocap.sim.controllers.wholebody import WholeBodyTracker
 from reactmocap.sim.reference import reference_path
+from reactmocap.sim.tracking import TrackResult
 
 SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]])
 
@@ -58,6 +59,33 @@ def test_a_standing_clip_recovers_from_a_moderate_push(standing: Motion, angle: 
 
 def test_a_standing_clip_falls_under_a_huge_push(standing: Motion) -> None:
     assert _push(standing, 0.0, 2000.0) == "fell"
+
+
+def test_a_pushed_standing_clip_turns_its_trunk_about_the_hips(shared_mocap_dir: Path) -> None:
+    """The shared standing clip pushed 100 N (Wooten's sideways figure) to its left at the chest
+    for 0.25 s: with the hip strategy (the whole-clip default) it stays up without a step;
+    without it (``hip_weight`` 0) its capture point leaves the left foot and it falls (it held
+    95 N)."""
+    from reactmocap.library.bvh import read_bvh
+
+    clip = shared_mocap_dir / "dataset-1_bye_normal_001.bvh"
+    if not clip.is_file():
+        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
+    bye = read_bvh(clip)
+    path = reference_path(World(build_character(bye, frame=0)), 0, bye)
+    assert path.sole_yaw is not None
+    yaw = path.sole_yaw[round(1.0 * path.fps)]
+    left = float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum())) + np.pi / 2
+    force = [100.0 * np.cos(left), 100.0 * np.sin(left), 0.0]
+
+    def push(params: dict[str, float]) -> TrackResult:
+        return push_clip(bye, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
+                         seconds=2.75, params=params)  # fmt: skip
+
+    res = push({})
+    # recovered, not still falling when the window ends: the pelvis back over the mocap's
+    assert res.report.status == "ok" and res.errors.root[-1] < 0.1
+    assert push({"hip_weight": 0.0}).report.status == "fell"
 
 
 def test_convex_hull_and_distances() -> None:

@@ -260,6 +260,9 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_time", float("nan")),
         ("trunk_weight", -1.0),
         ("torque_limit", -100.0),
+        ("hip_weight", -1.0),
+        ("hip_free", 0.0),
+        ("hip_free", 1.5),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

@@ -148,14 +148,15 @@ _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: feet (0.1 s), the targets keeping the capture point 5 cm inside them (0.1 s) and the chest's
 #: world turn held as tracked (weight 30, as the pelvis; after a push they give while the mocap
 #: stands and the capture point is off, back over 0.5 s: the hip strategy a standing body
-#: needs), the pelvis position servo at half stiffness (50 1/s^2; 30 once a walk is pushed).
+#: needs), the pelvis position servo at half stiffness (50 1/s^2; 30 once a walk is pushed),
+#: and after a push while the mocap stands a hip strategy (``hip_weight``) near the feet's edge.
 #: Without them
 #: the tracker follows the captured world path, as the 1 s benchmark windows, predictive
 #: sampling and the response pipeline's physical mode expect.
 WHOLE_CLIP: Mapping[str, Param] = MappingProxyType(
     {"touch": 0.003, "slide_speed": 0.5, "roll_band": 0.02, "anchor_tau": 0.1, "balance_tau": 0.1,
      "balance_margin": 0.05, "trunk_weight": 30.0, "trunk_give": 0.5, "kp_root": 50.0,
-     "kp_root_pushed": 30.0}
+     "kp_root_pushed": 30.0, "hip_weight": 300.0}
 )  # fmt: skip
 
 _REGISTRY: dict[str, ControllerSpec] = {

@@ -113,6 +113,16 @@ class WholeBodyTracker(AnchoredReference):
             sideways); a walk keeps them (it fell under smaller pushes without them).
         kp_root_pushed: with ``trunk_give``, a push that starts while the mocap does not stand
             sets ``kp_root`` to this for the rest of the rollout (0: unchanged).
+        hip_weight, hip_gain, hip_free, hip_margin, hip_back, hip_tilt: a hip strategy after
+            a push while the mocap stands (0: off): while the simulated capture point is
+            within ``hip_margin`` m of the feet's edge or beyond, rows of weight ``hip_weight``
+            ask the ground forces for the centre-of-mass acceleration that brings it back to
+            the mocap's (critically damped at ``hip_gain`` times omega), and the pelvis rows
+            and the waist, back and hip joint rows drop to ``hip_free`` of their weight, so
+            the trunk's turn about the hips lets the ground push the body back further than
+            the feet's centre of pressure could. It fades as the trunk turns ``hip_tilt`` rad
+            (the pelvis, waist and back rotation errors summed) and, once the capture point is
+            back inside, over ``hip_back`` s.
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
@@ -183,6 +193,12 @@ class WholeBodyTracker(AnchoredReference):
         trunk_give: float = 0.0,
         trunk_band: float = 0.1,
         kp_root_pushed: float = 0.0,
+        hip_weight: float = 0.0,
+        hip_gain: float = 2.0,
+        hip_free: float = 0.3,
+        hip_margin: float = 0.03,
+        hip_back: float = 0.5,
+        hip_tilt: float = 1.6,
         contact_weight: float = 1e4,
         contact_kv: float = 20.0,
         friction: float = 0.7,
@@ -220,7 +236,9 @@ class WholeBodyTracker(AnchoredReference):
                 "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint,
                 "root_weight": root_weight, "trunk_weight": trunk_weight, "contact_weight": contact_weight,
                 "trunk_give": trunk_give, "trunk_band": trunk_band,
-                "kp_root_pushed": kp_root_pushed,
+                "kp_root_pushed": kp_root_pushed, "hip_weight": hip_weight, "hip_gain": hip_gain,
+                "hip_free": hip_free, "hip_margin": hip_margin, "hip_back": hip_back,
+                "hip_tilt": hip_tilt,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
@@ -233,6 +251,11 @@ class WholeBodyTracker(AnchoredReference):
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
+        if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
+            raise ConfigError(
+                f"hip_free must be in (0, 1], hip_back and hip_tilt > 0 with hip_weight, got "
+                f"hip_free {hip_free!r}, hip_back {hip_back!r}, hip_tilt {hip_tilt!r}"
+            )
         servo = world.servo
         m = world.model
         if np.any(m.opt.gravity[:2]):
@@ -260,8 +283,23 @@ class WholeBodyTracker(AnchoredReference):
         self._give_band = float(trunk_band)
         self._kp_root_pushed = float(kp_root_pushed)
         self._pushed = False  # an external force has acted on the body
+        self._pushing = False  # one acts now
+        self._standing = False  # the mocap stands now (both feet planted for step_time)
         self._xfrc = np.zeros((len(wc.body_ids), 6))
         self._back_from = -np.inf  # the last time they were off
+        self._w_hip = float(hip_weight)
+        self._hip_gain = float(hip_gain)
+        self._hip_free = float(hip_free)
+        self._hip_margin = float(hip_margin)
+        self._hip_back = float(hip_back)
+        self._hip_tilt = float(hip_tilt)
+        self._hip_from = -np.inf  # the last time the hip strategy was fully on
+        self._hip_acc = np.zeros(2)  # the centre of mass's horizontal acceleration it asks
+        # the joints whose rows it frees: the trunk turns about the hips
+        self._hip_joints = np.concatenate(
+            [3 * BALL_JOINTS.index(j) + np.arange(3) for j in ("waist", "back", "l_hip", "r_hip")]
+        )
+        self._mass = float(m.body_subtreemass[wc.body_ids[0]])
         self._chest = int(wc.body_ids[SIM_BODIES.index("chest")])
         self.sqrt_wc = float(np.sqrt(contact_weight))
         self.contact_kv = float(contact_kv)
@@ -463,9 +501,26 @@ class WholeBodyTracker(AnchoredReference):
         r_y, r_b, r_0 = sol[:, :nj], sol[:, nj:-1], -sol[:, -1]
         # the rows other than the joints': (P, target), weights folded in
         tasks: list[tuple[F64, F64]] = []
+        hip = 0.0  # the hip strategy's strength (0-1)
+        wj = self._wj
         if nc:
-            tasks.append((self._root_rows, self._w_root * acc_des[:6]))
             w_trunk = self._push_response(t)
+            hip = self._hip_strength(t)
+            if hip:
+                # bounded: it fades as the trunk (pelvis, waist, back) turns ``hip_tilt`` rad
+                # off the mocap, so the joint rows bring it back before it folds
+                turn = self._dq[sl][3:12].reshape(3, 3)
+                hip *= max(0.0, 1.0 - float(np.linalg.norm(turn, axis=1).sum()) / self._hip_tilt)
+            root_rows, root_target = self._root_rows, self._w_root * acc_des[:6]
+            if hip:
+                # the pelvis's turn and the trunk's joints freed: their angular momentum
+                # lets the ground push the centre of mass back further than the feet's
+                # centre of pressure alone could
+                free = 1.0 - hip * (1.0 - self._hip_free)
+                root_rows, root_target = root_rows * free, root_target * free
+                wj = wj.copy()
+                wj[self._hip_joints] = free
+            tasks.append((root_rows, root_target))
             if w_trunk:
                 # the chest's world turn as the plan's own targets turn it (pelvis, waist and
                 # back together): without it the least squares spent the waist to hold the
@@ -483,7 +538,6 @@ class WholeBodyTracker(AnchoredReference):
             )
         # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
         # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
-        wj = self._wj
         swing = self._swing_targets(t)
         if swing:
             # a stepping leg follows its foot's target, not the mocap's leg
@@ -503,6 +557,14 @@ class WholeBodyTracker(AnchoredReference):
             u = pmat[:, 6:] - x[:, :nj]
             vb = x[:, nj:-1]
             c = np.concatenate([task[1] for task in tasks]) + x[:, -1]
+            if hip:
+                # the centre of mass's horizontal acceleration: the ground forces' sum (and
+                # the push's) over the mass, rows on beta only
+                w = self._w_hip * hip
+                push = self._xfrc[:, :2].sum(axis=0) if self._pushing else 0.0
+                u = np.concatenate([u, np.zeros((2, nj))])
+                vb = np.concatenate([vb, (w / self._mass) * sup.basis[:, :2].T])
+                c = np.concatenate([c, w * (self._hip_acc - push / self._mass)])
             # min |wj (y - a)|^2 + |U y + V beta - c|^2 + reg |beta|^2, beta >= 0: y eliminated
             # in closed form leaves e^T S^-1 e, e = U a + V beta - c, S = I + U D^-1 U^T
             # (a few rows instead of the QR of all 51 + r)
@@ -542,11 +604,11 @@ class WholeBodyTracker(AnchoredReference):
         off while an external force acts and, after one, while the capture point is more than
         ``trunk_band`` m from the mocap's; back linearly over ``trunk_give`` s after. A walk
         pushed gets the softer pelvis servo (``kp_root_pushed``)."""
-        if not (self._w_trunk and self._give):
+        if not ((self._w_trunk and self._give) or self._w_hip):
             return self._w_trunk
         # into a buffer: this runs every control tick
         np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
-        pushing = bool(self._xfrc.any())
+        pushing = self._pushing = bool(self._xfrc.any())
         i = self.clock.nearest(t)
         # standing: both feet planted for a balance step's time, as for balance steps (a
         # walk's double support is shorter; a walk kept its trunk rows, its figures dropped
@@ -557,12 +619,38 @@ class WholeBodyTracker(AnchoredReference):
             self.kp[:3] = self._kp_root_pushed
             self.kv[:3] = critical_kv(self._kp_root_pushed)
         self._pushed |= pushing
+        self._standing = standing
+        if not (self._w_trunk and self._give):
+            return self._w_trunk
         if self._pushed and standing:
             xi, omega = self.capture_point()
             c, v, _ = self.com_reference(t)
             if pushing or np.linalg.norm(xi - c[:2] - v[:2] / omega) > self._give_band:
                 self._back_from = t
         return self._w_trunk * min(1.0, max(0.0, t - self._back_from) / self._give)
+
+    def _hip_strength(self, t: float) -> float:
+        """The hip strategy (``hip_weight``) after :meth:`_push_response` at ``t``: while a
+        pushed body's mocap stands and its capture point is within ``hip_margin`` m of the feet's
+        edge or beyond, full (1), back to 0 linearly over ``hip_back`` s after. Sets the centre
+        of mass's horizontal acceleration that brings the capture point back to the mocap's
+        (critically damped at ``hip_gain`` times omega)."""
+        if not (self._w_hip and self._pushed and self._standing):
+            return 0.0
+        feet = [f for f in self._footprint(t) if len(f)]
+        if not feet:
+            return 0.0
+        points = np.concatenate(feet)
+        xi, omega = self.capture_point()
+        if outside_distance(xi, points) > -self._hip_margin:
+            self._hip_from = t
+        hip = 1.0 - min(1.0, (t - self._hip_from) / self._hip_back)
+        if hip:
+            c, v, _ = self.com_reference(t)
+            goal = c[:2] + v[:2] / omega
+            vel = self.world.data.subtree_linvel[self._root][:2]
+            self._hip_acc[:] = omega * (self._hip_gain * omega * (goal - xi) - vel)
+        return hip
 
     def _swing_task(
         self, f: int, v: F64, p_d: F64, v_d: F64, a_d: F64, up_d: F64 | None
@@ -646,11 +734,12 @@ class WholeBodyTracker(AnchoredReference):
             self.scale_gains(self._scale)
 
     def memory(self) -> tuple[object, ...]:
-        return (*super().memory(), self._pushed, self._back_from, self.kp[:3].copy(),
-                self.kv[:3].copy(), self._holding, self._scale)  # fmt: skip
+        return (*super().memory(), self._hip_from, self._pushed, self._back_from,
+                self.kp[:3].copy(), self.kv[:3].copy(), self._holding, self._scale)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
-        super().restore(memory[:-6])
+        super().restore(memory[:-7])
+        self._hip_from = float(memory[-7])  # type: ignore[arg-type]
         self._pushed = bool(memory[-6])
         self._back_from = float(memory[-5])  # type: ignore[arg-type]
         self.kp[:3], self.kv[:3] = memory[-4], memory[-3]
@@ -658,7 +747,7 @@ class WholeBodyTracker(AnchoredReference):
 
     def reset(self, world: World) -> None:
         self.reset_ground(world)
-        self._pushed, self._back_from = False, -np.inf
+        self._pushed, self._back_from, self._hip_from = False, -np.inf, -np.inf
         self._holding = False
         if self._stiffness != 1.0:
             self.stiffen_joints(1.0)
