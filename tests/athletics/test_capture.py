@@ -1,5 +1,6 @@
 """Perturbed starts (issue 19's capture regions): the vertical leap maneuver lands with the
-vertical leap's own landing, and a perturbed start settles onto both feet before the leap.
+vertical leap's own landing, and a perturbed start settles onto both feet before the leap
+(the vertical leap and the back tuck).
 Starts from ``capture_region``'s full-size distribution, seed 0."""
 
 from __future__ import annotations
@@ -20,9 +21,8 @@ from reactmocap.athletics.maneuvers import (
     run_maneuver,
 )
 
-VERTICAL_LEAP = (
-    Path(__file__).resolve().parents[2] / "examples/athletics/maneuvers/vertical_leap.toml"
-)
+MANEUVERS = Path(__file__).resolve().parents[2] / "examples/athletics/maneuvers"
+VERTICAL_LEAP = MANEUVERS / "vertical_leap.toml"
 FULL = {"joint_sd": math.radians(3.0), "pitch_sd": math.radians(2.0), "velocity_sd": 0.05,
         "spin_sd": 0.1}  # fmt: skip
 
@@ -71,3 +71,18 @@ def test_a_perturbed_start_settles_on_both_feet_before_the_leap() -> None:
         planted = _settle(starts[i], plant=True)
         assert "unsettled_s" not in planted and "balance1.hold" in planted["states"]
         assert not planted["fell"]
+
+
+def test_the_back_tuck_leaps_from_a_settled_start() -> None:
+    """Start 4 of the back tuck's full-size starts left the leap 0.3 s into the start moving
+    back at 1.1 m/s and fell after touchdown; settled onto both feet first (``plant``,
+    ``settled``: the file since 2026-12-02) it lands."""
+    m = load_maneuver(MANEUVERS / "back_somersault.toml")
+    assert m.phases[0].exit == "settled" and m.phases[0].params["plant"] is True
+    start = _starts(5)[4]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    phases = (Phase("balance", "after", seconds=0.3), *m.phases[1:])
+    old = dataclasses.replace(m, phases=phases, seconds=5.5)
+    r = run_maneuver(old, perturbation=start, fps=10.0).report
+    assert not (r["landed"] and not r["fell"])
