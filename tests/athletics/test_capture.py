@@ -27,7 +27,8 @@ FULL = {"joint_sd": math.radians(3.0), "pitch_sd": math.radians(2.0), "velocity_
         "spin_sd": 0.1}  # fmt: skip
 
 
-def _starts(n: int) -> list[Perturbation]:
+def full_starts(n: int) -> list[Perturbation]:
+    """The first ``n`` full-size starts of the benchmark's capture region (seed 0)."""
     rng = np.random.default_rng(0)
     return [Perturbation.sample(rng, **FULL) for _ in range(n)]
 
@@ -42,7 +43,7 @@ def test_the_vertical_leap_lands_with_the_vertical_leaps_own_delta() -> None:
     assert m.phases[land].params["delta"] == tables.VERTICAL_LANDING["male"][1]
     phases = [Phase("balance", "after", seconds=0.3), *m.phases[1:]]
     m = dataclasses.replace(m, phases=tuple(phases), seconds=4.0)
-    start = _starts(10)[9]
+    start = full_starts(10)[9]
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"]
     phases[land] = dataclasses.replace(phases[land], params={})
@@ -63,7 +64,7 @@ def test_a_perturbed_start_settles_on_both_feet_before_the_leap() -> None:
     """Starts 12 and 14 never settle under the plain balance (12 stands on one foot, the
     other hanging; 14 stands on its toes and falls forward): ``settled`` times out and the
     run reports it. With ``plant`` both settle onto both feet and hand over."""
-    starts = _starts(15)
+    starts = full_starts(15)
     for i in (12, 14):
         plain = _settle(starts[i], plant=False)
         assert plain["unsettled_s"] == pytest.approx(2.0, abs=0.01)
@@ -79,7 +80,7 @@ def test_the_back_tuck_leaps_from_a_settled_start() -> None:
     ``settled``: the file since 2026-12-02) it lands."""
     m = load_maneuver(MANEUVERS / "back_somersault.toml")
     assert m.phases[0].exit == "settled" and m.phases[0].params["plant"] is True
-    start = _starts(5)[4]
+    start = full_starts(5)[4]
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
     phases = (Phase("balance", "after", seconds=0.3), *m.phases[1:])

@@ -32,6 +32,7 @@ from reactmocap.athletics.tumble import (
 )
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.sim.bodies import SIM_BODIES
+from tests.athletics.test_capture import full_starts
 
 #: Fig. 5.2: moment of inertia about the somersault axis (kg m^2)
 THESIS_FIG_5_2 = {
@@ -216,10 +217,7 @@ def test_perturbed_back_tucks_land_with_the_legs_aimed_sideways() -> None:
     the feet 7 cm to the side of the COM, stood on one foot and fell sideways; start 5 stood on
     one foot and turned on backward. With the hips' roll taken from the pelvis's whole
     orientation (``aim_sideways``, the preset since 2026-12-02) both land on both feet."""
-    rng = np.random.default_rng(0)
-    full = {"joint_sd": math.radians(3.0), "pitch_sd": math.radians(2.0),
-            "velocity_sd": 0.05, "spin_sd": 0.1}  # fmt: skip
-    starts = [Perturbation.sample(rng, **full) for _ in range(6)]
+    starts = full_starts(6)
     m = somersault_maneuver()
     assert m.phases[3].params["aim_sideways"] is True
     for i in (0, 5):
@@ -239,10 +237,7 @@ def test_perturbed_back_tucks_land_with_the_legs_holding_their_aim() -> None:
     aimed in the pelvis's forward heading (which flips as the body passes the horizontal) and
     trailing their turning target: the feet swept forward under the body at 3-5 m/s when
     they touched. With ``spin_aim`` (the preset) the legs hold their aim and both land."""
-    rng = np.random.default_rng(0)
-    full = {"joint_sd": math.radians(3.0), "pitch_sd": math.radians(2.0),
-            "velocity_sd": 0.05, "spin_sd": 0.1}  # fmt: skip
-    starts = [Perturbation.sample(rng, **full) for _ in range(10)]
+    starts = full_starts(10)
     m = somersault_maneuver()
     assert m.phases[3].params["spin_aim"] is True
     land = replace(m.phases[3], params={**m.phases[3].params, "spin_aim": False})
@@ -295,10 +290,7 @@ def test_perturbed_pike_dives_enter_head_first() -> None:
     pike at -2.2 rad that grew into a tilt and a twist (-320, +247, -258 deg at the water,
     entries 32-42 deg off vertical); at the dive's hips (its largest principal axis) they
     stay in the plane and enter clean."""
-    rng = np.random.default_rng(0)
-    full = {"joint_sd": math.radians(3.0), "pitch_sd": math.radians(2.0),
-            "velocity_sd": 0.05, "spin_sd": 0.1}  # fmt: skip
-    starts = [Perturbation.sample(rng, **full) for _ in range(6)]
+    starts = full_starts(6)
     m = dive_maneuver("pike")
     for i in (0, 3, 5):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
