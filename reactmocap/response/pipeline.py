@@ -284,6 +284,19 @@ def _attacker_quality(cast: stages.Cast, out: final.Blend) -> dict[str, float | 
     }
 
 
+#: (quality field, name of its threshold in :mod:`reactmocap.metrics`, message) of the
+#: attacker's warnings; the threshold is read when warning, as the others are
+_ATTACKER_WARNINGS = (
+    ("attacker_speed_ratio", "WARN_ATTACKER_SPEED_RATIO",
+     "the attacker moves a joint {value:.2f}x faster than its clip ever does (more than {limit}x)"),
+    ("attacker_foot_skate_m", "WARN_ATTACKER_FOOT_SKATE_M",
+     "the attacker's planted feet slide {value:.2f} m in all (more than {limit} m)"),
+    ("attacker_lift_m", "WARN_ATTACKER_LIFT_M",
+     "the attacker's body is {value:.2f} m higher off the floor than its clip ever is (more "
+     "than {limit} m): held or blended in the air"),
+)  # fmt: skip
+
+
 def _warnings(
     scenario: Scenario,
     cast: stages.Cast,
@@ -309,18 +322,11 @@ def _warnings(
     if q["blend_root_turn_max_rad"] > qm.WARN_ROOT_TURN_RAD:
         out.append(f"the final blend turns the root by {q['blend_root_turn_max_rad']:.2f} rad "
                    f"(more than {qm.WARN_ROOT_TURN_RAD})")  # fmt: skip
-    ratio = q["attacker_speed_ratio"]
-    if ratio is not None and ratio > qm.WARN_ATTACKER_SPEED_RATIO:
-        out.append(f"the attacker moves a joint {ratio:.2f}x faster than its clip ever does "
-                   f"(more than {qm.WARN_ATTACKER_SPEED_RATIO}x)")  # fmt: skip
-    skate = q["attacker_foot_skate_m"]
-    if skate is not None and skate > qm.WARN_ATTACKER_FOOT_SKATE_M:
-        out.append(f"the attacker's planted feet slide {skate:.2f} m in all (more than "
-                   f"{qm.WARN_ATTACKER_FOOT_SKATE_M} m)")  # fmt: skip
-    lift = q["attacker_lift_m"]
-    if lift is not None and lift > qm.WARN_ATTACKER_LIFT_M:
-        out.append(f"the attacker's body is {lift:.2f} m higher off the floor than its clip "
-                   f"ever is (more than {qm.WARN_ATTACKER_LIFT_M} m): held or blended in the air")  # fmt: skip
+    # the attacker's fields are None without an attacker
+    for key, threshold, text in _ATTACKER_WARNINGS:
+        value, limit = q[key], getattr(qm, threshold)
+        if value is not None and value > limit:
+            out.append(text.format(value=value, limit=limit))
     if cast.attacker is not None and contact.time <= 0.0:
         out.append("the characters already touch when the scenario starts (place them apart)")
     if cast.attacker is not None and naive.contacts.empty:
