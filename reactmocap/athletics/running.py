@@ -516,7 +516,7 @@ class Runner:
                   ((ball_down, "heel_toe"), (after(0.12), "heel_toe"))),
             State("heel_toe", law(self._stance), self._enter_heel_toe,
                   ((stance_fraction, "toe"),)),
-            State("toe", law(self._stance), self._enter_toe,
+            State("toe", law(self._stance), None,
                   ((knee_extended, "unloading"), (left_ground, "flight"),
                    (after(0.3), "unloading"))),
             State("unloading", law(self._stance), None,
@@ -532,9 +532,6 @@ class Runner:
             stiff[_HIP[a]] = 0.0
             stiff[_KNEE[a]] = self.k["knee_hold"]
             stiff[_ANKLE[a]] = self.k["ankle_hold"]
-            if self.step_stance and self.machine.current.name in ("toe", "unloading"):
-                stiff[_KNEE[a]] = self.k["step_hold"]
-                stiff[_ANKLE[a]] = self.k["step_hold"]
         self.rig.set_stiffness(stiff)
 
     def _enter_flight(self, world: World, t: float) -> None:
@@ -588,11 +585,6 @@ class Runner:
         self.leg_rest = max(now, planned)
         self.leg_prev = 0.0
         self._set_stiffness(True)
-
-    def _enter_toe(self, world: World, t: float) -> None:
-        del world, t
-        if self.step_stance and self.k["step_hold"] != self.k["knee_hold"]:
-            self._set_stiffness(True)
 
     def _enter_heel_toe(self, world: World, t: float) -> None:
         del world

@@ -146,7 +146,6 @@ class RunParams:
     step_gain: float | Speeds = 20.0
     step_placement: float | Speeds = 1.0
     step_rise: float | Speeds = 1.0
-    step_hold: float | Speeds = 1.0
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
