@@ -89,10 +89,6 @@ START_SPEED = 3.5
 ACCEL = 1.5
 #: the most the pitch error's integral holds (rad s)
 PITCH_SUM = 0.1
-#: the most leg force (body weights) of the commanded step
-STEP_FORCE = 4.0
-#: the commanded step takes over from the leg spring at the first touchdown after this (s)
-STEP_AFTER = 2.0
 #: the path correction integrates from this time on (s; the start from the set pose strays)
 PATH_AFTER = 3.0
 #: the most the path correction's integral (cross-track times curvature) holds (s)
@@ -179,8 +175,6 @@ class Runner:
         self.t_touchdown = 0.0
         self.t_heel_toe = 0.0
         self.stance_estimate = k["stance_time"]
-        self.vz_touchdown = 0.0
-        self.step_stance = 0.0
         self.targets = np.zeros((NJ, 3))
         self.goal = np.zeros((NJ, 3))
         self.heel = np.zeros(2, dtype=bool)
@@ -410,35 +404,6 @@ class Runner:
             return heel + frac * (ball - heel)
         return ball
 
-    def _commanded_stance(self) -> float:
-        """The commanded stance time (s) from the commanded cadence, 0 when none or before
-        :data:`STEP_AFTER` (the start runs on the leg spring)."""
-        cadence = self.k["cadence"]
-        if cadence <= 0 or self.world.data.time < STEP_AFTER:
-            return 0.0
-        return (1.0 - self.k["flight_share"]) / cadence
-
-    def _step_force(self, t: float, up: float) -> float:
-        """The leg force (N, along the leg) of the commanded step: the body's vertical speed
-        follows a half-cosine from its touchdown value to the take-off speed that gives the
-        commanded flight (``g t_f / 2``) over the commanded stance, then the leg lets go."""
-        k = self.k
-        ts = self.step_stance
-        s = t - self.t_touchdown
-        if s >= ts or not self.senses.foot_contact[self.active]:
-            # pushing with the foot off the ground only swings the leg (the servo wound up
-            # and the leg kicked the body over)
-            return 0.0
-        v_to = 0.5 * self.g * k["flight_share"] / k["cadence"]
-        dv = v_to - self.vz_touchdown
-        rise = k["step_rise"] * ts
-        phase = math.pi * min(s / rise, 1.0)
-        want = self.vz_touchdown + 0.5 * dv * (1.0 - math.cos(phase))
-        acc = 0.5 * dv * math.pi / rise * math.sin(phase)
-        vz = float(self.senses.com_vel[2])
-        fz = self.mass * (self.g + acc + k["step_gain"] * (want - vz))
-        return min(fz / max(up, 0.5), STEP_FORCE * self.mass * self.g)
-
     def _leg_spring(self, t: float, dt: float, angles: F64) -> None:
         """The stance knee as a spring and the ankle as the thrust: the leg's length is the
         hip-to-ankle distance (what the knee's bend sets), ``L0`` the planned touchdown
@@ -461,13 +426,10 @@ class Runner:
         self.leg_prev = length
         stiff = k["leg_stiffness"] * self.mass * self.g / self.athlete.leg_length
         damp = 2.0 * k["leg_damping"] * math.sqrt(stiff * self.mass)
+        force = stiff * (self.leg_rest - length) - damp * rate
         state = self.machine.current.name
-        if self.step_stance:
-            force = self._step_force(t, float(u[2]))
-        else:
-            force = stiff * (self.leg_rest - length) - damp * rate
-            if state in ("toe", "unloading") and not self.released:
-                force += self.thrust_force
+        if state in ("toe", "unloading") and not self.released:
+            force += self.thrust_force
         force = max(force, 0.0)
         self.leg_force = force
         mujoco.mj_jac(self.world.model, d, self._jacp, None, point, self._feet[leg])
@@ -499,9 +461,7 @@ class Runner:
         def stance_fraction(_w: World, t: float, _ti: float) -> bool:
             return t - self.t_touchdown >= self.k["toe_fraction"] * self.stance_estimate
 
-        def knee_extended(_w: World, t: float, t_in: float) -> bool:
-            if self.step_stance:  # the commanded step lets go at its stance time
-                return t - self.t_touchdown >= self.step_stance
+        def knee_extended(_w: World, _t: float, t_in: float) -> bool:
             knee = self._joint_pitch(_KNEE[self.active])
             return t_in > 0.02 and knee <= self.knee_td + 0.05
 
@@ -542,7 +502,7 @@ class Runner:
             blend = self.k["stance_blend"]
             if blend < 1:
                 last = self.stance_estimate + blend * (last - self.stance_estimate)
-            self.stance_estimate = self.step_stance * self.k["step_placement"] or last
+            self.stance_estimate = last
             self.log.liftoffs.append((t, self.active))
             self.active = 1 - self.active
         h = self.heading()
@@ -554,8 +514,6 @@ class Runner:
         self.t_touchdown = t
         self.released = False
         self.vz_peak = -math.inf
-        self.vz_touchdown = float(self.senses.com_vel[2])
-        self.step_stance = self._commanded_stance()
         leg = self.active
         d = self.world.data
         self.td_pitch = self._pitch(self._thighs[1 - leg], _THIGH[1 - leg], self.heading())

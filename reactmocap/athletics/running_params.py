@@ -141,11 +141,6 @@ class RunParams:
     arm_gain: float | Speeds = (0.7815, 1.273, 1.336)
     arm_offset: float | Speeds = 0.05
     elbow: float | Speeds = 1.4
-    cadence: float | Speeds = 0.0
-    flight_share: float | Speeds = 0.45
-    step_gain: float | Speeds = 20.0
-    step_placement: float | Speeds = 1.0
-    step_rise: float | Speeds = 1.0
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
