@@ -37,6 +37,7 @@ __all__ = [
     "SUPPORTED",
     "VERTICAL_LANDING",
     "VERTICAL_LANDING_COM",
+    "VERTICAL_LANDING_COM_AIM",
     "VERTICAL_LANDING_COM_MOMENTUM",
     "broad_params",
     "effort_for",
@@ -183,6 +184,11 @@ VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]
 VERTICAL_LANDING_COM_MOMENTUM: Mapping[str, tuple[float, float]] = MappingProxyType(
     {"female": (0.015, 0.5)}
 )
+#: bodies whose "com" leap's landing aims the legs sideways from the pelvis's whole
+#: orientation (LandingParams.aim_sideways). Her 0.825 m leap (0.025 m grid, 2026-12-02)
+#: touched down on one foot and fell sideways 0.7 m, her 0.775 m one 0.8 m; with it 0.825
+#: lands, and 0.1-1.0 m in 0.05 steps still land 19 of 19 on both bodies
+VERTICAL_LANDING_COM_AIM: frozenset[str] = frozenset({"male", "female"})
 #: the landing after a broad jump, per body: (capture-point lead, ((touchdown speed m/s,
 #: foot-servo delta m), ...)), thesis Table 6.1 measured on broad jumps, not drops (a broad
 #: jump lands lower, with the trunk pitched forward). Each row: the middle of the deltas that
@@ -276,7 +282,8 @@ def landing_params(
         lead, table = VERTICAL_LANDING_COM[body]
         gain, ref = VERTICAL_LANDING_COM_MOMENTUM.get(body, (0.0, 0.0))
         return LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table,
-                             momentum_gain=gain, momentum_ref=ref)  # fmt: skip
+                             momentum_gain=gain, momentum_ref=ref,
+                             aim_sideways=body in VERTICAL_LANDING_COM_AIM)  # fmt: skip
     if vertical and body in VERTICAL_LANDING:
         lead, delta = VERTICAL_LANDING[body]
         return LandingParams(lead=lead, delta=delta)
