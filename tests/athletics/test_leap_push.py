@@ -108,3 +108,19 @@ def test_each_push_has_its_own_measured_range() -> None:
         run("leap", "female", height=timed[1] + 0.01, push="timed")
     with pytest.raises(ConfigError, match=f"{com[0]:g}-{com[1]:g} m .*'com'"):
         run("leap", "female", height=com[0] - 0.01)
+
+
+def test_the_female_0_825_m_com_leap_lands_with_the_legs_aimed_sideways(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Her 0.825 m com leap lands with the landing's legs aimed from the pelvis's whole
+    orientation (VERTICAL_LANDING_COM_AIM); aimed by the servo alone she touches down on one
+    foot and falls sideways."""
+    assert tables.landing_params("female", 0.0, vertical=True, push="com").aim_sideways
+    r = run("leap", "female", height=0.825, check_range=False)
+    assert r.report["landed"] and not r.report["fell"]
+    assert abs(r.log["com"][-1, 1]) < 0.1  # stood where she landed
+    monkeypatch.setattr(tables, "VERTICAL_LANDING_COM_AIM", frozenset())
+    r0 = run("leap", "female", height=0.825, check_range=False)
+    assert r0.report["fell"] and not r0.report["landed"]
+    assert abs(r0.log["com"][-1, 1]) > 0.3  # fell to the side
