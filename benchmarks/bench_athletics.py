@@ -44,7 +44,7 @@ def _landed(r: dict[str, Any]) -> bool:
 
 # ---------------------------------------------------------------------------------- tables
 def build_tables(
-    workers: int, parts: tuple[str, ...] = ("leap", "broad", "land")
+    workers: int, parts: tuple[str, ...] = ("leap", "com", "broad", "land")
 ) -> dict[str, Any]:
     """Rebuild the measured tables and supported ranges (``parts``: which; the others are
     kept as they are in measured.py)."""
@@ -63,7 +63,8 @@ def build_tables(
     for body in BODIES:
         t0 = time.time()
         if "leap" in parts:
-            leaps = calibrate.sweep("leap", body, grid, workers)
+            # the effort table is the timed push's (the com push plans its height itself)
+            leaps = calibrate.sweep("leap", body, [{**g, "push": "timed"} for g in grid], workers)
             table = calibrate.effort_table(leaps, "achieved_height_m", lifted)
             out["LEAP_TABLES"][body] = table
             # supported: the longest stretch of the table's heights whose leaps land
@@ -72,6 +73,10 @@ def build_tables(
             rng = _longest(heights, [ok.get(v, False) for v in heights])
             if rng:
                 supported.setdefault(("leap", "height"), {})[body] = rng
+        if "com" in parts:
+            rng = _com_range(body, workers)
+            if rng:
+                supported.setdefault(("leap", "height", "com"), {})[body] = rng
         if "broad" in parts:
             broads = calibrate.sweep("broad-jump", body, grid, workers)
             btable = calibrate.effort_table(broads, "achieved_distance_m", lifted)
@@ -154,6 +159,23 @@ def _longest(values: list[float], ok: list[bool]) -> tuple[float, float] | None:
         else:
             i += 1
     return None if best is None else (values[best[0]], values[best[1]])
+
+
+#: the "com" push's commands for its supported range (m): a 0.025 m grid
+COM_RANGE_GRID = np.round(np.arange(0.05, 1.2001, 0.025), 3)
+
+
+def _com_range(body: str, workers: int) -> tuple[float, float] | None:
+    """The "com" push's supported leap heights: the longest stretch of :data:`COM_RANGE_GRID`
+    commands that land (as the timed push's range: its table's heights that land; the
+    accuracy is printed, not part of the range)."""
+    grid = [{"height": float(h), "push": "com"} for h in COM_RANGE_GRID]
+    rows = calibrate.sweep("leap", body, grid, workers)
+    for r in rows:
+        print(f"  com {body} {r['height']:.3f} m: error "
+              f"{100 * (r['achieved_height_m'] - r['height']):+.1f} cm, landed {_landed(r)}, "
+              f"lift-off pitch momentum {r['liftoff_pitch_momentum']:+.2f}", flush=True)  # fmt: skip
+    return _longest([float(h) for h in COM_RANGE_GRID], [_landed(r) for r in rows])
 
 
 def _drop_for_com(body: str, com_height: float) -> float:
@@ -433,9 +455,10 @@ def main() -> int:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     ap.add_argument("--tables", action="store_true", help="rebuild tables and ranges")
-    ap.add_argument("--parts", default="leap,broad,land",
-                    help="with --tables: which of leap,broad,deltas,land to rebuild (deltas: "
-                         "the landing's Table 6.1, ~15 min; run it before land)")  # fmt: skip
+    ap.add_argument("--parts", default="leap,com,broad,land",
+                    help="with --tables: which of leap,com,broad,deltas,land to rebuild "
+                         "(com: the com push's supported heights; deltas: the landing's "
+                         "Table 6.1, ~15 min; run it before land)")  # fmt: skip
     ap.add_argument("--out", type=Path, help="folder for the plots")
     ap.add_argument("--json", type=Path, help="write every figure as JSON")
     ap.add_argument("--workers", type=int, default=1)

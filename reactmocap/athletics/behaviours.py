@@ -60,7 +60,8 @@ class Param:
     CLI), its default, and whether it must be > 0, >= 0 or anything finite."""
 
     name: str
-    default: float | None
+    #: a number, or one of ``choices`` for a text parameter
+    default: float | str | None
     unit: str
     help: str
     angle: bool = False
@@ -77,6 +78,8 @@ class Behaviour:
     runner: Callable[[Athlete, dict[str, Any], Callable[[float], None] | None], AthleticsResult]
     #: parameters whose supported range is measured (checked by :func:`run`)
     ranged: tuple[str, ...] = ()
+    #: the text parameter whose value selects its own measured range (the leap's push)
+    variant: str | None = None
 
 
 @dataclass
@@ -389,10 +392,10 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
         (Param("height", None, "m", "commanded COM rise at the apex over standing"),
          Param("effort", None, "", "leap effort 0-1 instead of a height (no table needed)"),
          Param("spin", None, "kg m^2/s", "take-off angular momentum (pitch) to aim for"),
-         Param("push", None, "", "push-off: 'timed' (the thesis's, default) or 'com' (a "
-               "servo on the COM, ground force planned)", choices=PUSHES),
+         Param("push", "com", "", "push-off: 'com' (a servo on the COM, ground force "
+               "planned) or 'timed' (the thesis's joints on fixed timing)", choices=PUSHES),
          _BACKPACK, _FPS),
-        lambda a, p, cb: _run_leap(a, p, cb), ("height",)),
+        lambda a, p, cb: _run_leap(a, p, cb), ("height",), variant="push"),
     "broad-jump": Behaviour(
         "broad-jump", "standing broad jump to a COM travel, land, balance (ch. 4.2, 8.2)",
         (Param("distance", None, "m", "commanded horizontal COM travel"),
@@ -452,7 +455,7 @@ def _params(b: Behaviour, given: Mapping[str, Any], check_range: bool, body: str
         raise ConfigError(f"{b.name} needs {needed}")
     if check_range:
         for name in b.ranged:
-            rng = tables.supported_range(b.name, name, body)
+            rng = tables.supported_range(b.name, name, body, out[b.variant] if b.variant else None)
             v = out[name]
             effort = name in ("height", "distance") and out.get("effort") is not None
             if rng is None or v is None or effort:
@@ -460,9 +463,10 @@ def _params(b: Behaviour, given: Mapping[str, Any], check_range: bool, body: str
             if not rng[0] - 1e-9 <= v <= rng[1] + 1e-9:
                 unit = next(p.unit for p in b.params if p.name == name)
                 shown = (math.degrees(v), *map(math.degrees, rng)) if unit == "deg" else (v, *rng)
+                kind = f" with {b.variant} {out[b.variant]!r}" if b.variant else ""
                 raise ConfigError(
                     f"{b.name} {name} {shown[0]:g} {unit} is outside the supported range "
-                    f"{shown[1]:g}-{shown[2]:g} {unit} for body {body!r} (measured; see "
+                    f"{shown[1]:g}-{shown[2]:g} {unit} for body {body!r}{kind} (measured; see "
                     "docs/athletics.md)"
                 )
     return out

@@ -23,6 +23,7 @@ from reactmocap.athletics.balance import (
     knee_for_length,
 )
 from reactmocap.athletics.bodies import EULER_ORDER
+from reactmocap.athletics.leap import pitch_momentum
 from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
 from reactmocap.athletics.rig import joint_index, per_joint
 from reactmocap.errors import ConfigError
@@ -125,6 +126,14 @@ class LandingParams:
             the window of deltas that land moved from -0.47 m to -0.52 and -0.57 m with the
             COM 1.15, 1.25, 1.35 m up).
         fall_ref: the fall (m) the deltas were measured at (``fall_gain``'s zero).
+        momentum_gain: how much farther ahead (m) the feet go per kg m^2/s of whole-body
+            pitch momentum (> 0 pitching forward, :func:`~reactmocap.athletics.leap.pitch_momentum`,
+            constant in the air) over ``momentum_ref``; 0: off. Why: the ground force must
+            also stop the body's rotation, and a force under feet behind the COM pitches the
+            body forward, so a body turning back needs its feet farther back (the female's
+            "com" leaps lift off with -1.1 to +1.6 kg m^2/s: at 0.75 m, +1.6, she landed only
+            with the feet 3-5 cm ahead of where her 0.7 and 0.8 m leaps, +0.4 / +0.9, land).
+        momentum_ref: the pitch momentum (kg m^2/s) the deltas were measured at.
     """
 
     knee: float = 0.6
@@ -145,6 +154,8 @@ class LandingParams:
     spin_aim: bool = False
     fall_gain: float = 0.0
     fall_ref: float = 0.0
+    momentum_gain: float = 0.0
+    momentum_ref: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -162,6 +173,8 @@ class LandingParams:
             "pitch_ease",
             "fall_gain",
             "fall_ref",
+            "momentum_gain",
+            "momentum_ref",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -246,6 +259,8 @@ class Landing(Basis):
             lead = p.lead * math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
             want = np.array([lead * v[0] + p.delta_at(float(v[0])), lead * v[1]])
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
+            if p.momentum_gain:  # the feet also stop the rotation (see momentum_gain)
+                want[0] += p.momentum_gain * (pitch_momentum(world, s) - p.momentum_ref)
             # eq. 6.1 as a correction on top of the geometric placement below
             x = s.local(feet - s.com, h)
             xd = s.local(fvel - s.com_vel, h)

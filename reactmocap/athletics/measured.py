@@ -180,5 +180,6 @@ SUPPORTED: dict[Any, Any] = {
     ("land", "drop"): {"male": (0.0, 2.2), "female": (0.0, 2.5)},
     ("land", "vx"): {"male": (-2.0, 3.0), "female": (-1.0, 3.0)},
     ("balance", "slope"): {"male": (0.0, 0.5235987755982988), "female": (0.0, 0.5846852994181004)},
+    ("leap", "height", "com"): {"male": (0.05, 1.2), "female": (0.075, 0.75)},
 }
 MEASURED_ON = "2026-12-02 (bench_athletics.py --tables)"

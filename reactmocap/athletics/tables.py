@@ -37,6 +37,8 @@ __all__ = [
     "SUPPORTED",
     "VERTICAL_LANDING",
     "VERTICAL_LANDING_COM",
+    "VERTICAL_LANDING_COM_AIM",
+    "VERTICAL_LANDING_COM_MOMENTUM",
     "broad_params",
     "effort_for",
     "landing_delta",
@@ -172,6 +174,21 @@ VERTICAL_LANDING_COM: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]
         }
     )
 )
+#: the "com" leap's landing's pitch-momentum feedback per body: (LandingParams.momentum_gain
+#: m per kg m^2/s, momentum_ref kg m^2/s). Her take-off's pitch momentum is set by the push's
+#: last two ticks (the feet rolling off) and scatters (-1.1 to +1.6 kg m^2/s over 0.1-1.0 m)
+#: where her drift speed grows smoothly: her 0.75 m leap (+1.57, -0.40 m/s) landed only with
+#: deltas 3-5 cm ahead of her table's, her 0.95 m one (-1.11, -0.41 m/s) 2 cm behind it. Over
+#: 0.1-1.0 m in 0.05 steps (landed of 19, 2026-12-02): gain/ref 0 17 (0.75, 0.95 fell),
+#: 0.01/0.8 18 (0.75), 0.015/0.3 and 0.015/0.5 19, 0.02/0.8 18 (0.95), 0.03/0.8 16
+VERTICAL_LANDING_COM_MOMENTUM: Mapping[str, tuple[float, float]] = MappingProxyType(
+    {"female": (0.015, 0.5)}
+)
+#: bodies whose "com" leap's landing aims the legs sideways from the pelvis's whole
+#: orientation (LandingParams.aim_sideways). Her 0.825 m leap (0.025 m grid, 2026-12-02)
+#: touched down on one foot and fell sideways 0.7 m, her 0.775 m one 0.8 m; with it 0.825
+#: lands, and 0.1-1.0 m in 0.05 steps still land 19 of 19 on both bodies
+VERTICAL_LANDING_COM_AIM: frozenset[str] = frozenset({"male", "female"})
 #: the landing after a broad jump, per body: (capture-point lead, ((touchdown speed m/s,
 #: foot-servo delta m), ...)), thesis Table 6.1 measured on broad jumps, not drops (a broad
 #: jump lands lower, with the trunk pitched forward). Each row: the middle of the deltas that
@@ -215,8 +232,9 @@ BROAD_ARMS: Mapping[str, float] = MappingProxyType({"female": 1.0, "male": 1.0})
 #: righting it at once threw the male's 0.96 m and the female's 0.67 m jumps back up off
 #: their legs (the hips' extension pushed into the floor)
 BROAD_PITCH_EASE = 0.3
-#: (behaviour, parameter) -> body -> (low, high): the measured supported range
-SUPPORTED: Mapping[tuple[str, str], Mapping[str, tuple[float, float]]] = MappingProxyType(
+#: (behaviour, parameter) -> body -> (low, high): the measured supported range; a key with a
+#: third item, the variant (the leap's push), holds that variant's own range
+SUPPORTED: Mapping[tuple[str, ...], Mapping[str, tuple[float, float]]] = MappingProxyType(
     measured.SUPPORTED
 )
 
@@ -262,7 +280,10 @@ def landing_params(
         return replace(base, pitch_ease=BROAD_PITCH_EASE, arms=arms)
     if vertical and push == "com" and body in VERTICAL_LANDING_COM:
         lead, table = VERTICAL_LANDING_COM[body]
-        return LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
+        gain, ref = VERTICAL_LANDING_COM_MOMENTUM.get(body, (0.0, 0.0))
+        return LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table,
+                             momentum_gain=gain, momentum_ref=ref,
+                             aim_sideways=body in VERTICAL_LANDING_COM_AIM)  # fmt: skip
     if vertical and body in VERTICAL_LANDING:
         lead, delta = VERTICAL_LANDING[body]
         return LandingParams(lead=lead, delta=delta)
@@ -284,10 +305,13 @@ def _with_fast_rows(
     return table + tuple(r for r in fast if r[0] > top)
 
 
-def supported_range(behaviour: str, param: str, body: str) -> tuple[float, float] | None:
+def supported_range(
+    behaviour: str, param: str, body: str, variant: str | None = None
+) -> tuple[float, float] | None:
     """The measured supported range of a behaviour's parameter for a body (a BVH body gets the
-    narrower of the two thesis bodies'); None if nothing was measured."""
-    ranges = SUPPORTED.get((behaviour, param))
+    narrower of the two thesis bodies'); None if nothing was measured. ``variant`` (the
+    leap's push): that variant's own range where one was measured, else the plain one."""
+    ranges = SUPPORTED.get((behaviour, param, variant or "")) or SUPPORTED.get((behaviour, param))
     if not ranges:
         return None
     if body in ranges:

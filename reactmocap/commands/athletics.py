@@ -52,13 +52,15 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         for flag, key, deg in flags:
             par = params[key]
             unit = "deg" if deg else par.unit
-            default = par.default if par.default is None or not deg else math.degrees(par.default)
+            default = par.default
+            if deg and isinstance(default, float):
+                default = math.degrees(default)
             p.add_argument(flag, type=float, default=None,
                            help=f"{par.help} ({unit}; default {default})")  # fmt: skip
         if name == "leap":
             push = params["push"]
             p.add_argument("--push", dest="push_off", choices=list(push.choices or ()),
-                           default=None, help=f"{push.help} (default timed)")  # fmt: skip
+                           default=None, help=f"{push.help} (default {push.default})")  # fmt: skip
         if name == "balance":
             p.add_argument("--com-offset", help="desired COM offset X,Y (m) from the support")
         p.add_argument("--out", type=output_file, help="BVH of the motion (default: NAME_BODY.bvh)")

@@ -33,15 +33,17 @@ def test_each_command_writes_bvh_and_report(
     assert motion.num_frames > 10 and "LeftUpLeg" in motion.skeleton.names
 
 
-def test_leap_push_flag_selects_the_com_push(tmp_path: Path) -> None:
+def test_leap_push_flag_selects_the_push_com_by_default(tmp_path: Path) -> None:
     rep = tmp_path / "r.json"
-    args = ["athletics", "leap", "--height", "0.3", "--push", "com"]
-    args += ["--out", str(tmp_path / "m.bvh")]
+    args = ["athletics", "leap", "--height", "0.3", "--out", str(tmp_path / "m.bvh")]
     assert main([*args, "--report", str(rep)]) == 0
     report = json.loads(rep.read_text())
     # the report names the push that ran, and the COM push stays under the timed push's force
     assert report["push"] == "com" and report["peak_grf_bw"] < 3.5
     assert abs(report["achieved_height_m"] - 0.3) < 0.03
+    assert main([*args, "--push", "timed", "--report", str(rep)]) == 0
+    timed = json.loads(rep.read_text())
+    assert timed["push"] == "timed" and timed["peak_grf_bw"] > 3.5
 
 
 def test_bad_input_is_one_line_and_nothing_is_written(

@@ -37,14 +37,15 @@ def test_vertical_leaps_land_with_the_ready_bend(monkeypatch: pytest.MonkeyPatch
     """The landing takes over at lift-off, so its knees are bent ready at touchdown, and
     places the feet by the vertical leap's own lead and delta. With her drops' landing (the
     capture-point lead of 1.0) the female's half-metre leap falls."""
-    r = run("leap", "female", height=0.5, check_range=False)
+    r = run("leap", "female", height=0.5, check_range=False, push="timed")
     assert r.report["landed"] and not r.report["fell"]
     reach = next(t for t, _, target in r.transitions if target == "land.reach")
     assert reach - r.report["time_to_liftoff_s"] < 0.02
-    m = run("leap", "male", height=0.2, check_range=False)  # fell before: feet too far back
+    # fell before: feet too far back
+    m = run("leap", "male", height=0.2, check_range=False, push="timed")
     assert m.report["landed"] and not m.report["fell"]
     monkeypatch.setattr(tables, "VERTICAL_LANDING", {})
-    r0 = run("leap", "female", height=0.5, check_range=False)
+    r0 = run("leap", "female", height=0.5, check_range=False, push="timed")
     assert abs(r0.report["achieved_height_m"] - r.report["achieved_height_m"]) < 0.01
     assert not r0.report["landed"]
 
@@ -129,7 +130,7 @@ def test_landing_pitch_ease_must_not_be_negative() -> None:
 
 def test_flight_conserves_angular_momentum() -> None:
     # a leap with pitch momentum; in the air only internal torques act
-    r = run("leap", "male", effort=0.4, spin=15.0)
+    r = run("leap", "male", effort=0.4, spin=15.0, push="timed")
     t, momentum = r.log["t"], r.log["momentum"]
     lift, down = r.report["time_to_liftoff_s"], r.report["touchdown_s"]
     flight = (t > lift + 0.01) & (t < down - 0.01)
@@ -159,7 +160,7 @@ def test_a_3_metre_drop_is_never_a_success() -> None:
 
 
 def test_commands_outside_the_measured_range_are_refused() -> None:
-    _, hi = tables.supported_range("leap", "height", "female") or (0.0, 0.0)
+    _, hi = tables.supported_range("leap", "height", "female", "com") or (0.0, 0.0)
     with pytest.raises(ConfigError, match=f"{hi:g}"):
         run("leap", "female", height=hi + 0.5)
     with pytest.raises(ConfigError, match="finite"):

@@ -13,7 +13,7 @@ from reactmocap.errors import ConfigError
 
 
 def test_a_half_metre_com_push_stays_under_3_5_body_weights_and_lands() -> None:
-    r = run("leap", "male", height=0.5, push="com")
+    r = run("leap", "male", height=0.5)  # the com push is the leap's default
     rep = r.report
     assert rep["push"] == "com"
     assert abs(rep["achieved_height_m"] - 0.5) <= 0.03
@@ -28,7 +28,7 @@ def test_a_half_metre_com_push_stays_under_3_5_body_weights_and_lands() -> None:
     span = (tl[1:] > thrust) & (tl[1:] < rep["touchdown_s"])
     assert np.linalg.norm(force[span], axis=1).max() / (rep["mass_kg"] * 9.81) <= 3.5
     # and the timed push makes well over that (the figure the com push replaces)
-    timed = run("leap", "male", height=0.5).report
+    timed = run("leap", "male", height=0.5, push="timed").report
     assert timed["peak_grf_bw"] > 6.0
 
 
@@ -77,3 +77,50 @@ def test_the_female_0_1_and_0_9_m_com_leaps_land_within_3_cm(height: float) -> N
     assert rep["landed"] and not rep["fell"]
     with pytest.raises(ConfigError, match="push_hip"):
         LeapParams(push_hip=-1.0)
+
+
+def test_the_female_0_75_m_com_leap_lands_on_its_pitch_momentum(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Her 0.75 m com leap lifts off pitching forward (+1.6 kg m^2/s, her neighbours' +0.4 to
+    +0.9): the landing puts the feet farther ahead by VERTICAL_LANDING_COM_MOMENTUM's gain and
+    she lands; on the drift speed's delta alone she falls."""
+    r = run("leap", "female", height=0.75)
+    assert r.report["liftoff_pitch_momentum"] > 1.2
+    assert abs(r.report["achieved_height_m"] - 0.75) <= 0.03
+    assert r.report["landed"] and not r.report["fell"]
+    monkeypatch.setattr(tables, "VERTICAL_LANDING_COM_MOMENTUM", {})
+    r0 = run("leap", "female", height=0.75)
+    assert r0.report["liftoff_pitch_momentum"] == pytest.approx(r.report["liftoff_pitch_momentum"])
+    assert not r0.report["landed"]
+
+
+def test_each_push_has_its_own_measured_range() -> None:
+    """The com push's heights are checked against its own measured range (the message names
+    it), the timed push's against the timed push's."""
+    com = tables.supported_range("leap", "height", "female", "com")
+    timed = tables.supported_range("leap", "height", "female", "timed")
+    assert com is not None and timed is not None and com != timed
+    assert timed == tables.supported_range("leap", "height", "female")
+    with pytest.raises(ConfigError, match=f"{com[0]:g}-{com[1]:g} m .*'com'"):
+        run("leap", "female", height=com[1] + 0.05)
+    with pytest.raises(ConfigError, match=f"{timed[0]:g}-{timed[1]:g} m .*'timed'"):
+        run("leap", "female", height=timed[1] + 0.01, push="timed")
+    with pytest.raises(ConfigError, match=f"{com[0]:g}-{com[1]:g} m .*'com'"):
+        run("leap", "female", height=com[0] - 0.01)
+
+
+def test_the_female_0_825_m_com_leap_lands_with_the_legs_aimed_sideways(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Her 0.825 m com leap lands with the landing's legs aimed from the pelvis's whole
+    orientation (VERTICAL_LANDING_COM_AIM); aimed by the servo alone she touches down on one
+    foot and falls sideways."""
+    assert tables.landing_params("female", 0.0, vertical=True, push="com").aim_sideways
+    r = run("leap", "female", height=0.825, check_range=False)
+    assert r.report["landed"] and not r.report["fell"]
+    assert abs(r.log["com"][-1, 1]) < 0.1  # stood where she landed
+    monkeypatch.setattr(tables, "VERTICAL_LANDING_COM_AIM", frozenset())
+    r0 = run("leap", "female", height=0.825, check_range=False)
+    assert r0.report["fell"] and not r0.report["landed"]
+    assert abs(r0.log["com"][-1, 1]) > 0.3  # fell to the side
