@@ -7,8 +7,6 @@ joint torques; why each part exists: ``docs/tracking.md``."""
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
@@ -25,7 +23,7 @@ from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.reference import ReferencePath
 from reactmocap.sim.world import World
 
-__all__ = ["AnchoredReference", "zmp_preview"]
+__all__ = ["AnchoredReference"]
 
 F64 = NDArray[np.float64]
 # no balance step once the pelvis has tilted this far from its start (cos 35 deg)
@@ -39,48 +37,6 @@ _DEADBAND_ARM = 0.5
 def _rot2(yaw: float) -> F64:
     c, s = np.cos(yaw), np.sin(yaw)
     return np.array([[c, -s], [s, c]])
-
-
-def zmp_preview(
-    path: ReferencePath, floor_z: float, gravity: float, *, margin: float, roll_band: float
-) -> ReferencePath:
-    """``path`` with its pelvis and centre of mass moved horizontally (offline, once per clip)
-    so that its ZMP (the linear inverted pendulum's, on this body model) stays ``margin`` m
-    inside the corners its planted feet keep down (within ``roll_band`` of the foot's lowest;
-    ``inf``: all). The pendulum's centre of mass ``x`` and ZMP ``p`` obey ``x - x'' / w^2 =
-    p``, whose bounded solution is ``p`` convolved with ``w / 2 exp(-w |t|)``: the ZMP's
-    correction convolved so gives the centre of mass's, which starts moving before the
-    violation (a preview; ``docs/tracking.md``, "Seventh pass")."""
-    assert path.com is not None and path.corners is not None
-    n = path.num_frames
-    if n < 3:
-        return path
-    dt = 1.0 / path.fps
-    com = path.com
-    acc = np.gradient(np.gradient(com, dt, axis=0), dt, axis=0)
-    h = np.maximum(com[:, 2] - floor_z, 0.3)
-    zmp = com[:, :2] - (h / np.maximum(gravity + acc[:, 2], 1.0))[:, None] * acc[:, :2]
-    z = path.corners[..., 2]
-    held = z - z.min(axis=2, keepdims=True) < roll_band  # (T, 2, 4)
-    fix = np.zeros((n, 2))
-    for i in np.flatnonzero(path.planted.any(axis=1)):  # once per frame of the clip, offline
-        points = path.corners[i][path.planted[i][:, None] & held[i]][:, :2]
-        fix[i] = clamp_to_support(zmp[i], points, margin) - zmp[i]
-    if not fix.any():
-        return path
-    omega = float(np.sqrt(gravity / np.median(h)))
-    k = min(n - 1, int(np.ceil(8.0 / (omega * dt))))  # the kernel to e^-8
-    kernel = 0.5 * omega * dt * np.exp(-omega * dt * np.abs(np.arange(-k, k + 1)))
-    shift = np.column_stack([np.convolve(fix[:, j], kernel)[k : k + n] for j in range(2)])
-    shift_v = np.gradient(shift, dt, axis=0)
-    q, v, a, c = path.q.copy(), path.v.copy(), path.a.copy(), com.copy()
-    q[:, :2] += shift
-    c[:, :2] += shift
-    v[:, :2] += shift_v
-    a[:, :2] += np.gradient(shift_v, dt, axis=0)
-    for arr in (q, v, a, c):
-        arr.flags.writeable = False
-    return replace(path, q=q, v=v, a=a, com=c)
 
 
 class AnchoredReference:
@@ -110,21 +66,16 @@ class AnchoredReference:
         place_gain: float,
         place_deadband: float,
         place_height: float,
-        zmp_margin: float | None = None,
     ) -> None:
         m = world.model
         wc = world.characters[character]
         self.world = world
         self.character = character
-        self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
-        self.roll_band = float(roll_band) if roll_band > 0 else np.inf
-        if zmp_margin is not None:
-            path = zmp_preview(path, self.floor_z, -float(m.opt.gravity[2]), margin=zmp_margin,
-                               roll_band=self.roll_band)  # fmt: skip
         #: the clip as this tracker follows it
         self.path = path
         self.clock = path.clock(start)
         self.feet, self.sole, self._corners = foot_soles(world, character, "WholeBodyTracker")
+        self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
         self.patch = wc.patch_ids
         self.patch_half = m.geom_size[self.patch, 2].copy()
         self.patch_arm = m.geom_friction[self.patch, 2].copy()
@@ -133,6 +84,7 @@ class AnchoredReference:
         self.anchor_touch = float(anchor_touch)
         self.anchor_deadband = float(anchor_deadband)
         self._return_rate = min(1.0, dt_slow / anchor_return) if anchor_return > 0 else 0.0
+        self.roll_band = float(roll_band) if roll_band > 0 else np.inf
         self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
         assert self.path.com is not None and self.path.sole is not None
         self._com: F64 = self.path.com

@@ -158,9 +158,6 @@ class WholeBodyTracker(AnchoredReference):
             above ``place_height``) and the simulated capture point is more than
             ``place_deadband`` m from the mocap's, the foot lands ``place_gain`` times that
             error (at most 0.4 m) from the mocap's landing (0: off; see ``docs/tracking.md``).
-        zmp_preview, zmp_margin: the clip's pelvis and centre of mass moved horizontally,
-            offline, so that its ZMP stays ``zmp_margin`` m inside the corners its planted feet
-            keep down (:func:`~reactmocap.sim.controllers.anchoring.zmp_preview`).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -226,8 +223,6 @@ class WholeBodyTracker(AnchoredReference):
         place_gain: float = 0.0,
         place_deadband: float = 0.15,
         place_height: float = 0.03,
-        zmp_preview: bool = False,
-        zmp_margin: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -253,7 +248,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "torque_limit": torque_limit,
-                "zmp_preview": zmp_preview, "zmp_margin": zmp_margin,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -354,7 +348,6 @@ class WholeBodyTracker(AnchoredReference):
             balance_margin=balance_margin, balance_tau=balance_tau, stepping=stepping,
             step_margin=step_margin, step_time=step_time, step_height=step_height,
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
-            zmp_margin=zmp_margin if zmp_preview else None,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
