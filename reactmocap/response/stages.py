@@ -20,7 +20,7 @@ from reactmocap.library.bvh import read_bvh
 from reactmocap.library.clip_library import ClipLibrary
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import ground_root, place
-from reactmocap.response.blend import blend_poses, transition_weights
+from reactmocap.response.blend import blend_poses, smoothstep, transition_weights
 from reactmocap.response.library_cache import LibraryCache
 from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_schedule
 from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
@@ -47,6 +47,7 @@ from reactmocap.sim.world import World, WorldConfig
 __all__ = [
     "CONTACT_EVERY",
     "PHYSICAL_TRACKERS",
+    "REPLAN_EASE_S",
     "SCAN_FPS",
     "UNSTABLE_TRIM_S",
     "Actor",
@@ -59,6 +60,7 @@ __all__ = [
     "desired_motion",
     "estimate_contact",
     "naive_simulation",
+    "replan_continuation",
     "search_continuation",
     "transition_simulation",
     "yields_to",
@@ -280,6 +282,11 @@ def desired_motion(cast: Cast, cfg: ResponseConfig, times: F64, impact: float, y
     found clip by the match time, where it is exactly the found clip."""
     rec = cast.recipient
     times = np.asarray(times, dtype=np.float64)
+    if target.via is not None:  # a re-plan: the first path, eased into the new clip by its match
+        first = desired_motion(cast, cfg, times, impact, yields, target.via)
+        found = ground_root(target.found.sample(target.best.time + (times - target.time)),
+                            rec.parts, turn=False)  # fmt: skip
+        return blend_poses(first, found, smoothstep((times - target.time) / REPLAN_EASE_S + 1.0))
     prev = rec.motion.sample((np.minimum(times, impact) if yields else times) + rec.clock0)
     prev = ground_root(prev, rec.parts, turn=False)
     if yields:
@@ -370,6 +377,14 @@ class Continuation:
     #: builds :attr:`alternatives` (on first use: most responses never need them)
     others: Callable[[], tuple[Continuation, ...]] | None = field(default=None, repr=False,
                                                                    compare=False)  # fmt: skip
+    #: a re-plan (``land_replan``): the continuation whose path the body follows until it eases
+    #: into this one over :data:`REPLAN_EASE_S` before ``time``
+    via: Continuation | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def first_match(self) -> float:
+        """The first continuation's match time (this one's without a re-plan)."""
+        return self.via.first_match if self.via is not None else self.time
 
     @cached_property
     def alternatives(self) -> tuple[Continuation, ...]:
@@ -384,7 +399,6 @@ def search_continuation(
     """Windows of Simulation 1 starting 0.1-1.0 s after the impact (later while contact lasts),
     each searched; the best over all starts wins."""
     cfg = scenario.response
-    index = cast.index
     t_impact = naive.impact_time
     first = t_impact + float(np.clip(naive.contact_end - t_impact, cfg.search_start,
                                      cfg.contact_shift_max))  # fmt: skip
@@ -392,9 +406,31 @@ def search_continuation(
         # a real hit: the active response after the reaction delay needs time to show, so the
         # recipient's own clip right after the hit cannot win by being closest
         first = max(first, t_impact + cfg.reaction_delay + cfg.active_min)
-    last = t_impact + cfg.search_end
+    return _search(scenario, cast, contact, naive, naive.motion, first, t_impact + cfg.search_end)
+
+
+def replan_continuation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
+                        naive: NaiveSimulation, cont: Continuation,
+                        sim2: TransitionSimulation) -> Continuation:  # fmt: skip
+    """The physical mode's re-plan (``land_replan``): the search again, on Simulation 2's body
+    (``sim2``, which did not land on ``cont``) in windows starting from ``cont``'s match to
+    ``land_replan`` s after it: a continuation for the body as the hit and the first clip left
+    it (its speed too, where Simulation 1's found a clip it could not stop on). The path
+    follows ``cont``'s until it eases into the new clip by its match."""
+    first = cont.time
+    found = _search(scenario, cast, contact, naive, sim2.motion, first,
+                    first + scenario.response.land_replan, alternatives=False)  # fmt: skip
+    return replace(found, via=cont)
+
+
+def _search(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
+            motion: Motion, first: float, last: float, alternatives: bool = True) -> Continuation:  # fmt: skip
+    """The best continuation of the simulated ``motion`` (frame 0 at the rewind) over windows
+    starting from scenario time ``first`` to ``last``."""
+    cfg = scenario.response
+    index = cast.index
     q_fps = index.window.fps
-    query = naive.motion.resample(q_fps)
+    query = motion.resample(q_fps)
     starts = np.arange(int(np.ceil((first - contact.rewind) * q_fps - 1e-9)),
                        int(np.floor((last - contact.rewind) * q_fps + 1e-9)) + 1)  # fmt: skip
     starts = starts[starts + index.length <= query.num_frames]
@@ -442,21 +478,21 @@ def search_continuation(
         return Continuation(r, index.top_k(query, start, n=cfg.top_k, parts=parts),
                             contact.rewind + start / q_fps, found, found_clip)  # fmt: skip
 
-    def alternatives() -> tuple[Continuation, ...]:
+    def others() -> tuple[Continuation, ...]:
         # the next-best window of each other clip, for land_tries
-        others: list[Continuation] = []
+        alts: list[Continuation] = []
         seen = {best.clip}
         for r, s in results:
-            if len(others) >= cfg.land_tries - 1:
+            if len(alts) >= cfg.land_tries - 1:
                 break
             if r.clip in seen or _runs_into(cast, cfg, r, contact.rewind + s / q_fps):
                 continue
             seen.add(r.clip)
-            others.append(continuation(r, s))
-        return tuple(others)
+            alts.append(continuation(r, s))
+        return tuple(alts)
 
     return replace(continuation(best, best_start),
-                   others=alternatives if cfg.land_tries > 1 else None)  # fmt: skip
+                   others=others if alternatives and cfg.land_tries > 1 else None)  # fmt: skip
 
 
 def _runs_into(cast: Cast, cfg: ResponseConfig, r: SearchResult, at: float) -> bool:
@@ -618,7 +654,9 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         offsets = np.arange(-(pad // step), pad // step + 1) * step
         landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind, clip, offsets, pad)
         if cfg.land_stiffness != 1.0 and isinstance(tracker, WholeBodyTracker):
-            recipient = _StiffenFrom(recipient, tracker, landing.after, cfg.land_stiffness)
+            # from the first match: a re-plan's body is the first try's until its path turns
+            stiff = max(cont.first_match, release) - rewind
+            recipient = _StiffenFrom(recipient, tracker, stiff, cfg.land_stiffness)
     ctrls = [recipient]
     fps = [cast.recipient.motion.fps]
     if cast.attacker is not None:
@@ -677,6 +715,11 @@ class _StiffenFrom:
             self.tracker.stiffen_joints(self.factor)
             self._done = True
         self.inner.control(world, t)
+
+
+#: a re-plan's path eases from the first continuation's into the new one over this many seconds
+#: before the new match
+REPLAN_EASE_S = 0.1
 
 
 #: the physical mode's time-warped landing check compares the body with the found clip at
