@@ -527,12 +527,15 @@ class _Landing:
     after its end) and ``offsets`` (ticks) time-warp the check: the body is compared with the
     found clip ``offsets`` ticks ahead of (or behind) the path too, and lands on the nearest
     (``phase``, s; the smallest shift among equals). A hit body that follows the clip late or
-    early is on it, at another frame; the blend then lands on that frame."""
+    early is on it, at another frame; the blend then lands on that frame.
+
+    A body :data:`LAND_GIVE_UP` times further off than at its closest, :data:`LAND_GIVE_UP_S`
+    after it and after ``keep`` s, stops the rollout (it lands where it came closest)."""
 
     def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float,
                  clip: F64 | None = None, offsets: NDArray[np.int64] | None = None,
-                 pad: int = 0) -> None:  # fmt: skip
-        self.cfg, self.q, self.rate, self.after = cfg, q, rate, after
+                 pad: int = 0, keep: float = 0.0) -> None:  # fmt: skip
+        self.cfg, self.q, self.rate, self.after, self.keep = cfg, q, rate, after, keep
         self.tol = np.array([cfg.land_position, cfg.land_angle, cfg.land_joint])
         self.clip, self.pad = clip, pad
         # the path itself first, then the shifts by size: argmin keeps the smallest among equals
@@ -571,6 +574,11 @@ class _Landing:
         if score <= 1.0:
             self.at = t
             return "landed on the found clip"
+        # long past its closest and far from it, the body has fallen away: the rest of
+        # ``land_within`` would only cost time (it lands where it came closest)
+        late = t > max(self.best[1] + LAND_GIVE_UP_S, self.keep)
+        if late and score > LAND_GIVE_UP * max(self.best[0], 1.0):
+            return "fell away from the found clip"
         return None
 
 
@@ -652,7 +660,10 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         clip = _found_path(cast, cont, ticks) if pad else None
         step = max(1, int(round(rate * LAND_WARP_STEP)))
         offsets = np.arange(-(pad // step), pad // step + 1) * step
-        landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind, clip, offsets, pad)
+        # a re-plan searches Simulation 2's body up to a window past land_replan: kept that long
+        keep = cont.first_match + cfg.land_replan + cast.index.window.duration - rewind
+        landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind, clip, offsets, pad,
+                           keep)  # fmt: skip
         if cfg.land_stiffness != 1.0 and isinstance(tracker, WholeBodyTracker):
             # from the first match: a re-plan's body is the first try's until its path turns
             stiff = max(cont.first_match, release) - rewind
@@ -717,6 +728,10 @@ class _StiffenFrom:
         self.inner.control(world, t)
 
 
+#: the physical mode's landing check gives up on a body this many seconds past its closest
+#: check and this many times further off (in tolerances, at least that many)
+LAND_GIVE_UP_S = 0.3
+LAND_GIVE_UP = 3.0
 #: a re-plan's path eases from the first continuation's into the new one over this many seconds
 #: before the new match
 REPLAN_EASE_S = 0.1
