@@ -93,12 +93,18 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     first = cont
     physical = cfg.mode == "physical"
     retries: list[tuple[stages.Continuation, bool]] = []
-    if not sim2.on_clip and physical and cfg.land_replan > 0 and sim2.unstable is None:
+    for _ in range(stages.REPLANS if physical and cfg.land_replan > 0 else 0):
+        if sim2.on_clip or sim2.unstable is not None:
+            break
         try:
-            retries.append((timed("search", stages.replan_continuation, scenario, cast, contact,
-                                  naive, first, sim2), False))  # fmt: skip
+            plan = timed("search", stages.replan_continuation, scenario, cast, contact, naive,
+                         cont, sim2)  # fmt: skip
         except SearchError:  # Simulation 2 too short for a window past the match
-            pass
+            break
+        other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, plan)
+        if _landing_score(scenario, other) >= _landing_score(scenario, sim2):
+            break
+        cont, sim2 = plan, other
     if not sim2.on_clip:
         retries += [(first, True)] * (physical and cfg.land_step_time > 0)
         retries += [(alt, False) for alt in first.alternatives]

@@ -47,6 +47,7 @@ from reactmocap.sim.world import World, WorldConfig
 __all__ = [
     "CONTACT_EVERY",
     "PHYSICAL_TRACKERS",
+    "REPLANS",
     "REPLAN_EASE_S",
     "SCAN_FPS",
     "UNSTABLE_TRIM_S",
@@ -661,7 +662,7 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         step = max(1, int(round(rate * LAND_WARP_STEP)))
         offsets = np.arange(-(pad // step), pad // step + 1) * step
         # a re-plan searches Simulation 2's body up to a window past land_replan: kept that long
-        keep = cont.first_match + cfg.land_replan + cast.index.window.duration - rewind
+        keep = cont.time + cfg.land_replan + cast.index.window.duration - rewind
         landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind, clip, offsets, pad,
                            keep)  # fmt: skip
         if cfg.land_stiffness != 1.0 and isinstance(tracker, WholeBodyTracker):
@@ -732,6 +733,8 @@ class _StiffenFrom:
 #: check and this many times further off (in tolerances, at least that many)
 LAND_GIVE_UP_S = 0.3
 LAND_GIVE_UP = 3.0
+#: the physical mode re-plans at most this many times, each from the last, while each comes closer
+REPLANS = 2
 #: a re-plan's path eases from the first continuation's into the new one over this many seconds
 #: before the new match
 REPLAN_EASE_S = 0.1
