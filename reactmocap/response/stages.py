@@ -734,7 +734,7 @@ class _StiffenFrom:
 LAND_GIVE_UP_S = 0.3
 LAND_GIVE_UP = 3.0
 #: the physical mode re-plans at most this many times, each from the last, while each comes closer
-REPLANS = 2
+REPLANS = 3
 #: a re-plan's path eases from the first continuation's into the new one over this many seconds
 #: before the new match
 REPLAN_EASE_S = 0.1
