@@ -733,7 +733,7 @@ class _StiffenFrom:
 #: check and this many times further off (in tolerances, at least that many)
 LAND_GIVE_UP_S = 0.3
 LAND_GIVE_UP = 3.0
-#: the physical mode re-plans at most this many times, each from the last, while each comes closer
+#: the physical mode re-plans at most this many times, each from the last while each comes closer
 REPLANS = 3
 #: a re-plan's path eases from the first continuation's into the new one over this many seconds
 #: before the new match
