@@ -425,9 +425,11 @@ def replan_continuation(scenario: Scenario, cast: Cast, contact: ContactEstimate
 
 
 def _search(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
-            motion: Motion, first: float, last: float, alternatives: bool = True) -> Continuation:  # fmt: skip
+            motion: Motion, first: float, last: float,
+            alternatives: bool = True) -> Continuation:  # fmt: skip
     """The best continuation of the simulated ``motion`` (frame 0 at the rewind) over windows
-    starting from scenario time ``first`` to ``last``."""
+    starting from scenario time ``first`` to ``last`` (with the next-best clips for
+    ``land_tries`` when ``alternatives``)."""
     cfg = scenario.response
     index = cast.index
     q_fps = index.window.fps
