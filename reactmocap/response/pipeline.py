@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from reactmocap import __version__
 from reactmocap import metrics as qm
+from reactmocap.errors import SearchError
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.response import final, stages
@@ -86,14 +87,30 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     settles = cfg.mode == "blend" and cfg.blend_settle > 0.0
     at_match = replace(scenario, response=replace(cfg, blend_settle=0.0)) if settles else scenario
     sim2 = timed("sim2", stages.transition_simulation, at_match, cast, contact, naive, cont)
-    # the body did not land: the same clip with balance steps (``land_step_time``), then the
-    # search's next-best clips (``land_tries``); the one it comes closest to wins
+    # the body did not land: a re-plan from where it is (``land_replan``), the same clip with
+    # balance steps (``land_step_time``), then the search's next-best clips (``land_tries``);
+    # the one it comes closest to wins
     first = cont
-    stepped = cfg.mode == "physical" and cfg.land_step_time > 0
-    retries = () if sim2.on_clip else (first,) * stepped + first.alternatives
-    for alt in retries:
+    physical = cfg.mode == "physical"
+    retries: list[tuple[stages.Continuation, bool]] = []
+    for _ in range(stages.REPLANS if physical and cfg.land_replan > 0 else 0):
+        if sim2.on_clip or sim2.unstable is not None:
+            break
+        try:
+            plan = timed("search", stages.replan_continuation, scenario, cast, contact, naive,
+                         cont, sim2)  # fmt: skip
+        except SearchError:  # Simulation 2 too short for a window past the match
+            break
+        other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, plan)
+        if _landing_score(scenario, other) >= _landing_score(scenario, sim2):
+            break
+        cont, sim2 = plan, other
+    if not sim2.on_clip:
+        retries += [(first, True)] * (physical and cfg.land_step_time > 0)
+        retries += [(alt, False) for alt in first.alternatives]
+    for alt, steps in retries:
         other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, alt,
-                      alt is first)  # fmt: skip
+                      steps)  # fmt: skip
         if _landing_score(scenario, other) < _landing_score(scenario, sim2):
             cont, sim2 = alt, other
         if sim2.on_clip:
@@ -263,6 +280,7 @@ def _report(
             "landing_gap": dict(zip(("pelvis_m", "root_rad", "joint_rad"), sim2.landing_gap)),
             "landing_phase_s": sim2.landing_phase,
             "balance_steps": sim2.balance_steps,
+            "replanned": cont.via is not None,
         },
         "timings_s": timings,
         "steps": {"sim1": naive.steps, "sim2": sim2.steps},

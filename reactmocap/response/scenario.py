@@ -138,6 +138,11 @@ class ResponseConfig:
     #: (before the search's next-best windows, ``land_tries``), and the closer of the two
     #: landings wins (0: no such retry)
     land_step_time: float = 0.2
+    #: physical mode: a body that does not land is re-planned first: the search runs again on
+    #: Simulation 2's body, over windows starting from the match to this many seconds after it,
+    #: and Simulation 2 runs again along the first path eased into the clip so found (0: no
+    #: re-plan)
+    land_replan: float = 0.3
     #: physical mode: when the body does not land, Simulation 2 runs again toward the search's
     #: next-best windows of other clips, up to ``land_tries`` continuations in all, and the one
     #: the body came closest to (its landing gap over the tolerances) wins: a continuation the
@@ -256,6 +261,7 @@ class _Reader:
                                   "friction_sim1", "friction_sim2", "kv", "yield_gain",
                                   "react_impulse", "active_min", "own_clip_margin", "attacker_assist",
                                   "yield_recover", "land_within", "land_warp", "blend_settle", "land_step_time",
+                                  "land_replan",
                                   "torque_limit"}  # fmt: skip
                 positive = name in {"duration", "kp", "sim1_duration", "search_end", "timestep",
                                     "total_mass", "land_position", "land_angle",

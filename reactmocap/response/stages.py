@@ -20,7 +20,7 @@ from reactmocap.library.bvh import read_bvh
 from reactmocap.library.clip_library import ClipLibrary
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import ground_root, place
-from reactmocap.response.blend import blend_poses, transition_weights
+from reactmocap.response.blend import blend_poses, smoothstep, transition_weights
 from reactmocap.response.library_cache import LibraryCache
 from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_schedule
 from reactmocap.response.scenario import CharacterSpec, ImpactSpec, ResponseConfig, Scenario
@@ -47,6 +47,8 @@ from reactmocap.sim.world import World, WorldConfig
 __all__ = [
     "CONTACT_EVERY",
     "PHYSICAL_TRACKERS",
+    "REPLANS",
+    "REPLAN_EASE_S",
     "SCAN_FPS",
     "UNSTABLE_TRIM_S",
     "Actor",
@@ -59,6 +61,7 @@ __all__ = [
     "desired_motion",
     "estimate_contact",
     "naive_simulation",
+    "replan_continuation",
     "search_continuation",
     "transition_simulation",
     "yields_to",
@@ -280,6 +283,11 @@ def desired_motion(cast: Cast, cfg: ResponseConfig, times: F64, impact: float, y
     found clip by the match time, where it is exactly the found clip."""
     rec = cast.recipient
     times = np.asarray(times, dtype=np.float64)
+    if target.via is not None:  # a re-plan: the first path, eased into the new clip by its match
+        first = desired_motion(cast, cfg, times, impact, yields, target.via)
+        found = ground_root(target.found.sample(target.best.time + (times - target.time)),
+                            rec.parts, turn=False)  # fmt: skip
+        return blend_poses(first, found, smoothstep((times - target.time) / REPLAN_EASE_S + 1.0))
     prev = rec.motion.sample((np.minimum(times, impact) if yields else times) + rec.clock0)
     prev = ground_root(prev, rec.parts, turn=False)
     if yields:
@@ -370,6 +378,14 @@ class Continuation:
     #: builds :attr:`alternatives` (on first use: most responses never need them)
     others: Callable[[], tuple[Continuation, ...]] | None = field(default=None, repr=False,
                                                                    compare=False)  # fmt: skip
+    #: a re-plan (``land_replan``): the continuation whose path the body follows until it eases
+    #: into this one over :data:`REPLAN_EASE_S` before ``time``
+    via: Continuation | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def first_match(self) -> float:
+        """The first continuation's match time (this one's without a re-plan)."""
+        return self.via.first_match if self.via is not None else self.time
 
     @cached_property
     def alternatives(self) -> tuple[Continuation, ...]:
@@ -384,7 +400,6 @@ def search_continuation(
     """Windows of Simulation 1 starting 0.1-1.0 s after the impact (later while contact lasts),
     each searched; the best over all starts wins."""
     cfg = scenario.response
-    index = cast.index
     t_impact = naive.impact_time
     first = t_impact + float(np.clip(naive.contact_end - t_impact, cfg.search_start,
                                      cfg.contact_shift_max))  # fmt: skip
@@ -392,9 +407,33 @@ def search_continuation(
         # a real hit: the active response after the reaction delay needs time to show, so the
         # recipient's own clip right after the hit cannot win by being closest
         first = max(first, t_impact + cfg.reaction_delay + cfg.active_min)
-    last = t_impact + cfg.search_end
+    return _search(scenario, cast, contact, naive, naive.motion, first, t_impact + cfg.search_end)
+
+
+def replan_continuation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
+                        naive: NaiveSimulation, cont: Continuation,
+                        sim2: TransitionSimulation) -> Continuation:  # fmt: skip
+    """The physical mode's re-plan (``land_replan``): the search again, on Simulation 2's body
+    (``sim2``, which did not land on ``cont``) in windows starting from ``cont``'s match to
+    ``land_replan`` s after it: a continuation for the body as the hit and the first clip left
+    it (its speed too, where Simulation 1's found a clip it could not stop on). The path
+    follows ``cont``'s until it eases into the new clip by its match."""
+    first = cont.time
+    found = _search(scenario, cast, contact, naive, sim2.motion, first,
+                    first + scenario.response.land_replan, alternatives=False)  # fmt: skip
+    return replace(found, via=cont)
+
+
+def _search(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
+            motion: Motion, first: float, last: float,
+            alternatives: bool = True) -> Continuation:  # fmt: skip
+    """The best continuation of the simulated ``motion`` (frame 0 at the rewind) over windows
+    starting from scenario time ``first`` to ``last`` (with the next-best clips for
+    ``land_tries`` when ``alternatives``)."""
+    cfg = scenario.response
+    index = cast.index
     q_fps = index.window.fps
-    query = naive.motion.resample(q_fps)
+    query = motion.resample(q_fps)
     starts = np.arange(int(np.ceil((first - contact.rewind) * q_fps - 1e-9)),
                        int(np.floor((last - contact.rewind) * q_fps + 1e-9)) + 1)  # fmt: skip
     starts = starts[starts + index.length <= query.num_frames]
@@ -442,21 +481,21 @@ def search_continuation(
         return Continuation(r, index.top_k(query, start, n=cfg.top_k, parts=parts),
                             contact.rewind + start / q_fps, found, found_clip)  # fmt: skip
 
-    def alternatives() -> tuple[Continuation, ...]:
+    def others() -> tuple[Continuation, ...]:
         # the next-best window of each other clip, for land_tries
-        others: list[Continuation] = []
+        alts: list[Continuation] = []
         seen = {best.clip}
         for r, s in results:
-            if len(others) >= cfg.land_tries - 1:
+            if len(alts) >= cfg.land_tries - 1:
                 break
             if r.clip in seen or _runs_into(cast, cfg, r, contact.rewind + s / q_fps):
                 continue
             seen.add(r.clip)
-            others.append(continuation(r, s))
-        return tuple(others)
+            alts.append(continuation(r, s))
+        return tuple(alts)
 
     return replace(continuation(best, best_start),
-                   others=alternatives if cfg.land_tries > 1 else None)  # fmt: skip
+                   others=others if alternatives and cfg.land_tries > 1 else None)  # fmt: skip
 
 
 def _runs_into(cast: Cast, cfg: ResponseConfig, r: SearchResult, at: float) -> bool:
@@ -491,12 +530,15 @@ class _Landing:
     after its end) and ``offsets`` (ticks) time-warp the check: the body is compared with the
     found clip ``offsets`` ticks ahead of (or behind) the path too, and lands on the nearest
     (``phase``, s; the smallest shift among equals). A hit body that follows the clip late or
-    early is on it, at another frame; the blend then lands on that frame."""
+    early is on it, at another frame; the blend then lands on that frame.
+
+    A body :data:`LAND_GIVE_UP` times further off than at its closest, :data:`LAND_GIVE_UP_S`
+    after it and after ``keep`` s, stops the rollout (it lands where it came closest)."""
 
     def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float,
                  clip: F64 | None = None, offsets: NDArray[np.int64] | None = None,
-                 pad: int = 0) -> None:  # fmt: skip
-        self.cfg, self.q, self.rate, self.after = cfg, q, rate, after
+                 pad: int = 0, keep: float = 0.0) -> None:  # fmt: skip
+        self.cfg, self.q, self.rate, self.after, self.keep = cfg, q, rate, after, keep
         self.tol = np.array([cfg.land_position, cfg.land_angle, cfg.land_joint])
         self.clip, self.pad = clip, pad
         # the path itself first, then the shifts by size: argmin keeps the smallest among equals
@@ -535,6 +577,11 @@ class _Landing:
         if score <= 1.0:
             self.at = t
             return "landed on the found clip"
+        # long past its closest and far from it, the body has fallen away: the rest of
+        # ``land_within`` would only cost time (it lands where it came closest)
+        late = t > max(self.best[1] + LAND_GIVE_UP_S, self.keep)
+        if late and score > LAND_GIVE_UP * max(self.best[0], 1.0):
+            return "fell away from the found clip"
         return None
 
 
@@ -616,9 +663,14 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
         clip = _found_path(cast, cont, ticks) if pad else None
         step = max(1, int(round(rate * LAND_WARP_STEP)))
         offsets = np.arange(-(pad // step), pad // step + 1) * step
-        landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind, clip, offsets, pad)
+        # a re-plan searches Simulation 2's body up to a window past land_replan: kept that long
+        keep = cont.time + cfg.land_replan + cast.index.window.duration - rewind
+        landing = _Landing(cfg, q, rate, max(cont.time, release) - rewind, clip, offsets, pad,
+                           keep)  # fmt: skip
         if cfg.land_stiffness != 1.0 and isinstance(tracker, WholeBodyTracker):
-            recipient = _StiffenFrom(recipient, tracker, landing.after, cfg.land_stiffness)
+            # from the first match: a re-plan's body is the first try's until its path turns
+            stiff = max(cont.first_match, release) - rewind
+            recipient = _StiffenFrom(recipient, tracker, stiff, cfg.land_stiffness)
     ctrls = [recipient]
     fps = [cast.recipient.motion.fps]
     if cast.attacker is not None:
@@ -677,6 +729,17 @@ class _StiffenFrom:
             self.tracker.stiffen_joints(self.factor)
             self._done = True
         self.inner.control(world, t)
+
+
+#: the physical mode's landing check gives up on a body this many seconds past its closest
+#: check and this many times further off (in tolerances, at least that many)
+LAND_GIVE_UP_S = 0.3
+LAND_GIVE_UP = 3.0
+#: the physical mode re-plans at most this many times, each from the last while each comes closer
+REPLANS = 3
+#: a re-plan's path eases from the first continuation's into the new one over this many seconds
+#: before the new match
+REPLAN_EASE_S = 0.1
 
 
 #: the physical mode's time-warped landing check compares the body with the found clip at

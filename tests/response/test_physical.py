@@ -44,8 +44,10 @@ def test_a_push_lands_physically_and_the_blend_corrects_only_the_small_gap() -> 
 
 
 def test_a_body_that_does_not_land_is_reported_not_hidden() -> None:
-    # the tracker cannot follow the found sway clip after this kick: the report must say so
-    rep = run_response(_physical("front_kick"), CACHE).report
+    # the tracker cannot follow the found sway clip after the facing sweep's kick from 0 deg,
+    # nor any re-planned or next-best one (the front kick example now lands on a re-plan):
+    # the report must say so
+    rep = run_response(_facing(0.0, "physical"), CACHE).report
     tr = rep["transition"]
     if tr["landed_on_clip"]:
         pytest.skip("the kick now lands physically: nothing left to report")
@@ -129,7 +131,7 @@ def test_a_body_that_does_not_land_tries_other_clips_and_keeps_the_closest() -> 
     from reactmocap.response import stages
 
     sc = _physical("front_kick")
-    sc = replace(sc, response=replace(sc.response, land_tries=1))
+    sc = replace(sc, response=replace(sc.response, land_tries=1, land_replan=0.0))
     one = run_response(sc, CACHE).report
     if one["transition"]["landed_on_clip"]:
         pytest.skip("the kick now lands physically on the nearest window")
@@ -156,7 +158,7 @@ def test_stiffening_from_the_match_lands_a_kick_that_does_not_land_without_it() 
 
     base = load_sweep(EXAMPLES / "sweep_facing.toml").points()[0].scenario
     sc = replace(base, recipient=replace(base.recipient, facing_deg=240.0),
-                 response=replace(base.response, mode="physical"))  # fmt: skip
+                 response=replace(base.response, mode="physical", land_replan=0.0))  # fmt: skip
     assert sc.response.land_stiffness > 1.0
     stiff = run_response(sc, CACHE).report
     built = run_response(replace(sc, response=replace(sc.response, land_stiffness=1.0)),
@@ -226,7 +228,8 @@ def test_a_kick_that_does_not_land_lands_when_simulated_again_with_balance_steps
     # support at 0.6-0.8 m/s and falls off the clip after the match; simulated again with
     # capture-point balance steps (`land_step_time`), it catches itself and lands
     sc = _facing(210.0, "physical")
-    sc = replace(sc, response=replace(sc.response, land_tries=1))  # the same clip only
+    # the same clip only, no re-plan before the stepped retry
+    sc = replace(sc, response=replace(sc.response, land_tries=1, land_replan=0.0))
     assert sc.response.land_step_time > 0.0
     stepped = run_response(sc, CACHE).report
     flat = run_response(replace(sc, response=replace(sc.response, land_step_time=0.0)),
@@ -244,4 +247,51 @@ def test_a_negative_land_step_time_is_a_clear_error() -> None:
     data = {"library": str(REPO / "data" / "synthetic_clips"), "recipient": {"clip": "guard"},
             "impact": {}, "response": {"mode": "physical", "land_step_time": -0.1}}  # fmt: skip
     with pytest.raises(ConfigError, match=r"\[response\]\.land_step_time"):
+        parse_scenario(data, source="s.toml")
+
+
+def test_a_kick_that_does_not_land_lands_on_a_clip_searched_again_from_where_the_body_is() -> None:
+    # the sweep's kick from 100 deg (found clip `fall_sideways`, searched on Simulation 1's
+    # body): Simulation 2's body does not land on it; searched again on Simulation 2's own body
+    # from the match (`land_replan`), its path eased into the window so found, it lands
+    sc = _facing(100.0, "physical")
+    sc = replace(sc, response=replace(sc.response, land_tries=1, land_step_time=0.0))
+    assert sc.response.land_replan > 0.0
+    replanned = run_response(sc, CACHE).report
+    once = run_response(replace(sc, response=replace(sc.response, land_replan=0.0)),
+                        CACHE).report  # fmt: skip
+    assert not once["transition"]["landed_on_clip"] and not once["transition"]["replanned"]
+    tr, q = replanned["transition"], replanned["quality"]
+    assert tr["landed_on_clip"] and tr["replanned"], tr
+    assert tr["match"] >= once["transition"]["match"]  # a window from the first match on
+    assert _score(replanned, sc) <= 1.0 < _score(once, sc)
+    assert q["blend_joint_correction_max_rad"] <= sc.response.land_joint + 1e-9, q
+    assert q["blend_root_offset_max_m"] <= sc.response.land_position + 1e-9, q
+
+
+def test_a_body_that_falls_away_from_the_clip_stops_early_and_lands_where_it_came_closest(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # the sweep's kick from 0 deg does not land on `sway`: Simulation 2 stops once the body is
+    # 3x further off than at its closest, 0.3 s after it, with the same landing as the whole
+    # `land_within` gives, in fewer steps
+    from reactmocap.response import stages
+
+    sc = _facing(0.0, "physical")
+    sc = replace(sc, response=replace(sc.response, land_tries=1, land_step_time=0.0,
+                                      land_replan=0.0))  # fmt: skip
+    early = run_response(sc, CACHE).report
+    monkeypatch.setattr(stages, "LAND_GIVE_UP", np.inf)
+    whole = run_response(sc, CACHE).report
+    assert not early["transition"]["landed_on_clip"]
+    assert early["transition"] == whole["transition"]
+    key = "blend_root_offset_max_m"
+    assert early["quality"][key] == whole["quality"][key]
+    assert early["steps"]["sim2"] < 0.75 * whole["steps"]["sim2"], (early["steps"], whole["steps"])
+
+
+def test_a_negative_land_replan_is_a_clear_error() -> None:
+    data = {"library": str(REPO / "data" / "synthetic_clips"), "recipient": {"clip": "guard"},
+            "impact": {}, "response": {"mode": "physical", "land_replan": -0.1}}  # fmt: skip
+    with pytest.raises(ConfigError, match=r"\[response\]\.land_replan"):
         parse_scenario(data, source="s.toml")
