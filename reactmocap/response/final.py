@@ -14,6 +14,7 @@ from reactmocap.library.placement import ground_root
 from reactmocap.metrics import (
     FALL_FRACTION,
     blend_correction_over_warning,
+    intended_fall,
     joint_speed_max_m_s,
     planted,
 )
@@ -444,10 +445,15 @@ def settle(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naiv
 
 def placed(cast: Cast, contact: ContactEstimate, cont: Continuation, sim2: TransitionSimulation,
            landed: float) -> tuple[Continuation, tuple[float, float]]:  # fmt: skip
-    """``cont`` with its found clip moved on the ground so that its pelvis is over Simulation
-    2's at scenario time ``landed``, and that shift (m): the search placed it over Simulation
-    1's at the match, and a falling body travels on (the blend mode's ``blend_place``)."""
-    pelvis = cast.recipient.parts.joint_of("pelvis")
+    """``cont`` with its found clip, where it falls, moved on the ground so that its pelvis is
+    over Simulation 2's at scenario time ``landed``, and that shift (m; zero for a clip that
+    does not fall): the search placed it over Simulation 1's at the match, and a falling body
+    travels on, where a standing one reaches its clip's place on its planted legs (the blend
+    mode's ``blend_place``)."""
+    parts = cast.recipient.parts
+    if not intended_fall(cont.found_clip, parts, cont.best.frame):
+        return cont, (0.0, 0.0)
+    pelvis = parts.joint_of("pelvis")
     body = sim2.motion.sample([landed - contact.rewind]).global_positions()[0, pelvis]
     clip = cont.found.sample([cont.best.time + (landed - cont.time)]).global_positions()[0, pelvis]
     dx, dy = (float(v) for v in body[:2] - clip[:2])

@@ -152,10 +152,10 @@ class ResponseConfig:
     #: (0: at the match, the paper). Only where the final blend at the match would warn (joint
     #: turn or root shift over the thresholds): Simulation 2 then runs again, this much longer
     blend_settle: float = 0.5
-    #: blend mode: the found clip is moved on the ground so that its pelvis is over Simulation
-    #: 2's at the landing (the search placed it over Simulation 1's at the match, and a
-    #: falling body travels on: the real walkers kicked lay 0.4-0.55 m past it); the report
-    #: gives the shift (``transition.found_shift_m``)
+    #: blend mode: a found clip that falls is moved on the ground so that its pelvis is over
+    #: Simulation 2's at the landing (the search placed it over Simulation 1's at the match,
+    #: and a falling body travels on: the real walkers kicked lay 0.4-0.55 m past it; a
+    #: standing clip keeps its place); the report gives the shift (``transition.found_shift_m``)
     blend_place: bool = True
     #: blend mode: the final blend corrects only the gap between Simulation 2 and the found
     #: clip at the landing, each joint's turn growing linearly over the transition as the root

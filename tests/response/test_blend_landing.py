@@ -82,8 +82,8 @@ def test_the_blend_mode_places_the_found_clip_where_simulation_2_lies(
 ) -> None:
     # the real walk backwards pushed from its left (bench_reactions' push, blend mode): the
     # body falls on past where the search placed fall_backward (over Simulation 1's pelvis at
-    # the match), and the blend dragged it 0.34 m back (a root warning); the clip moved on
-    # the ground to Simulation 2's pelvis at the landing leaves no such gap
+    # the match), and the blend dragged it 0.34 m back (a root warning); the fall clip moved
+    # on the ground to Simulation 2's pelvis at the landing leaves no such gap
     lib = tmp_path / "lib"
     lib.mkdir()
     for f in [*shared_mocap_dir.glob("*.bvh"), *SYNTHETIC.glob("*.bvh")]:
@@ -115,6 +115,11 @@ def test_the_blend_mode_places_the_found_clip_where_simulation_2_lies(
     assert np.hypot(*out.found_shift) > qm.WARN_ROOT_OFFSET_M and old.found_shift == (0.0, 0.0)
     assert np.allclose(out.found.root_positions[:, :2] - fall.found.root_positions[:, :2],
                        out.found_shift, atol=1e-9)  # fmt: skip
+    # a standing clip (the next-best guide) keeps the search's place: the body reaches it on
+    # its planted legs
+    standing = next(c for c in first.alternatives
+                    if not qm.intended_fall(c.found_clip, parts, c.best.frame))  # fmt: skip
+    assert final.placed(cast, contact, standing, sim2, sim2.landed) == (standing, (0.0, 0.0))
     # the whole response: this landing wins, without warnings, the shift reported; the
     # output's pelvis at the landing is Simulation 2's on the ground plane
     res = run_response(sc, cache)
