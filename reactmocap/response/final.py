@@ -14,6 +14,7 @@ from reactmocap.library.placement import ground_root
 from reactmocap.metrics import (
     FALL_FRACTION,
     blend_correction_over_warning,
+    intended_fall,
     joint_speed_max_m_s,
     planted,
 )
@@ -34,7 +35,7 @@ from reactmocap.rotations import quat_conj, quat_mul
 from reactmocap.sim.bodies import SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.impacts import overlap_depths
 
-__all__ = ["Blend", "blend", "settle"]
+__all__ = ["Blend", "blend", "placed", "settle"]
 
 F64 = NDArray[np.float64]
 #: the shortest span (s) over which the final blend moves the root (a contact that delays the
@@ -309,13 +310,17 @@ def _side_steps(motion: Motion, parts: BodyPartMap, offset: F64, direction: F64,
 class Blend:
     """The outputs: the ``recipient`` animation (mocap before the impact, the blended
     transition, the found clip after), the ``attacker``'s, the ``blended`` transition alone,
-    Simulation 2 over the same frames (``simulated``), and the ``seams`` between pieces."""
+    Simulation 2 over the same frames (``simulated``), the ``seams`` between pieces, and the
+    ``found`` clip where the blend placed it (moved ``found_shift`` m on the ground from
+    where the search placed it: ``blend_place``)."""
 
     recipient: Motion
     attacker: Motion | None
     blended: Motion
     simulated: Motion
     seams: list[int]
+    found: Motion
+    found_shift: tuple[float, float] = (0.0, 0.0)
 
 
 def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
@@ -328,6 +333,9 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     fps = rec.motion.fps
     i_imp = int(np.ceil(naive.impact_time * fps - 1e-9))
     i_end = int(round(sim2.landed * fps))
+    moved = (0.0, 0.0)
+    if cfg.mode == "blend" and cfg.blend_place:
+        cont, moved = placed(cast, contact, cont, sim2, sim2.landed)
     # every piece with a dummy top joint on the ground under the pelvis, unturned while blending
     # (ground_root): the blend then moves the body, not meters of offset between the clips'
     # dummy roots; the output is grounded and turned to the heading as a whole
@@ -341,7 +349,8 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     found = desired_motion(cast, cfg, times, naive.impact_time, yields_to(cfg, naive.impulse), cont)
     # the found clip's time at the landing (time-warped by the physical mode's landing phase)
     on = cont.best.time + (sim2.landed - cont.time) + sim2.landing_phase
-    if cfg.mode == "physical":  # close only the gap left at the landing, spread over the blend
+    if cfg.mode == "physical" or cfg.blend_end_gap:
+        # close only the gap left at the landing, spread over the blend
         end = grounded(cont.found.sample([on])) if sim2.landing_phase else found
         found = _with_end_gap(simulated, end)
     tail_n = int(np.floor(max(0.0, min(cfg.tail, cont.found.duration - on)) * fps))
@@ -361,7 +370,8 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
         pieces = [p.replace(fps=fps) for p in (before, blended, tail) if p is not None]
         recipient = ground_root(Motion.concatenate(pieces, name="recipient"), rec.parts)
         if cast.attacker is None or sim2.attacker is None:
-            return Blend(recipient, None, blended, simulated, _seams(i_imp, i_end, before))
+            return Blend(recipient, None, blended, simulated, _seams(i_imp, i_end, before),
+                         cont.found, moved)  # fmt: skip
         # the blend moved the recipient off its simulation: the attacker's simulated part
         # moves with the body it hit, so the two keep the spacing the physics gave them
         hit = int(rec.character.anchors[SIM_BODIES.index(_hit_body(contact))])
@@ -389,7 +399,8 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
         held = float(out_t[after][late[-1]]) + 1.0 / fps
     if cast.attacker is not None and attacker is not None:
         attacker = _step_aside(cast, recipient, attacker, naive.impact_time, speed)
-    return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before))
+    return Blend(recipient, attacker, blended, simulated, _seams(i_imp, i_end, before),
+                 cont.found, moved)  # fmt: skip
 
 
 def settle(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: NaiveSimulation,
@@ -398,8 +409,10 @@ def settle(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naiv
     past the match, and the final blend lands on the frame (from the match on, every
     :data:`SETTLE_STEP_S`) where it corrects least: its largest joint turn and pelvis shift
     (the foot lock's included; not the holds of limbs touching the attacker), each over its
-    warning threshold; the smallest of the larger wins, the earliest among equals. ``sim2``
-    unchanged otherwise (the paper: the match time)."""
+    warning threshold, with the found clip placed (``blend_place``) and the gap spread
+    (``blend_end_gap``) for that landing as :func:`blend` does; the smallest of the larger
+    wins, the earliest among equals. ``sim2`` unchanged otherwise (the paper: the match
+    time)."""
     cfg = scenario.response
     rec = cast.recipient
     fps = rec.motion.fps
@@ -412,18 +425,39 @@ def settle(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naiv
     times = np.arange(i_imp, i_last + 1) / fps
     simulated = ground_root(sim2.motion.sample(times - contact.rewind), rec.parts, turn=False)
     # what the blend corrects toward: exactly as in :func:`blend`
-    found = desired_motion(cast, cfg, times, naive.impact_time, yields_to(cfg, naive.impulse), cont)
+    yields = yields_to(cfg, naive.impulse)
+    found = desired_motion(cast, cfg, times, naive.impact_time, yields, cont)
     best, landed = np.inf, i_match
     step = max(1, int(round(SETTLE_STEP_S * fps)))
     for end in range(i_match - i_imp, times.size, step):
-        sim, out = simulated.slice(0, end + 1), final_blend(simulated.slice(0, end + 1),
-                                                            found.slice(0, end + 1))  # fmt: skip
+        if cfg.blend_place:
+            at = placed(cast, contact, cont, sim2, (i_imp + end) / fps)[0]
+            found = desired_motion(cast, cfg, times, naive.impact_time, yields, at)
+        sim, target = simulated.slice(0, end + 1), found.slice(0, end + 1)
+        out = final_blend(sim, _with_end_gap(sim, target) if cfg.blend_end_gap else target)
         if cfg.foot_lock:
             out = lock_feet(out, rec.parts)
         score = blend_correction_over_warning(sim, out, rec.parts)
         if score < best - 1e-9:
             best, landed = score, i_imp + end
     return replace(sim2, landed=landed / fps)
+
+
+def placed(cast: Cast, contact: ContactEstimate, cont: Continuation, sim2: TransitionSimulation,
+           landed: float) -> tuple[Continuation, tuple[float, float]]:  # fmt: skip
+    """``cont`` with its found clip, where it falls, moved on the ground so that its pelvis is
+    over Simulation 2's at scenario time ``landed``, and that shift (m; zero for a clip that
+    does not fall): the search placed it over Simulation 1's at the match, and a falling body
+    travels on, where a standing one reaches its clip's place on its planted legs (the blend
+    mode's ``blend_place``)."""
+    parts = cast.recipient.parts
+    if not intended_fall(cont.found_clip, parts, cont.best.frame):
+        return cont, (0.0, 0.0)
+    pelvis = parts.joint_of("pelvis")
+    body = sim2.motion.sample([landed - contact.rewind]).global_positions()[0, pelvis]
+    clip = cont.found.sample([cont.best.time + (landed - cont.time)]).global_positions()[0, pelvis]
+    dx, dy = (float(v) for v in body[:2] - clip[:2])
+    return replace(cont, found=cont.found.transformed(0.0, (dx, dy))), (dx, dy)
 
 
 def _with_end_gap(simulated: Motion, target: Motion) -> Motion:

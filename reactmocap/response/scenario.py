@@ -157,6 +157,18 @@ class ResponseConfig:
     #: (0: at the match, the paper). Only where the final blend at the match would warn (joint
     #: turn or root shift over the thresholds): Simulation 2 then runs again, this much longer
     blend_settle: float = 0.5
+    #: blend mode: a found clip that falls is moved on the ground so that its pelvis is over
+    #: Simulation 2's at the landing (the search placed it over Simulation 1's at the match,
+    #: and a falling body travels on: the real walkers kicked lay 0.4-0.55 m past it; a
+    #: standing clip keeps its place); the report gives the shift (``transition.found_shift_m``)
+    blend_place: bool = True
+    #: blend mode: the final blend corrects only the gap between Simulation 2 and the found
+    #: clip at the landing, each joint's turn growing linearly over the transition as the root
+    #: offset does (the paper's root; the physical mode's way), so the transition stays the
+    #: physics'; false: each frame is slerped toward what Simulation 2 was asked to do there,
+    #: its tracking error corrected along the way (a foot or an arm mid-fall 0.7-1.0 rad on
+    #: the real recipients)
+    blend_end_gap: bool = True
 
 
 @dataclass(frozen=True)

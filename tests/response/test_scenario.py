@@ -61,6 +61,10 @@ def test_good_scenario_and_defaults(tmp_path: Path) -> None:
             ("reaction_delay = 0.12", "reaction_delay = 0.12\ntorque_limit = -5"),
             r"\[response\].torque_limit: expected a number >= 0",
         ),
+        (
+            ("reaction_delay = 0.12", "reaction_delay = 0.12\nblend_place = 1"),
+            r"\[response\].blend_place: expected true or false",
+        ),
         (('clip = "guard"', ""), r"\[recipient\]: missing required key\(s\) \['clip'\]"),
         (('library = "', 'library = "/nonexistent/'), r"library: .* not found"),
         (("[response]", "[responce]"), r"top level: unknown key\(s\) \['responce'\]"),
