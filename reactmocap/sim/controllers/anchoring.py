@@ -394,18 +394,20 @@ class AnchoredReference:
 
     def _warp(self, t: float) -> None:
         """After a walk's push: the clip plays at a rate ``warp_gain`` of the way from 1 to
-        the body's speed over the mocap's (along the mocap's centre-of-mass velocity), so the
-        steps come as fast as the pushed body needs them and the rate returns to 1 as the body
-        slows to the reference (which is always a little slower)."""
+        the body's horizontal speed over the mocap's (centre of mass), so the steps come as
+        fast as the pushed body needs them and the rate returns to 1 as the body slows to the
+        reference (which is always a little slower)."""
         _, v, _ = self.com_reference(t)
         v_ref = v[:2] / self.rate
-        mujoco.mj_subtreeVel(self.world.model, self.world.data)
         n2 = float(v_ref @ v_ref)
         if n2 < 0.04:  # under 0.2 m/s: not walking
             return
-        speed = float(self.world.data.subtree_linvel[self._root][:2] @ v_ref) / n2
-        # faster only: a clip slowed for a sideways push (its speed along the walk drops)
-        # lost the right pushes it survived
+        ref = float(np.sqrt(n2))
+        mujoco.mj_subtreeVel(self.world.model, self.world.data)
+        # the whole speed, not its part along the walk: a sideways push is caught sooner by
+        # quicker steps too (the part along the walk drops then, and a clip slowed with it
+        # lost the right pushes it survived: the rate never goes below 1)
+        speed = float(np.linalg.norm(self.world.data.subtree_linvel[self._root][:2])) / ref
         target = min(max(1.0 + self.warp_gain * (speed - 1.0), 1.0), _WARP_MAX)
         self.rate += min(1.0, self._dt_slow / _WARP_TAU) * (target - self.rate)
         self.clock = replace(self.clock, start=self.clock.start + (self.rate - 1.0) * self._dt_slow)

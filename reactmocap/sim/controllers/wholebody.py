@@ -160,8 +160,8 @@ class WholeBodyTracker(AnchoredReference):
             error (at most 0.4 m) from the mocap's landing (0: off; see ``docs/tracking.md``).
         warp_gain: a push that starts while the mocap does not stand (a walk) makes the clip
             play faster for the rest of the rollout: at a rate ``warp_gain`` of the way from 1
-            to the body's speed over the mocap's (along the mocap's centre-of-mass velocity; at
-            most 1.8, never slower than 1), so the steps come as fast as the pushed body needs
+            to the body's horizontal speed over the mocap's (centre of mass; at most 1.8, never
+            slower than 1), so the steps come as fast as the pushed body needs
             and, the clip a little slower than the body, the body sheds the extra speed and the
             rate comes back to 1 (0: off; ``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
