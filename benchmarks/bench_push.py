@@ -8,7 +8,7 @@ SIMBICON's 350 N diagonal push while walking (Yin et al. 2007).
 
 Survival is not monotonic in the force once the tracker steps (a harder push can land a better
 step), so a bisection's answer is a value that was survived with every tested force below it
-that the search probed, not a guaranteed threshold.
+that the search probed, not a guaranteed threshold; ``--forces`` sweeps fixed forces instead.
 """
 
 from __future__ import annotations
@@ -87,7 +87,17 @@ def largest(
     return lo
 
 
-def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> list[float]:
+def sweep(job: tuple[str, float, float, float, float, dict[str, Any], list[float], float]) -> str:
+    """One direction at each fixed force: "x" survived, "." fell (a bisection reports whichever
+    path it took where survival is not monotonic in the force)."""
+    name, at, angle, duration, after, params, forces, settled = job
+    return "".join(
+        "x" if survives((name, at, angle, f, duration, after, params, settled)) else "."
+        for f in forces
+    )
+
+
+def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> list[Any]:
     motion = _clip(name)
     yaw = heading(motion, at)
     params = json.loads(args.params)
@@ -96,6 +106,12 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
         print(f"{name} falls unpushed within {args.after} s after {at} s: choose another clip")
         return [float("nan")] * 8
     dirs = [k for k in range(8) if LABELS[k] in args.dirs]
+    if args.forces:
+        sweeps = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.forces,
+                   args.settled) for k in dirs]  # fmt: skip
+        with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+            marks = dict(zip(dirs, pool.map(sweep, sweeps)))
+        return [marks.get(k, "") for k in range(8)]
     jobs = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.max_force,
              args.steps, args.settled) for k in dirs]  # fmt: skip
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
@@ -148,6 +164,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--settled", type=float, default=0.0,
                     help="also require the pelvis within this many m of the mocap's at the "
                          "window's end (0: upright is enough)")  # fmt: skip
+    ap.add_argument("--forces", type=float, nargs="+",
+                    help="instead of the bisection, try each of these forces (N) in each "
+                         "direction and print x (survived) or . (fell) per force")  # fmt: skip
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--only", choices=("standing", "walking"), help="measure one clip only")
     ap.add_argument("--dirs", nargs="+", choices=LABELS, default=list(LABELS),
@@ -173,12 +192,22 @@ def main(argv: list[str] | None = None) -> int:
         name, at = getattr(args, key).split(":")
         t0 = time.perf_counter()
         forces = measure(name, float(at), dur, args)
+        took = time.perf_counter() - t0
+        if args.forces:
+            n = sum(m.count("x") for m in forces)
+            total = sum(len(m) for m in forces)
+            out[key] = {"clip": name, "time_s": float(at), "duration_s": dur,
+                        "forces_n": args.forces, "survived": forces}  # fmt: skip
+            print(f"{key} {name} @ {at} s, {dur} s pushes at {args.forces} N ({took:.0f} s): "
+                  + ", ".join(f"{lab} {m}" for lab, m in zip(LABELS, forces) if m)
+                  + f"; survived {n}/{total}")  # fmt: skip
+            continue
         out[key] = {"clip": name, "time_s": float(at), "duration_s": dur, "max_force_n": forces}
-        print(f"{key} {name} @ {at} s, {dur} s pushes ({time.perf_counter() - t0:.0f} s): "
+        print(f"{key} {name} @ {at} s, {dur} s pushes ({took:.0f} s): "
               + ", ".join(f"{lab} {f:.0f} N" for lab, f in zip(LABELS, forces)))  # fmt: skip
     if args.json:
         args.json.write_text(json.dumps(out, indent=2) + "\n")
-    if args.plot:
+    if args.plot and not args.forces:
         plot(args.plot, [*earlier, out])
     return 0
 

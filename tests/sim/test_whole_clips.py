@@ -88,6 +88,30 @@ def test_a_pushed_standing_clip_turns_its_trunk_about_the_hips(shared_mocap_dir:
     assert push({"hip_weight": 0.0}).report.status == "fell"
 
 
+def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
+    """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
+    2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip
+    default) it walks on; without (0) the steps keep the clip's pace and it falls forward."""
+    from reactmocap.library.bvh import read_bvh
+
+    clip = shared_mocap_dir / "dataset-1_walk_normal_001.bvh"
+    if not clip.is_file():
+        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
+    walk = read_bvh(clip)
+    path = reference_path(World(build_character(walk, frame=0)), 0, walk)
+    assert path.sole_yaw is not None
+    yaw = path.sole_yaw[round(2.0 * path.fps)]
+    front_right = float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum())) - np.pi / 4
+    force = [350.0 * np.cos(front_right), 350.0 * np.sin(front_right), 0.0]
+
+    def push(params: dict[str, float]) -> TrackResult:
+        return push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
+                         seconds=2.7, params=params)  # fmt: skip
+
+    assert push({}).report.status == "ok"
+    assert push({"warp_gain": 0.0}).report.status == "fell"
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}

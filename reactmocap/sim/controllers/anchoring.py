@@ -1,11 +1,14 @@
 """The mocap as the whole-body tracker follows a whole clip: its ground path (heading and
 horizontal position) re-anchored to where the feet really are, its pelvis and centre-of-mass
 targets shifted so its capture point stays inside the feet, a mocap swing foot's landing moved
-by the capture point's error, and capture-point balance steps. The base of
+by the capture point's error, capture-point balance steps, and a pushed walk's clip played
+faster while the body is faster than it. The base of
 :class:`~reactmocap.sim.controllers.wholebody.WholeBodyTracker`, which turns these targets into
 joint torques; why each part exists: ``docs/tracking.md``."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -32,6 +35,10 @@ _STEP_TILT_COS = float(np.cos(np.radians(35.0)))
 _SLOW_PERIOD = 0.008
 # a heading error's dead band is the position dead band over this lever (m)
 _DEADBAND_ARM = 0.5
+# a pushed walk's clip plays at most this much faster, and follows the body's speed with
+# this time constant (s): within a step the centre of mass's speed swings by ~20%
+_WARP_MAX = 1.8
+_WARP_TAU = 0.1
 
 
 def _rot2(yaw: float) -> F64:
@@ -66,6 +73,7 @@ class AnchoredReference:
         place_gain: float,
         place_deadband: float,
         place_height: float,
+        warp_gain: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -74,6 +82,7 @@ class AnchoredReference:
         #: the clip as this tracker follows it
         self.path = path
         self.clock = path.clock(start)
+        self._clock0 = self.clock
         self.feet, self.sole, self._corners = foot_soles(world, character, "WholeBodyTracker")
         self.floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
         self.patch = wc.patch_ids
@@ -126,6 +135,12 @@ class AnchoredReference:
         self.anchor_yaw = 0.0
         self.anchor_shift = np.zeros(2)
         self._turn = (0.0, _rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
+        self.warp_gain = float(warp_gain)
+        self._dt_slow = float(dt_slow)
+        #: set once a walk is pushed: the clip's rate then follows the body's speed
+        self.warping = False
+        #: the clip's playing rate (1: as captured)
+        self.rate = 1.0
 
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
@@ -145,6 +160,9 @@ class AnchoredReference:
             v[:2] = rot @ v[:2]  # free-joint angular velocity is local: unchanged
             a[:2] = rot @ a[:2]
         q[:2] += self.balance_shift
+        if self.rate != 1.0:  # the clip played faster (see :meth:`_warp`)
+            v *= self.rate
+            a *= self.rate * self.rate
         return q, v, a, planted
 
     def _sole_corners(self) -> F64:
@@ -182,6 +200,9 @@ class AnchoredReference:
         c[:2] = rot @ c[:2] + self.anchor_shift + self.balance_shift
         v[:2] = rot @ v[:2]
         a[:2] = rot @ a[:2]
+        if self.rate != 1.0:  # the clip played faster (see :meth:`_warp`)
+            v *= self.rate
+            a *= self.rate * self.rate
         return c, v, a
 
     def _footprint(self, t: float) -> list[F64]:
@@ -368,6 +389,28 @@ class AnchoredReference:
             self._update_step(t)
             self.reanchor(t)
             self.rebalance(t)
+            if self.warping:
+                self._warp(t)
+
+    def _warp(self, t: float) -> None:
+        """After a walk's push: the clip plays at a rate ``warp_gain`` of the way from 1 to
+        the body's horizontal speed over the mocap's (centre of mass), so the steps come as
+        fast as the pushed body needs them and the rate returns to 1 as the body slows to the
+        reference (which is always a little slower)."""
+        _, v, _ = self.com_reference(t)
+        v_ref = v[:2] / self.rate
+        n2 = float(v_ref @ v_ref)
+        if n2 < 0.04:  # under 0.2 m/s: not walking
+            return
+        ref = float(np.sqrt(n2))
+        mujoco.mj_subtreeVel(self.world.model, self.world.data)
+        # the whole speed, not its part along the walk: a sideways push is caught sooner by
+        # quicker steps too (the part along the walk drops then, and a clip slowed with it
+        # lost the right pushes it survived: the rate never goes below 1)
+        speed = float(np.linalg.norm(self.world.data.subtree_linvel[self._root][:2])) / ref
+        target = min(max(1.0 + self.warp_gain * (speed - 1.0), 1.0), _WARP_MAX)
+        self.rate += min(1.0, self._dt_slow / _WARP_TAU) * (target - self.rate)
+        self.clock = replace(self.clock, start=self.clock.start + (self.rate - 1.0) * self._dt_slow)
 
     def reset_ground(self, world: World) -> None:
         """Back to the captured path, no shift, no step (a rollout's start)."""
@@ -379,6 +422,8 @@ class AnchoredReference:
         self.steps_taken = []
         self._step_ready = 0.0
         self._slow_next = 0.0
+        self.clock = replace(self._clock0, until=self.clock.until)
+        self.rate, self.warping = 1.0, False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
 
@@ -391,11 +436,11 @@ class AnchoredReference:
         balance shift, a step under way), for :meth:`restore` after a look ahead."""
         return (self.anchor_yaw, self.anchor_shift.copy(), self.balance_shift.copy(),
                 self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
-                self._slow_next)  # fmt: skip
+                self._slow_next, self.clock, self.rate, self.warping)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
-        yaw, shift, bal, place, step, taken, ready, slow = memory
+        yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping = memory
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -404,3 +449,5 @@ class AnchoredReference:
         del self.steps_taken[int(taken) :]  # type: ignore[call-overload]
         self._step_ready = float(ready)  # type: ignore[arg-type]
         self._slow_next = float(slow)  # type: ignore[arg-type]
+        self.clock = clock  # type: ignore[assignment]
+        self.rate, self.warping = float(rate), bool(warping)  # type: ignore[arg-type]

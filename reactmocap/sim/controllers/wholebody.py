@@ -158,6 +158,12 @@ class WholeBodyTracker(AnchoredReference):
             above ``place_height``) and the simulated capture point is more than
             ``place_deadband`` m from the mocap's, the foot lands ``place_gain`` times that
             error (at most 0.4 m) from the mocap's landing (0: off; see ``docs/tracking.md``).
+        warp_gain: a push that starts while the mocap does not stand (a walk) makes the clip
+            play faster for the rest of the rollout: at a rate ``warp_gain`` of the way from 1
+            to the body's horizontal speed over the mocap's (centre of mass; at most 1.8, never
+            slower than 1), so the steps come as fast as the pushed body needs
+            and, the clip a little slower than the body, the body sheds the extra speed and the
+            rate comes back to 1 (0: off; ``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -223,6 +229,7 @@ class WholeBodyTracker(AnchoredReference):
         place_gain: float = 0.0,
         place_deadband: float = 0.15,
         place_height: float = 0.03,
+        warp_gain: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -247,7 +254,7 @@ class WholeBodyTracker(AnchoredReference):
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
-                "place_height": place_height, "torque_limit": torque_limit,
+                "place_height": place_height, "warp_gain": warp_gain, "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -348,6 +355,7 @@ class WholeBodyTracker(AnchoredReference):
             balance_margin=balance_margin, balance_tau=balance_tau, stepping=stepping,
             step_margin=step_margin, step_time=step_time, step_height=step_height,
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
+            warp_gain=warp_gain,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
@@ -604,7 +612,7 @@ class WholeBodyTracker(AnchoredReference):
         off while an external force acts and, after one, while the capture point is more than
         ``trunk_band`` m from the mocap's; back linearly over ``trunk_give`` s after. A walk
         pushed gets the softer pelvis servo (``kp_root_pushed``)."""
-        if not ((self._w_trunk and self._give) or self._w_hip):
+        if not ((self._w_trunk and self._give) or self._w_hip or self.warp_gain):
             return self._w_trunk
         # into a buffer: this runs every control tick
         np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
@@ -614,10 +622,13 @@ class WholeBodyTracker(AnchoredReference):
         # walk's double support is shorter; a walk kept its trunk rows, its figures dropped
         # where they gave in double support)
         standing = bool(self.path.planted[i : i + self._stand_frames].all())
-        if pushing and not self._pushed and not standing and self._kp_root_pushed:
-            # a walk pushed: a softer pelvis servo lets its steps catch it
-            self.kp[:3] = self._kp_root_pushed
-            self.kv[:3] = critical_kv(self._kp_root_pushed)
+        if pushing and not self._pushed and not standing:
+            # a walk pushed: its clip follows the body's speed (``warp_gain``)
+            self.warping = self.warp_gain > 0
+            if self._kp_root_pushed:
+                # a softer pelvis servo lets its steps catch it
+                self.kp[:3] = self._kp_root_pushed
+                self.kv[:3] = critical_kv(self._kp_root_pushed)
         self._pushed |= pushing
         self._standing = standing
         if not (self._w_trunk and self._give):
