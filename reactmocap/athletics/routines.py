@@ -209,8 +209,10 @@ def somersault(
 
 
 # ---------------------------------------------------------------------------------- dives
-#: the dive's tumble lead (rad) per position, tuned by hand on the male body (5 m, 1.5 turns)
-DIVE_LEADS: Mapping[str, float] = MappingProxyType({"pike": 2.0, "tuck": 1.7, "layout": 0.0})
+#: the dive's tumble lead (rad) per position, tuned by hand on the male body (5 m, 1.5 turns);
+#: the pike's 1.6 since its hips are at DIVE_PIKE_HIP (2.0 before: the shallower pike turns
+#: slower, and the nominal entered 24 deg short of vertical; at 1.6, 3 deg)
+DIVE_LEADS: Mapping[str, float] = MappingProxyType({"pike": 1.6, "tuck": 1.7, "layout": 0.0})
 DIVE_DIRECTIONS = ("backward",)
 #: the pike dive's hip flexion (rad; the pike's own is -2.2): at -2.2 the somersault axis is
 #: the piked body's intermediate principal axis (an unstable turn); at -2.0 it is the largest
