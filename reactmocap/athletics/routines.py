@@ -209,12 +209,16 @@ def somersault(
 
 
 # ---------------------------------------------------------------------------------- dives
-#: the dive's tumble lead (rad) per position, tuned by hand on the male body (5 m, 1.5 turns)
-DIVE_LEADS: Mapping[str, float] = MappingProxyType({"pike": 2.0, "tuck": 1.7, "layout": 0.0})
+#: the dive's tumble lead (rad) per position, tuned by hand on the male body (5 m, 1.5 turns);
+#: the pike's 1.6 since its hips are at DIVE_PIKE_HIP (2.0 before: the shallower pike turns
+#: slower, and the nominal entered 24 deg short of vertical; at 1.6, 3 deg)
+DIVE_LEADS: Mapping[str, float] = MappingProxyType({"pike": 1.6, "tuck": 1.7, "layout": 0.0})
 DIVE_DIRECTIONS = ("backward",)
-#: the pike dive's hip flexion (rad; the pike's own is -2.2): the shallowest pike whose
-#: somersault axis is its largest principal axis, so the turn is stable (TumbleParams.hip)
-DIVE_PIKE_HIP = -2.0
+#: the pike dive's hip flexion (rad; the pike's own is -2.2): at -2.2 the somersault axis is
+#: the piked body's intermediate principal axis (an unstable turn); at -2.0 it is the largest
+#: by 0.28 kg m^2 only (male), and a take-off's few kg m^2/s of yaw or cartwheel still tilted
+#: the body out of the plane; at -1.9 by 0.59 (TumbleParams.hip; docs/athletics.md)
+DIVE_PIKE_HIP = -1.9
 #: the twists a dive is built for (turns)
 DIVE_TWISTS = (0.5, 1.0)
 #: the twisting dive (thesis 5.2's tilt twist), tuned by hand on the male body from 5 m: a

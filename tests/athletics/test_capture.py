@@ -1,6 +1,6 @@
 """Perturbed starts (issue 19's capture regions): the vertical leap maneuver lands with the
-vertical leap's own landing, and a perturbed start settles onto both feet before the leap
-(the vertical leap and the back tuck).
+vertical leap's own landing and stands planted on both feet after it, and a perturbed start
+settles onto both feet before the leap (the vertical leap and the back tuck).
 Starts from ``capture_region``'s full-size distribution, seed 0."""
 
 from __future__ import annotations
@@ -49,6 +49,22 @@ def test_the_vertical_leap_lands_with_the_vertical_leaps_own_delta() -> None:
     phases[land] = dataclasses.replace(phases[land], params={})
     old = run_maneuver(dataclasses.replace(m, phases=tuple(phases)), perturbation=start, fps=10.0)
     assert old.report["fell"]
+
+
+def test_the_vertical_leap_stands_up_planted_after_the_landing() -> None:
+    """Start 35 takes off with almost no pitch momentum (-0.2 kg m^2/s) and lands with the
+    COM 7 cm ahead of the feet: under the plain final balance the left foot tips onto its toes
+    (heel 3 cm up), loses its contacts and slides 14 cm back, and the body falls forward over
+    the other; with ``plant`` (the file since 2026-12-02) the ankles give way, both feet stay
+    down and it stands."""
+    m = load_maneuver(VERTICAL_LEAP)
+    assert m.phases[-1].params["plant"] is True
+    start = full_starts(36)[35]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    plain = dataclasses.replace(m.phases[-1], params={"settle": 0.5})
+    old = dataclasses.replace(m, phases=(*m.phases[:-1], plain))
+    assert run_maneuver(old, perturbation=start, fps=10.0).report["fell"]
 
 
 def _settle(start: Perturbation, plant: bool) -> dict:
