@@ -487,11 +487,15 @@ class Runner:
         """The base stiffness; in stance the active hip's servo is off (the attitude torque
         only) and its knee and ankle servos hold roll and yaw."""
         stiff = self._base_stiffness.copy()
+        bend = self.rig.axis_gain[:, 0]
+        bend[:] = 1.0
         if stance:
             a = self.active
             stiff[_HIP[a]] = 0.0
             stiff[_KNEE[a]] = self.k["knee_hold"]
             stiff[_ANKLE[a]] = self.k["ankle_hold"]
+            # their bending is the leg law's: the servos' damping there took half its push
+            bend[[_KNEE[a], _ANKLE[a]]] = self.k["bend_hold"]
         self.rig.set_stiffness(stiff)
 
     def _enter_flight(self, world: World, t: float) -> None:

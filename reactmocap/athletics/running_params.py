@@ -94,6 +94,9 @@ class RunParams:
             the vertical ground force (a friction coefficient times the lever).
         knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
             keep only their roll and yaw (the leg spring drives their pitch).
+        bend_hold: the share (0-1) of those servos' stiffness and damping kept about the
+            bending (pitch) axis (1: all, as tuned; 0: the bending is the leg law's alone).
+            Their damping there opposed the law's push by half.
         idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
             by the end of the stance ready for touchdown (rad).
         swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
@@ -135,6 +138,7 @@ class RunParams:
     yaw_grip: float | Speeds = 0.181
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
+    bend_hold: float | Speeds = 1.0
     idle_knee: float | Speeds = (2.182, 1.813, 1.692)
     reach_knee: float | Speeds = (1.192, 1.066, 1.102)
     swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
@@ -164,6 +168,9 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
+        bend = self.bend_hold if isinstance(self.bend_hold, tuple) else (self.bend_hold,)
+        if not all(0.0 <= b <= 1.0 for b in bend):
+            raise ConfigError(f"bend_hold must be in [0, 1], got {self.bend_hold}")
         lo, hi = SPEED_RANGE
         for speed in (lo, hi):
             r = self.at(speed)
