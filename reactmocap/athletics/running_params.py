@@ -100,6 +100,17 @@ class RunParams:
         idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
             by the end of the stance ready for touchdown (rad).
         swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
+        step_stance: the commanded step (s; 0: off, the leg spring and thrust above): from
+            :data:`~reactmocap.athletics.running.STEP_AFTER` on, each stance lasts this long,
+            the leg's force making the body's vertical speed go from its touchdown value to
+            ``step_takeoff`` (m/s) along a half-cosine, with ``step_gain`` (1/s) on the speed's
+            error; eqs. 1-2 take ``step_placement`` times it as ``t_s``. Given at every speed or
+            none. The leg spring's stance is about 0.17 s at 2.6 m/s whatever its values; a
+            human's (the shared run clip's) about 0.2 s with a flight of 0.17-0.22 s.
+        step_lead: in the commanded step's push (the toe and unloading states), the share of
+            the stance knee's and ankle's servo damping that is cancelled (their pitch targets
+            led by it): the servos, there to hold roll and yaw, took about half the push and
+            the body left the ground at 0.39 m/s of the 0.96 asked.
         arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
         elbow: elbow flexion (rad).
         turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
@@ -145,6 +156,11 @@ class RunParams:
     arm_gain: float | Speeds = (0.7815, 1.273, 1.336)
     arm_offset: float | Speeds = 0.05
     elbow: float | Speeds = 1.4
+    step_stance: float | Speeds = 0.0
+    step_takeoff: float | Speeds = 0.96
+    step_gain: float | Speeds = 20.0
+    step_placement: float | Speeds = 0.7
+    step_lead: float | Speeds = 0.3
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
@@ -184,6 +200,25 @@ class RunParams:
                 raise ConfigError(f"thrust_drop must be > 0, got {self.thrust_drop}")
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
+            if not (r["step_stance"] == 0 or 0.1 <= r["step_stance"] <= 0.5):
+                raise ConfigError(
+                    f"step_stance must be 0 (off) or 0.1-0.5 s, got {self.step_stance}"
+                )
+            if not (0 < r["step_takeoff"] <= 2 and r["step_gain"] >= 0):
+                raise ConfigError(
+                    f"step_takeoff must be in (0, 2] m/s and step_gain >= 0, got "
+                    f"{self.step_takeoff}, {self.step_gain}"
+                )
+            if not (0 < r["step_placement"] <= 2 and 0 <= r["step_lead"] <= 1):
+                raise ConfigError(
+                    f"step_placement must be in (0, 2] and step_lead in [0, 1], got "
+                    f"{self.step_placement}, {self.step_lead}"
+                )
+        steps = self.step_stance if isinstance(self.step_stance, tuple) else (self.step_stance,)
+        if 0 in steps and any(steps):
+            raise ConfigError(
+                f"step_stance must be given at every speed or none (0), got {self.step_stance}"
+            )
 
     def at(self, speed: float) -> dict[str, float]:
         """Every scalar tuning value at ``speed`` (triples interpolated, clamped to the
