@@ -182,7 +182,6 @@ class Runner:
         self.vz_touchdown = 0.0
         #: the stance the commanded step lasts (s; 0: the leg spring's stance)
         self.step_stance = 0.0
-        self.pitch_prev = np.zeros(NJ)
         self.targets = np.zeros((NJ, 3))
         self.goal = np.zeros((NJ, 3))
         self.heel = np.zeros(2, dtype=bool)
@@ -468,19 +467,9 @@ class Runner:
         ff[_KNEE[leg]] += tau[0:3]
         if state not in ("loading", "heel"):
             ff[_ANKLE[leg]] += tau[3:6]
-        # the knee's and ankle's servos keep no pitch stiffness of their own; in the commanded
-        # step's push their targets also lead by a share of their damping, which took half
-        # the push (the targets trail the joints, whose speed the damping opposes)
-        lead = 0.0
-        if k["step_stance"] and state in ("toe", "unloading"):
-            lead = k["step_lead"]
+        # the knee's and ankle's servos keep no pitch stiffness of their own
         for j in (_KNEE[leg], _ANKLE[leg]):
-            ahead = 0.0
-            if lead > 0 and self.rig._kp[j] > 0:
-                rate = (angles[j, 0] - self.pitch_prev[j]) / dt
-                ahead = lead * (2.0 / math.sqrt(self.rig._kp[j]) + dt) * rate
-            self.targets[j, 0] = self.goal[j, 0] = angles[j, 0] + ahead
-        self.pitch_prev[:] = angles[:, 0]
+            self.targets[j, 0] = self.goal[j, 0] = angles[j, 0]
 
     # ------------------------------------------------------------------ states
     def _states(self) -> list[State]:
@@ -529,15 +518,12 @@ class Runner:
         """The base stiffness; in stance the active hip's servo is off (the attitude torque
         only) and its knee and ankle servos hold roll and yaw."""
         stiff = self._base_stiffness.copy()
-        bend = self.rig.axis_gain[:, 0]
-        bend[:] = 1.0
+        self.rig.axis_gain[:, 0] = 1.0
         if stance:
             a = self.active
             stiff[_HIP[a]] = 0.0
             stiff[_KNEE[a]] = self.k["knee_hold"]
             stiff[_ANKLE[a]] = self.k["ankle_hold"]
-            # their bending is the leg law's: the servos' damping there took half its push
-            bend[[_KNEE[a], _ANKLE[a]]] = self.k["bend_hold"]
         self.rig.set_stiffness(stiff)
 
     def _enter_flight(self, world: World, t: float) -> None:
@@ -603,6 +589,11 @@ class Runner:
 
     def _stance(self, world: World, t: float) -> None:
         del world, t
+        # in the push the stance knee's and ankle's servos keep only a share of their gains
+        # about bending (roll and yaw held): their damping there took half the leg law's push
+        hold = self.k["push_hold"] if self.machine.current.name in ("toe", "unloading") else 1.0
+        a = self.active
+        self.rig.axis_gain[_KNEE[a], 0] = self.rig.axis_gain[_ANKLE[a], 0] = hold
         if not self.released and self.machine.current.name in ("toe", "unloading"):
             # the thrust stops once the body rises at the take-off speed wanted, or once its
             # rise slows (the take-off speed out of reach: pushing on to lift-off drove the
