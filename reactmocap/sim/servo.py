@@ -384,7 +384,11 @@ class PDServo:
         if self.torque_limit is not None:
             self._set_force_range(lt)
         if self._diag_damping:
-            diag = np.einsum("nji,nji->ni", lt, lt)  # diag(G^T G): the (shaped) inertia's
+            diag = (
+                np.einsum("nji,nji->ni", lt, lt)  # diag(G^T G): the shaped inertia's
+                if self._any_shaped
+                else np.einsum("nii->ni", self._inertia)
+            )
             self.world.model.dof_damping[self._didx] = self._base_damping + (
                 self._kv[:, None] * diag
             ).reshape(-1)
