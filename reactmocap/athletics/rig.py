@@ -144,6 +144,8 @@ class Rig:
         unit = np.eye(3)[[1, 0, 2]]
         right = np.repeat(quat_conj(athlete._right)[:, None, :], 3, axis=1)
         self._axes = quat_rotate(right, np.broadcast_to(unit, (NJ, 3, 3)))
+        self._sent_gain = np.ones((NJ, 3))  # what the servo has (sent only when changed)
+        self._gain_changed = np.zeros((NJ, 3), dtype=bool)
 
     # ------------------------------------------------------------------ setup
     def reset(self, angles: F64 | None = None) -> None:
@@ -159,6 +161,8 @@ class Rig:
         self._dur[:] = 1e-9
         self.offset[:] = 0.0
         self.axis_gain[:] = 1.0
+        self._sent_gain[:] = 1.0
+        servo.set_axis_gains(self.character, self._axes, self.axis_gain)
         self.support[:] = 0.0
         self.support_scale = 1.0
         self.support_dir = None
@@ -261,7 +265,10 @@ class Rig:
         """Write the servo's targets (smoothed angles plus :attr:`offset`) and feed-forward."""
         angles = self.desired(t) + self.offset
         self.servo.set_targets(self.character, self.athlete.joint_quats(angles))
-        self.servo.set_axis_gains(self.character, self._axes, self.axis_gain)
+        np.not_equal(self.axis_gain, self._sent_gain, out=self._gain_changed)
+        if self._gain_changed.any():
+            self.servo.set_axis_gains(self.character, self._axes, self.axis_gain)
+            self._sent_gain[:] = self.axis_gain
         if self.gravity_compensation:
             self._feedforward()
         else:
