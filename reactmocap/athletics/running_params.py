@@ -108,7 +108,9 @@ class RunParams:
             ``step_takeoff`` (m/s) along a half-cosine, with ``step_gain`` (1/s) on the speed's
             error; eqs. 1-2 take ``step_placement`` times it as ``t_s``. Given at every speed or
             none. The leg spring's stance is about 0.17 s at 2.6 m/s whatever its values; a
-            human's (the shared run clip's) about 0.2 s with a flight of 0.17-0.22 s.
+            human's (the shared run clip's) about 0.2 s with a flight of 0.17-0.22 s. An
+            opt-in for the clip's speed (2.61 m/s, with ``push_hold`` 0.75): it falls at
+            neighbouring speeds (``docs/athletics.md``, the eighth round).
         arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
         elbow: elbow flexion (rad).
         turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
