@@ -13,7 +13,15 @@ from numpy.typing import NDArray
 from reactmocap.athletics.rig import per_joint
 from reactmocap.errors import ConfigError
 
-__all__ = ["SPEED_RANGE", "TUNED_SPEEDS", "RunLog", "RunParams", "Speeds", "check_speed"]
+__all__ = [
+    "SPEED_RANGE",
+    "STEP_PARAMS",
+    "TUNED_SPEEDS",
+    "RunLog",
+    "RunParams",
+    "Speeds",
+    "check_speed",
+]
 
 #: the speeds the runner is built for (m/s), the paper's range
 SPEED_RANGE = (2.5, 5.0)
@@ -232,6 +240,18 @@ class RunParams:
 
 #: per-axis (roll, pitch, yaw) values, not per-speed
 _AXES = ("attitude_kp", "attitude_kv")
+
+#: an opt-in: the commanded step with the push let through, for the shared run clip's speed
+#: (2.61 m/s: its cadence and stride within 10%); it falls at neighbouring speeds
+#: (``docs/athletics.md``, the eighth round)
+STEP_PARAMS = RunParams(
+    step_stance=0.2391,
+    step_takeoff=0.9598,
+    step_placement=0.7,
+    speed_integral=(0.03, 0.0, 0.03),
+    toe_fraction=(0.6, 0.42, 0.3199),
+    push_hold=0.75,
+)
 
 
 @dataclass

@@ -9,6 +9,7 @@ import pytest
 from reactmocap.athletics.run_course import run_course
 from reactmocap.athletics.running import Runner, RunParams
 from reactmocap.athletics.running_body import _ANKLE, _KNEE
+from reactmocap.athletics.running_params import STEP_PARAMS
 from reactmocap.errors import ConfigError
 
 _CONTROL = Runner.control
@@ -51,22 +52,11 @@ def test_the_push_is_free_in_bending_and_held_in_roll_and_yaw(
         RunParams(push_hold=(1.0, 1.0, 1.5))
 
 
-#: the opt-in commanded step with the push let through (docs/athletics.md, eighth round)
-STEP = RunParams(
-    step_stance=0.2391,
-    step_takeoff=0.9598,
-    step_placement=0.7,
-    speed_integral=(0.03, 0.0, 0.03),
-    toe_fraction=(0.6, 0.42, 0.3199),
-    push_hold=0.75,
-)
-
-
 def test_the_commanded_step_lasts_its_stance() -> None:
     """From STEP_AFTER on each stance lasts ``step_stance`` (to a tick or two), where the
     leg spring's lasts about 0.17 s; a commanded step given at some speeds only is a
     ConfigError."""
-    res = run_course(2.61, seconds=4.0, fps=10.0, params=STEP)
+    res = run_course(2.61, seconds=4.0, fps=10.0, params=STEP_PARAMS)
     assert not res.report["fell"], res.report["notes"]
     log = res.runner.log
     downs = [t for t, *_ in log.touchdowns]
