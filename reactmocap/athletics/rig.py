@@ -72,6 +72,9 @@ class Rig:
       MuJoCo's joint damping (integrated implicitly): the damping a joint needs when it carries
       the body, which no outboard-inertia-scaled gain gives. :meth:`release` restores the
       model's damping.
+    * **Per-axis gains** (:attr:`axis_gain`): a share of each joint's stiffness and damping
+      per anatomical axis (the servo's :meth:`~reactmocap.sim.servo.PDServo.set_axis_gains`),
+      e.g. a stance knee free in bending, driven by feed-forward, and held in roll and yaw.
     * **Feed-forward** (:meth:`apply`): every joint holds its subtree up against gravity, and
       the legs whose feet carry weight (``support`` shares) push the body's weight into the
       ground through their Jacobians at the ankle (a force through the ankle: the ankle's own
