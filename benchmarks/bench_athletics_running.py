@@ -10,7 +10,9 @@ Sections:
   (``--eight-seconds``, 60: once round, 126 m): RMS cross-track error (goal <= 0.3 m) and
   how far along the path the runner got.
 * ``--phase``: the hip-knee phase plot (Fig. 6) of a run at the shared run clip's speed beside
-  the clip's, and their cadence and stride (goal: within 10%); writes the figure.
+  the clip's, and their cadence and stride (goal: within 10%); writes the figure. With
+  ``--step``, the opt-in commanded step with the push let through (``STEP_PARAMS``), its
+  figure as ``running_phase_step.png``.
 * ``--push``: the largest sideways impulse on the chest (over 0.1 s) the runner survives.
 * ``--vault``: the handspring vault against Table 1 (goal: all 16 rows inside the human range,
   velocities within 10% of the mean).
@@ -37,6 +39,7 @@ import numpy as np
 
 from reactmocap.athletics.run_course import run_course
 from reactmocap.athletics.running import TUNED_SPEEDS, RunParams
+from reactmocap.athletics.running_params import STEP_PARAMS
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT / ".." / "shared" / "mocap"
@@ -86,7 +89,7 @@ def paths(seconds: float, speed: float, eight_seconds: float) -> None:
     print()
 
 
-def phase(figures: Path) -> None:
+def phase(figures: Path, params: RunParams | None = None) -> None:
     from reactmocap.athletics.running import SPEED_RANGE
     from reactmocap.athletics.running_plots import clip_gait, hip_knee_angles, phase_plot
     from reactmocap.library.bvh import read_bvh
@@ -98,7 +101,7 @@ def phase(figures: Path) -> None:
     clip = read_bvh(RUN_CLIP)
     gait = clip_gait(clip)
     v = float(np.clip(gait["speed_m_s"] or 3.0, *SPEED_RANGE))
-    res = run_course(v, seconds=10.0, fps=60.0)
+    res = run_course(v, seconds=10.0, fps=60.0, params=params)
     r = res.report
     print(f"clip: {RUN_CLIP.name}, {gait['duration_s']:.2f} s, {gait['touchdowns']} touchdowns; "
           f"simulated at {v:.2f} m/s for 10 s\n")  # fmt: skip
@@ -118,7 +121,7 @@ def phase(figures: Path) -> None:
     figures.mkdir(parents=True, exist_ok=True)
     out = phase_plot({"simulated (left leg, last 2 s)": (hip[last, 0], knee[last, 0]),
                       "motion capture (left leg)": (chip[:, 0], cknee[:, 0])},
-                     figures / "running_phase.png",
+                     figures / ("running_phase.png" if params is None else "running_phase_step.png"),
                      title=f"hip-knee phase plot at {v:.2f} m/s")  # fmt: skip
     print(f"\nranges: simulated hip {np.degrees(hip[last, 0]).min():.0f} to "
           f"{np.degrees(hip[last, 0]).max():.0f} deg, knee {np.degrees(knee[last, 0]).min():.0f} to "
@@ -447,6 +450,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cloth-repeats", type=int, default=3,
                     help="alternating runs with and without cloth per garment")  # fmt: skip
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--step", action="store_true",
+                    help="--phase: the opt-in commanded step (STEP_PARAMS)")  # fmt: skip
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     if args.tune_speed is not None:
@@ -469,7 +474,7 @@ def main(argv: list[str] | None = None) -> int:
     if every or args.paths:
         paths(30.0, args.path_speed, args.eight_seconds)
     if every or args.phase:
-        phase(args.figures)
+        phase(args.figures, STEP_PARAMS if args.step else None)
     if every or args.push:
         push(3.5)
     if every or args.vault:

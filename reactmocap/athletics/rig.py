@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.errors import ConfigError, UnknownKeyError
-from reactmocap.rotations import quat_conj, quat_log, quat_mul
+from reactmocap.rotations import quat_conj, quat_log, quat_mul, quat_rotate
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.world import World
 
@@ -72,6 +72,9 @@ class Rig:
       MuJoCo's joint damping (integrated implicitly): the damping a joint needs when it carries
       the body, which no outboard-inertia-scaled gain gives. :meth:`release` restores the
       model's damping.
+    * **Per-axis gains** (:attr:`axis_gain`): a share of each joint's stiffness and damping
+      per anatomical axis (the servo's :meth:`~reactmocap.sim.servo.PDServo.set_axis_gains`),
+      e.g. a stance knee free in bending, driven by feed-forward, and held in roll and yaw.
     * **Feed-forward** (:meth:`apply`): every joint holds its subtree up against gravity, and
       the legs whose feet carry weight (``support`` shares) push the body's weight into the
       ground through their Jacobians at the ankle (a force through the ankle: the ankle's own
@@ -135,6 +138,17 @@ class Rig:
             [wc.ball_qpos_start + 4 * k + np.arange(4) for k in self._knees]
         )
         self.gravity_compensation = True
+        #: ``(15, 3)`` share of each joint's servo gains kept about each anatomical axis
+        #: (columns as the angles: pitch, roll, yaw; 1: all, 0: free, the axis driven by
+        #: feed-forward alone), written in place by a controller and sent by :meth:`apply`
+        self.axis_gain = np.ones((NJ, 3))
+        # the anatomical axes (the Euler order's Y, X, Z) in each joint's child frame, where
+        # the servo's error and MuJoCo's ball velocities live
+        unit = np.eye(3)[[1, 0, 2]]
+        right = np.repeat(quat_conj(athlete._right)[:, None, :], 3, axis=1)
+        self._axes = quat_rotate(right, np.broadcast_to(unit, (NJ, 3, 3)))
+        self._sent_gain = np.ones((NJ, 3))  # what the servo has (sent only when changed)
+        self._gain_changed = np.zeros((NJ, 3), dtype=bool)
 
     # ------------------------------------------------------------------ setup
     def reset(self, angles: F64 | None = None) -> None:
@@ -149,6 +163,9 @@ class Rig:
         self._t0[:] = 0.0
         self._dur[:] = 1e-9
         self.offset[:] = 0.0
+        self.axis_gain[:] = 1.0
+        self._sent_gain[:] = 1.0
+        servo.set_axis_gains(self.character, self._axes, self.axis_gain)
         self.support[:] = 0.0
         self.support_scale = 1.0
         self.support_dir = None
@@ -251,6 +268,10 @@ class Rig:
         """Write the servo's targets (smoothed angles plus :attr:`offset`) and feed-forward."""
         angles = self.desired(t) + self.offset
         self.servo.set_targets(self.character, self.athlete.joint_quats(angles))
+        np.not_equal(self.axis_gain, self._sent_gain, out=self._gain_changed)
+        if self._gain_changed.any():
+            self.servo.set_axis_gains(self.character, self._axes, self.axis_gain)
+            self._sent_gain[:] = self.axis_gain
         if self.gravity_compensation:
             self._feedforward()
         else:

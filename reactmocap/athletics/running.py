@@ -89,6 +89,10 @@ START_SPEED = 3.5
 ACCEL = 1.5
 #: the most the pitch error's integral holds (rad s)
 PITCH_SUM = 0.1
+#: the most leg force (body weights) of the commanded step
+STEP_FORCE = 4.0
+#: the commanded step takes over from the leg spring at the first touchdown after this (s)
+STEP_AFTER = 2.0
 #: the path correction integrates from this time on (s; the start from the set pose strays)
 PATH_AFTER = 3.0
 #: the most the path correction's integral (cross-track times curvature) holds (s)
@@ -175,6 +179,9 @@ class Runner:
         self.t_touchdown = 0.0
         self.t_heel_toe = 0.0
         self.stance_estimate = k["stance_time"]
+        self.vz_touchdown = 0.0
+        #: the stance the commanded step lasts (s; 0: the leg spring's stance)
+        self.step_stance = 0.0
         self.targets = np.zeros((NJ, 3))
         self.goal = np.zeros((NJ, 3))
         self.heel = np.zeros(2, dtype=bool)
@@ -404,6 +411,25 @@ class Runner:
             return heel + frac * (ball - heel)
         return ball
 
+    def _step_force(self, t: float, up: float) -> float:
+        """The leg force (N, along the leg; ``up`` its vertical share) of the commanded step:
+        the body's vertical speed follows a half-cosine from its touchdown value to
+        ``step_takeoff`` over ``step_stance``, then the leg lets go."""
+        k = self.k
+        ts = self.step_stance
+        s = t - self.t_touchdown
+        if s >= ts or not self.senses.foot_contact[self.active]:
+            # pushing with the foot off the ground only swings the leg (the law wound up and
+            # the leg kicked the body over)
+            return 0.0
+        dv = k["step_takeoff"] - self.vz_touchdown
+        phase = math.pi * s / ts
+        want = self.vz_touchdown + 0.5 * dv * (1.0 - math.cos(phase))
+        acc = 0.5 * dv * math.pi / ts * math.sin(phase)
+        vz = float(self.senses.com_vel[2])
+        fz = self.mass * (self.g + acc + k["step_gain"] * (want - vz))
+        return min(fz / max(up, 0.5), STEP_FORCE * self.mass * self.g)
+
     def _leg_spring(self, t: float, dt: float, angles: F64) -> None:
         """The stance knee as a spring and the ankle as the thrust: the leg's length is the
         hip-to-ankle distance (what the knee's bend sets), ``L0`` the planned touchdown
@@ -426,10 +452,13 @@ class Runner:
         self.leg_prev = length
         stiff = k["leg_stiffness"] * self.mass * self.g / self.athlete.leg_length
         damp = 2.0 * k["leg_damping"] * math.sqrt(stiff * self.mass)
-        force = stiff * (self.leg_rest - length) - damp * rate
         state = self.machine.current.name
-        if state in ("toe", "unloading") and not self.released:
-            force += self.thrust_force
+        if self.step_stance:
+            force = self._step_force(t, float(u[2]))
+        else:
+            force = stiff * (self.leg_rest - length) - damp * rate
+            if state in ("toe", "unloading") and not self.released:
+                force += self.thrust_force
         force = max(force, 0.0)
         self.leg_force = force
         mujoco.mj_jac(self.world.model, d, self._jacp, None, point, self._feet[leg])
@@ -461,7 +490,9 @@ class Runner:
         def stance_fraction(_w: World, t: float, _ti: float) -> bool:
             return t - self.t_touchdown >= self.k["toe_fraction"] * self.stance_estimate
 
-        def knee_extended(_w: World, _t: float, t_in: float) -> bool:
+        def knee_extended(_w: World, t: float, t_in: float) -> bool:
+            if self.step_stance:  # the commanded step lets go at its stance time
+                return t - self.t_touchdown >= self.step_stance
             knee = self._joint_pitch(_KNEE[self.active])
             return t_in > 0.02 and knee <= self.knee_td + 0.05
 
@@ -487,6 +518,7 @@ class Runner:
         """The base stiffness; in stance the active hip's servo is off (the attitude torque
         only) and its knee and ankle servos hold roll and yaw."""
         stiff = self._base_stiffness.copy()
+        self.rig.axis_gain[:, 0] = 1.0
         if stance:
             a = self.active
             stiff[_HIP[a]] = 0.0
@@ -502,7 +534,7 @@ class Runner:
             blend = self.k["stance_blend"]
             if blend < 1:
                 last = self.stance_estimate + blend * (last - self.stance_estimate)
-            self.stance_estimate = last
+            self.stance_estimate = self.step_stance * self.k["step_placement"] or last
             self.log.liftoffs.append((t, self.active))
             self.active = 1 - self.active
         h = self.heading()
@@ -514,6 +546,9 @@ class Runner:
         self.t_touchdown = t
         self.released = False
         self.vz_peak = -math.inf
+        self.vz_touchdown = float(self.senses.com_vel[2])
+        # the start runs on the leg spring: from the set pose the commanded step fell
+        self.step_stance = self.k["step_stance"] if t >= STEP_AFTER else 0.0
         leg = self.active
         d = self.world.data
         self.td_pitch = self._pitch(self._thighs[1 - leg], _THIGH[1 - leg], self.heading())
@@ -554,6 +589,11 @@ class Runner:
 
     def _stance(self, world: World, t: float) -> None:
         del world, t
+        # in the push the stance knee's and ankle's servos keep only a share of their gains
+        # about bending (roll and yaw held): their damping there took half the leg law's push
+        hold = self.k["push_hold"] if self.machine.current.name in ("toe", "unloading") else 1.0
+        a = self.active
+        self.rig.axis_gain[_KNEE[a], 0] = self.rig.axis_gain[_ANKLE[a], 0] = hold
         if not self.released and self.machine.current.name in ("toe", "unloading"):
             # the thrust stops once the body rises at the take-off speed wanted, or once its
             # rise slows (the take-off speed out of reach: pushing on to lift-off drove the

@@ -13,7 +13,15 @@ from numpy.typing import NDArray
 from reactmocap.athletics.rig import per_joint
 from reactmocap.errors import ConfigError
 
-__all__ = ["SPEED_RANGE", "TUNED_SPEEDS", "RunLog", "RunParams", "Speeds", "check_speed"]
+__all__ = [
+    "SPEED_RANGE",
+    "STEP_PARAMS",
+    "TUNED_SPEEDS",
+    "RunLog",
+    "RunParams",
+    "Speeds",
+    "check_speed",
+]
 
 #: the speeds the runner is built for (m/s), the paper's range
 SPEED_RANGE = (2.5, 5.0)
@@ -94,9 +102,23 @@ class RunParams:
             the vertical ground force (a friction coefficient times the lever).
         knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
             keep only their roll and yaw (the leg spring drives their pitch).
+        push_hold: in the push (the toe and unloading states), the share (0-1) of those
+            servos' stiffness and damping kept about the bending (pitch) axis, roll and yaw
+            held in full (1: all, as tuned). Their damping there took about half the push
+            (the knee -85 N m against the law's 179 at 2.61 m/s). The whole stance free (0
+            throughout) fell within 2 s: the landing needs the servos' give.
         idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
             by the end of the stance ready for touchdown (rad).
         swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
+        step_stance: the commanded step (s; 0: off, the leg spring and thrust above): from
+            :data:`~reactmocap.athletics.running.STEP_AFTER` on, each stance lasts this long,
+            the leg's force making the body's vertical speed go from its touchdown value to
+            ``step_takeoff`` (m/s) along a half-cosine, with ``step_gain`` (1/s) on the speed's
+            error; eqs. 1-2 take ``step_placement`` times it as ``t_s``. Given at every speed or
+            none. The leg spring's stance is about 0.17 s at 2.6 m/s whatever its values; a
+            human's (the shared run clip's) about 0.2 s with a flight of 0.17-0.22 s. An
+            opt-in for the clip's speed (2.61 m/s, with ``push_hold`` 0.75): it falls at
+            neighbouring speeds (``docs/athletics.md``, the eighth round).
         arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
         elbow: elbow flexion (rad).
         turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
@@ -135,12 +157,17 @@ class RunParams:
     yaw_grip: float | Speeds = 0.181
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
+    push_hold: float | Speeds = 1.0
     idle_knee: float | Speeds = (2.182, 1.813, 1.692)
     reach_knee: float | Speeds = (1.192, 1.066, 1.102)
     swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
     arm_gain: float | Speeds = (0.7815, 1.273, 1.336)
     arm_offset: float | Speeds = 0.05
     elbow: float | Speeds = 1.4
+    step_stance: float | Speeds = 0.0
+    step_takeoff: float | Speeds = 0.96
+    step_gain: float | Speeds = 20.0
+    step_placement: float | Speeds = 0.7
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
@@ -164,6 +191,9 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
+        hold = self.push_hold if isinstance(self.push_hold, tuple) else (self.push_hold,)
+        if not all(0.0 <= b <= 1.0 for b in hold):
+            raise ConfigError(f"push_hold must be in [0, 1], got {self.push_hold}")
         lo, hi = SPEED_RANGE
         for speed in (lo, hi):
             r = self.at(speed)
@@ -177,6 +207,22 @@ class RunParams:
                 raise ConfigError(f"thrust_drop must be > 0, got {self.thrust_drop}")
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
+            if not (r["step_stance"] == 0 or 0.1 <= r["step_stance"] <= 0.5):
+                raise ConfigError(
+                    f"step_stance must be 0 (off) or 0.1-0.5 s, got {self.step_stance}"
+                )
+            if not (0 < r["step_takeoff"] <= 2 and r["step_gain"] >= 0):
+                raise ConfigError(
+                    f"step_takeoff must be in (0, 2] m/s and step_gain >= 0, got "
+                    f"{self.step_takeoff}, {self.step_gain}"
+                )
+            if not 0 < r["step_placement"] <= 2:
+                raise ConfigError(f"step_placement must be in (0, 2], got {self.step_placement}")
+        steps = self.step_stance if isinstance(self.step_stance, tuple) else (self.step_stance,)
+        if 0 in steps and any(steps):
+            raise ConfigError(
+                f"step_stance must be given at every speed or none (0), got {self.step_stance}"
+            )
 
     def at(self, speed: float) -> dict[str, float]:
         """Every scalar tuning value at ``speed`` (triples interpolated, clamped to the
@@ -194,6 +240,18 @@ class RunParams:
 
 #: per-axis (roll, pitch, yaw) values, not per-speed
 _AXES = ("attitude_kp", "attitude_kv")
+
+#: an opt-in: the commanded step with the push let through, for the shared run clip's speed
+#: (2.61 m/s: its cadence and stride within 10%); it falls at neighbouring speeds
+#: (``docs/athletics.md``, the eighth round)
+STEP_PARAMS = RunParams(
+    step_stance=0.2391,
+    step_takeoff=0.9598,
+    step_placement=0.7,
+    speed_integral=(0.03, 0.0, 0.03),
+    toe_fraction=(0.6, 0.42, 0.3199),
+    push_hold=0.75,
+)
 
 
 @dataclass

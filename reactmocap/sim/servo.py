@@ -148,6 +148,16 @@ class PDServo:
         self._frozen = np.zeros(n, dtype=bool)
         self._gain_scale = np.ones(n)
         self._hot = np.zeros(n, dtype=bool)  # near a half turn: stiffness held in qfrc_applied
+        # per-axis gains (set_axis_gains): each joint's gears are shaped by S = A^T diag(sqrt(g))
+        # A, so its torque is S I S (kp e - kv qdot); identity (exactly) where no axis is scaled
+        self._shape = np.tile(np.eye(3), (n, 1, 1))
+        self._shaped = np.zeros(n, dtype=bool)
+        self._any_shaped = False
+        self._shape_tmp = np.empty((NJ, 3, 3))
+        self._shape_root = np.empty((NJ, 3))
+        self._shape_less = np.empty((NJ, 3), dtype=bool)
+        self._eye = np.eye(3)
+        self._lts = np.empty((n, 3, 3))
         self.freeze_scale = 4.0
         if torque_limit is not None and not (np.isfinite(torque_limit) and torque_limit > 0):
             raise ConfigError(f"torque_limit must be a positive number, got {torque_limit!r}")
@@ -213,6 +223,34 @@ class PDServo:
         m.actuator_biasprm[self._aidx, 0] = 0.0
         m.actuator_biasprm[self._aidx, 1] = -gain
         m.actuator_biasprm[self._aidx, 2] = 0.0 if self._diag_damping else -np.repeat(self._kv, 3)
+
+    def set_axis_gains(self, character: int, axes: F64, scale: F64) -> None:
+        """Per-axis gains of one character's joints: ``axes`` ``(15, 3, 3)`` (row ``i`` of
+        joint ``j``: a unit axis in the child frame, rows orthonormal), ``scale`` ``(15, 3)``
+        in [0, 1] the share of the joint's stiffness and damping left about each axis (0: the
+        axis is free, e.g. a stance knee's bending that a controller drives by torque alone).
+        Each tick without allocation; a joint whose scales are all 1 keeps the full servo
+        exactly."""
+        if scale.shape != (NJ, 3) or not (scale.min() >= 0.0 and scale.max() <= 1.0):
+            raise ConfigError(f"axis gain scales must be ({NJ}, 3) values in [0, 1]")
+        if axes.shape != (NJ, 3, 3):
+            raise ConfigError(f"axes must be ({NJ}, 3, 3), got {axes.shape}")
+        if character not in self.character_indices:
+            raise ConfigError(
+                f"character {character} is not driven by this servo {self.character_indices}"
+            )
+        base = self.character_indices.index(character) * NJ
+        sl = slice(base, base + NJ)
+        np.less(scale, 1.0, out=self._shape_less)
+        np.any(self._shape_less, axis=1, out=self._shaped[sl])
+        # S = I + A^T diag(sqrt(g) - 1) A: exactly I where every g is 1
+        np.sqrt(scale, out=self._shape_root)
+        self._shape_root -= 1.0
+        np.multiply(axes, self._shape_root[:, :, None], out=self._shape_tmp)
+        np.matmul(axes.transpose(0, 2, 1), self._shape_tmp, out=self._shape[sl])
+        self._shape[sl] += self._eye
+        self._any_shaped = bool(self._shaped.any())
+        self._dirty = True
 
     def _rows(self, character: int, joints: Sequence[str] | None) -> NDArray[np.intp]:
         if character not in self.character_indices:
@@ -335,6 +373,8 @@ class PDServo:
         xs = self._sum
         np.add(self._x0, self._x1, out=self._sum_flat)
         xs *= 2.0  # r0 + e0
+        if self._any_shaped:  # the gears shaped per axis: G = L^T S, so G^T G = S I S
+            lt = np.matmul(lt, self._shape, out=self._lts)
         np.matmul(lt, xs, out=self._ctrl)
         np.copyto(self._gear, lt)
         if not self._contiguous:
@@ -344,7 +384,11 @@ class PDServo:
         if self.torque_limit is not None:
             self._set_force_range(lt)
         if self._diag_damping:
-            diag = np.einsum("nii->ni", self._inertia)
+            diag = (
+                np.einsum("nji,nji->ni", lt, lt)  # diag(G^T G): the shaped inertia's
+                if self._any_shaped
+                else np.einsum("nii->ni", self._inertia)
+            )
             self.world.model.dof_damping[self._didx] = self._base_damping + (
                 self._kv[:, None] * diag
             ).reshape(-1)
@@ -374,7 +418,11 @@ class PDServo:
             return
         rows = np.flatnonzero(hot)
         e0 = 2.0 * half_e0[rows]
-        tau = self._kp[rows, None] * np.matmul(self._inertia[rows], e0[:, :, None])[:, :, 0]
+        inertia = self._inertia[rows]
+        if self._any_shaped:
+            shape = self._shape[rows]
+            inertia = shape @ inertia @ shape
+        tau = self._kp[rows, None] * np.matmul(inertia, e0[:, :, None])[:, :, 0]
         if self.torque_limit is not None:
             np.clip(tau, -self.torque_limit, self.torque_limit, out=tau)
         dofs = self._didx.reshape(self.n, 3)[rows]
@@ -418,6 +466,9 @@ class PDServo:
         d = self.world.data
         rows = slice(None) if character is None else self._rows(character, None)
         inertia = d.M[self._midx[rows]]
+        if self._any_shaped:
+            shape = self._shape[rows]
+            inertia = shape @ inertia @ shape
         u = -self._kv[rows, None] * d.qvel[self._didx].reshape(self.n, 3)[rows]
         kp = self._kp[rows]
         if kp.any():  # a damping-only servo (the whole-body tracker's) needs no log

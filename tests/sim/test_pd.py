@@ -341,3 +341,45 @@ def test_euler_worlds_take_the_damping_diagonal_in_dof_damping(guard: Motion) ->
     assert world.kinetic_energy(0) < 5.0  # standing, not flailing
     servo.clear()
     np.testing.assert_array_equal(m.dof_damping, base)
+
+
+def test_axis_gains_free_one_axis_and_keep_the_others(guard: Motion) -> None:
+    """Per-axis gains: with an axis's share 0 the servo exerts nothing about it (neither
+    stiffness nor damping), the torque is S I S (kp e - kv qdot) with S = A^T diag(sqrt g) A,
+    other joints and the other character keep theirs (to rounding), and shares of 1 give back
+    the full servo bit for bit; shares outside [0, 1] are a ConfigError naming the range."""
+    from scipy.spatial.transform import Rotation
+
+    from reactmocap.errors import ConfigError
+
+    world, servo = _random_world(guard, 1.0, 3)
+    d = world.data
+    servo.refresh()
+    mujoco.mj_forward(world.model, d)
+    full = d.qfrc_actuator[servo.dof_indices].reshape(-1, 3).copy()
+    axes = Rotation.random(NJ, random_state=4).as_matrix().transpose(0, 2, 1)  # rows: axes
+    scale = np.ones((NJ, 3))
+    scale[[3, 7], 0] = 0.0
+    scale[5] = (0.25, 1.0, 0.5)
+    servo.set_axis_gains(0, axes, scale)
+    servo.refresh()
+    mujoco.mj_forward(world.model, d)
+    act = d.qfrc_actuator[servo.dof_indices].reshape(-1, 3)
+    inertia = d.M[servo._midx]
+    for j in (3, 5, 7):
+        s = axes[j].T @ np.diag(np.sqrt(scale[j])) @ axes[j]
+        want = s @ inertia[j] @ s @ np.linalg.solve(inertia[j], full[j])
+        np.testing.assert_allclose(act[j], want, rtol=1e-9, atol=1e-9 * np.abs(full).max())
+    for j in (3, 7):
+        assert abs(act[j] @ axes[j, 0]) <= 1e-9 * np.abs(full[j]).max()
+        assert np.abs(act[j]).max() > 1e-3 * np.abs(full[j]).max()
+    rest = np.ones(2 * NJ, dtype=bool)
+    rest[[3, 5, 7]] = False
+    np.testing.assert_allclose(act[rest], full[rest], rtol=1e-12, atol=1e-12 * np.abs(full).max())
+    np.testing.assert_allclose(servo.torques(), act, rtol=1e-9, atol=1e-9 * np.abs(full).max())
+    servo.set_axis_gains(0, axes, np.ones((NJ, 3)))
+    servo.refresh()
+    mujoco.mj_forward(world.model, d)
+    assert np.array_equal(d.qfrc_actuator[servo.dof_indices].reshape(-1, 3), full)
+    with pytest.raises(ConfigError, match=r"in \[0, 1\]"):
+        servo.set_axis_gains(0, axes, np.full((NJ, 3), 1.5))

@@ -1,0 +1,69 @@
+"""The stance knee's and ankle's servos in the push: with ``push_hold`` their gains about
+bending are a share of the full ones, roll and yaw held (real MuJoCo, the thesis male)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from reactmocap.athletics.run_course import run_course
+from reactmocap.athletics.running import Runner, RunParams
+from reactmocap.athletics.running_body import _ANKLE, _KNEE
+from reactmocap.athletics.running_params import STEP_PARAMS
+from reactmocap.errors import ConfigError
+
+_CONTROL = Runner.control
+
+
+def _servo_bending(hold: float, monkeypatch: pytest.MonkeyPatch) -> tuple[float, float]:
+    """Mean |servo torque| about the stance knee's bending axis and about its other two axes
+    (N m) over the push ticks of a 1.5 s run at 2.61 m/s."""
+    bend: list[float] = []
+    other: list[float] = []
+
+    def traced(self: Runner, world, t: float) -> None:  # type: ignore[no-untyped-def]
+        _CONTROL(self, world, t)
+        if self.machine.current.name in ("toe", "unloading"):
+            j = _KNEE[self.active]
+            tau = self.world.servo.torques(self.character)[j]
+            axes = self.rig._axes[j]  # rows: bending, roll, yaw (child frame)
+            bend.append(abs(float(axes[0] @ tau)))
+            other.append(float(np.linalg.norm(axes[1:] @ tau)))
+            assert self.rig.axis_gain[_ANKLE[self.active], 0] == hold
+
+    monkeypatch.setattr(Runner, "control", traced)
+    res = run_course(2.61, seconds=1.5, fps=10.0, params=RunParams(push_hold=hold))
+    assert not res.report["fell"] and len(bend) > 20
+    return float(np.mean(bend)), float(np.mean(other))
+
+
+def test_the_push_is_free_in_bending_and_held_in_roll_and_yaw(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """As tuned (push_hold 1) the stance knee's servo opposes the push about bending with
+    tens of N m; with push_hold 0 it exerts nothing about bending and still holds the other
+    axes; a share outside [0, 1] is a ConfigError naming the range."""
+    full_bend, full_other = _servo_bending(1.0, monkeypatch)
+    free_bend, free_other = _servo_bending(0.0, monkeypatch)
+    assert full_bend > 20.0
+    assert free_bend < 1e-6 * full_bend
+    assert free_other > 0.2 * full_other
+    with pytest.raises(ConfigError, match=r"push_hold must be in \[0, 1\]"):
+        RunParams(push_hold=(1.0, 1.0, 1.5))
+
+
+def test_the_commanded_step_lasts_its_stance() -> None:
+    """From STEP_AFTER on each stance lasts ``step_stance`` (to a tick or two), where the
+    leg spring's lasts about 0.17 s; a commanded step given at some speeds only is a
+    ConfigError."""
+    res = run_course(2.61, seconds=4.0, fps=10.0, params=STEP_PARAMS)
+    assert not res.report["fell"], res.report["notes"]
+    log = res.runner.log
+    downs = [t for t, *_ in log.touchdowns]
+    stances = [
+        up - max(d for d in downs if d < up) for up, _ in log.liftoffs if up > 2.5 and up > downs[0]
+    ]
+    assert len(stances) >= 4
+    assert np.all(np.abs(np.array(stances) - 0.2391) < 0.012), stances
+    with pytest.raises(ConfigError, match="every speed or none"):
+        RunParams(step_stance=(0.0, 0.24, 0.24))
