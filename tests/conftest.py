@@ -18,6 +18,17 @@ SHARED_MOCAP = REPO.parent / "shared" / "mocap"
 SYNTHETIC = REPO / "data" / "synthetic_clips"
 
 
+def linked_library(root: Path, *folders: Path) -> Path:
+    """A library folder ``root/lib`` of links to every BVH in ``folders`` (e.g. the shared
+    clips and the synthetic ones side by side, as bench_reactions searches them)."""
+    lib = root / "lib"
+    lib.mkdir()
+    for folder in folders:
+        for f in folder.glob("*.bvh"):
+            (lib / f.name).symlink_to(f)
+    return lib
+
+
 @pytest.fixture(scope="session")
 def shared_mocap_dir() -> Path:
     d = SHARED_MOCAP / "bandai-namco-1"

@@ -23,7 +23,7 @@ from reactmocap.response.scenario import (
     load_scenario,
 )
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from tests.conftest import REPO, SYNTHETIC
+from tests.conftest import REPO, SYNTHETIC, linked_library
 
 EXAMPLES = REPO / "examples"
 CACHE = LibraryCache()
@@ -84,10 +84,7 @@ def test_the_blend_mode_places_the_found_clip_where_simulation_2_lies(
     # body falls on past where the search placed fall_backward (over Simulation 1's pelvis at
     # the match), and the blend dragged it 0.34 m back (a root warning); the fall clip moved
     # on the ground to Simulation 2's pelvis at the landing leaves no such gap
-    lib = tmp_path / "lib"
-    lib.mkdir()
-    for f in [*shared_mocap_dir.glob("*.bvh"), *SYNTHETIC.glob("*.bvh")]:
-        (lib / f.name).symlink_to(f)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     cfg = ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
                          torque_limit=1000.0)  # fmt: skip
     sc = Scenario(
@@ -175,10 +172,7 @@ def test_the_blend_mode_tries_other_clips_when_its_final_blend_would_warn(
     # rad and nothing is tried): Simulation 2 cannot follow the nearest window (the walk
     # itself, later) closely enough, and the final blend turns the left shin 0.9 rad; another
     # clip's window needs less
-    lib = tmp_path / "lib"
-    lib.mkdir()
-    for f in [*shared_mocap_dir.glob("*.bvh"), *SYNTHETIC.glob("*.bvh")]:
-        (lib / f.name).symlink_to(f)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     cfg = ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
                          torque_limit=1000.0, land_tries=1, blend_end_gap=False,
                          blend_place=False)  # fmt: skip

@@ -26,7 +26,7 @@ from reactmocap.response.scenario import (
     load_scenario,
 )
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from tests.conftest import REPO, SYNTHETIC
+from tests.conftest import REPO, SYNTHETIC, linked_library
 
 EXAMPLES = REPO / "examples"
 
@@ -164,12 +164,7 @@ def test_demo_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
 
 
 def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
-    lib = tmp_path / "lib"
-    lib.mkdir()
-    for f in shared_mocap_dir.glob("*.bvh"):
-        (lib / f.name).symlink_to(f)
-    for f in SYNTHETIC.glob("*.bvh"):
-        (lib / f.name).symlink_to(f)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     scenario = Scenario(
         library=lib,
         recipient=CharacterSpec("dataset-1_respond_normal_001", start=0.5),
@@ -198,14 +193,6 @@ def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
     assert fall.global_positions()[..., 2].min() > -0.05  # retargeted onto the floor, roughly
 
 
-def _shared_library(shared_mocap_dir: Path, tmp_path: Path) -> Path:
-    lib = tmp_path / "lib"
-    lib.mkdir()
-    for f in [*shared_mocap_dir.glob("*.bvh"), *SYNTHETIC.glob("*.bvh")]:
-        (lib / f.name).symlink_to(f)
-    return lib
-
-
 def _bench_physical(**kw: Any) -> ResponseConfig:
     """bench_reactions' real recipients: whole-body trackers, the physical mode landing
     within 0.25 m / 0.5 rad in 1 s, three tries."""
@@ -220,7 +207,7 @@ def _bench_kick(shared_mocap_dir: Path, tmp_path: Path, recipient: str, facing_d
     from dataclasses import replace
 
     return Scenario(
-        library=_shared_library(shared_mocap_dir, tmp_path),
+        library=linked_library(tmp_path, shared_mocap_dir, SYNTHETIC),
         recipient=CharacterSpec(recipient, start=0.5),
         attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
                               facing_deg=facing_deg, position=position),
@@ -254,7 +241,7 @@ def test_a_blend_held_by_contact_still_moves_the_root_smoothly(
     # correction is 0.05 m)
     from reactmocap.response.final import ROOT_BLEND_MIN_S
 
-    lib = _shared_library(shared_mocap_dir, tmp_path)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     scenario = _real_kick(lib, "dataset-1_walk_normal_001", 164.64459363196647,
                           (2.1888065748710512, 0.1540919325202299), "walk-kick")  # fmt: skip
     scenario = replace(scenario, response=replace(scenario.response, blend_place=False))
@@ -276,7 +263,7 @@ def test_the_attacker_blends_back_to_a_spinning_clip_no_faster_than_it(
     # the kick clip spins while the attacker's simulation has stopped, so blending back over
     # the straight-line gap turned the toes 1.61x faster than the capture ever moves them;
     # the blend back is now lengthened until no joint outruns the clip
-    lib = _shared_library(shared_mocap_dir, tmp_path)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     scenario = Scenario(
         library=lib,
         recipient=CharacterSpec("dataset-1_walk-back_normal_001", start=0.1),
@@ -298,7 +285,7 @@ def test_the_attacker_blends_back_to_a_spinning_clip_no_faster_than_it(
 def test_a_torque_limit_keeps_the_kicked_bow_stable(shared_mocap_dir: Path, tmp_path: Path) -> None:
     # the case below: the whole-body plan asks 41 kN m at a hip before Simulation 1 blows up;
     # with ``torque_limit`` (the plan's feed-forward bounded per joint) it runs to its end
-    lib = _shared_library(shared_mocap_dir, tmp_path)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     scenario = _real_kick(lib, "dataset-1_bow_normal_001", 167.42333060441473,
                           (0.9101249775269609, 0.24847072154800792), "bow-kick")  # fmt: skip
     scenario = replace(scenario, response=replace(scenario.response, torque_limit=1000.0))
@@ -315,7 +302,7 @@ def test_a_search_whose_nearest_windows_are_all_the_own_clip_looks_further(
     # limit): the 4 nearest windows of every search start are the bow itself, which a real hit
     # rules out; the response failed ("no library window continues the response") and now
     # looks OWN_CLIP_DEPTH windows down each start's ranking
-    lib = _shared_library(shared_mocap_dir, tmp_path)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     scenario = Scenario(
         library=lib,
         recipient=CharacterSpec("dataset-1_bow_normal_001", start=0.5),
@@ -368,7 +355,7 @@ def test_the_kicked_recipients_tail_does_not_run_into_the_attacker(
     # (11.6 cm) or fell (16.0 cm) onto the attacker its simulation left standing or lying
     # there, and the run's attacker, carried with the recipient's blend, moved 2.29x faster
     # than its clip; it now follows that blend no faster than its clip and steps aside
-    lib = _shared_library(shared_mocap_dir, tmp_path)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     scenario = Scenario(
         library=lib,
         recipient=CharacterSpec(recipient, start=start),
@@ -416,7 +403,7 @@ def test_an_unstable_simulation_1_is_reported_not_fatal(
     # is left and says so, rather than failing
     from reactmocap.response.stages import UNSTABLE_TRIM_S
 
-    lib = _shared_library(shared_mocap_dir, tmp_path)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     scenario = _real_kick(lib, "dataset-1_bow_normal_001", 167.42333060441473,
                           (0.9101249775269609, 0.24847072154800792), "bow-kick")  # fmt: skip
     res = run_response(scenario)

@@ -24,7 +24,7 @@ from reactmocap.response.scenario import (
     parse_scenario,
 )
 from reactmocap.sim.bodies import SIM_BODIES
-from tests.conftest import REPO, SYNTHETIC
+from tests.conftest import REPO, SYNTHETIC, linked_library
 from tests.fixtures.one_spine import dummy_root, write_one_spine
 
 EXAMPLES = REPO / "examples"
@@ -102,10 +102,7 @@ def test_strict_exits_non_zero_on_warnings(
 
 def test_one_spine_skeleton_as_recipient_attacker_and_in_a_library(tmp_path: Path) -> None:
     clips = synthetic_clips(60.0)
-    lib = tmp_path / "lib"
-    lib.mkdir()
-    for f in SYNTHETIC.glob("*.bvh"):
-        (lib / f.name).symlink_to(f)
+    lib = linked_library(tmp_path, SYNTHETIC)
     write_one_spine(clips["guard"], lib / "cmu_guard.bvh")
     write_one_spine(clips["front_kick"], lib / "cmu_kick.bvh")
     m = read_bvh(lib / "cmu_guard.bvh")
@@ -130,10 +127,7 @@ def test_one_spine_skeleton_as_recipient_attacker_and_in_a_library(tmp_path: Pat
 
 
 def test_an_unmappable_or_corrupt_clip_is_skipped_and_named(tmp_path: Path) -> None:
-    lib = tmp_path / "lib"
-    lib.mkdir()
-    for f in SYNTHETIC.glob("*.bvh"):
-        (lib / f.name).symlink_to(f)
+    lib = linked_library(tmp_path, SYNTHETIC)
     text = (SYNTHETIC / "sway.bvh").read_text().replace("LeftUpLeg", "Thing7")
     (lib / "odd.bvh").write_text(text)
     (lib / "broken.bvh").write_text("HIERARCHY\nROOT Hips\n{\n")

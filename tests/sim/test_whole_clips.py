@@ -61,22 +61,30 @@ def test_a_standing_clip_falls_under_a_huge_push(standing: Motion) -> None:
     assert _push(standing, 0.0, 2000.0) == "fell"
 
 
+def _shared_push(
+    shared_mocap_dir: Path, name: str, time: float, angle_deg: float, newtons: float
+) -> tuple[Motion, list[float]]:
+    """A shared clip and a horizontal push of ``newtons`` at ``angle_deg`` from where its feet
+    face at ``time`` (mean sole yaw; positive to the left)."""
+    from reactmocap.library.bvh import read_bvh
+
+    clip = shared_mocap_dir / f"dataset-1_{name}.bvh"
+    if not clip.is_file():
+        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
+    motion = read_bvh(clip)
+    path = reference_path(World(build_character(motion, frame=0)), 0, motion)
+    assert path.sole_yaw is not None
+    yaw = path.sole_yaw[round(time * path.fps)]
+    angle = float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum())) + np.radians(angle_deg)
+    return motion, [newtons * np.cos(angle), newtons * np.sin(angle), 0.0]
+
+
 def test_a_pushed_standing_clip_turns_its_trunk_about_the_hips(shared_mocap_dir: Path) -> None:
     """The shared standing clip pushed 100 N (Wooten's sideways figure) to its left at the chest
     for 0.25 s: with the hip strategy (the whole-clip default) it stays up without a step;
     without it (``hip_weight`` 0) its capture point leaves the left foot and it falls (it held
     95 N)."""
-    from reactmocap.library.bvh import read_bvh
-
-    clip = shared_mocap_dir / "dataset-1_bye_normal_001.bvh"
-    if not clip.is_file():
-        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
-    bye = read_bvh(clip)
-    path = reference_path(World(build_character(bye, frame=0)), 0, bye)
-    assert path.sole_yaw is not None
-    yaw = path.sole_yaw[round(1.0 * path.fps)]
-    left = float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum())) + np.pi / 2
-    force = [100.0 * np.cos(left), 100.0 * np.sin(left), 0.0]
+    bye, force = _shared_push(shared_mocap_dir, "bye_normal_001", 1.0, 90.0, 100.0)
 
     def push(params: dict[str, float]) -> TrackResult:
         return push_clip(bye, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
@@ -92,17 +100,7 @@ def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip
     default) it walks on; without (0) the steps keep the clip's pace and it falls forward."""
-    from reactmocap.library.bvh import read_bvh
-
-    clip = shared_mocap_dir / "dataset-1_walk_normal_001.bvh"
-    if not clip.is_file():
-        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
-    walk = read_bvh(clip)
-    path = reference_path(World(build_character(walk, frame=0)), 0, walk)
-    assert path.sole_yaw is not None
-    yaw = path.sole_yaw[round(2.0 * path.fps)]
-    front_right = float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum())) - np.pi / 4
-    force = [350.0 * np.cos(front_right), 350.0 * np.sin(front_right), 0.0]
+    walk, force = _shared_push(shared_mocap_dir, "walk_normal_001", 2.0, -45.0, 350.0)
 
     def push(params: dict[str, float]) -> TrackResult:
         return push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
