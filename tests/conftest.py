@@ -18,15 +18,22 @@ SHARED_MOCAP = REPO.parent / "shared" / "mocap"
 SYNTHETIC = REPO / "data" / "synthetic_clips"
 
 
-def linked_library(root: Path, *folders: Path) -> Path:
+def linked_library(root: Path, *folders: Path, without: tuple[str, ...] = ()) -> Path:
     """A library folder ``root/lib`` of links to every BVH in ``folders`` (e.g. the shared
-    clips and the synthetic ones side by side, as bench_reactions searches them)."""
+    clips and the synthetic ones side by side, as bench_reactions searches them) but the
+    clips named in ``without``."""
     lib = root / "lib"
     lib.mkdir()
     for folder in folders:
         for f in folder.glob("*.bvh"):
-            (lib / f.name).symlink_to(f)
+            if f.stem not in without:
+                (lib / f.name).symlink_to(f)
     return lib
+
+
+# the library some response tests' cases were found on, before the right-lying fall (the
+# search now finds it for some of those bodies, so the case no longer arises with it)
+BEFORE_RIGHT_FALL = ("fall_sideways_fast_right",)
 
 
 @pytest.fixture(scope="session")

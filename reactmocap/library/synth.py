@@ -452,7 +452,15 @@ CLIP_BUILDERS: dict[str, tuple[Callable[[], Clip], str]] = {
         "heavy reaction: fall_sideways twice as fast, on the left side 0.95 s in",
     ),
 }
-CLIP_INFO = {k: v[1] for k, v in CLIP_BUILDERS.items()}
+#: clips mirrored left/right from another (name -> (source, meaning)): the one sideways fall
+#: lies on the left side, where bodies pushed from the left in simulation lie on the right
+MIRRORED: dict[str, tuple[str, str]] = {
+    "fall_sideways_fast_right": (
+        "fall_sideways_fast",
+        "heavy reaction: fall_sideways_fast mirrored, on the right side 0.95 s in",
+    ),
+}
+CLIP_INFO = {k: v[1] for k, v in CLIP_BUILDERS.items()} | {k: v[1] for k, v in MIRRORED.items()}
 ATTACK_CLIPS = ("front_kick", "side_kick", "punch", "push")
 #: joints whose position (or end site) strikes, per attack clip
 STRIKERS: dict[str, tuple[str, ...]] = {
@@ -465,7 +473,12 @@ STRIKERS: dict[str, tuple[str, ...]] = {
 
 def synthetic_clips(fps: float = 60.0) -> dict[str, Motion]:
     """Every synthetic clip, name -> Motion (deterministic: no randomness)."""
-    return {name: clip_motion(build(), fps, name) for name, (build, _) in CLIP_BUILDERS.items()}
+    clips = {name: clip_motion(build(), fps, name) for name, (build, _) in CLIP_BUILDERS.items()}
+    for name, (src, _) in MIRRORED.items():
+        # the skeleton is symmetric, so the mirror's swapped offsets are its own
+        m = clips[src].mirror("y")
+        clips[name] = m.replace(skeleton=clips[src].skeleton, name=name)
+    return clips
 
 
 def write_synthetic_library(out_dir: str | Path, fps: float = 60.0) -> list[Path]:

@@ -26,7 +26,7 @@ from reactmocap.response.scenario import (
     load_scenario,
 )
 from reactmocap.rotations import quat_conj, quat_log, quat_mul
-from tests.conftest import REPO, SYNTHETIC, linked_library
+from tests.conftest import BEFORE_RIGHT_FALL, REPO, SYNTHETIC, linked_library
 
 EXAMPLES = REPO / "examples"
 
@@ -202,12 +202,13 @@ def _bench_physical(**kw: Any) -> ResponseConfig:
 
 
 def _bench_kick(shared_mocap_dir: Path, tmp_path: Path, recipient: str, facing_deg: float,
-                position: tuple[float, float], mode: str = "physical") -> Scenario:  # fmt: skip
+                position: tuple[float, float], mode: str = "physical",
+                without: tuple[str, ...] = ()) -> Scenario:  # fmt: skip
     """bench_reactions' real kick at a real recipient (its ``REAL`` settings, in ``mode``)."""
     from dataclasses import replace
 
     return Scenario(
-        library=linked_library(tmp_path, shared_mocap_dir, SYNTHETIC),
+        library=linked_library(tmp_path, shared_mocap_dir, SYNTHETIC, without=without),
         recipient=CharacterSpec(recipient, start=0.5),
         attacker=AttackerSpec("dataset-1_kick_normal_001", start=0.9333333333333333,
                               facing_deg=facing_deg, position=position),
@@ -241,7 +242,7 @@ def test_a_blend_held_by_contact_still_moves_the_root_smoothly(
     # correction is 0.05 m)
     from reactmocap.response.final import ROOT_BLEND_MIN_S
 
-    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC, without=BEFORE_RIGHT_FALL)
     scenario = _real_kick(lib, "dataset-1_walk_normal_001", 164.64459363196647,
                           (2.1888065748710512, 0.1540919325202299), "walk-kick")  # fmt: skip
     scenario = replace(scenario, response=replace(scenario.response, blend_place=False))
@@ -328,6 +329,7 @@ def test_a_leg_the_blend_turns_into_the_attacker_is_held_with_the_pelvis(
         "dataset-1_walk-right_normal_001",
         162.95691247341688,
         (2.0136727200528957, 0.0003111082439202495),
+        without=BEFORE_RIGHT_FALL,
     )
     res = run_response(scenario)
     assert res.report["quality"]["blend_root_offset_max_m"] > 0.3  # the case: a large correction
@@ -387,7 +389,7 @@ def test_an_unstable_simulation_2_is_reported_not_fatal_in_the_blend_mode(
                         lambda: SearchWeights(trunk_orientation=0.75))  # fmt: skip
     scenario = _bench_kick(shared_mocap_dir, tmp_path, "dataset-1_walk-right_normal_001",
                            162.95691247341688, (2.0136727200528957, 0.0003111082439202495),
-                           mode="blend")  # fmt: skip
+                           mode="blend", without=BEFORE_RIGHT_FALL)  # fmt: skip
     res = run_response(scenario)
     stopped = [w for w in res.report["warnings"] if w.startswith("Simulation 2 stopped early")]
     assert len(stopped) == 1 and "unstable" in stopped[0]
