@@ -432,7 +432,8 @@ def settle(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naiv
     for end in range(i_match - i_imp, times.size, step):
         if cfg.blend_place:
             at = placed(cast, contact, cont, sim2, (i_imp + end) / fps)[0]
-            found = desired_motion(cast, cfg, times, naive.impact_time, yields, at)
+            if at is not cont:  # a falling clip, moved for this landing (else as found)
+                found = desired_motion(cast, cfg, times, naive.impact_time, yields, at)
         sim, target = simulated.slice(0, end + 1), found.slice(0, end + 1)
         out = final_blend(sim, _with_end_gap(sim, target) if cfg.blend_end_gap else target)
         if cfg.foot_lock:
