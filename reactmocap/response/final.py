@@ -334,8 +334,11 @@ def blend(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naive
     i_imp = int(np.ceil(naive.impact_time * fps - 1e-9))
     i_end = int(round(sim2.landed * fps))
     moved = (0.0, 0.0)
-    if cfg.mode == "blend" and cfg.blend_place:
-        cont, moved = placed(cast, contact, cont, sim2, sim2.landed)
+    if cfg.blend_place:
+        # the physical mode's body landed within ``land_position`` of the clip: its ground
+        # residual is taken up by the clip's placement, the blend corrects the rest
+        within = cfg.land_position if cfg.mode == "physical" else None
+        cont, moved = placed(cast, contact, cont, sim2, sim2.landed, within)
     # every piece with a dummy top joint on the ground under the pelvis, unturned while blending
     # (ground_root): the blend then moves the body, not meters of offset between the clips'
     # dummy roots; the output is grounded and turned to the heading as a whole
@@ -445,19 +448,26 @@ def settle(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Naiv
 
 
 def placed(cast: Cast, contact: ContactEstimate, cont: Continuation, sim2: TransitionSimulation,
-           landed: float) -> tuple[Continuation, tuple[float, float]]:  # fmt: skip
-    """``cont`` with its found clip, where it falls, moved on the ground so that its pelvis is
-    over Simulation 2's at scenario time ``landed``, and that shift (m; zero for a clip that
-    does not fall): the search placed it over Simulation 1's at the match, and a falling body
-    travels on, where a standing one reaches its clip's place on its planted legs (the blend
-    mode's ``blend_place``)."""
+           landed: float, within: float | None = None) -> tuple[Continuation, tuple[float, float]]:  # fmt: skip
+    """``cont`` with its found clip moved on the ground so that its pelvis is over Simulation
+    2's at scenario time ``landed`` (the clip's frame there, time-warped by the landing's
+    phase), and that shift (m). ``within`` None (the blend mode's ``blend_place``): only a
+    clip that falls (zero shift otherwise): the search placed it over Simulation 1's at the
+    match, and a falling body travels on, where a standing one reaches its clip's place on its
+    planted legs. ``within`` a distance (the physical mode's): any clip, moved at most that
+    far (the body landed within ``land_position`` of the search's placement, and a shift on
+    flat ground is as valid a placement as the search's)."""
     parts = cast.recipient.parts
-    if not intended_fall(cont.found_clip, parts, cont.best.frame):
+    if within is None and not intended_fall(cont.found_clip, parts, cont.best.frame):
         return cont, (0.0, 0.0)
     pelvis = parts.joint_of("pelvis")
     body = sim2.motion.sample([landed - contact.rewind]).global_positions()[0, pelvis]
-    clip = cont.found.sample([cont.best.time + (landed - cont.time)]).global_positions()[0, pelvis]
-    dx, dy = (float(v) for v in body[:2] - clip[:2])
+    on = cont.best.time + (landed - cont.time) + sim2.landing_phase
+    clip = cont.found.sample([on]).global_positions()[0, pelvis]
+    d = body[:2] - clip[:2]
+    if within is not None:
+        d *= min(1.0, within / max(float(np.linalg.norm(d)), 1e-12))
+    dx, dy = (float(v) for v in d)
     return replace(cont, found=cont.found.transformed(0.0, (dx, dy))), (dx, dy)
 
 
