@@ -295,3 +295,44 @@ def test_a_negative_land_replan_is_a_clear_error() -> None:
             "impact": {}, "response": {"mode": "physical", "land_replan": -0.1}}  # fmt: skip
     with pytest.raises(ConfigError, match=r"\[response\]\.land_replan"):
         parse_scenario(data, source="s.toml")
+
+
+def test_a_landed_kick_is_placed_under_the_body_and_the_blend_corrects_only_the_rest() -> None:
+    # the sweep's kick from 60 deg lands on `step_left` 4 cm (ground plane) from where the
+    # search placed it: the clip is moved on the ground under the body's pelvis at the landing
+    # (`blend_place`, reported as `found_shift_m`), so the final blend moves the root only by
+    # what is left (the height); unplaced, it moves it the whole 4 cm
+    from reactmocap import metrics as qm
+    from reactmocap.response import final, stages
+
+    sc = _facing(60.0, "physical")
+    cfg = sc.response
+    cast = stages.cast(sc, CACHE)
+    contact = stages.estimate_contact(sc, cast)
+    naive = stages.naive_simulation(sc, cast, contact)
+    cont = stages.search_continuation(sc, cast, contact, naive)
+    sim2 = stages.transition_simulation(sc, cast, contact, naive, cont)
+    assert sim2.on_clip and sim2.landing_gap[0] > 0.03, sim2.landing_gap
+    parts = cast.recipient.parts
+    out = final.blend(sc, cast, contact, naive, cont, sim2)
+    old = final.blend(replace(sc, response=replace(cfg, blend_place=False)), cast, contact,
+                      naive, cont, sim2)  # fmt: skip
+    placed = qm.blend_root_offset_max_m(out.simulated, out.blended, parts)
+    dragged = qm.blend_root_offset_max_m(old.simulated, old.blended, parts)
+    assert dragged == pytest.approx(sim2.landing_gap[0], abs=0.005)
+    assert placed <= 0.02 < dragged, (placed, dragged)
+    shift = np.hypot(*out.found_shift)
+    assert 0.02 < shift <= cfg.land_position + 1e-9 and old.found_shift == (0.0, 0.0)
+    # what is left is the height: the found clip's pelvis over the body's on the ground plane
+    pelvis = parts.joint_of("pelvis")
+    body = out.simulated.global_positions()[-1, pelvis]
+    clip = out.blended.global_positions()[-1, pelvis]
+    assert np.allclose(body[:2], clip[:2], atol=1e-3), (body, clip)
+    assert placed == pytest.approx(abs(body[2] - clip[2]), abs=1e-3)
+    # the joints are not the placement's to correct: the same blend
+    same = qm.blend_joint_correction_max_rad(old.simulated, old.blended)
+    assert qm.blend_joint_correction_max_rad(out.simulated, out.blended) == pytest.approx(same)
+    # the shift is bounded by the landing tolerance, whatever the body's distance
+    near = final.placed(cast, contact, cont, sim2, sim2.landed, within=0.01)[1]
+    assert np.hypot(*near) == pytest.approx(0.01)
+    assert np.allclose(np.asarray(near) / 0.01, np.asarray(out.found_shift) / shift)
