@@ -102,7 +102,7 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
         except SearchError:  # Simulation 2 too short for a window past the match
             break
         other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, plan)
-        if _landing_score(scenario, other) >= _landing_score(scenario, sim2):
+        if _landing_score(other) >= _landing_score(sim2):
             break
         cont, sim2 = plan, other
     if not sim2.on_clip:
@@ -111,7 +111,7 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     for alt, steps in retries:
         other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, alt,
                       steps)  # fmt: skip
-        if _landing_score(scenario, other) < _landing_score(scenario, sim2):
+        if _landing_score(other) < _landing_score(sim2):
             cont, sim2 = alt, other
         if sim2.on_clip:
             break
@@ -161,14 +161,10 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     )
 
 
-def _landing_score(scenario: Scenario, sim2: stages.TransitionSimulation) -> float:
-    """How far Simulation 2's body landed from its found clip: its largest landing gap over
-    the tolerance (<= 1: landed; a simulation that went unstable is worst)."""
-    cfg = scenario.response
-    if sim2.unstable is not None:
-        return np.inf
-    tol = (cfg.land_position, cfg.land_angle, cfg.land_joint)
-    return float(np.max(np.asarray(sim2.landing_gap) / tol))
+def _landing_score(sim2: stages.TransitionSimulation) -> float:
+    """How close Simulation 2's body came to its found clip: its closest landing check's
+    largest gap over the tolerance (<= 1: landed; a simulation that went unstable is worst)."""
+    return np.inf if sim2.unstable is not None else sim2.landing_score
 
 
 def _blend_score(cast: stages.Cast, out: final.Blend) -> tuple[bool, float]:

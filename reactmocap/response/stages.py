@@ -20,6 +20,7 @@ from reactmocap.library.bvh import read_bvh
 from reactmocap.library.clip_library import ClipLibrary
 from reactmocap.library.motion import Motion
 from reactmocap.library.placement import ground_root, place
+from reactmocap.metrics import WARN_ROOT_TURN_RAD
 from reactmocap.response.blend import blend_poses, smoothstep, transition_weights
 from reactmocap.response.library_cache import LibraryCache
 from reactmocap.response.reaction import AssistUntilHit, YieldOnImpact, yield_schedule
@@ -548,6 +549,8 @@ class _Landing:
         self.gap = np.full(3, np.inf)  # the last check's pelvis (m), root and joint (rad) gaps
         self.phase = 0.0  # the last check's time shift onto the found clip (s)
         self.best = (np.inf, after, self.gap, 0.0)  # (largest gap / tolerance, time, gaps, phase)
+        # where a body that never lands hands off: the check the final blend corrects least
+        self.handoff = self.best
 
     def __call__(self, world: World, t: float) -> str | None:
         if t < self.after - 1e-9:
@@ -574,6 +577,15 @@ class _Landing:
         score, self.gap, self.phase = float(scores[k]), gaps[k], float(offs[k]) / self.rate
         if score < self.best[0]:
             self.best = (score, t, self.gap, self.phase)
+        # the final blend's correction: the pelvis's gap less the ground shift the clip's
+        # placement takes up (``final.placed``), the joints, the root's turn (its warning)
+        d = cur[:3] - want[:, :3]
+        ground = np.maximum(np.hypot(d[:, 0], d[:, 1]) - self.tol[0], 0.0)
+        left = np.maximum(np.maximum(np.hypot(ground, d[:, 2]) / self.tol[0],
+                                     turn[:, 0] / WARN_ROOT_TURN_RAD), gaps[:, 2] / self.tol[2])  # fmt: skip
+        h = int(np.argmin(left))
+        if left[h] < self.handoff[0]:
+            self.handoff = (float(left[h]), t, gaps[h], float(offs[h]) / self.rate)
         if score <= 1.0:
             self.at = t
             return "landed on the found clip"
@@ -614,6 +626,9 @@ class TransitionSimulation:
     landing_phase: float = 0.0
     #: physical mode: the tracker took at least one capture-point balance step (``land_step_time``)
     balance_steps: bool = False
+    #: physical mode: the closest landing check's largest gap over its tolerance (<= 1: landed;
+    #: how the retries compare rollouts; a body that never lands hands off elsewhere)
+    landing_score: float = 0.0
 
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
@@ -691,14 +706,15 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
     assert res.contact_log is not None
-    landed, on_clip, gap, phase = cont.time, True, (0.0, 0.0, 0.0), 0.0
+    landed, on_clip, gap, phase, score = cont.time, True, (0.0, 0.0, 0.0), 0.0, 0.0
     if landing is not None:
         on_clip = landing.at is not None
-        # not landed: where the body came closest (a simulation that went unstable before the
-        # match still lands no earlier than it)
-        _, at, last, phase = landing.best
+        # not landed: where the final blend corrects least (a simulation that went unstable
+        # before the match still lands no earlier than it)
+        score, (_, at, last, phase) = landing.best[0], landing.handoff
         if landing.at is not None:
             at, last, phase = landing.at, landing.gap, landing.phase
+            score = float(np.max(last / landing.tol))
         elif not np.isfinite(last).all():  # never checked (unstable before the match)
             at, last, phase = res.duration, landing.gap, 0.0
         landed = max(cont.time, rewind + min(at, res.duration))
@@ -707,7 +723,7 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     stepped = steps and isinstance(tracker, WholeBodyTracker) and bool(tracker.steps_taken)
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
                                 res.contact_log, release, landed, on_clip, gap,
-                                unstable, phase, stepped)  # fmt: skip
+                                unstable, phase, stepped, score)  # fmt: skip
 
 
 class _StiffenFrom:
