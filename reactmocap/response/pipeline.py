@@ -237,7 +237,7 @@ def _report(
             f"physical mode: the body did not reach the found clip within {cfg.land_within} s "
             f"(pelvis {gap[0]:.2f} m, root {gap[1]:.2f} rad, a joint {gap[2]:.2f} rad off; "
             f"tolerances {cfg.land_position} m, {cfg.land_angle} rad, {cfg.land_joint} rad, "
-            "where it came closest): the blend closed the rest"
+            "where the blend corrects least): the blend closed the rest"
         )
     return {
         "scenario": scenario.name,

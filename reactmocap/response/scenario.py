@@ -160,7 +160,9 @@ class ResponseConfig:
     #: blend mode: a found clip that falls is moved on the ground so that its pelvis is over
     #: Simulation 2's at the landing (the search placed it over Simulation 1's at the match,
     #: and a falling body travels on: the real walkers kicked lay 0.4-0.55 m past it; a
-    #: standing clip keeps its place); the report gives the shift (``transition.found_shift_m``)
+    #: standing clip keeps its place); physical mode: any found clip, moved at most
+    #: ``land_position`` (the body landed within that of it: the final blend then corrects the
+    #: height, not the ground offset); the report gives the shift (``transition.found_shift_m``)
     blend_place: bool = True
     #: blend mode: the final blend corrects only the gap between Simulation 2 and the found
     #: clip at the landing, each joint's turn growing linearly over the transition as the root

@@ -524,8 +524,11 @@ class _Landing:
     within the landing tolerances of the desired path ``q`` (qpos per control tick, ``rate``
     Hz from the rollout's start); ``at`` is then that time (None until it is). Until then it
     keeps the check where the body came closest (``best``: the largest gap over its
-    tolerance smallest): a body that never lands lands there, not wherever it has drifted (or
-    fallen) to when the time is up.
+    tolerance smallest; the give-up and the retries go by it) and the check where the final
+    blend corrects least (``handoff``: the pelvis's gap beyond the ground shift the clip's
+    placement takes up, over ``land_position``; the root's turn over its warning; the largest
+    joint over ``land_joint``; the largest of the three smallest): a body that never lands
+    hands off there, not wherever it has drifted (or fallen) to when the time is up.
 
     ``clip`` (the found clip's qpos per tick, ``pad`` ticks before the rollout's start and
     after its end) and ``offsets`` (ticks) time-warp the check: the body is compared with the
@@ -534,7 +537,7 @@ class _Landing:
     early is on it, at another frame; the blend then lands on that frame.
 
     A body :data:`LAND_GIVE_UP` times further off than at its closest, :data:`LAND_GIVE_UP_S`
-    after it and after ``keep`` s, stops the rollout (it lands where it came closest)."""
+    after it and after ``keep`` s, stops the rollout (a body fallen away hands off at an earlier check)."""
 
     def __init__(self, cfg: ResponseConfig, q: F64, rate: float, after: float,
                  clip: F64 | None = None, offsets: NDArray[np.int64] | None = None,
@@ -590,7 +593,7 @@ class _Landing:
             self.at = t
             return "landed on the found clip"
         # long past its closest and far from it, the body has fallen away: the rest of
-        # ``land_within`` would only cost time (it lands where it came closest)
+        # ``land_within`` would only cost time (it hands off at an earlier check)
         late = t > max(self.best[1] + LAND_GIVE_UP_S, self.keep)
         if late and score > LAND_GIVE_UP * max(self.best[0], 1.0):
             return "fell away from the found clip"

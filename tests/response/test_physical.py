@@ -336,3 +336,61 @@ def test_a_landed_kick_is_placed_under_the_body_and_the_blend_corrects_only_the_
     near = final.placed(cast, contact, cont, sim2, sim2.landed, within=0.01)[1]
     assert np.hypot(*near) == pytest.approx(0.01)
     assert np.allclose(np.asarray(near) / 0.01, np.asarray(out.found_shift) / shift)
+
+
+def test_a_body_that_never_lands_hands_off_where_the_blend_corrects_least() -> None:
+    # a real World on the light push's recipient, never within the tolerances: at 0.2 s a joint
+    # 0.15 rad off (the closest check: 1.5 tolerances), at 0.3 s the joints within 0.05 rad but
+    # the root turned 0.3 rad (1.8 tolerances of `land_angle`, half the root-turn warning) and
+    # the pelvis 6 cm off on the ground (what the clip's placement takes up, but 1 cm): the
+    # hand-off is the second, where the final blend turns no joint past `land_joint`
+    from reactmocap import metrics as qm
+    from reactmocap.response import stages
+    from reactmocap.rotations import quat_mul
+    from reactmocap.sim.world import World
+
+    sc = _physical("light_push")
+    cfg = sc.response
+    cast = stages.cast(sc, CACHE)
+    rec = cast.recipient
+    q = rec.character.qpos_from_motion(rec.motion)
+    world = World([rec.character])
+    span = world.characters[0].qpos_slice
+    landing = stages._Landing(cfg, q, rec.motion.fps, after=0.1)
+
+    def turned(a: float) -> np.ndarray:
+        return np.array([np.cos(a / 2), 0.0, 0.0, np.sin(a / 2)])
+
+    for t, joint, root, shift in ((0.2, 0.15, 0.0, 0.0), (0.3, 0.05, 0.3, 0.06)):
+        want = q[int(round(t * rec.motion.fps))].copy()
+        want[7:11] = quat_mul(want[7:11], turned(joint))  # the first joint after the free root
+        want[3:7] = quat_mul(turned(root), want[3:7])
+        want[0] += shift
+        world.data.qpos[span] = want
+        assert landing(world, t) is None  # never within the tolerances
+    assert landing.at is None
+    score, at, gap, _ = landing.best
+    assert at == 0.2 and score == pytest.approx(1.5, abs=1e-5)  # the closest check
+    left, at, gap, _ = landing.handoff
+    assert at == 0.3, landing.handoff
+    assert gap[2] == pytest.approx(0.05, abs=1e-6) and gap[1] == pytest.approx(0.3, abs=1e-6)
+    assert left == pytest.approx(max(0.01 / cfg.land_position, 0.3 / qm.WARN_ROOT_TURN_RAD,
+                                     0.5), abs=1e-5)  # fmt: skip
+
+
+def test_a_kick_that_does_not_land_hands_off_with_no_joint_past_the_tolerance() -> None:
+    # the sweep's kick from 270 deg never lands (re-plans, steps and other clips included): at
+    # its closest check a joint is 0.115 rad off; it hands off where the final blend turns no
+    # joint past `land_joint` (the root's turn within its warning), and the report still says
+    # it did not land
+    from reactmocap import metrics as qm
+
+    sc = _facing(270.0, "physical")
+    rep = run_response(sc, CACHE).report
+    tr, q = rep["transition"], rep["quality"]
+    assert not tr["landed_on_clip"], tr
+    assert _score(rep, sc) > 1.0
+    assert q["blend_joint_correction_max_rad"] <= sc.response.land_joint + 1e-9, q
+    assert q["blend_root_turn_max_rad"] <= qm.WARN_ROOT_TURN_RAD, q
+    assert q["blend_root_offset_max_m"] <= 0.02, q
+    assert any("physical mode" in w for w in rep["warnings"]), rep["warnings"]
