@@ -89,10 +89,11 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     sim2 = timed("sim2", stages.transition_simulation, at_match, cast, contact, naive, cont)
     # the body did not land: a re-plan from where it is (``land_replan``), the same clip with
     # balance steps (``land_step_time``), then the search's next-best clips (``land_tries``);
-    # the one it comes closest to wins
+    # the one it comes closest to wins; if none lands, the one the final blend corrects least
     first = cont
     physical = cfg.mode == "physical"
     retries: list[tuple[stages.Continuation, bool]] = []
+    tried = [(cont, sim2)]
     for _ in range(stages.REPLANS if physical and cfg.land_replan > 0 else 0):
         if sim2.on_clip or sim2.unstable is not None:
             break
@@ -102,6 +103,7 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
         except SearchError:  # Simulation 2 too short for a window past the match
             break
         other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, plan)
+        tried.append((plan, other))
         if _landing_score(other) >= _landing_score(sim2):
             break
         cont, sim2 = plan, other
@@ -111,10 +113,13 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
     for alt, steps in retries:
         other = timed("sim2", stages.transition_simulation, scenario, cast, contact, naive, alt,
                       steps)  # fmt: skip
+        tried.append((alt, other))
         if _landing_score(other) < _landing_score(sim2):
             cont, sim2 = alt, other
         if sim2.on_clip:
             break
+    if physical and not sim2.on_clip:
+        cont, sim2 = min(tried, key=lambda c: _handoff_score(c[1]))
     out = timed("blend", final.blend, scenario, cast, contact, naive, cont, sim2)
     tries = cfg.mode == "blend" and cfg.land_tries > 1
     score = _blend_score(cast, out) if tries or settles else (False, 0.0)
@@ -159,6 +164,12 @@ def run_response(scenario: Scenario, cache: LibraryCache | None = None) -> Respo
         hit=_hit_marks(scenario, cast, contact, sim2, out),
         undisturbed=rec.motion.sample(out.recipient.times + rec.clock0).replace(fps=fps),
     )
+
+
+def _handoff_score(sim2: stages.TransitionSimulation) -> float:
+    """What the final blend corrects at the hand-off of a body that never landed, over its
+    budgets (``stages._Landing.handoff``; a simulation that went unstable is worst)."""
+    return np.inf if sim2.unstable is not None else sim2.handoff_score
 
 
 def _landing_score(sim2: stages.TransitionSimulation) -> float:

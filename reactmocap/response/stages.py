@@ -632,6 +632,9 @@ class TransitionSimulation:
     #: physical mode: the closest landing check's largest gap over its tolerance (<= 1: landed;
     #: how the retries compare rollouts; a body that never lands hands off elsewhere)
     landing_score: float = 0.0
+    #: physical mode, a body that never landed: what the final blend corrects at the hand-off
+    #: (``_Landing.handoff``'s score); how such rollouts compare
+    handoff_score: float = 0.0
 
 
 def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstimate,
@@ -709,12 +712,12 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     )  # fmt: skip
     attacker = res.motion(1, fps[-1], name="attacker_sim") if cast.attacker is not None else None
     assert res.contact_log is not None
-    landed, on_clip, gap, phase, score = cont.time, True, (0.0, 0.0, 0.0), 0.0, 0.0
+    landed, on_clip, gap, phase, score, left = cont.time, True, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0
     if landing is not None:
         on_clip = landing.at is not None
         # not landed: where the final blend corrects least (a simulation that went unstable
         # before the match still lands no earlier than it)
-        score, (_, at, last, phase) = landing.best[0], landing.handoff
+        score, (left, at, last, phase) = landing.best[0], landing.handoff
         if landing.at is not None:
             at, last, phase = landing.at, landing.gap, landing.phase
             score = float(np.max(last / landing.tol))
@@ -726,7 +729,7 @@ def transition_simulation(scenario: Scenario, cast: Cast, contact: ContactEstima
     stepped = steps and isinstance(tracker, WholeBodyTracker) and bool(tracker.steps_taken)
     return TransitionSimulation(res.motion(0, name="sim2"), attacker, res.steps, world,
                                 res.contact_log, release, landed, on_clip, gap,
-                                unstable, phase, stepped, score)  # fmt: skip
+                                unstable, phase, stepped, score, left)  # fmt: skip
 
 
 class _StiffenFrom:
