@@ -8,13 +8,11 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
-from scipy.ndimage import maximum_filter1d, minimum_filter1d, uniform_filter1d
-from scipy.spatial.transform import Rotation
 
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
-from reactmocap.rotations import quat_continuous, quat_mul
-from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES, qvel_from_qpos
+from reactmocap.rotations import quat_continuous
+from reactmocap.sim.character import BALL_JOINTS, qvel_from_qpos
 from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.world import World
 
@@ -137,20 +135,16 @@ def reference_path(
     reach: float = 0.05,
     pivot_rate: float | None = 2.0,
     slide_speed: float | None = None,
-    flat_feet: float = 0.0,
 ) -> ReferencePath:
     """``source`` on ``world``'s ``character`` as a :class:`ReferencePath`: a Motion on the
     character's skeleton, or a ``(T, 67)`` qpos path sampled at ``fps``. Foot stance is
     measured on the character's own sole boxes (``pivot_rate`` rad/s; ``None``: no pivots); a
     foot whose lowest corner moves faster than ``slide_speed`` (m/s) is not planted (``None``:
-    any foot within ``reach``, the short-window and response trackers' stance). ``flat_feet``
-    (rad; 0: off): a foot near the floor whose sole is tilted less than this in a quiet stance
-    is levelled, its leg bent to keep it as near the floor (see :func:`_level_feet`)."""
+    any foot within ``reach``, the short-window and response trackers' stance)."""
     for name, value in (
         ("reach", reach),
         ("pivot_rate", 0.0 if pivot_rate is None else pivot_rate),
         ("slide_speed", 0.0 if slide_speed is None else slide_speed),
-        ("flat_feet", flat_feet),
     ):
         if not (np.isfinite(value) and value >= 0):
             raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -167,13 +161,9 @@ def reference_path(
         rate = float(fps)
     n = q.shape[0]
     q[:, 3:] = quat_continuous(q[:, 3:].reshape(n, NJ + 1, 4)).reshape(n, -1)
-    corner_z, centre, yaw, com, up = _sole_tracks(world, character, q)
-    if flat_feet > 0:
-        low_z = corner_z[..., 2].min(axis=2)
-        q = _level_feet(world, character, q, low_z < reach, float(flat_feet), rate)
-        corner_z, centre, yaw, com, up = _sole_tracks(world, character, q)
     v = qvel_from_qpos(q, rate)
     a = np.gradient(v, 1.0 / rate, axis=0) if n > 2 else np.zeros_like(v)
+    corner_z, centre, yaw, com, up = _sole_tracks(world, character, q)
     low = np.argmin(corner_z[..., 2], axis=2)[..., None, None]  # (T, 2, 1, 1)
     planted = np.take_along_axis(corner_z[..., 2], low[..., 0], axis=2)[..., 0] < reach
     rate_yaw = np.zeros((n, 2))
@@ -191,101 +181,6 @@ def reference_path(
     for arr in arrays:
         arr.flags.writeable = False
     return ReferencePath(q, v, a, planted, pivoting, rate, centre, yaw, corner_z, com, up)
-
-
-def _level_feet(
-    world: World, character: int, q: F64, near: NDArray[np.bool_], max_tilt: float, fps: float
-) -> F64:
-    """``q`` with each foot near the floor (``near`` ``(T, 2)``) turned level, in full below
-    ``max_tilt`` rad of tilt and fading out to ``2 max_tilt`` (a heel the actor raises high
-    stays raised), eased in and out over 0.1 s so the path's velocities stay bounded. The
-    ankle moves up or down by what levelling changes the sole's lowest corner's height (the
-    knee bends or straightens, the hip turns the leg onto the new ankle), so the levelled foot
-    is as near the floor as the mocap's. The box feet have no toes: a sole the mocap holds a
-    few degrees off level stands the simulated foot on one or two corners."""
-    n = q.shape[0]
-    pos, rot = _leg_frames(world, character, q)  # (T, 2, 3, 3), (T, 2, 3, 3, 3)
-    hip, knee, ankle = pos[:, :, 0], pos[:, :, 1], pos[:, :, 2]
-    thigh, shin, foot = rot[:, :, 0], rot[:, :, 1], rot[:, :, 2]
-    _, sole, box = foot_soles(world, character, "reference_path")
-    m = world.model
-    local = np.stack([Rotation.from_quat(m.geom_quat[s], scalar_first=True).as_matrix()
-                      for s in sole])  # fmt: skip
-    corners = m.geom_pos[sole][:, None] + np.einsum("fij,fkj->fki", local, box)  # foot frame
-    up = np.einsum("tfij,fj->tfi", foot, local[:, :, 2])
-    tilt = np.arccos(np.clip(up[..., 2], -1.0, 1.0))
-    # only a quiet stance: near the floor and never tilted beyond 2 max_tilt within 0.2 s
-    # (a heel rising to step or landing keeps the mocap's roll-off)
-    k = max(1, round(0.1 * fps))
-    quiet = near * np.clip(2.0 - maximum_filter1d(tilt, 4 * k + 1, axis=0) / max_tilt, 0, 1)
-    amount = uniform_filter1d(minimum_filter1d(quiet, 2 * k + 1, axis=0), 2 * k + 1, axis=0)
-    level = _turns(up, np.broadcast_to([0.0, 0.0, 1.0], up.shape), amount)
-    flat = level @ foot
-
-    def lowest(r: F64) -> F64:
-        return np.einsum("tfij,fkj->tfki", r, corners)[..., 2].min(axis=-1)
-
-    target = ankle.copy()
-    target[..., 2] -= lowest(flat) - lowest(foot)
-    # the knee bent (about the leg's plane's normal) to the hip-ankle distance the target
-    # needs, then the leg turned about the hip onto it
-    u, v = knee - hip, ankle - knee
-    l1, l2 = np.linalg.norm(u, axis=-1), np.linalg.norm(v, axis=-1)
-    fwd = np.einsum("tfij,fj->tfi", foot, local[:, :, 0])
-    normal = np.cross(u, v) + 1e-3 * (l1 * l2)[..., None] * np.cross(fwd, u)  # straight legs
-    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
-    bend = np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1), np.einsum("tfi,tfi->tf", u, v))
-    reach2 = np.sum((target - hip) ** 2, axis=-1)
-    bend_to = np.arccos(np.clip((reach2 - l1**2 - l2**2) / (2 * l1 * l2), -1.0, 1.0))
-    knee_turn = Rotation.from_rotvec((normal * (bend_to - bend)[..., None]).reshape(-1, 3))
-    knee_rot = knee_turn.as_matrix().reshape(n, 2, 3, 3)
-    moved = knee + np.einsum("tfij,tfj->tfi", knee_rot, v)
-    hip_rot = _turns(moved - hip, target - hip, np.ones((n, 2)))
-    leg = hip_rot @ knee_rot
-    turns = {
-        "hip": np.swapaxes(thigh, -1, -2) @ hip_rot @ thigh,
-        "knee": np.swapaxes(shin, -1, -2) @ knee_rot @ shin,
-        "ankle": np.swapaxes(foot, -1, -2) @ np.swapaxes(leg, -1, -2) @ flat,
-    }
-    out = q.copy()
-    for joint, turn in turns.items():
-        # a joint's world rotation is its parent's times its own: the turn in the child's
-        # frame multiplies the joint's quaternion from the right
-        wxyz = Rotation.from_matrix(turn.reshape(-1, 3, 3)).as_quat(scalar_first=True)
-        for f, side in enumerate("lr"):
-            adr = 7 + 4 * BALL_JOINTS.index(f"{side}_{joint}")
-            out[:, adr : adr + 4] = quat_mul(q[:, adr : adr + 4], wxyz.reshape(n, 2, 4)[:, f])
-    return out
-
-
-def _turns(a: F64, b: F64, amount: F64) -> F64:
-    """Rotation matrices ``(..., 3, 3)`` turning directions ``a`` toward ``b`` (``(..., 3)``)
-    by the fraction ``amount`` ``(...)`` of the angle between them (about ``a x b``)."""
-    axis = np.cross(a, b)
-    sin = np.linalg.norm(axis, axis=-1)
-    angle = np.arctan2(sin, np.einsum("...i,...i->...", a, b)) * amount
-    rotvec = axis * (angle / np.maximum(sin, 1e-12))[..., None]
-    return Rotation.from_rotvec(rotvec.reshape(-1, 3)).as_matrix().reshape(*a.shape, 3)
-
-
-def _leg_frames(world: World, character: int, q: F64) -> tuple[F64, F64]:
-    """Per qpos row, the thigh's, shin's and foot's world origins ``(T, 2, 3, 3)`` and
-    rotations ``(T, 2, 3, 3, 3)`` of the left then the right leg."""
-    m = world.model
-    wc = world.characters[character]
-    ids = np.array(
-        [[wc.body_ids[SIM_BODIES.index(f"{s}_{b}")] for b in ("thigh", "shin", "foot")]
-         for s in "lr"]
-    )  # fmt: skip
-    d = mujoco.MjData(m)
-    pos = np.empty((q.shape[0], 2, 3, 3))
-    rot = np.empty((q.shape[0], 2, 3, 3, 3))
-    for i in range(q.shape[0]):  # once per clip, not in the step loop
-        d.qpos[wc.qpos_slice] = q[i]
-        mujoco.mj_kinematics(m, d)
-        pos[i] = d.xpos[ids]
-        rot[i] = d.xmat[ids].reshape(2, 3, 3, 3)
-    return pos, rot
 
 
 def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F64, F64]:
