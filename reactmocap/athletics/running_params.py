@@ -121,8 +121,9 @@ class RunParams:
             neighbouring speeds (``docs/athletics.md``, the eighth round).
         step_landing: the commanded step's landing: the share (0-1) of ``step_stance`` over
             which the touchdown's downward speed is taken out along a quarter-sine, so the
-            leg's force at touchdown grows with the fall's speed (0: the half-cosine's, one
-            body weight whatever the fall).
+            leg's force at touchdown grows with the fall's speed, ``m (g + pi |v_z| / (2
+            share step_stance))``: the shorter the share, the harder (0: off, the
+            half-cosine's, about one body weight whatever the fall).
         step_speed_gain: the commanded step's forward speed regulated within the stance: a
             horizontal force of this gain (1/s) times the body's mass times the forward
             speed's error, against it, added to the leg's (at most
