@@ -433,19 +433,6 @@ class Runner:
         phase = math.pi * s / ts
         want = self.vz_touchdown + 0.5 * dv * (1.0 - math.cos(phase))
         acc = 0.5 * dv * math.pi / ts * math.sin(phase)
-        land = k["step_landing"]
-        if land > 0:
-            # the fall's speed taken out over the landing share of the stance along a
-            # quarter-sine, whose deceleration is largest at touchdown (the half-cosine's is
-            # zero there: a landing at 1-2 m/s downward met one body weight of law and 20-30
-            # of impact); the half-cosine's own share of the fall is taken back out
-            tl = land * ts
-            q = 0.5 * math.pi * min(s / tl, 1.0)
-            v0 = self.vz_touchdown
-            want += v0 * (0.5 * (1.0 - math.cos(phase)) - math.sin(q))
-            acc += v0 * (
-                0.5 * math.pi / ts * math.sin(phase) - 0.5 * math.pi / tl * math.cos(q) * (s < tl)
-            )
         vz = float(self.senses.com_vel[2])
         fz = self.mass * (self.g + acc + k["step_gain"] * (want - vz))
         return min(fz / max(up, 0.5), STEP_FORCE * self.mass * self.g)

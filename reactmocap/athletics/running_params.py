@@ -119,11 +119,6 @@ class RunParams:
             human's (the shared run clip's) about 0.2 s with a flight of 0.17-0.22 s. An
             opt-in for the clip's speed (2.61 m/s, with ``push_hold`` 0.75): it falls at
             neighbouring speeds (``docs/athletics.md``, the eighth round).
-        step_landing: the commanded step's landing: the share (0-1) of ``step_stance`` over
-            which the touchdown's downward speed is taken out along a quarter-sine, so the
-            leg's force at touchdown grows with the fall's speed, ``m (g + pi |v_z| / (2
-            share step_stance))``: the shorter the share, the harder (0: off, the
-            half-cosine's, about one body weight whatever the fall).
         step_speed_gain: the commanded step's forward speed regulated within the stance: a
             horizontal force of this gain (1/s) times the body's mass times the forward
             speed's error, against it, added to the leg's (at most
@@ -177,7 +172,6 @@ class RunParams:
     step_takeoff: float | Speeds = 0.96
     step_gain: float | Speeds = 20.0
     step_placement: float | Speeds = 0.7
-    step_landing: float | Speeds = 0.0
     step_speed_gain: float | Speeds = 0.0
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
@@ -205,9 +199,6 @@ class RunParams:
         hold = self.push_hold if isinstance(self.push_hold, tuple) else (self.push_hold,)
         if not all(0.0 <= b <= 1.0 for b in hold):
             raise ConfigError(f"push_hold must be in [0, 1], got {self.push_hold}")
-        land = self.step_landing if isinstance(self.step_landing, tuple) else (self.step_landing,)
-        if not all(0.0 <= b <= 1.0 for b in land):
-            raise ConfigError(f"step_landing must be in [0, 1], got {self.step_landing}")
         gain = self.step_speed_gain
         if not all(b >= 0.0 for b in (gain if isinstance(gain, tuple) else (gain,))):
             raise ConfigError(f"step_speed_gain must be >= 0 (1/s), got {gain}")
