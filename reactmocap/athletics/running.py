@@ -91,9 +91,6 @@ ACCEL = 1.5
 PITCH_SUM = 0.1
 #: the most leg force (body weights) of the commanded step
 STEP_FORCE = 4.0
-#: the most horizontal force the commanded step's speed regulation adds, as a share of the
-#: leg force's vertical part (within the foot's friction)
-STEP_TILT = 0.3
 #: the commanded step takes over from the leg spring at the first touchdown after this (s)
 STEP_AFTER = 2.0
 #: the path correction integrates from this time on (s; the start from the set pose strays)
@@ -160,7 +157,6 @@ class Runner:
         self._neutral_conj = quat_conj(athlete.neutral)
         self._bodies = np.asarray(wc.body_ids)
         self._jacp = np.zeros((3, m.nv))
-        self._force = np.zeros(3)  # the stance leg's force on the ground (N, world)
         b = wc.ball_dof_start
         # the knee's and ankle's dofs of each leg
         self._leg_cols = [
@@ -198,9 +194,6 @@ class Runner:
         self.leg_rest = 0.0
         self.leg_prev = 0.0
         self.leg_force = 0.0
-        #: the commanded step's speed regulation: its horizontal force along the desired
-        #: direction (N) this tick
-        self.speed_push = 0.0
         self.lo_pitch = [0.0, 0.0]
         self.td_pitch = 0.0
         self.pitch_sum = 0.0
@@ -468,23 +461,8 @@ class Runner:
                 force += self.thrust_force
         force = max(force, 0.0)
         self.leg_force = force
-        self.speed_push = 0.0
-        f = self._force
-        np.multiply(u, force, out=f)
-        if self.step_stance and k["step_speed_gain"] > 0:
-            # the forward speed regulated within the stance: the law's force tilted against
-            # the error along the desired direction, at most STEP_TILT of its vertical part
-            # (eqs. 1-2 act only once a step, and a freed push changed the speed by up to
-            # 0.5 m/s within one stance)
-            c, sn = math.cos(self.heading_d), math.sin(self.heading_d)
-            vel = self.senses.com_vel
-            err = c * float(vel[0]) + sn * float(vel[1]) - self.speed
-            top = STEP_TILT * float(f[2])
-            fh = self.speed_push = _clamp(-self.mass * k["step_speed_gain"] * err, -top, top)
-            f[0] += fh * c
-            f[1] += fh * sn
         mujoco.mj_jac(self.world.model, d, self._jacp, None, point, self._feet[leg])
-        tau = -self._jacp[:, self._leg_cols[leg]].T @ f
+        tau = -self._jacp[:, self._leg_cols[leg]].T @ (force * u)
         ff = self.rig._ff
         ff[_KNEE[leg]] += tau[0:3]
         if state not in ("loading", "heel"):

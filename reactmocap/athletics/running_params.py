@@ -119,10 +119,6 @@ class RunParams:
             human's (the shared run clip's) about 0.2 s with a flight of 0.17-0.22 s. An
             opt-in for the clip's speed (2.61 m/s, with ``push_hold`` 0.75): it falls at
             neighbouring speeds (``docs/athletics.md``, the eighth round).
-        step_speed_gain: the commanded step's forward speed regulated within the stance: a
-            horizontal force of this gain (1/s) times the body's mass times the forward
-            speed's error, against it, added to the leg's (at most
-            :data:`~reactmocap.athletics.running.STEP_TILT` of its vertical part; 0: none).
         arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
         elbow: elbow flexion (rad).
         turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
@@ -172,7 +168,6 @@ class RunParams:
     step_takeoff: float | Speeds = 0.96
     step_gain: float | Speeds = 20.0
     step_placement: float | Speeds = 0.7
-    step_speed_gain: float | Speeds = 0.0
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
@@ -199,9 +194,6 @@ class RunParams:
         hold = self.push_hold if isinstance(self.push_hold, tuple) else (self.push_hold,)
         if not all(0.0 <= b <= 1.0 for b in hold):
             raise ConfigError(f"push_hold must be in [0, 1], got {self.push_hold}")
-        gain = self.step_speed_gain
-        if not all(b >= 0.0 for b in (gain if isinstance(gain, tuple) else (gain,))):
-            raise ConfigError(f"step_speed_gain must be >= 0 (1/s), got {gain}")
         lo, hi = SPEED_RANGE
         for speed in (lo, hi):
             r = self.at(speed)
