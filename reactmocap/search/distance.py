@@ -15,6 +15,7 @@ from reactmocap.search.features import FeatureSet
 
 __all__ = [
     "BREAKDOWN_TERMS",
+    "CHEAP_ANGLE_ERROR",
     "QueryWindow",
     "body_weights",
     "embed_local",
@@ -31,6 +32,11 @@ __all__ = [
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
+
+#: rad: how far the cheaper ``d_theta`` (``window_distances(precise=False)``) may be off the
+#: precise one, so a cheap ``D`` is within this times the summed orientation weights of the
+#: precise ``D`` (measured at most 4.2e-4 on 40 synthetic queries against every window)
+CHEAP_ANGLE_ERROR = 1e-3
 
 BREAKDOWN_TERMS = (
     "trunk_position",

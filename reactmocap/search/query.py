@@ -24,6 +24,7 @@ from reactmocap.search.build import (
 )
 from reactmocap.search.config import SearchWeights, WindowConfig
 from reactmocap.search.distance import (
+    CHEAP_ANGLE_ERROR,
     QueryWindow,
     StanceCost,
     body_weights,
@@ -88,10 +89,8 @@ class QueryConstants:
     wq: F64  # (P, P): the same for orientation
     groups: F64  # (P, P, 3): row s = group_matrix with support s
     stance: StanceCost | None  # the stance-mismatch term, None when its weight is 0
-    #: how far the pre-ranking D may be off the metric it bounds, per unit of the orientation
-    #: weights: the coarse one's cheaper arithmetic loses about 1e-3 rad per d_theta, on the
-    #: query's side and the window's
-    prerank_slack: float
+    #: whether the pre-ranking uses the coarse frames (and the cheaper arithmetic)
+    coarse: bool
 
     @classmethod
     def of(cls, weights: SearchWeights, window: WindowConfig) -> QueryConstants:
@@ -109,7 +108,7 @@ class QueryConstants:
             wq=np.stack([w[1] for w in per_support]),
             groups=np.stack([group_matrix(fs, s) for s in range(len(fs.parts))]),
             stance=StanceCost.of(fs, weights, window.fps),
-            prerank_slack=2e-3 if window.length > COARSE_FRAMES else 0.0,
+            coarse=window.length > COARSE_FRAMES,
         )
         shared = (c.window_weights, c.coarse_offsets, c.coarse_weights, c.wp, c.wq, c.groups)
         for a in (*c.embedding, *shared):
@@ -318,7 +317,7 @@ def search_window(
         gap = np.linalg.norm(index.embedding[near] - e, axis=1) - index.interval_radius[near]
         rows = np.union1d(rows[rows < index.num_indexed], near[gap <= reach])
     cand = index.kept[rows]
-    coarse = index.length > COARSE_FRAMES
+    coarse = c.coarse
     d, _ = _distances(index, qw, c, cand, coarse=coarse)
     order = np.argsort(d, kind="stable")
     m = max(exact, n)
@@ -327,7 +326,8 @@ def search_window(
     # D is at least its kept start's minus interval_bound (docs/design.md, Search)
     pool, pd = _refine(index, qw, c, rows[order[:refine]], cand, d, coarse)
     tau = float(np.partition(pd, n - 1)[n - 1]) if pd.size >= n else np.inf
-    slack = c.prerank_slack * float(c.wq[qw.support].sum()) + 1e-9
+    # the cheaper arithmetic's error, on the kept start's side and the window's
+    slack = (2 * _cheap_error(c, qw) if coarse else 0.0) + 1e-9
     rest = order[refine:]
     low = rest[d[rest] - index.interval_bound[rows[rest], qw.support] <= tau + slack]
     if low.size:
@@ -358,6 +358,11 @@ def search_window(
         seconds=time.perf_counter() - t0,
     )
     return results, stats
+
+
+def _cheap_error(c: QueryConstants, qw: QueryWindow) -> float:
+    """How far a ``D`` from the cheaper arithmetic may be off the precise one."""
+    return CHEAP_ANGLE_ERROR * float(c.wq[qw.support].sum())
 
 
 def _refine(
@@ -530,6 +535,11 @@ def brute_force(
         # all frames, cheaper arithmetic (same D to ~1e-5); the shortlist is re-scored precisely
         d[i : i + chunk], _ = _distances(index, qw, c, valid[i : i + chunk], precise=False)
     m = min(d.size, max(50 * n, 64))
-    short = np.argpartition(d, m - 1)[:m] if m < d.size else np.arange(d.size)
+    if m < d.size:
+        # and every window the cheaper arithmetic may have put behind the m-th
+        dm = np.partition(d, m - 1)[m - 1]
+        short = np.flatnonzero(d <= dm + 2 * _cheap_error(c, qw))
+    else:
+        short = np.arange(d.size)
     ds, br = _distances(index, qw, c, valid[short], breakdown=True)
     return _results(index, qw, c, valid[short], ds, n, br)
