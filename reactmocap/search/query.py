@@ -286,14 +286,21 @@ def search_window(
     """Search with a prepared query window; returns the ``n`` best distinct windows and what the
     search did.
 
-    1. ``k`` nearest indexed (unique-frame) windows in the PCA embedding (KD-tree);
+    1. ``k`` nearest indexed (unique-frame) windows in the PCA embedding (KD-tree), and every
+       kept start whose ``interval_radius`` lets its interval hold a window as near as the
+       nearest kept one;
     2. pre-rank them with ``D`` including the query's support weight: on about
        ``COARSE_FRAMES`` window frames (weights aggregated) when ``L > COARSE_FRAMES``,
        otherwise exactly;
     3. every window in the surrounding unique-frame interval of the best ``refine`` is tested
-       too (the paper's local refinement), pre-ranked the same way;
-    4. exact ``D`` with its breakdown for the best ``max(exact, n)`` of all of these (every
-       tested window when ``L <= COARSE_FRAMES``); the ``n`` best distinct ones are returned.
+       too (the paper's local refinement), pre-ranked the same way, then that of every other
+       candidate whose ``D`` minus ``interval_bound`` is not above the ``n``-th best so far;
+    4. exact ``D`` with its breakdown for the best ``max(exact, n)`` of all of these; the ``n``
+       best distinct ones are returned.
+
+    A library window (any yaw and shift) is always found, at ``D`` ~0: its interval is among
+    the candidates of step 1 and is refined in step 3. With ``L <= COARSE_FRAMES`` the best
+    window of every candidate's interval is found.
 
     ``k = num_indexed`` and ``refine = num_indexed`` with ``L <= COARSE_FRAMES`` is an
     exhaustive search (equal to :func:`brute_force`).
