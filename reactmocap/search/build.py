@@ -156,11 +156,12 @@ def _unique_starts(
     window: WindowConfig,
     planted: NDArray[np.bool_] | None = None,
 ) -> tuple[I64, I64, I64]:
-    """Kept window starts and their refinement intervals (inclusive), clip by clip: a start is
-    kept whenever the pose path length since the last kept one crosses another multiple of
-    ``window.unique_tolerance``, at least every ``window.max_gap`` seconds, and (with
-    ``planted``, ``(N, F)`` feet in contact per frame) wherever a foot's contact changes, so
-    that each kept start's contacts hold until the next one."""
+    """Kept window starts and their refinement intervals (inclusive: from the kept start to the
+    last start before the next kept one, so each window is in one interval), clip by clip: a
+    start is kept whenever the pose path length since the last kept one crosses another
+    multiple of ``window.unique_tolerance``, at least every ``window.max_gap`` seconds, and
+    (with ``planted``, ``(N, F)`` feet in contact per frame) wherever a foot's contact changes,
+    so that each kept start's contacts hold until the next one."""
     wp, wq = body_weights(get_feature_set(weights.feature_set), weights, None)
     step = frame_pose_steps(fr.positions, fr.orientations, fr.heading, fr.origin, wp, wq)
     kept_list, lo_list, hi_list = [], [], []
@@ -185,7 +186,7 @@ def _unique_starts(
         if fill:
             local = np.unique(np.concatenate([local, *fill]))
         kept_list.append(a + local)
-        lo_list.append(a + np.concatenate([[0], local[:-1] + 1]))
+        lo_list.append(a + local)
         hi_list.append(a + np.concatenate([local[1:] - 1, [m - 1]]))
     return (
         np.concatenate(kept_list).astype(np.int64),

@@ -331,7 +331,11 @@ def search_window(
     # the intervals of the best `refine` candidates (the paper's local refinement), then every
     # other one whose bound lets it hold a window better than the n-th best so far: a window's
     # D is at least its kept start's minus interval_bound (docs/design.md, Search)
-    pool, pd = _refine(index, qw, c, rows[order[:refine]], cand, d, coarse)
+    best = rows[order[:refine]]
+    # around the best: their intervals and those that end at them (the starts before them)
+    before = best[best > 0] - 1
+    before = before[index.interval_hi[before] == index.kept[before + 1] - 1]
+    pool, pd = _refine(index, qw, c, np.union1d(best, before), cand, d, coarse)
     tau = float(np.partition(pd, n - 1)[n - 1]) if pd.size >= n else np.inf
     # the cheaper arithmetic's error, on the kept start's side and the window's
     slack = (2 * _cheap_error(c, qw) if coarse else 0.0) + 1e-9
