@@ -292,9 +292,10 @@ def search_window(
     2. pre-rank them with ``D`` including the query's support weight: on about
        ``COARSE_FRAMES`` window frames (weights aggregated) when ``L > COARSE_FRAMES``,
        otherwise exactly;
-    3. every window in the surrounding unique-frame interval of the best ``refine`` is tested
-       too (the paper's local refinement), pre-ranked the same way, then that of every other
-       candidate whose ``D`` minus ``interval_bound`` is not above the ``n``-th best so far;
+    3. every window in the unique-frame intervals of the best ``refine`` and in those ending
+       at them is tested too (the paper's local refinement), pre-ranked the same way, then
+       that of every other candidate whose ``D`` minus ``interval_bound`` is not above the
+       ``n``-th best so far;
     4. exact ``D`` with its breakdown for the best ``max(exact, n)`` of all of these; the ``n``
        best distinct ones are returned.
 
