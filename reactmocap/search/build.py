@@ -26,10 +26,19 @@ from reactmocap.search.distance import (
     embedding_frame_weights,
     frame_pose_steps,
     localize,
+    part_distances,
 )
 from reactmocap.search.features import calibrations_for, frame_features, get_feature_set
 from reactmocap.search.index import MotionIndex, valid_starts
-from reactmocap.search.types import _CHUNK, F32, F64, I64, MIRROR_SUFFIX, PCA_SAMPLE
+from reactmocap.search.types import (
+    _CHUNK,
+    COARSE_FRAMES,
+    F32,
+    F64,
+    I64,
+    MIRROR_SUFFIX,
+    PCA_SAMPLE,
+)
 
 __all__ = [
     "RATE_TOLERANCE",
@@ -38,6 +47,7 @@ __all__ = [
     "clip_source",
     "embedding_weights",
     "library_fingerprint",
+    "prerank_frames",
     "rate_step",
     "to_rate",
 ]
@@ -112,6 +122,16 @@ def embedding_weights(weights: SearchWeights, window: WindowConfig) -> Embedding
     return EmbeddingWeights(wp, wq, fw, offs)
 
 
+def prerank_frames(weights: SearchWeights, window: WindowConfig) -> tuple[I64, F64]:
+    """Window frames of the candidates' pre-ranking and their aggregated window weights: about
+    ``COARSE_FRAMES`` evenly spaced frames, the last one included (every frame when
+    ``L <= COARSE_FRAMES``)."""
+    L = window.length
+    step = max(1, int(np.ceil((L - 1) / (COARSE_FRAMES - 1))))
+    offsets = np.unique(np.append(np.arange(0, L, step), L - 1)).astype(np.int64)
+    return offsets, embedding_frame_weights(weights.window_weights(L), offsets)
+
+
 class _Frames(NamedTuple):
     """Features of every library frame at the index rate, clips concatenated."""
 
@@ -136,11 +156,12 @@ def _unique_starts(
     window: WindowConfig,
     planted: NDArray[np.bool_] | None = None,
 ) -> tuple[I64, I64, I64]:
-    """Kept window starts and their refinement intervals (inclusive), clip by clip: a start is
-    kept whenever the pose path length since the last kept one crosses another multiple of
-    ``window.unique_tolerance``, at least every ``window.max_gap`` seconds, and (with
-    ``planted``, ``(N, F)`` feet in contact per frame) wherever a foot's contact changes, so
-    that each kept start's contacts hold until the next one."""
+    """Kept window starts and their refinement intervals (inclusive: from the kept start to the
+    last start before the next kept one, so each window is in one interval), clip by clip: a
+    start is kept whenever the pose path length since the last kept one crosses another
+    multiple of ``window.unique_tolerance``, at least every ``window.max_gap`` seconds, and
+    (with ``planted``, ``(N, F)`` feet in contact per frame) wherever a foot's contact changes,
+    so that each kept start's contacts hold until the next one."""
     wp, wq = body_weights(get_feature_set(weights.feature_set), weights, None)
     step = frame_pose_steps(fr.positions, fr.orientations, fr.heading, fr.origin, wp, wq)
     kept_list, lo_list, hi_list = [], [], []
@@ -165,13 +186,71 @@ def _unique_starts(
         if fill:
             local = np.unique(np.concatenate([local, *fill]))
         kept_list.append(a + local)
-        lo_list.append(a + np.concatenate([[0], local[:-1] + 1]))
+        lo_list.append(a + local)
         hi_list.append(a + np.concatenate([local[1:] - 1, [m - 1]]))
     return (
         np.concatenate(kept_list).astype(np.int64),
         np.concatenate(lo_list).astype(np.int64),
         np.concatenate(hi_list).astype(np.int64),
     )
+
+
+def _interval_bounds(
+    fr: _Frames,
+    kept: I64,
+    lo: I64,
+    hi: I64,
+    project: Callable[[I64], F32],
+    kept_rows: F32,
+    weights: SearchWeights,
+    window: WindowConfig,
+    stance: StanceCost | None,
+    planted: NDArray[np.bool_] | None,
+) -> tuple[F32, F32]:
+    """Per kept start, how far the windows of its refinement interval can be from it:
+    ``(radius (K,) in the KD embedding, bound (K, P) on the pre-ranking D)``, the bound's column
+    ``s`` for a query whose support body is part ``s``. The pre-ranking ``D`` (its frames and
+    weights, the stance term) is a sum of metrics, so a query's ``D`` to any window of the
+    interval is at least its ``D`` to the kept start minus the bound; likewise in the embedding
+    with the radius (``docs/design.md``, Search)."""
+    fs = get_feature_set(weights.feature_set)
+    offsets, fw = prerank_frames(weights, window)
+    fw32 = fw.astype(np.float32)
+    wp, wq = body_weights(fs, weights, None)
+    # the support body's raise, per part: column s of the bound adds part s's
+    up_p = np.maximum(wp, weights.support_position) - wp
+    up_q = np.maximum(wq, weights.support_orientation) - wq
+    K, P = kept.size, len(fs.parts)
+    radius = np.zeros(K, dtype=np.float32)
+    bound = np.zeros((K, P), dtype=np.float64)
+    sizes = hi - lo + 1
+    chunk = max(1, _CHUNK // (2 * window.max_gap_frames))
+    for i in range(0, K, chunk):
+        j = np.arange(i, min(K, i + chunk))
+        a = int(lo[j[0]])
+        starts = np.arange(a, int(hi[j[-1]]) + 1, dtype=np.int64)
+        owner = np.repeat(j, sizes[j])  # one row per (kept start, window of its interval)
+        first = np.concatenate([[0], np.cumsum(sizes[j])[:-1]])
+        ps = lo[owner] - a + np.arange(owner.size) - np.repeat(first, sizes[j])
+        pk = kept[owner] - a
+        de = np.linalg.norm(project(starts)[ps] - kept_rows[owner], axis=1)
+        idx = starts[:, None] + offsets[None, :]
+        lp, lq = localize(
+            fr.positions[idx], fr.orientations[idx], fr.heading[starts], fr.origin[starts]
+        )
+        dp, da = part_distances(lp[ps], lq[ps], lp[pk], lq[pk])
+        sp = np.einsum("clp,l->cp", dp, fw32).astype(np.float64)
+        sa = np.einsum("clp,l->cp", da, fw32).astype(np.float64)
+        d = (sp @ wp + sa @ wq)[:, None] + sp * up_p + sa * up_q
+        if stance is not None and planted is not None:
+            d += (
+                stance.weight
+                * np.count_nonzero(planted[a + ps] != planted[kept[owner]], axis=1)[:, None]
+            )
+        radius[j] = np.maximum.reduceat(de, first)
+        bound[j] = np.maximum.reduceat(d, first, axis=0)
+    # float32 rounded up, so it stays a bound
+    return radius, np.nextafter(bound.astype(np.float32), np.float32(np.inf))
 
 
 def _fit_pca(
@@ -273,12 +352,17 @@ def build_index(
     mean, comps, explained, de = _fit_pca(
         fr, kept, ew, window.pca_dims, np.random.default_rng(seed)
     )
-    proj = np.empty((kept.size, comps.shape[1]), dtype=np.float32)
-    for i in range(0, kept.size, _CHUNK):
-        e = _embed_starts(fr, kept[i : i + _CHUNK], ew)
-        proj[i : i + e.shape[0]] = (e - mean) @ comps
-    if stance is not None and planted is not None:
-        proj = np.concatenate([proj, stance.columns(planted[kept])], axis=1)
+
+    def project(starts: I64) -> F32:
+        rows = (_embed_starts(fr, starts, ew) - mean) @ comps
+        if stance is None or planted is None:
+            return np.asarray(rows, dtype=np.float32)
+        return np.concatenate([rows, stance.columns(planted[starts])], axis=1)
+
+    proj = np.concatenate([project(kept[i : i + _CHUNK]) for i in range(0, kept.size, _CHUNK)])
+    radius, bound = _interval_bounds(
+        fr, kept, lo, hi, project, proj, weights, window, stance, planted
+    )
     nvalid = int(valid_starts(offsets, L).size)
     if progress:
         progress(
@@ -299,6 +383,8 @@ def build_index(
         kept=kept,
         interval_lo=lo,
         interval_hi=hi,
+        interval_radius=radius,
+        interval_bound=bound,
         pca_mean=mean,
         pca_components=comps,
         embedding=proj,

@@ -15,6 +15,7 @@ from reactmocap.search.features import FeatureSet
 
 __all__ = [
     "BREAKDOWN_TERMS",
+    "CHEAP_ANGLE_ERROR",
     "QueryWindow",
     "body_weights",
     "embed_local",
@@ -23,6 +24,7 @@ __all__ = [
     "frame_pose_steps",
     "group_matrix",
     "localize",
+    "part_distances",
     "select_support",
     "StanceCost",
     "window_distances",
@@ -30,6 +32,11 @@ __all__ = [
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
+
+#: rad: how far the cheaper ``d_theta`` (``window_distances(precise=False)``) may be off the
+#: precise one, so a cheap ``D`` is within this times the summed orientation weights of the
+#: precise ``D`` (measured at most 4.2e-4 on 40 synthetic queries against every window)
+CHEAP_ANGLE_ERROR = 1e-3
 
 BREAKDOWN_TERMS = (
     "trunk_position",
@@ -232,6 +239,26 @@ def embed_local(
     return out.reshape(c, -1)
 
 
+def part_distances(
+    lp: NDArray[np.floating],
+    lq: NDArray[np.floating],
+    qp: NDArray[np.floating],
+    qq: NDArray[np.floating],
+) -> tuple[NDArray[np.floating], NDArray[np.floating]]:
+    """Per body and frame ``(|dp|, d_theta)`` between local windows ``lp (C, L, P, 3)``, ``lq
+    (C, L, P, 4)`` and ``qp``, ``qq`` (broadcast against them); ``lp`` is overwritten."""
+    lp -= qp
+    dpos = np.sqrt(np.einsum("clpk,clpk->clp", lp, lp))  # (C, L, P)
+    # vec(conj(a) * b) = a_w b_v - b_w a_v - a_v x b_v, a = library (local), b = query;
+    # only the vector part is needed, so not quat_mul (which also forms w)
+    aw, ax, ay, az = lq[..., 0], lq[..., 1], lq[..., 2], lq[..., 3]
+    bw, bx, by, bz = qq[..., 0], qq[..., 1], qq[..., 2], qq[..., 3]
+    vx = aw * bx - bw * ax - (ay * bz - az * by)
+    vy = aw * by - bw * ay - (az * bx - ax * bz)
+    vz = aw * bz - bw * az - (ax * by - ay * bx)
+    return dpos, 2.0 * np.sqrt(vx * vx + vy * vy + vz * vz)
+
+
 def window_distances(
     positions: F32,
     orientations: F32,
@@ -266,16 +293,7 @@ def window_distances(
     h = heading[starts]
     if precise:
         lp, lq = localize(positions[idx], orientations[idx], h, origin[starts])
-        lp -= qp[None]
-        dpos = np.sqrt(np.einsum("clpk,clpk->clp", lp, lp))  # (C, L, P)
-        # vec(conj(a) * b) = a_w b_v - b_w a_v - a_v x b_v, a = library (local), b = query;
-        # only the vector part is needed, so not quat_mul (which also forms w)
-        aw, ax, ay, az = lq[..., 0], lq[..., 1], lq[..., 2], lq[..., 3]
-        bw, bx, by, bz = qq[None, ..., 0], qq[None, ..., 1], qq[None, ..., 2], qq[None, ..., 3]
-        vx = aw * bx - bw * ax - (ay * bz - az * by)
-        vy = aw * by - bw * ay - (az * bx - ax * bz)
-        vz = aw * bz - bw * az - (ax * by - ay * bx)
-        dang = 2.0 * np.sqrt(vx * vx + vy * vy + vz * vz)  # (C, L, P)
+        dpos, dang = part_distances(lp, lq, qp[None], qq[None])
     else:
         # cheaper form for pre-ranking: move the query into each library window's frame and use
         # d_theta = 2 sqrt(1 - (qa.qb)^2) (same value, less precise near 0)

@@ -51,7 +51,8 @@ __all__ = [
 #: the array fields of :class:`MotionIndex`, in the order they are saved
 ARRAYS = (
     "clip_fps", "clip_offsets", "positions", "orientations", "heading", "origin", "kept",
-    "interval_lo", "interval_hi", "pca_mean", "pca_components", "embedding",
+    "interval_lo", "interval_hi", "interval_radius", "interval_bound", "pca_mean",
+    "pca_components", "embedding",
 )  # fmt: skip
 
 
@@ -95,6 +96,10 @@ class MotionIndex:
     kept: I64  # (K,) global starts of the indexed (unique) windows
     interval_lo: I64  # (K,) refinement interval, inclusive
     interval_hi: I64  # (K,)
+    #: per kept start, the farthest window of its interval: in the KD embedding, and in the
+    #: pre-ranking D for each support body (build._interval_bounds)
+    interval_radius: F32  # (K,)
+    interval_bound: F32  # (K, P): column s for a query whose support body is part s
     pca_mean: F32  # (De,)
     pca_components: F32  # (De, d)
     embedding: F32  # (K, d)
@@ -103,6 +108,8 @@ class MotionIndex:
     info: dict[str, Any] = field(default_factory=dict)
     #: KD-tree over ``embedding``, built on construction
     tree: cKDTree = field(init=False, repr=False)
+    #: the largest ``interval_radius``: how far beyond the nearest kept start the KD-tree looks
+    max_radius: float = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "clip_names", tuple(self.clip_names))
@@ -110,6 +117,7 @@ class MotionIndex:
             object.__setattr__(self, name, _readonly(getattr(self, name)))
         self._validate()
         object.__setattr__(self, "tree", cKDTree(self.embedding, leafsize=32, balanced_tree=False))
+        object.__setattr__(self, "max_radius", float(self.interval_radius.max()))
 
     # ------------------------------------------------------------------ derived
     @property
@@ -179,6 +187,8 @@ class MotionIndex:
             (self.clip_fps.shape == (len(self.clip_names),), "clip_fps"),
             (self.kept.ndim == 1 and self.interval_lo.shape == (K,), "kept"),
             (self.interval_hi.shape == (K,), "intervals"),
+            (self.interval_radius.shape == (K,), "interval radius"),
+            (self.interval_bound.shape == (K, P), "interval bound"),
             (self.pca_components.ndim == 2 and self.pca_components.shape[0] == de, "pca"),
             (self.embedding.shape == (K, dims + self._stance_columns()), "embedding"),
         ]  # fmt: skip
@@ -196,9 +206,13 @@ class MotionIndex:
                 np.any(self.interval_lo > self.kept) or np.any(self.interval_hi < self.kept)
             ):
                 bad.append("intervals")
+            elif K and (self.interval_radius.min() < 0 or self.interval_bound.min() < 0):
+                bad.append("interval bounds")
             elif not all(
-                np.all(np.isfinite(a)) for a in (self.positions, self.orientations, self.embedding)
-            ):
+                np.all(np.isfinite(a))
+                for a in (self.positions, self.orientations, self.embedding, self.interval_radius,
+                          self.interval_bound)
+            ):  # fmt: skip
                 bad.append("non-finite values")
         if bad or K == 0:
             raise SearchError(f"corrupt search index (inconsistent {', '.join(bad) or 'kept'})")

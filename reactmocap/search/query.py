@@ -16,14 +16,19 @@ from reactmocap.errors import SearchError
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import Skeleton
-from reactmocap.search.build import EmbeddingWeights, embedding_weights, rate_step
+from reactmocap.search.build import (
+    EmbeddingWeights,
+    embedding_weights,
+    prerank_frames,
+    rate_step,
+)
 from reactmocap.search.config import SearchWeights, WindowConfig
 from reactmocap.search.distance import (
+    CHEAP_ANGLE_ERROR,
     QueryWindow,
     StanceCost,
     body_weights,
     embed_local,
-    embedding_frame_weights,
     group_matrix,
     localize,
     select_support,
@@ -64,6 +69,9 @@ __all__ = [
     "window_distance",
 ]
 
+#: float32 embeddings of one window computed in different batches differ by about 1e-6
+_EMBED_SLACK = 1e-4
+
 _K = TypeVar("_K")
 _V = TypeVar("_V")
 
@@ -81,26 +89,26 @@ class QueryConstants:
     wq: F64  # (P, P): the same for orientation
     groups: F64  # (P, P, 3): row s = group_matrix with support s
     stance: StanceCost | None  # the stance-mismatch term, None when its weight is 0
+    #: whether the pre-ranking uses the coarse frames (and the cheaper arithmetic)
+    coarse: bool
 
     @classmethod
     def of(cls, weights: SearchWeights, window: WindowConfig) -> QueryConstants:
         fs = get_feature_set(weights.feature_set)
-        L = window.length
-        ww = weights.window_weights(L)
-        # about COARSE_FRAMES evenly spaced frames, the last one included
-        step = max(1, int(np.ceil((L - 1) / (COARSE_FRAMES - 1))))
-        coarse = np.unique(np.append(np.arange(0, L, step), L - 1)).astype(np.int64)
+        ww = weights.window_weights(window.length)
+        coarse, coarse_weights = prerank_frames(weights, window)
         per_support = [body_weights(fs, weights, s) for s in range(len(fs.parts))]
         c = cls(
             feature_set=fs,
             embedding=embedding_weights(weights, window),
             window_weights=ww,
             coarse_offsets=coarse,
-            coarse_weights=embedding_frame_weights(ww, coarse),
+            coarse_weights=coarse_weights,
             wp=np.stack([w[0] for w in per_support]),
             wq=np.stack([w[1] for w in per_support]),
             groups=np.stack([group_matrix(fs, s) for s in range(len(fs.parts))]),
             stance=StanceCost.of(fs, weights, window.fps),
+            coarse=window.length > COARSE_FRAMES,
         )
         shared = (c.window_weights, c.coarse_offsets, c.coarse_weights, c.wp, c.wq, c.groups)
         for a in (*c.embedding, *shared):
@@ -278,14 +286,22 @@ def search_window(
     """Search with a prepared query window; returns the ``n`` best distinct windows and what the
     search did.
 
-    1. ``k`` nearest indexed (unique-frame) windows in the PCA embedding (KD-tree);
+    1. ``k`` nearest indexed (unique-frame) windows in the PCA embedding (KD-tree), and every
+       kept start whose ``interval_radius`` lets its interval hold a window as near as the
+       nearest kept one;
     2. pre-rank them with ``D`` including the query's support weight: on about
        ``COARSE_FRAMES`` window frames (weights aggregated) when ``L > COARSE_FRAMES``,
        otherwise exactly;
-    3. every window in the surrounding unique-frame interval of the best ``refine`` is tested
-       too (the paper's local refinement), pre-ranked the same way;
-    4. exact ``D`` with its breakdown for the best ``max(exact, n)`` of all of these (every
-       tested window when ``L <= COARSE_FRAMES``); the ``n`` best distinct ones are returned.
+    3. every window in the unique-frame intervals of the best ``refine`` and in those ending
+       at them is tested too (the paper's local refinement), pre-ranked the same way, then
+       that of every other candidate whose ``D`` minus ``interval_bound`` is not above the
+       ``n``-th best so far;
+    4. exact ``D`` with its breakdown for the best ``max(exact, n)`` of all of these; the ``n``
+       best distinct ones are returned.
+
+    A library window (any yaw and shift) is always found, at ``D`` ~0: its interval is among
+    the candidates of step 1 and is refined in step 3. With ``L <= COARSE_FRAMES`` the best
+    window of every candidate's interval is found.
 
     ``k = num_indexed`` and ``refine = num_indexed`` with ``L <= COARSE_FRAMES`` is an
     exhaustive search (equal to :func:`brute_force`).
@@ -299,29 +315,37 @@ def search_window(
     c = (cache or DEFAULT_CACHE).constants(index.weights, index.window)
     e = _embed_query(index, qw, c)
     k = min(k, index.num_indexed)
-    _, rows = index.tree.query(e, k=k)
-    rows = np.atleast_1d(np.asarray(rows, dtype=np.int64))
-    rows = rows[rows < index.num_indexed]
+    dk, rows = index.tree.query(e, k=k)
+    dk, rows = np.atleast_1d(dk), np.atleast_1d(np.asarray(rows, dtype=np.int64))
+    # every kept start whose interval can hold a window as near in the embedding as the nearest
+    # kept one (its interval_radius): a library window's own interval is always among them
+    reach = float(dk[0]) + _EMBED_SLACK
+    near = np.asarray(index.tree.query_ball_point(e, reach + index.max_radius), dtype=np.int64)
+    if near.size:
+        gap = np.linalg.norm(index.embedding[near] - e, axis=1) - index.interval_radius[near]
+        rows = np.union1d(rows[rows < index.num_indexed], near[gap <= reach])
     cand = index.kept[rows]
-    coarse = index.length > COARSE_FRAMES
+    coarse = c.coarse
     d, _ = _distances(index, qw, c, cand, coarse=coarse)
     order = np.argsort(d, kind="stable")
-    spans = [
-        np.arange(index.interval_lo[r], index.interval_hi[r] + 1, dtype=np.int64)
-        for r in rows[order[:refine]]
-    ]
-    extra = np.setdiff1d(np.concatenate(spans), cand) if spans else np.zeros(0, np.int64)
     m = max(exact, n)
-    if coarse:
-        # the interval windows are pre-ranked like the candidates; exact D for the best m
-        if extra.size:
-            de, _ = _distances(index, qw, c, extra, coarse=True)
-            pool, pd = np.concatenate([cand, extra]), np.concatenate([d, de])
-        else:
-            pool, pd = cand, d
-        starts = pool[np.argsort(pd, kind="stable")[:m]]
-    else:
-        starts = np.unique(np.concatenate([cand[order[:m]], extra]))
+    # the intervals of the best `refine` candidates (the paper's local refinement), then every
+    # other one whose bound lets it hold a window better than the n-th best so far: a window's
+    # D is at least its kept start's minus interval_bound (docs/design.md, Search)
+    best = rows[order[:refine]]
+    # around the best: their intervals and those that end at them (the starts before them)
+    before = best[best > 0] - 1
+    before = before[index.interval_hi[before] == index.kept[before + 1] - 1]
+    pool, pd = _refine(index, qw, c, np.union1d(best, before), cand, d, coarse)
+    tau = float(np.partition(pd, n - 1)[n - 1]) if pd.size >= n else np.inf
+    # the cheaper arithmetic's error, on the kept start's side and the window's
+    slack = (2 * _cheap_error(c, qw) if coarse else 0.0) + 1e-9
+    rest = order[refine:]
+    low = rest[d[rest] - index.interval_bound[rows[rest], qw.support] <= tau + slack]
+    if low.size:
+        pool, pd = _refine(index, qw, c, rows[low], pool, pd, coarse)
+    extra = pool[cand.size :]
+    starts = pool[np.argsort(pd, kind="stable")[:m]]
     dists, br = _distances(index, qw, c, starts, breakdown=True)
     if n > 1:
         # runners-up must be distinct windows: widen the exact set until n are found
@@ -346,6 +370,32 @@ def search_window(
         seconds=time.perf_counter() - t0,
     )
     return results, stats
+
+
+def _cheap_error(c: QueryConstants, qw: QueryWindow) -> float:
+    """How far a ``D`` from the cheaper arithmetic may be off the precise one."""
+    return CHEAP_ANGLE_ERROR * float(c.wq[qw.support].sum())
+
+
+def _refine(
+    index: MotionIndex,
+    qw: QueryWindow,
+    c: QueryConstants,
+    rows: I64,
+    pool: I64,
+    pd: F64,
+    coarse: bool,
+) -> tuple[I64, F64]:
+    """``pool`` and its pre-ranking ``D`` with the windows of the intervals of kept starts
+    ``rows`` added."""
+    size = index.interval_hi[rows] - index.interval_lo[rows] + 1
+    first = np.cumsum(size) - size
+    spans = np.repeat(index.interval_lo[rows] - first, size) + np.arange(int(size.sum()))
+    new = np.setdiff1d(spans, pool)
+    if new.size == 0:
+        return pool, pd
+    dn, _ = _distances(index, qw, c, new, coarse=coarse)
+    return np.concatenate([pool, new]), np.concatenate([pd, dn])
 
 
 def _pick(index: MotionIndex, starts: I64, dists: F64, n: int) -> I64:
@@ -497,6 +547,11 @@ def brute_force(
         # all frames, cheaper arithmetic (same D to ~1e-5); the shortlist is re-scored precisely
         d[i : i + chunk], _ = _distances(index, qw, c, valid[i : i + chunk], precise=False)
     m = min(d.size, max(50 * n, 64))
-    short = np.argpartition(d, m - 1)[:m] if m < d.size else np.arange(d.size)
+    if m < d.size:
+        # and every window the cheaper arithmetic may have put behind the m-th
+        dm = np.partition(d, m - 1)[m - 1]
+        short = np.flatnonzero(d <= dm + 2 * _cheap_error(c, qw))
+    else:
+        short = np.arange(d.size)
     ds, br = _distances(index, qw, c, valid[short], breakdown=True)
     return _results(index, qw, c, valid[short], ds, n, br)

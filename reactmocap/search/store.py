@@ -53,6 +53,16 @@ def save(index: MotionIndex, path: str | Path) -> Path:
     return p
 
 
+def _check_version(p: Path, meta: Any) -> None:
+    if not isinstance(meta, dict) or meta.get("format") != _FORMAT:
+        raise SearchError(f"{p}: not a reactmocap search index")
+    if meta.get("version") != FORMAT_VERSION:
+        raise SearchError(
+            f"{p}: search index format version {meta.get('version')} is not "
+            f"{FORMAT_VERSION}; rebuild it"
+        )
+
+
 def load(
     path: str | Path,
     *,
@@ -76,6 +86,7 @@ def load(
             if "meta" not in z.files:
                 raise SearchError(f"{p}: not a reactmocap search index (no metadata)")
             meta = json.loads(bytes(z["meta"]).decode())
+            _check_version(p, meta)  # an older format lacks arrays: say which version it is
             missing = [a for a in ARRAYS if a not in z.files]
             if missing:
                 raise SearchError(f"{p}: corrupt search index, missing arrays {missing}")
@@ -88,13 +99,6 @@ def load(
         raise SearchError(
             f"{p}: not a readable search index ({type(exc).__name__}: {exc})"
         ) from None
-    if not isinstance(meta, dict) or meta.get("format") != _FORMAT:
-        raise SearchError(f"{p}: not a reactmocap search index")
-    if meta.get("version") != FORMAT_VERSION:
-        raise SearchError(
-            f"{p}: search index format version {meta.get('version')} is not "
-            f"{FORMAT_VERSION}; rebuild it"
-        )
     try:
         w = SearchWeights.from_dict(meta["weights"])
         win = WindowConfig.from_dict(meta["window"])

@@ -28,8 +28,9 @@ __all__ = [
 ]
 
 #: version of the saved index; bumped whenever the stored features or embedding change
-#: 2: centre of mass from the one mass-fraction table; 3: the feet's contacts in the embedding
-FORMAT_VERSION = 3
+#: 2: centre of mass from the one mass-fraction table; 3: the feet's contacts in the embedding;
+#: 4: each refinement interval's radius and bound
+FORMAT_VERSION = 4
 MIRROR_SUFFIX = "_mirror"
 #: windows embedded (or localised) per batch: bounds the temporary arrays
 _CHUNK = 4096
