@@ -152,6 +152,17 @@ class WholeBodyTracker(AnchoredReference):
             capture point is ``step_margin`` m outside both feet while the mocap stands and
             the body is still up. Off by default: ``push`` turns it on (tracking a whole clip,
             the steps it took in fighting stances sometimes ended in a blow-up).
+        step_pushed: a push while the mocap stands turns ``stepping`` on for the rest of the
+            rollout (an unpushed clip never steps).
+        step_leg: during a balance step the pelvis target drops to where a leg ``step_leg``
+            times the pelvis's starting height reaches the step's target (at most 0.4 of that
+            height lower) and the stance leg's joint rows to 0.3, so the stance knee bends
+            (0: off; at the standing height a long step's foot hovered short of the floor).
+        step_alternate: a balance step within 0.5 s of one landing is by the other foot, and a
+            foot the body has lifted off the floor (the mocap's leg pose lifts the one left
+            behind) steps when the capture point leaves the other.
+        step_retarget: a balance step's target follows the capture point until 0.6 of the
+            swing (not in ``WHOLE_CLIP``: measured no better).
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -268,6 +279,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"hip_free must be in (0, 1], hip_back and hip_tilt > 0 with hip_weight, got "
                 f"hip_free {hip_free!r}, hip_back {hip_back!r}, hip_tilt {hip_tilt!r}"
+            )
+        if step_leg and not 0.5 <= step_leg <= 1.5:
+            raise ConfigError(
+                f"step_leg must be 0 (off) or in [0.5, 1.5] (a leg over the pelvis's height), "
+                f"got {step_leg!r}"
             )
         servo = world.servo
         m = world.model
