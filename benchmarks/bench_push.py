@@ -120,7 +120,10 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
 
 
 def _label(params: dict[str, Any]) -> str:
-    return "with balance steps" if params.get("stepping") else "no balance steps"
+    # balance steps: from the start with ``stepping``, after a standing push by default
+    if params.get("stepping") or params.get("step_pushed", True):
+        return "with balance steps"
+    return "no balance steps"
 
 
 def plot(out: Path, runs: list[dict[str, Any]]) -> None:
@@ -142,7 +145,9 @@ def plot(out: Path, runs: list[dict[str, Any]]) -> None:
             if key not in run:
                 continue
             forces = np.array(run[key]["max_force_n"])
-            ax.plot(ang, ring(forces), "o-", label=f"{run[key]['clip']}, {_label(run['params'])}")
+            # a walk's push never turns balance steps on
+            how = f", {_label(run['params'])}" if key == "standing" else ""
+            ax.plot(ang, ring(forces), "o-", label=f"{run[key]['clip']}{how}")
     axes[0].plot(ang, ring(np.array(WOOTEN_STANDING_N)), "--",
                  label="Wooten Fig. 7.7, approx. (no stepping)")  # fmt: skip
     axes[1].plot(ang, np.full(9, SIMBICON_WALKING_N), "--", label="SIMBICON goal 350 N")

@@ -105,8 +105,9 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--parts", type=Path, help="body-part rules TOML ([parts], [aliases])")
     p.add_argument("--mass", type=float, default=75.0, help="character mass (kg)")
     p.add_argument("--stepping", action="store_true",
-                   help="let the whole-body tracker take capture-point balance steps "
-                   "(experimental: off by default, see docs/tracking.md)")  # fmt: skip
+                   help="let the whole-body tracker take capture-point balance steps from "
+                   "the start (a push while the clip stands turns them on anyway; see "
+                   "docs/tracking.md)")  # fmt: skip
     p.add_argument("--strict", action="store_true",
                    help="exit 3 unless the character stayed up and stable (status ok)")  # fmt: skip
     p.add_argument(

@@ -86,14 +86,32 @@ def test_a_pushed_standing_clip_turns_its_trunk_about_the_hips(shared_mocap_dir:
     95 N)."""
     bye, force = _shared_push(shared_mocap_dir, "bye_normal_001", 1.0, 90.0, 100.0)
 
-    def push(params: dict[str, float]) -> TrackResult:
+    def push(params: dict[str, float | bool]) -> TrackResult:
         return push_clip(bye, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
                          seconds=2.75, params=params)  # fmt: skip
 
-    res = push({})
+    # without balance steps (the whole-clip default steps once the capture point leaves the
+    # feet by 2 cm, which it does here, and ends the step 0.1-0.3 m from the mocap)
+    res = push({"step_pushed": False})
     # recovered, not still falling when the window ends: the pelvis back over the mocap's
     assert res.report.status == "ok" and res.errors.root[-1] < 0.1
-    assert push({"hip_weight": 0.0}).report.status == "fell"
+    assert push({"hip_weight": 0.0, "step_pushed": False}).report.status == "fell"
+
+
+def test_a_pushed_standing_clip_steps_and_stays_up(shared_mocap_dir: Path) -> None:
+    """The shared standing clip pushed 200 N (Wooten's front figure) forward at the chest for
+    0.25 s: with the balance steps a push turns on (``step_pushed``, the whole-clip default) and
+    the pelvis lowered so the step reaches the floor (``step_leg``) it stays up; without steps,
+    or with steps at the standing height (their foot hovered short of the floor), it falls."""
+    bye, force = _shared_push(shared_mocap_dir, "bye_normal_001", 1.0, 0.0, 200.0)
+
+    def push(params: dict[str, float | bool]) -> str:
+        return push_clip(bye, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
+                         seconds=2.75, params=params).report.status  # fmt: skip
+
+    assert push({}) == "ok"
+    assert push({"step_pushed": False}) == "fell"
+    assert push({"step_leg": 0.0}) == "fell"
 
 
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:

@@ -74,6 +74,9 @@ class AnchoredReference:
         place_deadband: float,
         place_height: float,
         warp_gain: float = 0.0,
+        step_retarget: bool = False,
+        step_leg: float = 0.0,
+        step_alternate: bool = False,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -111,6 +114,10 @@ class AnchoredReference:
         self.step_margin = float(step_margin)
         self.step_time = float(step_time)
         self.step_height = float(step_height)
+        self.step_retarget = bool(step_retarget)
+        self.step_leg = float(step_leg)
+        self.step_alternate = bool(step_alternate)
+        self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self.place_gain = float(place_gain)
         self.place_deadband = float(place_deadband)
         self.place_height = float(place_height)
@@ -160,10 +167,22 @@ class AnchoredReference:
             v[:2] = rot @ v[:2]  # free-joint angular velocity is local: unchanged
             a[:2] = rot @ a[:2]
         q[:2] += self.balance_shift
+        if self.step is not None and self.step_leg:
+            q[2] = min(q[2], self._step_pelvis_z())
         if self.rate != 1.0:  # the clip played faster (see :meth:`_warp`)
             v *= self.rate
             a *= self.rate * self.rate
         return q, v, a, planted
+
+    def _step_pelvis_z(self) -> float:
+        """The pelvis height from which a leg ``step_leg`` times the pelvis's starting height
+        reaches the balance step's target from where the pelvis is (at most 0.4 of that height
+        lower): at the standing height a long step's foot hovered short of the floor."""
+        assert self.step is not None
+        leg = self.step_leg * (self._z0 - self.floor_z)
+        gap = self.step.target[:2] - self.world.data.qpos[self._z_adr - 2 : self._z_adr]
+        reach = float(np.sqrt(max(leg * leg - float(gap @ gap), 0.0)))
+        return self.floor_z + max(reach, 0.6 * (self._z0 - self.floor_z))
 
     def _sole_corners(self) -> F64:
         """``(2, 4, 3)`` the sole corners now (computed once per simulation time)."""
@@ -290,6 +309,15 @@ class AnchoredReference:
             if (s.phase(t) >= 0.6 and down) or t > s.t0 + 1.5 * s.duration:
                 self.step = None
                 self._step_ready = t + 0.05
+                self._landed = (s.foot, t)
+            elif self.step_retarget and s.phase(t) < 0.6:
+                # the capture point runs on while the push still acts: land where it is now
+                xi, omega = self.capture_point()
+                left = self._facing_left()
+                rest = s.t0 + s.duration - t
+                self.step = replace(
+                    s, target=np.r_[self._step_target(s.foot, xi, omega, rest, left), self.floor_z]
+                )
         if self.step is not None or not self.stepping or t < self._step_ready:
             return
         i = self.clock.nearest(t)
@@ -298,30 +326,54 @@ class AnchoredReference:
             return  # already going down: a step would only flail
         ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
         feet = self._footprint(t)
-        if not (ahead.all() and all(len(f) for f in feet)):
+        down = [len(f) > 0 for f in feet]
+        if not (ahead.all() and (all(down) or (self.step_alternate and any(down)))):
             return
         xi, omega = self.capture_point()
-        if outside_distance(xi, np.concatenate(feet)) <= self.step_margin:
+        support = np.concatenate(feet)
+        if outside_distance(xi, support) <= self.step_margin:
             return
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
-        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
-        left = np.array([-np.sin(heading), np.cos(heading)])
-        fall = xi - convex_hull(np.concatenate(feet)).mean(axis=0)
+        centre = self._sole_centres()
+        left = self._facing_left()
+        fall = xi - convex_hull(support).mean(axis=0)
         side = float(fall @ left)
         if abs(side) > abs(float(fall @ np.array([left[1], -left[0]]))):
             foot = 0 if side > 0 else 1  # a side step with the foot on that side
         else:  # the trailing foot
             foot = int(np.argmax(np.linalg.norm(centre[:, :2] - xi, axis=1)))
-        stance = centre[1 - foot, :2]
-        lateral = left if foot == 0 else -left
-        target = step_target(
-            xi, stance, centre[foot, :2], omega, self.step_time, beyond=0.05, max_length=0.6,
-            min_width=0.12, lateral=lateral,
-        )  # fmt: skip
+        if not all(down):
+            # a foot the body has lifted off the floor (after a step, the mocap's leg pose
+            # lifts the foot left behind) is the one free to catch it
+            foot = down.index(False)
+        elif self.step_alternate and t - self._landed[1] < 0.5:
+            # the foot that just landed carries the body: stepping it again pivoted the body
+            # over the foot left behind
+            foot = 1 - self._landed[0]
+        target = self._step_target(foot, xi, omega, self.step_time, left)
         self.step = Step(foot, t, self.step_time, centre[foot].copy(),
                          np.r_[target, self.floor_z], self.step_height)  # fmt: skip
         self.steps_taken.append(t)
+
+    def _sole_centres(self) -> F64:
+        """``(2, 3)`` the soles' bottom centres now."""
+        d = self.world.data
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        return d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
+
+    def _facing_left(self) -> F64:
+        """``(2,)`` the unit vector to the feet's left (their mean heading)."""
+        rot = self.world.data.geom_xmat[self.sole].reshape(2, 3, 3)
+        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
+        return np.array([-np.sin(heading), np.cos(heading)])
+
+    def _step_target(self, foot: int, xi: F64, omega: float, ahead: float, left: F64) -> F64:
+        """Where ``foot`` lands for the capture point ``xi`` ``ahead`` s from now (see
+        :func:`step_target`), pivoting over the other foot."""
+        centre = self._sole_centres()
+        return step_target(
+            xi, centre[1 - foot, :2], centre[foot, :2], omega, ahead, beyond=0.05,
+            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
+        )  # fmt: skip
 
     def rebalance(self, t: float) -> None:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
@@ -421,6 +473,7 @@ class AnchoredReference:
         self.step = None
         self.steps_taken = []
         self._step_ready = 0.0
+        self._landed = (-1, -np.inf)
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping = 1.0, False
@@ -436,11 +489,11 @@ class AnchoredReference:
         balance shift, a step under way), for :meth:`restore` after a look ahead."""
         return (self.anchor_yaw, self.anchor_shift.copy(), self.balance_shift.copy(),
                 self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
-                self._slow_next, self.clock, self.rate, self.warping)  # fmt: skip
+                self._slow_next, self.clock, self.rate, self.warping, self._landed)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
-        yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping = memory
+        yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed = memory
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -451,3 +504,4 @@ class AnchoredReference:
         self._slow_next = float(slow)  # type: ignore[arg-type]
         self.clock = clock  # type: ignore[assignment]
         self.rate, self.warping = float(rate), bool(warping)  # type: ignore[arg-type]
+        self._landed = landed  # type: ignore[assignment]

@@ -152,6 +152,17 @@ class WholeBodyTracker(AnchoredReference):
             capture point is ``step_margin`` m outside both feet while the mocap stands and
             the body is still up. Off by default: ``push`` turns it on (tracking a whole clip,
             the steps it took in fighting stances sometimes ended in a blow-up).
+        step_pushed: a push while the mocap stands turns ``stepping`` on for the rest of the
+            rollout (an unpushed clip never steps).
+        step_leg: during a balance step the pelvis target drops to where a leg ``step_leg``
+            times the pelvis's starting height reaches the step's target (at most 0.4 of that
+            height lower) and the stance leg's joint rows to 0.3, so the stance knee bends
+            (0: off; at the standing height a long step's foot hovered short of the floor).
+        step_alternate: a balance step within 0.5 s of one landing is by the other foot, and a
+            foot the body has lifted off the floor (the mocap's leg pose lifts the one left
+            behind) steps when the capture point leaves the other.
+        step_retarget: a balance step's target follows the capture point until 0.6 of the
+            swing (not in ``WHOLE_CLIP``: measured no better).
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -224,6 +235,10 @@ class WholeBodyTracker(AnchoredReference):
         step_margin: float = 0.02,
         step_time: float = 0.35,
         step_height: float = 0.06,
+        step_retarget: bool = False,
+        step_leg: float = 0.0,
+        step_pushed: bool = False,
+        step_alternate: bool = False,
         swing_weight: float = 10.0,
         kp_swing: float = 400.0,
         place_gain: float = 0.0,
@@ -252,7 +267,9 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_touch": anchor_touch,
                 "anchor_return": anchor_return, "anchor_deadband": anchor_deadband, "balance_margin": balance_margin,
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
-                "step_height": step_height, "swing_weight": swing_weight, "kp_swing": kp_swing,
+                "step_height": step_height, "step_retarget": step_retarget, "step_leg": step_leg,
+                "step_pushed": step_pushed, "step_alternate": step_alternate,
+                "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
@@ -262,6 +279,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"hip_free must be in (0, 1], hip_back and hip_tilt > 0 with hip_weight, got "
                 f"hip_free {hip_free!r}, hip_back {hip_back!r}, hip_tilt {hip_tilt!r}"
+            )
+        if step_leg and not 0.5 <= step_leg <= 1.5:
+            raise ConfigError(
+                f"step_leg must be 0 (off) or in [0.5, 1.5] (a leg over the pelvis's height), "
+                f"got {step_leg!r}"
             )
         servo = world.servo
         m = world.model
@@ -289,6 +311,7 @@ class WholeBodyTracker(AnchoredReference):
         self._give = float(trunk_give)
         self._give_band = float(trunk_band)
         self._kp_root_pushed = float(kp_root_pushed)
+        self._step_pushed = bool(step_pushed)
         self._pushed = False  # an external force has acted on the body
         self._pushing = False  # one acts now
         self._standing = False  # the mocap stands now (both feet planted for step_time)
@@ -355,7 +378,8 @@ class WholeBodyTracker(AnchoredReference):
             balance_margin=balance_margin, balance_tau=balance_tau, stepping=stepping,
             step_margin=step_margin, step_time=step_time, step_height=step_height,
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
-            warp_gain=warp_gain,
+            warp_gain=warp_gain, step_retarget=step_retarget, step_leg=step_leg,
+            step_alternate=step_alternate,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
@@ -513,7 +537,9 @@ class WholeBodyTracker(AnchoredReference):
         wj = self._wj
         if nc:
             w_trunk = self._push_response(t)
-            hip = self._hip_strength(t)
+            # a balance step under way is the response: the hip strategy's rows flung the
+            # swinging leg to push the body back and the foot never reached its target
+            hip = self._hip_strength(t) if self.step is None else 0.0
             if hip:
                 # bounded: it fades as the trunk (pelvis, waist, back) turns ``hip_tilt`` rad
                 # off the mocap, so the joint rows bring it back before it folds
@@ -552,6 +578,9 @@ class WholeBodyTracker(AnchoredReference):
             wj = wj.copy()
             for f in swing:
                 wj[self._leg_rows[f]] = 0.1
+            if self.step is not None and self.step_leg:
+                # the stance knee bends so the pelvis can lower (``step_leg``)
+                wj[self._leg_rows[1 - self.step.foot]] = 0.3
         for f, (p_d, v_d, a_d, up_d) in swing.items():
             tasks.append(self._swing_task(f, v, p_d, v_d, a_d, up_d))
         a = acc_des[6:]
@@ -612,7 +641,8 @@ class WholeBodyTracker(AnchoredReference):
         off while an external force acts and, after one, while the capture point is more than
         ``trunk_band`` m from the mocap's; back linearly over ``trunk_give`` s after. A walk
         pushed gets the softer pelvis servo (``kp_root_pushed``)."""
-        if not ((self._w_trunk and self._give) or self._w_hip or self.warp_gain):
+        if not ((self._w_trunk and self._give) or self._w_hip or self.warp_gain
+                or self._step_pushed):  # fmt: skip
             return self._w_trunk
         # into a buffer: this runs every control tick
         np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
@@ -629,6 +659,8 @@ class WholeBodyTracker(AnchoredReference):
                 # a softer pelvis servo lets its steps catch it
                 self.kp[:3] = self._kp_root_pushed
                 self.kv[:3] = critical_kv(self._kp_root_pushed)
+        if pushing and not self._pushed and standing and self._step_pushed:
+            self.stepping = True  # a standing body pushed steps when it must
         self._pushed |= pushing
         self._standing = standing
         if not (self._w_trunk and self._give):
