@@ -134,9 +134,10 @@ class BalanceGains:
     side_roll: tuple[float, float] | None = None
     #: hip strategy ``(gain, margin, forward, back)``: the pelvis pitched toward the fall by
     #: ``gain`` rad per metre that the capture point (COM + velocity / omega) lies beyond
-    #: ``margin`` m of the COM target along the feet, at most ``forward`` / ``back`` rad: once
-    #: the ankles have the centre of pressure at the toe or heel, the trunk's rotation moves
-    #: the hips back against the fall (angular momentum about the COM); ``None``: off
+    #: ``margin`` m of the COM target along the feet, at most ``forward`` / ``back`` rad, while
+    #: both feet are down: once the ankles have the centre of pressure at the toe or heel, the
+    #: trunk's rotation moves the hips back against the fall (angular momentum about the COM;
+    #: on one foot it cost the female's diagonal push 5 N, docs/athletics.md); ``None``: off
     bow: tuple[float, float, float, float] | None = None
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
@@ -273,7 +274,7 @@ class BalanceLaw:
         vel = s.local(s.com_vel, h)
         delta = np.clip(g.kp * err - g.kv * vel, -g.max_offset, g.max_offset)
         pitch = self._pitch_now(t) + self._lean()
-        if g.bow is not None:
+        if g.bow is not None and bool(s.foot_contact.all()):
             pitch += self._bow(s, err, vel, centre)
         hold_pelvis_and_feet(ctx, d, pitch, h, t)
         rig.offset[:] = 0.0
