@@ -134,7 +134,8 @@ class BalanceGains:
     side_roll: tuple[float, float] | None = None
     #: hip strategy ``(gain, margin, forward, back)``: the pelvis pitched toward the fall by
     #: ``gain`` rad per metre that the capture point (COM + velocity / omega) lies beyond
-    #: ``margin`` m of the COM target along the feet, at most ``forward`` / ``back`` rad, while
+    #: ``margin`` m of the COM target along the feet while the COM moves that way (a COM on
+    #: its way to a moved target sets nothing off), at most ``forward`` / ``back`` rad, while
     #: both feet are down: once the ankles have the centre of pressure at the toe or heel, the
     #: trunk's rotation moves the hips back against the fall (angular momentum about the COM;
     #: on one foot it cost the female's diagonal push 5 N, docs/athletics.md); ``None``: off
@@ -297,6 +298,8 @@ class BalanceLaw:
         gain, margin, forward, back = self.gains.bow  # type: ignore[misc]
         omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
         cp = float(vel[0]) / omega - float(err[0])  # capture point ahead of the target
+        if cp * float(vel[0]) <= 0.0:  # the COM on its way back (or to a moved target)
+            return 0.0
         beyond = math.copysign(max(abs(cp) - margin, 0.0), cp)
         return float(np.clip(gain * beyond, -back, forward))
 
