@@ -183,8 +183,9 @@ BALANCE_GAINS = BalanceGains()
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
 #: sideways slope balanced 19.5 -> 23.5-25.5 deg, docs/athletics.md), and on a sideways
 #: slope the sideways offset on the hips, not the ankles (23.5-25.5 -> 30-33.5 deg); a hip
-#: strategy (``bow``: the male's forward push 120 -> 140 N, docs/athletics.md; the back limit
-#: 0.35 rad, about a hip's extension); otherwise as :data:`BALANCE_GAINS`
+#: strategy (``bow``: the male's push forward 120 -> 135 N and back 160 -> 175 N, no direction
+#: lower, docs/athletics.md; the back limit 0.35 rad, about a hip's extension; from gain 25 on
+#: the bow hops the feet); otherwise as :data:`BALANCE_GAINS`
 STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
                               bow=(20.0, 0.05, 1.0, 0.35))  # fmt: skip
 
