@@ -132,6 +132,14 @@ class BalanceGains:
     #: one edge creeps downhill in MuJoCo's soft contact at half the friction cone
     #: (docs/athletics.md); ``None``: the thesis's everywhere
     side_roll: tuple[float, float] | None = None
+    #: hip strategy ``(gain, margin, forward, back)``: the pelvis pitched toward the fall by
+    #: ``gain`` rad per metre that the capture point (COM + velocity / omega) lies beyond
+    #: ``margin`` m of the COM target along the feet while the COM moves that way (a COM on
+    #: its way to a moved target sets nothing off), at most ``forward`` / ``back`` rad, while
+    #: both feet are down: once the ankles have the centre of pressure at the toe or heel, the
+    #: trunk's rotation moves the hips back against the fall (angular momentum about the COM;
+    #: on one foot it cost the female's diagonal push 5 N, docs/athletics.md); ``None``: off
+    bow: tuple[float, float, float, float] | None = None
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
         ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
@@ -145,6 +153,12 @@ class BalanceGains:
             v = getattr(self, name)
             if v is not None and (len(v) != 2 or not all(math.isfinite(x) for x in v)):
                 raise ConfigError(f"balance {name} must be 2 finite numbers, got {v!r}")
+        b = self.bow
+        if b is not None and (len(b) != 4 or not all(math.isfinite(x) and x >= 0 for x in b)):
+            raise ConfigError(
+                f"balance bow must be 4 finite numbers >= 0 (gain rad/m, margin m, forward "
+                f"and back limits rad), got {b!r}"
+            )
 
     def stiffness_array(self) -> F64:
         return per_joint(dict(self.stiffness))
@@ -168,9 +182,12 @@ BALANCE_GAINS = BalanceGains()
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
 #: sideways slope balanced 19.5 -> 23.5-25.5 deg, docs/athletics.md), and on a sideways
-#: slope the sideways offset on the hips, not the ankles (23.5-25.5 -> 30-33.5 deg); on
-#: flat floor as :data:`BALANCE_GAINS`
-STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0))
+#: slope the sideways offset on the hips, not the ankles (23.5-25.5 -> 30-33.5 deg); a hip
+#: strategy (``bow``: the male's push forward 120 -> 135 N and back 160 -> 175 N, no direction
+#: lower, docs/athletics.md; the back limit 0.35 rad, about a hip's extension; from gain 25 on
+#: the bow hops the feet); otherwise as :data:`BALANCE_GAINS`
+STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
+                              bow=(20.0, 0.05, 1.0, 0.35))  # fmt: skip
 
 
 class BalanceLaw:
@@ -259,6 +276,8 @@ class BalanceLaw:
         vel = s.local(s.com_vel, h)
         delta = np.clip(g.kp * err - g.kv * vel, -g.max_offset, g.max_offset)
         pitch = self._pitch_now(t) + self._lean()
+        if g.bow is not None and bool(s.foot_contact.all()):
+            pitch += self._bow(s, err, vel, centre)
         hold_pelvis_and_feet(ctx, d, pitch, h, t)
         rig.offset[:] = 0.0
         for k in range(2):
@@ -274,6 +293,16 @@ class BalanceLaw:
         hang = self._plant(s, d, h) if self.posture.plant else None
         self._level_legs(d, desired, hang)
         self._support(s)
+
+    def _bow(self, s, err: F64, vel: F64, centre: F64) -> float:  # type: ignore[no-untyped-def]
+        """:attr:`BalanceGains.bow`'s pitch (rad, forward > 0)."""
+        gain, margin, forward, back = self.gains.bow  # type: ignore[misc]
+        omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
+        cp = float(vel[0]) / omega - float(err[0])  # capture point ahead of the target
+        if cp * float(vel[0]) <= 0.0:  # the COM on its way back (or to a moved target)
+            return 0.0
+        beyond = math.copysign(max(abs(cp) - margin, 0.0), cp)
+        return float(np.clip(gain * beyond, -back, forward))
 
     def _plant(self, s, d, h: float) -> F64:  # type: ignore[no-untyped-def]
         """:attr:`Posture.plant`'s ankle give (on the rig's offsets); returns each foot's

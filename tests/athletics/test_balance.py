@@ -76,3 +76,19 @@ def test_on_a_sideways_slope_the_hips_shift_the_weight_and_the_feet_stay_flat() 
     assert slid.max() < 0.25
     with pytest.raises(ConfigError):
         BalanceGains(side_roll=(math.inf, 0.0))
+
+
+def test_a_forward_push_past_the_ankles_is_taken_by_the_hips() -> None:
+    # STANDING_GAINS.bow: 135 N forward for 0.25 s puts the capture point past the toes (the
+    # ankles alone: 120 N, the heels lift and the COM creeps over the toes, 2026-12-02); the
+    # trunk bows toward the fall and the body stands again on its feet: no step or hop (the
+    # contacts flicker for 4-5 ticks as the bow comes back; a bow at gain 30 hopped for 160)
+    r = run("balance", "male", check_range=False, seconds=3.0, push=135.0, push_dir=0.0)
+    assert r.report["balanced"] and not r.report["fell"]
+    log = r.log
+    after = log["t"] >= 0.5
+    assert np.count_nonzero(log["feet"][after] < 2) <= 10
+    lean = log["trunk"][:, 0]  # the pelvis-to-head line's forward part
+    assert lean[after].max() > 0.3 and abs(lean[-1]) < 0.1
+    with pytest.raises(ConfigError, match="bow"):
+        BalanceGains(bow=(20.0, -0.05, 1.0, 0.35))
