@@ -108,8 +108,10 @@ class MotionIndex:
     info: dict[str, Any] = field(default_factory=dict)
     #: KD-tree over ``embedding``, built on construction
     tree: cKDTree = field(init=False, repr=False)
-    #: the largest ``interval_radius``: how far beyond the nearest kept start the KD-tree looks
-    max_radius: float = field(init=False, repr=False)
+    #: rows whose ``interval_radius`` is above ``wide_radius`` (about 1%): a query tests them
+    #: directly, so its KD ball around the nearest kept start reaches ``wide_radius`` only
+    wide_rows: I64 = field(init=False, repr=False)
+    wide_radius: float = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "clip_names", tuple(self.clip_names))
@@ -117,7 +119,9 @@ class MotionIndex:
             object.__setattr__(self, name, _readonly(getattr(self, name)))
         self._validate()
         object.__setattr__(self, "tree", cKDTree(self.embedding, leafsize=32, balanced_tree=False))
-        object.__setattr__(self, "max_radius", float(self.interval_radius.max()))
+        cut = float(np.quantile(self.interval_radius, 0.99))
+        object.__setattr__(self, "wide_radius", cut)
+        object.__setattr__(self, "wide_rows", _readonly(np.flatnonzero(self.interval_radius > cut)))
 
     # ------------------------------------------------------------------ derived
     @property

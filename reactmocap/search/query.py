@@ -320,7 +320,13 @@ def search_window(
     # every kept start whose interval can hold a window as near in the embedding as the nearest
     # kept one (its interval_radius): a library window's own interval is always among them
     reach = float(dk[0]) + _EMBED_SLACK
-    near = np.asarray(index.tree.query_ball_point(e, reach + index.max_radius), dtype=np.int64)
+    # the few wide intervals directly, the rest by their KD ball (float32 norms: a slack more)
+    near = index.wide_rows
+    ball = reach + index.wide_radius + _EMBED_SLACK
+    if ball >= float(dk[-1]):
+        inside = index.tree.query_ball_point(e, ball)
+        near = np.union1d(np.asarray(inside, dtype=np.int64), near)
+    # else the ball lies inside the k nearest, which are candidates anyway
     if near.size:
         gap = np.linalg.norm(index.embedding[near] - e, axis=1) - index.interval_radius[near]
         rows = np.union1d(rows[rows < index.num_indexed], near[gap <= reach])

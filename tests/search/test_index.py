@@ -26,7 +26,7 @@ from reactmocap.search import (
 )
 from reactmocap.search.config import settings_hash
 from reactmocap.search.distance import StanceCost
-from reactmocap.search.query import distances
+from reactmocap.search.query import _EMBED_SLACK, DEFAULT_CACHE, _embed_query, distances
 from reactmocap.search.types import COARSE_FRAMES, DEFAULT_K
 
 
@@ -358,6 +358,36 @@ def test_no_leftover_temp_files_on_failed_save(tmp_path: Path, synth_index: Moti
         synth_index.save(target)  # cannot replace a directory
     assert [p.name for p in tmp_path.iterdir()] == ["dir_not_file"]
     assert not os.listdir(target)
+
+
+def test_the_candidates_are_the_k_nearest_and_every_interval_that_may_hold_a_nearer_window(
+    synth_index: MotionIndex, synth_clips: dict[str, Motion]
+) -> None:
+    """The KD candidates, with the widest intervals tested directly and the ball skipped when
+    it lies inside the k nearest, are exactly the k nearest and every kept start whose
+    ``interval_radius`` lets its interval hold a window as near as the nearest one (all rows
+    scanned here)."""
+    index = synth_index
+    c = DEFAULT_CACHE.constants(index.weights, index.window)
+    rng = np.random.default_rng(3)
+    names = sorted(synth_clips)
+    paths, wide_added = set(), 0
+    for _ in range(150):
+        m = synth_clips[names[int(rng.integers(len(names)))]]
+        span = int(np.ceil((index.length - 1) * m.fps / index.window.fps))
+        q = m.transformed(float(rng.uniform(-np.pi, np.pi)), rng.uniform(-5, 5, 2))
+        qw = prepare_query(index, q, int(rng.integers(0, m.num_frames - span)))
+        e = _embed_query(index, qw, c)
+        dk, rows = index.tree.query(e, k=min(DEFAULT_K, index.num_indexed))
+        reach = float(dk[0]) + _EMBED_SLACK
+        gap = np.linalg.norm(index.embedding - e, axis=1) - index.interval_radius
+        added = np.setdiff1d(np.flatnonzero(gap <= reach), rows)
+        assert search_window(index, qw)[1].candidates == rows.size + added.size
+        paths.add(bool(reach + index.wide_radius + _EMBED_SLACK < dk[-1]))
+        wide_added += int(np.isin(added, index.wide_rows).any())
+    # both ways (ball skipped and not) were taken, and wide intervals did add candidates
+    assert paths == {True, False} and wide_added > 0
+    assert 0 < index.wide_rows.size <= 0.02 * index.num_indexed
 
 
 def test_a_search_returns_its_stats_and_leaves_the_index_alone(
