@@ -1,6 +1,7 @@
 """The blend mode's landing: ``blend_settle`` lands the final blend where it corrects least
 (Simulation 2 runs on along the found clip past the match), and ``land_tries`` tries the
-search's next-best windows of other clips when the final blend would warn."""
+search's next-best windows of other clips (then the found clip's at earlier starts) when the
+final blend would warn."""
 
 from __future__ import annotations
 
