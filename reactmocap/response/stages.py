@@ -391,7 +391,8 @@ class Continuation:
     @cached_property
     def alternatives(self) -> tuple[Continuation, ...]:
         """The next-best continuations on other clips, best first (``land_tries - 1`` at
-        most)."""
+        most; in the blend mode, where fewer clips matched, then the found clip's at earlier
+        starts)."""
         return self.others() if self.others is not None else ()
 
 
