@@ -148,8 +148,10 @@ class ResponseConfig:
     #: the body came closest to (its landing gap over the tolerances) wins: a continuation the
     #: body can reach rather than the nearest window to Simulation 1. Blend mode: the same
     #: when the final blend would turn a joint or move the root beyond the warning thresholds,
-    #: and the continuation whose final blend corrects least (over those thresholds) wins.
-    #: Either way the others are searched and simulated only where the first would warn
+    #: and the continuation whose final blend corrects least (over those thresholds) wins;
+    #: where fewer other clips matched, the found clip's next-best windows at earlier starts
+    #: fill the tries. Either way the others are searched and simulated only where the first
+    #: would warn
     land_tries: int = 3
     #: blend mode: Simulation 2 tracks the found clip up to this many seconds past the match,
     #: and the final blend lands on the frame where it corrects least (``final.settle``: its

@@ -391,7 +391,8 @@ class Continuation:
     @cached_property
     def alternatives(self) -> tuple[Continuation, ...]:
         """The next-best continuations on other clips, best first (``land_tries - 1`` at
-        most)."""
+        most; in the blend mode, where fewer clips matched, then the found clip's at earlier
+        starts)."""
         return self.others() if self.others is not None else ()
 
 
@@ -483,7 +484,11 @@ def _search(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Nai
                             contact.rewind + start / q_fps, found, found_clip)  # fmt: skip
 
     def others() -> tuple[Continuation, ...]:
-        # the next-best window of each other clip, for land_tries
+        # the next-best window of each other clip, for land_tries; in the blend mode, where
+        # fewer other clips matched, then the found clip's next-best windows at earlier
+        # starts: a fall's still frames match a lying body at any start about equally, and
+        # how far the final blend must correct Simulation 2 there is not in the distance
+        # (later landings are blend_settle's; the physical mode re-plans, land_replan)
         alts: list[Continuation] = []
         seen = {best.clip}
         for r, s in results:
@@ -492,6 +497,16 @@ def _search(scenario: Scenario, cast: Cast, contact: ContactEstimate, naive: Nai
             if r.clip in seen or _runs_into(cast, cfg, r, contact.rewind + s / q_fps):
                 continue
             seen.add(r.clip)
+            alts.append(continuation(r, s))
+        for r, s in results if cfg.mode == "blend" else ():
+            if len(alts) >= cfg.land_tries - 1:
+                break
+            if (
+                r.clip != best.clip
+                or s >= best_start
+                or _runs_into(cast, cfg, r, contact.rewind + s / q_fps)
+            ):
+                continue
             alts.append(continuation(r, s))
         return tuple(alts)
 

@@ -1,6 +1,7 @@
 """The blend mode's landing: ``blend_settle`` lands the final blend where it corrects least
 (Simulation 2 runs on along the found clip past the match), and ``land_tries`` tries the
-search's next-best windows of other clips when the final blend would warn."""
+search's next-best windows of other clips (then the found clip's at earlier starts) when the
+final blend would warn."""
 
 from __future__ import annotations
 
@@ -201,3 +202,39 @@ def test_the_blend_mode_tries_other_clips_when_its_final_blend_would_warn(
     assert _score(three) < _score(one)  # it switched to a continuation it follows closer
     assert three["matched"]["clip"] != one["matched"]["clip"]
     assert three["quality"]["reaction_displacement_m"] > 0.05  # still a reaction
+
+
+def test_the_blend_mode_tries_the_found_fall_at_an_earlier_start(
+    shared_mocap_dir: Path, tmp_path: Path
+) -> None:
+    # the real walk-left pushed from the right (bench_reactions, blend mode): the body lies
+    # still at the match, and the fall's still frames match it at every start about equally
+    # (fall_sideways at 1.9 s nearest); one other clip matched at all (fall_sideways_fast,
+    # settled: a joint 0.90 rad, the body still falling 0.55 m/s onto a still frame), so the
+    # third try is the found fall at an earlier start, whose final blend needs no warning
+    lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
+    cfg = ResponseConfig(sim1_controller="wholebody", sim2_controller="wholebody",
+                         attacker_assist=100.0, mode="blend", land_position=0.25,
+                         land_angle=0.5, land_joint=0.5, land_within=1.0, land_tries=3,
+                         torque_limit=1000.0, blend_settle=0.5)  # fmt: skip
+    sc = Scenario(
+        library=lib,
+        recipient=CharacterSpec("dataset-1_walk-left_normal_001", start=0.5),
+        impact=ImpactSpec("chest", (-18.946436750860666, 249.28103123672616, 0.0), 1.0, 0.2),
+        response=cfg,
+        name="walk-left-right",
+    )  # fmt: skip
+    cache = LibraryCache()
+    cast = stages.cast(sc, cache)
+    contact = stages.estimate_contact(sc, cast)
+    naive = stages.naive_simulation(sc, cast, contact)
+    cont = stages.search_continuation(sc, cast, contact, naive)
+    again = [c for c in cont.alternatives if c.best.clip == cont.best.clip]
+    assert len(cont.alternatives) == 2 and len(again) == 1, cont.alternatives
+    assert again[0].time < cont.time  # later landings are blend_settle's
+    assert again[0].best.distance >= cont.best.distance  # the next-best window, not a closer
+    rep = run_response(sc, cache).report
+    assert rep["matched"]["clip"] == cont.best.clip
+    assert rep["transition"]["match"] == again[0].time
+    assert _score(rep) <= 1.0 and not rep["warnings"], rep["quality"]
+    assert rep["quality"]["reaction_displacement_m"] > 0.3  # a fall, not a stand
