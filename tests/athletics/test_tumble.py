@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -12,11 +13,13 @@ import pytest
 
 from reactmocap.athletics import athlete
 from reactmocap.athletics.backdrop import arm_windmill
-from reactmocap.athletics.maneuvers import Maneuver, Perturbation, run_maneuver
+from reactmocap.athletics.maneuvers import Maneuver, Perturbation, load_maneuver, run_maneuver
 from reactmocap.athletics.report import FALL_HEIGHT
 from reactmocap.athletics.rig import joint_index
 from reactmocap.athletics.routines import (
     DIVE_PIKE_HIP,
+    SETTLED_START,
+    TIMED_START,
     dive_maneuver,
     somersault,
     somersault_maneuver,
@@ -204,7 +207,9 @@ def test_perturbed_back_layouts_open_past_inverted_and_land() -> None:
     tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
              "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
     starts = [Perturbation.sample(rng, **tenth) for _ in range(11)]
+    # measured with the leap 0.3 s into the start (the preset now settles it first)
     m = somersault_maneuver("layout")
+    m = replace(m, phases=(TIMED_START, *m.phases[1:]))
     for i in (2, 10):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
         assert -330.0 < r["rotation_at_touchdown_deg"] < -280.0, (i, r["rotation_at_touchdown_deg"])
@@ -218,7 +223,9 @@ def test_perturbed_back_tucks_land_with_the_legs_aimed_sideways() -> None:
     one foot and turned on backward. With the hips' roll taken from the pelvis's whole
     orientation (``aim_sideways``, the preset since 2026-12-02) both land on both feet."""
     starts = full_starts(6)
+    # measured with the leap 0.3 s into the start (the preset now settles it first)
     m = somersault_maneuver()
+    m = replace(m, phases=(TIMED_START, *m.phases[1:]))
     assert m.phases[3].params["aim_sideways"] is True
     for i in (0, 5):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
@@ -247,6 +254,30 @@ def test_perturbed_back_tucks_land_with_the_legs_holding_their_aim() -> None:
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
         r = run_maneuver(off, perturbation=starts[i], fps=10.0).report
         assert r["fell"] and not r["landed"], i
+
+
+def test_the_somersault_command_leaps_from_a_settled_start_as_the_files_do() -> None:
+    """The command's presets start as ``back_somersault.toml`` does (since 2026-12-02): the
+    start settled onto both feet (:data:`SETTLED_START`) before the leap, not 0.3 s into it.
+    The male forward tuck and the full twist keep the timed start (:data:`TIMED_START_PRESETS`).
+    Start 4 of the full-size starts (seed 0) left the timed start moving back at 1.1 m/s and
+    fell after touchdown; settled first it lands."""
+    maneuvers = Path(__file__).parents[2] / "examples" / "athletics" / "maneuvers"
+    for stem in ("vertical_leap", "back_somersault"):
+        assert load_maneuver(maneuvers / f"{stem}.toml").phases[0] == SETTLED_START, stem
+    m = somersault_maneuver()
+    assert m.seconds == load_maneuver(maneuvers / "back_somersault.toml").seconds
+    for built in (m, somersault_maneuver("pike"), somersault_maneuver("layout"),
+                  somersault_maneuver(body="female")):  # fmt: skip
+        assert built.phases[0] == SETTLED_START, built.name
+    for built in (somersault_maneuver(direction="forward"),
+                  somersault_maneuver("layout", twist=1.0)):  # fmt: skip
+        assert built.phases[0] == TIMED_START, built.name
+    start = full_starts(5)[4]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    timed = replace(m, phases=(TIMED_START, *m.phases[1:]))
+    assert run_maneuver(timed, perturbation=start, fps=10.0).report["fell"]
 
 
 def test_the_side_heading_holds_through_a_somersault() -> None:
