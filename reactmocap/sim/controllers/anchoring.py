@@ -74,7 +74,6 @@ class AnchoredReference:
         place_deadband: float,
         place_height: float,
         warp_gain: float = 0.0,
-        step_retarget: bool = False,
         step_leg: float = 0.0,
         step_alternate: bool = False,
     ) -> None:
@@ -114,7 +113,6 @@ class AnchoredReference:
         self.step_margin = float(step_margin)
         self.step_time = float(step_time)
         self.step_height = float(step_height)
-        self.step_retarget = bool(step_retarget)
         self.step_leg = float(step_leg)
         self.step_alternate = bool(step_alternate)
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
@@ -310,14 +308,6 @@ class AnchoredReference:
                 self.step = None
                 self._step_ready = t + 0.05
                 self._landed = (s.foot, t)
-            elif self.step_retarget and s.phase(t) < 0.6:
-                # the capture point runs on while the push still acts: land where it is now
-                xi, omega = self.capture_point()
-                left = self._facing_left()
-                rest = s.t0 + s.duration - t
-                self.step = replace(
-                    s, target=np.r_[self._step_target(s.foot, xi, omega, rest, left), self.floor_z]
-                )
         if self.step is not None or not self.stepping or t < self._step_ready:
             return
         i = self.clock.nearest(t)
@@ -333,8 +323,10 @@ class AnchoredReference:
         support = np.concatenate(feet)
         if outside_distance(xi, support) <= self.step_margin:
             return
-        centre = self._sole_centres()
-        left = self._facing_left()
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
+        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
+        left = np.array([-np.sin(heading), np.cos(heading)])
         fall = xi - convex_hull(support).mean(axis=0)
         side = float(fall @ left)
         if abs(side) > abs(float(fall @ np.array([left[1], -left[0]]))):
@@ -349,31 +341,13 @@ class AnchoredReference:
             # the foot that just landed carries the body: stepping it again pivoted the body
             # over the foot left behind
             foot = 1 - self._landed[0]
-        target = self._step_target(foot, xi, omega, self.step_time, left)
+        target = step_target(
+            xi, centre[1 - foot, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
+            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
+        )  # fmt: skip
         self.step = Step(foot, t, self.step_time, centre[foot].copy(),
                          np.r_[target, self.floor_z], self.step_height)  # fmt: skip
         self.steps_taken.append(t)
-
-    def _sole_centres(self) -> F64:
-        """``(2, 3)`` the soles' bottom centres now."""
-        d = self.world.data
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        return d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
-
-    def _facing_left(self) -> F64:
-        """``(2,)`` the unit vector to the feet's left (their mean heading)."""
-        rot = self.world.data.geom_xmat[self.sole].reshape(2, 3, 3)
-        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
-        return np.array([-np.sin(heading), np.cos(heading)])
-
-    def _step_target(self, foot: int, xi: F64, omega: float, ahead: float, left: F64) -> F64:
-        """Where ``foot`` lands for the capture point ``xi`` ``ahead`` s from now (see
-        :func:`step_target`), pivoting over the other foot."""
-        centre = self._sole_centres()
-        return step_target(
-            xi, centre[1 - foot, :2], centre[foot, :2], omega, ahead, beyond=0.05,
-            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
-        )  # fmt: skip
 
     def rebalance(self, t: float) -> None:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's

@@ -161,8 +161,6 @@ class WholeBodyTracker(AnchoredReference):
         step_alternate: a balance step within 0.5 s of one landing is by the other foot, and a
             foot the body has lifted off the floor (the mocap's leg pose lifts the one left
             behind) steps when the capture point leaves the other.
-        step_retarget: a balance step's target follows the capture point until 0.6 of the
-            swing (not in ``WHOLE_CLIP``: measured no better).
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -235,7 +233,6 @@ class WholeBodyTracker(AnchoredReference):
         step_margin: float = 0.02,
         step_time: float = 0.35,
         step_height: float = 0.06,
-        step_retarget: bool = False,
         step_leg: float = 0.0,
         step_pushed: bool = False,
         step_alternate: bool = False,
@@ -267,7 +264,7 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_touch": anchor_touch,
                 "anchor_return": anchor_return, "anchor_deadband": anchor_deadband, "balance_margin": balance_margin,
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
-                "step_height": step_height, "step_retarget": step_retarget, "step_leg": step_leg,
+                "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
@@ -378,7 +375,7 @@ class WholeBodyTracker(AnchoredReference):
             balance_margin=balance_margin, balance_tau=balance_tau, stepping=stepping,
             step_margin=step_margin, step_time=step_time, step_height=step_height,
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
-            warp_gain=warp_gain, step_retarget=step_retarget, step_leg=step_leg,
+            warp_gain=warp_gain, step_leg=step_leg,
             step_alternate=step_alternate,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
