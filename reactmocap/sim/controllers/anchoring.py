@@ -31,6 +31,9 @@ __all__ = ["AnchoredReference"]
 F64 = NDArray[np.float64]
 # no balance step once the pelvis has tilted this far from its start (cos 35 deg)
 _STEP_TILT_COS = float(np.cos(np.radians(35.0)))
+# a fall nearer a diagonal than the heading (22.5 deg) steps with the foot on its side: a
+# front-right push stepped the left foot 0.43 m ahead and pitched over the right toes
+_SIDE_STEP_TAN = float(np.tan(np.radians(22.5)))
 # seconds between updates of the ground path, the balance shift and the step decision
 _SLOW_PERIOD = 0.008
 # a heading error's dead band is the position dead band over this lever (m)
@@ -329,8 +332,8 @@ class AnchoredReference:
         left = np.array([-np.sin(heading), np.cos(heading)])
         fall = xi - convex_hull(support).mean(axis=0)
         side = float(fall @ left)
-        if abs(side) > abs(float(fall @ np.array([left[1], -left[0]]))):
-            foot = 0 if side > 0 else 1  # a side step with the foot on that side
+        if abs(side) > _SIDE_STEP_TAN * abs(float(fall @ np.array([left[1], -left[0]]))):
+            foot = 0 if side > 0 else 1  # a side or diagonal step with the foot on that side
         else:  # the trailing foot
             foot = int(np.argmax(np.linalg.norm(centre[:, :2] - xi, axis=1)))
         if not all(down):
