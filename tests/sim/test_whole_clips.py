@@ -114,6 +114,17 @@ def test_a_pushed_standing_clip_steps_and_stays_up(shared_mocap_dir: Path) -> No
     assert push({"step_leg": 0.0}) == "fell"
 
 
+def test_a_diagonal_push_steps_with_the_foot_on_its_side(shared_mocap_dir: Path) -> None:
+    """The shared standing clip pushed 141 N (Wooten's diagonal figure) front-right at the chest
+    for 0.25 s stays up: its fall, about 25 deg off the heading when the step starts, is stepped
+    by the right foot; the trailing left foot, as before, stepped 0.43 m ahead, landed late
+    with the capture point at its toes and the body pitched over the right toes and fell."""
+    bye, force = _shared_push(shared_mocap_dir, "bye_normal_001", 1.0, -45.0, 141.0)
+    res = push_clip(bye, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
+                    seconds=2.75)  # fmt: skip
+    assert res.report.status == "ok", res.report.reason
+
+
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip
