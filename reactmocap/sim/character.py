@@ -37,13 +37,7 @@ from reactmocap.sim.bodies import (
     SIM_PARENTS,
     TREE,
 )
-from reactmocap.sim.geometry import (
-    BALL_PATCH_HALF_SIZE,
-    PATCH_GEOM_GROUP,
-    FootModel,
-    GeomSpec,
-    make_geoms,
-)
+from reactmocap.sim.geometry import BALL_PATCH_HALF_SIZE, PATCH_GEOM_GROUP, GeomSpec, make_geoms
 
 __all__ = [
     "BALL_JOINTS",
@@ -467,7 +461,6 @@ def build_character(
     mass_model: MassModel = "table",
     joint_limits: bool = True,
     inertials: Mapping[str, SegmentInertia] | None = None,
-    feet: FootModel = "box",
 ) -> Character:
     """Build the 51-DOF character of a skeleton.
 
@@ -484,8 +477,6 @@ def build_character(
             ``reactmocap.athletics.bodies``), in the reference pose's world frame; they replace
             the geoms' mass (``total_mass`` and ``mass_model`` are then unused) and the geoms
             only collide.
-        feet: the sole boxes' size, ``"box"`` or ``"anatomical"``
-            (:data:`reactmocap.sim.geometry.FOOT_MODELS`).
     """
     if isinstance(skeleton, Motion):
         reference = skeleton if reference is None else reference
@@ -543,7 +534,7 @@ def build_character(
         body_quat[b] = quat_normalize(quat_mul(quat_conj(G[p]), G[b]))
         body_pos[b] = quat_rotate(quat_conj(G[p]), P[b] - P[p])
 
-    geoms = make_geoms(skeleton, parts, anchors, ref, frame, P, G, feet)
+    geoms = make_geoms(skeleton, parts, anchors, ref, frame, P, G)
     char = Character(
         skeleton=skeleton,
         parts=parts,

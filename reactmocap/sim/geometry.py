@@ -4,9 +4,7 @@ and a ball-of-foot contact patch, sized from human proportions scaled by leg len
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
-from types import MappingProxyType
 from typing import Literal
 
 import numpy as np
@@ -19,14 +17,7 @@ from reactmocap.library.skeleton import Skeleton
 from reactmocap.rotations import quat_conj, quat_from_matrix, quat_rotate
 from reactmocap.sim.bodies import SIM_BODIES
 
-__all__ = [
-    "BALL_PATCH_HALF_SIZE",
-    "FOOT_MODELS",
-    "PATCH_GEOM_GROUP",
-    "FootModel",
-    "GeomSpec",
-    "make_geoms",
-]
+__all__ = ["BALL_PATCH_HALF_SIZE", "PATCH_GEOM_GROUP", "GeomSpec", "make_geoms"]
 
 F64 = NDArray[np.float64]
 
@@ -36,23 +27,7 @@ _RADIUS = {
     "pelvis": 0.095, "waist": 0.09, "chest": 0.105, "neck": 0.05, "head": 0.1,
     "upper_arm": 0.045, "forearm": 0.037, "hand": 0.03, "thigh": 0.075, "shin": 0.05,
 }  # fmt: skip
-FootModel = Literal["box", "anatomical"]
-#: sole boxes (m, at the 1.75 m reference; scaled with the leg): ``heel`` behind the ankle,
-#: ``toe`` past the ball (the toe joint), or ``length`` from the heel end when given (the tip
-#: then does not depend on where the skeleton puts its toe joint). ``box``: the original
-#: toeless box (~75% of an adult foot's length); ``anatomical``: an adult foot, length 0.152 H
-#: and breadth 0.055 H (Drillis & Contini 1966, in Winter, Biomechanics and Motor Control of
-#: Human Movement, 4th ed., Fig. 4.1), the ankle a quarter of its length from the heel.
-FOOT_MODELS: Mapping[str, Mapping[str, float]] = MappingProxyType(
-    {
-        "box": MappingProxyType(
-            {"heel": 0.06, "toe": 0.05, "half_width": 0.04, "half_height": 0.025}
-        ),
-        "anatomical": MappingProxyType(
-            {"heel": 0.066, "length": 0.266, "half_width": 0.048, "half_height": 0.025}
-        ),
-    }
-)
+_FOOT = {"heel": 0.06, "toe": 0.05, "half_width": 0.04, "half_height": 0.025}
 _HAND_LEN = 0.10
 #: half-size (m) of the ball-of-foot contact patch each foot carries switched off: a tracking
 #: controller turns it on, and the foot box off, while the actor pivots on that foot (a box's
@@ -96,12 +71,9 @@ def make_geoms(
     frame: int,
     P: F64,
     G: F64,
-    feet: FootModel = "box",
 ) -> tuple[GeomSpec, ...]:
     """Collision/mass geometry, computed in the reference pose's world frame and converted to
-    each body's local frame; ``feet`` names the sole boxes' size (:data:`FOOT_MODELS`)."""
-    if feet not in FOOT_MODELS:
-        raise SimulationError(f"feet must be one of {sorted(FOOT_MODELS)}, got {feet!r}")
+    each body's local frame."""
     idx = {b: i for i, b in enumerate(SIM_BODIES)}
 
     def at(b: str) -> F64:
@@ -208,7 +180,6 @@ def make_geoms(
             G[idx[f"{side}_foot"]],
             gpos_ref,
             grot_ref,
-            FOOT_MODELS[feet],
         )
         out.append(box)
         out.append(_ball_patch(box, ball_x))
@@ -236,7 +207,6 @@ def _foot_box(
     g_foot: F64,
     gpos: F64,
     grot: F64,
-    size: Mapping[str, float],
 ) -> tuple[GeomSpec, float]:
     """The foot box in the foot's local frame, and the ball's (toe joint's) offset from the
     box centre along the box's x axis.
@@ -289,18 +259,17 @@ def _foot_box(
     up = np.sqrt(1.0 - k * k) * n - k * fhat  # sole normal: the ball is (h_a - h_b) below
     fwd = _unit(fhat - up * float(up @ fhat))
     lat = np.cross(up, fwd)
-    x0 = -size["heel"] * s
-    ball = float(f @ fwd)
-    x1 = max(x0 + size["length"] * s, ball) if "length" in size else ball + size["toe"] * s
-    hz = size["half_height"] * s
+    x0 = -_FOOT["heel"] * s
+    x1 = float(f @ fwd) + _FOOT["toe"] * s
+    hz = _FOOT["half_height"] * s
     centre = fwd * 0.5 * (x0 + x1) + up * (-h_a + hz)
     quat = quat_from_matrix(np.stack([fwd, lat, up], axis=1))
     del g_foot
     box = GeomSpec(
         b,
         "box",
-        (0.5 * (x1 - x0), size["half_width"] * s, hz),
+        (0.5 * (x1 - x0), _FOOT["half_width"] * s, hz),
         pos=tuple(centre),
         quat=tuple(quat),
     )
-    return box, ball - 0.5 * (x0 + x1)
+    return box, float(f @ fwd) - 0.5 * (x0 + x1)
