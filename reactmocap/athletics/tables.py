@@ -92,7 +92,7 @@ DEFAULT_BROAD_CROUCH = ((0.0, 0.8, 0.3), (1.0, 0.65, 0.3))
 #: leg 0.5 with 0.3 rad the push passed behind the COM (pitch momentum +13.6 kg m^2/s at
 #: lift-off, where the spin feedback asks -5) and the landing pitched face down. Efforts up
 #: to 0.6 keep the default path (their landings were measured on it)
-#: Female (2026-12-03): her default path's up to effort 0.75 (her landings there measured on
+#: Female (2026-12-03): her default path (exactly) up to effort 0.75 (her landings measured on
 #: it), then to leg 0.5 with the trunk pitched 0.75 rad at 1.0; with her BROAD_COM_OFFSET,
 #: BROAD_SPIN and BROAD_SPIN_GAIN effort 1.0 lifts off at 3.8 m/s pitching back (-2.7 kg
 #: m^2/s), touches down with the trunk 35 deg from upright at 2.4 m/s and lands 1.80 m
@@ -100,7 +100,7 @@ DEFAULT_BROAD_CROUCH = ((0.0, 0.8, 0.3), (1.0, 0.65, 0.3))
 BROAD_CROUCH: Mapping[str, tuple[tuple[float, float, float], ...]] = MappingProxyType(
     {
         "male": ((0.0, 0.8, 0.3), (0.6, 0.71, 0.3), (1.0, 0.45, 0.6)),
-        "female": ((0.0, 0.8, 0.3), (0.75, 0.69, 0.3), (1.0, 0.5, 0.75)),
+        "female": ((0.0, 0.8, 0.3), (0.75, 0.6875, 0.3), (1.0, 0.5, 0.75)),
     }
 )
 #: the crouch's COM offset ahead of the feet (m; 0.12 + 0.1 s) stops growing at this, per
@@ -250,7 +250,17 @@ BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = Map
         ),
         "female": (
             0.5,
-            ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04), (2.43, -0.175)),
+            (
+                (0.44, 0.16),
+                (0.55, 0.12),
+                (0.82, 0.06),
+                (1.01, 0.06),
+                (1.2, 0.04),
+                (1.57, 0.04),
+                (2.06, -0.128),
+                (2.3, -0.175),
+                (2.43, -0.175),
+            ),
         ),
     }
 )
