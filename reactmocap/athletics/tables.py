@@ -22,6 +22,7 @@ from reactmocap.errors import ConfigError
 
 __all__ = [
     "BROAD_ARMS",
+    "BROAD_COM_OFFSET",
     "BROAD_CROUCH",
     "BROAD_LANDING",
     "BROAD_PITCH_EASE",
@@ -63,13 +64,21 @@ def broad_params(s: float, body: str | None = None) -> LeapParams:
     """The standing broad jump at effort ``s``: crouch, COM ahead of the feet, arm swing;
     the take-off's backward angular momentum is the body's :data:`BROAD_SPIN`."""
     s = float(np.clip(s, 0.0, 1.0))
-    spin = BROAD_SPIN.get(body or "", DEFAULT_BROAD_SPIN)
-    spin_gain = BROAD_SPIN_GAIN.get(body or "", DEFAULT_BROAD_SPIN_GAIN)
+    spin = _along(BROAD_SPIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN),)), s)
+    spin_gain = _along(BROAD_SPIN_GAIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN_GAIN),)), s)
     knots = np.array(BROAD_CROUCH.get(body or "", DEFAULT_BROAD_CROUCH)).T
     leg, pitch = (float(np.interp(s, knots[0], k)) for k in knots[1:])
-    return LeapParams(leg=leg, pitch=pitch, lean=0.0, com_offset=0.12 + 0.1 * s,
+    com_offset = min(0.12 + 0.1 * s, BROAD_COM_OFFSET.get(body or "", math.inf))
+    return LeapParams(leg=leg, pitch=pitch, lean=0.0, com_offset=com_offset,
                       stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
                       arms=-1.8 - 1.0 * s, broad=True, spin=spin, spin_gain=spin_gain, hold=0.1)  # fmt: skip
+
+
+def _along(knots: tuple[tuple[float, float], ...], s: float) -> float:
+    """A value along the effort: knots ``((effort, value), ...)``, interpolated (held past
+    the ends)."""
+    e, v = np.array(knots).T
+    return float(np.interp(s, e, v))
 
 
 #: the broad jump's crouch along the effort: knots (effort s, hip-to-ankle leg fraction,
@@ -83,9 +92,22 @@ DEFAULT_BROAD_CROUCH = ((0.0, 0.8, 0.3), (1.0, 0.65, 0.3))
 #: leg 0.5 with 0.3 rad the push passed behind the COM (pitch momentum +13.6 kg m^2/s at
 #: lift-off, where the spin feedback asks -5) and the landing pitched face down. Efforts up
 #: to 0.6 keep the default path (their landings were measured on it)
+#: Female (2026-12-03): her default path (exactly) up to effort 0.75 (her landings measured on
+#: it), then to leg 0.5 with the trunk pitched 0.75 rad at 1.0; with her BROAD_COM_OFFSET,
+#: BROAD_SPIN and BROAD_SPIN_GAIN effort 1.0 lifts off at 3.8 m/s pitching back (-2.7 kg
+#: m^2/s), touches down with the trunk 35 deg from upright at 2.4 m/s and lands 1.80 m
+#: (at pitch 0.6 she took off at 3.2 m/s, -0.2 kg m^2/s, touched down 65 deg forward, fell)
 BROAD_CROUCH: Mapping[str, tuple[tuple[float, float, float], ...]] = MappingProxyType(
-    {"male": ((0.0, 0.8, 0.3), (0.6, 0.71, 0.3), (1.0, 0.45, 0.6))}
+    {
+        "male": ((0.0, 0.8, 0.3), (0.6, 0.71, 0.3), (1.0, 0.45, 0.6)),
+        "female": ((0.0, 0.8, 0.3), (0.75, 0.6875, 0.3), (1.0, 0.5, 0.75)),
+    }
 )
+#: the crouch's COM offset ahead of the feet (m; 0.12 + 0.1 s) stops growing at this, per
+#: body. Female (2026-12-03), effort 1.0 on her deeper crouch: 0.22 took off at -0.0 kg m^2/s
+#: and touched down 70 deg forward, 0.2 at -2.7 and 35 deg; 0.17 at -3.4, but 1.8 m/s across
+#: (2.4 with 0.2)
+BROAD_COM_OFFSET: Mapping[str, float] = MappingProxyType({"female": 0.2})
 
 
 #: the broad jump's take-off pitch momentum (kg m^2/s, backward < 0)
@@ -94,14 +116,24 @@ DEFAULT_BROAD_SPIN = -5.0
 #: the male's, so the same momentum is a larger rotation) with -5 touched down from a low jump
 #: with the feet 0.13 m behind the COM after a 0.1 s flight and fell forward; with -1 her
 #: 0.35 and 0.43 m jumps land (-2: 0.43 m only; -3: none)
-BROAD_SPIN: Mapping[str, float] = MappingProxyType({"female": -1.0})
+#: Values are knots along the effort ``((effort, value), ...)``, interpolated. Female
+#: (2026-12-03): -1 up to effort 0.75, then to -5 at 1.0 (her deeper crouch: with -1 effort
+#: 1.0 lifted off at +3.5 kg m^2/s, pitching forward, and fell; with -5 at -2.7)
+BROAD_SPIN: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    {"female": ((0.75, -1.0), (1.0, -5.0))}
+)
 #: the take-off spin feedback's gain (LeapParams.spin_gain: hip offset per unit momentum error)
 DEFAULT_BROAD_SPIN_GAIN = 40.0
 #: per body. Male, 2026-12-02: with 40 the feedback hit its limit (spin_limit 0.6 rad) in his
 #: deeper crouch's pushes, and the lift-off momentum jumped between -4.9 and +2.0 kg m^2/s
 #: over efforts 0.85-1.0 (0.4 rad: +2.7 to +5.7, all 17 of efforts 0.8-1.0 fell; 80 or a
 #: 1.0 rad limit: -3.6 to +17); with 20 it stays -1 to -3.4 and the distance grows smoothly
-BROAD_SPIN_GAIN: Mapping[str, float] = MappingProxyType({"male": 20.0})
+#: Knots along the effort, as BROAD_SPIN. Female (2026-12-03): 40 up to effort 0.75, then to
+#: 20 at 1.0 (her deeper crouch's effort 1.0 with 40: -1.9 kg m^2/s, fell at every delta
+#: tried; with 20: -2.7, landed)
+BROAD_SPIN_GAIN: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
+    {"male": ((0.0, 20.0),), "female": ((0.75, 40.0), (1.0, 20.0))}
+)
 
 
 #: (effort s, achieved COM rise m) measured per body; benchmarks/bench_athletics.py --tables
@@ -216,7 +248,23 @@ BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = Map
                 (2.9, -0.19),
             ),
         ),
-        "female": (0.5, ((0.44, 0.16), (0.55, 0.12), (0.82, 0.06), (1.01, 0.06), (1.2, 0.04))),
+        "female": (
+            0.5,
+            (
+                (0.44, 0.16),
+                (0.55, 0.12),
+                (0.82, 0.06),
+                (1.01, 0.06),
+                (1.2, 0.04),
+                (1.57, 0.04),
+                (1.98, -0.125),
+                (2.08, -0.125),
+                (2.22, -0.14),
+                (2.33, -0.15),
+                (2.36, -0.175),
+                (2.43, -0.175),
+            ),
+        ),
     }
 )
 #: the shoulder pitch (rad, > 0 behind the trunk) a broad jump's landing swings the arms to
