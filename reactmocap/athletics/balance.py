@@ -142,10 +142,11 @@ class BalanceGains:
     #: on one foot it cost the female's diagonal push 5 N, docs/athletics.md); ``None``: off
     bow: tuple[float, float, float, float] | None = None
     #: arm strategy ``(gain, margin, limit)``: while the capture point lies more than
-    #: ``margin`` m behind the COM target along the feet, both arms are raised forward by
-    #: ``gain`` rad per metre beyond it, at most ``limit`` rad (their mass goes ahead and their
-    #: swing turns the body forward, against the fall); backward only: swung back on a forward
-    #: fall they cost the male's front-right push 20 N (docs/athletics.md); ``None``: off
+    #: ``margin`` m behind the COM target and the support centre along the feet, both arms are
+    #: raised forward by ``gain`` rad per metre beyond the target's margin, at most ``limit``
+    #: rad (their mass goes ahead and their swing turns the body forward, against the fall);
+    #: backward only: swung back on a forward fall they cost the male's front-right push 20 N
+    #: (docs/athletics.md); ``None``: off
     arms: tuple[float, float, float] | None = None
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
