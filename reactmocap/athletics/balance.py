@@ -276,6 +276,7 @@ class BalanceLaw:
         target = centre.copy()
         target[0] += c * off[0] - sn * off[1]
         target[1] += sn * off[0] + c * off[1]
+        ahead = float(off[0])  # the target ahead of the support centre, along the feet
         roll = (1.0, -0.5)
         if any(g.uphill) or g.side_roll is not None:
             n = s.floor_normal
@@ -283,6 +284,7 @@ class BalanceLaw:
             up = grad * g.uphill
             target[0] += c * up[0] - sn * up[1]
             target[1] += sn * up[0] + c * up[1]
+            ahead += float(up[0])
             if g.side_roll is not None:
                 w = min(abs(float(grad[1])) / SIDE_SLOPE, 1.0)
                 roll = (1.0 + w * (g.side_roll[0] - 1.0), -0.5 + w * (g.side_roll[1] + 0.5))
@@ -307,7 +309,7 @@ class BalanceLaw:
         if g.arms is not None:
             gain, margin, limit = g.arms
             # behind the support centre too: a COM on its way to a target moved ahead is left be
-            behind = cp + float(s.local(target - centre, h)[0]) < -margin
+            behind = cp + ahead < -margin
             rig.offset[_SHOULDER, 0] = -min(gain * max(-cp - margin, 0.0), limit) * behind
         lo, hi = ANKLE_LIMITS
         desired = rig.desired(t)
