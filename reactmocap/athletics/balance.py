@@ -56,6 +56,7 @@ _HIP = [joint_index(f"{s}_hip") for s in "lr"]
 _KNEE = [joint_index(f"{s}_knee") for s in "lr"]
 _ANKLE = [joint_index(f"{s}_ankle") for s in "lr"]
 _SPINE = [joint_index(j) for j in ("waist", "back")]
+_SHOULDER = np.array([joint_index(f"{s}_shoulder") for s in "lr"])
 _BODY = {b: i for i, b in enumerate(SIM_BODIES)}
 
 
@@ -140,6 +141,13 @@ class BalanceGains:
     #: trunk's rotation moves the hips back against the fall (angular momentum about the COM;
     #: on one foot it cost the female's diagonal push 5 N, docs/athletics.md); ``None``: off
     bow: tuple[float, float, float, float] | None = None
+    #: arm strategy ``(gain, margin, limit)``: while the capture point lies more than
+    #: ``margin`` m behind the COM target and the support centre along the feet, both arms are
+    #: raised forward by ``gain`` rad per metre beyond the target's margin, at most ``limit``
+    #: rad (their mass goes ahead and their swing turns the body forward, against the fall);
+    #: backward only: swung back on a forward fall they cost the male's front-right push 20 N
+    #: (docs/athletics.md); ``None``: off
+    arms: tuple[float, float, float] | None = None
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
         ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
@@ -158,6 +166,12 @@ class BalanceGains:
             raise ConfigError(
                 f"balance bow must be 4 finite numbers >= 0 (gain rad/m, margin m, forward "
                 f"and back limits rad), got {b!r}"
+            )
+        a = self.arms
+        if a is not None and (len(a) != 3 or not all(math.isfinite(x) and x >= 0 for x in a)):
+            raise ConfigError(
+                f"balance arms must be 3 finite numbers >= 0 (gain rad/m, margin m, limit "
+                f"rad), got {a!r}"
             )
 
     def stiffness_array(self) -> F64:
@@ -185,9 +199,10 @@ BALANCE_GAINS = BalanceGains()
 #: slope the sideways offset on the hips, not the ankles (23.5-25.5 -> 30-33.5 deg); a hip
 #: strategy (``bow``: the male's push forward 120 -> 135 N and back 160 -> 175 N, no direction
 #: lower, docs/athletics.md; the back limit 0.35 rad, about a hip's extension; from gain 25 on
-#: the bow hops the feet); otherwise as :data:`BALANCE_GAINS`
+#: the bow hops the feet); an arm strategy (``arms``: the push back 175 -> 185 N male, 60 -> 65
+#: female, no direction lower); otherwise as :data:`BALANCE_GAINS`
 STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
-                              bow=(20.0, 0.05, 1.0, 0.35))  # fmt: skip
+                              bow=(20.0, 0.05, 1.0, 0.35), arms=(40.0, 0.05, 2.0))  # fmt: skip
 
 
 class BalanceLaw:
@@ -261,6 +276,7 @@ class BalanceLaw:
         target = centre.copy()
         target[0] += c * off[0] - sn * off[1]
         target[1] += sn * off[0] + c * off[1]
+        ahead = float(off[0])  # the target ahead of the support centre, along the feet
         roll = (1.0, -0.5)
         if any(g.uphill) or g.side_roll is not None:
             n = s.floor_normal
@@ -268,6 +284,7 @@ class BalanceLaw:
             up = grad * g.uphill
             target[0] += c * up[0] - sn * up[1]
             target[1] += sn * up[0] + c * up[1]
+            ahead += float(up[0])
             if g.side_roll is not None:
                 w = min(abs(float(grad[1])) / SIDE_SLOPE, 1.0)
                 roll = (1.0 + w * (g.side_roll[0] - 1.0), -0.5 + w * (g.side_roll[1] + 0.5))
@@ -276,8 +293,12 @@ class BalanceLaw:
         vel = s.local(s.com_vel, h)
         delta = np.clip(g.kp * err - g.kv * vel, -g.max_offset, g.max_offset)
         pitch = self._pitch_now(t) + self._lean()
+        cp = 0.0
+        if g.bow is not None or g.arms is not None:
+            omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
+            cp = float(vel[0]) / omega - float(err[0])  # capture point ahead of the target
         if g.bow is not None and bool(s.foot_contact.all()):
-            pitch += self._bow(s, err, vel, centre)
+            pitch += self._bow(cp, float(vel[0]))
         hold_pelvis_and_feet(ctx, d, pitch, h, t)
         rig.offset[:] = 0.0
         for k in range(2):
@@ -285,6 +306,11 @@ class BalanceLaw:
             rig.offset[_ANKLE[k], 1] = roll[0] * delta[1]
             rig.offset[_HIP[k], 0] = 0.5 * delta[0]
             rig.offset[_HIP[k], 1] = roll[1] * delta[1]
+        if g.arms is not None:
+            gain, margin, limit = g.arms
+            # behind the support centre too: a COM on its way to a target moved ahead is left be
+            behind = cp + ahead < -margin
+            rig.offset[_SHOULDER, 0] = -min(gain * max(-cp - margin, 0.0), limit) * behind
         lo, hi = ANKLE_LIMITS
         desired = rig.desired(t)
         for k in range(2):
@@ -294,12 +320,11 @@ class BalanceLaw:
         self._level_legs(d, desired, hang)
         self._support(s)
 
-    def _bow(self, s, err: F64, vel: F64, centre: F64) -> float:  # type: ignore[no-untyped-def]
-        """:attr:`BalanceGains.bow`'s pitch (rad, forward > 0)."""
+    def _bow(self, cp: float, vel: float) -> float:
+        """:attr:`BalanceGains.bow`'s pitch (rad, forward > 0) for the capture point ``cp``
+        ahead of the COM target and the COM's velocity ``vel`` along the feet."""
         gain, margin, forward, back = self.gains.bow  # type: ignore[misc]
-        omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
-        cp = float(vel[0]) / omega - float(err[0])  # capture point ahead of the target
-        if cp * float(vel[0]) <= 0.0:  # the COM on its way back (or to a moved target)
+        if cp * vel <= 0.0:  # the COM on its way back (or to a moved target)
             return 0.0
         beyond = math.copysign(max(abs(cp) - margin, 0.0), cp)
         return float(np.clip(gain * beyond, -back, forward))

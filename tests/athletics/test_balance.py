@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
-from reactmocap.athletics import run
-from reactmocap.athletics.balance import BalanceGains
+from reactmocap.athletics import behaviours, run
+from reactmocap.athletics.balance import STANDING_GAINS, BalanceGains
 from reactmocap.errors import ConfigError
 
 
@@ -92,3 +93,17 @@ def test_a_forward_push_past_the_ankles_is_taken_by_the_hips() -> None:
     assert lean[after].max() > 0.3 and abs(lean[-1]) < 0.1
     with pytest.raises(ConfigError, match="bow"):
         BalanceGains(bow=(20.0, -0.05, 1.0, 0.35))
+
+
+def test_a_backward_push_is_taken_by_the_arms(monkeypatch: pytest.MonkeyPatch) -> None:
+    # STANDING_GAINS.arms: 185 N back for 0.25 s; the arms rise forward while the capture point
+    # lies behind the COM target and the male stands; without them he falls (the limit was
+    # 175 N with the bow alone, 2026-12-03)
+    push = {"check_range": False, "seconds": 3.0, "push": 185.0, "push_dir": math.pi}
+    r = run("balance", "male", **push)
+    assert r.report["balanced"] and not r.report["fell"]
+    no_arms = dataclasses.replace(STANDING_GAINS, arms=None)
+    monkeypatch.setattr(behaviours, "STANDING_GAINS", no_arms)
+    assert not run("balance", "male", **push).report["balanced"]
+    with pytest.raises(ConfigError, match="arms"):
+        BalanceGains(arms=(40.0, 0.05, -1.0))
