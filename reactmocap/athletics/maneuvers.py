@@ -147,12 +147,13 @@ def _build_leap(phase: Phase, ath: Athlete) -> Basis:
     effort = p.pop("effort", None)
     broad = bool(p.get("broad", False))
     if effort is not None:
-        base = (tables.broad_params if broad else tables.leap_params)(float(effort))
+        # the body's own broad jump (its crouch and take-off spin), as run("broad-jump")
+        base = (tables.broad_params(float(effort), ath.name) if broad
+                else tables.leap_params(float(effort)))  # fmt: skip
     else:
         base = LeapParams(broad=broad)
     if "timing" in p:
         p["timing"] = tuple(p["timing"])
-    del ath
     return Leap(replace(base, handover=phase.exit, **p))
 
 
@@ -186,10 +187,12 @@ def _build_backdrop(phase: Phase, ath: Athlete | None = None) -> Basis:
 
 
 def _build_land(phase: Phase, ath: Athlete) -> Basis:
-    base = tables.landing_params(ath.name, 0.0, after_leap=True)
-    if "delta" in phase.params:  # an explicit delta holds at every speed
+    p = dict(phase.params)
+    # broad: the landing after a broad jump (its delta per touchdown speed, arms, righting)
+    base = tables.landing_params(ath.name, 0.0, after_leap=True, broad=p.pop("broad", False))
+    if "delta" in p:  # an explicit delta holds at every speed
         base = replace(base, deltas=())
-    return Landing(replace(base, **phase.params))
+    return Landing(replace(base, **p))
 
 
 #: seconds a balance phase ending "settled" may take by default
@@ -216,7 +219,8 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
          "after": "after `seconds` in the air (the thesis's timed transition)"}, _build_tumble),
     "land": BasisSpec(
         "land", "passive landing (ch. 6); ends once it has settled and handed over",
-        _kinds(LandingParams, skip=("deltas",)), {"settled": "once the landing has settled"}, _build_land),
+        {"broad": "bool", **_kinds(LandingParams, skip=("deltas",))},
+        {"settled": "once the landing has settled"}, _build_land),
     "handspring": BasisSpec(
         "handspring", "back handspring's hand support (ch. 8.3): arched with the arms over the "
         "head until the hands touch, arms as struts, then push and snap down",
