@@ -187,12 +187,10 @@ def _build_backdrop(phase: Phase, ath: Athlete | None = None) -> Basis:
 
 
 def _build_land(phase: Phase, ath: Athlete) -> Basis:
-    p = dict(phase.params)
-    # broad: the landing after a broad jump (its delta per touchdown speed, arms, righting)
-    base = tables.landing_params(ath.name, 0.0, after_leap=True, broad=p.pop("broad", False))
-    if "delta" in p:  # an explicit delta holds at every speed
+    base = tables.landing_params(ath.name, 0.0, after_leap=True)
+    if "delta" in phase.params:  # an explicit delta holds at every speed
         base = replace(base, deltas=())
-    return Landing(replace(base, **p))
+    return Landing(replace(base, **phase.params))
 
 
 #: seconds a balance phase ending "settled" may take by default
@@ -219,8 +217,7 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
          "after": "after `seconds` in the air (the thesis's timed transition)"}, _build_tumble),
     "land": BasisSpec(
         "land", "passive landing (ch. 6); ends once it has settled and handed over",
-        {"broad": "bool", **_kinds(LandingParams, skip=("deltas",))},
-        {"settled": "once the landing has settled"}, _build_land),
+        _kinds(LandingParams, skip=("deltas",)), {"settled": "once the landing has settled"}, _build_land),
     "handspring": BasisSpec(
         "handspring", "back handspring's hand support (ch. 8.3): arched with the arms over the "
         "head until the hands touch, arms as struts, then push and snap down",

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import tables
+from reactmocap.athletics.behaviours import AthleticsResult
 from reactmocap.athletics.maneuvers import (
     Maneuver,
     Perturbation,
@@ -103,3 +104,30 @@ def test_the_back_tuck_leaps_from_a_settled_start() -> None:
     old = dataclasses.replace(m, phases=phases, seconds=5.5)
     r = run_maneuver(old, perturbation=start, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
+
+
+def test_the_broad_jump_crouches_with_both_feet_down() -> None:
+    """The broad jump's crouch moves the COM target 17 cm ahead of the feet. At once (the
+    leap's default, as Athletics I's tables were measured) the COM servo's ankle offsets step
+    and the nominal jump leaves the floor as the crouch begins; start 5 comes down from it on
+    one foot and falls before lift-off. Eased in over the crouch (``com_ease``, the file since
+    2026-12-03) both feet stay down through the crouch and start 5 lands."""
+    m = load_maneuver(MANEUVERS / "broad_jump.toml")
+    leap = next(i for i, p in enumerate(m.phases) if p.controller == "leap")
+    assert m.phases[leap].params["com_ease"] is True
+    stepped = dataclasses.replace(m.phases[leap], params={**m.phases[leap].params,
+                                                          "com_ease": False})  # fmt: skip
+    old = dataclasses.replace(m, phases=(*m.phases[:leap], stepped, *m.phases[leap + 1 :]))
+
+    def crouch_feet(r: AthleticsResult) -> np.ndarray:
+        t0, t1 = (t for t, _, target in r.transitions if target in ("leap.crouch", "leap.thrust"))
+        t = r.log["t"]
+        return r.log["feet"][(t >= t0 + 0.02) & (t < t1)]
+
+    assert crouch_feet(run_maneuver(m, fps=10.0)).min() == 2
+    assert crouch_feet(run_maneuver(old, fps=10.0)).min() == 0
+    start = full_starts(6)[5]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    r = run_maneuver(old, perturbation=start, fps=10.0)
+    assert r.report["fell"] and r.report["time_to_liftoff_s"] is None
