@@ -131,3 +131,19 @@ def test_the_broad_jump_crouches_with_both_feet_down() -> None:
     assert r["landed"] and not r["fell"]
     r = run_maneuver(old, perturbation=start, fps=10.0)
     assert r.report["fell"] and r.report["time_to_liftoff_s"] is None
+
+
+def test_the_broad_jump_lands_sideways_on_the_whole_capture_point() -> None:
+    """Start 30 touches down moving 0.33 m/s sideways; with the feet placed sideways at the
+    landing's forward lead (0.5 of the capture point) it stands up on one foot and falls
+    over; at the whole capture point (``side_lead`` 1.0, the file since 2026-12-03) it lands."""
+    m = load_maneuver(MANEUVERS / "broad_jump.toml")
+    land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
+    assert m.phases[land].params["side_lead"] == 1.0
+    start = full_starts(31)[30]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    params = {k: v for k, v in m.phases[land].params.items() if k != "side_lead"}
+    old = dataclasses.replace(m.phases[land], params=params)
+    old_m = dataclasses.replace(m, phases=(*m.phases[:land], old, *m.phases[land + 1 :]))
+    assert run_maneuver(old_m, perturbation=start, fps=10.0).report["fell"]
