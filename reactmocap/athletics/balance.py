@@ -250,7 +250,8 @@ class BalanceLaw:
         return self.posture.lean * max(0.0, knee - self._knee_standing)
 
     def _eased(self, t: float) -> float:
-        """How far (0-1, Hermite, as the pitch) the posture set last has come."""
+        """How far (0-1, Hermite, as the pitch) the posture set last has come (the pitch
+        keeps its own sum's operation order: the figures were measured on it)."""
         if not hasattr(self, "_t_pitch"):
             return 1.0
         s = min(max((t - self._t_pitch) / max(self.posture.settle, 1e-9), 0.0), 1.0)
