@@ -217,11 +217,19 @@ class BalanceLaw:
         a = self.athlete
         self.heading = 0.0
         self.com_target = np.zeros(3)
+        #: the COM offset eased from (set_posture's ease_com), or None
+        self._com0: tuple[float, float] | None = None
         self._knee_standing = float(np.mean(knee_for_length(
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
 
-    def set_posture(self, posture: Posture, t: float, gains: bool = True) -> None:
-        """Move the knees, spine and arms toward ``posture`` over ``posture.settle`` s."""
+    def set_posture(
+        self, posture: Posture, t: float, gains: bool = True, ease_com: bool = False
+    ) -> None:
+        """Move the knees, spine and arms toward ``posture`` over ``posture.settle`` s;
+        ``ease_com``: the COM target's offset too, from the last posture's (a step in it
+        steps the COM servo's ankle offsets: a broad jump's 17 cm hopped the body off the
+        floor as its crouch began)."""
+        self._com0 = self.posture.com_offset if ease_com else None
         self.posture = posture
         rig = self.ctx.rig
         if gains:
@@ -256,6 +264,14 @@ class BalanceLaw:
         knee = float(np.mean(self.ctx.rig.knee_flexion()))
         return self.posture.lean * max(0.0, knee - self._knee_standing)
 
+    def _eased(self, t: float) -> float:
+        """How far (0-1, Hermite, as the pitch) the posture set last has come (the pitch
+        keeps its own sum's operation order: the figures were measured on it)."""
+        if not hasattr(self, "_t_pitch"):
+            return 1.0
+        s = min(max((t - self._t_pitch) / max(self.posture.settle, 1e-9), 0.0), 1.0)
+        return s * s * (3 - 2 * s)
+
     def _pitch_now(self, t: float) -> float:
         if not hasattr(self, "_t_pitch"):
             return self.posture.pitch
@@ -271,12 +287,18 @@ class BalanceLaw:
         h = s.heading()
         self.heading = h
         centre = s.support_center(h, both=self.posture.plant)
-        off = np.asarray(self.posture.com_offset)
+        ox, oy = self.posture.com_offset
+        if self._com0 is not None:  # set_posture's ease_com
+            w = self._eased(t)
+            ox, oy = (
+                self._com0[0] + (ox - self._com0[0]) * w,
+                self._com0[1] + (oy - self._com0[1]) * w,
+            )
         c, sn = math.cos(h), math.sin(h)
         target = centre.copy()
-        target[0] += c * off[0] - sn * off[1]
-        target[1] += sn * off[0] + c * off[1]
-        ahead = float(off[0])  # the target ahead of the support centre, along the feet
+        target[0] += c * ox - sn * oy
+        target[1] += sn * ox + c * oy
+        ahead = ox  # the target ahead of the support centre, along the feet
         roll = (1.0, -0.5)
         if any(g.uphill) or g.side_roll is not None:
             n = s.floor_normal

@@ -134,6 +134,10 @@ class LandingParams:
             "com" leaps lift off with -1.1 to +1.6 kg m^2/s: at 0.75 m, +1.6, she landed only
             with the feet 3-5 cm ahead of where her 0.7 and 0.8 m leaps, +0.4 / +0.9, land).
         momentum_ref: the pitch momentum (kg m^2/s) the deltas were measured at.
+        side_lead: the sideways placement's lead (0-2, units of the capture point's);
+            ``None``: ``lead``. Why: ``lead`` is tuned with the forward delta, which has no
+            sideways counterpart; a perturbed broad jump touching down with 0.2-0.7 m/s
+            sideways stood up on one foot and fell sideways (docs/athletics.md).
     """
 
     knee: float = 0.6
@@ -156,6 +160,7 @@ class LandingParams:
     fall_ref: float = 0.0
     momentum_gain: float = 0.0
     momentum_ref: float = 0.0
+    side_lead: float | None = None
 
     def __post_init__(self) -> None:
         for name in (
@@ -179,6 +184,10 @@ class LandingParams:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
+        if self.side_lead is not None and not (
+            isinstance(self.side_lead, (int, float)) and 0.0 <= self.side_lead <= 2.0
+        ):
+            raise ConfigError(f"landing side_lead must be in [0, 2], got {self.side_lead!r}")
         if self.pitch_ease < 0:
             raise ConfigError(f"landing pitch_ease must be >= 0 s, got {self.pitch_ease}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
@@ -256,8 +265,10 @@ class Landing(Basis):
             # capture point: where the feet stop a pendulum of the COM's height (lead: its
             # time constant sqrt(z / g)), plus the foot-servo delta
             g = float(np.linalg.norm(world.model.opt.gravity))
-            lead = p.lead * math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
-            want = np.array([lead * v[0] + p.delta_at(float(v[0])), lead * v[1]])
+            tau = math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
+            lead = p.lead * tau
+            side = lead if p.side_lead is None else p.side_lead * tau
+            want = np.array([lead * v[0] + p.delta_at(float(v[0])), side * v[1]])
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
             if p.momentum_gain:  # the feet also stop the rotation (see momentum_gain)
                 want[0] += p.momentum_gain * (pitch_momentum(world, s) - p.momentum_ref)

@@ -127,6 +127,10 @@ class LeapParams:
     spin: float = 0.0
     spin_gain: float = 0.0
     accelerate: bool = False
+    #: the crouch moves the COM target to ``com_offset`` over the crouch, not at once (the
+    #: step kicks the ankles: the broad jump's 17 cm hopped the body off the floor and a
+    #: perturbed start came down on one foot); off by default: the tables were measured so
+    com_ease: bool = False
     #: when the leap hands over: ``"auto"`` (at the apex for a vertical leap, at lift-off for
     #: a broad jump), ``"apex"`` or ``"liftoff"`` (a somersault tucks at once)
     handover: str = "auto"
@@ -223,7 +227,8 @@ class Leap(Basis):
                 ctx.standing_com = float(s.com[2])
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
-                        arms=p.arms_back, settle=p.crouch, lean=p.lean), t)  # fmt: skip
+                        arms=p.arms_back, settle=p.crouch, lean=p.lean), t,
+                ease_com=p.com_ease)  # fmt: skip
 
         def thrust(world: World, t: float) -> None:
             del world

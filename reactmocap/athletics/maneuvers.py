@@ -147,12 +147,13 @@ def _build_leap(phase: Phase, ath: Athlete) -> Basis:
     effort = p.pop("effort", None)
     broad = bool(p.get("broad", False))
     if effort is not None:
-        base = (tables.broad_params if broad else tables.leap_params)(float(effort))
+        # the body's own broad jump (its crouch and take-off spin), as run("broad-jump")
+        base = (tables.broad_params(float(effort), ath.name) if broad
+                else tables.leap_params(float(effort)))  # fmt: skip
     else:
         base = LeapParams(broad=broad)
     if "timing" in p:
         p["timing"] = tuple(p["timing"])
-    del ath
     return Leap(replace(base, handover=phase.exit, **p))
 
 

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import tables
+from reactmocap.athletics.behaviours import AthleticsResult
 from reactmocap.athletics.maneuvers import (
     Maneuver,
     Perturbation,
@@ -103,3 +104,57 @@ def test_the_back_tuck_leaps_from_a_settled_start() -> None:
     old = dataclasses.replace(m, phases=phases, seconds=5.5)
     r = run_maneuver(old, perturbation=start, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
+
+
+def _broad_jump_timed() -> Maneuver:
+    """The broad jump file with the leap 0.3 s into the start, as its crouch and landing were
+    measured (the file settles the start first since 2026-12-03)."""
+    m = load_maneuver(MANEUVERS / "broad_jump.toml")
+    assert m.phases[0] == Phase("balance", "settled", {"plant": True}, 3.0)
+    return dataclasses.replace(
+        m, phases=(Phase("balance", "after", seconds=0.3), *m.phases[1:]), seconds=4.5
+    )
+
+
+def _with_params(m: Maneuver, i: int, params: dict) -> Maneuver:
+    phase = dataclasses.replace(m.phases[i], params=params)
+    return dataclasses.replace(m, phases=(*m.phases[:i], phase, *m.phases[i + 1 :]))
+
+
+def test_the_broad_jump_crouches_with_both_feet_down() -> None:
+    """The broad jump's crouch moves the COM target 17 cm ahead of the feet. At once (the
+    leap's default, as Athletics I's tables were measured) the COM servo's ankle offsets step
+    and the nominal jump leaves the floor as the crouch begins; start 5 comes down from it on
+    one foot and falls before lift-off. Eased in over the crouch (``com_ease``, the file since
+    2026-12-03) both feet stay down through the crouch and start 5 lands."""
+    m = _broad_jump_timed()
+    leap = next(i for i, p in enumerate(m.phases) if p.controller == "leap")
+    assert m.phases[leap].params["com_ease"] is True
+    old = _with_params(m, leap, {**m.phases[leap].params, "com_ease": False})
+
+    def crouch_feet(r: AthleticsResult) -> np.ndarray:
+        t0, t1 = (t for t, _, target in r.transitions if target in ("leap.crouch", "leap.thrust"))
+        t = r.log["t"]
+        return r.log["feet"][(t >= t0 + 0.02) & (t < t1)]
+
+    assert crouch_feet(run_maneuver(m, fps=10.0)).min() == 2
+    assert crouch_feet(run_maneuver(old, fps=10.0)).min() == 0
+    start = full_starts(6)[5]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    r = run_maneuver(old, perturbation=start, fps=10.0).report
+    assert r["fell"] and r["time_to_liftoff_s"] is None
+
+
+def test_the_broad_jump_lands_sideways_on_the_whole_capture_point() -> None:
+    """Start 30 touches down moving 0.33 m/s sideways; with the feet placed sideways at the
+    landing's forward lead (0.5 of the capture point) it stands up on one foot and falls
+    over; at the whole capture point (``side_lead`` 1.0, the file since 2026-12-03) it lands."""
+    m = _broad_jump_timed()
+    land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
+    assert m.phases[land].params["side_lead"] == 1.0
+    start = full_starts(31)[30]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    params = {k: v for k, v in m.phases[land].params.items() if k != "side_lead"}
+    assert run_maneuver(_with_params(m, land, params), perturbation=start, fps=10.0).report["fell"]

@@ -145,6 +145,12 @@ def test_landing_pitch_ease_must_not_be_negative() -> None:
         LandingParams(pitch_ease=-0.1)
 
 
+def test_landing_side_lead_must_be_in_range() -> None:
+    for bad in (-0.1, 2.5, float("nan")):
+        with pytest.raises(ConfigError, match=r"side_lead must be in \[0, 2\]"):
+            LandingParams(side_lead=bad)
+
+
 def test_flight_conserves_angular_momentum() -> None:
     # a leap with pitch momentum; in the air only internal torques act
     r = run("leap", "male", effort=0.4, spin=15.0, push="timed")

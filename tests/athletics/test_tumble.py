@@ -263,7 +263,7 @@ def test_the_somersault_command_leaps_from_a_settled_start_as_the_files_do() -> 
     Start 4 of the full-size starts (seed 0) left the timed start moving back at 1.1 m/s and
     fell after touchdown; settled first it lands."""
     maneuvers = Path(__file__).parents[2] / "examples" / "athletics" / "maneuvers"
-    for stem in ("vertical_leap", "back_somersault"):
+    for stem in ("vertical_leap", "back_somersault", "broad_jump"):
         assert load_maneuver(maneuvers / f"{stem}.toml").phases[0] == SETTLED_START, stem
     m = somersault_maneuver()
     assert m.seconds == load_maneuver(maneuvers / "back_somersault.toml").seconds
