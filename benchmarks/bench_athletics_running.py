@@ -328,6 +328,22 @@ _VAULT_PRE_SPACE = {
     "horse_distance": (1.3, 2.0, 0.04), "hand_target": (-0.15, 0.15, 0.02),
     "pike": (-0.3, 0.5, 0.05), "flight_stiffness": (1.0, 8.0, 0.4),
     "horse_push": (0.0, 1.5, 0.1), "arms_flight2": (-3.1, -1.6, 0.1),
+    "arm_spring": (0.0, 3.0, 0.2), "arm_damping": (0.0, 0.5, 0.05),
+    "yield_elbow": (0.0, 1.2, 0.1), "yield_shoulder": (-0.8, 0.8, 0.1),
+    "yield_s": (0.0, 0.15, 0.02), "block_shoulder": (-3.3, -2.0, 0.1),
+    "block_s": (0.02, 0.2, 0.02),
+}  # fmt: skip
+
+
+#: the vault's values after the horse's lift-off (``--tune-vault --vault-keys post``): the
+#: second flight's layout and tuck, the landing and the stance, for a new flight to land
+_VAULT_POST_SPACE = {
+    "layout2": (0.0, 0.3, 0.02), "turns2": (0.8, 1.15, 0.02),
+    "touchdown_com": (0.6, 1.2, 0.03), "land_knee": (0.2, 1.2, 0.05),
+    "land_lead": (0.3, 1.5, 0.06), "land_delta": (-0.3, 0.2, 0.03),
+    "land_damping": (0.2, 6.0, 0.3), "land_restore": (0.0, 0.5, 0.03),
+    "land_lean": (0.0, 1.2, 0.06), "mat_solref": (0.01, 0.08, 0.004),
+    "stand_leg": (0.7, 1.0, 0.02), "stand_settle": (0.2, 1.5, 0.1),
 }  # fmt: skip
 
 
@@ -357,8 +373,9 @@ def _vault_score(rep: dict, landing: bool) -> float:
 def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | None = None,
                out: Path | None = None, sample: int = 0, start: Path | None = None) -> None:  # fmt: skip
     """The vault's random search: ``keys`` "all" (every value, scored on Table 1 and the
-    landing) or "pre" (:data:`_VAULT_PRE_SPACE`, from the defaults, several values at once;
-    with ``seconds`` short of the landing, scored on Table 1 and clearing the horse only).
+    landing), "pre" (:data:`_VAULT_PRE_SPACE`, from the defaults, several values at once;
+    with ``seconds`` short of the landing, scored on Table 1 and clearing the horse only) or
+    "post" (:data:`_VAULT_POST_SPACE`, the landing's, the rest held at ``start``'s values).
     With ``sample``, first that many points of a Latin hypercube over the whole box (scipy's
     ``qmc``), the search then starting from the best of them and the defaults. Each run and
     each new best is printed and, with ``out``, the best written there as JSON; ``start``
@@ -379,13 +396,13 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
         "land_restore": (0.0, 0.5, 0.04), "land_lean": (0.0, 1.2, 0.1),
         "mat_solref": (0.01, 0.08, 0.006), "stand_leg": (0.7, 1.0, 0.03),
         "stand_settle": (0.2, 1.5, 0.1),
-    } if keys == "all" else _VAULT_PRE_SPACE  # fmt: skip
+    } if keys == "all" else _VAULT_PRE_SPACE if keys == "pre" else _VAULT_POST_SPACE  # fmt: skip
     landing = seconds is None
     best_j = math.inf
 
     def score(x: dict[str, float]) -> float:
         nonlocal best_j
-        rep = vault(params=dataclasses.replace(VaultParams(), **x), seconds=seconds).report
+        rep = vault(params=dataclasses.replace(VaultParams(), **fixed, **x), seconds=seconds).report
         j = _vault_score(rep, landing)
         t1 = rep["table1"]
         print(f"  run: {j:.3f}, {rep['table1_inside']}/16 inside, horse contact "
@@ -398,7 +415,7 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
                   flush=True)  # fmt: skip
             if out is not None:
                 tmp = out.with_suffix(".tmp")
-                tmp.write_text(json.dumps({"score": j, "params": x, "report": rep}, indent=1,
+                tmp.write_text(json.dumps({"score": j, "params": fixed | x, "report": rep}, indent=1,
                                           default=str))  # fmt: skip
                 tmp.replace(out)
         return j
@@ -406,8 +423,11 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
     rng = np.random.default_rng(seed)
     base = VaultParams()
     best = {k: float(getattr(base, k)) for k in space}
+    fixed: dict[str, float] = {}
     if start is not None:
-        best.update({k: float(v) for k, v in json.loads(start.read_text())["params"].items()})
+        values = {k: float(v) for k, v in json.loads(start.read_text())["params"].items()}
+        best.update({k: v for k, v in values.items() if k in space})
+        fixed = {k: v for k, v in values.items() if k not in space}
     if sample:
         from scipy.stats import qmc
 
@@ -438,8 +458,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--figures", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--tune-speed", type=float, help="search the runner's values at a speed")
     ap.add_argument("--tune-vault", action="store_true", help="search the vault's values")
-    ap.add_argument("--vault-keys", choices=("all", "pre"), default="all",
-                    help="--tune-vault: every value, or those before the horse's lift-off")  # fmt: skip
+    ap.add_argument("--vault-keys", choices=("all", "pre", "post"), default="all",
+                    help="--tune-vault: every value, those before the horse's lift-off, or "
+                         "the landing's (the others from --tune-from)")  # fmt: skip
     ap.add_argument("--vault-seconds", type=float,
                     help="--tune-vault: seconds per run (short of the landing: Table 1 only)")  # fmt: skip
     ap.add_argument("--tune-out", type=Path, help="--tune-vault: the best so far (JSON)")

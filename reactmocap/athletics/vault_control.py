@@ -65,12 +65,13 @@ class Vault(Basis):
         horse_geom = int(m.geom("horse_box").id)
         floor = int(m.geom("floor").id)
         board_dof = int(m.jnt_dofadr[m.joint("board_spring").id])
+        board_qpos = int(m.jnt_qposadr[m.joint("board_spring").id])
         own = world.geom_character == ctx.character
         part = world.geom_body
         feet = {SIM_BODIES.index(b) for b in ("l_foot", "r_foot")}
         hands = {SIM_BODIES.index(b) for b in ("l_hand", "r_hand", "l_forearm", "r_forearm")}
         f6 = np.zeros(6)
-        seen = {"board": 0, "horse": 0, "deepest": False}
+        seen = {"board": 0, "horse": 0, "deepest": False, "blocked": False}
         # the geoms that must stay above the horse's top while over it: all but the arms'
         check = np.flatnonzero(own & ~np.isin(part, list(hands)))
         is_box = m.geom_type == int(mujoco.mjtGeom.mjGEOM_BOX)
@@ -169,7 +170,7 @@ class Vault(Basis):
                 goal |= {_J[f"{s}_shoulder"]: (p.arms_push, 0.0, 0.0) for s in "lr"}
                 pose(goal, 0.05, t)
 
-        t_in = {"board": 0.0}
+        t_in = {"board": 0.0, "horse": 0.0}
 
         def _ti_since(t: float) -> float:
             return t - t_in["board"]
@@ -178,7 +179,11 @@ class Vault(Basis):
             t_in["board"] = t
             board_enter(w, t)
 
-        def left_board(_w: World, _t: float, t_in_state: float) -> bool:
+        def left_board(w: World, _t: float, t_in_state: float) -> bool:
+            if p.board_return > 0 and not (
+                seen["deepest"] and w.data.qpos[board_qpos] >= -p.board_return
+            ):
+                return False  # the legs push on through the plate's rebound
             return t_in_state > 0.02 and seen["board"] >= 2
 
         # -------------------------------------------------------------- first flight
@@ -212,6 +217,18 @@ class Vault(Basis):
         # -------------------------------------------------------------- horse contact
         def horse_enter(_w: World, t: float) -> None:
             seen["horse"] = 0
+            seen["blocked"] = False
+            if p.arm_spring > 0:
+                # not the paper's passive strut: the arms a spring-damper that yields under
+                # the arrival (shoulders give, elbows bend), then blocks (see horse())
+                stiff(flight | {"shoulder": p.arm_spring, "elbow": p.arm_spring, "wrist": 0.0})
+                rig.set_damping(per_joint({"shoulder": p.arm_damping, "elbow": p.arm_damping}))
+                now = rig.current_angles()
+                goal = {_J[f"{s}_elbow"]: (p.yield_elbow, 0.0, 0.0) for s in "lr"}
+                goal |= {_J[f"{s}_shoulder"]: (now[_J[f"{s}_shoulder"], 0] + p.yield_shoulder,
+                                               0.0, 0.0) for s in "lr"}  # fmt: skip
+                pose(goal, 0.0, t)
+                return
             values = flight | {"shoulder": p.horse_push, "wrist": 0.0, "elbow": 3.0}
             stiff(values)
             goal = {_J[f"{s}_elbow"]: (0.0, 0.0, 0.0) for s in "lr"}
@@ -222,6 +239,16 @@ class Vault(Basis):
         def horse(_w: World, t: float) -> None:
             _, on_h, _ = sense(t)
             seen["horse"] = 0 if on_h else seen["horse"] + 1
+            if p.arm_spring > 0 and not seen["blocked"] and t - t_in["horse"] >= p.yield_s:
+                # the block: the elbows straighten, the shoulders extend (girdle push)
+                seen["blocked"] = True
+                goal = {_J[f"{s}_elbow"]: (0.0, 0.0, 0.0) for s in "lr"}
+                goal |= {_J[f"{s}_shoulder"]: (p.block_shoulder, 0.0, 0.0) for s in "lr"}
+                pose(goal, p.block_s, t)
+
+        def horse_enter2(w: World, t: float) -> None:
+            t_in["horse"] = t
+            horse_enter(w, t)
 
         def left_horse(_w: World, _t: float, t_in_state: float) -> bool:
             return t_in_state > 0.02 and seen["horse"] >= 2
@@ -229,6 +256,8 @@ class Vault(Basis):
         # -------------------------------------------------------------- second flight
         def flight2_enter(_w: World, t: float) -> None:
             stiff(flight)
+            if p.arm_spring > 0:
+                rig.set_damping(np.zeros(NJ))
             goal = {_J[f"{s}_hip"]: (-p.pike2, 0.08 if s == "l" else -0.08, 0.0) for s in "lr"}
             goal |= {_J[f"{s}_knee"]: (0.0, 0.0, 0.0) for s in "lr"}
             goal |= {_J[j]: (0.0, 0.0, 0.0) for j in ("waist", "back")}
@@ -252,7 +281,7 @@ class Vault(Basis):
                   ((left_board, "flight1"), (after(0.4), "flight1"))),
             State("flight1", logged(flight1), flight1_enter,
                   ((on_horse, "horse"), (after(1.0), "flight2"))),
-            State("horse", logged(horse), horse_enter,
+            State("horse", logged(horse), horse_enter2,
                   ((left_horse, "flight2"), (after(0.6), "flight2"))),
             State("flight2", logged(flight2), flight2_enter, ((after(p.layout2), NEXT),)),
         ]  # fmt: skip

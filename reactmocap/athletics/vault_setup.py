@@ -78,6 +78,24 @@ class VaultParams:
         flight_stiffness: trunk and leg stiffness in the flights (units of m g L).
         horse_push: shoulder extension stiffness while on the horse (units of m g L; the
             paper's "no torque at the shoulder" is 0).
+        arm_spring: > 0 makes the horse contact active, unlike the paper: shoulders and
+            elbows become a spring of this stiffness (units of m g L) that first yields
+            (``yield_shoulder``, ``yield_elbow``) for ``yield_s`` seconds, then blocks (the
+            elbows straighten and the shoulders drive to ``block_shoulder`` over ``block_s``
+            seconds); 0: the paper's passive strut (``horse_push``).
+        arm_damping: the shoulders' and elbows' damping on the horse with ``arm_spring``
+            (units of m L sqrt(g L) N m s/rad).
+        yield_shoulder: the yield's shoulder pitch, from the angle at the hands' touchdown
+            (rad; > 0 lowers the arms toward the body).
+        yield_elbow: the yield's elbow flexion (rad, within [0, 2.5]).
+        yield_s: seconds from the hands' touchdown to the block.
+        block_shoulder: shoulder pitch the block drives to (rad; -pi: the arms in line with
+            the trunk, overhead).
+        block_s: seconds the block's move takes.
+        board_return: > 0 keeps the board state (the legs' push) until the push has begun
+            and the plate is back within this many metres of its rest height, so that a
+            bounce of the feet does not end it; 0: it ends on the feet's first bounce after
+            20 ms.
         layout2: seconds the second flight holds the layout after the hands leave the horse
             (the legs clear it) before the tumbling controller takes the body into
             ``position2``.
@@ -125,6 +143,14 @@ class VaultParams:
     pike: float = -0.06506
     flight_stiffness: float = 4.145
     horse_push: float = 0.0
+    arm_spring: float = 0.0
+    arm_damping: float = 0.0
+    yield_shoulder: float = 0.0
+    yield_elbow: float = 0.0
+    yield_s: float = 0.05
+    block_shoulder: float = -math.pi
+    block_s: float = 0.1
+    board_return: float = 0.0
     mat_solref: float = 0.022
     mat_damping: float = 1.0
     layout2: float = 0.065
@@ -153,6 +179,17 @@ class VaultParams:
                      "mat_solref", "mat_damping", "turns2", "touchdown_com", "stand_settle"):  # fmt: skip
             if getattr(self, name) <= 0:
                 raise ConfigError(f"vault parameter {name} must be > 0")
+        for name in ("arm_spring", "arm_damping", "yield_s", "board_return"):
+            if getattr(self, name) < 0:
+                raise ConfigError(
+                    f"vault parameter {name} must be >= 0, got {getattr(self, name)!r}"
+                )
+        if self.block_s <= 0:
+            raise ConfigError(f"vault parameter block_s must be > 0, got {self.block_s!r}")
+        if not 0.0 <= self.yield_elbow <= 2.5:
+            raise ConfigError(
+                f"vault yield_elbow must be within [0, 2.5], got {self.yield_elbow!r}"
+            )
         if not 0.3 <= self.stand_leg <= 1.0:
             raise ConfigError(f"vault stand_leg must be within [0.3, 1.0], got {self.stand_leg!r}")
 
