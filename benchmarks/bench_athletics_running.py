@@ -407,7 +407,11 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
         t1 = rep["table1"]
         print(f"  run: {j:.3f}, {rep['table1_inside']}/16 inside, horse contact "
               f"{t1['horse_contact_s'] or 0:.3f} s, board lift-off vz {t1['board_liftoff_vz_m_s'] or 0:.2f}"
-              f" m/s, cleared {rep['cleared']}", flush=True)  # fmt: skip
+              f" m/s, cleared {rep['cleared']}, outside {rep['table1_outside']}", flush=True)  # fmt: skip
+        if out is not None:  # every run, to find a good one that was not the best
+            with out.with_suffix(".runs.jsonl").open("a") as f:
+                f.write(json.dumps({"score": j, "params": fixed | x, "table1": t1,
+                                    "landed": rep["landed"]}) + "\n")  # fmt: skip
         if j < best_j:
             best_j = j
             print(f"  best {j:.3f}: {rep['table1_inside']}/16 inside, outside "

@@ -65,7 +65,6 @@ class Vault(Basis):
         horse_geom = int(m.geom("horse_box").id)
         floor = int(m.geom("floor").id)
         board_dof = int(m.jnt_dofadr[m.joint("board_spring").id])
-        board_qpos = int(m.jnt_qposadr[m.joint("board_spring").id])
         own = world.geom_character == ctx.character
         part = world.geom_body
         feet = {SIM_BODIES.index(b) for b in ("l_foot", "r_foot")}
@@ -179,11 +178,7 @@ class Vault(Basis):
             t_in["board"] = t
             board_enter(w, t)
 
-        def left_board(w: World, _t: float, t_in_state: float) -> bool:
-            if p.board_return > 0 and not (
-                seen["deepest"] and w.data.qpos[board_qpos] >= -p.board_return
-            ):
-                return False  # the legs push on through the plate's rebound
+        def left_board(_w: World, _t: float, t_in_state: float) -> bool:
             return t_in_state > 0.02 and seen["board"] >= 2
 
         # -------------------------------------------------------------- first flight

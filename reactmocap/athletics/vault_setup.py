@@ -92,10 +92,6 @@ class VaultParams:
         block_shoulder: shoulder pitch the block drives to (rad; -pi: the arms in line with
             the trunk, overhead).
         block_s: seconds the block's move takes.
-        board_return: > 0 keeps the board state (the legs' push) until the push has begun
-            and the plate is back within this many metres of its rest height, so that a
-            bounce of the feet does not end it; 0: it ends on the feet's first bounce after
-            20 ms.
         layout2: seconds the second flight holds the layout after the hands leave the horse
             (the legs clear it) before the tumbling controller takes the body into
             ``position2``.
@@ -150,7 +146,6 @@ class VaultParams:
     yield_s: float = 0.05
     block_shoulder: float = -math.pi
     block_s: float = 0.1
-    board_return: float = 0.0
     mat_solref: float = 0.022
     mat_damping: float = 1.0
     layout2: float = 0.065
@@ -179,7 +174,7 @@ class VaultParams:
                      "mat_solref", "mat_damping", "turns2", "touchdown_com", "stand_settle"):  # fmt: skip
             if getattr(self, name) <= 0:
                 raise ConfigError(f"vault parameter {name} must be > 0")
-        for name in ("arm_spring", "arm_damping", "yield_s", "board_return"):
+        for name in ("arm_spring", "arm_damping", "yield_s"):
             if getattr(self, name) < 0:
                 raise ConfigError(
                     f"vault parameter {name} must be >= 0, got {getattr(self, name)!r}"
