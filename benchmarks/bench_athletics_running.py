@@ -175,13 +175,23 @@ VAULT_LANDING_KEYS = ("turns2", "touchdown_com", "layout2", "land_knee", "land_l
                       "land_delta", "land_damping", "land_restore", "land_lean", "mat_solref")  # fmt: skip
 
 
-def vault_sensitivity(step: float = 0.02) -> None:
-    from reactmocap.athletics.vault import VaultParams, vault
+def _vault_base(start: Path | None = None):  # type: ignore[no-untyped-def]
+    """The vault's defaults, or with ``start`` (a ``--tune-out`` file) its values."""
+    from reactmocap.athletics.vault import VaultParams
+
+    if start is None:
+        return VaultParams()
+    values = json.loads(start.read_text())["params"]
+    return dataclasses.replace(VaultParams(), **{k: float(v) for k, v in values.items()})
+
+
+def vault_sensitivity(step: float = 0.02, start: Path | None = None) -> None:
+    from reactmocap.athletics.vault import vault
 
     print(f"## Vault landing sensitivity (each value {step:.0%} lower and higher)\n")
     print("| value | factor | landed | up after touchdown (s) | rotation at touchdown (deg) |")
     print("|---|---|---|---|---|")
-    base = VaultParams()
+    base = _vault_base(start)
     landed = 0
     for key in VAULT_LANDING_KEYS:
         for f in (1.0 - step, 1.0 + step):
@@ -190,6 +200,30 @@ def vault_sensitivity(step: float = 0.02) -> None:
             print(f"| {key} | {f:g} | {_fmt(r['landed'])} | {r['up_after_touchdown_s']:.2f} | "
                   f"{r['rotation_at_touchdown_deg']:.0f} |", flush=True)  # fmt: skip
     print(f"\nlanded in {landed} of {2 * len(VAULT_LANDING_KEYS)} runs\n")
+
+
+def vault_table_sensitivity(step: float = 0.02, seconds: float = 1.5,
+                            start: Path | None = None) -> None:  # fmt: skip
+    """Table 1 with each value before the horse's lift-off (:data:`_VAULT_PRE_SPACE` but the
+    ones at 0) 2% lower and higher, runs of ``seconds`` (Table 1's rows, not the landing)."""
+    from reactmocap.athletics.vault import vault
+
+    print(f"## Vault Table 1 sensitivity (each value {step:.0%} lower and higher)\n")
+    print("| value | factor | inside | horse contact (s) | board lift-off vz (m/s) | outside |")
+    print("|---|---|---|---|---|---|")
+    base = _vault_base(start)
+    full = 0
+    keys = [k for k in _VAULT_PRE_SPACE if getattr(base, k) != 0]
+    for key in keys:
+        for f in (1.0 - step, 1.0 + step):
+            p = dataclasses.replace(base, **{key: getattr(base, key) * f})
+            r = vault(params=p, seconds=seconds).report
+            full += r["table1_inside"] == 16
+            t1 = r["table1"]
+            print(f"| {key} | {f:g} | {r['table1_inside']} | {t1['horse_contact_s'] or 0:.3f} | "
+                  f"{t1['board_liftoff_vz_m_s'] or 0:.3f} | {', '.join(r['table1_outside'])} |",
+                  flush=True)  # fmt: skip
+    print(f"\nall 16 rows inside in {full} of {2 * len(keys)} runs\n")
 
 
 def cloth(seconds: float, speed: float, repeats: int = 3,
@@ -335,6 +369,12 @@ _VAULT_PRE_SPACE = {
 }  # fmt: skip
 
 
+#: the values of the first flight and the horse (``--tune-vault --vault-keys horse``): the
+#: board and the approach left as they are, whose values sit on the feet's bounce off the plate
+_VAULT_HORSE_KEYS = ("horse_distance", "hand_target", "pike", "flight_stiffness", "horse_push",
+                     "arms_flight2", "arm_spring", "arm_damping", "yield_elbow",
+                     "yield_shoulder", "yield_s", "block_shoulder", "block_s")  # fmt: skip
+
 #: the vault's values after the horse's lift-off (``--tune-vault --vault-keys post``): the
 #: second flight's layout and tuck, the landing and the stance, for a new flight to land
 _VAULT_POST_SPACE = {
@@ -349,7 +389,8 @@ _VAULT_POST_SPACE = {
 
 def _vault_score(rep: dict, landing: bool) -> float:
     """Table 1 (each row outside the human range 1 + how far out in spans, each row's
-    distance from the mean a little), clearing the horse and, with ``landing``, how long she
+    distance from the mean a little), clearing the horse, the share of the horse contact with
+    a forearm on it and, with ``landing``, how long she
     stayed up after touchdown and whether she landed."""
     from reactmocap.athletics.vault import TABLE1
 
@@ -363,6 +404,8 @@ def _vault_score(rep: dict, landing: bool) -> float:
         out = max(row.low - v, v - row.high, 0.0) / span
         j += (1.0 if out > 0 else 0.0) + 2.0 * out + 0.3 * abs(v - row.mean) / span
     j += 3.0 * (not rep["cleared"])
+    # a handspring's support is the hands': the forearms on the horse count against it
+    j += 3.0 * rep["horse_forearm_share"]
     if landing:
         # the landing: how long she stayed up after touchdown (to the run's end: landed)
         up = min(rep["up_after_touchdown_s"], 3.0) / 3.0
@@ -397,6 +440,8 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
         "mat_solref": (0.01, 0.08, 0.006), "stand_leg": (0.7, 1.0, 0.03),
         "stand_settle": (0.2, 1.5, 0.1),
     } if keys == "all" else _VAULT_PRE_SPACE if keys == "pre" else _VAULT_POST_SPACE  # fmt: skip
+    if keys == "horse":
+        space = {k: _VAULT_PRE_SPACE[k] for k in _VAULT_HORSE_KEYS}
     landing = seconds is None
     best_j = math.inf
 
@@ -441,7 +486,7 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
         scored += [(score(x), x) for x in (dict(zip(space, map(float, p))) for p in pts)]
         best = min(scored, key=lambda jx: jx[0])[1]
     best = _random_search(score, space, best, iterations, rng, tries=4,
-                          changed=(1, 5) if keys == "all" else (2, 7), sigma_max=3.0)  # fmt: skip
+                          changed=(2, 7) if keys in ("pre", "horse") else (1, 5), sigma_max=3.0)  # fmt: skip
     print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
 
 
@@ -451,6 +496,9 @@ def main(argv: list[str] | None = None) -> int:
         ap.add_argument(f"--{name}", action="store_true")
     ap.add_argument("--vault-sensitivity", action="store_true",
                     help="the vault's landing with each landing value moved by 2%%")  # fmt: skip
+    ap.add_argument("--vault-table-sensitivity", action="store_true",
+                    help="the vault's Table 1 with each value before the horse's lift-off "
+                         "moved by 2%%")  # fmt: skip
     ap.add_argument("--seconds", type=float, default=30.0, help="length of the speed runs")
     ap.add_argument("--path-speed", type=float, default=2.5, help="speed of the path runs")
     ap.add_argument(
@@ -462,13 +510,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--figures", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--tune-speed", type=float, help="search the runner's values at a speed")
     ap.add_argument("--tune-vault", action="store_true", help="search the vault's values")
-    ap.add_argument("--vault-keys", choices=("all", "pre", "post"), default="all",
-                    help="--tune-vault: every value, those before the horse's lift-off, or "
-                         "the landing's (the others from --tune-from)")  # fmt: skip
+    ap.add_argument("--vault-keys", choices=("all", "pre", "horse", "post"), default="all",
+                    help="--tune-vault: every value, those before the horse's lift-off, those "
+                         "of the first flight and the horse, or the landing's (the others "
+                         "from --tune-from)")  # fmt: skip
     ap.add_argument("--vault-seconds", type=float,
                     help="--tune-vault: seconds per run (short of the landing: Table 1 only)")  # fmt: skip
     ap.add_argument("--tune-out", type=Path, help="--tune-vault: the best so far (JSON)")
-    ap.add_argument("--tune-from", type=Path, help="--tune-vault: start from a --tune-out file")
+    ap.add_argument("--tune-from", type=Path,
+                    help="--tune-vault: start from a --tune-out file; --vault-sensitivity, "
+                         "--vault-table-sensitivity: around its values")  # fmt: skip
     ap.add_argument("--vault-sample", type=int, default=0,
                     help="--tune-vault: Latin-hypercube points over the box before the search")  # fmt: skip
     ap.add_argument("--iterations", type=int, default=30)
@@ -505,7 +556,9 @@ def main(argv: list[str] | None = None) -> int:
     if every or args.vault:
         vault_section()
     if args.vault_sensitivity:
-        vault_sensitivity()
+        vault_sensitivity(start=args.tune_from)
+    if args.vault_table_sensitivity:
+        vault_table_sensitivity(start=args.tune_from)
     if every or args.cloth:
         cloth(10.0, 3.5, args.cloth_repeats)
     print(f"(benchmark wall time {time.perf_counter() - t0:.0f} s)")

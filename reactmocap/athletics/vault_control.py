@@ -31,14 +31,15 @@ NJ = len(BALL_JOINTS)
 @dataclass
 class VaultLog:
     """Per tick: time, COM, COM velocity, vertical force from the board and from the horse
-    on the gymnast (N), whether the feet touch the board, the hands the horse, anything the
-    floor, and the lowest point of the body over the horse's top (m)."""
+    on the gymnast (N), whether the feet touch the board, the hands (or forearms) the horse,
+    anything the floor, the lowest point of the body over the horse's top (m), the body's
+    pitch and whether a forearm touches the horse."""
 
     rows: list[tuple] = field(default_factory=list)
 
     def arrays(self) -> dict[str, NDArray]:
         names = ("t", "com", "com_vel", "board_force", "horse_force", "on_board", "on_horse",
-                 "on_floor", "over_horse_clearance", "pitch")  # fmt: skip
+                 "on_floor", "over_horse_clearance", "pitch", "forearm_on_horse")  # fmt: skip
         if not self.rows:
             return {n: np.zeros(0) for n in names}
         return {n: np.array(c) for n, c in zip(names, zip(*self.rows))}
@@ -68,7 +69,8 @@ class Vault(Basis):
         own = world.geom_character == ctx.character
         part = world.geom_body
         feet = {SIM_BODIES.index(b) for b in ("l_foot", "r_foot")}
-        hands = {SIM_BODIES.index(b) for b in ("l_hand", "r_hand", "l_forearm", "r_forearm")}
+        forearms = {SIM_BODIES.index(b) for b in ("l_forearm", "r_forearm")}
+        hands = {SIM_BODIES.index(b) for b in ("l_hand", "r_hand")} | forearms
         f6 = np.zeros(6)
         seen = {"board": 0, "horse": 0, "deepest": False, "blocked": False}
         # the geoms that must stay above the horse's top while over it: all but the arms'
@@ -85,7 +87,7 @@ class Vault(Basis):
             """Contacts with the board (feet), the horse (hands) and the floor; logs a row."""
             d = world.data
             fb = fh = 0.0
-            on_b = on_h = on_f = False
+            on_b = on_h = on_f = on_fa = False
             for i in range(d.ncon):
                 g1, g2 = int(d.contact.geom[i, 0]), int(d.contact.geom[i, 1])
                 other = g2 if own[g1] else g1 if own[g2] else -1
@@ -100,6 +102,7 @@ class Vault(Basis):
                 elif other == horse_geom:
                     fh += fz
                     on_h |= int(part[mine]) in hands
+                    on_fa |= int(part[mine]) in forearms
                 else:
                     on_f = True
             s = ctx.sense(t)
@@ -118,7 +121,7 @@ class Vault(Basis):
                 clear = float((d.geom_xpos[g, 2] - low).min()) - horse_top
             pitch = _body_pitch(d, chest, ctx.athlete)
             self.log.rows.append((t, s.com.copy(), s.com_vel.copy(), fb, fh, on_b, on_h, on_f,
-                                  clear, pitch))  # fmt: skip
+                                  clear, pitch, on_fa))  # fmt: skip
             return on_b, on_h, on_f
 
         def pose(goal: dict[int, tuple[float, float, float]], dur: float, t: float) -> None:
