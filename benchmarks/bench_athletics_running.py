@@ -17,7 +17,10 @@ Sections:
 * ``--vault``: the handspring vault against Table 1 (goal: all 16 rows inside the human range,
   velocities within 10% of the mean).
 * ``--vault-sensitivity``: the vault with each second-flight and landing value 2% lower and
-  2% higher (20 runs): how many land.
+  2% higher (20 runs): how many land. ``--vault-table-sensitivity``: Table 1 with each value
+  before the horse's lift-off 2% lower and higher (1.5 s runs). With ``--vault-all-rows``
+  these and ``--vault`` use ``ALL_ROWS_VALUES`` (the active horse contact), with
+  ``--tune-from F`` a ``--tune-out`` file's values.
 * ``--cloth``: the same run with and without trousers: penetration and the slow-down ratio
   (goal: <= 1 cm, <= 1.5x); the trousers' penetration at 3 and 4 m/s too.
 * ``--tune-speed S`` and ``--tune-vault``: the searches that found the defaults (a (1+3)
@@ -150,11 +153,11 @@ def push(speed: float) -> None:
     )
 
 
-def vault_section() -> None:
+def vault_section(start: Path | None = None, all_rows: bool = False) -> None:
     from reactmocap.athletics.vault import TABLE1, vault
 
     print("## Handspring vault against Table 1 (scaled thesis female)\n")
-    r = vault().report
+    r = vault(params=_vault_base(start, all_rows)).report
     rows = r["table1"]
     print("| row | ours | human mean | human min | human max | inside | Hodgins 1995 |")
     print("|---|---|---|---|---|---|---|")
@@ -175,23 +178,28 @@ VAULT_LANDING_KEYS = ("turns2", "touchdown_com", "layout2", "land_knee", "land_l
                       "land_delta", "land_damping", "land_restore", "land_lean", "mat_solref")  # fmt: skip
 
 
-def _vault_base(start: Path | None = None):  # type: ignore[no-untyped-def]
-    """The vault's defaults, or with ``start`` (a ``--tune-out`` file) its values."""
-    from reactmocap.athletics.vault import VaultParams
+def _vault_base(start: Path | None = None, all_rows: bool = False):  # type: ignore[no-untyped-def]
+    """The vault's defaults, with ``all_rows`` its ``ALL_ROWS_VALUES``, or with ``start`` (a
+    ``--tune-out`` file) its values."""
+    from reactmocap.athletics.vault import ALL_ROWS_VALUES, VaultParams
 
+    if all_rows:
+        return dataclasses.replace(VaultParams(), **ALL_ROWS_VALUES)
     if start is None:
         return VaultParams()
     values = json.loads(start.read_text())["params"]
     return dataclasses.replace(VaultParams(), **{k: float(v) for k, v in values.items()})
 
 
-def vault_sensitivity(step: float = 0.02, start: Path | None = None) -> None:
+def vault_sensitivity(
+    step: float = 0.02, start: Path | None = None, all_rows: bool = False
+) -> None:
     from reactmocap.athletics.vault import vault
 
     print(f"## Vault landing sensitivity (each value {step:.0%} lower and higher)\n")
     print("| value | factor | landed | up after touchdown (s) | rotation at touchdown (deg) |")
     print("|---|---|---|---|---|")
-    base = _vault_base(start)
+    base = _vault_base(start, all_rows)
     landed = 0
     for key in VAULT_LANDING_KEYS:
         for f in (1.0 - step, 1.0 + step):
@@ -203,7 +211,7 @@ def vault_sensitivity(step: float = 0.02, start: Path | None = None) -> None:
 
 
 def vault_table_sensitivity(step: float = 0.02, seconds: float = 1.5,
-                            start: Path | None = None) -> None:  # fmt: skip
+                            start: Path | None = None, all_rows: bool = False) -> None:  # fmt: skip
     """Table 1 with each value before the horse's lift-off (:data:`_VAULT_PRE_SPACE` but the
     ones at 0) 2% lower and higher, runs of ``seconds`` (Table 1's rows, not the landing)."""
     from reactmocap.athletics.vault import vault
@@ -211,7 +219,7 @@ def vault_table_sensitivity(step: float = 0.02, seconds: float = 1.5,
     print(f"## Vault Table 1 sensitivity (each value {step:.0%} lower and higher)\n")
     print("| value | factor | inside | horse contact (s) | board lift-off vz (m/s) | outside |")
     print("|---|---|---|---|---|---|")
-    base = _vault_base(start)
+    base = _vault_base(start, all_rows)
     full = 0
     keys = [k for k in _VAULT_PRE_SPACE if getattr(base, k) != 0]
     for key in keys:
@@ -499,6 +507,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--vault-table-sensitivity", action="store_true",
                     help="the vault's Table 1 with each value before the horse's lift-off "
                          "moved by 2%%")  # fmt: skip
+    ap.add_argument("--vault-all-rows", action="store_true",
+                    help="--vault and its sensitivities with the vault's ALL_ROWS_VALUES")  # fmt: skip
     ap.add_argument("--seconds", type=float, default=30.0, help="length of the speed runs")
     ap.add_argument("--path-speed", type=float, default=2.5, help="speed of the path runs")
     ap.add_argument(
@@ -554,11 +564,11 @@ def main(argv: list[str] | None = None) -> int:
     if every or args.push:
         push(3.5)
     if every or args.vault:
-        vault_section()
+        vault_section(args.tune_from, args.vault_all_rows)
     if args.vault_sensitivity:
-        vault_sensitivity(start=args.tune_from)
+        vault_sensitivity(start=args.tune_from, all_rows=args.vault_all_rows)
     if args.vault_table_sensitivity:
-        vault_table_sensitivity(start=args.tune_from)
+        vault_table_sensitivity(start=args.tune_from, all_rows=args.vault_all_rows)
     if every or args.cloth:
         cloth(10.0, 3.5, args.cloth_repeats)
     print(f"(benchmark wall time {time.perf_counter() - t0:.0f} s)")

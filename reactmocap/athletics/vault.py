@@ -2,9 +2,9 @@
 springboard, springs onto a vaulting horse with her hands, turns a somersault over it and
 lands on the far side. Six states: hurdle step (the flight before the board), board contact
 (the board springs; at its deepest the knees extend and add energy), first flight (the
-shoulders aim the hands at the horse, eq. 12), horse contact (unlike the paper's passive
-straight arms, the arms a spring that yields and then blocks: ``VaultParams.arm_spring``),
-second flight (layout off the horse, then the athletics tumbling controller
+shoulders aim the hands at the horse, eq. 12), horse contact (arms straight, no shoulder or
+wrist torque; or, unlike the paper, with ``VaultParams.arm_spring`` the arms a spring that
+yields and then blocks), second flight (layout off the horse, then the athletics tumbling controller
 tucks to turn faster and opens when the rotation it predicts at touchdown is one somersault)
 and landing (the athletics landing and balance controllers). The body is the thesis female
 scaled to the mean gymnast of Table 1 (47.96 kg, 1.55 m); the board is a plate on a spring
