@@ -17,7 +17,10 @@ Sections:
 * ``--vault``: the handspring vault against Table 1 (goal: all 16 rows inside the human range,
   velocities within 10% of the mean).
 * ``--vault-sensitivity``: the vault with each second-flight and landing value 2% lower and
-  2% higher (20 runs): how many land.
+  2% higher (20 runs): how many land. ``--vault-table-sensitivity``: Table 1 with each value
+  before the horse's lift-off 2% lower and higher (1.5 s runs). With ``--vault-all-rows``
+  these and ``--vault`` use ``ALL_ROWS_VALUES`` (the active horse contact), with
+  ``--tune-from F`` a ``--tune-out`` file's values.
 * ``--cloth``: the same run with and without trousers: penetration and the slow-down ratio
   (goal: <= 1 cm, <= 1.5x); the trousers' penetration at 3 and 4 m/s too.
 * ``--tune-speed S`` and ``--tune-vault``: the searches that found the defaults (a (1+3)
@@ -150,11 +153,11 @@ def push(speed: float) -> None:
     )
 
 
-def vault_section() -> None:
+def vault_section(start: Path | None = None, all_rows: bool = False) -> None:
     from reactmocap.athletics.vault import TABLE1, vault
 
     print("## Handspring vault against Table 1 (scaled thesis female)\n")
-    r = vault().report
+    r = vault(params=_vault_base(start, all_rows)).report
     rows = r["table1"]
     print("| row | ours | human mean | human min | human max | inside | Hodgins 1995 |")
     print("|---|---|---|---|---|---|---|")
@@ -175,13 +178,28 @@ VAULT_LANDING_KEYS = ("turns2", "touchdown_com", "layout2", "land_knee", "land_l
                       "land_delta", "land_damping", "land_restore", "land_lean", "mat_solref")  # fmt: skip
 
 
-def vault_sensitivity(step: float = 0.02) -> None:
-    from reactmocap.athletics.vault import VaultParams, vault
+def _vault_base(start: Path | None = None, all_rows: bool = False):  # type: ignore[no-untyped-def]
+    """The vault's defaults, with ``all_rows`` its ``ALL_ROWS_VALUES``, or with ``start`` (a
+    ``--tune-out`` file) its values."""
+    from reactmocap.athletics.vault import ALL_ROWS_VALUES, VaultParams
+
+    if all_rows:
+        return dataclasses.replace(VaultParams(), **ALL_ROWS_VALUES)
+    if start is None:
+        return VaultParams()
+    values = json.loads(start.read_text())["params"]
+    return dataclasses.replace(VaultParams(), **{k: float(v) for k, v in values.items()})
+
+
+def vault_sensitivity(
+    step: float = 0.02, start: Path | None = None, all_rows: bool = False
+) -> None:
+    from reactmocap.athletics.vault import vault
 
     print(f"## Vault landing sensitivity (each value {step:.0%} lower and higher)\n")
     print("| value | factor | landed | up after touchdown (s) | rotation at touchdown (deg) |")
     print("|---|---|---|---|---|")
-    base = VaultParams()
+    base = _vault_base(start, all_rows)
     landed = 0
     for key in VAULT_LANDING_KEYS:
         for f in (1.0 - step, 1.0 + step):
@@ -190,6 +208,30 @@ def vault_sensitivity(step: float = 0.02) -> None:
             print(f"| {key} | {f:g} | {_fmt(r['landed'])} | {r['up_after_touchdown_s']:.2f} | "
                   f"{r['rotation_at_touchdown_deg']:.0f} |", flush=True)  # fmt: skip
     print(f"\nlanded in {landed} of {2 * len(VAULT_LANDING_KEYS)} runs\n")
+
+
+def vault_table_sensitivity(step: float = 0.02, seconds: float = 1.5,
+                            start: Path | None = None, all_rows: bool = False) -> None:  # fmt: skip
+    """Table 1 with each value before the horse's lift-off (:data:`_VAULT_PRE_SPACE` but the
+    ones at 0) 2% lower and higher, runs of ``seconds`` (Table 1's rows, not the landing)."""
+    from reactmocap.athletics.vault import vault
+
+    print(f"## Vault Table 1 sensitivity (each value {step:.0%} lower and higher)\n")
+    print("| value | factor | inside | horse contact (s) | board lift-off vz (m/s) | outside |")
+    print("|---|---|---|---|---|---|")
+    base = _vault_base(start, all_rows)
+    full = 0
+    keys = [k for k in _VAULT_PRE_SPACE if getattr(base, k) != 0]
+    for key in keys:
+        for f in (1.0 - step, 1.0 + step):
+            p = dataclasses.replace(base, **{key: getattr(base, key) * f})
+            r = vault(params=p, seconds=seconds).report
+            full += r["table1_inside"] == 16
+            t1 = r["table1"]
+            print(f"| {key} | {f:g} | {r['table1_inside']} | {t1['horse_contact_s'] or 0:.3f} | "
+                  f"{t1['board_liftoff_vz_m_s'] or 0:.3f} | {', '.join(r['table1_outside'])} |",
+                  flush=True)  # fmt: skip
+    print(f"\nall 16 rows inside in {full} of {2 * len(keys)} runs\n")
 
 
 def cloth(seconds: float, speed: float, repeats: int = 3,
@@ -328,12 +370,35 @@ _VAULT_PRE_SPACE = {
     "horse_distance": (1.3, 2.0, 0.04), "hand_target": (-0.15, 0.15, 0.02),
     "pike": (-0.3, 0.5, 0.05), "flight_stiffness": (1.0, 8.0, 0.4),
     "horse_push": (0.0, 1.5, 0.1), "arms_flight2": (-3.1, -1.6, 0.1),
+    "arm_spring": (0.0, 3.0, 0.2), "arm_damping": (0.0, 0.5, 0.05),
+    "yield_elbow": (0.0, 1.2, 0.1), "yield_shoulder": (-0.8, 0.8, 0.1),
+    "yield_s": (0.0, 0.15, 0.02), "block_shoulder": (-3.3, -2.0, 0.1),
+    "block_s": (0.02, 0.2, 0.02),
+}  # fmt: skip
+
+
+#: the values of the first flight and the horse (``--tune-vault --vault-keys horse``): the
+#: board and the approach left as they are, whose values sit on the feet's bounce off the plate
+_VAULT_HORSE_KEYS = ("horse_distance", "hand_target", "pike", "flight_stiffness", "horse_push",
+                     "arms_flight2", "arm_spring", "arm_damping", "yield_elbow",
+                     "yield_shoulder", "yield_s", "block_shoulder", "block_s")  # fmt: skip
+
+#: the vault's values after the horse's lift-off (``--tune-vault --vault-keys post``): the
+#: second flight's layout and tuck, the landing and the stance, for a new flight to land
+_VAULT_POST_SPACE = {
+    "layout2": (0.0, 0.3, 0.02), "turns2": (0.8, 1.15, 0.02),
+    "touchdown_com": (0.6, 1.2, 0.03), "land_knee": (0.2, 1.2, 0.05),
+    "land_lead": (0.3, 1.5, 0.06), "land_delta": (-0.3, 0.2, 0.03),
+    "land_damping": (0.2, 6.0, 0.3), "land_restore": (0.0, 0.5, 0.03),
+    "land_lean": (0.0, 1.2, 0.06), "mat_solref": (0.01, 0.08, 0.004),
+    "stand_leg": (0.7, 1.0, 0.02), "stand_settle": (0.2, 1.5, 0.1),
 }  # fmt: skip
 
 
 def _vault_score(rep: dict, landing: bool) -> float:
     """Table 1 (each row outside the human range 1 + how far out in spans, each row's
-    distance from the mean a little), clearing the horse and, with ``landing``, how long she
+    distance from the mean a little), clearing the horse, the share of the horse contact with
+    a forearm on it and, with ``landing``, how long she
     stayed up after touchdown and whether she landed."""
     from reactmocap.athletics.vault import TABLE1
 
@@ -347,6 +412,8 @@ def _vault_score(rep: dict, landing: bool) -> float:
         out = max(row.low - v, v - row.high, 0.0) / span
         j += (1.0 if out > 0 else 0.0) + 2.0 * out + 0.3 * abs(v - row.mean) / span
     j += 3.0 * (not rep["cleared"])
+    # a handspring's support is the hands': the forearms on the horse count against it
+    j += 3.0 * rep["horse_forearm_share"]
     if landing:
         # the landing: how long she stayed up after touchdown (to the run's end: landed)
         up = min(rep["up_after_touchdown_s"], 3.0) / 3.0
@@ -357,8 +424,9 @@ def _vault_score(rep: dict, landing: bool) -> float:
 def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | None = None,
                out: Path | None = None, sample: int = 0, start: Path | None = None) -> None:  # fmt: skip
     """The vault's random search: ``keys`` "all" (every value, scored on Table 1 and the
-    landing) or "pre" (:data:`_VAULT_PRE_SPACE`, from the defaults, several values at once;
-    with ``seconds`` short of the landing, scored on Table 1 and clearing the horse only).
+    landing), "pre" (:data:`_VAULT_PRE_SPACE`, from the defaults, several values at once;
+    with ``seconds`` short of the landing, scored on Table 1 and clearing the horse only) or
+    "post" (:data:`_VAULT_POST_SPACE`, the landing's, the rest held at ``start``'s values).
     With ``sample``, first that many points of a Latin hypercube over the whole box (scipy's
     ``qmc``), the search then starting from the best of them and the defaults. Each run and
     each new best is printed and, with ``out``, the best written there as JSON; ``start``
@@ -379,18 +447,24 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
         "land_restore": (0.0, 0.5, 0.04), "land_lean": (0.0, 1.2, 0.1),
         "mat_solref": (0.01, 0.08, 0.006), "stand_leg": (0.7, 1.0, 0.03),
         "stand_settle": (0.2, 1.5, 0.1),
-    } if keys == "all" else _VAULT_PRE_SPACE  # fmt: skip
+    } if keys == "all" else _VAULT_PRE_SPACE if keys == "pre" else _VAULT_POST_SPACE  # fmt: skip
+    if keys == "horse":
+        space = {k: _VAULT_PRE_SPACE[k] for k in _VAULT_HORSE_KEYS}
     landing = seconds is None
     best_j = math.inf
 
     def score(x: dict[str, float]) -> float:
         nonlocal best_j
-        rep = vault(params=dataclasses.replace(VaultParams(), **x), seconds=seconds).report
+        rep = vault(params=dataclasses.replace(VaultParams(), **fixed, **x), seconds=seconds).report
         j = _vault_score(rep, landing)
         t1 = rep["table1"]
         print(f"  run: {j:.3f}, {rep['table1_inside']}/16 inside, horse contact "
               f"{t1['horse_contact_s'] or 0:.3f} s, board lift-off vz {t1['board_liftoff_vz_m_s'] or 0:.2f}"
-              f" m/s, cleared {rep['cleared']}", flush=True)  # fmt: skip
+              f" m/s, cleared {rep['cleared']}, outside {rep['table1_outside']}", flush=True)  # fmt: skip
+        if out is not None:  # every run, to find a good one that was not the best
+            with out.with_suffix(".runs.jsonl").open("a") as f:
+                f.write(json.dumps({"score": j, "params": fixed | x, "table1": t1,
+                                    "landed": rep["landed"]}) + "\n")  # fmt: skip
         if j < best_j:
             best_j = j
             print(f"  best {j:.3f}: {rep['table1_inside']}/16 inside, outside "
@@ -398,7 +472,7 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
                   flush=True)  # fmt: skip
             if out is not None:
                 tmp = out.with_suffix(".tmp")
-                tmp.write_text(json.dumps({"score": j, "params": x, "report": rep}, indent=1,
+                tmp.write_text(json.dumps({"score": j, "params": fixed | x, "report": rep}, indent=1,
                                           default=str))  # fmt: skip
                 tmp.replace(out)
         return j
@@ -406,8 +480,11 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
     rng = np.random.default_rng(seed)
     base = VaultParams()
     best = {k: float(getattr(base, k)) for k in space}
+    fixed: dict[str, float] = {}
     if start is not None:
-        best.update({k: float(v) for k, v in json.loads(start.read_text())["params"].items()})
+        values = {k: float(v) for k, v in json.loads(start.read_text())["params"].items()}
+        best.update({k: v for k, v in values.items() if k in space})
+        fixed = {k: v for k, v in values.items() if k not in space}
     if sample:
         from scipy.stats import qmc
 
@@ -417,7 +494,7 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
         scored += [(score(x), x) for x in (dict(zip(space, map(float, p))) for p in pts)]
         best = min(scored, key=lambda jx: jx[0])[1]
     best = _random_search(score, space, best, iterations, rng, tries=4,
-                          changed=(1, 5) if keys == "all" else (2, 7), sigma_max=3.0)  # fmt: skip
+                          changed=(2, 7) if keys in ("pre", "horse") else (1, 5), sigma_max=3.0)  # fmt: skip
     print(json.dumps({k: round(v, 4) for k, v in best.items()}, indent=1))
 
 
@@ -427,6 +504,11 @@ def main(argv: list[str] | None = None) -> int:
         ap.add_argument(f"--{name}", action="store_true")
     ap.add_argument("--vault-sensitivity", action="store_true",
                     help="the vault's landing with each landing value moved by 2%%")  # fmt: skip
+    ap.add_argument("--vault-table-sensitivity", action="store_true",
+                    help="the vault's Table 1 with each value before the horse's lift-off "
+                         "moved by 2%%")  # fmt: skip
+    ap.add_argument("--vault-all-rows", action="store_true",
+                    help="--vault and its sensitivities with the vault's ALL_ROWS_VALUES")  # fmt: skip
     ap.add_argument("--seconds", type=float, default=30.0, help="length of the speed runs")
     ap.add_argument("--path-speed", type=float, default=2.5, help="speed of the path runs")
     ap.add_argument(
@@ -438,12 +520,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--figures", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--tune-speed", type=float, help="search the runner's values at a speed")
     ap.add_argument("--tune-vault", action="store_true", help="search the vault's values")
-    ap.add_argument("--vault-keys", choices=("all", "pre"), default="all",
-                    help="--tune-vault: every value, or those before the horse's lift-off")  # fmt: skip
+    ap.add_argument("--vault-keys", choices=("all", "pre", "horse", "post"), default="all",
+                    help="--tune-vault: every value, those before the horse's lift-off, those "
+                         "of the first flight and the horse, or the landing's (the others "
+                         "from --tune-from)")  # fmt: skip
     ap.add_argument("--vault-seconds", type=float,
                     help="--tune-vault: seconds per run (short of the landing: Table 1 only)")  # fmt: skip
     ap.add_argument("--tune-out", type=Path, help="--tune-vault: the best so far (JSON)")
-    ap.add_argument("--tune-from", type=Path, help="--tune-vault: start from a --tune-out file")
+    ap.add_argument("--tune-from", type=Path,
+                    help="--tune-vault: start from a --tune-out file; --vault-sensitivity, "
+                         "--vault-table-sensitivity: around its values")  # fmt: skip
     ap.add_argument("--vault-sample", type=int, default=0,
                     help="--tune-vault: Latin-hypercube points over the box before the search")  # fmt: skip
     ap.add_argument("--iterations", type=int, default=30)
@@ -478,9 +564,11 @@ def main(argv: list[str] | None = None) -> int:
     if every or args.push:
         push(3.5)
     if every or args.vault:
-        vault_section()
+        vault_section(args.tune_from, args.vault_all_rows)
     if args.vault_sensitivity:
-        vault_sensitivity()
+        vault_sensitivity(start=args.tune_from, all_rows=args.vault_all_rows)
+    if args.vault_table_sensitivity:
+        vault_table_sensitivity(start=args.tune_from, all_rows=args.vault_all_rows)
     if every or args.cloth:
         cloth(10.0, 3.5, args.cloth_repeats)
     print(f"(benchmark wall time {time.perf_counter() - t0:.0f} s)")

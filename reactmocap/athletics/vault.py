@@ -3,7 +3,8 @@ springboard, springs onto a vaulting horse with her hands, turns a somersault ov
 lands on the far side. Six states: hurdle step (the flight before the board), board contact
 (the board springs; at its deepest the knees extend and add energy), first flight (the
 shoulders aim the hands at the horse, eq. 12), horse contact (arms straight, no shoulder or
-wrist torque), second flight (layout off the horse, then the athletics tumbling controller
+wrist torque; or, unlike the paper, with ``VaultParams.arm_spring`` the arms a spring that
+yields and then blocks), second flight (layout off the horse, then the athletics tumbling controller
 tucks to turn faster and opens when the rotation it predicts at touchdown is one somersault)
 and landing (the athletics landing and balance controllers). The body is the thesis female
 scaled to the mean gymnast of Table 1 (47.96 kg, 1.55 m); the board is a plate on a spring
@@ -35,6 +36,7 @@ from reactmocap.athletics.sequencer import Sequencer
 from reactmocap.athletics.tumble import Tumble, TumbleParams
 from reactmocap.athletics.vault_control import Vault, VaultLog, _Logger
 from reactmocap.athletics.vault_setup import (
+    ALL_ROWS_VALUES,
     BOARD,
     HORSE,
     Apparatus,
@@ -60,6 +62,7 @@ from reactmocap.sim.world import World
 NJ = len(BALL_JOINTS)
 
 __all__ = [
+    "ALL_ROWS_VALUES",
     "BOARD",
     "GYMNAST_HEIGHT",
     "GYMNAST_MASS",
@@ -220,6 +223,11 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
     cleared = bool(
         rows["horse_contact_s"] is not None and (finite.size == 0 or finite.min() > -0.01)
     )
+    # Table 1 counts the forearms' contacts too; a handspring's support is the hands'
+    on_horse = log["on_horse"].astype(bool)
+    forearm_share = (
+        float(log["forearm_on_horse"][on_horse].astype(bool).mean()) if on_horse.any() else 0.0
+    )
     pitch = np.unwrap(log["pitch"]) if log["pitch"].size else np.zeros(0)
     rotation = float(np.degrees(pitch[-1] - pitch[0])) if pitch.size else 0.0
     td_i = int(np.flatnonzero(log["on_floor"].astype(bool))[0]) if log["on_floor"].any() else -1
@@ -257,6 +265,7 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
         "velocities_within_10pct": int(sum(close.values())),
         "cleared": cleared,
         "min_clearance_over_horse_m": float(finite.min()) if finite.size else None,
+        "horse_forearm_share": forearm_share,
         "landed": landed,
         "touchdown_s": td,
         "up_after_touchdown_s": up_s,

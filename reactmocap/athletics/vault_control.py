@@ -31,14 +31,15 @@ NJ = len(BALL_JOINTS)
 @dataclass
 class VaultLog:
     """Per tick: time, COM, COM velocity, vertical force from the board and from the horse
-    on the gymnast (N), whether the feet touch the board, the hands the horse, anything the
-    floor, and the lowest point of the body over the horse's top (m)."""
+    on the gymnast (N), whether the feet touch the board, the hands (or forearms) the horse,
+    anything the floor, the lowest point of the body over the horse's top (m), the body's
+    pitch and whether a forearm touches the horse."""
 
     rows: list[tuple] = field(default_factory=list)
 
     def arrays(self) -> dict[str, NDArray]:
         names = ("t", "com", "com_vel", "board_force", "horse_force", "on_board", "on_horse",
-                 "on_floor", "over_horse_clearance", "pitch")  # fmt: skip
+                 "on_floor", "over_horse_clearance", "pitch", "forearm_on_horse")  # fmt: skip
         if not self.rows:
             return {n: np.zeros(0) for n in names}
         return {n: np.array(c) for n, c in zip(names, zip(*self.rows))}
@@ -68,9 +69,10 @@ class Vault(Basis):
         own = world.geom_character == ctx.character
         part = world.geom_body
         feet = {SIM_BODIES.index(b) for b in ("l_foot", "r_foot")}
-        hands = {SIM_BODIES.index(b) for b in ("l_hand", "r_hand", "l_forearm", "r_forearm")}
+        forearms = {SIM_BODIES.index(b) for b in ("l_forearm", "r_forearm")}
+        hands = {SIM_BODIES.index(b) for b in ("l_hand", "r_hand")} | forearms
         f6 = np.zeros(6)
-        seen = {"board": 0, "horse": 0, "deepest": False}
+        seen = {"board": 0, "horse": 0, "deepest": False, "blocked": False}
         # the geoms that must stay above the horse's top while over it: all but the arms'
         check = np.flatnonzero(own & ~np.isin(part, list(hands)))
         is_box = m.geom_type == int(mujoco.mjtGeom.mjGEOM_BOX)
@@ -85,7 +87,7 @@ class Vault(Basis):
             """Contacts with the board (feet), the horse (hands) and the floor; logs a row."""
             d = world.data
             fb = fh = 0.0
-            on_b = on_h = on_f = False
+            on_b = on_h = on_f = on_fa = False
             for i in range(d.ncon):
                 g1, g2 = int(d.contact.geom[i, 0]), int(d.contact.geom[i, 1])
                 other = g2 if own[g1] else g1 if own[g2] else -1
@@ -100,6 +102,7 @@ class Vault(Basis):
                 elif other == horse_geom:
                     fh += fz
                     on_h |= int(part[mine]) in hands
+                    on_fa |= int(part[mine]) in forearms
                 else:
                     on_f = True
             s = ctx.sense(t)
@@ -118,7 +121,7 @@ class Vault(Basis):
                 clear = float((d.geom_xpos[g, 2] - low).min()) - horse_top
             pitch = _body_pitch(d, chest, ctx.athlete)
             self.log.rows.append((t, s.com.copy(), s.com_vel.copy(), fb, fh, on_b, on_h, on_f,
-                                  clear, pitch))  # fmt: skip
+                                  clear, pitch, on_fa))  # fmt: skip
             return on_b, on_h, on_f
 
         def pose(goal: dict[int, tuple[float, float, float]], dur: float, t: float) -> None:
@@ -169,7 +172,7 @@ class Vault(Basis):
                 goal |= {_J[f"{s}_shoulder"]: (p.arms_push, 0.0, 0.0) for s in "lr"}
                 pose(goal, 0.05, t)
 
-        t_in = {"board": 0.0}
+        t_in = {"board": 0.0, "horse": 0.0}
 
         def _ti_since(t: float) -> float:
             return t - t_in["board"]
@@ -212,6 +215,18 @@ class Vault(Basis):
         # -------------------------------------------------------------- horse contact
         def horse_enter(_w: World, t: float) -> None:
             seen["horse"] = 0
+            seen["blocked"] = False
+            if p.arm_spring > 0:
+                # not the paper's passive strut: the arms a spring-damper that yields under
+                # the arrival (shoulders give, elbows bend), then blocks (see horse())
+                stiff(flight | {"shoulder": p.arm_spring, "elbow": p.arm_spring, "wrist": 0.0})
+                rig.set_damping(per_joint({"shoulder": p.arm_damping, "elbow": p.arm_damping}))
+                now = rig.current_angles()
+                goal = {_J[f"{s}_elbow"]: (p.yield_elbow, 0.0, 0.0) for s in "lr"}
+                goal |= {_J[f"{s}_shoulder"]: (now[_J[f"{s}_shoulder"], 0] + p.yield_shoulder,
+                                               0.0, 0.0) for s in "lr"}  # fmt: skip
+                pose(goal, 0.0, t)
+                return
             values = flight | {"shoulder": p.horse_push, "wrist": 0.0, "elbow": 3.0}
             stiff(values)
             goal = {_J[f"{s}_elbow"]: (0.0, 0.0, 0.0) for s in "lr"}
@@ -222,6 +237,16 @@ class Vault(Basis):
         def horse(_w: World, t: float) -> None:
             _, on_h, _ = sense(t)
             seen["horse"] = 0 if on_h else seen["horse"] + 1
+            if p.arm_spring > 0 and not seen["blocked"] and t - t_in["horse"] >= p.yield_s:
+                # the block: the elbows straighten, the shoulders extend (girdle push)
+                seen["blocked"] = True
+                goal = {_J[f"{s}_elbow"]: (0.0, 0.0, 0.0) for s in "lr"}
+                goal |= {_J[f"{s}_shoulder"]: (p.block_shoulder, 0.0, 0.0) for s in "lr"}
+                pose(goal, p.block_s, t)
+
+        def horse_enter2(w: World, t: float) -> None:
+            t_in["horse"] = t
+            horse_enter(w, t)
 
         def left_horse(_w: World, _t: float, t_in_state: float) -> bool:
             return t_in_state > 0.02 and seen["horse"] >= 2
@@ -229,6 +254,8 @@ class Vault(Basis):
         # -------------------------------------------------------------- second flight
         def flight2_enter(_w: World, t: float) -> None:
             stiff(flight)
+            if p.arm_spring > 0:
+                rig.set_damping(np.zeros(NJ))
             goal = {_J[f"{s}_hip"]: (-p.pike2, 0.08 if s == "l" else -0.08, 0.0) for s in "lr"}
             goal |= {_J[f"{s}_knee"]: (0.0, 0.0, 0.0) for s in "lr"}
             goal |= {_J[j]: (0.0, 0.0, 0.0) for j in ("waist", "back")}
@@ -252,7 +279,7 @@ class Vault(Basis):
                   ((left_board, "flight1"), (after(0.4), "flight1"))),
             State("flight1", logged(flight1), flight1_enter,
                   ((on_horse, "horse"), (after(1.0), "flight2"))),
-            State("horse", logged(horse), horse_enter,
+            State("horse", logged(horse), horse_enter2,
                   ((left_horse, "flight2"), (after(0.6), "flight2"))),
             State("flight2", logged(flight2), flight2_enter, ((after(p.layout2), NEXT),)),
         ]  # fmt: skip

@@ -8,7 +8,14 @@ from dataclasses import replace
 
 import pytest
 
-from reactmocap.athletics.vault import TABLE1, TABLE1_KEYS, VaultParams, vault, vault_athlete
+from reactmocap.athletics.vault import (
+    ALL_ROWS_VALUES,
+    TABLE1,
+    TABLE1_KEYS,
+    VaultParams,
+    vault,
+    vault_athlete,
+)
 from reactmocap.errors import ReactMocapError
 
 
@@ -79,3 +86,37 @@ def test_unknown_second_flight_position_is_a_clear_error() -> None:
         VaultParams(position2="straddle")
     with pytest.raises(ReactMocapError, match="stand_leg"):
         VaultParams(stand_leg=1.5)
+
+
+@pytest.fixture(scope="module")
+def all_rows():  # type: ignore[no-untyped-def]
+    return vault(params=replace(VaultParams(), **ALL_ROWS_VALUES), fps=30.0)
+
+
+def test_with_the_active_horse_contact_all_16_rows_are_inside(all_rows) -> None:  # type: ignore[no-untyped-def]
+    # the arms yield and then block (not the paper's passive strut): the hands stay on the
+    # horse as long as Table 1's gymnasts' (0.19-0.30 s), and every row is in the human range
+    rep = all_rows.report
+    assert 0.19 <= rep["table1"]["horse_contact_s"] <= 0.30
+    assert rep["table1_inside"] == 16, rep["table1_outside"]
+    assert rep["velocities_within_10pct"] >= 5
+    assert rep["cleared"] and rep["landed"], rep["notes"]
+    # the forearms carry much of it (reported, since Table 1 counts them)
+    assert 0.5 < rep["horse_forearm_share"] <= 1.0
+
+
+def test_the_passive_strut_bounces_off_the_horse() -> None:
+    # the same values with the paper's straight arms and no shoulder torque on the horse
+    p = replace(replace(VaultParams(), **ALL_ROWS_VALUES), arm_spring=0.0)
+    rep = vault(params=p, seconds=1.5, fps=30.0).report
+    assert 0 < rep["table1"]["horse_contact_s"] < 0.19
+    assert rep["table1_inside"] < 16
+
+
+def test_bad_arm_values_are_clear_errors() -> None:
+    with pytest.raises(ReactMocapError, match="arm_spring"):
+        VaultParams(arm_spring=-1.0)
+    with pytest.raises(ReactMocapError, match=r"yield_elbow.*\[0, 2.5\]"):
+        VaultParams(yield_elbow=3.0)
+    with pytest.raises(ReactMocapError, match="block_s"):
+        VaultParams(block_s=0.0)
