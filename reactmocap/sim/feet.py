@@ -40,9 +40,7 @@ def foot_soles(
         ball = _in_sole(m, sole, wc.sole_contacts[:, 0], 1.0)
         import os
 
-        if os.environ.get("RM_PLAN") == "box4":  # EXPERIMENT
-            pass
-        elif os.environ.get("RM_PLAN") == "heel":  # EXPERIMENT
+        if os.environ.get("RM_PLAN") == "heel":  # EXPERIMENT
             corners = np.concatenate([ball, corners[:, 2:]], axis=1)
         else:
             corners = np.concatenate([tip, ball, corners[:, 2:]], axis=1)
