@@ -140,9 +140,6 @@ class Character:
     #: explicit mass, COM (body frame) and full inertia ``(ixx, iyy, izz, ixy, ixz, iyz)`` per
     #: body (see :func:`build_character`'s ``inertials``); None: mass from the geoms
     inertials: dict[str, tuple[float, tuple[float, ...], tuple[float, ...]]] | None = None
-    #: the forefoot's floor-contact time constant (s) when the sole's contact is split at the
-    #: ball (see :func:`build_character`'s ``forefoot``); None: the sole box touches
-    forefoot: float | None = None
 
     # ------------------------------------------------------------------ model
     def make_spec(self) -> mujoco.MjSpec:
@@ -179,16 +176,6 @@ class Character:
                     size=size,
                     fromto=list(g.fromto or ()),
                     density=rho,
-                )
-            elif g.sole_part is not None:
-                body.add_geom(
-                    name=f"{g.body}_{g.sole_part}",
-                    type=mujoco.mjtGeom.mjGEOM_BOX,
-                    size=size,
-                    pos=list(g.pos),
-                    quat=list(g.quat),
-                    density=0.0,
-                    group=PATCH_GEOM_GROUP,
                 )
             elif g.patch:
                 body.add_geom(
@@ -474,7 +461,6 @@ def build_character(
     mass_model: MassModel = "table",
     joint_limits: bool = True,
     inertials: Mapping[str, SegmentInertia] | None = None,
-    forefoot: float | None = None,
 ) -> Character:
     """Build the 51-DOF character of a skeleton.
 
@@ -491,11 +477,6 @@ def build_character(
             ``reactmocap.athletics.bodies``), in the reference pose's world frame; they replace
             the geoms' mass (``total_mass`` and ``mass_model`` are then unused) and the geoms
             only collide.
-        forefoot: a forefoot that yields: each sole's floor contact split at the ball into a
-            heel box and a forefoot box whose contact has this time constant (s; MuJoCo's
-            ``solref``, the floor's is 0.01), so a heel-raised stance stands on the ball and a
-            forefoot pressed like a toe bending, not on the box's front edge. Mass, sole box
-            and its corners unchanged. None (default): one rigid sole box touches.
     """
     if isinstance(skeleton, Motion):
         reference = skeleton if reference is None else reference
@@ -504,8 +485,6 @@ def build_character(
         raise SimulationError(f"total_mass must be a positive number of kg, got {total_mass!r}")
     if mass_model not in ("table", "geometry"):
         raise SimulationError(f"mass_model must be 'table' or 'geometry', got {mass_model!r}")
-    if forefoot is not None and not (np.isfinite(forefoot) and 0.001 <= forefoot <= 1.0):
-        raise SimulationError(f"forefoot must be a time constant in [0.001, 1] s, got {forefoot!r}")
     parts = map_body_parts(skeleton) if parts is None else parts
     anchor_part = {b: b for b in SIM_BODIES}
     if "neck" in parts.joints:
@@ -555,7 +534,7 @@ def build_character(
         body_quat[b] = quat_normalize(quat_mul(quat_conj(G[p]), G[b]))
         body_pos[b] = quat_rotate(quat_conj(G[p]), P[b] - P[p])
 
-    geoms = make_geoms(skeleton, parts, anchors, ref, frame, P, G, forefoot is not None)
+    geoms = make_geoms(skeleton, parts, anchors, ref, frame, P, G)
     char = Character(
         skeleton=skeleton,
         parts=parts,
@@ -571,7 +550,6 @@ def build_character(
         joint_limits=joint_limits,
         geoms=geoms,
         density_scale=dict.fromkeys(SIM_BODIES, 1.0),
-        forefoot=forefoot,
     )
     geo = char.segment_masses()
     if mass_model == "table":

@@ -14,7 +14,7 @@ from reactmocap.errors import SimulationError
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import Skeleton
-from reactmocap.rotations import quat_conj, quat_from_matrix, quat_mul, quat_rotate
+from reactmocap.rotations import quat_conj, quat_from_matrix, quat_rotate
 from reactmocap.sim.bodies import SIM_BODIES
 
 __all__ = ["BALL_PATCH_HALF_SIZE", "PATCH_GEOM_GROUP", "GeomSpec", "make_geoms"]
@@ -61,10 +61,6 @@ class GeomSpec:
     #: (MuJoCo leaves geoms that cannot collide at compile time out of the body's collision
     #: tree for good), and switched off by the World
     patch: bool = False
-    #: ``"heel"`` / ``"toe"``: a massless, hidden contact geom standing in for the sole box
-    #: behind / in front of the ball (a character built with ``forefoot``); the sole box then
-    #: only carries mass and its corners, and the World switches its contacts off
-    sole_part: Literal["heel", "toe"] | None = None
 
 
 def make_geoms(
@@ -75,11 +71,9 @@ def make_geoms(
     frame: int,
     P: F64,
     G: F64,
-    split_sole: bool = False,
 ) -> tuple[GeomSpec, ...]:
     """Collision/mass geometry, computed in the reference pose's world frame and converted to
-    each body's local frame. ``split_sole``: each foot also gets its sole's contact as two
-    boxes split at the ball (:func:`_sole_parts`)."""
+    each body's local frame."""
     idx = {b: i for i, b in enumerate(SIM_BODIES)}
 
     def at(b: str) -> F64:
@@ -189,34 +183,7 @@ def make_geoms(
         )
         out.append(box)
         out.append(_ball_patch(box, ball_x))
-        if split_sole:
-            out.extend(_sole_parts(box, ball_x))
     return tuple(out)
-
-
-def _sole_parts(box: GeomSpec, ball_x: float) -> tuple[GeomSpec, GeomSpec]:
-    """The sole box cut at the ball (``ball_x`` along its x axis from its centre) into a heel
-    part and a forefoot part, aligned with it and together filling it: the forefoot's own,
-    softer floor contact yields under load like a toe bending at the ball."""
-    hx = box.size[0]
-    if not -hx < ball_x < hx:
-        raise SimulationError(f"the ball ({ball_x:+.3f} m) is not inside the sole box (+-{hx:.3f})")
-
-    import os
-
-    pitch = np.radians(float(os.environ.get("RM_TOE_PITCH", "0")))  # EXPERIMENT
-    hz = box.size[2]
-
-    def part(name: Literal["heel", "toe"], x0: float, x1: float, up: float) -> GeomSpec:
-        # pitched toe-up by ``up`` about the ball line's bottom edge
-        q_up = np.array([np.cos(-up / 2), 0.0, np.sin(-up / 2), 0.0])
-        c = np.array([ball_x, 0.0, -hz]) + quat_rotate(q_up, [0.5 * (x0 + x1) - ball_x, 0, hz])
-        pos = np.asarray(box.pos) + quat_rotate(np.asarray(box.quat), c)
-        quat = quat_mul(np.asarray(box.quat), q_up)
-        size = (0.5 * (x1 - x0), box.size[1], box.size[2])
-        return GeomSpec(box.body, "box", size, pos=tuple(pos), quat=tuple(quat), sole_part=name)
-
-    return part("heel", -hx, ball_x, 0.0), part("toe", ball_x, hx, pitch)
 
 
 def _ball_patch(box: GeomSpec, ball_x: float) -> GeomSpec:

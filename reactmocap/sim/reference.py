@@ -177,14 +177,6 @@ def reference_path(
         # a foot skimming the floor (a low step, a slide in the capture) is not a support
         planted &= (slide < slide_speed) | turning
     pivoting = planted & turning
-    import os
-
-    if os.environ.get("RM_HEEL"):  # EXPERIMENT: heel-raised stances stand on the ball patch
-        zf = corner_z[:, :, :2, 2].mean(axis=2)
-        zb = corner_z[:, :, -2:, 2].mean(axis=2)
-        length = np.linalg.norm(corner_z[:, :, 0] - corner_z[:, :, -2], axis=-1)
-        raised = (zb - zf) / length > np.sin(np.radians(float(os.environ["RM_HEEL"])))
-        pivoting = pivoting | (planted & raised)
     arrays = (q, v, a, planted, pivoting, centre, yaw, corner_z, com, up)
     for arr in arrays:
         arr.flags.writeable = False
@@ -202,7 +194,7 @@ def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F
     half = m.geom_size[sole_ids, 2][:, None]
     d = mujoco.MjData(m)
     n = q.shape[0]
-    low = np.empty((n, *corners.shape))
+    low = np.empty((n, 2, 4, 3))
     centre = np.empty((n, 2, 3))
     yaw = np.empty((n, 2))
     com = np.empty((n, 3))

@@ -143,11 +143,6 @@ class WorldCharacter:
     #: (2,) left, right: each foot's sole box and ball-of-foot patch geoms
     sole_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     patch_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    #: ``(2, 2)`` left, right: the heel and forefoot boxes that touch for the sole box of a
-    #: character built with ``forefoot``; ``(2, 1)`` the sole box itself otherwise
-    sole_contacts: NDArray[np.int64] = field(
-        default_factory=lambda: np.zeros((0, 1), dtype=np.int64)
-    )
     #: first of the character's 45 servo actuators: 3 per ball joint, BALL_JOINTS order
     actuator_adr: int = -1
 
@@ -251,14 +246,10 @@ class World:
             geoms = np.flatnonzero(np.isin(m.geom_bodyid, ids))
             feet = [m.body(f"{pre}{side}_foot").id for side in "lr"]
             patches = [m.geom(f"{pre}{side}_foot_ball").id for side in "lr"]
-            split = ch.forefoot is not None
-            parts = [
-                [m.geom(f"{pre}{side}_foot_{p}").id for p in ("heel", "toe")] for side in "lr"
-            ] if split else [[], []]  # fmt: skip
             soles = [
                 g for f in feet for g in geoms
                 if m.geom_bodyid[g] == f and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
-                and g not in patches and g not in parts[0] + parts[1]
+                and g not in patches
             ]  # fmt: skip
             if len(soles) != 2:
                 raise SimulationError("each foot needs exactly one sole box (internal error)")
@@ -280,7 +271,6 @@ class World:
                     actuator_adr=acts[0],
                     sole_ids=np.array(soles, dtype=np.int64),
                     patch_ids=np.array(patches, dtype=np.int64),
-                    sole_contacts=np.array(parts if split else [[g] for g in soles], np.int64),
                 )
             )
         char = np.full(m.ngeom, -1, dtype=np.int64)
@@ -328,21 +318,6 @@ class World:
         m.geom_solmix[:] = 1.0
         m.geom_solmix[floor] = 1e9
         m.geom_solimp[:, :3] = cfg.contact_solimp
-        for wc in self.characters:
-            tc = wc.character.forefoot
-            if tc is None:
-                continue
-            if tc < 2 * cfg.timestep:
-                raise ConfigError(
-                    f"forefoot time constant {tc} must be at least twice the timestep "
-                    f"{cfg.timestep} (MuJoCo would silently clamp it)"
-                )
-            # the heel and forefoot boxes touch for the sole box, which keeps only its mass
-            m.geom_contype[wc.sole_ids] = 0
-            m.geom_conaffinity[wc.sole_ids] = 0
-            toe = wc.sole_contacts[:, 1]
-            m.geom_solref[toe] = (tc, 1.0)
-            m.geom_solmix[toe] = 1e12  # its softness wins over the floor's (solmix 1e9)
 
     def _apply_joint_settings(self) -> None:
         """Light damping scaled by each DOF's outboard inertia in the reference pose."""
@@ -367,11 +342,11 @@ class World:
         part of :meth:`get_state`: whoever switches a patch on switches it back."""
         m = self.model
         wc = self.characters[character]
-        box, patch = wc.sole_contacts[foot], wc.patch_ids[foot : foot + 1]
+        box, patch = int(wc.sole_ids[foot]), int(wc.patch_ids[foot])
         live, dead = (patch, box) if on else (box, patch)
-        if m.geom_contype[live[0]] == 0:
-            m.geom_contype[live] = m.geom_contype[dead[0]]
-            m.geom_conaffinity[live] = m.geom_conaffinity[dead[0]]
+        if m.geom_contype[live] == 0:
+            m.geom_contype[live] = m.geom_contype[dead]
+            m.geom_conaffinity[live] = m.geom_conaffinity[dead]
             m.geom_contype[dead] = 0
             m.geom_conaffinity[dead] = 0
 

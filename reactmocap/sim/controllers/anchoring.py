@@ -137,7 +137,7 @@ class AnchoredReference:
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
         self._corners_at: tuple[float, bytes] = (float("nan"), b"")
-        self._corners_now = np.zeros(self._corners.shape)
+        self._corners_now = np.zeros((2, 4, 3))
         #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
         #: ``x -> Rz(yaw) x + shift``
         self.anchor_yaw = 0.0

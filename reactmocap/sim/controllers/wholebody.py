@@ -24,7 +24,6 @@ from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.anchoring import AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import outside_distance
-from reactmocap.sim.feet import foot_soles
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
@@ -347,9 +346,8 @@ class WholeBodyTracker(AnchoredReference):
         self._ff = servo.feedforward[rows : rows + NJ]  # (15, 3) view
         edges = np.column_stack([self.mu * _PYRAMID, np.ones(4)])  # (4, 3)
         self._edges = edges.T  # (3, 4) columns: unnormalised pyramid edges
-        nc = foot_soles(world, character, "WholeBodyTracker")[2].shape[1]  # 6: a split sole
-        self._corner_basis = np.tile(edges, (nc, 1, 1))  # (corner, edge, xyz)
-        self._corner_owner = np.repeat(np.arange(nc), 4)
+        self._corner_basis = np.tile(edges, (4, 1, 1))  # (corner, edge, xyz)
+        self._corner_owner = np.repeat(np.arange(4), 4)
         self._patch_basis = np.concatenate([edges, np.tile(_UP.T, (4, 1))])
         self.last_plan: WholeBodyPlan | None = None
         #: ``(6,)`` extra pelvis acceleration asked of the plan (world linear m/s^2, local
@@ -519,10 +517,6 @@ class WholeBodyTracker(AnchoredReference):
         # purpose, so it acts as extra damping (compensating it, first version: 50% of the benchmark windows
         # tracked instead of 64%)
         h = d.qfrc_bias[sl]
-        import os
-
-        if os.environ.get("RM_TOEF"):  # EXPERIMENT: the forefoot's contact force as known
-            h = h - self._toe_qfrc(m, d)[sl]
         sup = self._support(d, planted, held)
         nc = len(sup.points)
         qb = sup.gen
@@ -638,23 +632,6 @@ class WholeBodyTracker(AnchoredReference):
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
-
-    def _toe_qfrc(self, m: mujoco.MjModel, d: mujoco.MjData) -> F64:
-        toes = self.wc.sole_contacts[:, -1]
-        q = np.zeros(m.nv)
-        fr = np.zeros(6)
-        for i in range(d.ncon):
-            con = d.contact[i]
-            g = int(con.geom2) if int(con.geom1) not in toes else int(con.geom1)
-            if g not in toes or con.efc_address < 0:
-                continue
-            mujoco.mj_contactForce(m, d, i, fr)
-            frame = con.frame.reshape(3, 3)
-            f = frame.T @ fr[:3]  # world, on geom2
-            if g == int(con.geom1):
-                f = -f
-            mujoco.mj_applyFT(m, d, f, np.zeros(3), con.pos, int(m.geom_bodyid[g]), q)
-        return q
 
     def _push_response(self, t: float) -> float:
         """Follows pushes and returns the trunk rows' weight at ``t``: while the mocap stands,
