@@ -127,10 +127,11 @@ def test_a_diagonal_push_steps_with_the_foot_on_its_side(shared_mocap_dir: Path)
 
 def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
     """The second shared standing clip pushed 100 N (Wooten's sideways figure) to its left at
-    the chest for 0.25 s: the left foot steps 0.45 m out, the wide stance lifts the right foot
-    off the floor and it steps back down within 0.1 m of where it was. Swung in the time of a step
-    that short (``step_short``, the whole-clip default) it lands while the body is still up;
-    taking the whole step time (0) the body fell toward it and the simulation diverged."""
+    the chest for 0.25 s: the left foot steps 0.45 m out, the wide stance rolls the right foot
+    onto an edge and it steps (the other foot after a landing) to within 0.1 m of where it was.
+    Swung in the time of a step that short (``step_short``, the whole-clip default) the body
+    stays up; over the whole step time (0) it fell toward that foot and the simulation
+    diverged."""
     byebye, force = _shared_push(shared_mocap_dir, "byebye_normal_001", 1.0, 90.0, 100.0)
 
     def push(params: dict[str, float]) -> str:
