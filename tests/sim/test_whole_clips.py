@@ -125,6 +125,23 @@ def test_a_diagonal_push_steps_with_the_foot_on_its_side(shared_mocap_dir: Path)
     assert res.report.status == "ok", res.report.reason
 
 
+def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
+    """The second shared standing clip pushed 100 N (Wooten's sideways figure) to its left at
+    the chest for 0.25 s: the left foot steps 0.45 m out, the wide stance rolls the right foot
+    onto an edge and it steps (the other foot after a landing) to within 0.1 m of where it was.
+    Swung in the time of a step that short (``step_short``, the whole-clip default) the body
+    stays up; over the whole step time (0) it fell toward that foot and the simulation
+    diverged."""
+    byebye, force = _shared_push(shared_mocap_dir, "byebye_normal_001", 1.0, 90.0, 100.0)
+
+    def push(params: dict[str, float]) -> str:
+        return push_clip(byebye, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
+                         seconds=2.75, params=params).report.status  # fmt: skip
+
+    assert push({}) == "ok"
+    assert push({"step_short": 0.0}) in ("fell", "unstable")
+
+
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip

@@ -34,6 +34,8 @@ _STEP_TILT_COS = float(np.cos(np.radians(35.0)))
 # a fall nearer a diagonal than the heading (22.5 deg) steps with the foot on its side: a
 # front-right push stepped the left foot 0.43 m ahead and pitched over the right toes
 _SIDE_STEP_TAN = float(np.tan(np.radians(22.5)))
+# the shortest balance step's time as a fraction of ``step_time`` (``step_short``)
+_SHORT_STEP_MIN = 0.4
 # seconds between updates of the ground path, the balance shift and the step decision
 _SLOW_PERIOD = 0.008
 # a heading error's dead band is the position dead band over this lever (m)
@@ -79,6 +81,7 @@ class AnchoredReference:
         warp_gain: float = 0.0,
         step_leg: float = 0.0,
         step_alternate: bool = False,
+        step_short: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -118,6 +121,7 @@ class AnchoredReference:
         self.step_height = float(step_height)
         self.step_leg = float(step_leg)
         self.step_alternate = bool(step_alternate)
+        self.step_short = float(step_short)
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self.place_gain = float(place_gain)
         self.place_deadband = float(place_deadband)
@@ -348,7 +352,13 @@ class AnchoredReference:
             xi, centre[1 - foot, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
             max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
         )  # fmt: skip
-        self.step = Step(foot, t, self.step_time, centre[foot].copy(),
+        duration = self.step_time
+        if self.step_short and self._landed[0] >= 0:
+            # after a step has landed, a short one (a foot put back down) need not take the
+            # whole step time
+            short = float(np.linalg.norm(target - centre[foot, :2])) / self.step_short
+            duration *= min(1.0, max(_SHORT_STEP_MIN, short))
+        self.step = Step(foot, t, duration, centre[foot].copy(),
                          np.r_[target, self.floor_z], self.step_height)  # fmt: skip
         self.steps_taken.append(t)
 

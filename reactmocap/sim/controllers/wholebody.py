@@ -161,6 +161,10 @@ class WholeBodyTracker(AnchoredReference):
         step_alternate: a balance step within 0.5 s of one landing is by the other foot, and a
             foot the body has lifted off the floor (the mocap's leg pose lifts the one left
             behind) steps when the capture point leaves the other.
+        step_short: after a balance step has landed, a step shorter than ``step_short`` m
+            swings in proportionally less time (at least 0.4 of ``step_time``; 0: off):
+            putting back down a foot that the wide stance after a step had lifted took the
+            whole step time while the body fell toward it.
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -236,6 +240,7 @@ class WholeBodyTracker(AnchoredReference):
         step_leg: float = 0.0,
         step_pushed: bool = False,
         step_alternate: bool = False,
+        step_short: float = 0.0,
         swing_weight: float = 10.0,
         kp_swing: float = 400.0,
         place_gain: float = 0.0,
@@ -266,6 +271,7 @@ class WholeBodyTracker(AnchoredReference):
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
+                "step_short": step_short,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "torque_limit": torque_limit,
@@ -376,7 +382,7 @@ class WholeBodyTracker(AnchoredReference):
             step_margin=step_margin, step_time=step_time, step_height=step_height,
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
             warp_gain=warp_gain, step_leg=step_leg,
-            step_alternate=step_alternate,
+            step_alternate=step_alternate, step_short=step_short,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
