@@ -79,7 +79,8 @@ def build_tables(
                 supported.setdefault(("leap", "height", "com"), {})[body] = rng
         if "broad" in parts:
             broads = calibrate.sweep("broad-jump", body, grid, workers)
-            btable = calibrate.effort_table(broads, "achieved_distance_m", lifted)
+            # over the jumps that land only: a command interpolates between landed jumps
+            btable = calibrate.effort_table(broads, "achieved_distance_m", _landed)
             out["BROAD_TABLES"][body] = btable
             if btable:
                 supported.setdefault(("broad-jump", "distance"), {})[body] = (
