@@ -106,6 +106,24 @@ def test_the_female_longest_broad_jump_lands_past_1_7_m(monkeypatch: pytest.Monk
     assert r0.report["fell"] and not r0.report["landed"]
 
 
+def test_the_female_commanded_broad_jumps_land_on_her_long_path(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Between her shallow crouch's 0.75 m and her longest jump her take-off holds the deep
+    crouch and sets the length by the COM offset (BROAD_LONG): it lifts off pitching back and
+    one landing delta lands it, so commanded 1.05 and 1.2 m land within 5 cm. On her former
+    path the same efforts take off pitching forward and fall."""
+    for distance in (1.05, 1.2):
+        r = run("broad-jump", "female", distance=distance)
+        assert r.report["landed"] and not r.report["fell"]
+        assert abs(r.report["achieved_distance_m"] - distance) <= 0.05
+        assert r.report["liftoff_pitch_momentum"] < -2.0
+        monkeypatch.setattr(tables, "BROAD_LONG", {})
+        r0 = run("broad-jump", "female", effort=r.report["effort"], check_range=False)
+        assert r0.report["fell"] and not r0.report["landed"]
+        monkeypatch.undo()
+
+
 def test_broad_jumps_land_with_the_trunk_righted_slowly(monkeypatch: pytest.MonkeyPatch) -> None:
     """A broad jump lands with the trunk pitched forward; the landing rights it over
     BROAD_PITCH_EASE s. Righted at once, the hips' extension pushes into the floor and
