@@ -23,7 +23,6 @@ from reactmocap.errors import ConfigError
 
 __all__ = [
     "BROAD_ARMS",
-    "BROAD_COM_OFFSET",
     "BROAD_CROUCH",
     "BROAD_LANDING",
     "BROAD_LONG",
@@ -75,9 +74,7 @@ def broad_params(s: float, body: str | None = None) -> LeapParams:
     spin_gain = _along(BROAD_SPIN_GAIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN_GAIN),)), at)
     knots = np.array(BROAD_CROUCH.get(body or "", DEFAULT_BROAD_CROUCH)).T
     leg, pitch = (float(np.interp(at, knots[0], k)) for k in knots[1:])
-    com_offset = min(0.12 + 0.1 * s, BROAD_COM_OFFSET.get(body or "", math.inf))
-    if on_long:
-        com_offset = _along(long.com_offset, s)  # type: ignore[union-attr]
+    com_offset = _along(long.com_offset, s) if on_long else 0.12 + 0.1 * s  # type: ignore[union-attr]
     return LeapParams(leg=leg, pitch=pitch, lean=0.0, com_offset=com_offset,
                       stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
                       arms=-1.8 - 1.0 * s, broad=True, spin=spin, spin_gain=spin_gain, hold=0.1)  # fmt: skip
@@ -102,21 +99,17 @@ DEFAULT_BROAD_CROUCH = ((0.0, 0.8, 0.3), (1.0, 0.65, 0.3))
 #: lift-off, where the spin feedback asks -5) and the landing pitched face down. Efforts up
 #: to 0.6 keep the default path (their landings were measured on it)
 #: Female (2026-12-03): her default path (exactly) up to effort 0.75 (her landings measured on
-#: it), then to leg 0.5 with the trunk pitched 0.75 rad at 1.0; with her BROAD_COM_OFFSET,
-#: BROAD_SPIN and BROAD_SPIN_GAIN effort 1.0 lifts off at 3.8 m/s pitching back (-2.7 kg
-#: m^2/s), touches down with the trunk 35 deg from upright at 2.4 m/s and lands 1.80 m
-#: (at pitch 0.6 she took off at 3.2 m/s, -0.2 kg m^2/s, touched down 65 deg forward, fell)
+#: it), then to leg 0.5 with the trunk pitched 0.75 rad at 1.0; with her BROAD_LONG COM offset
+#: (0.2 m at 1.0), BROAD_SPIN and BROAD_SPIN_GAIN effort 1.0 lifts off at 3.8 m/s pitching back
+#: (-2.7 kg m^2/s), touches down with the trunk 35 deg from upright at 2.4 m/s and lands 1.80 m
+#: (at pitch 0.6 she took off at 3.2 m/s, -0.2 kg m^2/s, touched down 65 deg forward, fell).
+#: Above effort 0.6 she runs her BROAD_LONG path, which takes this path's effort-1.0 values
 BROAD_CROUCH: Mapping[str, tuple[tuple[float, float, float], ...]] = MappingProxyType(
     {
         "male": ((0.0, 0.8, 0.3), (0.6, 0.71, 0.3), (1.0, 0.45, 0.6)),
         "female": ((0.0, 0.8, 0.3), (0.75, 0.6875, 0.3), (1.0, 0.5, 0.75)),
     }
 )
-#: the crouch's COM offset ahead of the feet (m; 0.12 + 0.1 s) stops growing at this, per
-#: body. Female (2026-12-03), effort 1.0 on her deeper crouch: 0.22 took off at -0.0 kg m^2/s
-#: and touched down 70 deg forward, 0.2 at -2.7 and 35 deg; 0.17 at -3.4, but 1.8 m/s across
-#: (2.4 with 0.2)
-BROAD_COM_OFFSET: Mapping[str, float] = MappingProxyType({"female": 0.2})
 
 
 #: the broad jump's take-off pitch momentum (kg m^2/s, backward < 0)
@@ -161,7 +154,9 @@ class BroadLong(NamedTuple):
 #: a shallow crouch to the deep one, and the take-offs there lifted off pitching forward by
 #: +0.1 to +4.1 kg m^2/s (or rolled) and 9 of 13 fell, each landing at single 0.025 m deltas
 #: if at all. Her deep crouch with the COM offset lowered takes off pitching back (-3.4 to
-#: -4.6) at 0.8-1.9 m/s touchdown, and one delta lands all of it (docs/athletics.md)
+#: -4.6) at 0.8-1.9 m/s touchdown, and one delta lands all of it (docs/athletics.md). The
+#: offset at 1.0: 0.22 took off at -0.0 kg m^2/s and touched down 70 deg forward, 0.2 at -2.7
+#: and 35 deg (1.80 m). Efforts 0.95-1.0 (0.172-0.2 m) still take off rolled: only the ends land
 BROAD_LONG: Mapping[str, BroadLong] = MappingProxyType(
     {
         "female": BroadLong(
