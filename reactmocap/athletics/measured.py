@@ -183,7 +183,7 @@ LANDING_DELTAS: dict[Any, Any] = {
 }
 SUPPORTED: dict[Any, Any] = {
     ("leap", "height"): {"male": (0.0857, 0.9987), "female": (0.0706, 0.7588)},
-    ("broad-jump", "distance"): {"male": (0.4406, 2.405), "female": (0.2877, 1.8033)},
+    ("broad-jump", "distance"): {"male": (0.4406, 2.405), "female": (0.2877, 1.654)},
     ("land", "drop"): {"male": (0.0, 2.2), "female": (0.0, 2.5)},
     ("land", "vx"): {"male": (-2.0, 3.0), "female": (-1.0, 3.0)},
     ("balance", "slope"): {"male": (0.0, 0.5235987755982988), "female": (0.0, 0.5846852994181004)},
