@@ -124,6 +124,16 @@ def test_the_female_commanded_broad_jumps_land_on_her_long_path(
         monkeypatch.undo()
 
 
+def test_the_female_broad_jump_range_is_what_lands() -> None:
+    """Her supported distance is measured as what lands (her table's efforts from 0 up to the
+    first that falls): a command past it, where her efforts 0.95-1.0 take off rolled and
+    fall, is refused with the range."""
+    lo, hi = tables.supported_range("broad-jump", "distance", "female") or (0.0, 0.0)
+    assert lo < 0.3 and 1.6 < hi < 1.7
+    with pytest.raises(ConfigError, match="supported range"):
+        run("broad-jump", "female", distance=1.75)
+
+
 def test_broad_jumps_land_with_the_trunk_righted_slowly(monkeypatch: pytest.MonkeyPatch) -> None:
     """A broad jump lands with the trunk pitched forward; the landing rights it over
     BROAD_PITCH_EASE s. Righted at once, the hips' extension pushes into the floor and
