@@ -67,14 +67,15 @@ def broad_params(s: float, body: str | None = None) -> LeapParams:
     the take-off's backward angular momentum is the body's :data:`BROAD_SPIN`."""
     s = float(np.clip(s, 0.0, 1.0))
     long = BROAD_LONG.get(body or "")
-    on_long = long is not None and s > long.start
+    if long is not None and s <= long.start:
+        long = None
     # on the long path the crouch and the take-off spin are the path's end's (effort 1.0)
-    at = 1.0 if on_long else s
+    at = s if long is None else 1.0
     spin = _along(BROAD_SPIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN),)), at)
     spin_gain = _along(BROAD_SPIN_GAIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN_GAIN),)), at)
     knots = np.array(BROAD_CROUCH.get(body or "", DEFAULT_BROAD_CROUCH)).T
     leg, pitch = (float(np.interp(at, knots[0], k)) for k in knots[1:])
-    com_offset = _along(long.com_offset, s) if on_long else 0.12 + 0.1 * s  # type: ignore[union-attr]
+    com_offset = 0.12 + 0.1 * s if long is None else _along(long.com_offset, s)
     return LeapParams(leg=leg, pitch=pitch, lean=0.0, com_offset=com_offset,
                       stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
                       arms=-1.8 - 1.0 * s, broad=True, spin=spin, spin_gain=spin_gain, hold=0.1)  # fmt: skip
