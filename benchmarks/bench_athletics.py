@@ -79,12 +79,18 @@ def build_tables(
                 supported.setdefault(("leap", "height", "com"), {})[body] = rng
         if "broad" in parts:
             broads = calibrate.sweep("broad-jump", body, grid, workers)
-            btable = calibrate.effort_table(broads, "achieved_distance_m", lifted)
+            # over the jumps that land only: a command interpolates between landed jumps
+            btable = calibrate.effort_table(broads, "achieved_distance_m", _landed)
             out["BROAD_TABLES"][body] = btable
-            if btable:
+            # supported: the table's jumps over the stretch of efforts from 0 that all land (a
+            # command past an effort that falls interpolates across it, and may fall too)
+            efforts = [g["effort"] for g in grid]
+            rng = calibrate.contiguous_range(efforts, [_landed(r) for r in broads], 0.0)
+            inside = [v for s, v in btable if rng and rng[0] <= s <= rng[1]]
+            if inside:
                 supported.setdefault(("broad-jump", "distance"), {})[body] = (
-                    btable[0][1],
-                    btable[-1][1],
+                    min(inside),
+                    max(inside),
                 )
         if "deltas" in parts:  # before "land" (a later run): its ranges use this table
             out["LANDING_DELTAS"][body] = _delta_table(body, workers)

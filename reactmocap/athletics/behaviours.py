@@ -230,7 +230,7 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
         params = replace(params, spin=float(p["spin"]))
     world = athletics_world(ath, backpack=float(p.get("backpack") or 0.0))
     landing = tables.landing_params(ath.name, 0.0, after_leap=True, vertical=not broad,
-                                    broad=broad, push=params.push)  # fmt: skip
+                                    broad=broad, push=params.push, effort=s)  # fmt: skip
     bases = [Balance(Posture(), seconds=LEAD_IN), Leap(params), Landing(landing),
              Balance(STAND_UP)]  # fmt: skip
     # the run lasts until well after touchdown: the flight time of the expected height

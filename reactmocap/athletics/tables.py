@@ -12,6 +12,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import replace
 from types import MappingProxyType
+from typing import NamedTuple
 
 import numpy as np
 
@@ -22,9 +23,9 @@ from reactmocap.errors import ConfigError
 
 __all__ = [
     "BROAD_ARMS",
-    "BROAD_COM_OFFSET",
     "BROAD_CROUCH",
     "BROAD_LANDING",
+    "BROAD_LONG",
     "BROAD_PITCH_EASE",
     "BROAD_SPIN",
     "BROAD_SPIN_GAIN",
@@ -36,6 +37,7 @@ __all__ = [
     "LEAP_LANDING_TABLE",
     "LEAP_TABLES",
     "SUPPORTED",
+    "BroadLong",
     "VERTICAL_LANDING",
     "VERTICAL_LANDING_COM",
     "VERTICAL_LANDING_COM_AIM",
@@ -64,11 +66,16 @@ def broad_params(s: float, body: str | None = None) -> LeapParams:
     """The standing broad jump at effort ``s``: crouch, COM ahead of the feet, arm swing;
     the take-off's backward angular momentum is the body's :data:`BROAD_SPIN`."""
     s = float(np.clip(s, 0.0, 1.0))
-    spin = _along(BROAD_SPIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN),)), s)
-    spin_gain = _along(BROAD_SPIN_GAIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN_GAIN),)), s)
+    long = BROAD_LONG.get(body or "")
+    if long is not None and s <= long.start:
+        long = None
+    # on the long path the crouch and the take-off spin are the path's end's (effort 1.0)
+    at = s if long is None else 1.0
+    spin = _along(BROAD_SPIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN),)), at)
+    spin_gain = _along(BROAD_SPIN_GAIN.get(body or "", ((0.0, DEFAULT_BROAD_SPIN_GAIN),)), at)
     knots = np.array(BROAD_CROUCH.get(body or "", DEFAULT_BROAD_CROUCH)).T
-    leg, pitch = (float(np.interp(s, knots[0], k)) for k in knots[1:])
-    com_offset = min(0.12 + 0.1 * s, BROAD_COM_OFFSET.get(body or "", math.inf))
+    leg, pitch = (float(np.interp(at, knots[0], k)) for k in knots[1:])
+    com_offset = 0.12 + 0.1 * s if long is None else _along(long.com_offset, s)
     return LeapParams(leg=leg, pitch=pitch, lean=0.0, com_offset=com_offset,
                       stiffness=0.3 + 1.0 * s, timing=BROAD_TIMING, ankle_gain=3.6,
                       arms=-1.8 - 1.0 * s, broad=True, spin=spin, spin_gain=spin_gain, hold=0.1)  # fmt: skip
@@ -93,21 +100,17 @@ DEFAULT_BROAD_CROUCH = ((0.0, 0.8, 0.3), (1.0, 0.65, 0.3))
 #: lift-off, where the spin feedback asks -5) and the landing pitched face down. Efforts up
 #: to 0.6 keep the default path (their landings were measured on it)
 #: Female (2026-12-03): her default path (exactly) up to effort 0.75 (her landings measured on
-#: it), then to leg 0.5 with the trunk pitched 0.75 rad at 1.0; with her BROAD_COM_OFFSET,
-#: BROAD_SPIN and BROAD_SPIN_GAIN effort 1.0 lifts off at 3.8 m/s pitching back (-2.7 kg
-#: m^2/s), touches down with the trunk 35 deg from upright at 2.4 m/s and lands 1.80 m
-#: (at pitch 0.6 she took off at 3.2 m/s, -0.2 kg m^2/s, touched down 65 deg forward, fell)
+#: it), then to leg 0.5 with the trunk pitched 0.75 rad at 1.0; with her BROAD_LONG COM offset
+#: (0.2 m at 1.0), BROAD_SPIN and BROAD_SPIN_GAIN effort 1.0 lifts off at 3.8 m/s pitching back
+#: (-2.7 kg m^2/s), touches down with the trunk 35 deg from upright at 2.4 m/s and lands 1.80 m
+#: (at pitch 0.6 she took off at 3.2 m/s, -0.2 kg m^2/s, touched down 65 deg forward, fell).
+#: Above effort 0.6 she runs her BROAD_LONG path, which takes this path's effort-1.0 values
 BROAD_CROUCH: Mapping[str, tuple[tuple[float, float, float], ...]] = MappingProxyType(
     {
         "male": ((0.0, 0.8, 0.3), (0.6, 0.71, 0.3), (1.0, 0.45, 0.6)),
         "female": ((0.0, 0.8, 0.3), (0.75, 0.6875, 0.3), (1.0, 0.5, 0.75)),
     }
 )
-#: the crouch's COM offset ahead of the feet (m; 0.12 + 0.1 s) stops growing at this, per
-#: body. Female (2026-12-03), effort 1.0 on her deeper crouch: 0.22 took off at -0.0 kg m^2/s
-#: and touched down 70 deg forward, 0.2 at -2.7 and 35 deg; 0.17 at -3.4, but 1.8 m/s across
-#: (2.4 with 0.2)
-BROAD_COM_OFFSET: Mapping[str, float] = MappingProxyType({"female": 0.2})
 
 
 #: the broad jump's take-off pitch momentum (kg m^2/s, backward < 0)
@@ -133,6 +136,43 @@ DEFAULT_BROAD_SPIN_GAIN = 40.0
 #: tried; with 20: -2.7, landed)
 BROAD_SPIN_GAIN: Mapping[str, tuple[tuple[float, float], ...]] = MappingProxyType(
     {"male": ((0.0, 20.0),), "female": ((0.75, 40.0), (1.0, 20.0))}
+)
+
+
+class BroadLong(NamedTuple):
+    """A body's long broad jumps (:data:`BROAD_LONG`): above effort ``start`` the crouch, trunk
+    pitch and take-off spin are the body's effort-1.0 jump's, the COM offset ahead of the feet
+    follows ``com_offset`` (knots ``((effort, m), ...)``), and the landing is ``landing``
+    (capture-point lead, ((touchdown speed m/s, foot-servo delta m), ...)), as
+    :data:`BROAD_LANDING`."""
+
+    start: float
+    com_offset: tuple[tuple[float, float], ...]
+    landing: tuple[float, tuple[tuple[float, float], ...]]
+
+
+#: per body. Female (2026-12-03): between her effort 0.6 (0.75 m) and 0.925 her path went from
+#: a shallow crouch to the deep one, and the take-offs there lifted off pitching forward by
+#: +0.1 to +4.1 kg m^2/s (or rolled) and 9 of 13 fell, each landing at single 0.025 m deltas
+#: if at all. Her deep crouch with the COM offset lowered takes off pitching back (-3.4 to
+#: -4.6) at 0.8-1.9 m/s touchdown, and one delta lands all of it (docs/athletics.md). The
+#: offset at 1.0: 0.22 took off at -0.0 kg m^2/s and touched down 70 deg forward, 0.2 at -2.7
+#: and 35 deg (1.80 m). Efforts 0.95-1.0 (0.172-0.2 m) still take off rolled: only the ends land
+BROAD_LONG: Mapping[str, BroadLong] = MappingProxyType(
+    {
+        "female": BroadLong(
+            start=0.6,
+            com_offset=(
+                (0.6, 0.129),
+                (0.7, 0.14),
+                (0.8, 0.15),
+                (0.9, 0.163),
+                (0.95, 0.172),
+                (1.0, 0.2),
+            ),
+            landing=(0.5, ((0.0, -0.175),)),
+        )
+    }
 )
 
 
@@ -256,13 +296,6 @@ BROAD_LANDING: Mapping[str, tuple[float, tuple[tuple[float, float], ...]]] = Map
                 (0.82, 0.06),
                 (1.01, 0.06),
                 (1.2, 0.04),
-                (1.57, 0.04),
-                (1.98, -0.125),
-                (2.08, -0.125),
-                (2.22, -0.14),
-                (2.33, -0.15),
-                (2.36, -0.175),
-                (2.43, -0.175),
             ),
         ),
     }
@@ -311,6 +344,7 @@ def landing_params(
     vertical: bool = False,
     broad: bool = False,
     push: str = "timed",
+    effort: float | None = None,
 ) -> LandingParams:
     """The landing controller's parameters for a body and a horizontal velocity (m/s); the
     delta table goes with them (interpolated in the air) unless ``after_leap`` and the body
@@ -318,10 +352,15 @@ def landing_params(
     :data:`VERTICAL_LANDING` where it has one; ``broad``: after a broad jump, the body's
     :data:`BROAD_LANDING` where it has one, the arms swung to :data:`BROAD_ARMS` in the air
     where it has one, and the trunk righted over :data:`BROAD_PITCH_EASE`. ``push``: the
-    vertical leap's push-off (``"com"``: the body's :data:`VERTICAL_LANDING_COM` first)."""
+    vertical leap's push-off (``"com"``: the body's :data:`VERTICAL_LANDING_COM` first).
+    ``effort``: the broad jump's; on the body's :data:`BROAD_LONG` path its landing."""
     if broad:
         base = landing_params(body, velocity, after_leap=True)
-        if body in BROAD_LANDING:
+        long = BROAD_LONG.get(body)
+        if long is not None and effort is not None and effort > long.start:
+            lead, table = long.landing
+            base = LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
+        elif body in BROAD_LANDING:
             lead, table = BROAD_LANDING[body]
             base = LandingParams(lead=lead, delta=landing_delta(table, velocity), deltas=table)
         arms = BROAD_ARMS.get(body, base.arms)

@@ -91,19 +91,47 @@ def test_the_male_2_m_broad_jump_takes_off_pitching_back(monkeypatch: pytest.Mon
 
 def test_the_female_longest_broad_jump_lands_past_1_7_m(monkeypatch: pytest.MonkeyPatch) -> None:
     """Her longest jumps crouch deeper with the trunk pitched 0.75 rad, the COM offset held at
-    0.2 m and the take-off aiming for -5 kg m^2/s at gain 20 (BROAD_CROUCH, BROAD_COM_OFFSET,
+    0.2 m and the take-off aiming for -5 kg m^2/s at gain 20 (BROAD_CROUCH, BROAD_LONG,
     BROAD_SPIN, BROAD_SPIN_GAIN): effort 1.0 lifts off pitching back and lands past the
     thesis's 1.57 m and the issue's 1.7 m. Without her entries it pitches forward and falls."""
     r = run("broad-jump", "female", effort=1.0, check_range=False)
     assert r.report["liftoff_pitch_momentum"] < -1.0
     assert r.report["landed"] and not r.report["fell"]
     assert r.report["achieved_distance_m"] > 1.7
-    for name in ("BROAD_CROUCH", "BROAD_COM_OFFSET", "BROAD_SPIN", "BROAD_SPIN_GAIN"):
+    for name in ("BROAD_CROUCH", "BROAD_SPIN", "BROAD_SPIN_GAIN", "BROAD_LONG"):
         monkeypatch.setattr(tables, name, {k: v for k, v in getattr(tables, name).items()
                                            if k != "female"})  # fmt: skip
     r0 = run("broad-jump", "female", effort=1.0, check_range=False)
     assert r0.report["liftoff_pitch_momentum"] > 0.0
     assert r0.report["fell"] and not r0.report["landed"]
+
+
+def test_the_female_commanded_broad_jumps_land_on_her_long_path(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Between her shallow crouch's 0.75 m and her longest jump her take-off holds the deep
+    crouch and sets the length by the COM offset (BROAD_LONG): it lifts off pitching back and
+    one landing delta lands it, so commanded 1.05 and 1.2 m land within 5 cm. On her former
+    path the same efforts take off pitching forward and fall."""
+    for distance in (1.05, 1.2):
+        r = run("broad-jump", "female", distance=distance)
+        assert r.report["landed"] and not r.report["fell"]
+        assert abs(r.report["achieved_distance_m"] - distance) <= 0.05
+        assert r.report["liftoff_pitch_momentum"] < -2.0
+        monkeypatch.setattr(tables, "BROAD_LONG", {})
+        r0 = run("broad-jump", "female", effort=r.report["effort"], check_range=False)
+        assert r0.report["fell"] and not r0.report["landed"]
+        monkeypatch.undo()
+
+
+def test_the_female_broad_jump_range_is_what_lands() -> None:
+    """Her supported distance is measured as what lands (her table's efforts from 0 up to the
+    first that falls): a command past it, where her efforts 0.95-1.0 take off rolled and
+    fall, is refused with the range."""
+    lo, hi = tables.supported_range("broad-jump", "distance", "female") or (0.0, 0.0)
+    assert lo < 0.3 and 1.6 < hi < 1.7
+    with pytest.raises(ConfigError, match="supported range"):
+        run("broad-jump", "female", distance=1.75)
 
 
 def test_broad_jumps_land_with_the_trunk_righted_slowly(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -125,7 +153,9 @@ def test_the_female_broad_jump_swings_the_arms_back_to_land(
 ) -> None:
     """After a broad jump her landing swings the arms from overhead on behind the trunk
     (BROAD_ARMS), which turns the rest of the body back in the air: the trunk touches down
-    less pitched forward, and a 1.4 m/s landing that fell with the arms held in front lands."""
+    less pitched forward, and a 1.4 m/s landing that fell with the arms held in front lands
+    (her shallow crouch's effort 0.65, without her long path, BROAD_LONG)."""
+    monkeypatch.setattr(tables, "BROAD_LONG", {})
     r = run("broad-jump", "female", effort=0.65, check_range=False)
     assert r.report["landed"] and not r.report["fell"]
     assert r.report["achieved_distance_m"] > 0.85
