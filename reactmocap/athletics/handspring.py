@@ -61,14 +61,6 @@ class HandspringParams:
         snap_knees: knee flexion of the snap-down (the legs reach the floor bent, to absorb).
         snap: seconds the push and snap-down take.
         max_seconds: hand over to the landing after this long at the latest.
-        push_gain: the push's shoulder target moved by this many radians per radian that the
-            somersault rotation at the hands' contact lies past ``push_ref`` (forward > 0);
-            0: off (the thesis's fixed push). Why: the push's spin rises steeply with the
-            rotation at contact (about 4 kg m^2/s per degree of the male's, seen at a tenth of
-            the capture perturbation), and a shoulder target farther over the head takes spin
-            out (about 60 kg m^2/s per radian): a late contact pushes less and the second
-            flight keeps about the spin the landing is tuned for (docs/athletics.md).
-        push_ref: the rotation at contact (rad, backward < 0) where the push is ``push``.
     """
 
     arms: float = -2.9
@@ -85,8 +77,6 @@ class HandspringParams:
     snap_knees: float = 0.0
     snap: float = 0.15
     max_seconds: float = 2.0
-    push_gain: float = 0.0
-    push_ref: float = 0.0
 
     def __post_init__(self) -> None:
         for name, v in vars(self).items():
@@ -96,8 +86,6 @@ class HandspringParams:
             raise ConfigError(
                 "handspring entry, snap and max_seconds must be > 0 and push_after >= 0"
             )
-        if not 0.0 <= self.push_gain <= 10.0:
-            raise ConfigError(f"handspring push_gain must be in [0, 10], got {self.push_gain!r}")
 
 
 class Handspring(Basis):
@@ -161,7 +149,6 @@ class Handspring(Basis):
             del world
             memo["contact"] = t
             memo["pushed"] = False
-            memo["push"] = p.push + p.push_gain * (ctx.rotation - p.push_ref)
             rig.set_stiffness(per_joint(SUPPORT_STIFFNESS))
             if p.give > 0:  # the arms give a little on impact, then push
                 goal = np.full((NJ, 3), np.nan)
@@ -177,7 +164,7 @@ class Handspring(Basis):
             if not memo["pushed"] and t - memo["contact"] >= p.push_after:
                 memo["pushed"] = True
                 rec["push"] = t
-                goal = pose(memo["push"], p.snap_trunk, p.snap_hips, p.snap_knees, 0.0)
+                goal = pose(p.push, p.snap_trunk, p.snap_hips, p.snap_knees, 0.0)
                 rig.move(goal, p.snap, t, list(range(NJ)))
 
         def hands_on(_w: World, t: float, _t_in: float) -> bool:
