@@ -144,7 +144,7 @@ class LandingParams:
             the COM stop the spin by the ground force's moment, whose arm grows with their
             distance, so a landing that must stop more spin puts them farther; the male back
             handspring's landing lands only within about 6 kg m^2/s of its -95 (a
-            perturbed push leaves -70 to -115; docs/athletics.md). Measured about the
+            perturbed push leaves -69 to -116; docs/athletics.md). Measured about the
             left-right axis because the pelvis's heading flips as an inverted body turns.
     """
 

@@ -107,8 +107,9 @@ def test_the_landing_places_the_feet_by_the_spin_the_push_left() -> None:
     landing begins (``spin_ref``, the file since 2026-12-03) the feet land farther back and it
     stands."""
     rng = np.random.default_rng(0)
-    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2), "velocity_sd": 0.005,
-             "spin_sd": 0.01}  # fmt: skip
+    # the benchmark's tenth-size distribution, written as it writes it (the same floats)
+    tenth = {"joint_sd": math.radians(3.0) * 0.1, "pitch_sd": math.radians(2.0) * 0.1,
+             "velocity_sd": 0.05 * 0.1, "spin_sd": 0.1 * 0.1}  # fmt: skip
     start = [Perturbation.sample(rng, **tenth) for _ in range(4)][3]
     m = load_maneuver(EXAMPLE)
     land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
