@@ -138,6 +138,14 @@ class LandingParams:
             ``None``: ``lead``. Why: ``lead`` is tuned with the forward delta, which has no
             sideways counterpart; a perturbed broad jump touching down with 0.2-0.7 m/s
             sideways stood up on one foot and fell sideways (docs/athletics.md).
+        spin_ref: the delta is scaled by the whole-body angular momentum about the pelvis's
+            left-right axis when the reach begins (constant in the air) over this (kg m^2/s,
+            the spin the delta was tuned at, backward < 0); 0: off. Why: feet placed behind
+            the COM stop the spin by the ground force's moment, whose arm grows with their
+            distance, so a landing that must stop more spin puts them farther; the male back
+            handspring's landing lands only within about 6 kg m^2/s of its -95 (a
+            perturbed push leaves -69 to -116; docs/athletics.md). Measured about the
+            left-right axis because the pelvis's heading flips as an inverted body turns.
     """
 
     knee: float = 0.6
@@ -161,6 +169,7 @@ class LandingParams:
     momentum_gain: float = 0.0
     momentum_ref: float = 0.0
     side_lead: float | None = None
+    spin_ref: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -180,6 +189,7 @@ class LandingParams:
             "fall_ref",
             "momentum_gain",
             "momentum_ref",
+            "spin_ref",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -246,6 +256,11 @@ class Landing(Basis):
             moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
             rig.move(goal, 0.2, t, moving)
             memo["lag"] = float(rig.lag(_HIP).mean()) if p.spin_aim else 0.0
+            memo["scale"] = 1.0
+            if p.spin_ref:  # the spin to stop against the delta's (see spin_ref)
+                sn = ctx.sense(t)
+                spin = float(world.data.subtree_angmom[sn.root] @ sn.side_axis())
+                memo["scale"] = spin / p.spin_ref
             memo["fall"] = p.fall_ref
             if p.fall_gain:  # the fall predicted now, in the landing pose (see fall_gain)
                 sn = ctx.sense(t)
@@ -268,7 +283,7 @@ class Landing(Basis):
             tau = math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
             lead = p.lead * tau
             side = lead if p.side_lead is None else p.side_lead * tau
-            want = np.array([lead * v[0] + p.delta_at(float(v[0])), side * v[1]])
+            want = np.array([lead * v[0] + p.delta_at(float(v[0])) * memo["scale"], side * v[1]])
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
             if p.momentum_gain:  # the feet also stop the rotation (see momentum_gain)
                 want[0] += p.momentum_gain * (pitch_momentum(world, s) - p.momentum_ref)

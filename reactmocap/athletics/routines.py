@@ -364,6 +364,9 @@ HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
 #: and lands on feet placed farther behind her (the hip swing allowed past asin 0.9) with
 #: stiffer, more damped knees, which stop the legs bouncing her back into the air
 HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, float]]] = MappingProxyType({
+    # the male's landing scales its delta by the spin the push left (LandingParams.spin_ref:
+    # the spin at the nominal's release), 2026-12-03
+    "male": MappingProxyType({"land": MappingProxyType({"spin_ref": -96.8})}),
     "female": MappingProxyType({
         "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 2.0}),
         "land": MappingProxyType({"delta": -0.6, "swing_cap": 0.97, "knee_stiffness": 1.0,

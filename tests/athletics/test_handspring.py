@@ -6,6 +6,7 @@ run's own log."""
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -14,7 +15,7 @@ import pytest
 
 from reactmocap.athletics.handspring import HandspringParams
 from reactmocap.athletics.land import LandingParams
-from reactmocap.athletics.maneuvers import load_maneuver, run_maneuver
+from reactmocap.athletics.maneuvers import Perturbation, load_maneuver, run_maneuver
 from reactmocap.athletics.routines import handspring, handspring_maneuver
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError
@@ -37,6 +38,8 @@ def test_bad_handspring_parameters_are_config_errors() -> None:
     for cap in (0.0, 1.0, float("nan")):
         with pytest.raises(ConfigError, match="swing_cap"):
             LandingParams(swing_cap=cap)
+    with pytest.raises(ConfigError, match="spin_ref"):
+        LandingParams(spin_ref=float("inf"))
 
 
 def test_the_hands_carry_the_body_past_inverted_and_the_report_matches_the_log() -> None:
@@ -95,3 +98,25 @@ def test_the_female_handspring_lands_on_feet_placed_past_the_default_hip_swing()
     )
     capped = run_maneuver(replace(m, phases=phases), fps=10.0).report
     assert capped["landed"] is False and capped["fell"] is True
+
+
+def test_the_landing_places_the_feet_by_the_spin_the_push_left() -> None:
+    """Start 3 of the capture region's tenth-size starts (seed 0): the push leaves -99.7
+    kg m^2/s at touchdown against the nominal's -96, too much for the fixed delta (it turned
+    on over its feet to -397 deg and fell); with the delta scaled by the spin measured as the
+    landing begins (``spin_ref``, the file since 2026-12-03) the feet land farther back and it
+    stands."""
+    rng = np.random.default_rng(0)
+    # the benchmark's tenth-size distribution, written as it writes it (the same floats)
+    tenth = {"joint_sd": math.radians(3.0) * 0.1, "pitch_sd": math.radians(2.0) * 0.1,
+             "velocity_sd": 0.05 * 0.1, "spin_sd": 0.1 * 0.1}  # fmt: skip
+    start = [Perturbation.sample(rng, **tenth) for _ in range(4)][3]
+    m = load_maneuver(EXAMPLE)
+    land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
+    assert m.phases[land].params["spin_ref"] == -96.8
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 45.0
+    phases = list(m.phases)
+    phases[land] = replace(phases[land], params={"delta": -0.45})
+    old = run_maneuver(replace(m, phases=tuple(phases)), perturbation=start, fps=10.0).report
+    assert old["fell"] and not old["landed"]
