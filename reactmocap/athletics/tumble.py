@@ -136,7 +136,9 @@ class TumbleParams:
         turns: somersaults to turn (> 0; the direction follows the angular momentum).
         entry: seconds the joints take to reach the position (Hermite).
         lead: rotation (rad) before the predicted total at which to open (the opening takes
-            time, during which the body still turns faster than open).
+            time, during which the body still turns faster than open); with ``open_inertia``
+            below the position's, a negative lead opens once the prediction is that far
+            short of the turn (the landing turns the rest).
         touchdown_height: COM height (fraction of the standing COM height) at which the
             feet are predicted to touch.
         latest: open, however far the rotation has got, once the feet are predicted to
@@ -168,11 +170,11 @@ class TumbleParams:
         open_delay: seconds of the time to touchdown that the prediction leaves out: the
             opened body is taken to turn at ``L / open_inertia`` over the rest only, ``L /
             open_inertia * max(t - open_delay, 0)``; 0: over all of it. Why: the layout's
-            reach pikes deeper the longer it has, so its turn grows with its time about four
-            times faster than its mean rate (measured on perturbed back layouts: 19 rad/s per
-            second of reach against 6 on average); a rate over the whole time made the
-            opening follow the take-off's small momentum and height errors the wrong way
-            and scattered the touchdown over -287..-319 deg (docs/athletics.md).
+            reach pikes deeper the longer it has, so its turn grows by about 19 rad per
+            second of reach against a mean rate of 6 rad/s (perturbed back layouts); a rate
+            over the whole time made the opening follow the take-off's small momentum and
+            height errors the wrong way and scattered the touchdown over -287..-319 deg
+            (docs/athletics.md).
         extend: fraction (0-1) of the way from the position to the landing pose that the
             hips and knees extend before the opening (thesis 8.5.1: in the forward somersault
             they extend slightly in the air before the landing controller takes over, so the
