@@ -74,8 +74,10 @@ TIMED_START_PRESETS = frozenset({"male/forward"})
 #: stop the forward spin (landed at 35-45 cm; at 30 cm the crouch sank too deep). The back
 #: layout (inertia 18.5 kg m^2 against the tuck's 4.7) needs the leap at effort 0.9 aiming at
 #: -90 kg m^2/s with the hips allowed 1.5 rad (it gets -77.0, 1.2 m of COM rise); it holds the
-#: layout until the rotation predicted for the landing's reach (which pikes the body to put the
-#: feet under it: predicted at 8.0 kg m^2) comes down to the turn, and lands with the knees bent
+#: layout until the rotation predicted for the touchdown comes down to the turn less 0.96 rad
+#: (the landing's reach pikes the body to put the feet under it, and pikes deeper the longer
+#: it has: its turn is predicted as L / 4.0 kg m^2 over the time to touchdown less 0.217 s,
+#: ``open_delay``; since 2026-12-03, before L / 8.0 over all of it), and lands with the knees bent
 #: 1.0 rad, the feet 13 cm behind the capture point (landed at 12-13 cm, not 15 or 17). At
 #: effort 0.8 (before 2026-12-02) the opening sat at the edge where the reach, opened short of
 #: inverted, folds the body into a deep pike and turns it over: perturbed starts, a little
@@ -102,7 +104,8 @@ SOMERSAULT_PRESETS: Mapping[
                           MappingProxyType({"lead": 3.4}),
                           MappingProxyType({"delta": -0.15, "knee": 1.0})),
         "backward/layout": (MappingProxyType({"effort": 0.9, "spin": -90.0, "spin_limit": 1.5}),
-                            MappingProxyType({"lead": 0.0, "open_inertia": 8.0}),
+                            MappingProxyType({"lead": -0.96, "open_inertia": 4.0,
+                                              "open_delay": 0.217}),
                             MappingProxyType({"delta": -0.13, "knee": 1.0})),
         "forward": (MappingProxyType({"effort": 1.0, "spin": 60.0, "spin_limit": 1.0,
                                       "com_offset": 0.08, "arms_back": -2.8, "arms": 0.0}),

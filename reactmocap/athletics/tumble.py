@@ -136,7 +136,9 @@ class TumbleParams:
         turns: somersaults to turn (> 0; the direction follows the angular momentum).
         entry: seconds the joints take to reach the position (Hermite).
         lead: rotation (rad) before the predicted total at which to open (the opening takes
-            time, during which the body still turns faster than open).
+            time, during which the body still turns faster than open); with ``open_inertia``
+            below the position's, a negative lead opens once the prediction is that far
+            short of the turn (the landing turns the rest).
         touchdown_height: COM height (fraction of the standing COM height) at which the
             feet are predicted to touch.
         latest: open, however far the rotation has got, once the feet are predicted to
@@ -165,6 +167,14 @@ class TumbleParams:
             prediction uses; None: the landing pose's (:data:`LANDING_POSE`). When it is
             below the position's own (the layout), the prediction falls through the flight
             and the tumble opens once it has come down to ``turns`` (+ ``lead``) instead.
+        open_delay: seconds of the time to touchdown that the prediction leaves out: the
+            opened body is taken to turn at ``L / open_inertia`` over the rest only, ``L /
+            open_inertia * max(t - open_delay, 0)``; 0: over all of it. Why: the layout's
+            reach pikes deeper the longer it has, so its turn grows by about 19 rad per
+            second of reach against a mean rate of 6 rad/s (perturbed back layouts); a rate
+            over the whole time made the opening follow the take-off's small momentum and
+            height errors the wrong way and scattered the touchdown over -287..-319 deg
+            (docs/athletics.md).
         extend: fraction (0-1) of the way from the position to the landing pose that the
             hips and knees extend before the opening (thesis 8.5.1: in the forward somersault
             they extend slightly in the air before the landing controller takes over, so the
@@ -194,6 +204,7 @@ class TumbleParams:
     extend: float = 0.0
     extend_lead: float = 0.5
     hip: float | None = None
+    open_delay: float = 0.0
 
     def __post_init__(self) -> None:
         position_angles(self.position)  # an unknown position lists the valid ones
@@ -218,6 +229,8 @@ class TumbleParams:
             math.isfinite(self.open_inertia) and self.open_inertia > 0
         ):
             raise ConfigError(f"tumble open_inertia must be > 0, got {self.open_inertia!r}")
+        if not (isinstance(self.open_delay, (int, float)) and 0.0 <= self.open_delay < 5.0):
+            raise ConfigError(f"tumble open_delay must be in [0, 5) s, got {self.open_delay!r}")
         if self.hip is not None and not (math.isfinite(self.hip) and -2.6 <= self.hip <= 0.0):
             raise ConfigError(f"tumble hip must be in [-2.6, 0] rad, got {self.hip!r}")
 
@@ -305,7 +318,8 @@ class Tumble(Basis):
             if aim is None:
                 aim = p.touchdown_height * (ctx.standing_com or float(s.com[2]))
             memo["t_td"] = time_to_height(ctx, aim)
-            memo["predicted"] = ctx.rotation + momentum / i_open * memo["t_td"]
+            turning = max(memo["t_td"] - p.open_delay, 0.0)
+            memo["predicted"] = ctx.rotation + momentum / i_open * turning
             want = 2.0 * math.pi * p.turns - p.lead - p.extend_lead
             if (p.extend and "extended" not in memo and t - memo["t0"] > p.entry
                     and abs(memo["predicted"]) >= want):  # fmt: skip

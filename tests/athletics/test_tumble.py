@@ -64,6 +64,9 @@ def test_positions_and_params_are_checked() -> None:
         TumbleParams(position="straddle")
     with pytest.raises(ConfigError, match="> 0"):
         TumbleParams(turns=0.0)
+    for bad in (-0.1, math.nan, 5.0):
+        with pytest.raises(ConfigError, match=r"open_delay must be in \[0, 5\) s"):
+            TumbleParams(open_delay=bad)
 
 
 @pytest.fixture(scope="module")
@@ -214,6 +217,32 @@ def test_perturbed_back_layouts_open_past_inverted_and_land() -> None:
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
         assert -330.0 < r["rotation_at_touchdown_deg"] < -280.0, (i, r["rotation_at_touchdown_deg"])
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+
+
+def test_the_back_layout_opens_by_the_reach_s_turn_over_its_time() -> None:
+    """Starts 28 and 42 of ``back_layout.toml``'s capture region at a tenth (seed 0). With the
+    reach's turn predicted as L / 8.0 kg m^2 over all the time to touchdown (before
+    2026-12-03) both opened a tick early, touched down near -305.5 deg still turning backward
+    and fell. The reach pikes deeper the longer it has, so its turn grows about four times
+    faster with its time than its mean rate: predicted over the time less ``open_delay``
+    (the file), both open a tick later, touch down near -303 deg and land."""
+    rng = np.random.default_rng(0)
+    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
+             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
+    starts = [Perturbation.sample(rng, **tenth) for _ in range(43)]
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    tumble = m.phases[2]
+    assert tumble.controller == "tumble" and tumble.params["open_delay"] > 0.0
+    old = replace(tumble, params={**tumble.params, "lead": 0.0, "open_inertia": 8.0,
+                                  "open_delay": 0.0})  # fmt: skip
+    before = replace(m, phases=(*m.phases[:2], old, *m.phases[3:]))
+    for i in (28, 42):
+        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
+        assert -305.0 < r["rotation_at_touchdown_deg"] < -301.0, (i, r["rotation_at_touchdown_deg"])
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+        r = run_maneuver(before, perturbation=starts[i], fps=10.0).report
+        assert r["rotation_at_touchdown_deg"] < -305.0, (i, r["rotation_at_touchdown_deg"])
+        assert r["fell"] and not r["landed"], i
 
 
 def test_perturbed_back_tucks_land_with_the_legs_aimed_sideways() -> None:
