@@ -148,6 +148,9 @@ class BalanceGains:
     #: backward only: swung back on a forward fall they cost the male's front-right push 20 N
     #: (docs/athletics.md); ``None``: off
     arms: tuple[float, float, float] | None = None
+    #: the sideways COM servo's gains (``kp``, ``kv``) as a multiple of the fore-aft ones
+    #: (the leap's crouch on yawed feet drifts sideways: docs/athletics.md)
+    side: float = 1.0
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
         ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
@@ -166,6 +169,10 @@ class BalanceGains:
             raise ConfigError(
                 f"balance bow must be 4 finite numbers >= 0 (gain rad/m, margin m, forward "
                 f"and back limits rad), got {b!r}"
+            )
+        if not (math.isfinite(self.side) and 0.0 < self.side <= 5.0):
+            raise ConfigError(
+                f"balance side must be in (0, 5] (a multiple of kp, kv), got {self.side!r}"
             )
         a = self.arms
         if a is not None and (len(a) != 3 or not all(math.isfinite(x) and x >= 0 for x in a)):
@@ -313,7 +320,9 @@ class BalanceLaw:
         self.com_target = target
         err = s.local(target - s.com, h)
         vel = s.local(s.com_vel, h)
-        delta = np.clip(g.kp * err - g.kv * vel, -g.max_offset, g.max_offset)
+        delta = g.kp * err - g.kv * vel
+        delta[1] *= g.side
+        np.clip(delta, -g.max_offset, g.max_offset, out=delta)
         pitch = self._pitch_now(t) + self._lean()
         cp = 0.0
         if g.bow is not None or g.arms is not None:

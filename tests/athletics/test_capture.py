@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import tables
+from reactmocap.athletics.balance import BalanceGains
 from reactmocap.athletics.behaviours import AthleticsResult
+from reactmocap.athletics.leap import LeapParams
 from reactmocap.athletics.maneuvers import (
     Maneuver,
     Perturbation,
@@ -21,6 +23,7 @@ from reactmocap.athletics.maneuvers import (
     load_maneuver,
     run_maneuver,
 )
+from reactmocap.errors import ReactMocapError
 
 MANEUVERS = Path(__file__).resolve().parents[2] / "examples/athletics/maneuvers"
 VERTICAL_LEAP = MANEUVERS / "vertical_leap.toml"
@@ -158,3 +161,35 @@ def test_the_broad_jump_lands_sideways_on_the_whole_capture_point() -> None:
     assert r["landed"] and not r["fell"]
     params = {k: v for k, v in m.phases[land].params.items() if k != "side_lead"}
     assert run_maneuver(_with_params(m, land, params), perturbation=start, fps=10.0).report["fell"]
+
+
+def test_the_broad_jump_crouches_on_yawed_feet_without_drifting_sideways() -> None:
+    """Start 6 stands with its feet yawed apart (right toe out ~30 deg): under the balance's
+    sideways COM gains the crouch's knees carry the COM 7 cm sideways and it leaves at
+    0.54 m/s sideways, stands up on one foot after the landing and falls. With the crouch's
+    sideways gains doubled (``crouch_side`` 2.0, the file since 2026-12-03) it leaves slower
+    sideways and lands. The whole file, settled start included."""
+    m = load_maneuver(MANEUVERS / "broad_jump.toml")
+    leap = next(i for i, p in enumerate(m.phases) if p.controller == "leap")
+    assert m.phases[leap].params["crouch_side"] == 2.0
+    old = _with_params(m, leap, {**m.phases[leap].params, "crouch_side": 1.0})
+    start = full_starts(7)[6]
+
+    def sideways_at_liftoff(r: AthleticsResult) -> float:
+        lift = r.report["time_to_liftoff_s"]
+        i = int(np.searchsorted(r.log["t"], lift))
+        return abs(float(r.log["com_vel"][i, 1]))
+
+    new = run_maneuver(m, perturbation=start, fps=10.0)
+    assert new.report["landed"] and not new.report["fell"]
+    was = run_maneuver(old, perturbation=start, fps=10.0)
+    assert was.report["fell"]
+    assert sideways_at_liftoff(new) < 0.42 < 0.5 < sideways_at_liftoff(was)
+
+
+def test_the_crouch_side_gain_is_checked() -> None:
+    """A crouch's sideways gain multiple outside (0, 5] is refused, naming the field."""
+    with pytest.raises(ReactMocapError, match="crouch_side"):
+        LeapParams(crouch_side=0.0)
+    with pytest.raises(ReactMocapError, match="side"):
+        BalanceGains(side=6.0)
