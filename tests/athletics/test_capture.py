@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import tables
-from reactmocap.athletics.balance import BalanceGains
+from reactmocap.athletics.balance import Balance, BalanceGains
 from reactmocap.athletics.behaviours import AthleticsResult
 from reactmocap.athletics.leap import LeapParams
 from reactmocap.athletics.maneuvers import (
@@ -152,8 +152,12 @@ def test_the_broad_jump_crouches_with_both_feet_down() -> None:
 def test_the_broad_jump_lands_sideways_on_the_whole_capture_point() -> None:
     """Start 30 touches down moving 0.33 m/s sideways; with the feet placed sideways at the
     landing's forward lead (0.5 of the capture point) it stands up on one foot and falls
-    over; at the whole capture point (``side_lead`` 1.0, the file since 2026-12-03) it lands."""
+    over; at the whole capture point (``side_lead`` 1.0, the file since 2026-12-03) it lands.
+    The crouch at the balance's sideways gains, as this was measured (``crouch_side`` 2.0,
+    the file's since, sends start 30 off slower sideways)."""
     m = _broad_jump_timed()
+    leap = next(i for i, p in enumerate(m.phases) if p.controller == "leap")
+    m = _with_params(m, leap, {**m.phases[leap].params, "crouch_side": 1.0})
     land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
     assert m.phases[land].params["side_lead"] == 1.0
     start = full_starts(31)[30]
@@ -193,3 +197,29 @@ def test_the_crouch_side_gain_is_checked() -> None:
         LeapParams(crouch_side=0.0)
     with pytest.raises(ReactMocapError, match="side"):
         BalanceGains(side=6.0)
+
+
+def test_the_vertical_leap_settles_with_a_lighter_rear_foot() -> None:
+    """Start 31 of seed 1 stands staggered and still, the COM on its target, but its rear
+    foot bears under a fifth of the weight (the inclined leg reaches a little less low):
+    under :data:`SETTLED`'s 0.2 it never settles and fails there; with ``settle_share`` 0.1
+    (the vertical leap's file since 2026-12-03) it leaps and lands."""
+    m = load_maneuver(VERTICAL_LEAP)
+    assert m.phases[0].params["settle_share"] == 0.1
+    rng = np.random.default_rng(1)
+    start = [Perturbation.sample(rng, **FULL) for _ in range(32)][31]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and "unsettled_s" not in r
+    old = _with_params(m, 0, {"plant": True})
+    r = run_maneuver(old, perturbation=start, fps=10.0).report
+    assert r["unsettled_s"] == pytest.approx(3.0, abs=0.01) and not r["landed"]
+
+
+def test_a_settle_share_is_checked() -> None:
+    """A foot's settled share outside (0, 0.5], or on a balance that does not exit
+    ``settled``, is refused naming the field."""
+    with pytest.raises(ReactMocapError, match="settle_share"):
+        Balance(settle_within=3.0, settle_share=0.6)
+    m = Maneuver("m", (Phase("balance", "never", {"settle_share": 0.1}),), seconds=1.0)
+    with pytest.raises(ReactMocapError, match="settle_share"):
+        run_maneuver(m)
