@@ -113,7 +113,7 @@ def _broad_jump_timed() -> Maneuver:
     """The broad jump file with the leap 0.3 s into the start, as its crouch and landing were
     measured (the file settles the start first since 2026-12-03)."""
     m = load_maneuver(MANEUVERS / "broad_jump.toml")
-    assert m.phases[0] == Phase("balance", "settled", {"plant": True}, 3.0)
+    assert m.phases[0] == Phase("balance", "settled", {"plant": True, "settle_share": 0.1}, 3.0)
     return dataclasses.replace(
         m, phases=(Phase("balance", "after", seconds=0.3), *m.phases[1:]), seconds=4.5
     )
@@ -203,9 +203,10 @@ def test_the_vertical_leap_settles_with_a_lighter_rear_foot() -> None:
     """Start 31 of seed 1 stands staggered and still, the COM on its target, but its rear
     foot bears under a fifth of the weight (the inclined leg reaches a little less low):
     under :data:`SETTLED`'s 0.2 it never settles and fails there; with ``settle_share`` 0.1
-    (the vertical leap's file since 2026-12-03) it leaps and lands."""
+    (the vertical leap's and the broad jump's files since 2026-12-03) it leaps and lands."""
     m = load_maneuver(VERTICAL_LEAP)
     assert m.phases[0].params["settle_share"] == 0.1
+    assert load_maneuver(MANEUVERS / "broad_jump.toml").phases[0] == m.phases[0]
     rng = np.random.default_rng(1)
     start = [Perturbation.sample(rng, **FULL) for _ in range(32)][31]
     r = run_maneuver(m, perturbation=start, fps=10.0).report
