@@ -148,6 +148,9 @@ class BalanceGains:
     #: backward only: swung back on a forward fall they cost the male's front-right push 20 N
     #: (docs/athletics.md); ``None``: off
     arms: tuple[float, float, float] | None = None
+    #: the sideways COM servo's gains (``kp``, ``kv``) as a multiple of the fore-aft ones
+    #: (the leap's crouch on yawed feet drifts sideways: docs/athletics.md)
+    side: float = 1.0
     stiffness: tuple[tuple[str, float], ...] = (
         ("waist", 2.0), ("back", 2.0), ("neck", 0.3), ("shoulder", 0.3), ("elbow", 0.15),
         ("wrist", 0.05), ("hip", 3.0), ("knee", 3.0), ("ankle", 3.0),
@@ -166,6 +169,10 @@ class BalanceGains:
             raise ConfigError(
                 f"balance bow must be 4 finite numbers >= 0 (gain rad/m, margin m, forward "
                 f"and back limits rad), got {b!r}"
+            )
+        if not (math.isfinite(self.side) and 0.0 < self.side <= 5.0):
+            raise ConfigError(
+                f"balance side must be in (0, 5] (a multiple of kp, kv), got {self.side!r}"
             )
         a = self.arms
         if a is not None and (len(a) != 3 or not all(math.isfinite(x) and x >= 0 for x in a)):
@@ -313,7 +320,9 @@ class BalanceLaw:
         self.com_target = target
         err = s.local(target - s.com, h)
         vel = s.local(s.com_vel, h)
-        delta = np.clip(g.kp * err - g.kv * vel, -g.max_offset, g.max_offset)
+        delta = g.kp * err - g.kv * vel
+        delta[1] *= g.side
+        np.clip(delta, -g.max_offset, g.max_offset, out=delta)
         pitch = self._pitch_now(t) + self._lean()
         cp = 0.0
         if g.bow is not None or g.arms is not None:
@@ -445,8 +454,10 @@ def _flat_feet(foot_now: F64, normal: F64) -> F64:
 _X = np.array([1.0, 0.0, 0.0])
 
 
-def settled(ctx: Context, bl: BalanceLaw) -> Event:
-    """Fires once the body stands settled on both feet under ``bl`` (:data:`SETTLED`)."""
+def settled(ctx: Context, bl: BalanceLaw, share: float | None = None) -> Event:
+    """Fires once the body stands settled on both feet under ``bl`` (:data:`SETTLED`; each
+    foot bearing ``share`` of the weight instead of its share if given)."""
+    need = SETTLED["share"] if share is None else share
     load = np.zeros(2)  # each foot's contact force, low-passed
     clock = np.array([-1.0, math.nan])  # the last tick, and since when it has been settled
     weight = ctx.senses.mass * float(np.linalg.norm(ctx.world.model.opt.gravity))
@@ -457,7 +468,7 @@ def settled(ctx: Context, bl: BalanceLaw) -> Event:
         clock[0] = t
         load[:] += k * (s.foot_force - load)
         h = s.heading()
-        ok = (bool(s.foot_contact.all()) and float(load.min()) >= SETTLED["share"] * weight
+        ok = (bool(s.foot_contact.all()) and float(load.min()) >= need * weight
               and float(np.hypot(*s.com_vel[:2])) < SETTLED["speed"]
               and float(np.hypot(*s.local(bl.com_target - s.com, h))) < SETTLED["offset"])  # fmt: skip
         if not ok:
@@ -475,7 +486,9 @@ class Balance(Basis):
     hand over) or forever (``None``). With ``settle_within`` it hands over once
     :func:`settled` (the posture's COM target reached, still, on both feet); a body not
     settled within that many seconds stays in the state ``unsettled`` (the sequence never
-    goes on) and the time is in the hand-over dict (``"unsettled_s"``): a failure."""
+    goes on) and the time is in the hand-over dict (``"unsettled_s"``): a failure.
+    ``settle_share``: the weight each foot must bear to count as settled (default
+    :data:`SETTLED`'s)."""
 
     name = "balance"
     initial = "hold"
@@ -487,12 +500,20 @@ class Balance(Basis):
         gains: BalanceGains = BALANCE_GAINS,
         until: Event | None = None,
         settle_within: float | None = None,
+        settle_share: float | None = None,
     ) -> None:
         self.posture = posture or Posture()
         if seconds is not None and not (math.isfinite(seconds) and seconds >= 0):
             raise ConfigError(f"balance seconds must be >= 0, got {seconds!r}")
         if settle_within is not None and not (math.isfinite(settle_within) and settle_within > 0):
             raise ConfigError(f"balance settle_within must be > 0 s, got {settle_within!r}")
+        if settle_share is not None and not (
+            math.isfinite(settle_share) and 0.0 < settle_share <= 0.5
+        ):
+            raise ConfigError(
+                f"balance settle_share must be in (0, 0.5] of the weight per foot, got {settle_share!r}"
+            )
+        self.settle_share = settle_share
         self.seconds = seconds
         self.settle_within = settle_within
         self.gains = gains
@@ -523,9 +544,12 @@ class Balance(Basis):
             del world
             ctx.handover["unsettled_s"] = t
 
-        exits += [(settled(ctx, bl), NEXT), (after(self.settle_within), "unsettled")]
+        exits += [
+            (settled(ctx, bl, self.settle_share), NEXT),
+            (after(self.settle_within), "unsettled"),
+        ]
         return [State("hold", hold, enter, tuple(exits)), State("unsettled", hold, timed_out)]
 
     def with_posture(self, **changes: object) -> Balance:
         return Balance(replace(self.posture, **changes), self.seconds, self.gains, self.until,  # type: ignore[arg-type]
-                       self.settle_within)  # fmt: skip
+                       self.settle_within, self.settle_share)  # fmt: skip

@@ -131,6 +131,11 @@ class LeapParams:
     #: step kicks the ankles: the broad jump's 17 cm hopped the body off the floor and a
     #: perturbed start came down on one foot); off by default: the tables were measured so
     com_ease: bool = False
+    #: the crouch's sideways COM servo gains as a multiple of the balance's
+    #: (:attr:`BalanceGains.side`): on feet yawed apart by a perturbed start the crouch's knees
+    #: carried the COM sideways and the broad jump left at up to 0.5 m/s sideways; 1: as the
+    #: balance (the tables were measured so)
+    crouch_side: float = 1.0
     #: when the leap hands over: ``"auto"`` (at the apex for a vertical leap, at lift-off for
     #: a broad jump), ``"apex"`` or ``"liftoff"`` (a somersault tucks at once)
     handover: str = "auto"
@@ -156,11 +161,16 @@ class LeapParams:
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
                 self.hold, *self.timing, self.ankle_gain, self.ankle_extension, self.liftoff_hip,
-                self.stiffness, self.lean,
+                self.stiffness, self.lean, self.crouch_side,
                 self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
                 self.push_ramp, self.push_limit, self.push_hip, self.push_ankle]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
+        if not 0.0 < self.crouch_side <= 5.0:
+            raise ConfigError(
+                f"leap crouch_side must be in (0, 5] (a multiple of the balance's sideways "
+                f"gains), got {self.crouch_side}"
+            )
         if not 0.3 <= self.leg <= 1.0:
             raise ConfigError(f"leap crouch leg fraction must be in [0.3, 1.0], got {self.leg}")
         if min(self.timing) <= 0 or self.crouch <= 0 or self.hold < 0 or self.ankle_gain <= 0:
@@ -215,7 +225,7 @@ class Leap(Basis):
 
     def states(self, ctx: Context) -> list[State]:
         p = self.params
-        bl = BalanceLaw(ctx, BALANCE_GAINS)
+        bl = BalanceLaw(ctx, replace(BALANCE_GAINS, side=p.crouch_side))
         every = ctx.control_every
         memo: dict[str, Any] = {}
 

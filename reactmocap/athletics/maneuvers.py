@@ -135,11 +135,16 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
     p = dict(phase.params)
     if "com_offset" in p:
         p["com_offset"] = tuple(p["com_offset"])
+    share = p.pop("settle_share", None)
+    if share is not None and phase.exit != "settled":
+        raise ConfigError(
+            f"balance settle_share applies to the exit 'settled' only, not {phase.exit!r}"
+        )
     seconds = phase.seconds if phase.exit == "after" else None
     within = None
     if phase.exit == "settled":
         within = phase.seconds if phase.seconds is not None else SETTLE_WITHIN
-    return Balance(Posture(**p), seconds=seconds, settle_within=within)
+    return Balance(Posture(**p), seconds=seconds, settle_within=within, settle_share=share)
 
 
 def _build_leap(phase: Phase, ath: Athlete) -> Basis:
@@ -198,7 +203,9 @@ SETTLE_WITHIN = 2.0
 _LEAP_KINDS = {"effort": "number", **_kinds(LeapParams, skip=("handover",))}
 CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
     "balance": BasisSpec(
-        "balance", "stand balanced in a posture (thesis ch. 7)", _kinds(Posture),
+        "balance", "stand balanced in a posture (thesis ch. 7); `settle_share`: the weight "
+        "each foot must bear for the exit `settled` (default 0.2)",
+        {**_kinds(Posture), "settle_share": "number"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
          "settled": "once standing still on both feet with the COM over them (a perturbed "
                     "start); not settled within `seconds` (default 2): the run fails there"},

@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import tables
+from reactmocap.athletics.balance import Balance, BalanceGains
 from reactmocap.athletics.behaviours import AthleticsResult
+from reactmocap.athletics.leap import LeapParams
 from reactmocap.athletics.maneuvers import (
     Maneuver,
     Perturbation,
@@ -21,6 +23,7 @@ from reactmocap.athletics.maneuvers import (
     load_maneuver,
     run_maneuver,
 )
+from reactmocap.errors import ReactMocapError
 
 MANEUVERS = Path(__file__).resolve().parents[2] / "examples/athletics/maneuvers"
 VERTICAL_LEAP = MANEUVERS / "vertical_leap.toml"
@@ -110,7 +113,7 @@ def _broad_jump_timed() -> Maneuver:
     """The broad jump file with the leap 0.3 s into the start, as its crouch and landing were
     measured (the file settles the start first since 2026-12-03)."""
     m = load_maneuver(MANEUVERS / "broad_jump.toml")
-    assert m.phases[0] == Phase("balance", "settled", {"plant": True}, 3.0)
+    assert m.phases[0] == Phase("balance", "settled", {"plant": True, "settle_share": 0.1}, 3.0)
     return dataclasses.replace(
         m, phases=(Phase("balance", "after", seconds=0.3), *m.phases[1:]), seconds=4.5
     )
@@ -149,8 +152,12 @@ def test_the_broad_jump_crouches_with_both_feet_down() -> None:
 def test_the_broad_jump_lands_sideways_on_the_whole_capture_point() -> None:
     """Start 30 touches down moving 0.33 m/s sideways; with the feet placed sideways at the
     landing's forward lead (0.5 of the capture point) it stands up on one foot and falls
-    over; at the whole capture point (``side_lead`` 1.0, the file since 2026-12-03) it lands."""
+    over; at the whole capture point (``side_lead`` 1.0, the file since 2026-12-03) it lands.
+    The crouch at the balance's sideways gains, as this was measured (``crouch_side`` 2.0,
+    the file's since, sends start 30 off slower sideways)."""
     m = _broad_jump_timed()
+    leap = next(i for i, p in enumerate(m.phases) if p.controller == "leap")
+    m = _with_params(m, leap, {**m.phases[leap].params, "crouch_side": 1.0})
     land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
     assert m.phases[land].params["side_lead"] == 1.0
     start = full_starts(31)[30]
@@ -158,3 +165,62 @@ def test_the_broad_jump_lands_sideways_on_the_whole_capture_point() -> None:
     assert r["landed"] and not r["fell"]
     params = {k: v for k, v in m.phases[land].params.items() if k != "side_lead"}
     assert run_maneuver(_with_params(m, land, params), perturbation=start, fps=10.0).report["fell"]
+
+
+def test_the_broad_jump_crouches_on_yawed_feet_without_drifting_sideways() -> None:
+    """Start 6 stands with its feet yawed apart (right toe out ~30 deg): under the balance's
+    sideways COM gains the crouch's knees carry the COM 7 cm sideways and it leaves at
+    0.54 m/s sideways, stands up on one foot after the landing and falls. With the crouch's
+    sideways gains doubled (``crouch_side`` 2.0, the file since 2026-12-03) it leaves slower
+    sideways and lands. The whole file, settled start included."""
+    m = load_maneuver(MANEUVERS / "broad_jump.toml")
+    leap = next(i for i, p in enumerate(m.phases) if p.controller == "leap")
+    assert m.phases[leap].params["crouch_side"] == 2.0
+    old = _with_params(m, leap, {**m.phases[leap].params, "crouch_side": 1.0})
+    start = full_starts(7)[6]
+
+    def sideways_at_liftoff(r: AthleticsResult) -> float:
+        lift = r.report["time_to_liftoff_s"]
+        i = int(np.searchsorted(r.log["t"], lift))
+        return abs(float(r.log["com_vel"][i, 1]))
+
+    new = run_maneuver(m, perturbation=start, fps=10.0)
+    assert new.report["landed"] and not new.report["fell"]
+    was = run_maneuver(old, perturbation=start, fps=10.0)
+    assert was.report["fell"]
+    assert sideways_at_liftoff(new) < 0.42 < 0.5 < sideways_at_liftoff(was)
+
+
+def test_the_crouch_side_gain_is_checked() -> None:
+    """A crouch's sideways gain multiple outside (0, 5] is refused, naming the field."""
+    with pytest.raises(ReactMocapError, match="crouch_side"):
+        LeapParams(crouch_side=0.0)
+    with pytest.raises(ReactMocapError, match="side"):
+        BalanceGains(side=6.0)
+
+
+def test_the_vertical_leap_settles_with_a_lighter_rear_foot() -> None:
+    """Start 31 of seed 1 stands staggered and still, the COM on its target, but its rear
+    foot bears under a fifth of the weight (the inclined leg reaches a little less low):
+    under :data:`SETTLED`'s 0.2 it never settles and fails there; with ``settle_share`` 0.1
+    (the vertical leap's and the broad jump's files since 2026-12-03) it leaps and lands."""
+    m = load_maneuver(VERTICAL_LEAP)
+    assert m.phases[0].params["settle_share"] == 0.1
+    assert load_maneuver(MANEUVERS / "broad_jump.toml").phases[0] == m.phases[0]
+    rng = np.random.default_rng(1)
+    start = [Perturbation.sample(rng, **FULL) for _ in range(32)][31]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and "unsettled_s" not in r
+    old = _with_params(m, 0, {"plant": True})
+    r = run_maneuver(old, perturbation=start, fps=10.0).report
+    assert r["unsettled_s"] == pytest.approx(3.0, abs=0.01) and not r["landed"]
+
+
+def test_a_settle_share_is_checked() -> None:
+    """A foot's settled share outside (0, 0.5], or on a balance that does not exit
+    ``settled``, is refused naming the field."""
+    with pytest.raises(ReactMocapError, match="settle_share"):
+        Balance(settle_within=3.0, settle_share=0.6)
+    m = Maneuver("m", (Phase("balance", "never", {"settle_share": 0.1}),), seconds=1.0)
+    with pytest.raises(ReactMocapError, match="settle_share"):
+        run_maneuver(m)

@@ -293,7 +293,10 @@ def test_the_somersault_command_leaps_from_a_settled_start_as_the_files_do() -> 
     fell after touchdown; settled first it lands."""
     maneuvers = Path(__file__).parents[2] / "examples" / "athletics" / "maneuvers"
     for stem in ("vertical_leap", "back_somersault", "broad_jump"):
-        assert load_maneuver(maneuvers / f"{stem}.toml").phases[0] == SETTLED_START, stem
+        first = load_maneuver(maneuvers / f"{stem}.toml").phases[0]
+        if stem != "back_somersault":  # their own settled share (test_capture.py)
+            first = replace(first, params={"plant": first.params["plant"]})
+        assert first == SETTLED_START, stem
     m = somersault_maneuver()
     assert m.seconds == load_maneuver(maneuvers / "back_somersault.toml").seconds
     for built in (m, somersault_maneuver("pike"), somersault_maneuver("layout"),
