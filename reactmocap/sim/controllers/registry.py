@@ -151,15 +151,16 @@ _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: needs), the pelvis position servo at half stiffness (50 1/s^2; 30 once a walk is pushed),
 #: and after a push while the mocap stands a hip strategy (``hip_weight``) near the feet's edge
 #: and balance steps once the capture point leaves them (``step_pushed``; the pelvis lowered so
-#: the step reaches the floor, the next step by the other foot or by one lifted off the floor).
-#: Without them
+#: the step reaches the floor, the next step by the other foot or by one lifted off the floor);
+#: after a walk's sideways push its outer swing foot placed out from the capture point
+#: (``place_pushed``). Without them
 #: the tracker follows the captured world path, as the 1 s benchmark windows, predictive
 #: sampling and the response pipeline's physical mode expect.
 WHOLE_CLIP: Mapping[str, Param] = MappingProxyType(
     {"touch": 0.003, "slide_speed": 0.5, "roll_band": 0.02, "anchor_tau": 0.1, "balance_tau": 0.1,
      "balance_margin": 0.05, "trunk_weight": 30.0, "trunk_give": 0.5, "kp_root": 50.0,
      "kp_root_pushed": 30.0, "hip_weight": 300.0, "warp_gain": 0.8, "step_pushed": True,
-     "step_leg": 0.9, "step_alternate": True}
+     "step_leg": 0.9, "step_alternate": True, "place_pushed": 1.0}
 )  # fmt: skip
 
 _REGISTRY: dict[str, ControllerSpec] = {
