@@ -47,7 +47,7 @@ _WARP_TAU = 0.1
 # for a capture-point error this many times more sideways than along the walk: wider steps,
 # and placements where the clip's own sway or the walk's speed carried the error, lost more
 # pushes than they caught (``docs/tracking.md``)
-_PLACE_WIDTH = 0.5
+_PLACE_WIDTH = 0.6
 _PLACE_AGAINST = 0.25
 _PLACE_SIDEWAYS = 3.0
 

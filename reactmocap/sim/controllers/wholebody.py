@@ -178,7 +178,7 @@ class WholeBodyTracker(AnchoredReference):
         place_pushed: after a sideways walk's push (within 30 deg of the side), a swinging
             foot on the side the body falls to lands ``place_pushed`` times the sideways gap
             between the simulated and the mocap's capture point, grown to the mocap's landing
-            (a linear inverted pendulum), further out (at most 0.5 m outside the stance foot;
+            (a linear inverted pendulum), further out (at most 0.6 m outside the stance foot;
             only past ``place_deadband``, while the clip walks away from that side and the
             capture point is past the stance foot; the pelvis lowered so the leg reaches;
             0: off; ``docs/tracking.md``).
