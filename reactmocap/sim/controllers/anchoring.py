@@ -324,6 +324,11 @@ class AnchoredReference:
         v[:2] = rot @ v[:2]
         return p, v
 
+    def sole_heading(self) -> float:
+        """The simulated soles' mean yaw (rad)."""
+        rot = self.world.data.geom_xmat[self.sole].reshape(2, 3, 3)
+        return float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
+
     def _place_walk(self, t: float) -> None:
         """After a sideways walk's push (``place_pushed``): a swinging foot lands where the
         simulated capture point will be when the mocap's foot comes down (pivoting over the
@@ -342,11 +347,11 @@ class AnchoredReference:
         c_ref, v_ref, _ = self.com_reference(t)
         # the push's part only: a walk's own capture point runs ahead of its stance foot
         miss = xi - c_ref[:2] - v_ref[:2] / omega
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
+        heading = self.sole_heading()
         left = np.array([-np.sin(heading), np.cos(heading)])
         i = self.clock.nearest(t)
         ahead = self.path.sole[i : i + round(0.5 * self.path.fps), :, 2] - self.floor_z
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
         centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
         for f in range(2):  # two feet
             if low[f] < self.anchor_touch or self._mocap_swing(t, f) is None:

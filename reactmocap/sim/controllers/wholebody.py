@@ -665,8 +665,7 @@ class WholeBodyTracker(AnchoredReference):
             self.warping = self.warp_gain > 0
             # and a sideways push places its swing feet (``place_pushed``): placing them after
             # a diagonal one lost more front-right pushes than it caught
-            rot = self.world.data.geom_xmat[self.sole].reshape(2, 3, 3)
-            heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
+            heading = self.sole_heading()
             f = self._xfrc[:, :2].sum(axis=0)
             along = abs(np.cos(heading) * f[0] + np.sin(heading) * f[1])
             side = abs(np.cos(heading) * f[1] - np.sin(heading) * f[0])
