@@ -156,6 +156,24 @@ def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None
     assert push({"warp_gain": 0.0}).report.status == "fell"
 
 
+def test_a_walk_pushed_sideways_places_its_outer_foot_and_stays_up(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared left-curving walk pushed 350 N (SIMBICON's figure) toward its right at the
+    chest for 0.2 s at 1.5 s: with its outer (right) swing foot placed out from the capture
+    point (``place_pushed``, opt-in: the held-out walk lost 3 of 56 pushes with it) it stays up;
+    without (the whole-clip default), that foot lands where the clip puts it, 0.4-0.6 m inside
+    the capture point, and the walk falls to the right."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, -90.0, 350.0)
+
+    def push(params: dict[str, float]) -> TrackResult:
+        return push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
+                         seconds=2.7, params=params)  # fmt: skip
+
+    assert push({"place_pushed": 1.0}).report.status == "ok"
+    assert push({}).report.status == "fell"
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}

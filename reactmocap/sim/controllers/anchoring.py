@@ -44,6 +44,14 @@ _DEADBAND_ARM = 0.5
 # this time constant (s): within a step the centre of mass's speed swings by ~20%
 _WARP_MAX = 1.8
 _WARP_TAU = 0.1
+# a pushed walk's placed foot lands at most this far (m) outside its stance foot, only while
+# the clip's centre of mass runs more than this fast (m/s) away from the fall's side, and only
+# for a capture-point error this many times more sideways than along the walk: wider steps,
+# and placements where the clip's own sway or the walk's speed carried the error, lost more
+# pushes than they caught (``docs/tracking.md``)
+_PLACE_WIDTH = 0.6
+_PLACE_AGAINST = 0.25
+_PLACE_SIDEWAYS = 3.0
 
 
 def _rot2(yaw: float) -> F64:
@@ -82,6 +90,7 @@ class AnchoredReference:
         step_leg: float = 0.0,
         step_alternate: bool = False,
         step_short: float = 0.0,
+        place_pushed: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -129,6 +138,15 @@ class AnchoredReference:
         #: horizontal shift of a mocap swing foot's landing (m): the capture point's error
         #: against the mocap's beyond ``place_deadband``
         self.place_shift = np.zeros(2)
+        self.place_pushed = float(place_pushed)
+        #: set once a walk is pushed: ``place_pushed`` then moves its swing feet's landings
+        self.placing = False
+        # per foot: a pushed walk's landing move (m), and whether it was moved and is still in
+        # the air (kept on its moved landing while the mocap's stance flickers: its gliding
+        # foot counts as planted)
+        self._place_move = np.zeros((2, 2))
+        self._place_land = np.zeros((2, 2))  # the moved landing (world, m)
+        self._placed = np.zeros(2, dtype=bool)
         #: the balance step under way (None: none)
         self.step: Step | None = None
         #: rollout times of the balance steps taken
@@ -173,19 +191,22 @@ class AnchoredReference:
             a[:2] = rot @ a[:2]
         q[:2] += self.balance_shift
         if self.step is not None and self.step_leg:
-            q[2] = min(q[2], self._step_pelvis_z())
+            q[2] = min(q[2], self._step_pelvis_z(self.step.target[:2]))
+        elif self.step_leg and self._place_move.any():
+            # a pushed walk's foot placed further out reaches the floor the same way
+            f = int(np.argmax(np.abs(self._place_move).sum(axis=1)))
+            q[2] = min(q[2], self._step_pelvis_z(self._place_land[f]))
         if self.rate != 1.0:  # the clip played faster (see :meth:`_warp`)
             v *= self.rate
             a *= self.rate * self.rate
         return q, v, a, planted
 
-    def _step_pelvis_z(self) -> float:
+    def _step_pelvis_z(self, target: F64) -> float:
         """The pelvis height from which a leg ``step_leg`` times the pelvis's starting height
-        reaches the balance step's target from where the pelvis is (at most 0.4 of that height
+        reaches a step's ``target`` (2,) from where the pelvis is (at most 0.4 of that height
         lower): at the standing height a long step's foot hovered short of the floor."""
-        assert self.step is not None
         leg = self.step_leg * (self._z0 - self.floor_z)
-        gap = self.step.target[:2] - self.world.data.qpos[self._z_adr - 2 : self._z_adr]
+        gap = target - self.world.data.qpos[self._z_adr - 2 : self._z_adr]
         reach = float(np.sqrt(max(leg * leg - float(gap @ gap), 0.0)))
         return self.floor_z + max(reach, 0.6 * (self._z0 - self.floor_z))
 
@@ -272,26 +293,88 @@ class AnchoredReference:
         if self.step is not None:
             p, v, a = self.step.at(t)
             out[self.step.foot] = (p, v, a, np.array([0.0, 0.0, 1.0]))
-        if not self.place_shift.any():
+        if not (self.place_shift.any() or self._place_move.any()):
             return out
+        for f in range(2):  # two feet
+            if f in out or not (self.place_shift.any() or self._place_move[f].any()):
+                continue
+            sole = self._mocap_swing(t, f)
+            if sole is None:
+                continue
+            p, v = sole
+            p[:2] += self.place_shift + self._place_move[f]
+            # a pushed walk's foot also comes down level where it lands (lateral rows alone
+            # left it hanging 0.2-0.4 m up, short of the landing)
+            out[f] = (p, v, np.zeros(3), np.array([0.0, 0.0, 1.0]) if self.placing else None)
+        return out
+
+    def _mocap_swing(self, t: float, f: int) -> tuple[F64, F64] | None:
+        """The mocap's sole centre of foot ``f`` at ``t`` (position, velocity; world, as
+        re-anchored) while it swings (a pushed walk's placed foot: until it lands), else
+        ``None``."""
         assert self.path.sole is not None
         x = self.clock.frame(t)
-        i = self.clock.nearest(t)
         i0 = int(x)
         i1 = min(i0 + 1, self.path.num_frames - 1)
         w = x - i0
+        if self.path.planted[self.clock.nearest(t), f] and not self._placed[f]:
+            return None
+        p = (1 - w) * self.path.sole[i0, f] + w * self.path.sole[i1, f]
+        if p[2] - self.floor_z < self.place_height and not self._placed[f]:
+            return None
+        v = (1 - w) * self._sole_v[i0, f] + w * self._sole_v[i1, f]
         rot = _rot2(self.anchor_yaw)
+        p[:2] = rot @ p[:2] + self.anchor_shift
+        v[:2] = rot @ v[:2]
+        return p, v
+
+    def sole_heading(self) -> float:
+        """The simulated soles' mean yaw (rad)."""
+        rot = self.world.data.geom_xmat[self.sole].reshape(2, 3, 3)
+        return float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
+
+    def _place_walk(self, t: float) -> None:
+        """After a sideways walk's push (``place_pushed``): a swinging foot lands where the
+        simulated capture point will be when the mocap's foot comes down (pivoting over the
+        other foot, a linear inverted pendulum), when that is further out than the mocap's
+        landing: ``place_pushed`` times the sideways gap out (at most ``_PLACE_WIDTH`` outside
+        the stance foot), kept until the foot is down. Only sideways (the clip played faster,
+        ``warp_gain``, takes the speed along the walk), only outward and only with the capture
+        point past the stance foot (no crossing step), only while the clip walks away from
+        the fall's side (``docs/tracking.md``)."""
+        d = self.world.data
+        low = self._sole_corners()[:, :, 2].min(axis=1) - self.floor_z
+        self._placed &= low >= self.anchor_touch  # landed
+        self._place_move[:] = 0.0
+        assert self.path.sole is not None
+        xi, omega = self.capture_point()
+        c_ref, v_ref, _ = self.com_reference(t)
+        # the push's part only: a walk's own capture point runs ahead of its stance foot
+        miss = xi - c_ref[:2] - v_ref[:2] / omega
+        heading = self.sole_heading()
+        left = np.array([-np.sin(heading), np.cos(heading)])
+        i = self.clock.nearest(t)
+        ahead = self.path.sole[i : i + round(0.5 * self.path.fps), :, 2] - self.floor_z
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
         for f in range(2):  # two feet
-            if self.path.planted[i, f] or f in out:
+            if low[f] < self.anchor_touch or self._mocap_swing(t, f) is None:
                 continue
-            p = (1 - w) * self.path.sole[i0, f] + w * self.path.sole[i1, f]
-            if p[2] - self.floor_z < self.place_height:
-                continue
-            v = (1 - w) * self._sole_v[i0, f] + w * self._sole_v[i1, f]
-            p[:2] = rot @ p[:2] + self.anchor_shift + self.place_shift
-            v[:2] = rot @ v[:2]
-            out[f] = (p, v, np.zeros(3), None)
-        return out
+            k = int(np.argmax(ahead[:, f] < self.place_height))  # the mocap's landing
+            land = _rot2(self.anchor_yaw) @ self.path.sole[i + k, f, :2] + self.anchor_shift
+            out = left if f == 0 else -left
+            side = float(miss @ out)
+            along = abs(float(miss @ np.array([left[1], -left[0]])))
+            gap = side * np.exp(omega * k / (self.path.fps * self.rate))
+            # the clip walks away from the fall's side, and the capture point is past the
+            # stance foot on this foot's side (no crossing step)
+            against = float(v_ref[:2] @ out) < -_PLACE_AGAINST
+            past = float((xi - centre[1 - f, :2]) @ out) > 0
+            if against and past and side > _PLACE_SIDEWAYS * along and gap > self.place_deadband:
+                width = _PLACE_WIDTH - float((land - centre[1 - f, :2]) @ out)
+                self._place_move[f] = max(0.0, min(self.place_pushed * gap, width)) * out
+                self._place_land[f] = land + self._place_move[f]
+                self._placed[f] = True
 
     def _update_step(self, t: float) -> None:
         """End a balance step that has landed; start one when the capture point has left both
@@ -299,6 +382,8 @@ class AnchoredReference:
         nothing else."""
         d = self.world.data
         self.place_shift = np.zeros(2)
+        if self.placing:
+            self._place_walk(t)
         if self.place_gain and not self.path.planted[self.clock.nearest(t)].all():
             xi, omega = self.capture_point()
             c_ref, cv_ref, _ = self.com_reference(t)
@@ -457,6 +542,9 @@ class AnchoredReference:
         self.anchor_shift = np.zeros(2)
         self.balance_shift = np.zeros(2)
         self.place_shift = np.zeros(2)
+        self.placing = False
+        self._place_move[:] = 0.0
+        self._placed[:] = False
         self.step = None
         self.steps_taken = []
         self._step_ready = 0.0
@@ -476,11 +564,13 @@ class AnchoredReference:
         balance shift, a step under way), for :meth:`restore` after a look ahead."""
         return (self.anchor_yaw, self.anchor_shift.copy(), self.balance_shift.copy(),
                 self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
-                self._slow_next, self.clock, self.rate, self.warping, self._landed)  # fmt: skip
+                self._slow_next, self.clock, self.rate, self.warping, self._landed,
+                self.placing, self._place_move.copy(), self._placed.copy())  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
-        yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed = memory
+        (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
+         place_move, placed) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -492,3 +582,6 @@ class AnchoredReference:
         self.clock = clock  # type: ignore[assignment]
         self.rate, self.warping = float(rate), bool(warping)  # type: ignore[arg-type]
         self._landed = landed  # type: ignore[assignment]
+        self.placing = bool(placing)
+        self._place_move[:] = place_move  # type: ignore[call-overload]
+        self._placed[:] = placed  # type: ignore[call-overload]

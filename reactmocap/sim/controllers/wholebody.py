@@ -38,6 +38,8 @@ _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 _UP = np.array([[0.0], [0.0], [1.0]])
 # largest acceleration a swinging foot's rows ask for (m/s^2, and rad/s^2 for its tilt)
 _SWING_ACC = 100.0
+# a walk's push within this angle of sideways (tan 30 deg) places its swing feet
+_PLACE_SIDE_TAN = float(np.tan(np.radians(30.0)))
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
 # r @ _LEVI_CIVITA, reshaped (3, 3), is -[r]x (the cross-product matrix's negative)
 _LEVI_CIVITA = np.array(
@@ -177,6 +179,13 @@ class WholeBodyTracker(AnchoredReference):
             slower than 1), so the steps come as fast as the pushed body needs
             and, the clip a little slower than the body, the body sheds the extra speed and the
             rate comes back to 1 (0: off; ``docs/tracking.md``).
+        place_pushed: after a sideways walk's push (within 30 deg of the side), a swinging
+            foot on the side the body falls to lands ``place_pushed`` times the sideways gap
+            between the simulated and the mocap's capture point, grown to the mocap's landing
+            (a linear inverted pendulum), further out (at most 0.6 m outside the stance foot;
+            only past ``place_deadband``, while the clip walks away from that side and the
+            capture point is past the stance foot; the pelvis lowered so the leg reaches;
+            0: off; ``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -247,6 +256,7 @@ class WholeBodyTracker(AnchoredReference):
         place_deadband: float = 0.15,
         place_height: float = 0.03,
         warp_gain: float = 0.0,
+        place_pushed: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -274,7 +284,8 @@ class WholeBodyTracker(AnchoredReference):
                 "step_short": step_short,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
-                "place_height": place_height, "warp_gain": warp_gain, "torque_limit": torque_limit,
+                "place_height": place_height, "warp_gain": warp_gain, "place_pushed": place_pushed,
+                "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -383,6 +394,7 @@ class WholeBodyTracker(AnchoredReference):
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
             warp_gain=warp_gain, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
+            place_pushed=place_pushed,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
@@ -645,7 +657,7 @@ class WholeBodyTracker(AnchoredReference):
         ``trunk_band`` m from the mocap's; back linearly over ``trunk_give`` s after. A walk
         pushed gets the softer pelvis servo (``kp_root_pushed``)."""
         if not ((self._w_trunk and self._give) or self._w_hip or self.warp_gain
-                or self._step_pushed):  # fmt: skip
+                or self._step_pushed or self.place_pushed):  # fmt: skip
             return self._w_trunk
         # into a buffer: this runs every control tick
         np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
@@ -658,6 +670,13 @@ class WholeBodyTracker(AnchoredReference):
         if pushing and not self._pushed and not standing:
             # a walk pushed: its clip follows the body's speed (``warp_gain``)
             self.warping = self.warp_gain > 0
+            # and a sideways push places its swing feet (``place_pushed``): placing them after
+            # a diagonal one lost more front-right pushes than it caught
+            heading = self.sole_heading()
+            f = self._xfrc[:, :2].sum(axis=0)
+            along = abs(np.cos(heading) * f[0] + np.sin(heading) * f[1])
+            side = abs(np.cos(heading) * f[1] - np.sin(heading) * f[0])
+            self.placing = self.place_pushed > 0 and along < _PLACE_SIDE_TAN * side
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
                 self.kp[:3] = self._kp_root_pushed
