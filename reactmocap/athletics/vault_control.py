@@ -214,6 +214,7 @@ class Vault(Basis):
 
         # -------------------------------------------------------------- horse contact
         def horse_enter(_w: World, t: float) -> None:
+            t_in["horse"] = t
             seen["horse"] = 0
             seen["blocked"] = False
             if p.arm_spring > 0:
@@ -243,10 +244,6 @@ class Vault(Basis):
                 goal = {_J[f"{s}_elbow"]: (0.0, 0.0, 0.0) for s in "lr"}
                 goal |= {_J[f"{s}_shoulder"]: (p.block_shoulder, 0.0, 0.0) for s in "lr"}
                 pose(goal, p.block_s, t)
-
-        def horse_enter2(w: World, t: float) -> None:
-            t_in["horse"] = t
-            horse_enter(w, t)
 
         def left_horse(_w: World, _t: float, t_in_state: float) -> bool:
             return t_in_state > 0.02 and seen["horse"] >= 2
@@ -279,7 +276,7 @@ class Vault(Basis):
                   ((left_board, "flight1"), (after(0.4), "flight1"))),
             State("flight1", logged(flight1), flight1_enter,
                   ((on_horse, "horse"), (after(1.0), "flight2"))),
-            State("horse", logged(horse), horse_enter2,
+            State("horse", logged(horse), horse_enter,
                   ((left_horse, "flight2"), (after(0.6), "flight2"))),
             State("flight2", logged(flight2), flight2_enter, ((after(p.layout2), NEXT),)),
         ]  # fmt: skip
