@@ -24,7 +24,7 @@ from reactmocap.athletics.behaviours import LANDED_AFTER
 from reactmocap.athletics.machine import NEXT, Basis, Context, law
 from reactmocap.athletics.report import FALL_HEIGHT, standing_balanced
 from reactmocap.athletics.rig import joint_index, per_joint
-from reactmocap.athletics.tumble import TUMBLE_STIFFNESS
+from reactmocap.athletics.tumble import TUMBLE_STIFFNESS, composite_inertia, time_to_height
 from reactmocap.errors import ConfigError
 from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import State, after
@@ -61,6 +61,19 @@ class HandspringParams:
         snap_knees: knee flexion of the snap-down (the legs reach the floor bent, to absorb).
         snap: seconds the push and snap-down take.
         max_seconds: hand over to the landing after this long at the latest.
+        aim: the rotation (rad, backward < 0) at which the hands should meet the floor; 0:
+            off (the knees held at ``knees``). Otherwise the knees steer it in the air: the
+            rotation at contact is predicted each tick from the whole-body angular momentum
+            over the current pose's inertia and the COM's ballistic time to ``aim_height``,
+            and the knees flex ``aim_gain`` rad per rad of predicted over-shortfall about
+            ``knees`` (more flexion: less inertia, faster turning), clipped to
+            [0, ``aim_knees``]. Why: the leap's take-off speed varies with the start and the
+            hands then meet the floor early or late, where the push makes too little or
+            far too much spin.
+        aim_gain: knee flexion (rad) per rad of predicted rotation short of ``aim``.
+        aim_height: the COM height at hand contact the prediction falls to, as a fraction of
+            the standing COM height.
+        aim_knees: the most knee flexion the aim may ask for (rad).
     """
 
     arms: float = -2.9
@@ -77,6 +90,10 @@ class HandspringParams:
     snap_knees: float = 0.0
     snap: float = 0.15
     max_seconds: float = 2.0
+    aim: float = 0.0
+    aim_gain: float = 4.0
+    aim_height: float = 1.03
+    aim_knees: float = 0.9
 
     def __post_init__(self) -> None:
         for name, v in vars(self).items():
@@ -85,6 +102,16 @@ class HandspringParams:
         if self.entry <= 0 or self.snap <= 0 or self.max_seconds <= 0 or self.push_after < 0:
             raise ConfigError(
                 "handspring entry, snap and max_seconds must be > 0 and push_after >= 0"
+            )
+        if not -2.0 * math.pi <= self.aim <= 0.0:
+            raise ConfigError(
+                f"handspring aim must be in [-2 pi, 0] rad (backward < 0; 0: off), got {self.aim}"
+            )
+        if self.aim_gain < 0 or not 0.3 <= self.aim_height <= 2.0 or not 0 < self.aim_knees <= 2.0:
+            raise ConfigError(
+                f"handspring aim_gain must be >= 0, aim_height in [0.3, 2] (of the standing "
+                f"COM) and aim_knees in (0, 2] rad, got {self.aim_gain}, {self.aim_height}, "
+                f"{self.aim_knees}"
             )
 
 
@@ -137,6 +164,26 @@ class Handspring(Basis):
                 rec["last"] = t
             return bool(hands)
 
+        knees = [joint_index(f"{s}_knee") for s in "lr"]
+        bend = np.full((NJ, 3), np.nan)
+        bend[knees] = 0.0
+        bodies = np.asarray(ctx.world.characters[ctx.character].body_ids)
+
+        def aim(world: World, t: float) -> None:
+            """The knees steer the rotation at hand contact (``aim``; as the tumble's opening,
+            the rotation to come is the momentum over the current inertia times the fall)."""
+            s = ctx.sense(t)
+            h = ctx.heading0 if ctx.heading0 is not None else s.heading()
+            axis = np.array([-math.sin(h), math.cos(h), 0.0])
+            momentum = float(world.data.subtree_angmom[s.root] @ axis)
+            inertia = float(axis @ composite_inertia(world.model, world.data, bodies)[0] @ axis)
+            fall = time_to_height(ctx, p.aim_height * (ctx.standing_com or float(s.com[2])))
+            predicted = ctx.rotation + momentum / inertia * fall
+            knee = float(np.clip(p.knees + p.aim_gain * (predicted - p.aim), 0.0, p.aim_knees))
+            rec["aim_knees"] = knee
+            bend[knees, 0] = knee
+            rig.move(bend, 0.0, t, knees)
+
         def reach_enter(world: World, t: float) -> None:
             del world
             rig.set_stiffness(per_joint(TUMBLE_STIFFNESS))
@@ -179,7 +226,7 @@ class Handspring(Basis):
             return bool(ctx.sense(t).foot_contact.any())
 
         return [
-            State("reach", law(lambda w, t: None, every), reach_enter,
+            State("reach", law(aim if p.aim else lambda w, t: None, every), reach_enter,
                   ((hands_on, "support"), (feet, NEXT), (after(p.max_seconds), NEXT))),
             State("support", law(support, every), support_enter,
                   ((released, NEXT), (after(p.max_seconds), NEXT))),
@@ -219,6 +266,8 @@ def handspring_report(
         "hands_last_contact_s": last,
         "handspring_push_s": rec["push"],
         "handspring_other_contacts": sorted(rec["others"]),
+        # the knees' flexion the aim (HandspringParams.aim) last asked for in the air
+        "handspring_aim_knees": rec.get("aim_knees"),
         "fell": fell,
         "landed": bool(landed),
     }
