@@ -31,6 +31,7 @@ __all__ = [
     "dive_maneuver",
     "HANDSPRING_BODY_PRESET",
     "HANDSPRING_PRESET",
+    "HANDSPRING_SECONDS",
     "handspring",
     "handspring_maneuver",
     "somersault",
@@ -368,14 +369,25 @@ HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
 #: stiffer, more damped knees, which stop the legs bouncing her back into the air
 HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, float]]] = MappingProxyType({
     # the male's landing scales its delta by the spin the push left (LandingParams.spin_ref:
-    # the spin at the nominal's release), 2026-12-03
-    "male": MappingProxyType({"land": MappingProxyType({"spin_ref": -96.8})}),
+    # the spin at the nominal's release, 2026-12-03). Since 2026-12-03 his knees aim the
+    # hands' contact at -196 deg (HandspringParams.aim) about a 0.4 rad bend, on a leap that
+    # falls a little short for it (spin_limit 1.3: -76 kg m^2/s), and his feet land farther back
+    "male": MappingProxyType({
+        "leap": MappingProxyType({"spin_limit": 1.3}),
+        "handspring": MappingProxyType({"aim": -3.42, "knees": 0.4}),
+        "land": MappingProxyType({"delta": -0.55, "spin_ref": -96.8}),
+    }),
     "female": MappingProxyType({
         "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 2.0}),
         "land": MappingProxyType({"delta": -0.6, "swing_cap": 0.97, "knee_stiffness": 1.0,
                                   "damping": 2.0}),
     }),
 })  # fmt: skip
+
+
+#: seconds a body's handspring is simulated (others 5.0): the male's aimed contact touches
+#: down later and stands up ~0.4 s later (2026-12-03)
+HANDSPRING_SECONDS: Mapping[str, float] = MappingProxyType({"male": 5.5})
 
 
 def handspring_maneuver(body: str = "male") -> Maneuver:
@@ -385,10 +397,12 @@ def handspring_maneuver(body: str = "male") -> Maneuver:
     the male one aims its leap at the male's angular momentum scaled by its layout inertia
     (the same spin rate); that is untuned and its report says what happened."""
     leap = dict(HANDSPRING_PRESET["leap"])
+    hands = dict(HANDSPRING_PRESET["handspring"])
     land = dict(HANDSPRING_PRESET["land"])
     own = HANDSPRING_BODY_PRESET.get(body)
     if own is not None:
         leap.update(own.get("leap", {}))
+        hands.update(own.get("handspring", {}))
         land.update(own.get("land", {}))
     elif body != "male":
         ratio = somersault_inertia(athlete(body), "layout") / somersault_inertia(
@@ -398,11 +412,11 @@ def handspring_maneuver(body: str = "male") -> Maneuver:
     phases = (
         TIMED_START,
         Phase("leap", "liftoff", leap),
-        Phase("handspring", "released", dict(HANDSPRING_PRESET["handspring"])),
+        Phase("handspring", "released", hands),
         Phase("land", "settled", land),
         Phase("balance", "never", {"settle": 2.0}),
     )
-    return Maneuver("back_handspring", phases, body, 5.0)
+    return Maneuver("back_handspring", phases, body, HANDSPRING_SECONDS.get(body, 5.0))
 
 
 def handspring(

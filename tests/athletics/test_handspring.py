@@ -15,7 +15,7 @@ import pytest
 
 from reactmocap.athletics.handspring import HandspringParams
 from reactmocap.athletics.land import LandingParams
-from reactmocap.athletics.maneuvers import Perturbation, load_maneuver, run_maneuver
+from reactmocap.athletics.maneuvers import Maneuver, Perturbation, load_maneuver, run_maneuver
 from reactmocap.athletics.routines import handspring, handspring_maneuver
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError
@@ -40,6 +40,10 @@ def test_bad_handspring_parameters_are_config_errors() -> None:
             LandingParams(swing_cap=cap)
     with pytest.raises(ConfigError, match="spin_ref"):
         LandingParams(spin_ref=float("inf"))
+    with pytest.raises(ConfigError, match=r"aim must be in \[-2 pi, 0\]"):
+        HandspringParams(aim=0.5)
+    with pytest.raises(ConfigError, match="aim_knees"):
+        HandspringParams(aim=-3.4, aim_knees=0.0)
 
 
 def test_the_hands_carry_the_body_past_inverted_and_the_report_matches_the_log() -> None:
@@ -100,23 +104,69 @@ def test_the_female_handspring_lands_on_feet_placed_past_the_default_hip_swing()
     assert capped["landed"] is False and capped["fell"] is True
 
 
-def test_the_landing_places_the_feet_by_the_spin_the_push_left() -> None:
-    """Start 3 of the capture region's tenth-size starts (seed 0): the push leaves -99.7
-    kg m^2/s at touchdown against the nominal's -96, too much for the fixed delta (it turned
-    on over its feet to -397 deg and fell); with the delta scaled by the spin measured as the
-    landing begins (``spin_ref``, the file since 2026-12-03) the feet land farther back and it
-    stands."""
+def _starts(scale: float, n: int) -> list[Perturbation]:
+    """The first ``n`` of the capture region's starts (seed 0) at ``scale`` of the benchmark's
+    distribution, written as it writes it (the same floats)."""
     rng = np.random.default_rng(0)
-    # the benchmark's tenth-size distribution, written as it writes it (the same floats)
-    tenth = {"joint_sd": math.radians(3.0) * 0.1, "pitch_sd": math.radians(2.0) * 0.1,
-             "velocity_sd": 0.05 * 0.1, "spin_sd": 0.1 * 0.1}  # fmt: skip
-    start = [Perturbation.sample(rng, **tenth) for _ in range(4)][3]
-    m = load_maneuver(EXAMPLE)
+    sd = {"joint_sd": math.radians(3.0) * scale, "pitch_sd": math.radians(2.0) * scale,
+          "velocity_sd": 0.05 * scale, "spin_sd": 0.1 * scale}  # fmt: skip
+    return [Perturbation.sample(rng, **sd) for _ in range(n)]
+
+
+def _with(m: Maneuver, controller: str, params: dict[str, float]) -> Maneuver:
+    """``m`` with ``controller``'s phase parameters replaced by ``params``."""
+    phases = tuple(replace(ph, params=params) if ph.controller == controller else ph
+                   for ph in m.phases)  # fmt: skip
+    return replace(m, phases=phases)
+
+
+#: the file as it was before the knees' aim (2026-12-03): the leap's feedback allowed 1.5 rad,
+#: the knees straight in the air, the feet 45 cm behind the capture point, 5.0 s
+BEFORE_AIM = {
+    "leap": {"effort": 0.6, "spin": -110.0, "spin_limit": 1.5, "com_offset": -0.1},
+    "handspring": {"give": 0.5, "push_after": 0.06, "push": -2.65, "snap_hips": -1.2,
+                   "snap_trunk": 0.5, "snap_knees": 0.6, "snap": 0.1},
+    "land": {"delta": -0.45, "spin_ref": -96.8},
+}  # fmt: skip
+
+
+def test_the_landing_places_the_feet_by_the_spin_the_push_left() -> None:
+    """Start 3 of the capture region's tenth-size starts (seed 0), on the file before the
+    knees' aim: the push leaves -99.7 kg m^2/s at touchdown against the nominal's -96, too
+    much for the fixed delta (it turned on over its feet to -397 deg and fell); with the delta
+    scaled by the spin measured as the landing begins (``spin_ref``) the feet land farther
+    back and it stands."""
+    start = _starts(0.1, 4)[3]
+    m = replace(load_maneuver(EXAMPLE), seconds=5.0)
+    for controller, params in BEFORE_AIM.items():
+        m = _with(m, controller, params)
     land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
-    assert m.phases[land].params["spin_ref"] == -96.8
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 45.0
     phases = list(m.phases)
     phases[land] = replace(phases[land], params={"delta": -0.45})
     old = run_maneuver(replace(m, phases=tuple(phases)), perturbation=start, fps=10.0).report
     assert old["fell"] and not old["landed"]
+
+
+def test_the_knees_aim_the_hands_contact_at_the_rotation_the_push_needs() -> None:
+    """Full-size starts 2 and 12 (seed 0): start 2 leaps high and would meet the floor late
+    (-203.6 deg with the knees held at the file's 0.4 rad), start 12 leaps with too little
+    spin and early (-174.4 deg); both fall so. With the knees steering the rotation predicted
+    at contact (``aim``, the file since 2026-12-03) start 2 straightens them, start 12 bends
+    them, both meet the floor within 15 deg of the aimed -196 deg and land."""
+    starts = _starts(1.0, 13)
+    m = load_maneuver(EXAMPLE)
+    hands = next(p for p in m.phases if p.controller == "handspring").params
+    assert hands["aim"] == -3.42
+    held = _with(m, "handspring", {k: v for k, v in hands.items() if k != "aim"})
+    for i, late in ((2, True), (12, False)):
+        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 45.0
+        assert abs(r["rotation_at_hands_deg"] + 196.0) <= 15.0
+        knees = r["handspring_aim_knees"]
+        assert knees < 0.4 if late else knees > 0.4
+        off = run_maneuver(held, perturbation=starts[i], fps=10.0).report
+        assert off["fell"] and not off["landed"] and off["handspring_aim_knees"] is None
+        h = off["rotation_at_hands_deg"]
+        assert h < -199.0 if late else h > -185.0
