@@ -65,9 +65,9 @@ class HandspringParams:
             off (the knees held at ``knees``). Otherwise the knees steer it in the air: the
             rotation at contact is predicted each tick from the whole-body angular momentum
             over the current pose's inertia and the COM's ballistic time to ``aim_height``,
-            and the knees flex ``aim_gain`` rad per rad of predicted over-shortfall about
-            ``knees`` (more flexion: less inertia, faster turning), clipped to
-            [0, ``aim_knees``]. Why: the leap's take-off speed varies with the start and the
+            and the knees flex about ``knees`` by ``aim_gain`` rad per rad that the
+            prediction falls short of ``aim`` (straighten as it runs past; more flexion:
+            less inertia, faster turning), clipped to [0, ``aim_knees``]. Why: the leap's take-off speed varies with the start and the
             hands then meet the floor early or late, where the push makes too little or
             far too much spin.
         aim_gain: knee flexion (rad) per rad of predicted rotation short of ``aim``.
@@ -173,8 +173,7 @@ class Handspring(Basis):
             """The knees steer the rotation at hand contact (``aim``; as the tumble's opening,
             the rotation to come is the momentum over the current inertia times the fall)."""
             s = ctx.sense(t)
-            h = ctx.heading0 if ctx.heading0 is not None else s.heading()
-            axis = np.array([-math.sin(h), math.cos(h), 0.0])
+            axis = memo["axis"]
             momentum = float(world.data.subtree_angmom[s.root] @ axis)
             inertia = float(axis @ composite_inertia(world.model, world.data, bodies)[0] @ axis)
             fall = time_to_height(ctx, p.aim_height * (ctx.standing_com or float(s.com[2])))
@@ -186,6 +185,9 @@ class Handspring(Basis):
 
         def reach_enter(world: World, t: float) -> None:
             del world
+            # the somersault axis the aim measures about: the start's left-right axis
+            h = ctx.heading0 if ctx.heading0 is not None else ctx.sense(t).heading()
+            memo["axis"] = np.array([-math.sin(h), math.cos(h), 0.0])
             rig.set_stiffness(per_joint(TUMBLE_STIFFNESS))
             rig.support[:] = 0.0
             rig.offset[:] = 0.0
