@@ -161,17 +161,31 @@ def test_a_walk_pushed_sideways_places_its_outer_foot_and_stays_up(
 ) -> None:
     """The shared left-curving walk pushed 350 N (SIMBICON's figure) toward its right at the
     chest for 0.2 s at 1.5 s: with its outer (right) swing foot placed out from the capture
-    point (``place_pushed``, opt-in: the held-out walk lost 3 of 56 pushes with it) it stays up;
-    without (the whole-clip default), that foot lands where the clip puts it, 0.4-0.6 m inside
-    the capture point, and the walk falls to the right."""
+    point (``place_pushed``, the whole-clip default) it stays up; without (0), that foot lands
+    where the clip puts it, 0.4-0.6 m inside the capture point, and the walk falls to the
+    right."""
     walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, -90.0, 350.0)
 
     def push(params: dict[str, float]) -> TrackResult:
         return push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
                          seconds=2.7, params=params)  # fmt: skip
 
-    assert push({"place_pushed": 1.0}).report.status == "ok"
-    assert push({}).report.status == "fell"
+    assert push({}).report.status == "ok"
+    assert push({"place_pushed": 0.0}).report.status == "fell"
+
+
+def test_a_walk_pushed_sideways_places_only_the_step_the_push_starts(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared right-curving walk pushed 300 N toward its left at the chest for 0.2 s at
+    1.5 s: its first step after the push crosses over (no placement), the next, 0.7 s after
+    the push starts, is the clip's own wide left step. Placed too (before the placement's
+    0.5 s window), that step went out and back and the body fell forward over it; now the
+    clip's step lands and the walk stays up."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 90.0, 300.0)
+    res = push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
+                    seconds=2.7, params={"place_pushed": 1.0})  # fmt: skip
+    assert res.report.status == "ok"
 
 
 def test_convex_hull_and_distances() -> None:

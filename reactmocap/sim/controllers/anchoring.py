@@ -50,8 +50,11 @@ _WARP_TAU = 0.1
 # and placements where the clip's own sway or the walk's speed carried the error, lost more
 # pushes than they caught (``docs/tracking.md``)
 _PLACE_WIDTH = 0.6
-_PLACE_AGAINST = 0.25
+_PLACE_AGAINST = 0.3
 _PLACE_SIDEWAYS = 3.0
+# and only this long (s) after the push starts: a later swing is the clip's own step, which
+# already lands out (placing it too lost a walk's pushes toward the side its clip walks from)
+_PLACE_WINDOW = 0.5
 
 
 def _rot2(yaw: float) -> F64:
@@ -140,7 +143,9 @@ class AnchoredReference:
         self.place_shift = np.zeros(2)
         self.place_pushed = float(place_pushed)
         #: set once a walk is pushed: ``place_pushed`` then moves its swing feet's landings
+        #: until ``_place_until`` (rollout time, s)
         self.placing = False
+        self._place_until = -np.inf
         # per foot: a pushed walk's landing move (m), and whether it was moved and is still in
         # the air (kept on its moved landing while the mocap's stance flickers: its gliding
         # foot counts as planted)
@@ -341,11 +346,14 @@ class AnchoredReference:
         the stance foot), kept until the foot is down. Only sideways (the clip played faster,
         ``warp_gain``, takes the speed along the walk), only outward and only with the capture
         point past the stance foot (no crossing step), only while the clip walks away from
-        the fall's side (``docs/tracking.md``)."""
+        the fall's side, and only for ``_PLACE_WINDOW`` s after the push starts
+        (``docs/tracking.md``)."""
         d = self.world.data
         low = self._sole_corners()[:, :, 2].min(axis=1) - self.floor_z
         self._placed &= low >= self.anchor_touch  # landed
         self._place_move[:] = 0.0
+        if t > self._place_until:
+            return
         assert self.path.sole is not None
         xi, omega = self.capture_point()
         c_ref, v_ref, _ = self.com_reference(t)
@@ -542,7 +550,7 @@ class AnchoredReference:
         self.anchor_shift = np.zeros(2)
         self.balance_shift = np.zeros(2)
         self.place_shift = np.zeros(2)
-        self.placing = False
+        self.placing, self._place_until = False, -np.inf
         self._place_move[:] = 0.0
         self._placed[:] = False
         self.step = None
@@ -565,12 +573,13 @@ class AnchoredReference:
         return (self.anchor_yaw, self.anchor_shift.copy(), self.balance_shift.copy(),
                 self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
-                self.placing, self._place_move.copy(), self._placed.copy())  # fmt: skip
+                self.placing, self._place_until, self._place_move.copy(),
+                self._placed.copy())  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
-         place_move, placed) = memory  # fmt: skip
+         until, place_move, placed) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -583,5 +592,6 @@ class AnchoredReference:
         self.rate, self.warping = float(rate), bool(warping)  # type: ignore[arg-type]
         self._landed = landed  # type: ignore[assignment]
         self.placing = bool(placing)
+        self._place_until = float(until)  # type: ignore[arg-type]
         self._place_move[:] = place_move  # type: ignore[call-overload]
         self._placed[:] = placed  # type: ignore[call-overload]

@@ -21,7 +21,7 @@ from scipy.optimize import nnls
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.controllers.anchoring import AnchoredReference
+from reactmocap.sim.controllers.anchoring import _PLACE_WINDOW, AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import outside_distance
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
@@ -184,8 +184,8 @@ class WholeBodyTracker(AnchoredReference):
             between the simulated and the mocap's capture point, grown to the mocap's landing
             (a linear inverted pendulum), further out (at most 0.6 m outside the stance foot;
             only past ``place_deadband``, while the clip walks away from that side and the
-            capture point is past the stance foot; the pelvis lowered so the leg reaches;
-            0: off; ``docs/tracking.md``).
+            capture point is past the stance foot, and only in the 0.5 s after the push
+            starts; the pelvis lowered so the leg reaches; 0: off; ``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -677,6 +677,7 @@ class WholeBodyTracker(AnchoredReference):
             along = abs(np.cos(heading) * f[0] + np.sin(heading) * f[1])
             side = abs(np.cos(heading) * f[1] - np.sin(heading) * f[0])
             self.placing = self.place_pushed > 0 and along < _PLACE_SIDE_TAN * side
+            self._place_until = t + _PLACE_WINDOW
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
                 self.kp[:3] = self._kp_root_pushed
