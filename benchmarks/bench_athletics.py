@@ -410,7 +410,7 @@ def capture(workers: int, starts: int = 50) -> dict[str, Any]:
 
     out: dict[str, Any] = {}
     for name in ("back_somersault", "back_layout", "vertical_leap", "broad_jump", "dive_pike",
-                 "back_handspring", "back_handspring_female"):  # fmt: skip
+                 "back_handspring", "back_handspring_female", "forward_somersault"):  # fmt: skip
         m = load_maneuver(ROOT / "examples" / "athletics" / "maneuvers" / f"{name}.toml")
         for label, scale in (("full", 1.0), ("tenth", 0.1)):
             sd = {"joint_sd": math.radians(3.0) * scale, "pitch_sd": math.radians(2.0) * scale,
