@@ -145,14 +145,37 @@ class WorldCharacter:
     patch_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     #: first of the character's 45 servo actuators: 3 per ball joint, BALL_JOINTS order
     actuator_adr: int = -1
+    #: ``(k,)`` the toe hinges' qpos and dof addresses (none without toes)
+    toe_qpos: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
+    toe_dofs: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
+    #: ``(67,)``, ``(51,)`` the addresses of :meth:`Character.layout`
+    qpos_index: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
+    qvel_index: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
 
     @property
-    def qpos_slice(self) -> slice:
+    def qpos_slice(self) -> slice | NDArray[np.intp]:
+        """The character's 67 qpos (free joint, then the balls): a slice, or with toes (whose
+        hinges sit between the balls) their addresses."""
+        if len(self.toe_qpos):
+            return self.qpos_index
         return slice(self.qpos_adr, self.qpos_adr + 7 + 4 * len(BALL_JOINTS))
 
     @property
-    def qvel_slice(self) -> slice:
+    def qvel_slice(self) -> slice | NDArray[np.intp]:
+        """The character's 51 qvel, as :attr:`qpos_slice`."""
+        if len(self.toe_dofs):
+            return self.qvel_index
         return slice(self.dof_adr, self.dof_adr + 6 + 3 * len(BALL_JOINTS))
+
+    @property
+    def ball_dofs(self) -> NDArray[np.intp]:
+        """``(45,)`` the ball joints' dof addresses (BALL_JOINTS order)."""
+        return self.qvel_index[6:]
+
+    @property
+    def ball_qpos(self) -> NDArray[np.intp]:
+        """``(60,)`` the ball joints' qpos addresses (BALL_JOINTS order)."""
+        return self.qpos_index[7:]
 
     @property
     def ball_qpos_start(self) -> int:
@@ -241,9 +264,13 @@ class World:
             balls = [m.joint(pre + j).id for j in BALL_JOINTS]
             qadr = int(m.jnt_qposadr[root])
             dadr = int(m.jnt_dofadr[root])
-            if [int(m.jnt_qposadr[j]) for j in balls] != [qadr + 7 + 4 * i for i in range(15)]:
-                raise SimulationError("ball joints are not contiguous in qpos (internal error)")
-            geoms = np.flatnonzero(np.isin(m.geom_bodyid, ids))
+            layout = ch.layout()
+            if [int(m.jnt_qposadr[j]) for j in balls] != list(qadr + layout[0][7::4]):
+                raise SimulationError(
+                    "ball joints are not where the character has them (internal error)"
+                )
+            toe_ids = np.array([m.body(pre + name).id for name, _, _ in ch.toes], dtype=np.int64)
+            geoms = np.flatnonzero(np.isin(m.geom_bodyid, np.r_[ids, toe_ids]))
             feet = [m.body(f"{pre}{side}_foot").id for side in "lr"]
             patches = [m.geom(f"{pre}{side}_foot_ball").id for side in "lr"]
             soles = [
@@ -271,6 +298,10 @@ class World:
                     actuator_adr=acts[0],
                     sole_ids=np.array(soles, dtype=np.int64),
                     patch_ids=np.array(patches, dtype=np.int64),
+                    toe_qpos=(qadr + layout[2]).astype(np.intp),
+                    toe_dofs=(dadr + layout[3]).astype(np.intp),
+                    qpos_index=(qadr + layout[0]).astype(np.intp),
+                    qvel_index=(dadr + layout[1]).astype(np.intp),
                 )
             )
         char = np.full(m.ngeom, -1, dtype=np.int64)
@@ -280,6 +311,10 @@ class World:
                 sel = m.geom_bodyid == bid
                 char[sel] = wc.index
                 body[sel] = i
+            for name, foot, _ in wc.character.toes:  # a toe's geoms count as its foot's
+                sel = m.geom_bodyid == m.body(wc.prefix + name).id
+                char[sel] = wc.index
+                body[sel] = SIM_BODIES.index(foot)
         char.flags.writeable = False
         body.flags.writeable = False
         #: ``(ngeom,)`` the character each geom belongs to (-1: the floor)
@@ -323,7 +358,7 @@ class World:
         """Light damping scaled by each DOF's outboard inertia in the reference pose."""
         m, d, cfg = self.model, self.data, self.config
         for wc in self.characters:
-            d.qpos[wc.qpos_slice] = wc.character.model.qpos0
+            d.qpos[wc.qpos_adr : wc.qpos_adr + wc.character.model.nq] = wc.character.model.qpos0
         # the mass matrix only: no collision pass (characters all at their origin would touch)
         mujoco.mj_kinematics(m, d)
         mujoco.mj_comPos(m, d)
@@ -331,7 +366,7 @@ class World:
         diag = np.empty(m.nv)
         diag[:] = d.M[m.M_rowadr + m.M_rownnz - 1]  # diagonal = last entry of each CSR row
         for wc in self.characters:
-            dofs = np.arange(wc.ball_dof_start, wc.ball_dof_start + 3 * len(BALL_JOINTS))
+            dofs = wc.ball_dofs
             m.dof_damping[dofs] = cfg.joint_damping * diag[dofs]
         m.jnt_solref[:] = cfg.limit_solref
         mujoco.mj_resetData(m, d)
@@ -405,6 +440,8 @@ class World:
             raise SimulationError(f"qpos must be 67 finite numbers, got shape {qpos.shape}")
         self.data.qpos[wc.qpos_slice] = qpos
         self.data.qvel[wc.qvel_slice] = 0.0 if qvel is None else qvel
+        self.data.qpos[wc.toe_qpos] = 0.0  # toes at rest
+        self.data.qvel[wc.toe_dofs] = 0.0
         self.state_epoch += 1
         mujoco.mj_forward(self.model, self.data)
 

@@ -24,6 +24,7 @@ from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.anchoring import AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import outside_distance
+from reactmocap.sim.feet import box_corners, sole_corners_world
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
@@ -318,7 +319,15 @@ class WholeBodyTracker(AnchoredReference):
         ]
         self._kp0, self._kv0 = self.kp.copy(), self.kv.copy()
         self._w_root = float(root_weight)
-        self._root_rows = np.eye(6, NV) * self._w_root
+        # a toed character's toe hinges are unactuated like the pelvis: the program's dofs are
+        # the pelvis's 6, the toes' k, then the joints' 45 (``_dofs`` in that order); its
+        # results go back to the 51 of the reference (``_ref``) (None: no toes, as MuJoCo has it)
+        k_toes = len(wc.toe_dofs)
+        self._nu = 6 + k_toes
+        self._ref: NDArray[np.intp] | None = None
+        if k_toes:
+            self._ref = np.r_[np.arange(6), self._nu + np.arange(3 * NJ)].astype(np.intp)
+        self._root_rows = np.eye(6, NV + k_toes) * self._w_root
         self._free = np.zeros(0, dtype=bool)  # the last NNLS solution's positive coefficients
         self._wj = np.ones(3 * NJ)
         self._w_trunk = float(trunk_weight)
@@ -350,7 +359,16 @@ class WholeBodyTracker(AnchoredReference):
         self.mu = float(friction) * float(world.config.friction)
         self.touch = float(touch)
         self.sqrt_reg = float(np.sqrt(force_reg))
-        self._dofs = wc.qvel_slice
+        self._dofs: slice | NDArray[np.intp] = wc.qvel_slice
+        self._msel: tuple[slice | NDArray[np.intp], ...] = (self._dofs, self._dofs)
+        self._acc = np.zeros(NV + k_toes)  # the desired accelerations in the program's order
+        if k_toes:
+            qv = wc.qvel_index
+            self._dofs = np.r_[qv[:6], wc.toe_dofs, qv[6:]].astype(np.intp)
+            self._msel = np.ix_(self._dofs, self._dofs)
+            self._toes = [int(m.body(wc.prefix + name).id) for name, _, _ in wc.character.toes]
+            self._toe_geoms = np.array([np.flatnonzero(m.geom_bodyid == b)[0] for b in self._toes])
+            self._toe_corners = box_corners(m, self._toe_geoms)
         self._full = np.zeros((m.nv, m.nv))
         # translation rows over rotation rows, filled by mj_jac / mj_jacDot through views
         self._jac6 = np.zeros((6, m.nv))
@@ -424,11 +442,8 @@ class WholeBodyTracker(AnchoredReference):
         """The contact model at the current state: the sole corners MuJoCo has in contact that
         the mocap holds down (``held`` ``(2, 4)``), or the ball patch of a pivoting foot, of
         the feet planted in the mocap."""
-        m = self.world.model
         corners = self._sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
-        sl = self._dofs
-        qdot = d.qvel[sl]
         feet: list[int] = []
         gens: list[F64] = []  # (nb_f, ndof) the generators as generalised forces
         bases: list[F64] = []  # (nb_f, 3) world force per unit coefficient
@@ -437,70 +452,57 @@ class WholeBodyTracker(AnchoredReference):
         rows: list[F64] = []
         bias: list[F64] = []
         k0 = 0
+        toe_corners = (
+            sole_corners_world(d, self._toe_geoms, self._toe_corners) if self._ref is not None
+            else None
+        )  # fmt: skip
         for f in range(2):
             if not planted[f]:
                 continue
+            # (body, points, basis, owner, still, patch): the foot's, then its toe's
+            groups: list[tuple[int, F64, F64, NDArray[np.int64], int, bool]] = []
             if patch_on[f]:
                 rot = d.geom_xmat[self.patch[f]].reshape(3, 3)
                 p = d.geom_xpos[self.patch[f]] - rot[:, 2] * self.patch_half[f]  # bottom face
                 low = p[2] - self.patch_half[f] * np.abs(rot[2, :2]).sum()  # its lowest corner
-                if low - self.floor_z >= self.touch:
-                    continue
-                axes = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, :2].T.copy()
-                axes[:, 2] = 0.0  # the centre-of-pressure range lies on the floor
-                axes /= np.linalg.norm(axes, axis=1, keepdims=True)
-                # the patch's centre holds still (pyramid), its centre-of-pressure corners push
-                p_f = np.concatenate([p[None], p + self.patch_arm[f] * (_PATCH_SIGNS @ axes)])
-                basis, owner, still = self._patch_basis, _PATCH_OWNER, 1
+                if low - self.floor_z < self.touch:
+                    axes = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, :2].T.copy()
+                    axes[:, 2] = 0.0  # the centre-of-pressure range lies on the floor
+                    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+                    # the patch's centre holds still (pyramid), its centre-of-pressure corners
+                    # push
+                    p_f = np.concatenate([p[None], p + self.patch_arm[f] * (_PATCH_SIGNS @ axes)])
+                    groups.append(
+                        (int(self.feet[f]), p_f, self._patch_basis, _PATCH_OWNER, 1, True)
+                    )
             else:
                 touching = corners[f, :, 2] - self.floor_z < self.touch
-                if not touching.any():
-                    continue
-                if (touching & held[f]).any():
-                    touching &= held[f]
-                p_f = corners[f, touching]
-                k = len(p_f)
-                basis, owner, still = self._corner_basis[:k], self._corner_owner[: 4 * k], k
+                if touching.any():
+                    if (touching & held[f]).any():
+                        touching &= held[f]
+                    p_f = corners[f, touching]
+                    k = len(p_f)
+                    groups.append((int(self.feet[f]), p_f, self._corner_basis[:k],
+                                   self._corner_owner[: 4 * k], k, False))  # fmt: skip
+            if toe_corners is not None:
+                # the toe's corners on the floor, on the toe body: its hinge is in the program
+                touching = toe_corners[f, :, 2] - self.floor_z < self.touch
+                if touching.any():
+                    p_f = toe_corners[f, touching]
+                    k = len(p_f)
+                    groups.append((self._toes[f], p_f, self._corner_basis[:k],
+                                   self._corner_owner[: 4 * k], k, False))  # fmt: skip
+            if not groups:
+                continue
             feet.append(f)
-            # every point of the foot from the foot's Jacobians at its origin (two calls, not
-            # two per point): a point r from it moves at v + w x r and accelerates (qdd = 0) at
-            # a + alpha x r + w x (w' x r), w' the body's velocity of MuJoCo's last forward
-            # pass (``cvel``), as ``mj_jacDot`` has it (with w' = w, results moved: a whole walk
-            # drifted 1.1 m instead of 0.45 m)
-            body = int(self.feet[f])
-            o = d.xpos[body]
-            mujoco.mj_jac(m, d, self._jacp, self._jacr, o, body)
-            mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, o, body)
-            jr = self._jac6[3:, sl]
-            w = jr @ qdot
-            acc0 = self._jacd6[:, sl] @ qdot  # (a, alpha) of the origin
-            r = p_f - o
-            neg_skew = (r @ _LEVI_CIVITA).reshape(-1, 3, 3)  # -[r]x: r x u = -neg_skew u
-            jac = self._jac6[:3, sl] + neg_skew @ jr  # (k, 3, ndof)
-            pts.append(p_f)
-            bases.append(basis.reshape(-1, 3))
-            owners.append(owner + k0)
-            k0 += len(p_f)
-            rows.append(jac[:still].reshape(-1, jac.shape[-1]))
-            rs = r[:still]
-            w_old = d.cvel[body, :3]
-            # w x (w' x r) = w' (w . r) - r (w . w')
-            acc = (
-                acc0[:3] + neg_skew[:still] @ acc0[3:] + np.outer(rs @ w, w_old) - rs * (w @ w_old)
-            )
-            bias.append(acc.reshape(-1))
-            if patch_on[f]:  # its centre's pyramid, its corners' upward pushes
-                gens.append(self._edges.T @ jac[0])
-                gens.append(jac[1:, 2])
-                # the foot does not roll or pitch on its patch; its yaw is free
-                rows.append(jr[:2].copy())  # the buffer is the next foot's
-                bias.append(acc0[3:5])
-            else:  # corners: one pyramid each
-                gens.append((self._edges.T @ jac).reshape(-1, jac.shape[-1]))
+            for body, p_f, basis, owner, still, patch in groups:
+                k0 = self._contact_rows(d, body, p_f, basis, owner, still, patch, k0,
+                                        (pts, bases, owners, rows, bias, gens))  # fmt: skip
         if not feet:
+            nv = len(self._acc)
             z = np.zeros((0, 3))
             return _Support(
-                (), z, z, np.zeros(0, np.int64), np.zeros((NV, 0)), np.zeros((0, NV)), np.zeros(0)
+                (), z, z, np.zeros(0, np.int64), np.zeros((nv, 0)), np.zeros((0, nv)), np.zeros(0)
             )
         return _Support(
             feet=tuple(feet),
@@ -511,6 +513,57 @@ class WholeBodyTracker(AnchoredReference):
             rows=np.concatenate(rows),
             bias=np.concatenate(bias),
         )
+
+    def _contact_rows(
+        self,
+        d: mujoco.MjData,
+        body: int,
+        p_f: F64,
+        basis: F64,
+        owner: NDArray[np.int64],
+        still: int,
+        patch: bool,
+        k0: int,
+        out: tuple[list[F64], list[F64], list[NDArray[np.int64]], list[F64], list[F64], list[F64]],
+    ) -> int:
+        """Appends one body's contact points ``p_f`` to ``out`` (points, bases, owners, rows,
+        bias, generators; see :meth:`_support`); returns the next point's number."""
+        m, sl = self.world.model, self._dofs
+        qdot = d.qvel[sl]
+        pts, bases, owners, rows, bias, gens = out
+        # every point of the foot from the foot's Jacobians at its origin (two calls, not
+        # two per point): a point r from it moves at v + w x r and accelerates (qdd = 0) at
+        # a + alpha x r + w x (w' x r), w' the body's velocity of MuJoCo's last forward
+        # pass (``cvel``), as ``mj_jacDot`` has it (with w' = w, results moved: a whole walk
+        # drifted 1.1 m instead of 0.45 m)
+        o = d.xpos[body]
+        mujoco.mj_jac(m, d, self._jacp, self._jacr, o, body)
+        mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, o, body)
+        jr = self._jac6[3:, sl]
+        w = jr @ qdot
+        acc0 = self._jacd6[:, sl] @ qdot  # (a, alpha) of the origin
+        r = p_f - o
+        neg_skew = (r @ _LEVI_CIVITA).reshape(-1, 3, 3)  # -[r]x: r x u = -neg_skew u
+        jac = self._jac6[:3, sl] + neg_skew @ jr  # (k, 3, ndof)
+        pts.append(p_f)
+        bases.append(basis.reshape(-1, 3))
+        owners.append(owner + k0)
+        k0 += len(p_f)
+        rows.append(jac[:still].reshape(-1, jac.shape[-1]))
+        rs = r[:still]
+        w_old = d.cvel[body, :3]
+        # w x (w' x r) = w' (w . r) - r (w . w')
+        acc = acc0[:3] + neg_skew[:still] @ acc0[3:] + np.outer(rs @ w, w_old) - rs * (w @ w_old)
+        bias.append(acc.reshape(-1))
+        if patch:  # its centre's pyramid, its corners' upward pushes
+            gens.append(self._edges.T @ jac[0])
+            gens.append(jac[1:, 2])
+            # the foot does not roll or pitch on its patch; its yaw is free
+            rows.append(jr[:2].copy())  # the buffer is the next foot's
+            bias.append(acc0[3:5])
+        else:  # corners: one pyramid each
+            gens.append((self._edges.T @ jac).reshape(-1, jac.shape[-1]))
+        return k0
 
     def plan(self, t: float) -> WholeBodyPlan:
         """Solve the tracking program at rollout time ``t`` for the current state (MuJoCo's
@@ -526,23 +579,33 @@ class WholeBodyTracker(AnchoredReference):
         np.copyto(self._qref, d.qpos)
         self._qref[self.wc.qpos_slice] = qr
         mujoco.mj_differentiatePos(m, self._dq, 1.0, d.qpos, self._qref)
-        acc_des = ar + self.kp * self._dq[sl] + self.kv * (vr - v)
+        dq = self._dq[sl]
+        ref, nu = self._ref, self._nu
+        if ref is not None:  # the reference's 51 of the program's order
+            v, dq = v[ref], dq[ref]
+        acc_des = ar + self.kp * dq + self.kv * (vr - v)
         acc_des[:6] += self.root_bias
+        if ref is not None:  # the toes: no target (unactuated, their rows come from dynamics)
+            self._acc[ref] = acc_des
+            acc_des, v = self._acc, d.qvel[sl]
 
         mujoco.mj_fullM(m, d, self._full)
-        big_m = self._full[sl, sl]
+        big_m = self._full[self._msel]
         # gravity and Coriolis; MuJoCo's passive joint damping is left out of the plan on
         # purpose, so it acts as extra damping (compensating it, first version: 50% of the benchmark windows
         # tracked instead of 64%)
         h = d.qfrc_bias[sl]
+        if ref is not None:  # but the toe hinges' spring and damper are their only torque
+            h[6:nu] -= d.qfrc_passive[self.wc.toe_dofs]
         sup = self._support(d, planted, held)
         nc = len(sup.points)
         qb = sup.gen
         nb = qb.shape[1]
         nj = 3 * NJ
         # unknowns: the joint accelerations y (45) and the pyramid coefficients beta (nb); the
-        # pelvis follows from its Newton-Euler equation, qdd_root = r_0 + r_b beta - r_y y
-        _, sol, info = dposv(big_m[:6, :6], np.column_stack([big_m[:6, 6:], qb[:6], h[:6]]))
+        # pelvis (and any toes) follow from their Newton-Euler equations,
+        # qdd_root = r_0 + r_b beta - r_y y
+        _, sol, info = dposv(big_m[:nu, :nu], np.column_stack([big_m[:nu, nu:], qb[:nu], h[:nu]]))
         if info:
             raise SimulationError(f"WholeBodyTracker: singular pelvis inertia at t = {t:.4f} s")
         r_y, r_b, r_0 = sol[:, :nj], sol[:, nj:-1], -sol[:, -1]
@@ -558,7 +621,7 @@ class WholeBodyTracker(AnchoredReference):
             if hip:
                 # bounded: it fades as the trunk (pelvis, waist, back) turns ``hip_tilt`` rad
                 # off the mocap, so the joint rows bring it back before it folds
-                turn = self._dq[sl][3:12].reshape(3, 3)
+                turn = dq[3:12].reshape(3, 3)
                 hip *= max(0.0, 1.0 - float(np.linalg.norm(turn, axis=1).sum()) / self._hip_tilt)
             root_rows, root_target = self._root_rows, self._w_root * acc_des[:6]
             if hip:
@@ -598,15 +661,15 @@ class WholeBodyTracker(AnchoredReference):
                 wj[self._leg_rows[1 - self.step.foot]] = 0.3
         for f, (p_d, v_d, a_d, up_d) in swing.items():
             tasks.append(self._swing_task(f, v, p_d, v_d, a_d, up_d))
-        a = acc_des[6:]
+        a = acc_des[nu:]
         beta = np.zeros(0)
         if not tasks:
             y = a.copy()
         else:
             # the rows P qdd - target = U y + V beta - c, with the pelvis's row of qdd from sol
             pmat = np.concatenate([task[0] for task in tasks])
-            x = pmat[:, :6] @ sol
-            u = pmat[:, 6:] - x[:, :nj]
+            x = pmat[:, :nu] @ sol
+            u = pmat[:, nu:] - x[:, :nj]
             vb = x[:, nj:-1]
             c = np.concatenate([task[1] for task in tasks]) + x[:, -1]
             if hip:
@@ -640,15 +703,18 @@ class WholeBodyTracker(AnchoredReference):
                 e0 = e0 + vb @ beta
             z, _ = dpotrs(chol, e0, lower=1)
             y = a - ud.T @ z
-        qdd = np.empty(NV)
-        qdd[6:] = y
-        qdd[:6] = r_0 + r_b @ beta - r_y @ y
-        tau = big_m[6:] @ qdd + h[6:] - qb[6:] @ beta
+        qdd = np.empty(len(acc_des))
+        qdd[nu:] = y
+        qdd[:nu] = r_0 + r_b @ beta - r_y @ y
+        tau = big_m[nu:] @ qdd + h[nu:] - qb[nu:] @ beta
         forces = np.zeros((nc, 3))
         np.add.at(forces, sup.owner, sup.basis * beta[:, None])
+        gen = qb @ beta
+        if ref is not None:
+            qdd, acc_des, gen = qdd[ref], acc_des[ref], gen[ref]
         return WholeBodyPlan(
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
-            forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
+            forces=forces, desired_qacc=acc_des, generalized_contact=gen,
         )  # fmt: skip
 
     def _push_response(self, t: float) -> float:
