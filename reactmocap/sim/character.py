@@ -209,6 +209,16 @@ class Character:
                     fromto=list(g.fromto or ()),
                     density=rho,
                 )
+            elif g.outline:
+                body.add_geom(
+                    name=f"{g.body}_sole",
+                    type=mujoco.mjtGeom.mjGEOM_BOX,
+                    size=size,
+                    pos=list(g.pos),
+                    quat=list(g.quat),
+                    density=0.0,
+                    group=PATCH_GEOM_GROUP,
+                )
             elif g.patch:
                 body.add_geom(
                     name=f"{g.body}_ball",
@@ -446,9 +456,9 @@ class Character:
         return np.linalg.norm(d.xpos[ids] - lib, axis=1)
 
     def toe_fk_errors(self, motion: Motion, frame: int = 0) -> F64:
-        """``(k,)`` distance (m) between each toe body's tip (the end of its sole box, at the
-        hinge angle of :meth:`toe_angles`) in MuJoCo and the same point carried rigidly by
-        the skeleton's toe joint, for one frame: how well the hinge follows the clip's toes."""
+        """``(k,)`` angle (rad) between each toe body's orientation in MuJoCo, at the hinge
+        angles of :meth:`toe_angles`, and the skeleton's toe joint, for one frame: what the
+        hinge cannot follow of the clip's toes (their turn off the hinge axis)."""
         self._check_motion(motion)
         m = self.model
         d = mujoco.MjData(m)
@@ -456,15 +466,11 @@ class Character:
         d.qpos[qi] = self.qpos_from_motion(motion, [frame])[0]
         d.qpos[ti] = self.toe_angles(motion, [frame])[0]
         mujoco.mj_kinematics(m, d)
-        pos, rot = _take_frames(motion, np.array([frame])).forward_kinematics()
+        _, rot = _take_frames(motion, np.array([frame])).forward_kinematics()
         out = np.zeros(len(self.toes))
         for k, (name, _, _) in enumerate(self.toes):
-            b = m.body(name).id
-            g = next(g for g in self.geoms if g.body == name)
-            tip = np.asarray(g.pos) + quat_rotate(np.asarray(g.quat), np.array([g.size[0], 0, 0]))
-            sim = d.xpos[b] + d.xmat[b].reshape(3, 3) @ tip
-            j = self.parts.joint_of(name)
-            out[k] = float(np.linalg.norm(sim - (pos[0, j] + quat_rotate(rot[0, j], tip))))
+            rel = quat_mul(quat_conj(rot[0, self.parts.joint_of(name)]), d.xquat[m.body(name).id])
+            out[k] = float(np.linalg.norm(quat_log(quat_canonical(rel))))
         return out
 
     def check_fk(self, motion: Motion, frame: int = 0, tol: float = 1e-3) -> float:
@@ -648,7 +654,7 @@ def build_character(
         f, j = SIM_BODIES.index(foot), parts.joint_of(name)
         toe_pos.append(quat_rotate(quat_conj(G[f]), gpos[j] - P[f]))
         toe_quat.append(quat_normalize(quat_mul(quat_conj(G[f]), grot[j])))
-        box = next(g for g in geoms if g.body == name)
+        box = next(g for g in geoms if g.body == name)  # the toe's sole box
         rot = np.asarray(box.quat)
         toe_axis.append(quat_rotate(rot, np.array([0.0, 1.0, 0.0])))
         # the hinge lies across the sole under the ball, where the foot pivots on the floor:

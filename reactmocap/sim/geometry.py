@@ -4,7 +4,7 @@ and a ball-of-foot contact patch, sized from human proportions scaled by leg len
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -61,6 +61,10 @@ class GeomSpec:
     #: (MuJoCo leaves geoms that cannot collide at compile time out of the body's collision
     #: tree for good), and switched off by the World
     patch: bool = False
+    #: a massless, hidden box that never collides: a toed foot's whole sole, heel to toe tip,
+    #: the outline the tracker's stance and footprint logic reads (its contact is the heel
+    #: box and the toe's)
+    outline: bool = False
 
 
 def make_geoms(
@@ -189,6 +193,7 @@ def make_geoms(
                 raise SimulationError(
                     f"toes=True needs a {side}_toe joint in the skeleton (none was mapped)"
                 )
+            out.append(replace(box, outline=True))
             box, toe = _cut_at_ball(box, ball_x)
             # the toe part in the toe joint's frame at the reference frame
             g_f, p_f = G[idx[f"{side}_foot"]], P[idx[f"{side}_foot"]]

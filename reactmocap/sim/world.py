@@ -145,6 +145,11 @@ class WorldCharacter:
     patch_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     #: first of the character's 45 servo actuators: 3 per ball joint, BALL_JOINTS order
     actuator_adr: int = -1
+    #: (2,) the box each foot touches the floor with: its sole box, or with toes the sole
+    #: cut at the ball (``sole_ids`` is then the whole sole's outline, which never collides)
+    heel_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    #: ``(k,)`` the toes' sole boxes (none without toes)
+    toe_geoms: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     #: ``(k,)`` the toe hinges' qpos and dof addresses (none without toes)
     toe_qpos: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
     toe_dofs: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
@@ -273,12 +278,18 @@ class World:
             geoms = np.flatnonzero(np.isin(m.geom_bodyid, np.r_[ids, toe_ids]))
             feet = [m.body(f"{pre}{side}_foot").id for side in "lr"]
             patches = [m.geom(f"{pre}{side}_foot_ball").id for side in "lr"]
-            soles = [
-                g for f in feet for g in geoms
-                if m.geom_bodyid[g] == f and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
-                and g not in patches
+            boxes = [
+                [g for g in geoms if m.geom_bodyid[g] == f
+                 and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX and g not in patches]
+                for f in feet
             ]  # fmt: skip
-            if len(soles) != 2:
+            if ch.toes:  # the sole is the outline; the foot touches through its heel box
+                outline = [m.geom(f"{pre}{side}_foot_sole").id for side in "lr"]
+                heels = [g for f in boxes for g in f if g not in outline]
+                soles = outline
+            else:
+                soles = heels = [g for f in boxes for g in f]
+            if len(soles) != 2 or len(heels) != 2:
                 raise SimulationError("each foot needs exactly one sole box (internal error)")
             acts = [m.actuator(f"{pre}{j}/servo{a}").id for j in BALL_JOINTS for a in range(3)]
             if acts != list(range(acts[0], acts[0] + 3 * len(BALL_JOINTS))) or any(
@@ -298,6 +309,8 @@ class World:
                     actuator_adr=acts[0],
                     sole_ids=np.array(soles, dtype=np.int64),
                     patch_ids=np.array(patches, dtype=np.int64),
+                    heel_ids=np.array(heels, dtype=np.int64),
+                    toe_geoms=np.flatnonzero(np.isin(m.geom_bodyid, toe_ids)).astype(np.int64),
                     toe_qpos=(qadr + layout[2]).astype(np.intp),
                     toe_dofs=(dadr + layout[3]).astype(np.intp),
                     qpos_index=(qadr + layout[0]).astype(np.intp),
@@ -341,6 +354,9 @@ class World:
         m.geom_conaffinity[m.geom("floor").id] = all_bits
         m.geom_condim[:] = 3
         for wc in self.characters:
+            if wc.character.toes:
+                m.geom_contype[wc.sole_ids] = 0
+                m.geom_conaffinity[wc.sole_ids] = 0
             m.geom_contype[wc.patch_ids] = 0
             m.geom_conaffinity[wc.patch_ids] = 0
             m.geom_condim[wc.patch_ids] = 6
@@ -377,11 +393,15 @@ class World:
         part of :meth:`get_state`: whoever switches a patch on switches it back."""
         m = self.model
         wc = self.characters[character]
-        box, patch = int(wc.sole_ids[foot]), int(wc.patch_ids[foot])
+        box, patch = int(wc.heel_ids[foot]), int(wc.patch_ids[foot])
         live, dead = (patch, box) if on else (box, patch)
         if m.geom_contype[live] == 0:
             m.geom_contype[live] = m.geom_contype[dead]
             m.geom_conaffinity[live] = m.geom_conaffinity[dead]
+            if len(wc.toe_geoms):  # the patch stands in for the whole forefoot, toes and all
+                toe = int(wc.toe_geoms[foot])
+                m.geom_contype[toe] = m.geom_contype[box] if not on else 0
+                m.geom_conaffinity[toe] = m.geom_conaffinity[box] if not on else 0
             m.geom_contype[dead] = 0
             m.geom_conaffinity[dead] = 0
 

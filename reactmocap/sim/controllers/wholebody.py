@@ -66,6 +66,8 @@ class _Support:
     gen: F64
     rows: F64
     bias: F64
+    #: ``(2, nb)`` each generator's torque on each toe's hinge (None: no toes)
+    hinge: F64 | None = None
 
 
 @dataclass(frozen=True)
@@ -319,15 +321,7 @@ class WholeBodyTracker(AnchoredReference):
         ]
         self._kp0, self._kv0 = self.kp.copy(), self.kv.copy()
         self._w_root = float(root_weight)
-        # a toed character's toe hinges are unactuated like the pelvis: the program's dofs are
-        # the pelvis's 6, the toes' k, then the joints' 45 (``_dofs`` in that order); its
-        # results go back to the 51 of the reference (``_ref``) (None: no toes, as MuJoCo has it)
-        k_toes = len(wc.toe_dofs)
-        self._nu = 6 + k_toes
-        self._ref: NDArray[np.intp] | None = None
-        if k_toes:
-            self._ref = np.r_[np.arange(6), self._nu + np.arange(3 * NJ)].astype(np.intp)
-        self._root_rows = np.eye(6, NV + k_toes) * self._w_root
+        self._root_rows = np.eye(6, NV) * self._w_root
         self._free = np.zeros(0, dtype=bool)  # the last NNLS solution's positive coefficients
         self._wj = np.ones(3 * NJ)
         self._w_trunk = float(trunk_weight)
@@ -359,16 +353,18 @@ class WholeBodyTracker(AnchoredReference):
         self.mu = float(friction) * float(world.config.friction)
         self.touch = float(touch)
         self.sqrt_reg = float(np.sqrt(force_reg))
-        self._dofs: slice | NDArray[np.intp] = wc.qvel_slice
+        self._dofs = wc.qvel_slice
         self._msel: tuple[slice | NDArray[np.intp], ...] = (self._dofs, self._dofs)
-        self._acc = np.zeros(NV + k_toes)  # the desired accelerations in the program's order
-        if k_toes:
-            qv = wc.qvel_index
-            self._dofs = np.r_[qv[:6], wc.toe_dofs, qv[6:]].astype(np.intp)
-            self._msel = np.ix_(self._dofs, self._dofs)
+        #: a toed character: each toe's body, sole box, its corners and hinge dof (a toe is
+        #: massless in the program, its hinge held at its angle: its inertia is the foot's)
+        self._toes: list[int] = []
+        if len(wc.toe_dofs):
+            self._msel = np.ix_(wc.qvel_index, wc.qvel_index)
             self._toes = [int(m.body(wc.prefix + name).id) for name, _, _ in wc.character.toes]
             self._toe_geoms = np.array([np.flatnonzero(m.geom_bodyid == b)[0] for b in self._toes])
             self._toe_corners = box_corners(m, self._toe_geoms)
+            # the feet touch through their soles cut at the ball (``sole`` is the outline)
+            self._heel_corners = box_corners(m, wc.heel_ids)
         self._full = np.zeros((m.nv, m.nv))
         # translation rows over rotation rows, filled by mj_jac / mj_jacDot through views
         self._jac6 = np.zeros((6, m.nv))
@@ -444,7 +440,10 @@ class WholeBodyTracker(AnchoredReference):
         the feet planted in the mocap."""
         corners = self._sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
+        if self._toes:  # a toed foot's front corners are at the ball
+            corners = sole_corners_world(d, self.wc.heel_ids, self._heel_corners)
         feet: list[int] = []
+        hinge: list[F64] = []  # (2, nb_f) each generator's torque on each toe hinge
         gens: list[F64] = []  # (nb_f, ndof) the generators as generalised forces
         bases: list[F64] = []  # (nb_f, 3) world force per unit coefficient
         owners: list[NDArray[np.int64]] = []  # (nb_f,) the point of each coefficient
@@ -453,9 +452,8 @@ class WholeBodyTracker(AnchoredReference):
         bias: list[F64] = []
         k0 = 0
         toe_corners = (
-            sole_corners_world(d, self._toe_geoms, self._toe_corners) if self._ref is not None
-            else None
-        )  # fmt: skip
+            sole_corners_world(d, self._toe_geoms, self._toe_corners) if self._toes else None
+        )
         for f in range(2):
             if not planted[f]:
                 continue
@@ -484,8 +482,9 @@ class WholeBodyTracker(AnchoredReference):
                     k = len(p_f)
                     groups.append((int(self.feet[f]), p_f, self._corner_basis[:k],
                                    self._corner_owner[: 4 * k], k, False))  # fmt: skip
-            if toe_corners is not None:
-                # the toe's corners on the floor, on the toe body: its hinge is in the program
+            if toe_corners is not None and not patch_on[f]:
+                # the toe's corners on the floor, on the toe body (its hinge held at its angle;
+                # the toe rows in plan() balance its torque)
                 touching = toe_corners[f, :, 2] - self.floor_z < self.touch
                 if touching.any():
                     p_f = toe_corners[f, touching]
@@ -497,12 +496,11 @@ class WholeBodyTracker(AnchoredReference):
             feet.append(f)
             for body, p_f, basis, owner, still, patch in groups:
                 k0 = self._contact_rows(d, body, p_f, basis, owner, still, patch, k0,
-                                        (pts, bases, owners, rows, bias, gens))  # fmt: skip
+                                        (pts, bases, owners, rows, bias, gens), hinge)  # fmt: skip
         if not feet:
-            nv = len(self._acc)
             z = np.zeros((0, 3))
             return _Support(
-                (), z, z, np.zeros(0, np.int64), np.zeros((nv, 0)), np.zeros((0, nv)), np.zeros(0)
+                (), z, z, np.zeros(0, np.int64), np.zeros((NV, 0)), np.zeros((0, NV)), np.zeros(0)
             )
         return _Support(
             feet=tuple(feet),
@@ -512,6 +510,7 @@ class WholeBodyTracker(AnchoredReference):
             gen=np.concatenate(gens).T,
             rows=np.concatenate(rows),
             bias=np.concatenate(bias),
+            hinge=np.concatenate(hinge, axis=1) if self._toes else None,
         )
 
     def _contact_rows(
@@ -525,6 +524,7 @@ class WholeBodyTracker(AnchoredReference):
         patch: bool,
         k0: int,
         out: tuple[list[F64], list[F64], list[NDArray[np.int64]], list[F64], list[F64], list[F64]],
+        hinge: list[F64],
     ) -> int:
         """Appends one body's contact points ``p_f`` to ``out`` (points, bases, owners, rows,
         bias, generators; see :meth:`_support`); returns the next point's number."""
@@ -563,6 +563,13 @@ class WholeBodyTracker(AnchoredReference):
             bias.append(acc0[3:5])
         else:  # corners: one pyramid each
             gens.append((self._edges.T @ jac).reshape(-1, jac.shape[-1]))
+        if self._toes:  # the generators' torques on the toe hinges (zero off the toes)
+            cols = self.wc.toe_dofs
+            jh = self._jac6[:3, cols] + neg_skew @ self._jac6[3:, cols]  # (k, 3, 2)
+            if patch:
+                hinge.append(np.concatenate([(self._edges.T @ jh[0]).T, jh[1:, 2].T], axis=1))
+            else:
+                hinge.append((self._edges.T @ jh).transpose(2, 0, 1).reshape(len(cols), -1))
         return k0
 
     def plan(self, t: float) -> WholeBodyPlan:
@@ -579,15 +586,8 @@ class WholeBodyTracker(AnchoredReference):
         np.copyto(self._qref, d.qpos)
         self._qref[self.wc.qpos_slice] = qr
         mujoco.mj_differentiatePos(m, self._dq, 1.0, d.qpos, self._qref)
-        dq = self._dq[sl]
-        ref, nu = self._ref, self._nu
-        if ref is not None:  # the reference's 51 of the program's order
-            v, dq = v[ref], dq[ref]
-        acc_des = ar + self.kp * dq + self.kv * (vr - v)
+        acc_des = ar + self.kp * self._dq[sl] + self.kv * (vr - v)
         acc_des[:6] += self.root_bias
-        if ref is not None:  # the toes: no target (unactuated, their rows come from dynamics)
-            self._acc[ref] = acc_des
-            acc_des, v = self._acc, d.qvel[sl]
 
         mujoco.mj_fullM(m, d, self._full)
         big_m = self._full[self._msel]
@@ -595,17 +595,14 @@ class WholeBodyTracker(AnchoredReference):
         # purpose, so it acts as extra damping (compensating it, first version: 50% of the benchmark windows
         # tracked instead of 64%)
         h = d.qfrc_bias[sl]
-        if ref is not None:  # but the toe hinges' spring and damper are their only torque
-            h[6:nu] -= d.qfrc_passive[self.wc.toe_dofs]
         sup = self._support(d, planted, held)
         nc = len(sup.points)
         qb = sup.gen
         nb = qb.shape[1]
         nj = 3 * NJ
         # unknowns: the joint accelerations y (45) and the pyramid coefficients beta (nb); the
-        # pelvis (and any toes) follow from their Newton-Euler equations,
-        # qdd_root = r_0 + r_b beta - r_y y
-        _, sol, info = dposv(big_m[:nu, :nu], np.column_stack([big_m[:nu, nu:], qb[:nu], h[:nu]]))
+        # pelvis follows from its Newton-Euler equation, qdd_root = r_0 + r_b beta - r_y y
+        _, sol, info = dposv(big_m[:6, :6], np.column_stack([big_m[:6, 6:], qb[:6], h[:6]]))
         if info:
             raise SimulationError(f"WholeBodyTracker: singular pelvis inertia at t = {t:.4f} s")
         r_y, r_b, r_0 = sol[:, :nj], sol[:, nj:-1], -sol[:, -1]
@@ -621,7 +618,7 @@ class WholeBodyTracker(AnchoredReference):
             if hip:
                 # bounded: it fades as the trunk (pelvis, waist, back) turns ``hip_tilt`` rad
                 # off the mocap, so the joint rows bring it back before it folds
-                turn = dq[3:12].reshape(3, 3)
+                turn = self._dq[sl][3:12].reshape(3, 3)
                 hip *= max(0.0, 1.0 - float(np.linalg.norm(turn, axis=1).sum()) / self._hip_tilt)
             root_rows, root_target = self._root_rows, self._w_root * acc_des[:6]
             if hip:
@@ -661,15 +658,15 @@ class WholeBodyTracker(AnchoredReference):
                 wj[self._leg_rows[1 - self.step.foot]] = 0.3
         for f, (p_d, v_d, a_d, up_d) in swing.items():
             tasks.append(self._swing_task(f, v, p_d, v_d, a_d, up_d))
-        a = acc_des[nu:]
+        a = acc_des[6:]
         beta = np.zeros(0)
         if not tasks:
             y = a.copy()
         else:
             # the rows P qdd - target = U y + V beta - c, with the pelvis's row of qdd from sol
             pmat = np.concatenate([task[0] for task in tasks])
-            x = pmat[:, :nu] @ sol
-            u = pmat[:, nu:] - x[:, :nj]
+            x = pmat[:, :6] @ sol
+            u = pmat[:, 6:] - x[:, :nj]
             vb = x[:, nj:-1]
             c = np.concatenate([task[1] for task in tasks]) + x[:, -1]
             if hip:
@@ -680,6 +677,16 @@ class WholeBodyTracker(AnchoredReference):
                 u = np.concatenate([u, np.zeros((2, nj))])
                 vb = np.concatenate([vb, (w / self._mass) * sup.basis[:, :2].T])
                 c = np.concatenate([c, w * (self._hip_acc - push / self._mass)])
+            if sup.hinge is not None and nb:
+                # each toe holds still on its hinge: the ground's torque on it meets its
+                # spring and damper's (a massless toe, ``qfrc_passive``), weighted as the
+                # no-slip rows (1 N m as 1 m/s^2; by the toe's tiny inertia the rows
+                # swamped the regulariser's scale and held every force near zero)
+                toe = self.wc.toe_dofs
+                w = self.sqrt_wc
+                u = np.concatenate([u, np.zeros((len(toe), nj))])
+                vb = np.concatenate([vb, w * sup.hinge])
+                c = np.concatenate([c, -w * d.qfrc_passive[toe]])
             # min |wj (y - a)|^2 + |U y + V beta - c|^2 + reg |beta|^2, beta >= 0: y eliminated
             # in closed form leaves e^T S^-1 e, e = U a + V beta - c, S = I + U D^-1 U^T
             # (a few rows instead of the QR of all 51 + r)
@@ -703,18 +710,15 @@ class WholeBodyTracker(AnchoredReference):
                 e0 = e0 + vb @ beta
             z, _ = dpotrs(chol, e0, lower=1)
             y = a - ud.T @ z
-        qdd = np.empty(len(acc_des))
-        qdd[nu:] = y
-        qdd[:nu] = r_0 + r_b @ beta - r_y @ y
-        tau = big_m[nu:] @ qdd + h[nu:] - qb[nu:] @ beta
+        qdd = np.empty(NV)
+        qdd[6:] = y
+        qdd[:6] = r_0 + r_b @ beta - r_y @ y
+        tau = big_m[6:] @ qdd + h[6:] - qb[6:] @ beta
         forces = np.zeros((nc, 3))
         np.add.at(forces, sup.owner, sup.basis * beta[:, None])
-        gen = qb @ beta
-        if ref is not None:
-            qdd, acc_des, gen = qdd[ref], acc_des[ref], gen[ref]
         return WholeBodyPlan(
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
-            forces=forces, desired_qacc=acc_des, generalized_contact=gen,
+            forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
 
     def _push_response(self, t: float) -> float:
@@ -905,6 +909,7 @@ class WholeBodyTracker(AnchoredReference):
             self._check_balance(t)
         plan = self.plan(t)
         self.last_plan = plan
+
         # the servo (damping only by default) keeps acting between ticks; at the tick the
         # total joint torque is the plan's (within ``torque_limit``)
         self._ff[:] = plan.torques
