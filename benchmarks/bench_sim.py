@@ -256,13 +256,12 @@ EXCUSE_AFTER_S = 0.5
 PHC_THRESHOLD_M = 0.5
 
 
-def _track_whole(job: tuple[Path, str, bool]) -> dict[str, object]:
+def _track_whole(job: tuple[Path, str]) -> dict[str, object]:
     """One whole clip: status, fall time, errors, PHC's criterion, feasibility excuse, rates."""
-    path, controller, toes = job
+    path, controller = job
     motion = _read_bvh(path)
     cpu = time.process_time()
-    res = track_clip(motion, controller=controller,
-                     character_kwargs={"toes": True} if toes else None)  # fmt: skip
+    res = track_clip(motion, controller=controller)
     cpu = time.process_time() - cpu
     rep = res.report
     roll = res.rollout
@@ -283,19 +282,18 @@ def _track_whole(job: tuple[Path, str, bool]) -> dict[str, object]:
     }  # fmt: skip
 
 
-def bench_whole(controllers: list[str], jobs: int, toes: bool = False) -> None:
+def bench_whole(controllers: list[str], jobs: int) -> None:
     clips = sorted(SHARED.glob("*/*.bvh"))
     if not clips:
         print(f"\n(no shared clips under {SHARED.resolve()}: whole clips skipped)")
         return
     with ProcessPoolExecutor(max_workers=jobs) as pool:
         for controller in controllers:
-            body = ", toe hinges" if toes else ""
-            print(f"\n## whole clips, {controller} (default gains{body}; {jobs} processes)")
+            print(f"\n## whole clips, {controller} (default gains; {jobs} processes)")
             print(f"{'clip':<30} {'s':>5} {'status':<8} {'fell at':>7} {'excused':>7} "
                   f"{'max root m':>10} {'PHC ok':>6} {'RT wall':>7} {'RT cpu':>6}")  # fmt: skip
             t0 = time.perf_counter()
-            rows = list(pool.map(_track_whole, [(p, controller, toes) for p in clips]))
+            rows = list(pool.map(_track_whole, [(p, controller) for p in clips]))
             for r in rows:
                 fell = "-" if r["fell_at_s"] is None else f"{r['fell_at_s']:.2f}"
                 print(
@@ -355,10 +353,6 @@ def main(argv: list[str] | None = None) -> int:
         help="controllers tracking the whole shared clips (predictive: ~40x slower)",
     )  # fmt: skip
     ap.add_argument("--jobs", type=int, default=2, help="processes for the tracking runs")
-    ap.add_argument(
-        "--toes", action="store_true",
-        help="whole clips on characters with toe hinges (build_character(toes=True))",
-    )  # fmt: skip
     args = ap.parse_args(argv)
     print(f"mujoco {mujoco.__version__}, python {sys.version.split()[0]}")
     if "steps" not in args.skip:
@@ -370,7 +364,7 @@ def main(argv: list[str] | None = None) -> int:
     if "tracking" not in args.skip:
         bench_tracking(args.assist, args.controllers, args.jobs)
     if "whole" not in args.skip:
-        bench_whole(args.whole_controllers, args.jobs, args.toes)
+        bench_whole(args.whole_controllers, args.jobs)
     return 0
 
 

@@ -7,15 +7,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-__all__ = [
-    "BALL_JOINTS",
-    "BODY_ALIASES",
-    "JOINT_RANGE",
-    "SIM_BODIES",
-    "SIM_PARENTS",
-    "TOES",
-    "TREE",
-]
+__all__ = ["BALL_JOINTS", "BODY_ALIASES", "JOINT_RANGE", "SIM_BODIES", "SIM_PARENTS", "TREE"]
 
 # (body = part, parent body, ball joint name); preorder, which is MuJoCo's body/joint order.
 TREE: tuple[tuple[str, str | None, str | None], ...] = (
@@ -38,13 +30,6 @@ TREE: tuple[tuple[str, str | None, str | None], ...] = (
 )
 SIM_BODIES: tuple[str, ...] = tuple(b for b, _, _ in TREE)
 BALL_JOINTS: tuple[str, ...] = tuple(j for _, _, j in TREE if j is not None)
-#: the optional toe segments (``build_character(toes=True)``): (body, parent foot, hinge joint),
-#: the body anchored at the skeleton's toe joint; their hinges follow their foot's ball joint in
-#: MuJoCo's order, so a toed character's qpos is not one block of balls (``Character.layout``)
-TOES: tuple[tuple[str, str, str], ...] = (
-    ("l_toe", "l_foot", "l_toe"),
-    ("r_toe", "r_foot", "r_toe"),
-)
 BODY_ALIASES: Mapping[str, str] = {"abdomen": "waist", "thorax": "chest", "neck": "head"}
 #: parent body index of each of SIM_BODIES (-1 for the pelvis)
 SIM_PARENTS = np.array([-1 if p is None else SIM_BODIES.index(p) for _, p, _ in TREE])

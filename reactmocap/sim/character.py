@@ -35,7 +35,6 @@ from reactmocap.sim.bodies import (
     JOINT_RANGE,
     SIM_BODIES,
     SIM_PARENTS,
-    TOES,
     TREE,
 )
 from reactmocap.sim.geometry import BALL_PATCH_HALF_SIZE, PATCH_GEOM_GROUP, GeomSpec, make_geoms
@@ -56,15 +55,6 @@ __all__ = [
 
 F64 = NDArray[np.float64]
 MassModel = Literal["table", "geometry"]
-
-#: the toe hinge's passive spring (N m/rad) and damper (N m s/rad), 1.75 m adult: the
-#: metatarsophalangeal joint's quasi-stiffness in push-off, roughly 0.5 N m/deg (Rao et al.;
-#: the toe lies flat while the heel rises, yet holds the body's weight ahead of the ball)
-TOE_STIFFNESS = 30.0
-TOE_DAMPING = 0.3
-#: the hinge's range (rad) about the reference pose, about the sole's left axis (negative:
-#: the toes bend up): up to ~50 deg (the clips' walks reach 30-37), down 20
-TOE_RANGE = (-0.9, 0.35)
 
 
 #: where a virtual chest starts on a single spine joint: this fraction of the way to the neck
@@ -150,18 +140,6 @@ class Character:
     #: explicit mass, COM (body frame) and full inertia ``(ixx, iyy, izz, ixy, ixz, iyz)`` per
     #: body (see :func:`build_character`'s ``inertials``); None: mass from the geoms
     inertials: dict[str, tuple[float, tuple[float, ...], tuple[float, ...]]] | None = None
-    #: ``(k, 3)``, ``(k, 4)``, ``(k, 3)``, ``(k, 3)`` each toe body's rest transform in its
-    #: foot's frame, its hinge axis and a point of it in its own frame (``k`` 0 without toes,
-    #: 2 with: :data:`TOES`)
-    toe_pos: F64 = field(default_factory=lambda: np.zeros((0, 3)))
-    toe_quat: F64 = field(default_factory=lambda: np.zeros((0, 4)))
-    toe_axis: F64 = field(default_factory=lambda: np.zeros((0, 3)))
-    toe_hinge: F64 = field(default_factory=lambda: np.zeros((0, 3)))
-
-    @property
-    def toes(self) -> tuple[tuple[str, str, str], ...]:
-        """The toe segments this character has (:data:`TOES`, or none)."""
-        return TOES[: len(self.toe_pos)]
 
     # ------------------------------------------------------------------ model
     def make_spec(self) -> mujoco.MjSpec:
@@ -187,19 +165,9 @@ class Character:
                 if self.joint_limits:
                     j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
                     j.range = [0.0, JOINT_RANGE[_kind(joint)]]
-        for k, (name, foot, joint) in enumerate(self.toes):
-            body = bodies[foot].add_body(name=name, pos=self.toe_pos[k], quat=self.toe_quat[k])
-            bodies[name] = body
-            body.add_joint(
-                name=joint, type=mujoco.mjtJoint.mjJNT_HINGE, axis=self.toe_axis[k],
-                pos=self.toe_hinge[k],
-                stiffness=TOE_STIFFNESS, damping=TOE_DAMPING,
-                limited=mujoco.mjtLimited.mjLIMITED_TRUE, range=list(TOE_RANGE),
-            )  # fmt: skip
         for k, g in enumerate(self.geoms):
             body = bodies[g.body]
-            mass_body = _TOE_FOOT.get(g.body, g.body)  # a toe is made of its foot's stuff
-            rho = dens[_kind(mass_body)] * self.density_scale[mass_body]
+            rho = dens[_kind(g.body)] * self.density_scale[g.body]
             size = list(g.size) + [0.0] * (3 - len(g.size))
             if g.kind == "capsule":
                 body.add_geom(
@@ -208,16 +176,6 @@ class Character:
                     size=size,
                     fromto=list(g.fromto or ()),
                     density=rho,
-                )
-            elif g.outline:
-                body.add_geom(
-                    name=f"{g.body}_sole",
-                    type=mujoco.mjtGeom.mjGEOM_BOX,
-                    size=size,
-                    pos=list(g.pos),
-                    quat=list(g.quat),
-                    density=0.0,
-                    group=PATCH_GEOM_GROUP,
                 )
             elif g.patch:
                 body.add_geom(
@@ -250,50 +208,9 @@ class Character:
         return self._model
 
     def segment_masses(self) -> dict[str, float]:
-        """Mass (kg) of each sim body, keyed by body part name (a foot's with its toe's)."""
+        """Mass (kg) of each sim body, keyed by body part name."""
         m = self.model
-        out = {b: float(m.body_mass[m.body(b).id]) for b in SIM_BODIES}
-        for name, foot, _ in self.toes:
-            out[foot] += float(m.body_mass[m.body(name).id])
-        return out
-
-    def layout(
-        self,
-    ) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.intp], NDArray[np.intp]]:
-        """Where the state lives in this character's own qpos / qvel: the ``(67,)`` and
-        ``(51,)`` positions of the free joint and the ball joints (the order of
-        :meth:`qpos_from_motion`), then the ``(k,)`` and ``(k,)`` of the toe hinges. Without
-        toes the first two are ``arange(67)`` and ``arange(51)``."""
-        m = self.model
-        q, v = [np.arange(7)], [np.arange(6)]
-        for j in BALL_JOINTS:
-            jid = m.joint(j).id
-            q.append(m.jnt_qposadr[jid] + np.arange(4))
-            v.append(m.jnt_dofadr[jid] + np.arange(3))
-        toes = [m.joint(j).id for _, _, j in self.toes]
-        return (
-            np.concatenate(q).astype(np.intp),
-            np.concatenate(v).astype(np.intp),
-            m.jnt_qposadr[toes].astype(np.intp),
-            m.jnt_dofadr[toes].astype(np.intp),
-        )
-
-    def toe_angles(self, motion: Motion, frames: Sequence[int] | NDArray | None = None) -> F64:
-        """``(T, k)`` each toe hinge's angle (rad) in motion frames: the skeleton's toe joint
-        turned relative to its foot, away from the reference pose, about the hinge axis."""
-        self._check_motion(motion)
-        idx = np.arange(motion.num_frames) if frames is None else np.asarray(frames, int)
-        sub = motion if frames is None else _take_frames(motion, idx)
-        out = np.zeros((idx.size, len(self.toes)))
-        if not self.toes:
-            return out
-        _, rot = sub.forward_kinematics()
-        for k, (_, foot, _) in enumerate(self.toes):
-            toe_j = self.parts.joint_of(self.toes[k][0])
-            g_f = rot[:, self.anchors[SIM_BODIES.index(foot)]]
-            rel = quat_mul(quat_conj(self.toe_quat[k]), quat_mul(quat_conj(g_f), rot[:, toe_j]))
-            out[:, k] = quat_log(quat_canonical(rel)) @ self.toe_axis[k]
-        return out
+        return {b: float(m.body_mass[m.body(b).id]) for b in SIM_BODIES}
 
     # ------------------------------------------------------------------ Motion -> state
     def _check_motion(self, motion: Motion) -> None:
@@ -446,32 +363,12 @@ class Character:
         self._check_motion(motion)
         m = self.model
         d = mujoco.MjData(m)
-        qi, _, ti, _ = self.layout()
-        d.qpos[qi] = self.qpos_from_motion(motion, [frame])[0]
-        d.qpos[ti] = self.toe_angles(motion, [frame])[0]
+        d.qpos[:] = self.qpos_from_motion(motion, [frame])[0]
         mujoco.mj_kinematics(m, d)
         ids = [m.body(b).id for b in SIM_BODIES]
         pos, rot = _take_frames(motion, np.array([frame])).forward_kinematics()
         lib = pos[0, self.anchors] + quat_rotate(rot[0, self.anchors], self.anchor_offsets)
         return np.linalg.norm(d.xpos[ids] - lib, axis=1)
-
-    def toe_fk_errors(self, motion: Motion, frame: int = 0) -> F64:
-        """``(k,)`` angle (rad) between each toe body's orientation in MuJoCo, at the hinge
-        angles of :meth:`toe_angles`, and the skeleton's toe joint, for one frame: what the
-        hinge cannot follow of the clip's toes (their turn off the hinge axis)."""
-        self._check_motion(motion)
-        m = self.model
-        d = mujoco.MjData(m)
-        qi, _, ti, _ = self.layout()
-        d.qpos[qi] = self.qpos_from_motion(motion, [frame])[0]
-        d.qpos[ti] = self.toe_angles(motion, [frame])[0]
-        mujoco.mj_kinematics(m, d)
-        _, rot = _take_frames(motion, np.array([frame])).forward_kinematics()
-        out = np.zeros(len(self.toes))
-        for k, (name, _, _) in enumerate(self.toes):
-            rel = quat_mul(quat_conj(rot[0, self.parts.joint_of(name)]), d.xquat[m.body(name).id])
-            out[k] = float(np.linalg.norm(quat_log(quat_canonical(rel))))
-        return out
 
     def check_fk(self, motion: Motion, frame: int = 0, tol: float = 1e-3) -> float:
         """Raise :class:`SimulationError` with a diagnosis unless every body agrees with the
@@ -546,10 +443,6 @@ class Character:
         return key
 
 
-#: a toe body's mass comes from its foot's (the table's foot fraction covers both)
-_TOE_FOOT = {name: foot for name, foot, _ in TOES}
-
-
 def _take_frames(motion: Motion, idx: NDArray[np.int64]) -> Motion:
     tr = None if motion.translations is None else motion.translations[idx]
     return motion.replace(
@@ -568,7 +461,6 @@ def build_character(
     mass_model: MassModel = "table",
     joint_limits: bool = True,
     inertials: Mapping[str, SegmentInertia] | None = None,
-    toes: bool = False,
 ) -> Character:
     """Build the 51-DOF character of a skeleton.
 
@@ -585,10 +477,6 @@ def build_character(
             ``reactmocap.athletics.bodies``), in the reference pose's world frame; they replace
             the geoms' mass (``total_mass`` and ``mass_model`` are then unused) and the geoms
             only collide.
-        toes: a toe segment under each foot (:data:`TOES`), anchored at the skeleton's toe
-            joint and hinged there across the sole, a passive spring-damper
-            (:data:`TOE_STIFFNESS`, :data:`TOE_DAMPING`, :data:`TOE_RANGE`): the sole box is
-            cut at the ball, its front part the toe's. Off: the foot is one rigid box.
     """
     if isinstance(skeleton, Motion):
         reference = skeleton if reference is None else reference
@@ -646,21 +534,7 @@ def build_character(
         body_quat[b] = quat_normalize(quat_mul(quat_conj(G[p]), G[b]))
         body_pos[b] = quat_rotate(quat_conj(G[p]), P[b] - P[p])
 
-    if toes and inertials is not None:
-        raise SimulationError("toes=True needs the geoms' mass (inertials=None): no toe inertial")
-    geoms = make_geoms(skeleton, parts, anchors, ref, frame, P, G, toes=bool(toes))
-    toe_pos, toe_quat, toe_axis, toe_hinge = [], [], [], []
-    for name, foot, _ in TOES if toes else ():
-        f, j = SIM_BODIES.index(foot), parts.joint_of(name)
-        toe_pos.append(quat_rotate(quat_conj(G[f]), gpos[j] - P[f]))
-        toe_quat.append(quat_normalize(quat_mul(quat_conj(G[f]), grot[j])))
-        box = next(g for g in geoms if g.body == name)  # the toe's sole box
-        rot = np.asarray(box.quat)
-        toe_axis.append(quat_rotate(rot, np.array([0.0, 1.0, 0.0])))
-        # the hinge lies across the sole under the ball, where the foot pivots on the floor:
-        # hinged at the joint itself (above the sole), a bent toe's edge slid on the floor
-        # and friction held it bent (traced: 10 deg for 0.3 s after a landing)
-        toe_hinge.append(np.asarray(box.pos) + quat_rotate(rot, -np.asarray(box.size) * [1, 0, 1]))
+    geoms = make_geoms(skeleton, parts, anchors, ref, frame, P, G)
     char = Character(
         skeleton=skeleton,
         parts=parts,
@@ -676,10 +550,6 @@ def build_character(
         joint_limits=joint_limits,
         geoms=geoms,
         density_scale=dict.fromkeys(SIM_BODIES, 1.0),
-        toe_pos=np.array(toe_pos).reshape(-1, 3),
-        toe_quat=quat_canonical(np.array(toe_quat).reshape(-1, 4)),
-        toe_axis=np.array(toe_axis).reshape(-1, 3),
-        toe_hinge=np.array(toe_hinge).reshape(-1, 3),
     )
     geo = char.segment_masses()
     if mass_model == "table":

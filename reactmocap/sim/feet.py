@@ -10,7 +10,7 @@ from reactmocap.errors import ConfigError
 from reactmocap.sim.character import SIM_BODIES
 from reactmocap.sim.world import World
 
-__all__ = ["FEET", "box_corners", "foot_soles", "sole_corners_world"]
+__all__ = ["FEET", "foot_soles", "sole_corners_world"]
 
 F64 = NDArray[np.float64]
 #: the two foot bodies, left then right (index 0 and 1 everywhere a foot is numbered)
@@ -29,18 +29,13 @@ def foot_soles(
     sole = wc.sole_ids
     if sole.shape != (2,) or np.any(m.geom_type[sole] != mujoco.mjtGeom.mjGEOM_BOX):
         raise ConfigError(f"{who} needs a sole box geom per foot")
-    return feet, sole, box_corners(m, sole)
-
-
-def box_corners(m: mujoco.MjModel, boxes: NDArray[np.int64]) -> F64:
-    """``(n, 4, 3)`` the four bottom corners of box geoms in their own frames."""
-    return np.stack(
-        [np.column_stack([_SIGNS * h[:2], np.full(4, -h[2])]) for h in m.geom_size[boxes]]
+    corners = np.stack(
+        [np.column_stack([_SIGNS * h[:2], np.full(4, -h[2])]) for h in m.geom_size[sole]]
     )
+    return feet, sole, corners
 
 
 def sole_corners_world(d: mujoco.MjData, sole: NDArray[np.int64], corners: F64) -> F64:
-    """``(2, 4, 3)`` world positions of the sole corners from :func:`foot_soles` (or of any
-    boxes' from :func:`box_corners`)."""
-    rot = d.geom_xmat[sole].reshape(-1, 3, 3)
+    """``(2, 4, 3)`` world positions of the sole corners from :func:`foot_soles`."""
+    rot = d.geom_xmat[sole].reshape(2, 3, 3)
     return np.einsum("fij,fkj->fki", rot, corners) + d.geom_xpos[sole][:, None]

@@ -4,7 +4,7 @@ and a ball-of-foot contact patch, sized from human proportions scaled by leg len
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -14,7 +14,7 @@ from reactmocap.errors import SimulationError
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import Skeleton
-from reactmocap.rotations import quat_conj, quat_from_matrix, quat_mul, quat_rotate
+from reactmocap.rotations import quat_conj, quat_from_matrix, quat_rotate
 from reactmocap.sim.bodies import SIM_BODIES
 
 __all__ = ["BALL_PATCH_HALF_SIZE", "PATCH_GEOM_GROUP", "GeomSpec", "make_geoms"]
@@ -61,10 +61,6 @@ class GeomSpec:
     #: (MuJoCo leaves geoms that cannot collide at compile time out of the body's collision
     #: tree for good), and switched off by the World
     patch: bool = False
-    #: a massless, hidden box that never collides: a toed foot's whole sole, heel to toe tip,
-    #: the outline the tracker's stance and footprint logic reads (its contact is the heel
-    #: box and the toe's)
-    outline: bool = False
 
 
 def make_geoms(
@@ -75,11 +71,9 @@ def make_geoms(
     frame: int,
     P: F64,
     G: F64,
-    toes: bool = False,
 ) -> tuple[GeomSpec, ...]:
     """Collision/mass geometry, computed in the reference pose's world frame and converted to
-    each body's local frame. ``toes``: each sole box is cut at the ball, its part ahead of the
-    ball a box of the toe body (anchored at the skeleton's toe joint)."""
+    each body's local frame."""
     idx = {b: i for i, b in enumerate(SIM_BODIES)}
 
     def at(b: str) -> F64:
@@ -187,38 +181,9 @@ def make_geoms(
             gpos_ref,
             grot_ref,
         )
-        if toes:
-            toe_j = parts.joints.get(f"{side}_toe")
-            if toe_j is None:
-                raise SimulationError(
-                    f"toes=True needs a {side}_toe joint in the skeleton (none was mapped)"
-                )
-            out.append(replace(box, outline=True))
-            box, toe = _cut_at_ball(box, ball_x)
-            # the toe part in the toe joint's frame at the reference frame
-            g_f, p_f = G[idx[f"{side}_foot"]], P[idx[f"{side}_foot"]]
-            g_t, p_t = grot_ref[frame, toe_j], gpos_ref[frame, toe_j]
-            centre = p_f + quat_rotate(g_f, np.asarray(toe.pos))
-            quat = quat_mul(quat_conj(g_t), quat_mul(g_f, np.asarray(toe.quat)))
-            pos = quat_rotate(quat_conj(g_t), centre - p_t)
-            out.append(GeomSpec(f"{side}_toe", "box", toe.size, pos=tuple(pos), quat=tuple(quat)))
-            ball_x = box.size[0]
         out.append(box)
         out.append(_ball_patch(box, ball_x))
     return tuple(out)
-
-
-def _cut_at_ball(box: GeomSpec, ball_x: float) -> tuple[GeomSpec, GeomSpec]:
-    """A sole box cut across at the ball (``ball_x`` along its x axis from its centre): the
-    part behind it and the part ahead, both in the box's body frame, same breadth and height."""
-    hx, hy, hz = box.size
-    rot = np.asarray(box.quat)
-    parts = []
-    for x0, x1 in ((-hx, ball_x), (ball_x, hx)):
-        pos = np.asarray(box.pos) + quat_rotate(rot, np.array([0.5 * (x0 + x1), 0.0, 0.0]))
-        parts.append(GeomSpec(box.body, "box", (0.5 * (x1 - x0), hy, hz), pos=tuple(pos),
-                              quat=box.quat))  # fmt: skip
-    return parts[0], parts[1]
 
 
 def _ball_patch(box: GeomSpec, ball_x: float) -> GeomSpec:

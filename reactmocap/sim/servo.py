@@ -81,8 +81,8 @@ class PDServo:
         qidx, didx, aidx = [], [], []
         for i in idx:
             wc = world.characters[i]
-            qidx.append(wc.ball_qpos)
-            didx.append(wc.ball_dofs)
+            qidx.append(wc.ball_qpos_start + np.arange(4 * NJ))
+            didx.append(wc.ball_dof_start + np.arange(3 * NJ))
             aidx.append(wc.actuator_adr + np.arange(3 * NJ))
         self._qidx = np.concatenate(qidx).astype(np.intp)
         self._didx = np.concatenate(didx).astype(np.intp)

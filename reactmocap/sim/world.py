@@ -145,42 +145,14 @@ class WorldCharacter:
     patch_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     #: first of the character's 45 servo actuators: 3 per ball joint, BALL_JOINTS order
     actuator_adr: int = -1
-    #: (2,) the box each foot touches the floor with: its sole box, or with toes the sole
-    #: cut at the ball (``sole_ids`` is then the whole sole's outline, which never collides)
-    heel_ids: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    #: ``(k,)`` the toes' sole boxes (none without toes)
-    toe_geoms: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    #: ``(k,)`` the toe hinges' qpos and dof addresses (none without toes)
-    toe_qpos: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
-    toe_dofs: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
-    #: ``(67,)``, ``(51,)`` the addresses of :meth:`Character.layout`
-    qpos_index: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
-    qvel_index: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
 
     @property
-    def qpos_slice(self) -> slice | NDArray[np.intp]:
-        """The character's 67 qpos (free joint, then the balls): a slice, or with toes (whose
-        hinges sit between the balls) their addresses."""
-        if len(self.toe_qpos):
-            return self.qpos_index
+    def qpos_slice(self) -> slice:
         return slice(self.qpos_adr, self.qpos_adr + 7 + 4 * len(BALL_JOINTS))
 
     @property
-    def qvel_slice(self) -> slice | NDArray[np.intp]:
-        """The character's 51 qvel, as :attr:`qpos_slice`."""
-        if len(self.toe_dofs):
-            return self.qvel_index
+    def qvel_slice(self) -> slice:
         return slice(self.dof_adr, self.dof_adr + 6 + 3 * len(BALL_JOINTS))
-
-    @property
-    def ball_dofs(self) -> NDArray[np.intp]:
-        """``(45,)`` the ball joints' dof addresses (BALL_JOINTS order)."""
-        return self.qvel_index[6:]
-
-    @property
-    def ball_qpos(self) -> NDArray[np.intp]:
-        """``(60,)`` the ball joints' qpos addresses (BALL_JOINTS order)."""
-        return self.qpos_index[7:]
 
     @property
     def ball_qpos_start(self) -> int:
@@ -269,27 +241,17 @@ class World:
             balls = [m.joint(pre + j).id for j in BALL_JOINTS]
             qadr = int(m.jnt_qposadr[root])
             dadr = int(m.jnt_dofadr[root])
-            layout = ch.layout()
-            if [int(m.jnt_qposadr[j]) for j in balls] != list(qadr + layout[0][7::4]):
-                raise SimulationError(
-                    "ball joints are not where the character has them (internal error)"
-                )
-            toe_ids = np.array([m.body(pre + name).id for name, _, _ in ch.toes], dtype=np.int64)
-            geoms = np.flatnonzero(np.isin(m.geom_bodyid, np.r_[ids, toe_ids]))
+            if [int(m.jnt_qposadr[j]) for j in balls] != [qadr + 7 + 4 * i for i in range(15)]:
+                raise SimulationError("ball joints are not contiguous in qpos (internal error)")
+            geoms = np.flatnonzero(np.isin(m.geom_bodyid, ids))
             feet = [m.body(f"{pre}{side}_foot").id for side in "lr"]
             patches = [m.geom(f"{pre}{side}_foot_ball").id for side in "lr"]
-            boxes = [
-                [g for g in geoms if m.geom_bodyid[g] == f
-                 and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX and g not in patches]
-                for f in feet
+            soles = [
+                g for f in feet for g in geoms
+                if m.geom_bodyid[g] == f and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
+                and g not in patches
             ]  # fmt: skip
-            if ch.toes:  # the sole is the outline; the foot touches through its heel box
-                outline = [m.geom(f"{pre}{side}_foot_sole").id for side in "lr"]
-                heels = [g for f in boxes for g in f if g not in outline]
-                soles = outline
-            else:
-                soles = heels = [g for f in boxes for g in f]
-            if len(soles) != 2 or len(heels) != 2:
+            if len(soles) != 2:
                 raise SimulationError("each foot needs exactly one sole box (internal error)")
             acts = [m.actuator(f"{pre}{j}/servo{a}").id for j in BALL_JOINTS for a in range(3)]
             if acts != list(range(acts[0], acts[0] + 3 * len(BALL_JOINTS))) or any(
@@ -309,12 +271,6 @@ class World:
                     actuator_adr=acts[0],
                     sole_ids=np.array(soles, dtype=np.int64),
                     patch_ids=np.array(patches, dtype=np.int64),
-                    heel_ids=np.array(heels, dtype=np.int64),
-                    toe_geoms=np.flatnonzero(np.isin(m.geom_bodyid, toe_ids)).astype(np.int64),
-                    toe_qpos=(qadr + layout[2]).astype(np.intp),
-                    toe_dofs=(dadr + layout[3]).astype(np.intp),
-                    qpos_index=(qadr + layout[0]).astype(np.intp),
-                    qvel_index=(dadr + layout[1]).astype(np.intp),
                 )
             )
         char = np.full(m.ngeom, -1, dtype=np.int64)
@@ -324,10 +280,6 @@ class World:
                 sel = m.geom_bodyid == bid
                 char[sel] = wc.index
                 body[sel] = i
-            for name, foot, _ in wc.character.toes:  # a toe's geoms count as its foot's
-                sel = m.geom_bodyid == m.body(wc.prefix + name).id
-                char[sel] = wc.index
-                body[sel] = SIM_BODIES.index(foot)
         char.flags.writeable = False
         body.flags.writeable = False
         #: ``(ngeom,)`` the character each geom belongs to (-1: the floor)
@@ -354,9 +306,6 @@ class World:
         m.geom_conaffinity[m.geom("floor").id] = all_bits
         m.geom_condim[:] = 3
         for wc in self.characters:
-            if wc.character.toes:
-                m.geom_contype[wc.sole_ids] = 0
-                m.geom_conaffinity[wc.sole_ids] = 0
             m.geom_contype[wc.patch_ids] = 0
             m.geom_conaffinity[wc.patch_ids] = 0
             m.geom_condim[wc.patch_ids] = 6
@@ -374,7 +323,7 @@ class World:
         """Light damping scaled by each DOF's outboard inertia in the reference pose."""
         m, d, cfg = self.model, self.data, self.config
         for wc in self.characters:
-            d.qpos[wc.qpos_adr : wc.qpos_adr + wc.character.model.nq] = wc.character.model.qpos0
+            d.qpos[wc.qpos_slice] = wc.character.model.qpos0
         # the mass matrix only: no collision pass (characters all at their origin would touch)
         mujoco.mj_kinematics(m, d)
         mujoco.mj_comPos(m, d)
@@ -382,7 +331,7 @@ class World:
         diag = np.empty(m.nv)
         diag[:] = d.M[m.M_rowadr + m.M_rownnz - 1]  # diagonal = last entry of each CSR row
         for wc in self.characters:
-            dofs = wc.ball_dofs
+            dofs = np.arange(wc.ball_dof_start, wc.ball_dof_start + 3 * len(BALL_JOINTS))
             m.dof_damping[dofs] = cfg.joint_damping * diag[dofs]
         m.jnt_solref[:] = cfg.limit_solref
         mujoco.mj_resetData(m, d)
@@ -393,15 +342,11 @@ class World:
         part of :meth:`get_state`: whoever switches a patch on switches it back."""
         m = self.model
         wc = self.characters[character]
-        box, patch = int(wc.heel_ids[foot]), int(wc.patch_ids[foot])
+        box, patch = int(wc.sole_ids[foot]), int(wc.patch_ids[foot])
         live, dead = (patch, box) if on else (box, patch)
         if m.geom_contype[live] == 0:
             m.geom_contype[live] = m.geom_contype[dead]
             m.geom_conaffinity[live] = m.geom_conaffinity[dead]
-            if len(wc.toe_geoms):  # the patch stands in for the whole forefoot, toes and all
-                toe = int(wc.toe_geoms[foot])
-                m.geom_contype[toe] = m.geom_contype[box] if not on else 0
-                m.geom_conaffinity[toe] = m.geom_conaffinity[box] if not on else 0
             m.geom_contype[dead] = 0
             m.geom_conaffinity[dead] = 0
 
@@ -460,8 +405,6 @@ class World:
             raise SimulationError(f"qpos must be 67 finite numbers, got shape {qpos.shape}")
         self.data.qpos[wc.qpos_slice] = qpos
         self.data.qvel[wc.qvel_slice] = 0.0 if qvel is None else qvel
-        self.data.qpos[wc.toe_qpos] = 0.0  # toes at rest
-        self.data.qvel[wc.toe_dofs] = 0.0
         self.state_epoch += 1
         mujoco.mj_forward(self.model, self.data)
 

@@ -160,7 +160,7 @@ class AnchoredReference:
         self._gravity = m.opt.gravity.copy()
         self._root = int(wc.body_ids[0])
         self._slow_next = 0.0
-        self._z_adr = wc.qpos_adr + 2
+        self._z_adr = wc.qpos_slice.start + 2
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
         self._corners_at: tuple[float, bytes] = (float("nan"), b"")

@@ -24,7 +24,6 @@ from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.anchoring import _PLACE_WINDOW, AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import outside_distance
-from reactmocap.sim.feet import box_corners, sole_corners_world
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
@@ -66,8 +65,6 @@ class _Support:
     gen: F64
     rows: F64
     bias: F64
-    #: ``(2, nb)`` each generator's torque on each toe's hinge (None: no toes)
-    hinge: F64 | None = None
 
 
 @dataclass(frozen=True)
@@ -354,17 +351,6 @@ class WholeBodyTracker(AnchoredReference):
         self.touch = float(touch)
         self.sqrt_reg = float(np.sqrt(force_reg))
         self._dofs = wc.qvel_slice
-        self._msel: tuple[slice | NDArray[np.intp], ...] = (self._dofs, self._dofs)
-        #: a toed character: each toe's body, sole box, its corners and hinge dof (a toe is
-        #: massless in the program, its hinge held at its angle: its inertia is the foot's)
-        self._toes: list[int] = []
-        if len(wc.toe_dofs):
-            self._msel = np.ix_(wc.qvel_index, wc.qvel_index)
-            self._toes = [int(m.body(wc.prefix + name).id) for name, _, _ in wc.character.toes]
-            self._toe_geoms = np.array([np.flatnonzero(m.geom_bodyid == b)[0] for b in self._toes])
-            self._toe_corners = box_corners(m, self._toe_geoms)
-            # the feet touch through their soles cut at the ball (``sole`` is the outline)
-            self._heel_corners = box_corners(m, wc.heel_ids)
         self._full = np.zeros((m.nv, m.nv))
         # translation rows over rotation rows, filled by mj_jac / mj_jacDot through views
         self._jac6 = np.zeros((6, m.nv))
@@ -438,12 +424,12 @@ class WholeBodyTracker(AnchoredReference):
         """The contact model at the current state: the sole corners MuJoCo has in contact that
         the mocap holds down (``held`` ``(2, 4)``), or the ball patch of a pivoting foot, of
         the feet planted in the mocap."""
+        m = self.world.model
         corners = self._sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
-        if self._toes:  # a toed foot's front corners are at the ball
-            corners = sole_corners_world(d, self.wc.heel_ids, self._heel_corners)
+        sl = self._dofs
+        qdot = d.qvel[sl]
         feet: list[int] = []
-        hinge: list[F64] = []  # (2, nb_f) each generator's torque on each toe hinge
         gens: list[F64] = []  # (nb_f, ndof) the generators as generalised forces
         bases: list[F64] = []  # (nb_f, 3) world force per unit coefficient
         owners: list[NDArray[np.int64]] = []  # (nb_f,) the point of each coefficient
@@ -451,52 +437,66 @@ class WholeBodyTracker(AnchoredReference):
         rows: list[F64] = []
         bias: list[F64] = []
         k0 = 0
-        toe_corners = (
-            sole_corners_world(d, self._toe_geoms, self._toe_corners) if self._toes else None
-        )
         for f in range(2):
             if not planted[f]:
                 continue
-            # (body, points, basis, owner, still, patch): the foot's, then its toe's
-            groups: list[tuple[int, F64, F64, NDArray[np.int64], int, bool]] = []
             if patch_on[f]:
                 rot = d.geom_xmat[self.patch[f]].reshape(3, 3)
                 p = d.geom_xpos[self.patch[f]] - rot[:, 2] * self.patch_half[f]  # bottom face
                 low = p[2] - self.patch_half[f] * np.abs(rot[2, :2]).sum()  # its lowest corner
-                if low - self.floor_z < self.touch:
-                    axes = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, :2].T.copy()
-                    axes[:, 2] = 0.0  # the centre-of-pressure range lies on the floor
-                    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
-                    # the patch's centre holds still (pyramid), its centre-of-pressure corners
-                    # push
-                    p_f = np.concatenate([p[None], p + self.patch_arm[f] * (_PATCH_SIGNS @ axes)])
-                    groups.append(
-                        (int(self.feet[f]), p_f, self._patch_basis, _PATCH_OWNER, 1, True)
-                    )
+                if low - self.floor_z >= self.touch:
+                    continue
+                axes = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, :2].T.copy()
+                axes[:, 2] = 0.0  # the centre-of-pressure range lies on the floor
+                axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+                # the patch's centre holds still (pyramid), its centre-of-pressure corners push
+                p_f = np.concatenate([p[None], p + self.patch_arm[f] * (_PATCH_SIGNS @ axes)])
+                basis, owner, still = self._patch_basis, _PATCH_OWNER, 1
             else:
                 touching = corners[f, :, 2] - self.floor_z < self.touch
-                if touching.any():
-                    if (touching & held[f]).any():
-                        touching &= held[f]
-                    p_f = corners[f, touching]
-                    k = len(p_f)
-                    groups.append((int(self.feet[f]), p_f, self._corner_basis[:k],
-                                   self._corner_owner[: 4 * k], k, False))  # fmt: skip
-            if toe_corners is not None and not patch_on[f]:
-                # the toe's corners on the floor, on the toe body (its hinge held at its angle;
-                # the toe rows in plan() balance its torque)
-                touching = toe_corners[f, :, 2] - self.floor_z < self.touch
-                if touching.any():
-                    p_f = toe_corners[f, touching]
-                    k = len(p_f)
-                    groups.append((self._toes[f], p_f, self._corner_basis[:k],
-                                   self._corner_owner[: 4 * k], k, False))  # fmt: skip
-            if not groups:
-                continue
+                if not touching.any():
+                    continue
+                if (touching & held[f]).any():
+                    touching &= held[f]
+                p_f = corners[f, touching]
+                k = len(p_f)
+                basis, owner, still = self._corner_basis[:k], self._corner_owner[: 4 * k], k
             feet.append(f)
-            for body, p_f, basis, owner, still, patch in groups:
-                k0 = self._contact_rows(d, body, p_f, basis, owner, still, patch, k0,
-                                        (pts, bases, owners, rows, bias, gens), hinge)  # fmt: skip
+            # every point of the foot from the foot's Jacobians at its origin (two calls, not
+            # two per point): a point r from it moves at v + w x r and accelerates (qdd = 0) at
+            # a + alpha x r + w x (w' x r), w' the body's velocity of MuJoCo's last forward
+            # pass (``cvel``), as ``mj_jacDot`` has it (with w' = w, results moved: a whole walk
+            # drifted 1.1 m instead of 0.45 m)
+            body = int(self.feet[f])
+            o = d.xpos[body]
+            mujoco.mj_jac(m, d, self._jacp, self._jacr, o, body)
+            mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, o, body)
+            jr = self._jac6[3:, sl]
+            w = jr @ qdot
+            acc0 = self._jacd6[:, sl] @ qdot  # (a, alpha) of the origin
+            r = p_f - o
+            neg_skew = (r @ _LEVI_CIVITA).reshape(-1, 3, 3)  # -[r]x: r x u = -neg_skew u
+            jac = self._jac6[:3, sl] + neg_skew @ jr  # (k, 3, ndof)
+            pts.append(p_f)
+            bases.append(basis.reshape(-1, 3))
+            owners.append(owner + k0)
+            k0 += len(p_f)
+            rows.append(jac[:still].reshape(-1, jac.shape[-1]))
+            rs = r[:still]
+            w_old = d.cvel[body, :3]
+            # w x (w' x r) = w' (w . r) - r (w . w')
+            acc = (
+                acc0[:3] + neg_skew[:still] @ acc0[3:] + np.outer(rs @ w, w_old) - rs * (w @ w_old)
+            )
+            bias.append(acc.reshape(-1))
+            if patch_on[f]:  # its centre's pyramid, its corners' upward pushes
+                gens.append(self._edges.T @ jac[0])
+                gens.append(jac[1:, 2])
+                # the foot does not roll or pitch on its patch; its yaw is free
+                rows.append(jr[:2].copy())  # the buffer is the next foot's
+                bias.append(acc0[3:5])
+            else:  # corners: one pyramid each
+                gens.append((self._edges.T @ jac).reshape(-1, jac.shape[-1]))
         if not feet:
             z = np.zeros((0, 3))
             return _Support(
@@ -510,67 +510,7 @@ class WholeBodyTracker(AnchoredReference):
             gen=np.concatenate(gens).T,
             rows=np.concatenate(rows),
             bias=np.concatenate(bias),
-            hinge=np.concatenate(hinge, axis=1) if self._toes else None,
         )
-
-    def _contact_rows(
-        self,
-        d: mujoco.MjData,
-        body: int,
-        p_f: F64,
-        basis: F64,
-        owner: NDArray[np.int64],
-        still: int,
-        patch: bool,
-        k0: int,
-        out: tuple[list[F64], list[F64], list[NDArray[np.int64]], list[F64], list[F64], list[F64]],
-        hinge: list[F64],
-    ) -> int:
-        """Appends one body's contact points ``p_f`` to ``out`` (points, bases, owners, rows,
-        bias, generators; see :meth:`_support`); returns the next point's number."""
-        m, sl = self.world.model, self._dofs
-        qdot = d.qvel[sl]
-        pts, bases, owners, rows, bias, gens = out
-        # every point of the foot from the foot's Jacobians at its origin (two calls, not
-        # two per point): a point r from it moves at v + w x r and accelerates (qdd = 0) at
-        # a + alpha x r + w x (w' x r), w' the body's velocity of MuJoCo's last forward
-        # pass (``cvel``), as ``mj_jacDot`` has it (with w' = w, results moved: a whole walk
-        # drifted 1.1 m instead of 0.45 m)
-        o = d.xpos[body]
-        mujoco.mj_jac(m, d, self._jacp, self._jacr, o, body)
-        mujoco.mj_jacDot(m, d, self._jacd, self._jacrd, o, body)
-        jr = self._jac6[3:, sl]
-        w = jr @ qdot
-        acc0 = self._jacd6[:, sl] @ qdot  # (a, alpha) of the origin
-        r = p_f - o
-        neg_skew = (r @ _LEVI_CIVITA).reshape(-1, 3, 3)  # -[r]x: r x u = -neg_skew u
-        jac = self._jac6[:3, sl] + neg_skew @ jr  # (k, 3, ndof)
-        pts.append(p_f)
-        bases.append(basis.reshape(-1, 3))
-        owners.append(owner + k0)
-        k0 += len(p_f)
-        rows.append(jac[:still].reshape(-1, jac.shape[-1]))
-        rs = r[:still]
-        w_old = d.cvel[body, :3]
-        # w x (w' x r) = w' (w . r) - r (w . w')
-        acc = acc0[:3] + neg_skew[:still] @ acc0[3:] + np.outer(rs @ w, w_old) - rs * (w @ w_old)
-        bias.append(acc.reshape(-1))
-        if patch:  # its centre's pyramid, its corners' upward pushes
-            gens.append(self._edges.T @ jac[0])
-            gens.append(jac[1:, 2])
-            # the foot does not roll or pitch on its patch; its yaw is free
-            rows.append(jr[:2].copy())  # the buffer is the next foot's
-            bias.append(acc0[3:5])
-        else:  # corners: one pyramid each
-            gens.append((self._edges.T @ jac).reshape(-1, jac.shape[-1]))
-        if self._toes:  # the generators' torques on the toe hinges (zero off the toes)
-            cols = self.wc.toe_dofs
-            jh = self._jac6[:3, cols] + neg_skew @ self._jac6[3:, cols]  # (k, 3, 2)
-            if patch:
-                hinge.append(np.concatenate([(self._edges.T @ jh[0]).T, jh[1:, 2].T], axis=1))
-            else:
-                hinge.append((self._edges.T @ jh).transpose(2, 0, 1).reshape(len(cols), -1))
-        return k0
 
     def plan(self, t: float) -> WholeBodyPlan:
         """Solve the tracking program at rollout time ``t`` for the current state (MuJoCo's
@@ -590,7 +530,7 @@ class WholeBodyTracker(AnchoredReference):
         acc_des[:6] += self.root_bias
 
         mujoco.mj_fullM(m, d, self._full)
-        big_m = self._full[self._msel]
+        big_m = self._full[sl, sl]
         # gravity and Coriolis; MuJoCo's passive joint damping is left out of the plan on
         # purpose, so it acts as extra damping (compensating it, first version: 50% of the benchmark windows
         # tracked instead of 64%)
@@ -677,16 +617,6 @@ class WholeBodyTracker(AnchoredReference):
                 u = np.concatenate([u, np.zeros((2, nj))])
                 vb = np.concatenate([vb, (w / self._mass) * sup.basis[:, :2].T])
                 c = np.concatenate([c, w * (self._hip_acc - push / self._mass)])
-            if sup.hinge is not None and nb:
-                # each toe holds still on its hinge: the ground's torque on it meets its
-                # spring and damper's (a massless toe, ``qfrc_passive``), weighted as the
-                # no-slip rows (1 N m as 1 m/s^2; by the toe's tiny inertia the rows
-                # swamped the regulariser's scale and held every force near zero)
-                toe = self.wc.toe_dofs
-                w = self.sqrt_wc
-                u = np.concatenate([u, np.zeros((len(toe), nj))])
-                vb = np.concatenate([vb, w * sup.hinge])
-                c = np.concatenate([c, -w * d.qfrc_passive[toe]])
             # min |wj (y - a)|^2 + |U y + V beta - c|^2 + reg |beta|^2, beta >= 0: y eliminated
             # in closed form leaves e^T S^-1 e, e = U a + V beta - c, S = I + U D^-1 U^T
             # (a few rows instead of the QR of all 51 + r)
@@ -910,7 +840,6 @@ class WholeBodyTracker(AnchoredReference):
             self._check_balance(t)
         plan = self.plan(t)
         self.last_plan = plan
-
         # the servo (damping only by default) keeps acting between ticks; at the tick the
         # total joint torque is the plan's (within ``torque_limit``)
         self._ff[:] = plan.torques
