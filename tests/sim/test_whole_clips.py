@@ -142,6 +142,23 @@ def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
     assert push({"step_short": 0.0}) in ("fell", "unstable")
 
 
+def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> None:
+    """The third shared standing clip, whose capture point stands 1-2 cm inside its toes,
+    pushed 100 N forward at the chest for 0.25 s: the hip strategy holds the capture point
+    only by folding the trunk. Bounded at 0.8 rad once balance steps are on (``hip_tilt_step``,
+    the whole-clip default) the step starts sooner and the body stays up; at the no-step bound
+    (1.6 rad) the trunk folded 1.3 rad, straightening it as the step began threw the body
+    forward past the step and it fell."""
+    respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 100.0)
+
+    def push(params: dict[str, float]) -> str:
+        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
+                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
+
+    assert push({}) == "ok"
+    assert push({"hip_tilt_step": 0.0}) in ("fell", "unstable")
+
+
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip
