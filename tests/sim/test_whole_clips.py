@@ -145,7 +145,7 @@ def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
 def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> None:
     """The third shared standing clip, whose capture point stands 1-2 cm inside its toes,
     pushed 100 N forward at the chest for 0.25 s: the hip strategy holds the capture point
-    only by folding the trunk. Bounded at 0.8 rad once balance steps are on (``hip_tilt_step``,
+    only by folding the trunk. Bounded at 0.5 rad once balance steps are on (``hip_tilt_step``,
     the whole-clip default) the step starts sooner and the body stays up; at the no-step bound
     (1.6 rad) the trunk folded 1.3 rad, straightening it as the step began threw the body
     forward past the step and it fell."""

@@ -126,8 +126,8 @@ class WholeBodyTracker(AnchoredReference):
             (the pelvis, waist and back rotation errors summed) and, once the capture point is
             back inside, over ``hip_back`` s.
         hip_tilt_step: ``hip_tilt`` while balance steps are on (0: ``hip_tilt``): a step then
-            takes over from a hip strategy that cannot hold, before the trunk has folded far;
-            straightening a trunk folded 1.3 rad threw the body forward as the step began.
+            takes over from a hip strategy that cannot hold before the trunk has folded far
+            (straightening a trunk folded 1.3 rad threw the body forward as the step began).
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
