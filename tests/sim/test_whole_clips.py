@@ -102,7 +102,9 @@ def test_a_pushed_standing_clip_steps_and_stays_up(shared_mocap_dir: Path) -> No
     """The shared standing clip pushed 200 N (Wooten's front figure) forward at the chest for
     0.25 s: with the balance steps a push turns on (``step_pushed``, the whole-clip default) and
     the pelvis lowered so the step reaches the floor (``step_leg``) it stays up; without steps,
-    or with steps at the standing height (their foot hovered short of the floor), it falls."""
+    or with steps at the standing height (their foot hovered short of the floor) after the
+    hip strategy has folded the trunk as far as it does without steps (``hip_tilt_step`` 0;
+    with the earlier step, ``step_leg`` 0 survives this push too), it falls."""
     bye, force = _shared_push(shared_mocap_dir, "bye_normal_001", 1.0, 0.0, 200.0)
 
     def push(params: dict[str, float | bool]) -> str:
@@ -111,7 +113,7 @@ def test_a_pushed_standing_clip_steps_and_stays_up(shared_mocap_dir: Path) -> No
 
     assert push({}) == "ok"
     assert push({"step_pushed": False}) == "fell"
-    assert push({"step_leg": 0.0}) == "fell"
+    assert push({"step_leg": 0.0, "hip_tilt_step": 0.0}) == "fell"
 
 
 def test_a_diagonal_push_steps_with_the_foot_on_its_side(shared_mocap_dir: Path) -> None:
@@ -131,7 +133,8 @@ def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
     onto an edge and it steps (the other foot after a landing) to within 0.1 m of where it was.
     Swung in the time of a step that short (``step_short``, the whole-clip default) the body
     stays up; over the whole step time (0) it fell toward that foot and the simulation
-    diverged."""
+    diverged (with the trunk folded as far as without steps, ``hip_tilt_step`` 0: with the
+    earlier first step the body survives this push without ``step_short`` too)."""
     byebye, force = _shared_push(shared_mocap_dir, "byebye_normal_001", 1.0, 90.0, 100.0)
 
     def push(params: dict[str, float]) -> str:
@@ -139,7 +142,24 @@ def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
                          seconds=2.75, params=params).report.status  # fmt: skip
 
     assert push({}) == "ok"
-    assert push({"step_short": 0.0}) in ("fell", "unstable")
+    assert push({"step_short": 0.0, "hip_tilt_step": 0.0}) in ("fell", "unstable")
+
+
+def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> None:
+    """The third shared standing clip, whose capture point stands 1-2 cm inside its toes,
+    pushed 100 N forward at the chest for 0.25 s: the hip strategy holds the capture point
+    only by folding the trunk. Bounded at 0.5 rad once balance steps are on (``hip_tilt_step``,
+    the whole-clip default) the step starts sooner and the body stays up; at the no-step bound
+    (1.6 rad) the trunk folded 1.3 rad, straightening it as the step began threw the body
+    forward past the step and it fell."""
+    respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 100.0)
+
+    def push(params: dict[str, float]) -> str:
+        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
+                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
+
+    assert push({}) == "ok"
+    assert push({"hip_tilt_step": 0.0}) in ("fell", "unstable")
 
 
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:

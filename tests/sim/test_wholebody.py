@@ -267,6 +267,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_leg", 3.0),
         ("step_short", -0.3),
         ("place_pushed", -1.0),
+        ("hip_tilt_step", -0.5),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

@@ -29,7 +29,9 @@ from reactmocap.sim.world import World
 __all__ = ["AnchoredReference"]
 
 F64 = NDArray[np.float64]
-# no balance step once the pelvis has tilted this far from its start (cos 35 deg)
+# no balance step once the pelvis has tilted this far from its start (cos 35 deg), nor after it
+# ever has: a body flung head over heels by a 2000 N push came round upright in the air and
+# stepped with a foot 0.9 m up until the simulation blew up
 _STEP_TILT_COS = float(np.cos(np.radians(35.0)))
 # a fall nearer a diagonal than the heading (22.5 deg) steps with the foot on its side: a
 # front-right push stepped the left foot 0.43 m ahead and pitched over the right toes
@@ -135,6 +137,7 @@ class AnchoredReference:
         self.step_alternate = bool(step_alternate)
         self.step_short = float(step_short)
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
+        self._gone_down = False  # the pelvis has tilted past the balance steps' limit
         self.place_gain = float(place_gain)
         self.place_deadband = float(place_deadband)
         self.place_height = float(place_height)
@@ -412,7 +415,8 @@ class AnchoredReference:
             return
         i = self.clock.nearest(t)
         up = d.xmat[self._root].reshape(3, 3)[:, 2]
-        if up @ self._root_up0 < _STEP_TILT_COS or d.qpos[self._z_adr] < 0.75 * self._z0:
+        self._gone_down |= bool(up @ self._root_up0 < _STEP_TILT_COS)
+        if self._gone_down or d.qpos[self._z_adr] < 0.75 * self._z0:
             return  # already going down: a step would only flail
         ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
         feet = self._footprint(t)
@@ -557,6 +561,7 @@ class AnchoredReference:
         self.steps_taken = []
         self._step_ready = 0.0
         self._landed = (-1, -np.inf)
+        self._gone_down = False
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping = 1.0, False
@@ -574,12 +579,12 @@ class AnchoredReference:
                 self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
-                self._placed.copy())  # fmt: skip
+                self._placed.copy(), self._gone_down)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
-         until, place_move, placed) = memory  # fmt: skip
+         until, place_move, placed, gone_down) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -595,3 +600,4 @@ class AnchoredReference:
         self._place_until = float(until)  # type: ignore[arg-type]
         self._place_move[:] = place_move  # type: ignore[call-overload]
         self._placed[:] = placed  # type: ignore[call-overload]
+        self._gone_down = bool(gone_down)

@@ -125,6 +125,9 @@ class WholeBodyTracker(AnchoredReference):
             the feet's centre of pressure could. It fades as the trunk turns ``hip_tilt`` rad
             (the pelvis, waist and back rotation errors summed) and, once the capture point is
             back inside, over ``hip_back`` s.
+        hip_tilt_step: ``hip_tilt`` while balance steps are on (0: ``hip_tilt``): a step then
+            takes over from a hip strategy that cannot hold before the trunk has folded far
+            (straightening a trunk folded 1.3 rad threw the body forward as the step began).
         contact_weight, contact_kv: ``w_c`` and ``k_c`` of the no-slip term.
         friction: fraction of the floor's friction coefficient the plan may use.
         reach: a foot is planted in the mocap when its sole is within ``reach`` m of the
@@ -227,6 +230,7 @@ class WholeBodyTracker(AnchoredReference):
         hip_margin: float = 0.03,
         hip_back: float = 0.5,
         hip_tilt: float = 1.6,
+        hip_tilt_step: float = 0.0,
         contact_weight: float = 1e4,
         contact_kv: float = 20.0,
         friction: float = 0.7,
@@ -272,7 +276,7 @@ class WholeBodyTracker(AnchoredReference):
                 "trunk_give": trunk_give, "trunk_band": trunk_band,
                 "kp_root_pushed": kp_root_pushed, "hip_weight": hip_weight, "hip_gain": hip_gain,
                 "hip_free": hip_free, "hip_margin": hip_margin, "hip_back": hip_back,
-                "hip_tilt": hip_tilt,
+                "hip_tilt": hip_tilt, "hip_tilt_step": hip_tilt_step,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
                 "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
@@ -337,6 +341,7 @@ class WholeBodyTracker(AnchoredReference):
         self._hip_margin = float(hip_margin)
         self._hip_back = float(hip_back)
         self._hip_tilt = float(hip_tilt)
+        self._hip_tilt_step = float(hip_tilt_step) or self._hip_tilt
         self._hip_from = -np.inf  # the last time the hip strategy was fully on
         self._hip_acc = np.zeros(2)  # the centre of mass's horizontal acceleration it asks
         # the joints whose rows it frees: the trunk turns about the hips
@@ -559,7 +564,8 @@ class WholeBodyTracker(AnchoredReference):
                 # bounded: it fades as the trunk (pelvis, waist, back) turns ``hip_tilt`` rad
                 # off the mocap, so the joint rows bring it back before it folds
                 turn = self._dq[sl][3:12].reshape(3, 3)
-                hip *= max(0.0, 1.0 - float(np.linalg.norm(turn, axis=1).sum()) / self._hip_tilt)
+                tilt = self._hip_tilt_step if self.stepping else self._hip_tilt
+                hip *= max(0.0, 1.0 - float(np.linalg.norm(turn, axis=1).sum()) / tilt)
             root_rows, root_target = self._root_rows, self._w_root * acc_des[:6]
             if hip:
                 # the pelvis's turn and the trunk's joints freed: their angular momentum
