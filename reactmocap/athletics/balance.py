@@ -149,7 +149,7 @@ class BalanceGains:
     #: (docs/athletics.md); ``None``: off
     arms: tuple[float, float, float] | None = None
     #: arm windmilling ``(rate, margin)``: while the capture point lies more than ``margin`` m
-    #: beyond the COM target (and, backward, the support centre) along the feet, both arms
+    #: beyond the COM target and the support centre along the feet, both arms
     #: circle at ``rate`` rad/s in the sense whose reaction pitches the body against the fall
     #: (back-up-over on a forward fall), and finish the circle they are on once it is back
     #: (their momentum given back when the COM is caught); ``None``: off
@@ -208,6 +208,9 @@ PLANT_DEADBAND = 0.015
 #: moves slower than ``speed`` (m/s, horizontal) within ``offset`` (m) of the balance's COM
 #: target, all for ``hold`` s in a row
 SETTLED = MappingProxyType({"share": 0.2, "tau": 0.05, "speed": 0.05, "offset": 0.03, "hold": 0.2})
+#: :attr:`BalanceGains.windmill` only on a floor less steep than this (tan): on a 33 deg
+#: sideways slope the circling arms tipped the female over (docs/athletics.md)
+WINDMILL_SLOPE = 0.05
 #: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
 SIDE_SLOPE = 0.2
 BALANCE_GAINS = BalanceGains()
@@ -361,7 +364,9 @@ class BalanceLaw:
             behind = cp + ahead < -margin
             rig.offset[_SHOULDER, 0] = -min(gain * max(-cp - margin, 0.0), limit) * behind
         if g.windmill is not None:
-            rig.offset[_SHOULDER, 0] += self._windmill(cp, ahead, t)
+            n = s.floor_normal
+            level = math.hypot(float(n[0]), float(n[1])) < WINDMILL_SLOPE * float(n[2])
+            rig.offset[_SHOULDER, 0] += self._windmill(cp, ahead, t, level)
         lo, hi = ANKLE_LIMITS
         desired = rig.desired(t)
         for k in range(2):
@@ -371,13 +376,17 @@ class BalanceLaw:
         self._level_legs(d, desired, hang)
         self._support(s)
 
-    def _windmill(self, cp: float, ahead: float, t: float) -> float:
+    def _windmill(self, cp: float, ahead: float, t: float, level: bool = True) -> float:
         """:attr:`BalanceGains.windmill`'s shoulder pitch (rad) for the capture point ``cp``
-        ahead of the COM target, the target ``ahead`` of the support centre."""
+        ahead of the COM target, the target ``ahead`` of the support centre; off the level
+        (:data:`WINDMILL_SLOPE`) the arms only finish their circle."""
         rate, margin = self.gains.windmill  # type: ignore[misc]
         dt = max(t - self._t_wind, 0.0) if self._t_wind == self._t_wind else 0.0
         self._t_wind = t
-        falling = cp > margin or (cp < -margin and cp + ahead < -margin)
+        # beyond the support centre's margin too: a COM on its way to a moved target is left be
+        fwd = cp > margin and cp + ahead > margin
+        back = cp < -margin and cp + ahead < -margin
+        falling = level and (fwd or back)
         if falling:  # forward: the arms go back and over (pitch > 0), else the other way
             self._wind_dir = 1.0 if cp > 0.0 else -1.0
         nxt = self._wind + self._wind_dir * rate * dt

@@ -120,8 +120,8 @@ def test_a_forward_push_past_the_toes_is_taken_by_windmilling_arms(
     circle: list[float] = []
     windmill = BalanceLaw._windmill
 
-    def spy(law: BalanceLaw, cp: float, ahead: float, t: float) -> float:
-        circle.append(windmill(law, cp, ahead, t))
+    def spy(law: BalanceLaw, cp: float, ahead: float, t: float, level: bool = True) -> float:
+        circle.append(windmill(law, cp, ahead, t, level))
         return circle[-1]
 
     monkeypatch.setattr(BalanceLaw, "_windmill", spy)
