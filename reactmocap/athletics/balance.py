@@ -148,6 +148,12 @@ class BalanceGains:
     #: backward only: swung back on a forward fall they cost the male's front-right push 20 N
     #: (docs/athletics.md); ``None``: off
     arms: tuple[float, float, float] | None = None
+    #: arm windmilling ``(rate, margin)``: while the capture point lies more than ``margin`` m
+    #: beyond the COM target and the support centre along the feet, both arms
+    #: circle at ``rate`` rad/s in the sense whose reaction pitches the body against the fall
+    #: (back-up-over on a forward fall), and finish the circle they are on once it is back
+    #: (their momentum given back when the COM is caught); ``None``: off
+    windmill: tuple[float, float] | None = None
     #: the sideways COM servo's gains (``kp``, ``kv``) as a multiple of the fore-aft ones
     #: (the leap's crouch on yawed feet drifts sideways: docs/athletics.md)
     side: float = 1.0
@@ -174,6 +180,11 @@ class BalanceGains:
             raise ConfigError(
                 f"balance side must be in (0, 5] (a multiple of kp, kv), got {self.side!r}"
             )
+        w = self.windmill
+        if w is not None and (len(w) != 2 or not all(math.isfinite(x) and x >= 0 for x in w)):
+            raise ConfigError(
+                f"balance windmill must be 2 finite numbers >= 0 (rate rad/s, margin m), got {w!r}"
+            )
         a = self.arms
         if a is not None and (len(a) != 3 or not all(math.isfinite(x) and x >= 0 for x in a)):
             raise ConfigError(
@@ -197,6 +208,9 @@ PLANT_DEADBAND = 0.015
 #: moves slower than ``speed`` (m/s, horizontal) within ``offset`` (m) of the balance's COM
 #: target, all for ``hold`` s in a row
 SETTLED = MappingProxyType({"share": 0.2, "tau": 0.05, "speed": 0.05, "offset": 0.03, "hold": 0.2})
+#: :attr:`BalanceGains.windmill` only on a floor less steep than this (tan): on a 33 deg
+#: sideways slope the circling arms tipped the female over (docs/athletics.md)
+WINDMILL_SLOPE = 0.05
 #: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
 SIDE_SLOPE = 0.2
 BALANCE_GAINS = BalanceGains()
@@ -207,9 +221,12 @@ BALANCE_GAINS = BalanceGains()
 #: strategy (``bow``: the male's push forward 120 -> 135 N and back 160 -> 175 N, no direction
 #: lower, docs/athletics.md; the back limit 0.35 rad, about a hip's extension; from gain 25 on
 #: the bow hops the feet); an arm strategy (``arms``: the push back 175 -> 185 N male, 60 -> 65
-#: female, no direction lower); otherwise as :data:`BALANCE_GAINS`
+#: female, no direction lower); arm windmilling (``windmill``, 8 rad/s: the male's push
+#: forward 135 -> 165 N and back 185 -> 200 N, the female's 90 -> 95 and 65 -> 75, the feet
+#: kept down, docs/athletics.md); otherwise as :data:`BALANCE_GAINS`
 STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
-                              bow=(20.0, 0.05, 1.0, 0.35), arms=(40.0, 0.05, 2.0))  # fmt: skip
+                              bow=(20.0, 0.05, 1.0, 0.35), arms=(40.0, 0.05, 2.0),
+                              windmill=(8.0, 0.05))  # fmt: skip
 
 
 class BalanceLaw:
@@ -226,6 +243,10 @@ class BalanceLaw:
         self.com_target = np.zeros(3)
         #: the COM offset eased from (set_posture's ease_com), or None
         self._com0: tuple[float, float] | None = None
+        #: :attr:`BalanceGains.windmill`: the arms' circle (rad), its sense, the last tick
+        self._wind = 0.0
+        self._wind_dir = 0.0
+        self._t_wind = math.nan
         self._knee_standing = float(np.mean(knee_for_length(
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
 
@@ -325,7 +346,7 @@ class BalanceLaw:
         np.clip(delta, -g.max_offset, g.max_offset, out=delta)
         pitch = self._pitch_now(t) + self._lean()
         cp = 0.0
-        if g.bow is not None or g.arms is not None:
+        if g.bow is not None or g.arms is not None or g.windmill is not None:
             omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
             cp = float(vel[0]) / omega - float(err[0])  # capture point ahead of the target
         if g.bow is not None and bool(s.foot_contact.all()):
@@ -342,6 +363,10 @@ class BalanceLaw:
             # behind the support centre too: a COM on its way to a target moved ahead is left be
             behind = cp + ahead < -margin
             rig.offset[_SHOULDER, 0] = -min(gain * max(-cp - margin, 0.0), limit) * behind
+        if g.windmill is not None:
+            n = s.floor_normal
+            level = math.hypot(float(n[0]), float(n[1])) < WINDMILL_SLOPE * float(n[2])
+            rig.offset[_SHOULDER, 0] += self._windmill(cp, ahead, t, level)
         lo, hi = ANKLE_LIMITS
         desired = rig.desired(t)
         for k in range(2):
@@ -350,6 +375,29 @@ class BalanceLaw:
         hang = self._plant(s, d, h) if self.posture.plant else None
         self._level_legs(d, desired, hang)
         self._support(s)
+
+    def _windmill(self, cp: float, ahead: float, t: float, level: bool = True) -> float:
+        """:attr:`BalanceGains.windmill`'s shoulder pitch (rad) for the capture point ``cp``
+        ahead of the COM target, the target ``ahead`` of the support centre; off the level
+        (:data:`WINDMILL_SLOPE`) the arms only finish their circle."""
+        rate, margin = self.gains.windmill  # type: ignore[misc]
+        dt = max(t - self._t_wind, 0.0) if self._t_wind == self._t_wind else 0.0
+        self._t_wind = t
+        # beyond the support centre's margin too: a COM on its way to a moved target is left be
+        fwd = cp > margin and cp + ahead > margin
+        back = cp < -margin and cp + ahead < -margin
+        falling = level and (fwd or back)
+        if falling:  # forward: the arms go back and over (pitch > 0), else the other way
+            self._wind_dir = 1.0 if cp > 0.0 else -1.0
+        nxt = self._wind + self._wind_dir * rate * dt
+        if not falling and self._wind_dir:  # caught: finish the circle the arms are on
+            turn = self._wind / (2.0 * math.pi)
+            whole = math.ceil(turn - 1e-9) if self._wind_dir > 0 else math.floor(turn + 1e-9)
+            end = 2.0 * math.pi * whole
+            if (nxt - end) * self._wind_dir >= 0.0:
+                nxt, self._wind_dir = end, 0.0
+        self._wind = nxt
+        return self._wind
 
     def _bow(self, cp: float, vel: float) -> float:
         """:attr:`BalanceGains.bow`'s pitch (rad, forward > 0) for the capture point ``cp``

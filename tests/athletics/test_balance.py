@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics import behaviours, run
-from reactmocap.athletics.balance import STANDING_GAINS, BalanceGains
+from reactmocap.athletics.balance import STANDING_GAINS, BalanceGains, BalanceLaw
 from reactmocap.errors import ConfigError
 
 
@@ -98,12 +98,43 @@ def test_a_forward_push_past_the_ankles_is_taken_by_the_hips() -> None:
 def test_a_backward_push_is_taken_by_the_arms(monkeypatch: pytest.MonkeyPatch) -> None:
     # STANDING_GAINS.arms: 185 N back for 0.25 s; the arms rise forward while the capture point
     # lies behind the COM target and the male stands; without them he falls (the limit was
-    # 175 N with the bow alone, 2026-12-03)
+    # 175 N with the bow alone, 2026-12-03); without the windmilling, which alone also takes it
+    base = dataclasses.replace(STANDING_GAINS, windmill=None)
+    monkeypatch.setattr(behaviours, "STANDING_GAINS", base)
     push = {"check_range": False, "seconds": 3.0, "push": 185.0, "push_dir": math.pi}
     r = run("balance", "male", **push)
     assert r.report["balanced"] and not r.report["fell"]
-    no_arms = dataclasses.replace(STANDING_GAINS, arms=None)
+    no_arms = dataclasses.replace(base, arms=None)
     monkeypatch.setattr(behaviours, "STANDING_GAINS", no_arms)
     assert not run("balance", "male", **push).report["balanced"]
     with pytest.raises(ConfigError, match="arms"):
         BalanceGains(arms=(40.0, 0.05, -1.0))
+
+
+def test_a_forward_push_past_the_toes_is_taken_by_windmilling_arms(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # STANDING_GAINS.windmill: 160 N forward for 0.25 s; the arms circle back and over while the
+    # capture point lies past the COM target, finish their circle, and the male stands with his
+    # feet down; without them he falls (the limit was 135 N with the bow and arms, 2026-12-03)
+    circle: list[float] = []
+    windmill = BalanceLaw._windmill
+
+    def spy(law: BalanceLaw, cp: float, ahead: float, t: float, level: bool = True) -> float:
+        circle.append(windmill(law, cp, ahead, t, level))
+        return circle[-1]
+
+    monkeypatch.setattr(BalanceLaw, "_windmill", spy)
+    push = {"check_range": False, "seconds": 3.0, "push": 160.0, "push_dir": 0.0}
+    r = run("balance", "male", **push)
+    assert r.report["balanced"] and not r.report["fell"]
+    after = r.log["t"] >= 0.5
+    assert np.count_nonzero(r.log["feet"][after] < 2) <= 10
+    assert max(circle) >= 2.0 * math.pi and circle[-1] == pytest.approx(
+        2.0 * math.pi * round(circle[-1] / (2.0 * math.pi))
+    )
+    no_windmill = dataclasses.replace(STANDING_GAINS, windmill=None)
+    monkeypatch.setattr(behaviours, "STANDING_GAINS", no_windmill)
+    assert not run("balance", "male", **push).report["balanced"]
+    with pytest.raises(ConfigError, match="windmill"):
+        BalanceGains(windmill=(8.0, math.nan))
