@@ -409,8 +409,9 @@ def capture(workers: int, starts: int = 50) -> dict[str, Any]:
     from reactmocap.athletics.maneuvers import capture_region, load_maneuver
 
     out: dict[str, Any] = {}
-    for name in ("back_somersault", "back_layout", "vertical_leap", "broad_jump", "dive_pike",
-                 "back_handspring", "back_handspring_female", "forward_somersault"):  # fmt: skip
+    for name in ("back_somersault", "back_somersault_female", "back_layout", "vertical_leap",
+                 "broad_jump", "dive_pike", "back_handspring", "back_handspring_female",
+                 "forward_somersault"):  # fmt: skip
         m = load_maneuver(ROOT / "examples" / "athletics" / "maneuvers" / f"{name}.toml")
         for label, scale in (("full", 1.0), ("tenth", 0.1)):
             sd = {"joint_sd": math.radians(3.0) * scale, "pitch_sd": math.radians(2.0) * scale,

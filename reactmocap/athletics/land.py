@@ -27,7 +27,14 @@ from reactmocap.athletics.leap import pitch_momentum
 from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
 from reactmocap.athletics.rig import joint_index, per_joint
 from reactmocap.errors import ConfigError
-from reactmocap.rotations import quat_conj, quat_from_euler, quat_from_yaw, quat_mul, quat_to_euler
+from reactmocap.rotations import (
+    quat_conj,
+    quat_exp,
+    quat_from_euler,
+    quat_from_yaw,
+    quat_mul,
+    quat_to_euler,
+)
 from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import State, after
 from reactmocap.sim.world import World
@@ -115,6 +122,13 @@ class LandingParams:
             the feet touched, and a few ms of that decided where they landed). The legs hold
             their aim in the world and the feet arrive still under the COM. Off (the
             default): as before.
+        twist_aim: with ``aim_sideways``, the hips' roll from where the pelvis will be once
+            the hips get there (its whole angular velocity times the servo's lag,
+            ``Rig.lag``), not where it is. Why: a take-off's few kg m^2/s of cartwheel
+            momentum becomes a twist about the long axis as the opening body passes the
+            horizontal, where its inertia is least; the female back tuck's pelvis rolled at
+            ~4 rad/s through the reach and her feet touched down 10-17 cm to the side of the
+            COM, and she stood up on one foot and fell sideways. Off (the default): as before.
         fall_gain: how much nearer (m) the feet go per m/s of horizontal speed and per metre
             that the fall exceeds ``fall_ref`` (s/m); 0: off (the deltas hold for one drop
             height only). The fall is predicted as the reach begins: the soles' clearance
@@ -164,6 +178,7 @@ class LandingParams:
     swing_cap: float = 0.9
     aim_sideways: bool = False
     spin_aim: bool = False
+    twist_aim: bool = False
     fall_gain: float = 0.0
     fall_ref: float = 0.0
     momentum_gain: float = 0.0
@@ -255,7 +270,7 @@ class Landing(Basis):
                 goal[joint_index(j)] = 0.0
             moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
             rig.move(goal, 0.2, t, moving)
-            memo["lag"] = float(rig.lag(_HIP).mean()) if p.spin_aim else 0.0
+            memo["lag"] = float(rig.lag(_HIP).mean()) if p.spin_aim or p.twist_aim else 0.0
             memo["scale"] = 1.0
             if p.spin_ref:  # the spin to stop against the delta's (see spin_ref)
                 sn = ctx.sense(t)
@@ -315,7 +330,8 @@ class Landing(Basis):
                     side = float(np.clip((middle[1] + want[1]) / max(length, 0.2), -0.5, 0.5))
                     thighs[k] = (-swing + geom - servo[0], math.asin(side) + servo[1], 0.0)
             if p.aim_sideways:  # the roll from the pelvis's whole orientation; pitch as above
-                goal[_HIP, 1] = _hips_for_thighs(ctx, d, thighs, h)[:, 1]
+                ahead = memo["lag"] * d.cvel[s.root, :3] if p.twist_aim else None
+                goal[_HIP, 1] = _hips_for_thighs(ctx, d, thighs, h, ahead)[:, 1]
             rig.move(goal, 0.0, t, _HIP)
             rig.offset[:] = 0.0
             for k in range(2):
@@ -433,10 +449,15 @@ class Landing(Basis):
         ]  # fmt: skip
 
 
-def _hips_for_thighs(ctx: Context, d, thighs: np.ndarray, heading: float) -> np.ndarray:  # type: ignore[no-untyped-def]
+def _hips_for_thighs(  # type: ignore[no-untyped-def]
+    ctx: Context, d, thighs: np.ndarray, heading: float, ahead: np.ndarray | None = None
+) -> np.ndarray:
     """``(2, 3)`` hip angles that give the thighs the world ``thighs`` ``(2, 3)`` (anatomical
-    pitch, roll, yaw in the heading frame) from where the pelvis is now, in all three axes."""
+    pitch, roll, yaw in the heading frame) from where the pelvis is now, in all three axes,
+    or turned on by the world rotation vector ``ahead`` (``twist_aim``)."""
     pelvis = quat_mul(d.xquat[ctx.senses.root], quat_conj(ctx.athlete.neutral[0]))
+    if ahead is not None:
+        pelvis = quat_mul(quat_exp(ahead), pelvis)
     want = quat_mul(quat_from_yaw(heading)[None], quat_from_euler(thighs, EULER_ORDER))
     eul = quat_to_euler(quat_mul(quat_conj(pelvis)[None], want), EULER_ORDER)
     eul[:, 2] = 0.0  # the hips' yaw targets stay 0, as elsewhere

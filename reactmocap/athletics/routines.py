@@ -92,7 +92,11 @@ TIMED_START_PRESETS = frozenset({"male/forward"})
 #: size, seed 0). The female back tuck reaches the same way (``spin_aim``; chosen on the nominal
 #: alone: lead 3.2-4.0 and delta -0.12/-0.16 land at 4 of the 6 corners, lead 3.6 / delta
 #: -0.16 in the middle; before, lead 3.2 and delta -0.12 were the only landing one of six):
-#: 41/50 at a tenth from 22, 9/50 at full size from 2 (seed 0, 2026-12-02).
+#: 41/50 at a tenth from 22, 9/50 at full size from 2 (seed 0, 2026-12-02). Since 2026-12-03 her
+#: legs' sideways aim is taken from where the pelvis will be once the hips get there
+#: (``aim_sideways`` with ``twist_aim``): a take-off's cartwheel momentum twists her opening body
+#: about its long axis at ~4 rad/s, her feet touched down 10-17 cm to the side of the COM and
+#: she stood up on one foot and fell sideways (docs/athletics.md).
 SOMERSAULT_PRESETS: Mapping[
     str, Mapping[str, tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]]
 ] = MappingProxyType({
@@ -117,7 +121,8 @@ SOMERSAULT_PRESETS: Mapping[
     "female": MappingProxyType({
         "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0}),
                      MappingProxyType({"lead": 3.6}),
-                     MappingProxyType({"delta": -0.16, "spin_aim": True})),
+                     MappingProxyType({"delta": -0.16, "spin_aim": True, "aim_sideways": True,
+                                       "twist_aim": True})),
     }),
 })  # fmt: skip
 DIRECTIONS = ("backward", "forward")

@@ -285,6 +285,37 @@ def test_perturbed_back_tucks_land_with_the_legs_holding_their_aim() -> None:
         assert r["fell"] and not r["landed"], i
 
 
+def test_perturbed_female_back_tucks_land_with_the_legs_aimed_where_the_pelvis_will_be() -> None:
+    """Starts 0 and 5 of the capture region at full size (seed 0), on the female body. Her
+    take-off's few kg m^2/s of cartwheel momentum twist her opening body about its long axis
+    (the pelvis rolling at ~4 rad/s through the reach), and with the legs' sideways aim taken
+    from where the pelvis is (``aim_sideways`` alone, or the preset before: ``spin_aim``
+    alone) start 0's feet touched down 10-17 cm to the side of the COM, she stood up on one
+    foot and fell sideways. With the aim taken from where the pelvis will be once the hips
+    get there (``twist_aim``, the preset since 2026-12-03) both land."""
+    starts = full_starts(6)
+    m = somersault_maneuver(body="female")
+    assert m.phases[3].params["twist_aim"] is True
+    for i in (0, 5):
+        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+    for off in ({"twist_aim": False}, {"twist_aim": False, "aim_sideways": False}):
+        land = replace(m.phases[3], params={**m.phases[3].params, **off})
+        before = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
+        r = run_maneuver(before, perturbation=starts[0], fps=10.0).report
+        assert r["fell"] and not r["landed"], off
+
+
+def test_the_female_back_somersault_file_is_the_preset() -> None:
+    """``back_somersault_female.toml`` (the capture benchmark's) runs the command's preset."""
+    path = Path(__file__).parents[2] / "examples/athletics/maneuvers/back_somersault_female.toml"
+    m, f = somersault_maneuver(body="female"), load_maneuver(path)
+    assert (f.body, f.seconds) == (m.body, m.seconds)
+    for built, read in zip(m.phases, f.phases, strict=True):
+        params = {k: v for k, v in read.params.items() if (k, v) != ("turns", 1.0)}
+        assert replace(read, params=params) == built
+
+
 def test_the_somersault_command_leaps_from_a_settled_start_as_the_files_do() -> None:
     """The command's presets start as ``back_somersault.toml`` does (since 2026-12-02): the
     start settled onto both feet (:data:`SETTLED_START`) before the leap, not 0.3 s into it.
