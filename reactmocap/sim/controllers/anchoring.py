@@ -96,6 +96,7 @@ class AnchoredReference:
         step_alternate: bool = False,
         step_short: float = 0.0,
         place_pushed: float = 0.0,
+        step_width: float = 0.12,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -136,6 +137,7 @@ class AnchoredReference:
         self.step_leg = float(step_leg)
         self.step_alternate = bool(step_alternate)
         self.step_short = float(step_short)
+        self.step_width = float(step_width)
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
         self.place_gain = float(place_gain)
@@ -447,7 +449,7 @@ class AnchoredReference:
             foot = 1 - self._landed[0]
         target = step_target(
             xi, centre[1 - foot, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
-            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
+            max_length=0.6, min_width=self.step_width, lateral=left if foot == 0 else -left,
         )  # fmt: skip
         duration = self.step_time
         if self.step_short and self._landed[0] >= 0:

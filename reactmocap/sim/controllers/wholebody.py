@@ -170,6 +170,9 @@ class WholeBodyTracker(AnchoredReference):
             swings in proportionally less time (at least 0.4 of ``step_time``; 0: off):
             putting back down a foot that the wide stance after a step had lifted took the
             whole step time while the body fell toward it.
+        step_width: a balance step lands at least ``step_width`` m to its own side of the
+            stance foot (m, in [0.05, 0.4]): a forward step landing 0.11 m beside the stance
+            foot left both feet on their edges in a narrow lunge, and the body fell sideways.
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -254,6 +257,7 @@ class WholeBodyTracker(AnchoredReference):
         step_pushed: bool = False,
         step_alternate: bool = False,
         step_short: float = 0.0,
+        step_width: float = 0.12,
         swing_weight: float = 10.0,
         kp_swing: float = 400.0,
         place_gain: float = 0.0,
@@ -285,7 +289,7 @@ class WholeBodyTracker(AnchoredReference):
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
-                "step_short": step_short,
+                "step_short": step_short, "step_width": step_width,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "place_pushed": place_pushed,
@@ -302,6 +306,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_leg must be 0 (off) or in [0.5, 1.5] (a leg over the pelvis's height), "
                 f"got {step_leg!r}"
+            )
+        if not 0.05 <= step_width <= 0.4:
+            raise ConfigError(
+                f"step_width must be in [0.05, 0.4] m (a balance step beside the stance foot), "
+                f"got {step_width!r}"
             )
         servo = world.servo
         m = world.model
@@ -399,7 +408,7 @@ class WholeBodyTracker(AnchoredReference):
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
             warp_gain=warp_gain, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
-            place_pushed=place_pushed,
+            place_pushed=place_pushed, step_width=step_width,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
