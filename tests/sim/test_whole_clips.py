@@ -164,10 +164,11 @@ def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> Non
 
 def test_a_forward_balance_step_lands_wide_enough(shared_mocap_dir: Path) -> None:
     """``respond_normal_001`` pushed 125 N forward at the chest for 0.25 s: its first balance
-    step lands 0.5 m ahead. At least ``step_width`` (the whole-clip default) beside the stance
-    foot the body stays up; 0.12 m beside it (the option's default) both feet rolled onto
-    their edges in a narrow lunge (the front on its heel, the rear on its toes), the capture
-    point drifted off that line, the next step had one corner to push on and the body fell."""
+    step (right foot) lands 0.5 m ahead and the capture point drifts left of the two feet, so
+    the left foot steps next. With the right foot landed 0.15 m beside the left
+    (``step_width`` 0.18, the whole-clip default) that step lands and the body stays up;
+    landed 0.11 m beside it (0.12) the right foot rolled onto an edge with at most one corner
+    down, the plan had nothing to push on and the body fell backward over it."""
     respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 125.0)
 
     def push(params: dict[str, float]) -> str:
