@@ -152,7 +152,7 @@ _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: and after a push while the mocap stands a hip strategy (``hip_weight``) near the feet's edge
 #: and balance steps once the capture point leaves them (``step_pushed``; the pelvis lowered so
 #: the step reaches the floor, the next step by the other foot or by one lifted off the floor,
-#: a short step quicker).
+#: a short step quicker, a forward step wider: ``step_width``).
 #: Without them
 #: the tracker follows the captured world path, as the 1 s benchmark windows, predictive
 #: sampling and the response pipeline's physical mode expect.

@@ -170,10 +170,11 @@ class WholeBodyTracker(AnchoredReference):
             swings in proportionally less time (at least 0.4 of ``step_time``; 0: off):
             putting back down a foot that the wide stance after a step had lifted took the
             whole step time while the body fell toward it.
-        step_width: a balance step lands at least ``step_width`` m to its own side of the
-            stance foot (m, in [0.05, 0.4]): a forward step landed 0.11 m beside it at 0.12,
-            the capture point drifted off that narrow stance and the next step was taken on
-            a foot rolled onto its edge.
+        step_width: a forward balance step (the capture point ahead of the feet's centre)
+            lands at least ``step_width`` m to its own side of the stance foot (m, in
+            [0.05, 0.4]; other steps 0.12): landed 0.11 m beside it, the capture point
+            drifted off that narrow stance and the next step stood on a foot rolled onto
+            its edge.
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
