@@ -162,23 +162,6 @@ def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> Non
     assert push({"hip_tilt_step": 0.0}) in ("fell", "unstable")
 
 
-def test_a_forward_balance_step_lands_wide_enough(shared_mocap_dir: Path) -> None:
-    """``respond_normal_001`` pushed 125 N forward at the chest for 0.25 s: its first balance
-    step (right foot) lands 0.5 m ahead and the capture point drifts left of the two feet, so
-    the left foot steps next. With the right foot landed 0.15 m beside the left
-    (``step_width`` 0.18, the whole-clip default) that step lands and the body stays up;
-    landed 0.11 m beside it (0.12) the right foot rolled onto an edge with at most one corner
-    down, the plan had nothing to push on and the body fell backward over it."""
-    respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 125.0)
-
-    def push(params: dict[str, float]) -> str:
-        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
-                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
-
-    assert push({}) == "ok"
-    assert push({"step_width": 0.12}) in ("fell", "unstable")
-
-
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip

@@ -36,8 +36,6 @@ _STEP_TILT_COS = float(np.cos(np.radians(35.0)))
 # a fall nearer a diagonal than the heading (22.5 deg) steps with the foot on its side: a
 # front-right push stepped the left foot 0.43 m ahead and pitched over the right toes
 _SIDE_STEP_TAN = float(np.tan(np.radians(22.5)))
-# how far beside the stance foot a balance step lands at least (m; a forward one: ``step_width``)
-_STEP_WIDTH = 0.12
 # the shortest balance step's time as a fraction of ``step_time`` (``step_short``)
 _SHORT_STEP_MIN = 0.4
 # seconds between updates of the ground path, the balance shift and the step decision
@@ -98,7 +96,6 @@ class AnchoredReference:
         step_alternate: bool = False,
         step_short: float = 0.0,
         place_pushed: float = 0.0,
-        step_width: float = 0.12,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -139,7 +136,6 @@ class AnchoredReference:
         self.step_leg = float(step_leg)
         self.step_alternate = bool(step_alternate)
         self.step_short = float(step_short)
-        self.step_width = float(step_width)
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
         self.place_gain = float(place_gain)
@@ -437,8 +433,7 @@ class AnchoredReference:
         left = np.array([-np.sin(heading), np.cos(heading)])
         fall = xi - convex_hull(support).mean(axis=0)
         side = float(fall @ left)
-        forward = float(fall @ np.array([left[1], -left[0]]))
-        if abs(side) > _SIDE_STEP_TAN * abs(forward):
+        if abs(side) > _SIDE_STEP_TAN * abs(float(fall @ np.array([left[1], -left[0]]))):
             foot = 0 if side > 0 else 1  # a side or diagonal step with the foot on that side
         else:  # the trailing foot
             foot = int(np.argmax(np.linalg.norm(centre[:, :2] - xi, axis=1)))
@@ -450,12 +445,9 @@ class AnchoredReference:
             # the foot that just landed carries the body: stepping it again pivoted the body
             # over the foot left behind
             foot = 1 - self._landed[0]
-        # a forward step wider (``step_width``): landed 0.11 m beside the stance foot, the
-        # next step stood on a foot rolled onto its edge
-        width = self.step_width if forward > 0 else _STEP_WIDTH
         target = step_target(
             xi, centre[1 - foot, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
-            max_length=0.6, min_width=width, lateral=left if foot == 0 else -left,
+            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
         )  # fmt: skip
         duration = self.step_time
         if self.step_short and self._landed[0] >= 0:

@@ -152,7 +152,7 @@ _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: and after a push while the mocap stands a hip strategy (``hip_weight``) near the feet's edge
 #: and balance steps once the capture point leaves them (``step_pushed``; the pelvis lowered so
 #: the step reaches the floor, the next step by the other foot or by one lifted off the floor,
-#: a short step quicker, a forward step wider: ``step_width``).
+#: a short step quicker).
 #: Without them
 #: the tracker follows the captured world path, as the 1 s benchmark windows, predictive
 #: sampling and the response pipeline's physical mode expect.
@@ -161,7 +161,6 @@ WHOLE_CLIP: Mapping[str, Param] = MappingProxyType(
      "balance_margin": 0.05, "trunk_weight": 30.0, "trunk_give": 0.5, "kp_root": 50.0,
      "kp_root_pushed": 30.0, "hip_weight": 300.0, "hip_tilt_step": 0.5, "warp_gain": 0.8,
      "step_pushed": True, "step_leg": 0.9, "step_alternate": True, "step_short": 0.3,
-     "step_width": 0.18,
      "place_pushed": 1.0}
 )  # fmt: skip
 

@@ -170,11 +170,6 @@ class WholeBodyTracker(AnchoredReference):
             swings in proportionally less time (at least 0.4 of ``step_time``; 0: off):
             putting back down a foot that the wide stance after a step had lifted took the
             whole step time while the body fell toward it.
-        step_width: a forward balance step (the capture point ahead of the feet's centre)
-            lands at least ``step_width`` m to its own side of the stance foot (m, in
-            [0.05, 0.4]; other steps 0.12): landed 0.11 m beside it, the capture point
-            drifted off that narrow stance and the next step stood on a foot rolled onto
-            its edge.
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -259,7 +254,6 @@ class WholeBodyTracker(AnchoredReference):
         step_pushed: bool = False,
         step_alternate: bool = False,
         step_short: float = 0.0,
-        step_width: float = 0.12,
         swing_weight: float = 10.0,
         kp_swing: float = 400.0,
         place_gain: float = 0.0,
@@ -291,7 +285,7 @@ class WholeBodyTracker(AnchoredReference):
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
-                "step_short": step_short, "step_width": step_width,
+                "step_short": step_short,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "place_pushed": place_pushed,
@@ -308,11 +302,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_leg must be 0 (off) or in [0.5, 1.5] (a leg over the pelvis's height), "
                 f"got {step_leg!r}"
-            )
-        if not 0.05 <= step_width <= 0.4:
-            raise ConfigError(
-                f"step_width must be in [0.05, 0.4] m (a balance step beside the stance foot), "
-                f"got {step_width!r}"
             )
         servo = world.servo
         m = world.model
@@ -410,7 +399,7 @@ class WholeBodyTracker(AnchoredReference):
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
             warp_gain=warp_gain, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
-            place_pushed=place_pushed, step_width=step_width,
+            place_pushed=place_pushed,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
