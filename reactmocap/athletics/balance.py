@@ -390,8 +390,11 @@ class BalanceLaw:
                 rig.offset[_SHOULDER, 0] += self._windmill(0, cp, ahead, dt, level, *g.windmill)
             if g.windmill_side is not None:
                 rate, margin, lean = g.windmill_side
-                # a fall to the left (+y) is a roll about -x: the arms roll that way too
-                spin = self._windmill(1, -cp_side, -left, dt, level, rate, margin)
+                # a fall to the left (+y) is a roll about -x: the arms roll that way too; only
+                # while the arms do not circle fore-aft (with both, or on whichever fall ran
+                # more across the feet, the front diagonals lost 10-55 N, docs/athletics.md)
+                across = -cp_side * (self._wind_dir[0] == 0.0)
+                spin = self._windmill(1, across, -left, dt, level, rate, margin)
                 rig.offset[_SHOULDER, 1] += spin
                 rig.offset[_SHOULDER, 0] -= lean * (self._wind_dir[1] != 0.0)
         lo, hi = ANKLE_LIMITS
