@@ -158,7 +158,9 @@ class BalanceGains:
     #: both arms circling about the fore-aft axis (roll) at ``rate`` rad/s in the sense
     #: whose reaction rolls the body against a sideways fall, the circle's plane tipped
     #: ``lean`` rad forward so the arms pass in front of the hips and behind the head (the
-    #: body does not collide with itself); a diagonal fall runs both circles; ``None``: off
+    #: body does not collide with itself), only while the arms do not circle fore-aft; opt-in:
+    #: the female's sideways push 75 -> 95 N but her front diagonals lost 10-25 N
+    #: (docs/athletics.md); ``None``: off
     windmill_side: tuple[float, float, float] | None = None
     #: the sideways COM servo's gains (``kp``, ``kv``) as a multiple of the fore-aft ones
     #: (the leap's crouch on yawed feet drifts sideways: docs/athletics.md)
