@@ -195,11 +195,13 @@ class BalanceGains:
             )
         ws = self.windmill_side
         if ws is not None and (
-            len(ws) != 3 or not all(math.isfinite(x) and 0 <= x <= 10 for x in ws)
+            len(ws) != 3
+            or not all(math.isfinite(x) and x >= 0 for x in ws[:2])
+            or not abs(ws[2]) <= 0.5 * math.pi
         ):
             raise ConfigError(
-                f"balance windmill_side must be 3 finite numbers in [0, 10] (rate rad/s, "
-                f"margin m, lean rad), got {ws!r}"
+                f"balance windmill_side must be (rate rad/s >= 0, margin m >= 0, lean rad in "
+                f"[-pi/2, pi/2]), got {ws!r}"
             )
         a = self.arms
         if a is not None and (len(a) != 3 or not all(math.isfinite(x) and x >= 0 for x in a)):

@@ -171,4 +171,4 @@ def test_a_sideways_push_is_taken_by_arms_circling_in_the_frontal_plane(
     monkeypatch.setattr(behaviours, "STANDING_GAINS", no_side)
     assert not run("balance", "female", **push).report["balanced"]
     with pytest.raises(ConfigError, match="windmill_side"):
-        BalanceGains(windmill_side=(8.0, 0.05, -0.5))
+        BalanceGains(windmill_side=(8.0, 0.05, 2.0))
