@@ -154,6 +154,14 @@ class BalanceGains:
     #: (back-up-over on a forward fall), and finish the circle they are on once it is back
     #: (their momentum given back when the COM is caught); ``None``: off
     windmill: tuple[float, float] | None = None
+    #: sideways arm windmilling ``(rate, margin, lean)``: as ``windmill`` across the feet,
+    #: both arms circling about the fore-aft axis (roll) at ``rate`` rad/s in the sense
+    #: whose reaction rolls the body against a sideways fall, the circle's plane tipped
+    #: ``lean`` rad forward so the arms pass in front of the hips and behind the head (the
+    #: body does not collide with itself), only while the arms do not circle fore-aft; opt-in:
+    #: the female's sideways push 75 -> 95 N but her front diagonals lost 10-25 N
+    #: (docs/athletics.md); ``None``: off
+    windmill_side: tuple[float, float, float] | None = None
     #: the sideways COM servo's gains (``kp``, ``kv``) as a multiple of the fore-aft ones
     #: (the leap's crouch on yawed feet drifts sideways: docs/athletics.md)
     side: float = 1.0
@@ -184,6 +192,16 @@ class BalanceGains:
         if w is not None and (len(w) != 2 or not all(math.isfinite(x) and x >= 0 for x in w)):
             raise ConfigError(
                 f"balance windmill must be 2 finite numbers >= 0 (rate rad/s, margin m), got {w!r}"
+            )
+        ws = self.windmill_side
+        if ws is not None and (
+            len(ws) != 3
+            or not all(math.isfinite(x) and x >= 0 for x in ws[:2])
+            or not abs(ws[2]) <= 0.5 * math.pi
+        ):
+            raise ConfigError(
+                f"balance windmill_side must be (rate rad/s >= 0, margin m >= 0, lean rad in "
+                f"[-pi/2, pi/2]), got {ws!r}"
             )
         a = self.arms
         if a is not None and (len(a) != 3 or not all(math.isfinite(x) and x >= 0 for x in a)):
@@ -243,9 +261,10 @@ class BalanceLaw:
         self.com_target = np.zeros(3)
         #: the COM offset eased from (set_posture's ease_com), or None
         self._com0: tuple[float, float] | None = None
-        #: :attr:`BalanceGains.windmill`: the arms' circle (rad), its sense, the last tick
-        self._wind = 0.0
-        self._wind_dir = 0.0
+        #: :attr:`BalanceGains.windmill` (index 0, pitch) and ``windmill_side`` (1, roll): the
+        #: arms' circle (rad), its sense; the last tick
+        self._wind = [0.0, 0.0]
+        self._wind_dir = [0.0, 0.0]
         self._t_wind = math.nan
         self._knee_standing = float(np.mean(knee_for_length(
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
@@ -328,6 +347,7 @@ class BalanceLaw:
         target[1] += sn * ox + c * oy
         ahead = ox  # the target ahead of the support centre, along the feet
         roll = (1.0, -0.5)
+        left = oy  # the target left of the support centre
         if any(g.uphill) or g.side_roll is not None:
             n = s.floor_normal
             grad = s.local(-n / max(float(n[2]), 1e-6), h)  # the floor's gradient, heading frame
@@ -335,6 +355,7 @@ class BalanceLaw:
             target[0] += c * up[0] - sn * up[1]
             target[1] += sn * up[0] + c * up[1]
             ahead += float(up[0])
+            left += float(up[1])
             if g.side_roll is not None:
                 w = min(abs(float(grad[1])) / SIDE_SLOPE, 1.0)
                 roll = (1.0 + w * (g.side_roll[0] - 1.0), -0.5 + w * (g.side_roll[1] + 0.5))
@@ -345,10 +366,11 @@ class BalanceLaw:
         delta[1] *= g.side
         np.clip(delta, -g.max_offset, g.max_offset, out=delta)
         pitch = self._pitch_now(t) + self._lean()
-        cp = 0.0
-        if g.bow is not None or g.arms is not None or g.windmill is not None:
+        cp = cp_side = 0.0
+        if any(x is not None for x in (g.bow, g.arms, g.windmill, g.windmill_side)):
             omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
             cp = float(vel[0]) / omega - float(err[0])  # capture point ahead of the target
+            cp_side = float(vel[1]) / omega - float(err[1])  # ... and left of it
         if g.bow is not None and bool(s.foot_contact.all()):
             pitch += self._bow(cp, float(vel[0]))
         hold_pelvis_and_feet(ctx, d, pitch, h, t)
@@ -363,10 +385,22 @@ class BalanceLaw:
             # behind the support centre too: a COM on its way to a target moved ahead is left be
             behind = cp + ahead < -margin
             rig.offset[_SHOULDER, 0] = -min(gain * max(-cp - margin, 0.0), limit) * behind
-        if g.windmill is not None:
+        if g.windmill is not None or g.windmill_side is not None:
             n = s.floor_normal
             level = math.hypot(float(n[0]), float(n[1])) < WINDMILL_SLOPE * float(n[2])
-            rig.offset[_SHOULDER, 0] += self._windmill(cp, ahead, t, level)
+            dt = max(t - self._t_wind, 0.0) if self._t_wind == self._t_wind else 0.0
+            self._t_wind = t
+            if g.windmill is not None:
+                rig.offset[_SHOULDER, 0] += self._windmill(0, cp, ahead, dt, level, *g.windmill)
+            if g.windmill_side is not None:
+                rate, margin, lean = g.windmill_side
+                # a fall to the left (+y) is a roll about -x: the arms roll that way too; only
+                # while the arms do not circle fore-aft (with both, or on whichever fall ran
+                # more across the feet, the front diagonals lost 10-55 N, docs/athletics.md)
+                across = -cp_side * (self._wind_dir[0] == 0.0)
+                spin = self._windmill(1, across, -left, dt, level, rate, margin)
+                rig.offset[_SHOULDER, 1] += spin
+                rig.offset[_SHOULDER, 0] -= lean * (self._wind_dir[1] != 0.0)
         lo, hi = ANKLE_LIMITS
         desired = rig.desired(t)
         for k in range(2):
@@ -376,28 +410,29 @@ class BalanceLaw:
         self._level_legs(d, desired, hang)
         self._support(s)
 
-    def _windmill(self, cp: float, ahead: float, t: float, level: bool = True) -> float:
-        """:attr:`BalanceGains.windmill`'s shoulder pitch (rad) for the capture point ``cp``
-        ahead of the COM target, the target ``ahead`` of the support centre; off the level
-        (:data:`WINDMILL_SLOPE`) the arms only finish their circle."""
-        rate, margin = self.gains.windmill  # type: ignore[misc]
-        dt = max(t - self._t_wind, 0.0) if self._t_wind == self._t_wind else 0.0
-        self._t_wind = t
+    def _windmill(
+        self, k: int, cp: float, ahead: float, dt: float, level: bool, rate: float, margin: float
+    ) -> float:
+        """The arms' circle (rad) about axis ``k`` (0: pitch, :attr:`BalanceGains.windmill`;
+        1: roll, ``windmill_side``) for the capture point ``cp`` beyond the COM target in that
+        circle's positive sense, the target ``ahead`` of the support centre that way; off the
+        level (:data:`WINDMILL_SLOPE`) the arms only finish their circle."""
         # beyond the support centre's margin too: a COM on its way to a moved target is left be
         fwd = cp > margin and cp + ahead > margin
         back = cp < -margin and cp + ahead < -margin
         falling = level and (fwd or back)
         if falling:  # forward: the arms go back and over (pitch > 0), else the other way
-            self._wind_dir = 1.0 if cp > 0.0 else -1.0
-        nxt = self._wind + self._wind_dir * rate * dt
-        if not falling and self._wind_dir:  # caught: finish the circle the arms are on
-            turn = self._wind / (2.0 * math.pi)
-            whole = math.ceil(turn - 1e-9) if self._wind_dir > 0 else math.floor(turn + 1e-9)
+            self._wind_dir[k] = 1.0 if cp > 0.0 else -1.0
+        sense = self._wind_dir[k]
+        nxt = self._wind[k] + sense * rate * dt
+        if not falling and sense:  # caught: finish the circle the arms are on
+            turn = self._wind[k] / (2.0 * math.pi)
+            whole = math.ceil(turn - 1e-9) if sense > 0 else math.floor(turn + 1e-9)
             end = 2.0 * math.pi * whole
-            if (nxt - end) * self._wind_dir >= 0.0:
-                nxt, self._wind_dir = end, 0.0
-        self._wind = nxt
-        return self._wind
+            if (nxt - end) * sense >= 0.0:
+                nxt, self._wind_dir[k] = end, 0.0
+        self._wind[k] = nxt
+        return nxt
 
     def _bow(self, cp: float, vel: float) -> float:
         """:attr:`BalanceGains.bow`'s pitch (rad, forward > 0) for the capture point ``cp``

@@ -120,9 +120,11 @@ def test_a_forward_push_past_the_toes_is_taken_by_windmilling_arms(
     circle: list[float] = []
     windmill = BalanceLaw._windmill
 
-    def spy(law: BalanceLaw, cp: float, ahead: float, t: float, level: bool = True) -> float:
-        circle.append(windmill(law, cp, ahead, t, level))
-        return circle[-1]
+    def spy(law: BalanceLaw, k: int, *args: float) -> float:
+        got = windmill(law, k, *args)
+        if k == 0:
+            circle.append(got)
+        return got
 
     monkeypatch.setattr(BalanceLaw, "_windmill", spy)
     push = {"check_range": False, "seconds": 3.0, "push": 160.0, "push_dir": 0.0}
@@ -138,3 +140,35 @@ def test_a_forward_push_past_the_toes_is_taken_by_windmilling_arms(
     assert not run("balance", "male", **push).report["balanced"]
     with pytest.raises(ConfigError, match="windmill"):
         BalanceGains(windmill=(8.0, math.nan))
+
+
+def test_a_sideways_push_is_taken_by_arms_circling_in_the_frontal_plane(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # BalanceGains.windmill_side: 85 N to the female's left for 0.25 s; both arms roll about the
+    # fore-aft axis against the fall, finish their circle, and she stands; without them she
+    # falls (her limit was 75 N with the sagittal windmill, 2026-12-03)
+    circle: list[float] = []
+    windmill = BalanceLaw._windmill
+
+    def spy(law: BalanceLaw, k: int, *args: float) -> float:
+        got = windmill(law, k, *args)
+        if k == 1:
+            circle.append(got)
+        return got
+
+    monkeypatch.setattr(BalanceLaw, "_windmill", spy)
+    side = dataclasses.replace(STANDING_GAINS, windmill_side=(8.0, 0.05, 0.5))
+    monkeypatch.setattr(behaviours, "STANDING_GAINS", side)
+    push = {"check_range": False, "seconds": 3.0, "push": 85.0, "push_dir": math.pi / 2}
+    r = run("balance", "female", **push)
+    assert r.report["balanced"] and not r.report["fell"]
+    # a fall to the left rolls the arms about -x; they end on a whole circle
+    assert min(circle) <= -2.0 * math.pi and circle[-1] == pytest.approx(
+        2.0 * math.pi * round(circle[-1] / (2.0 * math.pi))
+    )
+    no_side = dataclasses.replace(STANDING_GAINS, windmill_side=None)
+    monkeypatch.setattr(behaviours, "STANDING_GAINS", no_side)
+    assert not run("balance", "female", **push).report["balanced"]
+    with pytest.raises(ConfigError, match="windmill_side"):
+        BalanceGains(windmill_side=(8.0, 0.05, 2.0))
