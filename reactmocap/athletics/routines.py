@@ -119,7 +119,8 @@ SOMERSAULT_PRESETS: Mapping[
                     MappingProxyType({"delta": 0.4, "knee": 0.4, "restore": 0.2})),
     }),
     "female": MappingProxyType({
-        "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0}),
+        "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0,
+                                       "tilt_gain": 10.0}),
                      MappingProxyType({"lead": 3.6}),
                      MappingProxyType({"delta": -0.16, "spin_aim": True, "aim_sideways": True,
                                        "twist_aim": True})),
