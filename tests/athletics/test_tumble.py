@@ -294,16 +294,19 @@ def test_perturbed_female_back_tucks_land_with_the_legs_aimed_where_the_pelvis_w
     from where the pelvis is (``aim_sideways`` alone, or the preset before: ``spin_aim``
     alone) start 0's feet touched down 10-17 cm to the side of the COM, she stood up on one
     foot and fell sideways. With the aim taken from where the pelvis will be once the hips
-    get there (``twist_aim``, the preset since 2026-12-03) both land."""
+    get there (``twist_aim``, the preset since 2026-12-03) both land. The ablations push off
+    as the preset did then (no ``tilt_gain``: with it start 0 lands without ``twist_aim``
+    too)."""
     starts = full_starts(6)
     m = somersault_maneuver(body="female")
     assert m.phases[3].params["twist_aim"] is True
     for i in (0, 5):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+    leap = replace(m.phases[1], params={**m.phases[1].params, "tilt_gain": 0.0})
     for off in ({"twist_aim": False}, {"twist_aim": False, "aim_sideways": False}):
         land = replace(m.phases[3], params={**m.phases[3].params, **off})
-        before = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
+        before = replace(m, phases=(m.phases[0], leap, m.phases[2], land, *m.phases[4:]))
         r = run_maneuver(before, perturbation=starts[0], fps=10.0).report
         assert r["fell"] and not r["landed"], off
 
