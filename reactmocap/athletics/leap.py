@@ -99,6 +99,11 @@ COM_PUSH_LEG = 0.6
 COM_PUSH_SPIN: Mapping[str, float] = MappingProxyType({"male": -2.0, "female": -1.3})
 #: the "com" push's horizontal COM servo through the ankles (rad/m, rad s/m; the balance's)
 ANKLE_KP, ANKLE_KV = 2.0, 0.5
+#: the largest hip roll and yaw offset (rad) the push's tilt feedback may make (tilt_gain)
+TILT_LIMIT = 0.3
+#: the tilt feedback's yaw gain as a multiple of its roll gain (tilt_gain): the yaw
+#: momentum is the smaller, and the one that told the female back tuck's landings apart
+TILT_YAW = 4.0
 #: stiffness in the air (the legs only position themselves)
 FLIGHT_STIFFNESS = {
     "waist": 2.0, "back": 2.0, "neck": 0.3, "shoulder": 0.3, "elbow": 0.15, "wrist": 0.05,
@@ -157,13 +162,20 @@ class LeapParams:
     #: the "com" push's hip and ankle stiffness (m g L N m/rad; see COM_PUSH_LEGS)
     push_hip: float = 1.0
     push_ankle: float = 1.0
+    #: the timed push also servos the whole-body angular momentum's roll (about the heading's
+    #: forward axis: cartwheel) and yaw (twist) to zero through the hips' roll and yaw (rad per
+    #: unit of momentum in m L^2 rad/s, as ``spin_gain``; yaw ``TILT_YAW`` times it; at most
+    #: ``TILT_LIMIT``): a take-off's yaw and cartwheel momentum twist a somersault's opening
+    #: body; 0: off (as before)
+    tilt_gain: float = 0.0
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
                 self.hold, *self.timing, self.ankle_gain, self.ankle_extension, self.liftoff_hip,
                 self.stiffness, self.lean, self.crouch_side,
                 self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
-                self.push_ramp, self.push_limit, self.push_hip, self.push_ankle]  # fmt: skip
+                self.push_ramp, self.push_limit, self.push_hip, self.push_ankle,
+                self.tilt_gain]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.0 < self.crouch_side <= 5.0:
@@ -187,6 +199,8 @@ class LeapParams:
                 f"leap push_hip and push_ankle must be in [0, 10] m g L/rad, got "
                 f"{self.push_hip}, {self.push_ankle}"
             )
+        if not 0.0 <= self.tilt_gain <= 100.0:
+            raise ConfigError(f"leap tilt_gain must be in [0, 100] rad, got {self.tilt_gain}")
         if self.handover not in HANDOVERS:
             raise ConfigError(
                 f"leap handover must be one of {list(HANDOVERS)}, got {self.handover!r}"
@@ -228,6 +242,10 @@ class Leap(Basis):
         bl = BalanceLaw(ctx, replace(BALANCE_GAINS, side=p.crouch_side))
         every = ctx.control_every
         memo: dict[str, Any] = {}
+        knees = [joint_index(f"{k}_knee") for k in "lr"]
+        ankles = [joint_index(f"{k}_ankle") for k in "lr"]
+        hips = [joint_index(f"{k}_hip") for k in "lr"]
+        tilt = np.zeros(2)  # the tilt feedback's roll and yaw momentum (tilt_gain)
 
         def crouch(world: World, t: float) -> None:
             del world
@@ -285,6 +303,17 @@ class Leap(Basis):
                 off = float(np.clip(ramp * p.spin_gain * err, -p.spin_limit, p.spin_limit))
                 for j in (joint_index("l_hip"), joint_index("r_hip")):
                     ctx.rig.offset[j, 0] = off
+            if p.tilt_gain > 0:
+                # roll and yaw momentum to zero, the hips tilting and turning the push about
+                # the COM as the pitch feedback above (same ramp)
+                h = s.heading()
+                lw = world.data.subtree_angmom[s.root]
+                tilt[:] = lw[0] * math.cos(h) + lw[1] * math.sin(h), lw[2]
+                ramp = min(1.0, (t - memo["t_thrust"]) / SPIN_RAMP)
+                scale = ramp * p.tilt_gain / (ctx.athlete.mass * ctx.athlete.leg_length**2)
+                tilt[0] *= scale
+                tilt[1] *= TILT_YAW * scale
+                ctx.rig.offset[hips, 1:] = np.clip(tilt, -TILT_LIMIT, TILT_LIMIT)
 
         g = float(np.linalg.norm(ctx.world.model.opt.gravity))
 
@@ -320,10 +349,6 @@ class Leap(Basis):
             for j in ("waist", "back"):
                 goal[joint_index(j)] = 0.0
             rig.move(goal, dur, t, [*arms, joint_index("waist"), joint_index("back")])
-
-        knees = [joint_index(f"{k}_knee") for k in "lr"]
-        ankles = [joint_index(f"{k}_ankle") for k in "lr"]
-        hips = [joint_index(f"{k}_hip") for k in "lr"]
 
         def com_push(world: World, t: float) -> None:
             s = ctx.sense(t)

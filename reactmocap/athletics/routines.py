@@ -96,7 +96,9 @@ TIMED_START_PRESETS = frozenset({"male/forward"})
 #: legs' sideways aim is taken from where the pelvis will be once the hips get there
 #: (``aim_sideways`` with ``twist_aim``): a take-off's cartwheel momentum twists her opening body
 #: about its long axis at ~4 rad/s, her feet touched down 10-17 cm to the side of the COM and
-#: she stood up on one foot and fell sideways (docs/athletics.md).
+#: she stood up on one foot and fell sideways (docs/athletics.md). Since 2026-12-03 her push
+#: also servos the cartwheel and yaw momentum to zero (the leap's ``tilt_gain``): the
+#: take-off's yaw momentum told her landings apart.
 SOMERSAULT_PRESETS: Mapping[
     str, Mapping[str, tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]]
 ] = MappingProxyType({
@@ -119,7 +121,8 @@ SOMERSAULT_PRESETS: Mapping[
                     MappingProxyType({"delta": 0.4, "knee": 0.4, "restore": 0.2})),
     }),
     "female": MappingProxyType({
-        "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0}),
+        "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0,
+                                       "tilt_gain": 10.0}),
                      MappingProxyType({"lead": 3.6}),
                      MappingProxyType({"delta": -0.16, "spin_aim": True, "aim_sideways": True,
                                        "twist_aim": True})),

@@ -13,6 +13,8 @@ import pytest
 
 from reactmocap.athletics import athlete
 from reactmocap.athletics.backdrop import arm_windmill
+from reactmocap.athletics.behaviours import AthleticsResult
+from reactmocap.athletics.leap import LeapParams
 from reactmocap.athletics.maneuvers import Maneuver, Perturbation, load_maneuver, run_maneuver
 from reactmocap.athletics.report import FALL_HEIGHT
 from reactmocap.athletics.rig import joint_index
@@ -292,18 +294,54 @@ def test_perturbed_female_back_tucks_land_with_the_legs_aimed_where_the_pelvis_w
     from where the pelvis is (``aim_sideways`` alone, or the preset before: ``spin_aim``
     alone) start 0's feet touched down 10-17 cm to the side of the COM, she stood up on one
     foot and fell sideways. With the aim taken from where the pelvis will be once the hips
-    get there (``twist_aim``, the preset since 2026-12-03) both land."""
+    get there (``twist_aim``, the preset since 2026-12-03) both land. The ablations push off
+    as the preset did then (no ``tilt_gain``: with it start 0 lands without ``twist_aim``
+    too)."""
     starts = full_starts(6)
     m = somersault_maneuver(body="female")
     assert m.phases[3].params["twist_aim"] is True
     for i in (0, 5):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+    leap = replace(m.phases[1], params={**m.phases[1].params, "tilt_gain": 0.0})
     for off in ({"twist_aim": False}, {"twist_aim": False, "aim_sideways": False}):
         land = replace(m.phases[3], params={**m.phases[3].params, **off})
-        before = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
+        before = replace(m, phases=(m.phases[0], leap, m.phases[2], land, *m.phases[4:]))
         r = run_maneuver(before, perturbation=starts[0], fps=10.0).report
         assert r["fell"] and not r["landed"], off
+
+
+def _liftoff_momentum(r: AthleticsResult) -> np.ndarray:
+    """The whole-body angular momentum (world, kg m^2/s) just after lift-off."""
+    t = r.log["t"]
+    k = min(int(np.searchsorted(t, r.report["time_to_liftoff_s"] + 0.02)), t.size - 1)
+    return np.asarray(r.log["momentum"][k])
+
+
+def test_the_female_back_tuck_pushes_off_with_little_yaw_momentum() -> None:
+    """Start 3 of the capture region at full size (seed 0), female. The take-off's yaw
+    momentum told her landings apart (above 0.61 kg m^2/s 19% landed, below 90%): it twists
+    the opening body. Without the push's tilt feedback (``tilt_gain`` 0, the preset before)
+    she left with 1.07 kg m^2/s and fell; with it (the preset since 2026-12-03) with about
+    half, and lands."""
+    start = full_starts(4)[3]
+    m = somersault_maneuver(body="female")
+    assert m.phases[1].params["tilt_gain"] > 0
+    r = run_maneuver(m, perturbation=start, fps=10.0)
+    assert r.report["landed"] and not r.report["fell"]
+    assert abs(r.report["rotation_deg"] + 360.0) <= 30.0
+    assert abs(_liftoff_momentum(r)[2]) < 0.6
+    leap = replace(m.phases[1], params={**m.phases[1].params, "tilt_gain": 0.0})
+    r = run_maneuver(replace(m, phases=(m.phases[0], leap, *m.phases[2:])), perturbation=start,
+                     fps=10.0)  # fmt: skip
+    assert r.report["fell"] and not r.report["landed"]
+    assert abs(_liftoff_momentum(r)[2]) > 0.9
+
+
+def test_the_leap_refuses_a_tilt_gain_out_of_range() -> None:
+    for bad in (-1.0, 101.0, math.nan):
+        with pytest.raises(ConfigError, match="tilt_gain|finite"):
+            LeapParams(tilt_gain=bad)
 
 
 def test_the_female_back_somersault_file_is_the_preset() -> None:
