@@ -111,30 +111,38 @@ def test_a_backward_push_is_taken_by_the_arms(monkeypatch: pytest.MonkeyPatch) -
         BalanceGains(arms=(40.0, 0.05, -1.0))
 
 
+def _record_windmill(monkeypatch: pytest.MonkeyPatch, k: int) -> list[float]:
+    """Every angle ``BalanceLaw._windmill`` returns for circle ``k`` (0 fore-aft, 1 sideways)."""
+    circle: list[float] = []
+    windmill = BalanceLaw._windmill
+
+    def spy(law: BalanceLaw, kk: int, *args: float) -> float:
+        got = windmill(law, kk, *args)
+        if kk == k:
+            circle.append(got)
+        return got
+
+    monkeypatch.setattr(BalanceLaw, "_windmill", spy)
+    return circle
+
+
+def _on_a_whole_circle(angle: float) -> bool:
+    return angle == pytest.approx(2.0 * math.pi * round(angle / (2.0 * math.pi)))
+
+
 def test_a_forward_push_past_the_toes_is_taken_by_windmilling_arms(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     # STANDING_GAINS.windmill: 160 N forward for 0.25 s; the arms circle back and over while the
     # capture point lies past the COM target, finish their circle, and the male stands with his
     # feet down; without them he falls (the limit was 135 N with the bow and arms, 2026-12-03)
-    circle: list[float] = []
-    windmill = BalanceLaw._windmill
-
-    def spy(law: BalanceLaw, k: int, *args: float) -> float:
-        got = windmill(law, k, *args)
-        if k == 0:
-            circle.append(got)
-        return got
-
-    monkeypatch.setattr(BalanceLaw, "_windmill", spy)
+    circle = _record_windmill(monkeypatch, 0)
     push = {"check_range": False, "seconds": 3.0, "push": 160.0, "push_dir": 0.0}
     r = run("balance", "male", **push)
     assert r.report["balanced"] and not r.report["fell"]
     after = r.log["t"] >= 0.5
     assert np.count_nonzero(r.log["feet"][after] < 2) <= 10
-    assert max(circle) >= 2.0 * math.pi and circle[-1] == pytest.approx(
-        2.0 * math.pi * round(circle[-1] / (2.0 * math.pi))
-    )
+    assert max(circle) >= 2.0 * math.pi and _on_a_whole_circle(circle[-1])
     no_windmill = dataclasses.replace(STANDING_GAINS, windmill=None)
     monkeypatch.setattr(behaviours, "STANDING_GAINS", no_windmill)
     assert not run("balance", "male", **push).report["balanced"]
@@ -148,25 +156,14 @@ def test_a_sideways_push_is_taken_by_arms_circling_in_the_frontal_plane(
     # BalanceGains.windmill_side: 85 N to the female's left for 0.25 s; both arms roll about the
     # fore-aft axis against the fall, finish their circle, and she stands; without them she
     # falls (her limit was 75 N with the sagittal windmill, 2026-12-03)
-    circle: list[float] = []
-    windmill = BalanceLaw._windmill
-
-    def spy(law: BalanceLaw, k: int, *args: float) -> float:
-        got = windmill(law, k, *args)
-        if k == 1:
-            circle.append(got)
-        return got
-
-    monkeypatch.setattr(BalanceLaw, "_windmill", spy)
+    circle = _record_windmill(monkeypatch, 1)
     side = dataclasses.replace(STANDING_GAINS, windmill_side=(8.0, 0.05, 0.5))
     monkeypatch.setattr(behaviours, "STANDING_GAINS", side)
     push = {"check_range": False, "seconds": 3.0, "push": 85.0, "push_dir": math.pi / 2}
     r = run("balance", "female", **push)
     assert r.report["balanced"] and not r.report["fell"]
     # a fall to the left rolls the arms about -x; they end on a whole circle
-    assert min(circle) <= -2.0 * math.pi and circle[-1] == pytest.approx(
-        2.0 * math.pi * round(circle[-1] / (2.0 * math.pi))
-    )
+    assert min(circle) <= -2.0 * math.pi and _on_a_whole_circle(circle[-1])
     no_side = dataclasses.replace(STANDING_GAINS, windmill_side=None)
     monkeypatch.setattr(behaviours, "STANDING_GAINS", no_side)
     assert not run("balance", "female", **push).report["balanced"]
