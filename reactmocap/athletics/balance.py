@@ -388,7 +388,7 @@ class BalanceLaw:
         if g.windmill is not None or g.windmill_side is not None:
             n = s.floor_normal
             level = math.hypot(float(n[0]), float(n[1])) < WINDMILL_SLOPE * float(n[2])
-            dt = max(t - self._t_wind, 0.0) if self._t_wind == self._t_wind else 0.0
+            dt = 0.0 if math.isnan(self._t_wind) else max(t - self._t_wind, 0.0)
             self._t_wind = t
             if g.windmill is not None:
                 rig.offset[_SHOULDER, 0] += self._windmill(0, cp, ahead, dt, level, *g.windmill)

@@ -294,23 +294,22 @@ class Leap(Basis):
             if memo.get("ramp", -1.0) < 1.0:  # the push's stiffness comes in smoothly
                 memo["ramp"] = ramp
                 ctx.rig.set_stiffness(memo["stiff0"] + ramp * (memo["stiff1"] - memo["stiff0"]))
+            # the momentum feedbacks' ramp, and their unit of momentum (m L^2 rad/s)
+            spin_ramp = min(1.0, (t - memo["t_thrust"]) / SPIN_RAMP)
+            unit = ctx.athlete.mass * ctx.athlete.leg_length**2
             if p.spin_gain > 0:
                 # whole-body angular momentum about the COM (mj_subtreeVel has run), pitch
                 # axis of the heading frame: the hips tilt the push ahead of or behind the COM
-                pitch_l = pitch_momentum(world, s)
-                err = (pitch_l - p.spin) / (ctx.athlete.mass * ctx.athlete.leg_length**2)
-                ramp = min(1.0, (t - memo["t_thrust"]) / SPIN_RAMP)
-                off = float(np.clip(ramp * p.spin_gain * err, -p.spin_limit, p.spin_limit))
-                for j in (joint_index("l_hip"), joint_index("r_hip")):
-                    ctx.rig.offset[j, 0] = off
+                err = (pitch_momentum(world, s) - p.spin) / unit
+                off = float(np.clip(spin_ramp * p.spin_gain * err, -p.spin_limit, p.spin_limit))
+                ctx.rig.offset[hips, 0] = off
             if p.tilt_gain > 0:
                 # roll and yaw momentum to zero, the hips tilting and turning the push about
-                # the COM as the pitch feedback above (same ramp)
+                # the COM as the pitch feedback above
                 h = s.heading()
                 lw = world.data.subtree_angmom[s.root]
                 tilt[:] = lw[0] * math.cos(h) + lw[1] * math.sin(h), lw[2]
-                ramp = min(1.0, (t - memo["t_thrust"]) / SPIN_RAMP)
-                scale = ramp * p.tilt_gain / (ctx.athlete.mass * ctx.athlete.leg_length**2)
+                scale = spin_ramp * p.tilt_gain / unit
                 tilt[0] *= scale
                 tilt[1] *= TILT_YAW * scale
                 ctx.rig.offset[hips, 1:] = np.clip(tilt, -TILT_LIMIT, TILT_LIMIT)

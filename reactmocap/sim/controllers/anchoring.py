@@ -341,6 +341,12 @@ class AnchoredReference:
         rot = self.world.data.geom_xmat[self.sole].reshape(2, 3, 3)
         return float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
 
+    def _start_placing(self, placing: bool, t: float) -> None:
+        """A walk pushed at ``t``: ``place_pushed`` moves its swing feet's landings (when
+        ``placing``) for ``_PLACE_WINDOW`` s."""
+        self.placing = placing
+        self._place_until = t + _PLACE_WINDOW
+
     def _place_walk(self, t: float) -> None:
         """After a sideways walk's push (``place_pushed``): a swinging foot lands where the
         simulated capture point will be when the mocap's foot comes down (pivoting over the

@@ -21,7 +21,7 @@ from scipy.optimize import nnls
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.controllers.anchoring import _PLACE_WINDOW, AnchoredReference
+from reactmocap.sim.controllers.anchoring import AnchoredReference
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import outside_distance
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
@@ -682,8 +682,7 @@ class WholeBodyTracker(AnchoredReference):
             f = self._xfrc[:, :2].sum(axis=0)
             along = abs(np.cos(heading) * f[0] + np.sin(heading) * f[1])
             side = abs(np.cos(heading) * f[1] - np.sin(heading) * f[0])
-            self.placing = self.place_pushed > 0 and along < _PLACE_SIDE_TAN * side
-            self._place_until = t + _PLACE_WINDOW
+            self._start_placing(self.place_pushed > 0 and along < _PLACE_SIDE_TAN * side, t)
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
                 self.kp[:3] = self._kp_root_pushed
