@@ -22,7 +22,7 @@ import numpy as np
 
 from reactmocap.athletics.balance import knee_for_length
 from reactmocap.athletics.bodies import Athlete
-from reactmocap.athletics.paths import Course, Straight
+from reactmocap.athletics.paths import Course, Polyline, Straight
 from reactmocap.athletics.rig import Rig, per_joint
 from reactmocap.athletics.running_body import (
     _ANKLE,
@@ -53,6 +53,7 @@ from reactmocap.athletics.running_params import (
     RunLog,
     RunParams,
     check_speed,
+    default_params,
 )
 from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
@@ -107,7 +108,8 @@ class Runner:
         athlete: the athlete's anatomical frames.
         speed: desired speed (m/s, within :data:`SPEED_RANGE`).
         course: facing direction or path to follow (default: straight ahead along +X).
-        params: tuning.
+        params: tuning (default: :func:`default_params` at ``speed``: on a straight line the
+            commanded step near the shared run clip's speed, the leg spring's gait elsewhere).
         control_every: physics steps per control tick.
     """
 
@@ -130,7 +132,9 @@ class Runner:
         self.target = check_speed(speed)
         self.speed = min(self.target, START_SPEED)
         self.course = course or Straight(0.0)
-        self.params = params or RunParams()
+        c = self.course
+        straight = isinstance(c, Polyline) and not c.closed and c.len.size == 1
+        self.params = params or default_params(self.target, straight)
         self.k = self.params.at(self.speed)
         self.accel = ACCEL
         self.character = character
@@ -548,6 +552,7 @@ class Runner:
         self.vz_peak = -math.inf
         self.vz_touchdown = float(self.senses.com_vel[2])
         # the start runs on the leg spring: from the set pose the commanded step fell
+        switch = not self.step_stance and t >= STEP_AFTER and self.k["step_stance"] > 0
         self.step_stance = self.k["step_stance"] if t >= STEP_AFTER else 0.0
         leg = self.active
         d = self.world.data
@@ -570,6 +575,10 @@ class Runner:
                 cap = ERROR_CAP
                 bias = self.speed_bias + self.k["speed_integral"] * _clamp(err, -cap, cap)
                 self.speed_bias = _clamp(bias, -0.3, 0.3)
+        if switch:
+            # the commanded step's correction starts at its steady value: built up from the
+            # spring's, it took 6-8 s and the step ran up to 0.4 m/s slow meanwhile
+            self.speed_bias = self.k["step_bias"]
         self.step_start = (t, com)
         # the spring's rest length: the hip-to-ankle length at touchdown as planned, or as
         # it landed if longer
