@@ -10,10 +10,9 @@ Sections:
   (``--eight-seconds``, 60: once round, 126 m): RMS cross-track error (goal <= 0.3 m) and
   how far along the path the runner got.
 * ``--phase``: the hip-knee phase plot (Fig. 6) of a run at the shared run clip's speed beside
-  the clip's, and their cadence and stride (goal: within 10%), measured after the first 3 s
-  of a 10 s run as every run's figures; writes the figure. The default at the clip's speed is
-  the commanded step (``STEP_PARAMS``); with ``--spring``, the leg spring's gait
-  (``RunParams()``, the default elsewhere), its figure as ``running_phase_spring.png``.
+  the clip's, and their cadence and stride (goal: within 10%); writes the figure. With
+  ``--step``, the opt-in commanded step with the push let through (``STEP_PARAMS``), its
+  figure as ``running_phase_step.png``.
 * ``--push``: the largest sideways impulse on the chest (over 0.1 s) the runner survives.
 * ``--vault``: the handspring vault against Table 1 (goal: all 16 rows inside the human range,
   velocities within 10% of the mean).
@@ -43,6 +42,7 @@ import numpy as np
 
 from reactmocap.athletics.run_course import run_course
 from reactmocap.athletics.running import TUNED_SPEEDS, RunParams
+from reactmocap.athletics.running_params import STEP_PARAMS
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT / ".." / "shared" / "mocap"
@@ -124,7 +124,7 @@ def phase(figures: Path, params: RunParams | None = None) -> None:
     figures.mkdir(parents=True, exist_ok=True)
     out = phase_plot({"simulated (left leg, last 2 s)": (hip[last, 0], knee[last, 0]),
                       "motion capture (left leg)": (chip[:, 0], cknee[:, 0])},
-                     figures / ("running_phase.png" if params is None else "running_phase_spring.png"),
+                     figures / ("running_phase.png" if params is None else "running_phase_step.png"),
                      title=f"hip-knee phase plot at {v:.2f} m/s")  # fmt: skip
     print(f"\nranges: simulated hip {np.degrees(hip[last, 0]).min():.0f} to "
           f"{np.degrees(hip[last, 0]).max():.0f} deg, knee {np.degrees(knee[last, 0]).min():.0f} to "
@@ -536,9 +536,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cloth-repeats", type=int, default=3,
                     help="alternating runs with and without cloth per garment")  # fmt: skip
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--spring", action="store_true",
-                    help="--phase: the leg spring's gait (RunParams()) instead of the default "
-                         "at the clip's speed (the commanded step)")  # fmt: skip
+    ap.add_argument("--step", action="store_true",
+                    help="--phase: the opt-in commanded step (STEP_PARAMS)")  # fmt: skip
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     if args.tune_speed is not None:
@@ -561,7 +560,7 @@ def main(argv: list[str] | None = None) -> int:
     if every or args.paths:
         paths(30.0, args.path_speed, args.eight_seconds)
     if every or args.phase:
-        phase(args.figures, RunParams() if args.spring else None)
+        phase(args.figures, STEP_PARAMS if args.step else None)
     if every or args.push:
         push(3.5)
     if every or args.vault:

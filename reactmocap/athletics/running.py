@@ -22,7 +22,7 @@ import numpy as np
 
 from reactmocap.athletics.balance import knee_for_length
 from reactmocap.athletics.bodies import Athlete
-from reactmocap.athletics.paths import Course, Polyline, Straight
+from reactmocap.athletics.paths import Course, Straight
 from reactmocap.athletics.rig import Rig, per_joint
 from reactmocap.athletics.running_body import (
     _ANKLE,
@@ -53,7 +53,6 @@ from reactmocap.athletics.running_params import (
     RunLog,
     RunParams,
     check_speed,
-    default_params,
 )
 from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
@@ -108,8 +107,7 @@ class Runner:
         athlete: the athlete's anatomical frames.
         speed: desired speed (m/s, within :data:`SPEED_RANGE`).
         course: facing direction or path to follow (default: straight ahead along +X).
-        params: tuning (default: :func:`default_params` at ``speed``: on a straight line the
-            commanded step near the shared run clip's speed, the leg spring's gait elsewhere).
+        params: tuning.
         control_every: physics steps per control tick.
     """
 
@@ -132,9 +130,7 @@ class Runner:
         self.target = check_speed(speed)
         self.speed = min(self.target, START_SPEED)
         self.course = course or Straight(0.0)
-        c = self.course
-        straight = isinstance(c, Polyline) and not c.closed and c.len.size == 1
-        self.params = params or default_params(self.target, straight)
+        self.params = params or RunParams()
         self.k = self.params.at(self.speed)
         self.accel = ACCEL
         self.character = character

@@ -16,13 +16,11 @@ from reactmocap.errors import ConfigError
 __all__ = [
     "SPEED_RANGE",
     "STEP_PARAMS",
-    "STEP_SPEEDS",
     "TUNED_SPEEDS",
     "RunLog",
     "RunParams",
     "Speeds",
     "check_speed",
-    "default_params",
 ]
 
 #: the speeds the runner is built for (m/s), the paper's range
@@ -119,8 +117,8 @@ class RunParams:
             error; eqs. 1-2 take ``step_placement`` times it as ``t_s``. Given at every speed or
             none. The leg spring's stance is about 0.17 s at 2.6 m/s whatever its values; a
             human's (the shared run clip's) about 0.2 s with a flight of 0.17-0.22 s. An
-            opt-in for the clip's speed (2.61 m/s, with ``push_hold`` 0.75): it falls at
-            neighbouring speeds (``docs/athletics.md``, the eighth round).
+            opt-in for the clip's speed (:data:`STEP_PARAMS`, with ``push_hold``): it is not
+            robust (``docs/athletics.md``, the eighth to tenth rounds).
         step_bias: at the switch into the commanded step, the placement's slow correction
             (``speed_integral``'s sum, m) starts from this, the step's steady value (-0.08 m
             at 2.5-2.7 m/s), rather than from the spring's: built up step by step it took
@@ -250,9 +248,9 @@ class RunParams:
 #: per-axis (roll, pitch, yaw) values, not per-speed
 _AXES = ("attitude_kp", "attitude_kv")
 
-#: the commanded step with the push let through, the default at :data:`STEP_SPEEDS` (around the
-#: shared run clip's 2.61 m/s: its cadence and stride within about 10%); the leg spring's gait
-#: elsewhere (``docs/athletics.md``, "Tenth round")
+#: an opt-in: the commanded step with the push let through, for the shared run clip's speed
+#: (2.61 m/s: its cadence and stride within 10%, at the edge); it held 30 s at 2.5-2.7 m/s, but
+#: moved by 2% its values mostly fell (``docs/athletics.md``, the tenth round)
 STEP_PARAMS = RunParams(
     step_stance=0.226,
     step_takeoff=0.835,
@@ -263,18 +261,6 @@ STEP_PARAMS = RunParams(
     toe_fraction=(0.562, 0.42, 0.3199),
     push_hold=0.836,
 )
-#: the speeds (m/s, inclusive) whose default is :data:`STEP_PARAMS`: it held 30 s at 2.5-2.7
-#: m/s and fell at 2.8 and 3 m/s
-STEP_SPEEDS = (2.55, 2.7)
-
-
-def default_params(speed: float, straight: bool = True) -> RunParams:
-    """The runner's default tuning at ``speed`` (m/s): :data:`STEP_PARAMS` on a straight
-    course within :data:`STEP_SPEEDS`, else ``RunParams()`` (the leg spring's gait). Paths keep
-    the spring's gait at every speed: on 10 m loops the commanded step fell in its first
-    seconds."""
-    lo, hi = STEP_SPEEDS
-    return STEP_PARAMS if straight and lo <= check_speed(speed) <= hi else RunParams()
 
 
 @dataclass
