@@ -548,6 +548,7 @@ class Runner:
         self.vz_peak = -math.inf
         self.vz_touchdown = float(self.senses.com_vel[2])
         # the start runs on the leg spring: from the set pose the commanded step fell
+        switch = not self.step_stance and t >= STEP_AFTER and self.k["step_stance"] > 0
         self.step_stance = self.k["step_stance"] if t >= STEP_AFTER else 0.0
         leg = self.active
         d = self.world.data
@@ -570,6 +571,10 @@ class Runner:
                 cap = ERROR_CAP
                 bias = self.speed_bias + self.k["speed_integral"] * _clamp(err, -cap, cap)
                 self.speed_bias = _clamp(bias, -0.3, 0.3)
+        if switch:
+            # the commanded step's correction starts at its steady value: built up from the
+            # spring's, it took 6-8 s and the step ran up to 0.4 m/s slow meanwhile
+            self.speed_bias = self.k["step_bias"]
         self.step_start = (t, com)
         # the spring's rest length: the hip-to-ankle length at touchdown as planned, or as
         # it landed if longer

@@ -3,6 +3,8 @@ bending are a share of the full ones, roll and yaw held (real MuJoCo, the thesis
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -53,7 +55,7 @@ def test_the_push_is_free_in_bending_and_held_in_roll_and_yaw(
 
 
 def test_the_commanded_step_lasts_its_stance() -> None:
-    """From STEP_AFTER on each stance lasts ``step_stance`` (to a tick or two), where the
+    """From STEP_AFTER on each stance lasts ``step_stance`` (0.226 s, to a tick or two), where the
     leg spring's lasts about 0.17 s; a commanded step given at some speeds only is a
     ConfigError."""
     res = run_course(2.61, seconds=4.0, fps=10.0, params=STEP_PARAMS)
@@ -64,6 +66,25 @@ def test_the_commanded_step_lasts_its_stance() -> None:
         up - max(d for d in downs if d < up) for up, _ in log.liftoffs if up > 2.5 and up > downs[0]
     ]
     assert len(stances) >= 4
-    assert np.all(np.abs(np.array(stances) - 0.2391) < 0.012), stances
+    assert np.all(np.abs(np.array(stances) - STEP_PARAMS.step_stance) < 0.012), stances
     with pytest.raises(ConfigError, match="every speed or none"):
         RunParams(step_stance=(0.0, 0.24, 0.24))
+
+
+@pytest.mark.parametrize("bias", [STEP_PARAMS.step_bias, 0.0])
+def test_the_commanded_step_is_at_speed_when_the_figures_start(bias: float) -> None:
+    """The commanded step's placement correction starts at its steady value (``step_bias``),
+    so over 3-6 s of a run at 2.61 m/s (the figures start at 3 s) the runner is within 0.06
+    m/s of the speed, at the step's cadence (under 3 steps/s; the leg spring's gait: 3.5).
+    Started from the spring's correction instead (``step_bias`` 0) the steps after the
+    switch run 0.2-0.4 m/s slow. A bias outside +-0.3 m is a ConfigError naming it."""
+    params = dataclasses.replace(STEP_PARAMS, step_bias=bias)
+    r = run_course(2.61, seconds=6.0, fps=10.0, params=params).report
+    assert not r["fell"] and r["figures_from_s"] == 3.0
+    assert r["cadence_steps_s"] < 3.0
+    if bias:
+        assert abs(r["mean_speed_m_s"] - 2.61) < 0.06, r
+    else:
+        assert r["mean_speed_m_s"] < 2.61 - 0.15, r
+    with pytest.raises(ConfigError, match=r"step_bias must be in \[-0.3, 0.3\]"):
+        RunParams(step_bias=0.5)
