@@ -72,7 +72,7 @@ def _check(args: argparse.Namespace) -> int:
     from reactmocap.library.clip_library import find_bvh_files
 
     rules = load_rules(args.parts) if args.parts else None
-    bad = total = unmapped = 0
+    ok = bad = unmapped = 0
     for path in args.paths:
         try:
             files = find_bvh_files(path)
@@ -84,21 +84,21 @@ def _check(args: argparse.Namespace) -> int:
             print(f"error: {path}: no .bvh files found")
             bad += 1
         for f in files:
-            total += 1
             try:
                 m = read_bvh(f)
             except ReactMocapError as exc:
                 bad += 1
                 print(f"error: {exc}")
                 continue
+            ok += 1
             print(f"ok: {f} ({m.num_frames} frames, {m.fps:g} fps)")
             try:
                 parts_for(m.skeleton, rules)
             except ReactMocapError as exc:
                 unmapped += 1
                 print(f"warning: {f}: {exc}")
-    print(f"{total - bad} ok, {bad} bad, {unmapped} not mappable onto body parts")
-    return 1 if bad or total == 0 else 0
+    print(f"{ok} ok, {bad} bad, {unmapped} not mappable onto body parts")
+    return 1 if bad or ok == 0 else 0
 
 
 def _convert(args: argparse.Namespace) -> int:
