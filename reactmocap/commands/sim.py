@@ -158,11 +158,13 @@ def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # t
             for k, v in data.items()
         }
         atomic_write_text(args.report, json.dumps(clean, indent=2) + "\n")
+    tracked = f"{data['seconds']:.2f} s"
     if data["status"] != "ok":
         print(f"{data['clip']}: {data['status'].upper()}: {data['reason']}; the outputs stop "
               "there")  # fmt: skip
+        tracked = f"{motion.duration:.2f} of {tracked}"  # the run ended early: say how early
     print(
-        f"{data['clip']}: {data['seconds']:.2f} s tracked, fell={data['fell']}, "
+        f"{data['clip']}: {tracked} tracked, fell={data['fell']}, "
         f"mean joint error {data['mean_joint_error_rad']:.3f} rad, root error "
         f"{data['root_error_m']:.3f} m, {data['realtime_factor']:.2f}x real time"
     )
