@@ -7,6 +7,7 @@ import math
 import sys
 from pathlib import Path
 
+from reactmocap.commands import output_dir, output_file
 from reactmocap.errors import ConfigError, ReactMocapError
 
 __all__ = ["register"]
@@ -33,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     conv = sub.add_parser("convert", help="read a BVH and write it back (resample, mirror)")
     conv.add_argument("input", type=Path)
-    conv.add_argument("output", type=Path)
+    conv.add_argument("output", type=output_file)
     conv.add_argument("--fps", type=float, help="resample to this frame rate")
     conv.add_argument("--mirror", action="store_true", help="mirror left/right")
     conv.add_argument("--unit", choices=["m", "cm", "mm", "in"], help="override unit detection")
@@ -41,7 +42,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     conv.set_defaults(func=_convert)
 
     synth = sub.add_parser("synth", help="generate the synthetic default clip library")
-    synth.add_argument("out_dir", type=Path)
+    synth.add_argument("out_dir", type=output_dir)
     synth.add_argument("--fps", type=float, default=60.0)
     synth.set_defaults(func=_synth)
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from reactmocap.commands import output_dir
+
 __all__ = ["register"]
 
 DEMO_SCENARIO = Path(__file__).resolve().parents[2] / "examples" / "front_kick.toml"
@@ -16,7 +18,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )  # fmt: skip
     rsp.add_argument("scenario", type=Path)
-    rsp.add_argument("--out", type=Path, required=True, help="output folder")
+    rsp.add_argument("--out", type=output_dir, required=True, help="output folder")
     rsp.add_argument("--parts", type=Path, help="body-part rules TOML (over the scenario's)")
     _flags(rsp)
     rsp.set_defaults(func=_respond)
@@ -25,7 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         "demo", help="run the bundled demo scenario (a front kick) on the synthetic clips",
         description=_OUTPUTS, formatter_class=argparse.RawDescriptionHelpFormatter,
     )  # fmt: skip
-    demo.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
+    demo.add_argument("--out", type=output_dir, default=Path("out/demo"), help="output folder")
     _flags(demo)
     demo.set_defaults(func=_demo)
 
