@@ -123,11 +123,11 @@ def _run(args: argparse.Namespace) -> int:
 def _summary(r: dict[str, Any], out: Path) -> None:
     name = r["behaviour"]
     bits = [f"{name} ({r['body']})"]
-    if "achieved_height_m" in r:
-        bits.append(f"height {r['achieved_height_m']:.3f} m (asked {r['commanded_height_m']:.3f})")
-    if "achieved_distance_m" in r:
-        bits.append(f"distance {r['achieved_distance_m']:.3f} m "
-                    f"(asked {r['commanded_distance_m']:.3f})")  # fmt: skip
+    for what in ("height", "distance"):
+        if f"achieved_{what}_m" in r:
+            asked = r[f"commanded_{what}_m"]
+            asked = f"effort {r['effort']:g}" if asked is None else f"asked {asked:.3f}"
+            bits.append(f"{what} {r[f'achieved_{what}_m']:.3f} m ({asked})")
     for key in ("landed", "balanced", "fell"):
         if key in r:
             bits.append(f"{key}={r[key]}")
