@@ -40,8 +40,8 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     ath = sub.add_parser(
         "athletics",
-        help="athletic controllers: leap, broad jump, land, balance, run, vault, maneuver, "
-        "somersault, dive",
+        help="athletic controllers: leap, broad-jump, land, balance, run, vault, maneuver, "
+        "somersault, dive, handspring, bicycle, group",
     )
     inner = ath.add_subparsers(dest="behaviour", metavar="BEHAVIOUR", required=True)
     for name, flags in _FLAGS.items():
@@ -55,8 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
             default = par.default
             if deg and isinstance(default, float):
                 default = math.degrees(default)
+            notes = [n for n in (unit, None if default is None else f"default {default}") if n]
             p.add_argument(flag, type=float, default=None,
-                           help=f"{par.help} ({unit}; default {default})")  # fmt: skip
+                           help=f"{par.help} ({'; '.join(notes)})" if notes else par.help)  # fmt: skip
         if name == "leap":
             push = params["push"]
             p.add_argument("--push", dest="push_off", choices=list(push.choices or ()),

@@ -43,7 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     synth = sub.add_parser("synth", help="generate the synthetic default clip library")
     synth.add_argument("out_dir", type=output_dir)
-    synth.add_argument("--fps", type=float, default=60.0)
+    synth.add_argument("--fps", type=float, default=60.0, help="frame rate (default 60)")
     synth.set_defaults(func=_synth)
 
 

@@ -18,7 +18,10 @@ __all__ = ["register"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    track = sub.add_parser("track", help="track a clip with the PD servo on a simulated character")
+    track = sub.add_parser(
+        "track",
+        help="track a clip physically on a simulated character (default: the whole-body tracker)",
+    )
     track.add_argument("clip", type=Path, help="input BVH")
     track.add_argument("--start", type=float, default=0.0, help="clip time to start at (s)")
     track.add_argument("--seconds", type=float, help="how long to track (default: to the end)")

@@ -73,3 +73,23 @@ def test_an_effort_outside_0_1_is_refused(
         err = capsys.readouterr().err.strip()
         assert err.startswith(f"reactmocap: error: {cmd} effort must be ") and "got" in err
     assert not out.exists()
+
+
+def test_the_help_lists_every_athletics_command_and_no_empty_notes() -> None:
+    # before: the top-level help left out handspring, bicycle and group, and flags without a
+    # unit or default read "(; default None)"
+    import argparse
+
+    from reactmocap.cli import build_parser
+
+    def subparsers(p: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+        acts = [a for a in p._actions if isinstance(a, argparse._SubParsersAction)]
+        return dict(acts[0].choices) if acts else {}
+
+    top = build_parser()
+    summary = " ".join(top.format_help().split())
+    athletics = subparsers(top)["athletics"]
+    for name, p in subparsers(athletics).items():
+        assert name in summary.split("athletic controllers:")[1], name
+        text = p.format_help()
+        assert "(;" not in text and "default None" not in text, name
