@@ -10,6 +10,9 @@ from reactmocap.commands import output_dir
 __all__ = ["register"]
 
 DEMO_SCENARIO = Path(__file__).resolve().parents[2] / "examples" / "front_kick.toml"
+#: a chest displacement (``reaction_displacement_m``) below this (m) is printed as no visible
+#: reaction: its direction against the impulse is noise then
+NO_REACTION_M = 0.01
 
 
 def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
@@ -71,11 +74,13 @@ def _run(scenario_path: Path, out: Path, plot: bool, video: bool, strict: bool,
         f"yaw {m['yaw_deg']:.1f} deg) in {report['timings_s']['total']:.2f} s; "
         f"fell={q['fell']} penetration={q['penetration_max_m']:.3f} m"
     )
-    print(
-        f"reaction {q['reaction_displacement_m']:.2f} m "
-        f"({q['reaction_direction_error_deg']:.0f} deg off the impulse of "
-        f"{q['contact_impulse_Ns']:.1f} N s), transition {q['transition_s']:.2f} s"
-    )
+    shift, impulse = q["reaction_displacement_m"], q["contact_impulse_Ns"]
+    if shift < NO_REACTION_M:
+        what = f"no visible reaction (chest {shift:.3f} m off its clip; impulse {impulse:.1f} N s)"
+    else:
+        what = (f"reaction {shift:.2f} m ({q['reaction_direction_error_deg']:.0f} deg off the "
+                f"impulse of {impulse:.1f} N s)")  # fmt: skip
+    print(f"{what}, transition {q['transition_s']:.2f} s")
     for key, path in report["outputs"].items():
         print(f"  {key:10s} {path}")
     for w in report["warnings"]:
