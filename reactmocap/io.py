@@ -1,5 +1,6 @@
 """Atomic file writing: outputs are written to a temporary sibling and renamed into place, so a
-crash or an exception never leaves a half-written file. Reading TOML input files with errors
+crash or an exception never leaves a half-written file; a path that cannot be written raises
+:class:`~reactmocap.errors.OutputError` naming it and why. Reading TOML input files with errors
 that name the file."""
 
 from __future__ import annotations
