@@ -256,7 +256,7 @@ def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0)
                 raise ConfigError(
                     f"{spec}:{n + 1}: expected 'x,y' in metres, got {line!r}"
                 ) from None
-            if not max(abs(x), abs(y)) <= MAX_COORD:  # NaN too
+            if not (abs(x) <= MAX_COORD and abs(y) <= MAX_COORD):  # NaN too
                 raise ConfigError(f"{spec}:{n + 1}: expected finite x,y within "
                                   f"+-{MAX_COORD:g} m, got {line!r}")  # fmt: skip
             rows.append((x, y))

@@ -85,6 +85,7 @@ def test_csv_path(tmp_path: Path) -> None:
     [
         ("0,0\n", "p.csv: a path needs at least 2 'x,y' points, got 1"),
         ("0,0\nnan,1\n", "p.csv:2: expected finite x,y within"),
+        ("0,0\n1,nan\n", "p.csv:2: expected finite x,y within"),
         ("0,0\n1e300,0\n", "p.csv:2: expected finite x,y within"),
         ("0,0,0\n5,0,1\n", "p.csv:2: expected 'x,y' in metres"),
     ],
