@@ -132,15 +132,17 @@ def _read(path: Path):  # type: ignore[no-untyped-def]
 FEASIBILITY_NOTE_S = 0.1
 
 
-def _infeasible_seconds(clip, report, mass: float) -> float | None:  # type: ignore[no-untyped-def]
+def _infeasible_seconds(clip, report, mass: float, tracked: float) -> float | None:  # type: ignore[no-untyped-def]
     """Seconds of the tracked span where the clip asks for more moment than a foot can give
-    (``support_feasibility``, 2x its bound); None for clips too short to differentiate."""
+    (``support_feasibility``, 2x its bound); None for clips too short to differentiate. A run
+    that fell or diverged counts only the ``tracked`` seconds it ran."""
     from reactmocap.sim.feasibility import support_feasibility
 
     if clip.num_frames < 3:
         return None
     check = support_feasibility(clip, total_mass=mass)
-    return check.infeasible_seconds(report.start, report.seconds)
+    seconds = report.seconds if report.status == "ok" else min(tracked, report.seconds)
+    return check.infeasible_seconds(report.start, seconds)
 
 
 def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # type: ignore[no-untyped-def]
@@ -153,7 +155,7 @@ def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # t
         write_bvh(motion, tmp)  # then renamed into place: never a half-written output
         tmp.replace(args.out)
     data = report.to_dict()
-    infeasible = _infeasible_seconds(clip, report, args.mass)
+    infeasible = _infeasible_seconds(clip, report, args.mass, motion.duration)
     data["infeasible_single_support_s"] = infeasible
     if args.report is not None:
         clean = {
