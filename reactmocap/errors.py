@@ -12,6 +12,7 @@ __all__ = [
     "ConfigError",
     "LibraryError",
     "MotionError",
+    "OutputError",
     "ReactMocapError",
     "SearchError",
     "SimulationError",
@@ -68,6 +69,11 @@ class UnknownKeyError(ReactMocapError, KeyError):
 
     def __str__(self) -> str:  # KeyError would repr() the message
         return str(self.args[0]) if self.args else ""
+
+
+class OutputError(ReactMocapError, OSError):
+    """An output file could not be written (read-only folder, a file where a folder should be,
+    disk full). Names the path and why. An ``OSError`` too, for callers that tolerate one."""
 
 
 class SearchError(ReactMocapError):

@@ -1,5 +1,6 @@
 """Atomic file writing: outputs are written to a temporary sibling and renamed into place, so a
-crash or an exception never leaves a half-written file. Reading TOML input files with errors
+crash or an exception never leaves a half-written file; a path that cannot be written raises
+:class:`~reactmocap.errors.OutputError` naming it and why. Reading TOML input files with errors
 that name the file."""
 
 from __future__ import annotations
@@ -12,9 +13,16 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
-from reactmocap.errors import ConfigError
+from reactmocap.errors import ConfigError, OutputError
 
-__all__ = ["atomic_write", "atomic_write_bytes", "atomic_write_text", "read_toml", "save_png"]
+__all__ = [
+    "atomic_write",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "read_toml",
+    "save_png",
+    "unwritable_reason",
+]
 
 
 def _umask() -> int:
@@ -27,19 +35,46 @@ def _umask() -> int:
 def atomic_write(path: str | Path, mode: str = "w") -> Iterator[IO]:  # type: ignore[type-arg]
     """Open a temporary file beside ``path``; on success rename it over ``path``."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    except OSError as exc:
+        raise _output_error(target, exc) from None
     try:
         with os.fdopen(fd, mode) as fh:
             yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
+            try:
+                fh.flush()
+                os.fsync(fh.fileno())
+            except OSError as exc:
+                raise _output_error(target, exc) from None
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; honour the umask like open()
-        os.replace(tmp, target)
+        try:
+            os.replace(tmp, target)
+        except OSError as exc:
+            raise _output_error(target, exc) from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+def unwritable_reason(path: str | Path) -> str | None:
+    """Why no file can be written at ``path`` (its missing folders are created on writing),
+    or None: checked before a long computation, so that it is not lost at the end."""
+    folder = Path(path).absolute().parent
+    while not folder.exists():
+        folder = folder.parent
+    if not folder.is_dir():
+        return f"{folder} is a file, not a folder"
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return f"cannot write into {folder} (read-only or no permission)"
+    return None
+
+
+def _output_error(target: Path, exc: OSError) -> OutputError:
+    why = unwritable_reason(target) or exc.strerror or str(exc)
+    return OutputError(f"cannot write {target}: {why}")
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:

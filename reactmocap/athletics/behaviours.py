@@ -57,7 +57,7 @@ CONTROL_EVERY = 8
 @dataclass(frozen=True)
 class Param:
     """A behaviour's parameter: SI units inside (``angle``: radians inside, degrees at the
-    CLI), its default, and whether it must be > 0, >= 0 or anything finite."""
+    CLI), its default, and the bounds it must keep (``minimum``, ``maximum``) or anything finite."""
 
     name: str
     #: a number, or one of ``choices`` for a text parameter
@@ -66,6 +66,7 @@ class Param:
     help: str
     angle: bool = False
     minimum: float | None = None
+    maximum: float | None = None
     #: a text parameter's valid values (a number otherwise)
     choices: tuple[str, ...] = ()
 
@@ -247,6 +248,7 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     _, force = ground_force(log, ctx.rig.mass, world.model.opt.gravity)
     push = (t[1:] > (thrust or 0.0)) & (t[:-1] < (lift if lift is not None else -1.0))
     rep: dict[str, Any] = {"effort": s}
+    commanded = None if p.get("effort") is not None else target  # an effort asks no height
     if not broad:
         rep["push"] = params.push
     if broad:
@@ -255,11 +257,11 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
         settled = next((tr.time for tr in seq.transitions if tr.target == "land.recover"),
                        (ctx.touchdown_time or t[-1]) + 0.3)  # fmt: skip
         i = min(int(np.searchsorted(t, settled)), t.size - 1)
-        rep["commanded_distance_m"] = target
+        rep["commanded_distance_m"] = commanded
         rep["achieved_distance_m"] = float(log["com"][i, 0] - log["com"][0, 0])
         rep["final_distance_m"] = float(log["com"][-1, 0] - log["com"][0, 0])
     else:
-        rep["commanded_height_m"] = target
+        rep["commanded_height_m"] = commanded
         # the apex of the flight (lift-off to touchdown), not a later bounce off the landing
         td = ctx.touchdown_time
         flight = (t >= (lift if lift is not None else np.inf)) & (
@@ -390,7 +392,8 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
     "leap": Behaviour(
         "leap", "vertical leap to a COM rise, land, balance (thesis ch. 4, 6, 8.1)",
         (Param("height", None, "m", "commanded COM rise at the apex over standing"),
-         Param("effort", None, "", "leap effort 0-1 instead of a height (no table needed)"),
+         Param("effort", None, "", "leap effort 0-1 instead of a height (no table needed)",
+               minimum=0.0, maximum=1.0),
          Param("spin", None, "kg m^2/s", "take-off angular momentum (pitch) to aim for"),
          Param("push", "com", "", "push-off: 'com' (a servo on the COM, ground force "
                "planned) or 'timed' (the thesis's joints on fixed timing)", choices=PUSHES),
@@ -399,7 +402,8 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
     "broad-jump": Behaviour(
         "broad-jump", "standing broad jump to a COM travel, land, balance (ch. 4.2, 8.2)",
         (Param("distance", None, "m", "commanded horizontal COM travel"),
-         Param("effort", None, "", "jump effort 0-1 instead of a distance"),
+         Param("effort", None, "", "jump effort 0-1 instead of a distance", minimum=0.0,
+               maximum=1.0),
          Param("spin", None, "kg m^2/s", "take-off angular momentum (pitch) to aim for"),
          _BACKPACK, _FPS),
         lambda a, p, cb: _run_leap(a, p, cb, broad=True), ("distance",)),
@@ -442,8 +446,11 @@ def _params(b: Behaviour, given: Mapping[str, Any], check_range: bool, body: str
                 raise ConfigError(f"{b.name} {p.name} must be a number, got {v!r}") from None
             if not math.isfinite(v):
                 raise ConfigError(f"{b.name} {p.name} must be a finite number, got {v!r}")
+            unit = f" {p.unit}" if p.unit else ""
             if p.minimum is not None and v < p.minimum:
-                raise ConfigError(f"{b.name} {p.name} must be >= {p.minimum} {p.unit}, got {v}")
+                raise ConfigError(f"{b.name} {p.name} must be >= {p.minimum}{unit}, got {v}")
+            if p.maximum is not None and v > p.maximum:
+                raise ConfigError(f"{b.name} {p.name} must be <= {p.maximum}{unit}, got {v}")
         out[p.name] = v
     needed = [p.name for p in b.params if p.default is None and out[p.name] is None
               and p.name not in ("effort", "spin", "pelvis_height", "push")]  # fmt: skip

@@ -309,6 +309,9 @@ def check_phase(phase: Phase, where: str) -> Phase:
                 f"parameters are {sorted(spec.params)}"
             )
         params[key] = _check_value(spec.params[key], value, f"{where}.params.{key}")
+    effort = params.get("effort") if phase.controller == "leap" else None
+    if effort is not None and not 0.0 <= effort <= 1.0:  # the measured tables' range
+        raise ConfigError(f"{where}.params.effort: must be 0-1, got {effort:g}")
     if phase.controller == "tumble" and params.get("position", "tuck") not in POSITIONS:
         raise ConfigError(
             f"{where}.params.position: unknown position {params['position']!r}; valid "

@@ -32,6 +32,8 @@ __all__ = [
 F64 = NDArray[np.float64]
 #: pure-pursuit look-ahead distance (m)
 LOOKAHEAD = 3.0
+#: largest |x| or |y| of a path file's point (m)
+MAX_COORD = 1e6
 #: how fast a commanded facing is turned toward (rad/s)
 TURN_RATE = 0.2
 
@@ -241,19 +243,25 @@ def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0)
     if path.suffix.lower() == ".csv":
         if not path.is_file():
             raise ConfigError(f"path file {spec!r} does not exist")
-        rows = []
+        rows: list[tuple[float, float]] = []
         for n, line in enumerate(path.read_text().splitlines()):
             bits = [b.strip() for b in line.replace(";", ",").split(",") if b.strip()]
             if not bits:
                 continue
             try:
-                rows.append((float(bits[0]), float(bits[1])))
-            except (ValueError, IndexError):
+                x, y = (float(b) for b in bits)  # exactly two: a third column was dropped
+            except ValueError:
                 if n == 0 and not rows:
                     continue  # a header
                 raise ConfigError(
                     f"{spec}:{n + 1}: expected 'x,y' in metres, got {line!r}"
                 ) from None
+            if not (abs(x) <= MAX_COORD and abs(y) <= MAX_COORD):  # NaN too
+                raise ConfigError(f"{spec}:{n + 1}: expected finite x,y within "
+                                  f"+-{MAX_COORD:g} m, got {line!r}")  # fmt: skip
+            rows.append((x, y))
+        if len(rows) < 2:
+            raise ConfigError(f"{spec}: a path needs at least 2 'x,y' points, got {len(rows)}")
         return Polyline(np.array(rows))
     raise ConfigError(
         f"unknown path {spec!r}; valid paths are 'line', 'circle:R', 'eight:R' or FILE.csv"

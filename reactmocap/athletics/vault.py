@@ -231,7 +231,8 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
     pitch = np.unwrap(log["pitch"]) if log["pitch"].size else np.zeros(0)
     rotation = float(np.degrees(pitch[-1] - pitch[0])) if pitch.size else 0.0
     td_i = int(np.flatnonzero(log["on_floor"].astype(bool))[0]) if log["on_floor"].any() else -1
-    rotation_td = float(np.degrees(pitch[td_i] - pitch[0])) if pitch.size else 0.0
+    # no touchdown in the run (cut short): no rotation at it, not the last frame's
+    rotation_td = float(np.degrees(pitch[td_i] - pitch[0])) if pitch.size and td_i >= 0 else None
     t = log["t"]
     floor = log["on_floor"].astype(bool)
     td = float(t[np.flatnonzero(floor)[0]]) if floor.any() else None

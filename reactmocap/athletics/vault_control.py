@@ -23,6 +23,8 @@ from reactmocap.sim.controllers.base import FunctionController
 from reactmocap.sim.controllers.machine import State, after
 from reactmocap.sim.world import World
 
+__all__ = ["Vault", "VaultLog"]
+
 NJ = len(BALL_JOINTS)
 
 # ---------------------------------------------------------------------------------- control

@@ -23,6 +23,17 @@ from reactmocap.library.motion import Motion
 from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.world import World
 
+__all__ = [
+    "ALL_ROWS_VALUES",
+    "BOARD",
+    "HORSE",
+    "Apparatus",
+    "VaultParams",
+    "vault_athlete",
+    "vault_start",
+    "vault_world",
+]
+
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
 

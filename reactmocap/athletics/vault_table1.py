@@ -9,6 +9,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+__all__ = [
+    "GYMNAST_HEIGHT",
+    "GYMNAST_MASS",
+    "TABLE1",
+    "TABLE1_KEYS",
+    "Table1Row",
+    "table1",
+]
+
 
 # ---------------------------------------------------------------------------------- Table 1
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -175,7 +175,32 @@ def load_baseline(path: str | Path) -> dict[str, Any]:
     if not isinstance(doc, dict) or doc.get("format") != BASELINE_FORMAT or "stats" not in doc:
         raise ConfigError(f"{p}: not a reactmocap baseline (format {BASELINE_FORMAT})")
     _tolerances(doc.get("tolerances"), str(p))  # validate early
+    _check_fields(doc, p)
     return doc
+
+
+def _check_fields(doc: Mapping[str, Any], p: Path) -> None:
+    """A ConfigError naming the field of a hand-edited baseline whose type :func:`compare`
+    cannot use (it failed there with a traceback)."""
+
+    def is_num(v: Any) -> bool:
+        return isinstance(v, int | float) and not isinstance(v, bool)
+
+    def table(key: str, rows: Callable[[Any], bool], expected: str) -> None:
+        value = doc.get(key, {})
+        if not isinstance(value, Mapping):
+            raise ConfigError(f"{p}: {key}: expected a table, got {value!r}")
+        for name, row in value.items():
+            if not rows(row):
+                raise ConfigError(f"{p}: {key}.{name}: expected {expected}, got {row!r}")
+
+    for key in ("count", "failures"):
+        if key in doc and not is_num(doc[key]):
+            raise ConfigError(f"{p}: {key}: expected a number, got {doc[key]!r}")
+    table("stats", lambda r: isinstance(r, Mapping) and all(
+        v is None or is_num(v) for v in r.values()), "a table of numbers")  # fmt: skip
+    table("scenarios", lambda r: isinstance(r, Mapping), "a table")
+    table("versions", lambda r: r is None or isinstance(r, str), "a version string")
 
 
 @dataclass(frozen=True)

@@ -337,7 +337,9 @@ def run_batch(
     ``task`` replaces the response pipeline (tests of the batch machinery)."""
     run_fn = get_runner(runner)
     say = log if log is not None else (lambda s: print(s, file=sys.stderr))
-    workers = max(1, int(workers if workers else (os.cpu_count() or 1)))
+    if workers is not None and not (isinstance(workers, int) and workers >= 1):
+        raise ConfigError(f"workers must be an integer >= 1 (None: the CPU count), got {workers!r}")
+    workers = workers or os.cpu_count() or 1
     out = Path(out_dir)
     points = sweep.points()  # validates every point before anything runs
     out.mkdir(parents=True, exist_ok=True)

@@ -40,8 +40,8 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     ath = sub.add_parser(
         "athletics",
-        help="athletic controllers: leap, broad jump, land, balance, run, vault, maneuver, "
-        "somersault, dive",
+        help="athletic controllers: leap, broad-jump, land, balance, run, vault, maneuver, "
+        "somersault, dive, handspring, bicycle, group",
     )
     inner = ath.add_subparsers(dest="behaviour", metavar="BEHAVIOUR", required=True)
     for name, flags in _FLAGS.items():
@@ -55,8 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
             default = par.default
             if deg and isinstance(default, float):
                 default = math.degrees(default)
+            notes = [n for n in (unit, None if default is None else f"default {default}") if n]
             p.add_argument(flag, type=float, default=None,
-                           help=f"{par.help} ({unit}; default {default})")  # fmt: skip
+                           help=f"{par.help} ({'; '.join(notes)})" if notes else par.help)  # fmt: skip
         if name == "leap":
             push = params["push"]
             p.add_argument("--push", dest="push_off", choices=list(push.choices or ()),
@@ -123,11 +124,11 @@ def _run(args: argparse.Namespace) -> int:
 def _summary(r: dict[str, Any], out: Path) -> None:
     name = r["behaviour"]
     bits = [f"{name} ({r['body']})"]
-    if "achieved_height_m" in r:
-        bits.append(f"height {r['achieved_height_m']:.3f} m (asked {r['commanded_height_m']:.3f})")
-    if "achieved_distance_m" in r:
-        bits.append(f"distance {r['achieved_distance_m']:.3f} m "
-                    f"(asked {r['commanded_distance_m']:.3f})")  # fmt: skip
+    for what in ("height", "distance"):
+        if f"achieved_{what}_m" in r:
+            asked = r[f"commanded_{what}_m"]
+            asked = f"effort {r['effort']:g}" if asked is None else f"asked {asked:.3f}"
+            bits.append(f"{what} {r[f'achieved_{what}_m']:.3f} m ({asked})")
     for key in ("landed", "balanced", "fell"):
         if key in r:
             bits.append(f"{key}={r[key]}")

@@ -10,7 +10,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from reactmocap.commands import output_file
+from reactmocap.commands import output_dir, output_file
 from reactmocap.commands.athletics import _Bar
 from reactmocap.errors import ConfigError
 
@@ -51,7 +51,7 @@ def register(inner: argparse._SubParsersAction) -> None:  # type: ignore[type-ar
 
 def _common(p: argparse.ArgumentParser, out: str) -> None:
     p.add_argument("--body", default="male", help="male, female or a BVH file (CLIP.bvh)")
-    p.add_argument("--out", type=Path, default=Path(out),
+    p.add_argument("--out", type=output_dir, default=Path(out),
                    help=f"folder for rider{{k}}.bvh and bicycle{{k}}.bvh (default {out}/)")  # fmt: skip
     p.add_argument("--report", type=output_file, help="JSON report")
     p.add_argument("--plot", type=output_file, help="PNG: top-view paths, speed and heading")

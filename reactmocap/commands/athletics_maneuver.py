@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from reactmocap.commands import output_file
+from reactmocap.commands import output_dir, output_file
 
 __all__ = ["register_maneuvers"]
 
@@ -30,7 +30,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )  # fmt: skip
     m.add_argument("file", type=Path, help="MANEUVER.toml")
-    m.add_argument("--out", type=Path, required=True,
+    m.add_argument("--out", type=output_dir, required=True,
                    help="folder for NAME.bvh and NAME.json (the report)")  # fmt: skip
     m.add_argument("--body", help="male, female or a BVH file (default: the file's body)")
     m.add_argument("--video", type=output_file, help="MP4 (or GIF) of the motion")

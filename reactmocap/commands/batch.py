@@ -9,6 +9,8 @@ import sys
 from pathlib import Path
 from types import FrameType
 
+from reactmocap.commands import output_dir
+
 __all__ = ["register"]
 
 
@@ -22,7 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     )
     b.add_argument("target", metavar="SWEEP.toml|plot", help="a sweep file, or `plot`")
     b.add_argument("dir", nargs="?", type=Path, metavar="DIR", help="results folder (for plot)")
-    b.add_argument("--out", type=Path, metavar="DIR", help="results folder (for a sweep)")
+    b.add_argument("--out", type=output_dir, metavar="DIR", help="results folder (for a sweep)")
     b.add_argument(
         "--workers",
         type=int,

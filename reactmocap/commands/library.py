@@ -7,6 +7,7 @@ import math
 import sys
 from pathlib import Path
 
+from reactmocap.commands import output_dir, output_file
 from reactmocap.errors import ConfigError, ReactMocapError
 
 __all__ = ["register"]
@@ -33,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 
     conv = sub.add_parser("convert", help="read a BVH and write it back (resample, mirror)")
     conv.add_argument("input", type=Path)
-    conv.add_argument("output", type=Path)
+    conv.add_argument("output", type=output_file)
     conv.add_argument("--fps", type=float, help="resample to this frame rate")
     conv.add_argument("--mirror", action="store_true", help="mirror left/right")
     conv.add_argument("--unit", choices=["m", "cm", "mm", "in"], help="override unit detection")
@@ -41,8 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     conv.set_defaults(func=_convert)
 
     synth = sub.add_parser("synth", help="generate the synthetic default clip library")
-    synth.add_argument("out_dir", type=Path)
-    synth.add_argument("--fps", type=float, default=60.0)
+    synth.add_argument("out_dir", type=output_dir)
+    synth.add_argument("--fps", type=float, default=60.0, help="frame rate (default 60)")
     synth.set_defaults(func=_synth)
 
 
@@ -72,7 +73,7 @@ def _check(args: argparse.Namespace) -> int:
     from reactmocap.library.clip_library import find_bvh_files
 
     rules = load_rules(args.parts) if args.parts else None
-    bad = total = unmapped = 0
+    ok = bad = unmapped = 0
     for path in args.paths:
         try:
             files = find_bvh_files(path)
@@ -84,21 +85,21 @@ def _check(args: argparse.Namespace) -> int:
             print(f"error: {path}: no .bvh files found")
             bad += 1
         for f in files:
-            total += 1
             try:
                 m = read_bvh(f)
             except ReactMocapError as exc:
                 bad += 1
                 print(f"error: {exc}")
                 continue
+            ok += 1
             print(f"ok: {f} ({m.num_frames} frames, {m.fps:g} fps)")
             try:
                 parts_for(m.skeleton, rules)
             except ReactMocapError as exc:
                 unmapped += 1
                 print(f"warning: {f}: {exc}")
-    print(f"{total - bad} ok, {bad} bad, {unmapped} not mappable onto body parts")
-    return 1 if bad or total == 0 else 0
+    print(f"{ok} ok, {bad} bad, {unmapped} not mappable onto body parts")
+    return 1 if bad or ok == 0 else 0
 
 
 def _convert(args: argparse.Namespace) -> int:

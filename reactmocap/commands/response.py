@@ -5,9 +5,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from reactmocap.commands import output_dir
+
 __all__ = ["register"]
 
 DEMO_SCENARIO = Path(__file__).resolve().parents[2] / "examples" / "front_kick.toml"
+#: a chest displacement (``reaction_displacement_m``) below this (m) is printed as no visible
+#: reaction: its direction against the impulse is noise then
+NO_REACTION_M = 0.01
 
 
 def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
@@ -16,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )  # fmt: skip
     rsp.add_argument("scenario", type=Path)
-    rsp.add_argument("--out", type=Path, required=True, help="output folder")
+    rsp.add_argument("--out", type=output_dir, required=True, help="output folder")
     rsp.add_argument("--parts", type=Path, help="body-part rules TOML (over the scenario's)")
     _flags(rsp)
     rsp.set_defaults(func=_respond)
@@ -25,7 +30,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         "demo", help="run the bundled demo scenario (a front kick) on the synthetic clips",
         description=_OUTPUTS, formatter_class=argparse.RawDescriptionHelpFormatter,
     )  # fmt: skip
-    demo.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
+    demo.add_argument("--out", type=output_dir, default=Path("out/demo"), help="output folder")
     _flags(demo)
     demo.set_defaults(func=_demo)
 
@@ -69,11 +74,13 @@ def _run(scenario_path: Path, out: Path, plot: bool, video: bool, strict: bool,
         f"yaw {m['yaw_deg']:.1f} deg) in {report['timings_s']['total']:.2f} s; "
         f"fell={q['fell']} penetration={q['penetration_max_m']:.3f} m"
     )
-    print(
-        f"reaction {q['reaction_displacement_m']:.2f} m "
-        f"({q['reaction_direction_error_deg']:.0f} deg off the impulse of "
-        f"{q['contact_impulse_Ns']:.1f} N s), transition {q['transition_s']:.2f} s"
-    )
+    shift, impulse = q["reaction_displacement_m"], q["contact_impulse_Ns"]
+    if shift < NO_REACTION_M:
+        what = f"no visible reaction (chest {shift:.3f} m off its clip; impulse {impulse:.1f} N s)"
+    else:
+        what = (f"reaction {shift:.2f} m ({q['reaction_direction_error_deg']:.0f} deg off the "
+                f"impulse of {impulse:.1f} N s)")  # fmt: skip
+    print(f"{what}, transition {q['transition_s']:.2f} s")
     for key, path in report["outputs"].items():
         print(f"  {key:10s} {path}")
     for w in report["warnings"]:

@@ -24,6 +24,16 @@ def _shift(text: str) -> tuple[float, float]:
     return parts[0], parts[1]
 
 
+def _degrees(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):  # NaN reached the query as "rotations contain NaN or inf"
+        raise argparse.ArgumentTypeError(f"expected a finite angle in degrees, got {text!r}")
+    return value
+
+
 def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     p = sub.add_parser("search", help="build and query the motion-search index")
     ssub = p.add_subparsers(dest="search_command", metavar="ACTION", required=True)
@@ -51,7 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     q.add_argument(
         "--frame", type=int, required=True, metavar="F", help="start frame (clip's own fps)"
     )
-    q.add_argument("--yaw", type=float, default=0.0, metavar="DEG")
+    q.add_argument("--yaw", type=_degrees, default=0.0, metavar="DEG")
     q.add_argument("--shift", type=_shift, default=(0.0, 0.0), metavar="X,Y")
     q.add_argument("--top", type=int, default=5, metavar="K")
     q.add_argument(

@@ -18,7 +18,10 @@ __all__ = ["register"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    track = sub.add_parser("track", help="track a clip with the PD servo on a simulated character")
+    track = sub.add_parser(
+        "track",
+        help="track a clip physically on a simulated character (default: the whole-body tracker)",
+    )
     track.add_argument("clip", type=Path, help="input BVH")
     track.add_argument("--start", type=float, default=0.0, help="clip time to start at (s)")
     track.add_argument("--seconds", type=float, help="how long to track (default: to the end)")
@@ -129,15 +132,17 @@ def _read(path: Path):  # type: ignore[no-untyped-def]
 FEASIBILITY_NOTE_S = 0.1
 
 
-def _infeasible_seconds(clip, report, mass: float) -> float | None:  # type: ignore[no-untyped-def]
+def _infeasible_seconds(clip, report, mass: float, tracked: float) -> float | None:  # type: ignore[no-untyped-def]
     """Seconds of the tracked span where the clip asks for more moment than a foot can give
-    (``support_feasibility``, 2x its bound); None for clips too short to differentiate."""
+    (``support_feasibility``, 2x its bound); None for clips too short to differentiate. A run
+    that fell or diverged counts only the ``tracked`` seconds it ran."""
     from reactmocap.sim.feasibility import support_feasibility
 
     if clip.num_frames < 3:
         return None
     check = support_feasibility(clip, total_mass=mass)
-    return check.infeasible_seconds(report.start, report.seconds)
+    seconds = report.seconds if report.status == "ok" else min(tracked, report.seconds)
+    return check.infeasible_seconds(report.start, seconds)
 
 
 def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # type: ignore[no-untyped-def]
@@ -150,7 +155,7 @@ def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # t
         write_bvh(motion, tmp)  # then renamed into place: never a half-written output
         tmp.replace(args.out)
     data = report.to_dict()
-    infeasible = _infeasible_seconds(clip, report, args.mass)
+    infeasible = _infeasible_seconds(clip, report, args.mass, motion.duration)
     data["infeasible_single_support_s"] = infeasible
     if args.report is not None:
         clean = {
@@ -158,11 +163,13 @@ def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # t
             for k, v in data.items()
         }
         atomic_write_text(args.report, json.dumps(clean, indent=2) + "\n")
+    tracked = f"{data['seconds']:.2f} s"
     if data["status"] != "ok":
         print(f"{data['clip']}: {data['status'].upper()}: {data['reason']}; the outputs stop "
               "there")  # fmt: skip
+        tracked = f"{motion.duration:.2f} of {tracked}"  # the run ended early: say how early
     print(
-        f"{data['clip']}: {data['seconds']:.2f} s tracked, fell={data['fell']}, "
+        f"{data['clip']}: {tracked} tracked, fell={data['fell']}, "
         f"mean joint error {data['mean_joint_error_rad']:.3f} rad, root error "
         f"{data['root_error_m']:.3f} m, {data['realtime_factor']:.2f}x real time"
     )

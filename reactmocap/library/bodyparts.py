@@ -148,7 +148,7 @@ def _load_overrides(rules: str | Path | Mapping[str, object] | None) -> dict[str
     if rules is None:
         return {}
     if isinstance(rules, Mapping):
-        return dict(rules)
+        return _checked(dict(rules), "")
     path = Path(rules)
     data = read_toml(path, "body-part rules")
     unknown = set(data) - {"parts", "aliases"}
@@ -156,7 +156,31 @@ def _load_overrides(rules: str | Path | Mapping[str, object] | None) -> dict[str
         raise ConfigError(
             f"{path}: unknown sections {sorted(unknown)}; expected [parts], [aliases]"
         )
-    return data
+    return _checked(data, f"{path}: ")
+
+
+def _checked(rules: dict[str, object], where: str) -> dict[str, object]:
+    """``rules`` if its ``[parts]`` map known parts to joint names and its ``[aliases]`` known
+    kinds to lists of names; a ConfigError naming the field otherwise (``where``: the file)."""
+    parts, aliases = rules.get("parts") or {}, rules.get("aliases") or {}
+    for section, table in (("parts", parts), ("aliases", aliases)):
+        if not isinstance(table, Mapping):
+            raise ConfigError(f"{where}[{section}] must be a table, got {table!r}")
+    for part, joint in parts.items():  # type: ignore[attr-defined]
+        if part not in BODY_PARTS:
+            raise ConfigError(
+                f"{where}[parts] has unknown part {part!r}; parts are {list(BODY_PARTS)}"
+            )
+        if not isinstance(joint, str):
+            raise ConfigError(f"{where}[parts].{part}: expected a joint name, got {joint!r}")
+    for kind, names in aliases.items():  # type: ignore[attr-defined]
+        if kind not in _BASE_NAMES:
+            raise ConfigError(
+                f"{where}[aliases] has unknown kind {kind!r}; kinds are {list(_BASE_NAMES)}"
+            )
+        if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
+            raise ConfigError(f"{where}[aliases].{kind}: expected a list of names, got {names!r}")
+    return rules
 
 
 def map_body_parts(
@@ -170,12 +194,6 @@ def map_body_parts(
     over = _load_overrides(rules)
     explicit = dict(over.get("parts", {}) or {})  # type: ignore[call-overload]
     aliases: dict[str, list[str]] = dict(over.get("aliases", {}) or {})  # type: ignore[call-overload]
-    for part in explicit:
-        if part not in BODY_PARTS:
-            raise ConfigError(f"[parts] has unknown part {part!r}; parts are {list(BODY_PARTS)}")
-    for kind in aliases:
-        if kind not in _BASE_NAMES:
-            raise ConfigError(f"[aliases] has unknown kind {kind!r}; kinds are {list(_BASE_NAMES)}")
 
     split = [_split(n) for n in skeleton.names]
     out: dict[str, int] = {}

@@ -59,6 +59,10 @@ _OPENERS = ("ROOT", "JOINT", "End")  # statements that must be followed by '{'
 _KEYWORDS = (*_OPENERS, "OFFSET", "CHANNELS")
 _BINARY = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
 _UNIT_FRAMES = 10  # frames used to detect the unit
+#: largest magnitude of an OFFSET or channel value (file units or degrees): 1e7 cm is 100 km,
+#: 1e7 degrees 28,000 turns; beyond it no motion is meant, and squared distances overflow
+MAX_VALUE = 1e7
+_RANGE = f"finite numbers within +-{MAX_VALUE:g}"
 
 
 @dataclass
@@ -313,6 +317,8 @@ def _offset(value: list[str], line: int, fail: _Fail) -> Vec3:
         raise fail(f"non-numeric OFFSET {' '.join(value[1:])!r}", line, "3 numbers") from None
     if not np.all(np.isfinite((x, y, z))):
         raise fail(f"OFFSET {' '.join(value[1:])}", line, "finite numbers")
+    if max(abs(x), abs(y), abs(z)) > MAX_VALUE:
+        raise fail(f"OFFSET {' '.join(value[1:])} out of range", line, _RANGE)
     return (x, y, z)
 
 
@@ -364,11 +370,14 @@ def _frames(body: list[str], first: int, n: int, n_ch: int, fail: _Fail) -> F64:
             raise fail(f"{len(rows) - n} frame lines beyond Frames: {n}", rows[n][0],
                        f"{n} frame lines")  # fmt: skip
         raise fail("unreadable frame data", first, f"{n} lines of {n_ch} numbers")
-    finite = np.isfinite(data).all(axis=1)
-    if not finite.all():
-        row = int(np.flatnonzero(~finite)[0])
+    sane = (np.abs(data) <= MAX_VALUE).all(axis=1)  # False for NaN too
+    if not sane.all():
+        row = int(np.flatnonzero(~sane)[0])
         line = first + [k for k, s in enumerate(body) if s.strip()][row]
-        raise fail("NaN or infinite value in frame data", line, "finite numbers")
+        if not np.isfinite(data[row]).all():
+            raise fail("NaN or infinite value in frame data", line, "finite numbers")
+        big = data[row][np.argmax(np.abs(data[row]))]
+        raise fail(f"value {big:g} out of range in frame data", line, _RANGE)
     return data
 
 

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from reactmocap.errors import ConfigError
 from reactmocap.library.keyframes import (
     GUARD,
     JOINT_INDEX,
@@ -473,6 +474,8 @@ STRIKERS: dict[str, tuple[str, ...]] = {
 
 def synthetic_clips(fps: float = 60.0) -> dict[str, Motion]:
     """Every synthetic clip, name -> Motion (deterministic: no randomness)."""
+    if not (np.isfinite(fps) and fps > 0):  # NaN reached np.arange as a ValueError
+        raise ConfigError(f"fps must be a positive frame rate, got {fps!r}")
     clips = {name: clip_motion(build(), fps, name) for name, (build, _) in CLIP_BUILDERS.items()}
     for name, (src, _) in MIRRORED.items():
         # the skeleton is symmetric, so the mirror's swapped offsets are its own
@@ -485,10 +488,11 @@ def write_synthetic_library(out_dir: str | Path, fps: float = 60.0) -> list[Path
     """Write every clip as ``out_dir/<name>.bvh``; returns the paths written."""
     from reactmocap.library.bvh import write_bvh
 
+    clips = synthetic_clips(fps)  # before the folder: a bad fps leaves none behind
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = []
-    for name, motion in synthetic_clips(fps).items():
+    for name, motion in clips.items():
         path = out / f"{name}.bvh"
         write_bvh(motion, path)
         paths.append(path)

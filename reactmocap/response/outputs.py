@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from reactmocap.errors import OutputError
+from reactmocap.io import unwritable_reason
 from reactmocap.library.bodyparts import map_body_parts
 from reactmocap.library.bvh import write_bvh
 from reactmocap.library.motion import Motion
@@ -29,8 +31,12 @@ def write_outputs(
 ) -> dict[str, Any]:
     """Write a response's files into ``out`` (see the module docstring); returns the report
     with ``outputs`` filled in."""
-    out.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=".partial-", dir=out))
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        stage = Path(tempfile.mkdtemp(prefix=".partial-", dir=out))
+    except OSError as exc:
+        why = unwritable_reason(out / "report.json") or exc.strerror or exc
+        raise OutputError(f"cannot write into {out}: {why}") from None
     try:
         names: dict[str, str] = {}
         write_bvh(result.recipient, stage / "recipient.bvh")

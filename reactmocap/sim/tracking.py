@@ -164,6 +164,8 @@ def track_clip(
             f"cannot track {seconds} s from {start} s: the clip {motion.name!r} lasts "
             f"{motion.duration:.3f} s"
         )
+    if not (np.isfinite(root_assist) and root_assist >= 0):  # a negative gain was silently off
+        raise ConfigError(f"root_assist must be a finite gain >= 0 (0: off), got {root_assist!r}")
     spec = controller_spec(controller)
     if root_assist > 0 and controller != "pd":
         raise ConfigError(

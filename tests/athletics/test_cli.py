@@ -23,12 +23,16 @@ from reactmocap.library.bvh import read_bvh
     ],
 )  # fmt: skip
 def test_each_command_writes_bvh_and_report(
-    args: list[str], keys: list[str], tmp_path: Path
+    args: list[str], keys: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out, rep = tmp_path / "m.bvh", tmp_path / "r.json"
     assert main(["athletics", *args, "--out", str(out), "--report", str(rep)]) == 0
     report = json.loads(rep.read_text())
     assert all(k in report for k in keys)
+    if "--effort" in args:  # an effort asks no height or distance: not "asked 0.000"
+        what = "height" if args[0] == "leap" else "distance"
+        assert report[f"commanded_{what}_m"] is None
+        assert f"m (effort {args[-1]})" in capsys.readouterr().out
     motion = read_bvh(out)
     assert motion.num_frames > 10 and "LeftUpLeg" in motion.skeleton.names
 
@@ -56,3 +60,36 @@ def test_bad_input_is_one_line_and_nothing_is_written(
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("reactmocap: error:")
     assert not out.exists()
+
+
+@pytest.mark.parametrize("effort", ["5", "-1"])
+def test_an_effort_outside_0_1_is_refused(
+    effort: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # before: --effort 5 ran (a 1 m leap past the strength model) though the help says 0-1
+    out = tmp_path / "m.bvh"
+    for cmd in ("leap", "broad-jump"):
+        assert main(["athletics", cmd, "--effort", effort, "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith(f"reactmocap: error: {cmd} effort must be ") and "got" in err
+    assert not out.exists()
+
+
+def test_the_help_lists_every_athletics_command_and_no_empty_notes() -> None:
+    # before: the top-level help left out handspring, bicycle and group, and flags without a
+    # unit or default read "(; default None)"
+    import argparse
+
+    from reactmocap.cli import build_parser
+
+    def subparsers(p: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+        acts = [a for a in p._actions if isinstance(a, argparse._SubParsersAction)]
+        return dict(acts[0].choices) if acts else {}
+
+    top = build_parser()
+    summary = " ".join(top.format_help().split())
+    athletics = subparsers(top)["athletics"]
+    for name, p in subparsers(athletics).items():
+        assert name in summary.split("athletic controllers:")[1], name
+        text = p.format_help()
+        assert "(;" not in text and "default None" not in text, name

@@ -61,6 +61,9 @@ def test_a_missing_exit_event_is_a_config_error_naming_the_field(tmp_path: Path)
          r"phase\[1\]\.params\.spinn"),
         ('[[phase]]\ncontroller = "leap"\nparams = { spin = "fast" }\nexit = { event = "apex" }\n',
          r"phase\[1\]\.params\.spin must be a number"),
+        # an effort beyond the measured 0-1 ran (7: a leap past the tables)
+        ('[[phase]]\ncontroller = "leap"\nparams = { effort = 7 }\nexit = { event = "apex" }\n',
+         r"phase\[1\]\.params\.effort: must be 0-1, got 7"),
         ('[[phase]]\ncontroller = "tumble"\nparams = { position = "straddle" }\n'
          'exit = { event = "open" }\n', r"phase\[1\]\.params\.position"),
         ('[[phase]]\ncontroller = "balance"\nexit = { event = "after" }\n',

@@ -80,6 +80,26 @@ def test_csv_path(tmp_path: Path) -> None:
         parse_course(str(f))
 
 
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("0,0\n", "p.csv: a path needs at least 2 'x,y' points, got 1"),
+        ("0,0\nnan,1\n", "p.csv:2: expected finite x,y within"),
+        ("0,0\n1,nan\n", "p.csv:2: expected finite x,y within"),
+        ("0,0\n1e300,0\n", "p.csv:2: expected finite x,y within"),
+        ("0,0,0\n5,0,1\n", "p.csv:2: expected 'x,y' in metres"),
+    ],
+)
+def test_a_bad_csv_path_names_the_file_and_line(tmp_path: Path, text: str, message: str) -> None:
+    # before: one point or a NaN gave "got (1, 2)" without the file, 1e300 ran (overflowing),
+    # and a third column was silently dropped
+    f = tmp_path / "p.csv"
+    f.write_text(text)
+    with pytest.raises(ConfigError) as err:
+        parse_course(str(f))
+    assert str(err.value).startswith(str(tmp_path / message))
+
+
 def test_circle_steering() -> None:
     c = Circle((0.0, 10.0), 10.0)  # anticlockwise, through the origin heading +X
     heading, curvature, cross = c.steer(np.array([0.0, 0.0]), 0.0)

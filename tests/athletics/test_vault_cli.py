@@ -17,3 +17,7 @@ def test_vault_command_writes_bvh_report_plot(tmp_path: Path) -> None:
     report = json.loads(rep.read_text())
     assert set(report["table1"]) == set(TABLE1_KEYS)
     assert out.stat().st_size > 1000 and plot.stat().st_size > 1000
+    # 1 s ends in the second flight: no touchdown, so no rotation at it (it gave the last
+    # frame's, 363 deg)
+    assert report["touchdown_s"] is None and report["rotation_at_touchdown_deg"] is None
+    assert not report["landed"] and report["notes"]

@@ -127,3 +127,23 @@ def test_update_keeps_tolerance_overrides_and_missing_inputs_are_clear(tmp_path:
     assert load_baseline(base)["tolerances"] == {"foot_skate_m": {"abs": 0.5, "rel": 0.0}}
     assert main(["regress", str(tmp_path / "nothing"), "--baseline", str(base)]) == 2
     assert main(["regress", str(d), "--baseline", str(tmp_path / "none.json")]) == 2
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("stats", "oops", "stats: expected a table, got 'oops'"),
+        ("stats", {"match_distance": "x"}, "stats.match_distance: expected a table of numbers"),
+        ("scenarios", 5, "scenarios: expected a table, got 5"),
+        ("count", "eight", "count: expected a number, got 'eight'"),
+    ],
+)
+def test_a_baseline_field_of_the_wrong_type_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], field: str, value: Any, message: str
+) -> None:
+    # before: compare() failed on them with an AttributeError/TypeError/ValueError traceback
+    d = _results(tmp_path, _rows())
+    base = tmp_path / "b.json"
+    base.write_text(json.dumps(make_baseline(_rows(), VERSIONS) | {field: value}))
+    assert main(["regress", str(d), "--baseline", str(base)]) == 2
+    assert capsys.readouterr().err.startswith(f"reactmocap: error: {base}: {message}")

@@ -112,3 +112,17 @@ def test_results_folder_refuses_another_base(write_sweep, tmp_path: Path) -> Non
     b = load_sweep(write_sweep("facing_deg = [0]", base=EXAMPLES / "side_kick_chest.toml"))
     with pytest.raises(ConfigError, match="different base scenario"):
         run_batch(b, tmp_path / "o", runner="serial", task=fake_tasks.fake_report, progress=False)
+
+
+@pytest.mark.parametrize("workers", [0, -3])
+def test_workers_below_one_are_refused_before_anything_runs(
+    write_sweep, tmp_path: Path, workers: int
+) -> None:  # type: ignore[no-untyped-def]
+    from reactmocap.errors import ConfigError
+
+    sweep = load_sweep(write_sweep("facing_deg = [0]"))
+    with pytest.raises(ConfigError, match=f"workers must be an integer >= 1 .*got {workers}"):
+        run_batch(
+            sweep, tmp_path / "o", workers=workers, task=fake_tasks.fake_report, progress=False
+        )
+    assert not (tmp_path / "o").exists()

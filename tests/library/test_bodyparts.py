@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from reactmocap.errors import BodyPartMappingError, ConfigError
-from reactmocap.library.bodyparts import BODY_PARTS, OPTIONAL_PARTS, map_body_parts
+from reactmocap.library.bodyparts import BODY_PARTS, OPTIONAL_PARTS, load_rules, map_body_parts
 from reactmocap.library.skeleton import Skeleton
 
 
@@ -97,6 +97,27 @@ def test_toml_override(tmp_path: Path) -> None:
     missing.write_text('[parts]\npelvis = "nope"\n')
     with pytest.raises(BodyPartMappingError, match="'nope': no such joint"):
         map_body_parts(skeleton(names, parents), missing)
+
+
+@pytest.mark.parametrize(
+    ("text", "field"),
+    [
+        ("[parts]\npelvis = 5\n", "[parts].pelvis: expected a joint name, got 5"),
+        ("[parts]\nbogus = 'Hips'\n", "[parts] has unknown part 'bogus'"),
+        ("[aliases]\nthigh = 'thighbone'\n", "[aliases].thigh: expected a list of names"),
+        ("parts = 3\n", "[parts] must be a table, got 3"),
+    ],
+)
+def test_a_bad_rules_file_is_refused_on_loading_naming_file_and_field(
+    tmp_path: Path, text: str, field: str
+) -> None:
+    # before: `pelvis = 5` was accepted (the rules silently did not fit), and an unknown part
+    # surfaced only as each clip's "not mappable" warning, without the file
+    rules = tmp_path / "rules.toml"
+    rules.write_text(text)
+    with pytest.raises(ConfigError) as err:
+        load_rules(rules)
+    assert str(err.value).startswith(f"{rules}: {field}")
 
 
 def test_aliases_extend_rules() -> None:

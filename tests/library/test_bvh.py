@@ -437,6 +437,21 @@ def test_nan_or_inf(tmp_path: Path, value: str) -> None:
     assert e.line == 8 and e.expected == "finite numbers"
 
 
+@pytest.mark.parametrize("value", ["1e300", "-2e7"])
+def test_values_out_of_range(tmp_path: Path, value: str) -> None:
+    # finite but absurd (100 km, 28,000 turns and more): refused at its line, not left to
+    # overflow later (1e300 cm made `search build` fail with numpy's "must not contain infs")
+    lines = lines_of(SMALL)
+    lines[20] = lines[20].replace("90", value, 1)
+    e = bad(join(lines), tmp_path)
+    assert e.line == 21 and e.expected == "finite numbers within +-1e+07"
+    assert f"value {float(value):g} out of range" in e.reason
+    lines = lines_of(SMALL)
+    lines[7] = f"    OFFSET 0 {value} 0"
+    e = bad(join(lines), tmp_path)
+    assert e.line == 8 and "out of range" in e.reason
+
+
 def test_missing_hierarchy(tmp_path: Path) -> None:
     e = bad(join(lines_of(SMALL)[1:]), tmp_path)
     assert e.line == 1 and e.expected == "HIERARCHY"

@@ -116,6 +116,19 @@ def test_cli_info_check_convert(
     assert "missing.bvh" in capsys.readouterr().err
 
 
+def test_cli_check_counts_a_missing_path_as_bad_not_as_a_negative_ok(
+    small_lib: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a missing path or a folder without BVH files is one bad entry; no file was read, so
+    # nothing is ok (it printed "-1 ok, 1 bad" before)
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main(["library", "check", str(tmp_path / "missing.bvh"), str(empty)]) == 1
+    assert capsys.readouterr().out.splitlines()[-1].startswith("0 ok, 2 bad")
+    assert main(["library", "check", str(small_lib), str(tmp_path / "missing.bvh")]) == 1
+    assert capsys.readouterr().out.splitlines()[-1].startswith("3 ok, 1 bad")
+
+
 def test_cli_version(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as exc:
         main(["--version"])

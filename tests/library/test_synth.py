@@ -236,3 +236,16 @@ def test_write_library(tmp_path: Path) -> None:
     assert sorted(p.name for p in paths) == sorted(f"{n}.bvh" for n in CLIP_INFO)
     m = read_bvh(paths[0])
     assert m.skeleton.names == synthetic_skeleton().names
+
+
+@pytest.mark.parametrize("fps", ["0", "nan", "-30"])
+def test_synth_refuses_a_bad_frame_rate_and_makes_no_folder(
+    fps: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # before: 0 left an empty folder behind, nan a ValueError traceback
+    from reactmocap.cli import main
+
+    assert main(["synth", str(tmp_path / "clips"), "--fps", fps]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("reactmocap: error: fps must be a positive frame rate") and fps in err
+    assert not (tmp_path / "clips").exists()

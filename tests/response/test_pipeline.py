@@ -148,6 +148,24 @@ def test_every_example_scenario_runs(path: Path, tmp_path: Path) -> None:
     assert read_bvh(tmp_path / "recipient.bvh").num_frames > 10
 
 
+def test_respond_says_when_nothing_visible_happened(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # before: a 1 N push printed "reaction 0.00 m (87 deg off the impulse of 0.1 N s)"
+    text = (EXAMPLES / "light_push.toml").read_text()
+    scenario = tmp_path / "tiny.toml"
+    scenario.write_text(
+        text.replace('"../data/synthetic_clips"', repr(str(SYNTHETIC)).replace("'", '"')).replace(
+            "-250.0", "-1.0"
+        )
+    )
+    assert main(["respond", str(scenario), "--out", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert report["quality"]["reaction_displacement_m"] < 0.01
+    assert "no visible reaction (chest 0.0" in out and "deg off the impulse" not in out
+
+
 def test_demo_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["demo", "--out", str(tmp_path), "--plot", "--video"]) == 0
     out = capsys.readouterr().out

@@ -94,3 +94,17 @@ def test_bad_shift_is_a_usage_error(tmp_path: Path) -> None:
                 "1",
             ]
         )
+
+
+@pytest.mark.parametrize("yaw", ["nan", "inf", "abc"])
+def test_a_yaw_that_is_no_angle_is_a_usage_error_naming_it(
+    yaw: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = ["search", "query", str(tmp_path / "x.npz"), "--clip", "a", "--frame", "0"]
+    with pytest.raises(SystemExit) as exc:
+        main([*args, "--yaw", yaw])
+    assert exc.value.code == 2
+    assert (
+        f"argument --yaw: expected a finite angle in degrees, got '{yaw}'"
+        in capsys.readouterr().err
+    )

@@ -106,6 +106,12 @@ def test_root_assist_only_with_plain_pd(guard_loop: Motion, controller: str) -> 
     assert rep.root_assist == 100.0 and rep.controller == "pd"
 
 
+@pytest.mark.parametrize("gain", [-5.0, float("nan")])
+def test_root_assist_refuses_a_negative_or_nan_gain(guard_loop: Motion, gain: float) -> None:
+    with pytest.raises(ConfigError, match="root_assist must be a finite gain >= 0"):
+        track_clip(guard_loop, seconds=0.2, root_assist=gain, controller="pd")
+
+
 def test_stance_legs_get_stiffer_gains(clips: dict[str, Motion]) -> None:
     guard = clips["guard"]
     world = World(build_character(guard, frame=0))

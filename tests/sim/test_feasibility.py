@@ -149,3 +149,23 @@ def test_cli_feasibility(
     bad = tmp_path / "bad.json"
     assert main(["feasibility", str(clip), "--min-seconds", "-1", "--report", str(bad)]) == 2
     assert "--min-seconds" in capsys.readouterr().err and not bad.exists()
+
+
+def test_cli_track_counts_infeasible_seconds_only_up_to_a_fall(
+    shared_mocap_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The bare PD servo falls in the real kick clip at 1.57 s, before its first stretch no
+    foot can produce (1.67 s): nothing infeasible was tracked. Before, the report and the note
+    counted the 4 s asked for (0.77 s)."""
+    import json
+
+    from reactmocap.cli import main
+
+    clip = shared_mocap_dir / "dataset-1_kick_normal_001.bvh"
+    report = tmp_path / "track.json"
+    args = ["track", str(clip), "--seconds", "4", "--controller", "pd", "--report", str(report)]
+    assert main(args) == 0
+    data = json.loads(report.read_text())
+    assert data["status"] == "fell" and data["fell_at_s"] < 1.66
+    assert data["infeasible_single_support_s"] == 0.0
+    assert "of this span" not in capsys.readouterr().out
