@@ -45,6 +45,9 @@ NJ = len(BALL_JOINTS)
 _HIP = [joint_index(f"{s}_hip") for s in "lr"]
 _KNEE = [joint_index(f"{s}_knee") for s in "lr"]
 _ANKLE = [joint_index(f"{s}_ankle") for s in "lr"]
+_SHOULDER = [joint_index(f"{s}_shoulder") for s in "lr"]
+#: the most the arms spread out to the sides (shoulder roll, rad) against a twist (twist_arms)
+ARMS_SPREAD = 1.4
 #: stiffness while reaching for the ground (units of m g L N m/rad)
 LANDING_STIFFNESS = {
     "waist": 3.0, "back": 3.0, "neck": 0.3, "shoulder": 0.3, "elbow": 0.15, "wrist": 0.05,
@@ -152,6 +155,19 @@ class LandingParams:
             ``None``: ``lead``. Why: ``lead`` is tuned with the forward delta, which has no
             sideways counterpart; a perturbed broad jump touching down with 0.2-0.7 m/s
             sideways stood up on one foot and fell sideways (docs/athletics.md).
+        twist_arms: the arms spread against a twist in the reach: both shoulders roll out
+            to the sides by this much (rad) per unit (m L^2 rad/s) of the whole-body angular
+            momentum about the pelvis's long axis, measured each tick, at most
+            :data:`ARMS_SPREAD`; 0: off (the arms as ``arms``). Why: the opened body's
+            inertia about its long axis is least (female 0.82 kg m^2 with the arms forward,
+            1.74 with them out), and the 2-4 kg m^2/s about it that the tuck opens with (a
+            take-off's cartwheel and yaw momentum) twisted the female back tuck's reach at up
+            to 7 rad/s: 40-120 degrees by touchdown, on one foot first (docs/athletics.md).
+        stance_push: while absorbing, the legs push along the line from the feet that carry
+            the weight (their shares) to the COM, not from the middle of both feet; off (the
+            default): from the middle. Why: a foot that lands first, or a pair of feet to one
+            side of the COM, tilted the line, and up to 6 body weights along it threw the
+            COM sideways off the foot under it.
         spin_ref: the delta is scaled by the whole-body angular momentum about the pelvis's
             left-right axis when the reach begins (constant in the air) over this (kg m^2/s,
             the spin the delta was tuned at, backward < 0); 0: off. Why: feet placed behind
@@ -185,6 +201,8 @@ class LandingParams:
     momentum_ref: float = 0.0
     side_lead: float | None = None
     spin_ref: float = 0.0
+    twist_arms: float = 0.0
+    stance_push: bool = False
 
     def __post_init__(self) -> None:
         for name in (
@@ -205,10 +223,13 @@ class LandingParams:
             "momentum_gain",
             "momentum_ref",
             "spin_ref",
+            "twist_arms",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
+        if not 0.0 <= self.twist_arms <= 100.0:
+            raise ConfigError(f"landing twist_arms must be in [0, 100] rad, got {self.twist_arms}")
         if self.side_lead is not None and not (
             isinstance(self.side_lead, (int, float)) and 0.0 <= self.side_lead <= 2.0
         ):
@@ -272,6 +293,7 @@ class Landing(Basis):
             rig.move(goal, 0.2, t, moving)
             memo["lag"] = float(rig.lag(_HIP).mean()) if p.spin_aim or p.twist_aim else 0.0
             memo["scale"] = 1.0
+            memo["unit"] = ctx.athlete.mass * ctx.athlete.leg_length**2
             if p.spin_ref:  # the spin to stop against the delta's (see spin_ref)
                 sn = ctx.sense(t)
                 spin = float(world.data.subtree_angmom[sn.root] @ sn.side_axis())
@@ -336,6 +358,10 @@ class Landing(Basis):
             rig.offset[:] = 0.0
             for k in range(2):
                 rig.offset[_ANKLE[k], 0] = p.toes
+            if p.twist_arms:  # the arms out against a twist (see twist_arms)
+                twist = float(d.subtree_angmom[s.root] @ s.long_axis()) / memo["unit"]
+                spread = min(p.twist_arms * abs(twist), ARMS_SPREAD)
+                rig.offset[_SHOULDER, 1] = (spread, -spread)
 
         def absorb_enter(world: World, t: float) -> None:
             rig.move(rig.desired(t) + rig.offset, 0.0, t, _HIP)
@@ -392,7 +418,10 @@ class Landing(Basis):
             vertical = float(np.clip(1.0 + decel / g, 1.0, MAX_SUPPORT))
             # along the legs, from the feet to the COM, as a passive leg pushes: its
             # horizontal part takes the horizontal speed off as the COM passes over the feet
-            line = s.com - s.sole_corners().mean(axis=(0, 1))
+            if p.stance_push and rig.support.any():  # from the feet that carry the weight
+                line = s.com - rig.support @ s.sole_corners().mean(axis=1)
+            else:
+                line = s.com - s.sole_corners().mean(axis=(0, 1))
             line /= max(float(line @ s.floor_normal), 0.2)
             rig.support_scale = vertical * float(np.linalg.norm(line))
             rig.support_dir = line / np.linalg.norm(line)

@@ -98,7 +98,9 @@ TIMED_START_PRESETS = frozenset({"male/forward"})
 #: about its long axis at ~4 rad/s, her feet touched down 10-17 cm to the side of the COM and
 #: she stood up on one foot and fell sideways (docs/athletics.md). Since 2026-12-03 her push
 #: also servos the cartwheel and yaw momentum to zero (the leap's ``tilt_gain``): the
-#: take-off's yaw momentum told her landings apart.
+#: take-off's yaw momentum told her landings apart. Since 2026-12-03 her arms spread in the
+#: reach against the twist the opening body makes (``twist_arms``), and her legs absorb the
+#: touchdown pushing from the feet that carry the weight (``stance_push``).
 SOMERSAULT_PRESETS: Mapping[
     str, Mapping[str, tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]]
 ] = MappingProxyType({
@@ -125,7 +127,8 @@ SOMERSAULT_PRESETS: Mapping[
                                        "tilt_gain": 10.0}),
                      MappingProxyType({"lead": 3.6}),
                      MappingProxyType({"delta": -0.16, "spin_aim": True, "aim_sideways": True,
-                                       "twist_aim": True})),
+                                       "twist_aim": True, "twist_arms": 15.0,
+                                       "stance_push": True})),
     }),
 })  # fmt: skip
 DIRECTIONS = ("backward", "forward")

@@ -48,6 +48,7 @@ class Senses:
         self._f6 = np.zeros(6)
         self._forward = _axis_in_body(athlete, np.array([1.0, 0.0, 0.0]))
         self._left = _axis_in_body(athlete, np.array([0.0, 1.0, 0.0]))
+        self._up = _axis_in_body(athlete, np.array([0.0, 0.0, 1.0]))
         self.time = -1.0
         self.com = np.zeros(3)
         self.com_vel = np.zeros(3)
@@ -134,6 +135,10 @@ class Senses:
         """The pelvis's anatomical left-right axis (world, unit; left > 0): the axis a
         somersault turns about."""
         return self.world.data.xmat[self.root].reshape(3, 3) @ self._left
+
+    def long_axis(self) -> F64:
+        """The pelvis's anatomical up axis (world, unit): the long axis a body twists about."""
+        return self.world.data.xmat[self.root].reshape(3, 3) @ self._up
 
     def side_heading(self) -> float:
         """Heading (rad about +Z) of the forward axis a quarter turn from the pelvis's

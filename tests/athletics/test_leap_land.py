@@ -181,6 +181,12 @@ def test_landing_side_lead_must_be_in_range() -> None:
             LandingParams(side_lead=bad)
 
 
+def test_landing_twist_arms_must_be_in_range() -> None:
+    for bad in (-1.0, 101.0, float("nan")):
+        with pytest.raises(ConfigError, match="twist_arms"):
+            LandingParams(twist_arms=bad)
+
+
 def test_flight_conserves_angular_momentum() -> None:
     # a leap with pitch momentum; in the air only internal torques act
     r = run("leap", "male", effort=0.4, spin=15.0, push="timed")

@@ -287,6 +287,10 @@ def test_perturbed_back_tucks_land_with_the_legs_holding_their_aim() -> None:
         assert r["fell"] and not r["landed"], i
 
 
+#: the female back tuck's landing before 2026-12-03's arms against the twist
+ARMS_OFF = {"twist_arms": 0.0, "stance_push": False}
+
+
 def test_perturbed_female_back_tucks_land_with_the_legs_aimed_where_the_pelvis_will_be() -> None:
     """Starts 0 and 5 of the capture region at full size (seed 0), on the female body. Her
     take-off's few kg m^2/s of cartwheel momentum twist her opening body about its long axis
@@ -305,7 +309,7 @@ def test_perturbed_female_back_tucks_land_with_the_legs_aimed_where_the_pelvis_w
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
     leap = replace(m.phases[1], params={**m.phases[1].params, "tilt_gain": 0.0})
     for off in ({"twist_aim": False}, {"twist_aim": False, "aim_sideways": False}):
-        land = replace(m.phases[3], params={**m.phases[3].params, **off})
+        land = replace(m.phases[3], params={**m.phases[3].params, **ARMS_OFF, **off})
         before = replace(m, phases=(m.phases[0], leap, m.phases[2], land, *m.phases[4:]))
         r = run_maneuver(before, perturbation=starts[0], fps=10.0).report
         assert r["fell"] and not r["landed"], off
@@ -332,10 +336,44 @@ def test_the_female_back_tuck_pushes_off_with_little_yaw_momentum() -> None:
     assert abs(r.report["rotation_deg"] + 360.0) <= 30.0
     assert abs(_liftoff_momentum(r)[2]) < 0.6
     leap = replace(m.phases[1], params={**m.phases[1].params, "tilt_gain": 0.0})
-    r = run_maneuver(replace(m, phases=(m.phases[0], leap, *m.phases[2:])), perturbation=start,
-                     fps=10.0)  # fmt: skip
+    land = replace(m.phases[3], params={**m.phases[3].params, **ARMS_OFF})
+    before = replace(m, phases=(m.phases[0], leap, m.phases[2], land, *m.phases[4:]))
+    r = run_maneuver(before, perturbation=start, fps=10.0)
     assert r.report["fell"] and not r.report["landed"]
     assert abs(_liftoff_momentum(r)[2]) > 0.9
+
+
+def _air_twist(r: AthleticsResult) -> float:
+    """The twist (deg) from lift-off to touchdown."""
+    t, twist = r.log["t"], r.log["twist"]
+    k0, k1 = np.searchsorted(t, (r.report["time_to_liftoff_s"], r.report["touchdown_s"]))
+    return math.degrees(float(twist[min(k1, t.size - 1)] - twist[k0]))
+
+
+def test_perturbed_female_back_tucks_land_with_the_arms_out_against_the_twist() -> None:
+    """Starts 9 and 16 of the capture region at full size (seed 0), female. Her tuck opens
+    with 2-4 kg m^2/s of angular momentum about the long axis, about which the opened body's
+    inertia is least: with the arms forward (the preset before) start 9 twisted 105 degrees
+    between lift-off and touchdown, touched down on one foot and fell sideways. With the arms
+    spread against the twist in the reach (``twist_arms``) it twists about half that, and
+    with the absorbing legs pushing from the foot that carries the weight (``stance_push``)
+    both starts land (the preset since 2026-12-03); either alone, or neither, and start 9
+    falls."""
+    starts = full_starts(17)
+    m = somersault_maneuver(body="female")
+    assert m.phases[3].params["twist_arms"] > 0 and m.phases[3].params["stance_push"]
+    for i in (9, 16):
+        r = run_maneuver(m, perturbation=starts[i], fps=10.0)
+        assert r.report["landed"] and not r.report["fell"], i
+        assert abs(r.report["rotation_deg"] + 360.0) <= 30.0, i
+        assert abs(_air_twist(r)) < 70.0, i
+    for off in (ARMS_OFF, {"twist_arms": 0.0}, {"stance_push": False}):
+        land = replace(m.phases[3], params={**m.phases[3].params, **off})
+        r = run_maneuver(replace(m, phases=(*m.phases[:3], land, *m.phases[4:])),
+                         perturbation=starts[9], fps=10.0)  # fmt: skip
+        assert r.report["fell"] and not r.report["landed"], off
+        if off.get("twist_arms") == 0.0:  # the arms forward: the twist as before
+            assert abs(_air_twist(r)) > 90.0, off
 
 
 def test_the_leap_refuses_a_tilt_gain_out_of_range() -> None:
