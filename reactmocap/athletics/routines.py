@@ -66,13 +66,14 @@ TIMED_START_PRESETS = frozenset({"male/forward"})
 #: (aiming at -66 kg m^2/s with the hips' feedback allowed 1.3 rad, it gets -59.6 against the
 #: tuck's -49), opens earlier (lead 3.4 rad) and reaches for the floor with the knees bent
 #: 1.0 rad (at 0.6 its straight-legged touchdown bounced). The forward preset (male) crouches with
-#: the arms overhead and swings them forward and down through the push, the COM 8 cm ahead of
-#: the feet, the hips' momentum feedback aiming at +60 kg m^2/s; it stays tucked until the
-#: prediction reaches the full turn (the opening costs a forward somersault rotation: the legs
-#: swing down and the trunk back), extending hips and knees 60% toward the landing pose first
-#: (thesis 8.5.1: without it the legs are still folded at touchdown and the landing sinks the
-#: pelvis below the fall line), and lands with the feet 40 cm ahead of the capture point to
-#: stop the forward spin (landed at 35-45 cm; at 30 cm the crouch sank too deep). The back
+#: the arms overhead, the COM 5 cm ahead of the feet (moved there over the crouch), and pushes
+#: with the "com" servo, whose centre of pressure steers the take-off momentum to +49 kg m^2/s
+#: (since 2026-12-03; the timed push, aimed at +60 with the hips' feedback, hopped off the
+#: floor as it began and left in two modes, +43 or +34); it stays tucked until the prediction
+#: reaches the full turn less 0.45 rad, so the legs reach the floor out, extending hips and
+#: knees 60% toward the landing pose first (thesis 8.5.1), and lands with the feet 4 cm ahead
+#: of the capture point, knees bent 0.5 rad (docs/athletics.md: about half the perturbed
+#: starts land at a tenth of the capture region's perturbation; the landing decides). The back
 #: layout (inertia 18.5 kg m^2 against the tuck's 4.7) needs the leap at effort 0.9 aiming at
 #: -90 kg m^2/s with the hips allowed 1.5 rad (it gets -77.0, 1.2 m of COM rise); it holds the
 #: layout until the rotation predicted for the touchdown comes down to the turn less 0.96 rad
@@ -102,7 +103,7 @@ TIMED_START_PRESETS = frozenset({"male/forward"})
 #: reach against the twist the opening body makes (``twist_arms``), and her legs absorb the
 #: touchdown pushing from the feet that carry the weight (``stance_push``).
 SOMERSAULT_PRESETS: Mapping[
-    str, Mapping[str, tuple[Mapping[str, float], Mapping[str, float], Mapping[str, float]]]
+    str, Mapping[str, tuple[Mapping[str, float | str], Mapping[str, float], Mapping[str, float]]]
 ] = MappingProxyType({
     "male": MappingProxyType({
         "backward": (MappingProxyType({"effort": 0.6, "spin": -55.0, "spin_limit": 1.0}),
@@ -116,11 +117,14 @@ SOMERSAULT_PRESETS: Mapping[
                             MappingProxyType({"lead": -0.96, "open_inertia": 4.0,
                                               "open_delay": 0.217}),
                             MappingProxyType({"delta": -0.13, "knee": 1.0})),
-        "forward": (MappingProxyType({"effort": 1.0, "spin": 60.0, "spin_limit": 1.0,
-                                      "com_offset": 0.08, "arms_back": -2.8, "arms": 0.0}),
-                    MappingProxyType({"lead": 0.0, "latest": 0.0, "extend": 0.6,
+        "forward": (MappingProxyType({"effort": 1.0, "push": "com", "rise": 0.85, "leg": 0.6,
+                                      "pitch": 0.0, "lean": 0.0, "push_hip": 0.5,
+                                      "push_ankle": 1.0, "spin": 49.0, "com_offset": 0.05,
+                                      "com_ease": True, "arms_back": -2.8, "arms": 0.0}),
+                    MappingProxyType({"lead": 0.45, "latest": 0.0, "extend": 0.6,
                                       "extend_lead": 0.15}),
-                    MappingProxyType({"delta": 0.4, "knee": 0.4, "restore": 0.2})),
+                    MappingProxyType({"delta": 0.04, "knee": 0.5, "restore": 0.4,
+                                      "damping": 1.75})),
     }),
     "female": MappingProxyType({
         "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0,
@@ -198,6 +202,7 @@ def somersault_maneuver(
             f"unknown somersault position {position!r}; valid positions are {sorted(POSITIONS)}"
         )
     start = SETTLED_START
+    leap: Mapping[str, float | str]
     if twist:
         leap, tumble, land = _twist_preset(position, direction, body, twist)
         start = TIMED_START

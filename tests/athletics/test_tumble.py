@@ -187,11 +187,29 @@ def test_the_forward_tuck_somersault_turns_360_forward_and_lands() -> None:
     # turned -635 degrees and fell)
     assert abs(r["rotation_deg"] - 360.0) <= 45.0
     assert r["landed"] and not r["fell"]
-    assert r["flight_momentum_drift"] <= 0.01
+    # 1.5%, not 1%: the reach, opened 0.24 s before touchdown, swings the hips from -2.1 to
+    # +0.4 rad in 0.15 s, and the momentum moves by 1.2% over those ticks (nothing touches)
+    assert r["flight_momentum_drift"] <= 0.015
     # `fell` is the log's: nothing but the feet touched and the pelvis stayed above half its
     # standing height (this landing's crouch is deep: docs/athletics.md)
     pelvis = res.log["pelvis"]
     assert not res.log["others"].any() and pelvis.min() >= FALL_HEIGHT * pelvis[0]
+
+
+def test_the_forward_tuck_lands_with_2_and_4_kg_backpacks_untuned() -> None:
+    """Thesis 8.5.2: the forward tuck carries a 2 or a 4 kg backpack without re-tuning. Its
+    "com" push leaves the floor once (the timed push before it hopped off as it began and left
+    at +43 or +34 kg m^2/s; both backpacks fell) with its momentum near the aimed +49."""
+    for kg in (2.0, 4.0):
+        res = somersault("tuck", "forward", "male", backpack=kg, fps=10.0)
+        r = res.report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0, kg
+        assert 46.0 < r["liftoff_pitch_momentum"] < 54.0, kg
+        times = {to: t for t, _, to in res.transitions}
+        t = res.log["t"]
+        push = (t >= times["leap.thrust"]) & (t <= times["leap.flight"] + 0.004)
+        down = res.log["feet"][push] > 0
+        assert int(np.sum(down[:-1] & ~down[1:])) == 1, kg  # the feet leave once
 
 
 def test_the_back_pike_lands_on_more_momentum_than_the_tuck(back_tuck) -> None:  # type: ignore[no-untyped-def]
