@@ -166,20 +166,19 @@ def _checked(rules: dict[str, object], where: str) -> dict[str, object]:
     for section, table in (("parts", parts), ("aliases", aliases)):
         if not isinstance(table, Mapping):
             raise ConfigError(f"{where}[{section}] must be a table, got {table!r}")
-    for part, joint in parts.items():  # type: ignore[attr-defined]
-        if part not in BODY_PARTS:
-            raise ConfigError(
-                f"{where}[parts] has unknown part {part!r}; parts are {list(BODY_PARTS)}"
-            )
-        if not isinstance(joint, str):
-            raise ConfigError(f"{where}[parts].{part}: expected a joint name, got {joint!r}")
-    for kind, names in aliases.items():  # type: ignore[attr-defined]
-        if kind not in _BASE_NAMES:
-            raise ConfigError(
-                f"{where}[aliases] has unknown kind {kind!r}; kinds are {list(_BASE_NAMES)}"
-            )
-        if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
-            raise ConfigError(f"{where}[aliases].{kind}: expected a list of names, got {names!r}")
+    checks = (
+        ("parts", parts, BODY_PARTS, "part", "a joint name", lambda v: isinstance(v, str)),
+        ("aliases", aliases, _BASE_NAMES, "kind", "a list of names",
+         lambda v: isinstance(v, list) and all(isinstance(n, str) for n in v)),
+    )  # fmt: skip
+    for section, table, valid, what, expected, ok in checks:
+        for key, value in table.items():  # type: ignore[attr-defined]
+            if key not in valid:
+                raise ConfigError(
+                    f"{where}[{section}] has unknown {what} {key!r}; {what}s are {list(valid)}"
+                )
+            if not ok(value):
+                raise ConfigError(f"{where}[{section}].{key}: expected {expected}, got {value!r}")
     return rules
 
 
