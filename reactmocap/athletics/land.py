@@ -151,6 +151,12 @@ class LandingParams:
             "com" leaps lift off with -1.1 to +1.6 kg m^2/s: at 0.75 m, +1.6, she landed only
             with the feet 3-5 cm ahead of where her 0.7 and 0.8 m leaps, +0.4 / +0.9, land).
         momentum_ref: the pitch momentum (kg m^2/s) the deltas were measured at.
+        momentum_side: ``momentum_gain``'s momentum taken about the pelvis's left-right axis
+            when the reach begins (as ``spin_ref``'s), not about the heading's pitch axis each
+            tick. Why: the heading flips by half a turn as an inverted body passes the
+            horizontal; a somersault's weak take-off (the female back tuck's under 22 of her
+            usual 23 kg m^2/s) landed with the feet placed for the usual spin, 2 cm too far
+            behind the COM, and fell forward (docs/athletics.md).
         side_lead: the sideways placement's lead (0-2, units of the capture point's);
             ``None``: ``lead``. Why: ``lead`` is tuned with the forward delta, which has no
             sideways counterpart; a perturbed broad jump touching down with 0.2-0.7 m/s
@@ -199,6 +205,7 @@ class LandingParams:
     fall_ref: float = 0.0
     momentum_gain: float = 0.0
     momentum_ref: float = 0.0
+    momentum_side: bool = False
     side_lead: float | None = None
     spin_ref: float = 0.0
     twist_arms: float = 0.0
@@ -294,10 +301,11 @@ class Landing(Basis):
             memo["lag"] = float(rig.lag(_HIP).mean()) if p.spin_aim or p.twist_aim else 0.0
             memo["scale"] = 1.0
             memo["unit"] = ctx.athlete.mass * ctx.athlete.leg_length**2
-            if p.spin_ref:  # the spin to stop against the delta's (see spin_ref)
+            if p.spin_ref or p.momentum_side:  # the spin the feet must stop (constant in the air)
                 sn = ctx.sense(t)
-                spin = float(world.data.subtree_angmom[sn.root] @ sn.side_axis())
-                memo["scale"] = spin / p.spin_ref
+                memo["spin"] = float(world.data.subtree_angmom[sn.root] @ sn.side_axis())
+            if p.spin_ref:  # the spin to stop against the delta's (see spin_ref)
+                memo["scale"] = memo["spin"] / p.spin_ref
             memo["fall"] = p.fall_ref
             if p.fall_gain:  # the fall predicted now, in the landing pose (see fall_gain)
                 sn = ctx.sense(t)
@@ -323,7 +331,8 @@ class Landing(Basis):
             want = np.array([lead * v[0] + p.delta_at(float(v[0])) * memo["scale"], side * v[1]])
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
             if p.momentum_gain:  # the feet also stop the rotation (see momentum_gain)
-                want[0] += p.momentum_gain * (pitch_momentum(world, s) - p.momentum_ref)
+                spin = memo["spin"] if p.momentum_side else pitch_momentum(world, s)
+                want[0] += p.momentum_gain * (spin - p.momentum_ref)
             # eq. 6.1 as a correction on top of the geometric placement below
             x = s.local(feet - s.com, h)
             xd = s.local(fvel - s.com_vel, h)

@@ -101,7 +101,9 @@ TIMED_START_PRESETS = frozenset({"male/forward"})
 #: also servos the cartwheel and yaw momentum to zero (the leap's ``tilt_gain``): the
 #: take-off's yaw momentum told her landings apart. Since 2026-12-03 her arms spread in the
 #: reach against the twist the opening body makes (``twist_arms``), and her legs absorb the
-#: touchdown pushing from the feet that carry the weight (``stance_push``).
+#: touchdown pushing from the feet that carry the weight (``stance_push``). Since 2026-12-03 her
+#: feet land farther ahead after a weak take-off (``momentum_gain`` with ``momentum_side``):
+#: placed for her usual spin, they stopped a smaller one too hard and she fell forward.
 SOMERSAULT_PRESETS: Mapping[
     str, Mapping[str, tuple[Mapping[str, float | str], Mapping[str, float], Mapping[str, float]]]
 ] = MappingProxyType({
@@ -132,7 +134,8 @@ SOMERSAULT_PRESETS: Mapping[
                      MappingProxyType({"lead": 3.6}),
                      MappingProxyType({"delta": -0.16, "spin_aim": True, "aim_sideways": True,
                                        "twist_aim": True, "twist_arms": 15.0,
-                                       "stance_push": True})),
+                                       "stance_push": True, "momentum_gain": 0.015,
+                                       "momentum_ref": -23.0, "momentum_side": True})),
     }),
 })  # fmt: skip
 DIRECTIONS = ("backward", "forward")

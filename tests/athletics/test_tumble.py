@@ -346,10 +346,14 @@ def test_the_female_back_tuck_pushes_off_with_little_yaw_momentum() -> None:
     momentum told her landings apart (above 0.61 kg m^2/s 19% landed, below 90%): it twists
     the opening body. Without the push's tilt feedback (``tilt_gain`` 0, the preset before)
     she left with 1.07 kg m^2/s and fell; with it (the preset since 2026-12-03) with about
-    half, and lands."""
+    half, and lands. Both with the landing as it was measured then, without the feet placed
+    for the spin (``momentum_gain``), with which this start, twisted 31 degrees in the air,
+    falls sideways."""
     start = full_starts(4)[3]
     m = somersault_maneuver(body="female")
     assert m.phases[1].params["tilt_gain"] > 0
+    land = replace(m.phases[3], params={**m.phases[3].params, "momentum_gain": 0.0})
+    m = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
     r = run_maneuver(m, perturbation=start, fps=10.0)
     assert r.report["landed"] and not r.report["fell"]
     assert abs(r.report["rotation_deg"] + 360.0) <= 30.0
@@ -393,6 +397,25 @@ def test_perturbed_female_back_tucks_land_with_the_arms_out_against_the_twist() 
         assert r.report["fell"] and not r.report["landed"], off
         if off.get("twist_arms") == 0.0:  # the arms forward: the twist as before
             assert abs(_air_twist(r)) > 90.0, off
+
+
+def test_a_weak_female_back_tuck_take_off_lands_with_the_feet_placed_for_its_spin() -> None:
+    """Starts 14 and 24 of the capture region at full size (seed 0), female. Both push off
+    weakly (under 22 of her usual 23 kg m^2/s backward); with the feet placed for the usual
+    spin (the preset before) they touched down 4-5 cm behind the COM, stopped the smaller
+    spin too hard and fell forward. With the feet moved ahead by the spin measured about the
+    pelvis's left-right axis as the reach begins (``momentum_gain`` with ``momentum_side``,
+    the preset since 2026-12-03) both land."""
+    starts = full_starts(25)
+    m = somersault_maneuver(body="female")
+    assert m.phases[3].params["momentum_side"] is True
+    land = replace(m.phases[3], params={**m.phases[3].params, "momentum_gain": 0.0})
+    before = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
+    for i in (14, 24):
+        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
+        r = run_maneuver(before, perturbation=starts[i], fps=10.0).report
+        assert r["fell"] and not r["landed"], i
 
 
 def test_the_leap_refuses_a_tilt_gain_out_of_range() -> None:
