@@ -297,12 +297,20 @@ def test_perturbed_back_tucks_land_with_the_legs_holding_their_aim() -> None:
     starts = full_starts(10)
     m = somersault_maneuver()
     assert m.phases[3].params["spin_aim"] is True
-    land = replace(m.phases[3], params={**m.phases[3].params, "spin_aim": False})
-    off = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
-    for i in (8, 9):
-        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
+    _land_only_with_the_landing_as_is(m, {"spin_aim": False}, [starts[8], starts[9]])
+
+
+def _land_only_with_the_landing_as_is(
+    m: Maneuver, off: dict[str, object], starts: list[Perturbation]
+) -> None:
+    """Each start lands a back somersault with ``m`` and falls with its landing (phase 3)
+    changed by ``off``."""
+    land = replace(m.phases[3], params={**m.phases[3].params, **off})
+    before = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
+    for i, start in enumerate(starts):
+        r = run_maneuver(m, perturbation=start, fps=10.0).report
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
-        r = run_maneuver(off, perturbation=starts[i], fps=10.0).report
+        r = run_maneuver(before, perturbation=start, fps=10.0).report
         assert r["fell"] and not r["landed"], i
 
 
@@ -409,13 +417,7 @@ def test_a_weak_female_back_tuck_take_off_lands_with_the_feet_placed_for_its_spi
     starts = full_starts(25)
     m = somersault_maneuver(body="female")
     assert m.phases[3].params["momentum_side"] is True
-    land = replace(m.phases[3], params={**m.phases[3].params, "momentum_gain": 0.0})
-    before = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
-    for i in (14, 24):
-        r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
-        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, i
-        r = run_maneuver(before, perturbation=starts[i], fps=10.0).report
-        assert r["fell"] and not r["landed"], i
+    _land_only_with_the_landing_as_is(m, {"momentum_gain": 0.0}, [starts[14], starts[24]])
 
 
 def test_the_leap_refuses_a_tilt_gain_out_of_range() -> None:
