@@ -40,7 +40,7 @@ import numpy as np
 
 from reactmocap.athletics import tables
 from reactmocap.athletics.backdrop import Backdrop, backdrop_keyframes
-from reactmocap.athletics.balance import Balance, Posture
+from reactmocap.athletics.balance import BALANCE_GAINS, STANDING_GAINS, Balance, Posture
 from reactmocap.athletics.behaviours import (
     AthleticsResult,
     _landing,
@@ -140,11 +140,17 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
         raise ConfigError(
             f"balance settle_share applies to the exit 'settled' only, not {phase.exit!r}"
         )
+    gains = p.pop("gains", "balance")
+    if gains not in BALANCE_GAIN_SETS:
+        raise ConfigError(
+            f"balance gains must be one of {sorted(BALANCE_GAIN_SETS)}, got {gains!r}"
+        )
     seconds = phase.seconds if phase.exit == "after" else None
     within = None
     if phase.exit == "settled":
         within = phase.seconds if phase.seconds is not None else SETTLE_WITHIN
-    return Balance(Posture(**p), seconds=seconds, settle_within=within, settle_share=share)
+    return Balance(Posture(**p), seconds=seconds, gains=BALANCE_GAIN_SETS[gains],
+                   settle_within=within, settle_share=share)  # fmt: skip
 
 
 def _build_leap(phase: Phase, ath: Athlete) -> Basis:
@@ -200,12 +206,17 @@ def _build_land(phase: Phase, ath: Athlete) -> Basis:
 
 #: seconds a balance phase ending "settled" may take by default
 SETTLE_WITHIN = 2.0
+#: a balance phase's ``gains`` by name: the thesis's COM servo, or the standing behaviour's
+#: (its hip and arm strategies and windmilling against a fall; on a level floor the rest is the
+#: same)
+BALANCE_GAIN_SETS = MappingProxyType({"balance": BALANCE_GAINS, "standing": STANDING_GAINS})
 _LEAP_KINDS = {"effort": "number", **_kinds(LeapParams, skip=("handover",))}
 CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
     "balance": BasisSpec(
         "balance", "stand balanced in a posture (thesis ch. 7); `settle_share`: the weight "
-        "each foot must bear for the exit `settled` (default 0.2)",
-        {**_kinds(Posture), "settle_share": "number"},
+        "each foot must bear for the exit `settled` (default 0.2); `gains`: \"balance\" "
+        "(default) or \"standing\" (the hip and arm strategies against a fall as well)",
+        {**_kinds(Posture), "settle_share": "number", "gains": "string"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
          "settled": "once standing still on both feet with the COM over them (a perturbed "
                     "start); not settled within `seconds` (default 2): the run fails there"},

@@ -22,7 +22,9 @@ __all__ = [
     "DIVE_TWISTS",
     "PLATFORM_MAX",
     "SETTLED_START",
+    "SETTLED_START_STANDING",
     "SOMERSAULT_PRESETS",
+    "STANDING_START_PRESETS",
     "TIMED_START",
     "TIMED_START_PRESETS",
     "TWIST_DIVE",
@@ -47,6 +49,15 @@ __all__ = [
 #: (``vertical_leap.toml``, ``back_somersault.toml``) write the same phase (a test holds them
 #: to it)
 SETTLED_START = Phase("balance", "settled", MappingProxyType({"plant": True}), 3.0)
+#: :data:`SETTLED_START` with the standing behaviour's hip and arm strategies against a fall
+#: (``gains = "standing"``): the female back tuck's perturbed starts that stood with the COM
+#: ~9 cm behind the feet's middle fell backward while settling under the ankles alone
+#: (docs/athletics.md); ``back_somersault_female.toml`` writes the same phase
+SETTLED_START_STANDING = Phase("balance", "settled",
+                               MappingProxyType({"plant": True, "gains": "standing"}), 3.0)  # fmt: skip
+#: the :data:`SOMERSAULT_PRESETS` entries (``body/key``) that start from
+#: :data:`SETTLED_START_STANDING`
+STANDING_START_PRESETS = frozenset({"female/backward"})
 #: the timed start: the next phase begins 0.3 s into the start, settled or not (the dives, the
 #: handspring and :data:`TIMED_START_PRESETS`)
 TIMED_START = Phase("balance", "after", MappingProxyType({}), 0.3)
@@ -216,6 +227,8 @@ def somersault_maneuver(
         leap, tumble, land = presets[key]
         if f"{owner}/{key}" in TIMED_START_PRESETS:
             start = TIMED_START
+        elif f"{owner}/{key}" in STANDING_START_PRESETS:
+            start = SETTLED_START_STANDING
     phases = (
         start,
         Phase("leap", "liftoff", dict(leap)),

@@ -15,12 +15,20 @@ from reactmocap.athletics import athlete
 from reactmocap.athletics.backdrop import arm_windmill
 from reactmocap.athletics.behaviours import AthleticsResult
 from reactmocap.athletics.leap import LeapParams
-from reactmocap.athletics.maneuvers import Maneuver, Perturbation, load_maneuver, run_maneuver
+from reactmocap.athletics.maneuvers import (
+    CONTROLLERS,
+    Maneuver,
+    Perturbation,
+    Phase,
+    load_maneuver,
+    run_maneuver,
+)
 from reactmocap.athletics.report import FALL_HEIGHT
 from reactmocap.athletics.rig import joint_index
 from reactmocap.athletics.routines import (
     DIVE_PIKE_HIP,
     SETTLED_START,
+    SETTLED_START_STANDING,
     TIMED_START,
     dive_maneuver,
     somersault,
@@ -420,6 +428,31 @@ def test_a_weak_female_back_tuck_take_off_lands_with_the_feet_placed_for_its_spi
     _land_only_with_the_landing_as_is(m, {"momentum_gain": 0.0}, [starts[14], starts[24]])
 
 
+def test_a_female_back_tuck_start_settles_with_the_hips_and_arms_against_its_fall() -> None:
+    """Start 38 of the capture region at full size (seed 0), female. It stands with the COM
+    about 9 cm behind the balance's target over the feet; under the COM servo alone (``gains``
+    "balance", the preset before) the ankles do not bring it back, it drifts further back,
+    falls while settling and never leaps (``unsettled_s``). With the standing behaviour's hip
+    and arm strategies as well (``gains`` "standing", the preset since 2026-12-03) it settles
+    and lands."""
+    start = full_starts(39)[38]
+    m = somersault_maneuver(body="female")
+    assert m.phases[0].params["gains"] == "standing"
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert "unsettled_s" not in r
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    first = replace(m.phases[0], params={**m.phases[0].params, "gains": "balance"})
+    r = run_maneuver(replace(m, phases=(first, *m.phases[1:])), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["unsettled_s"] == pytest.approx(3.0) and r["time_to_liftoff_s"] is None
+
+
+def test_the_balance_phase_refuses_an_unknown_gain_set() -> None:
+    with pytest.raises(ConfigError, match="balance gains must be one of"):
+        CONTROLLERS["balance"].build(Phase("balance", "settled", {"gains": "stiff"}),
+                                     athlete("female"))  # fmt: skip
+
+
 def test_the_leap_refuses_a_tilt_gain_out_of_range() -> None:
     for bad in (-1.0, 101.0, math.nan):
         with pytest.raises(ConfigError, match="tilt_gain|finite"):
@@ -450,9 +483,11 @@ def test_the_somersault_command_leaps_from_a_settled_start_as_the_files_do() -> 
         assert first == SETTLED_START, stem
     m = somersault_maneuver()
     assert m.seconds == load_maneuver(maneuvers / "back_somersault.toml").seconds
-    for built in (m, somersault_maneuver("pike"), somersault_maneuver("layout"),
-                  somersault_maneuver(body="female")):  # fmt: skip
+    for built in (m, somersault_maneuver("pike"), somersault_maneuver("layout")):
         assert built.phases[0] == SETTLED_START, built.name
+    female = somersault_maneuver(body="female")  # the same, with the standing gains
+    assert female.phases[0] == SETTLED_START_STANDING
+    assert replace(female.phases[0], params={"plant": True}) == SETTLED_START
     for built in (somersault_maneuver(direction="forward"),
                   somersault_maneuver("layout", twist=1.0)):  # fmt: skip
         assert built.phases[0] == TIMED_START, built.name
