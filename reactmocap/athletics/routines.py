@@ -22,11 +22,10 @@ __all__ = [
     "DIVE_TWISTS",
     "PLATFORM_MAX",
     "SETTLED_START",
+    "PRESET_STARTS",
     "SETTLED_START_STANDING",
     "SOMERSAULT_PRESETS",
-    "STANDING_START_PRESETS",
     "TIMED_START",
-    "TIMED_START_PRESETS",
     "TWIST_DIVE",
     "TWIST_SOMERSAULT_PRESETS",
     "dive",
@@ -55,21 +54,21 @@ SETTLED_START = Phase("balance", "settled", MappingProxyType({"plant": True}), 3
 #: (docs/athletics.md); ``back_somersault_female.toml`` writes the same phase
 SETTLED_START_STANDING = Phase("balance", "settled",
                                MappingProxyType({"plant": True, "gains": "standing"}), 3.0)  # fmt: skip
-#: the :data:`SOMERSAULT_PRESETS` entries (``body/key``) that start from
-#: :data:`SETTLED_START_STANDING`
-STANDING_START_PRESETS = frozenset({"female/backward"})
 #: the timed start: the next phase begins 0.3 s into the start, settled or not (the dives, the
-#: handspring and :data:`TIMED_START_PRESETS`)
+#: handspring and the timed entries of :data:`PRESET_STARTS`)
 TIMED_START = Phase("balance", "after", MappingProxyType({}), 0.3)
 #: seconds a somersault is simulated: from :data:`TIMED_START` 5.5; from :data:`SETTLED_START`
 #: 2.7 more, what the settle may take beyond 0.3 s (8.2, as ``back_somersault.toml``)
 SOMERSAULT_SECONDS = MappingProxyType({"after": 5.5, "settled": 8.2})
-#: the :data:`SOMERSAULT_PRESETS` entries (``body/key``) that still leap 0.3 s into the start,
-#: not from :data:`SETTLED_START`: the male forward tuck, settled first, sinks its landing's
-#: crouch 3 mm further, below the fall line, and falls. The twisting presets keep it too
-#: (settled, the full twist's perturbed starts landed 0 of 29 at full size, against 2/50:
-#: docs/athletics.md, 2026-12-02)
-TIMED_START_PRESETS = frozenset({"male/forward"})
+#: the :data:`SOMERSAULT_PRESETS` entries (``body/key``) that do not start from
+#: :data:`SETTLED_START`, and their start. The male forward tuck still leaps 0.3 s into the
+#: start: settled first, it sinks its landing's crouch 3 mm further, below the fall line, and
+#: falls (the twisting presets keep the timed start too: settled, the full twist's perturbed
+#: starts landed 0 of 29 at full size, against 2/50: docs/athletics.md, 2026-12-02). The female
+#: backward presets settle with the standing gains (:data:`SETTLED_START_STANDING`).
+PRESET_STARTS: Mapping[str, Phase] = MappingProxyType({
+    "male/forward": TIMED_START, "female/backward": SETTLED_START_STANDING,
+})  # fmt: skip
 #: the built-in somersaults, tuned by hand (as the thesis's, section 8.4) per body:
 #: body -> ``direction`` or ``direction/position`` -> (leap, tumble, landing parameters); a
 #: position with no preset of its own uses its direction's (the tuck's) leap and landing with
@@ -215,7 +214,6 @@ def somersault_maneuver(
         raise UnknownKeyError(
             f"unknown somersault position {position!r}; valid positions are {sorted(POSITIONS)}"
         )
-    start = SETTLED_START
     leap: Mapping[str, float | str]
     if twist:
         leap, tumble, land = _twist_preset(position, direction, body, twist)
@@ -225,10 +223,7 @@ def somersault_maneuver(
         presets = SOMERSAULT_PRESETS[owner]
         key = f"{direction}/{position}" if f"{direction}/{position}" in presets else direction
         leap, tumble, land = presets[key]
-        if f"{owner}/{key}" in TIMED_START_PRESETS:
-            start = TIMED_START
-        elif f"{owner}/{key}" in STANDING_START_PRESETS:
-            start = SETTLED_START_STANDING
+        start = PRESET_STARTS.get(f"{owner}/{key}", SETTLED_START)
     phases = (
         start,
         Phase("leap", "liftoff", dict(leap)),

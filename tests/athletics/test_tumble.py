@@ -472,7 +472,7 @@ def test_the_female_back_somersault_file_is_the_preset() -> None:
 def test_the_somersault_command_leaps_from_a_settled_start_as_the_files_do() -> None:
     """The command's presets start as ``back_somersault.toml`` does (since 2026-12-02): the
     start settled onto both feet (:data:`SETTLED_START`) before the leap, not 0.3 s into it.
-    The male forward tuck and the full twist keep the timed start (:data:`TIMED_START_PRESETS`).
+    The male forward tuck and the full twist keep the timed start (:data:`PRESET_STARTS`).
     Start 4 of the full-size starts (seed 0) left the timed start moving back at 1.1 m/s and
     fell after touchdown; settled first it lands."""
     maneuvers = Path(__file__).parents[2] / "examples" / "athletics" / "maneuvers"
