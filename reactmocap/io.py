@@ -19,6 +19,7 @@ __all__ = [
     "atomic_write",
     "atomic_write_bytes",
     "atomic_write_text",
+    "output_errors",
     "read_toml",
     "save_png",
     "unwritable_reason",
@@ -35,28 +36,33 @@ def _umask() -> int:
 def atomic_write(path: str | Path, mode: str = "w") -> Iterator[IO]:  # type: ignore[type-arg]
     """Open a temporary file beside ``path``; on success rename it over ``path``."""
     target = Path(path)
-    try:
+    with output_errors(target):
         target.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    except OSError as exc:
-        raise _output_error(target, exc) from None
     try:
         with os.fdopen(fd, mode) as fh:
             yield fh
-            try:
+            with output_errors(target):
                 fh.flush()
                 os.fsync(fh.fileno())
-            except OSError as exc:
-                raise _output_error(target, exc) from None
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; honour the umask like open()
-        try:
+        with output_errors(target):
             os.replace(tmp, target)
-        except OSError as exc:
-            raise _output_error(target, exc) from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+@contextlib.contextmanager
+def output_errors(path: str | Path) -> Iterator[None]:
+    """Turn an ``OSError`` raised inside into an :class:`OutputError` naming ``path`` and why
+    (what :func:`unwritable_reason` finds, else the system's message)."""
+    try:
+        yield
+    except OSError as exc:
+        why = unwritable_reason(path) or exc.strerror or str(exc)
+        raise OutputError(f"cannot write {path}: {why}") from None
 
 
 def unwritable_reason(path: str | Path) -> str | None:
@@ -70,11 +76,6 @@ def unwritable_reason(path: str | Path) -> str | None:
     if not os.access(folder, os.W_OK | os.X_OK):
         return f"cannot write into {folder} (read-only or no permission)"
     return None
-
-
-def _output_error(target: Path, exc: OSError) -> OutputError:
-    why = unwritable_reason(target) or exc.strerror or str(exc)
-    return OutputError(f"cannot write {target}: {why}")
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:

@@ -13,8 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.errors import OutputError
-from reactmocap.io import unwritable_reason
+from reactmocap.io import output_errors
 from reactmocap.library.bodyparts import map_body_parts
 from reactmocap.library.bvh import write_bvh
 from reactmocap.library.motion import Motion
@@ -31,12 +30,9 @@ def write_outputs(
 ) -> dict[str, Any]:
     """Write a response's files into ``out`` (see the module docstring); returns the report
     with ``outputs`` filled in."""
-    try:
+    with output_errors(out / "report.json"):
         out.mkdir(parents=True, exist_ok=True)
         stage = Path(tempfile.mkdtemp(prefix=".partial-", dir=out))
-    except OSError as exc:
-        why = unwritable_reason(out / "report.json") or exc.strerror or exc
-        raise OutputError(f"cannot write into {out}: {why}") from None
     try:
         names: dict[str, str] = {}
         write_bvh(result.recipient, stage / "recipient.bvh")
