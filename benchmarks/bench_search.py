@@ -206,9 +206,7 @@ def run_size(
     return out
 
 
-def window_study(
-    base: dict[str, Motion], args: argparse.Namespace, rng: np.random.Generator
-) -> None:
+def window_study(base: dict[str, Motion], args: argparse.Namespace) -> None:
     """Self-retrieval robustness vs window length. Queries: base-library windows (random yaw and
     shift) with smooth rotation noise on every joint. A hit is a window equivalent to the source:
     the same clip within one frame, or any window whose exact D to the *clean* source window is
@@ -276,7 +274,7 @@ def main() -> None:
         f"(loaded in {time.perf_counter() - t:.1f} s)"
     )
     if args.window_study:
-        window_study(base, args, rng)
+        window_study(base, args)
         return
     for size in args.sizes:
         r = run_size(base, size, args, rng)

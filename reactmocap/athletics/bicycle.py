@@ -350,11 +350,6 @@ class Bicycle:
         return self.world.data.xpos[self.frame_id].copy()
 
     @property
-    def contact_point(self) -> F64:
-        """``(3,)`` the point under the rear wheel's centre, a wheel radius down (world)."""
-        return self.position - np.array([0.0, 0.0, self.params.rear.radius])
-
-    @property
     def velocity(self) -> F64:
         """``(3,)`` world velocity of the rear wheel's centre."""
         return self.world.data.qvel[self.dof_adr : self.dof_adr + 3].copy()
@@ -380,15 +375,6 @@ class Bicycle:
     def fallen(self) -> bool:
         return abs(self.roll) > FALLEN_ROLL
 
-    def crank_dof(self) -> int:
-        return self._v["crank"]
-
-    def steer_dof(self) -> int:
-        return self._v["steer"]
-
-    def steer_qpos(self) -> int:
-        return self._q["steer"]
-
     # roll and steer from recorded qpos rows (the engine records qpos only)
     def roll_steer_from_qpos(self, qpos: F64) -> tuple[F64, F64]:
         """``(T,)`` roll and steer (rad) from recorded qpos rows ``(T, nq)``."""
@@ -397,11 +383,6 @@ class Bicycle:
         # world z component of the body's y axis: 2 (y z + w x)
         roll = np.arcsin(np.clip(2.0 * (y * z + w * x), -1.0, 1.0))
         return roll, qpos[:, self._q["steer"]].copy()
-
-    def yaw_from_qpos(self, qpos: F64) -> F64:
-        q = qpos[:, self.qpos_adr + 3 : self.qpos_adr + 7]
-        w, x, y, z = q.T
-        return np.arctan2(2.0 * (x * y + w * z), 1.0 - 2.0 * (y * y + z * z))
 
 
 def _yaw_pitch_quat(yaw: float, pitch: float) -> F64:

@@ -169,12 +169,6 @@ class Polyline:
         u = (s - self.cum[i]) / self.len[i]
         return self.points[i] + u * self.seg[i]
 
-    def direction_at(self, s: float) -> float:
-        if self.closed:
-            s = s % self.total
-        i = int(np.clip(np.searchsorted(self.cum, s, side="right") - 1, 0, len(self.len) - 1))
-        return math.atan2(self.seg[i, 1], self.seg[i, 0])
-
     def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
         del t
         p = np.asarray(pos[:2], dtype=np.float64)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from reactmocap.response.plots import _pyplot
 __all__ = ["commanded_plot", "run_plot", "series_plot"]
 
 
-def _save(plt, fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
+def _save(fig: Any, path: str | Path) -> Path:
     """Lay the figure out, write it as PNG (atomically) and close it."""
     fig.tight_layout()
     return save_png(fig, path)
@@ -42,7 +43,7 @@ def run_plot(result, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
             ax.axvline(time, color="0.7", lw=0.8)
         a1.text(time, a1.get_ylim()[1], dst, rotation=90, va="top", fontsize=7)
     a1.set_title(f"{result.behaviour} ({result.body})")
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def commanded_plot(
@@ -74,7 +75,7 @@ def commanded_plot(
         ax.set_xlabel(f"desired {quantity} (m)")
         ax.set_ylabel(f"actual {quantity} (m)")
         ax.legend(fontsize=8)
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def series_plot(
@@ -98,4 +99,4 @@ def series_plot(
     if title:
         ax.set_title(title)
     ax.legend(fontsize=8)
-    return _save(plt, fig, path)
+    return _save(fig, path)

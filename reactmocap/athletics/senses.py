@@ -10,7 +10,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import Athlete
-from reactmocap.rotations import quat_from_yaw
 from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.world import World
@@ -154,9 +153,6 @@ class Senses:
         c, s = np.cos(h), np.sin(h)
         v = np.asarray(v, dtype=np.float64)
         return np.stack([c * v[..., 0] + s * v[..., 1], -s * v[..., 0] + c * v[..., 1]], -1)
-
-    def heading_quat(self, heading: float | None = None) -> F64:
-        return quat_from_yaw(self.heading() if heading is None else heading)
 
     def support_center(self, heading: float | None = None, both: bool = False) -> F64:
         """World point (on the floor) at the middle of the support area's extents in the

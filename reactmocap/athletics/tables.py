@@ -406,7 +406,3 @@ def supported_range(
     lo = max(r[0] for r in ranges.values())
     hi = min(r[1] for r in ranges.values())
     return (lo, hi) if lo <= hi else None
-
-
-def _finite(value: float) -> bool:
-    return isinstance(value, (int, float)) and math.isfinite(value)

@@ -11,7 +11,7 @@ import hashlib
 import io
 import json
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -249,7 +249,3 @@ def load_library(
         reasons = "; ".join(f"{x.path.name}: {x.reason}" for x in lib.failures[:5])
         raise LibraryError(f"{root}: no clip could be loaded ({reasons})")
     return lib.with_mirrors() if mirror else lib
-
-
-def as_clip_mapping(lib: ClipLibrary | Mapping[str, Motion]) -> Mapping[str, Motion]:
-    return lib.clips if isinstance(lib, ClipLibrary) else lib

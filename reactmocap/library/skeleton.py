@@ -32,11 +32,6 @@ class BVHLayout:
     up: Literal["y", "z"] = "z"
     end_sites: dict[int, tuple[float, float, float]] = field(default_factory=dict)
 
-    def rotation_order(self, joint: int) -> str:
-        """Intrinsic Euler order such as ``"ZXY"`` for joint ``joint`` (``"ZXY"`` if none)."""
-        order = "".join(c[0] for c in self.channels[joint] if c in ROTATION_CHANNELS)
-        return order if len(order) == 3 else "ZXY"
-
     def has_position(self, joint: int) -> bool:
         return any(c in POSITION_CHANNELS for c in self.channels[joint])
 

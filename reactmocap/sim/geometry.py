@@ -94,9 +94,6 @@ def make_geoms(
     def local(b: str, x: F64) -> F64:
         return quat_rotate(quat_conj(G[idx[b]]), x - P[idx[b]])
 
-    def local_dir(b: str, v: F64) -> F64:
-        return quat_rotate(quat_conj(G[idx[b]]), v)
-
     def capsule(b: str, a: F64, c: F64, radius: float) -> GeomSpec:
         la, lc = local(b, a), local(b, c)
         if np.linalg.norm(lc - la) < 1e-4:  # degenerate bone: a sphere

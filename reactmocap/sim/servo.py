@@ -334,9 +334,6 @@ class PDServo:
         np.multiply(q[:, _RIDX], _RSIGN, out=self._rd[sl])
         self._dirty = True
 
-    def set_targets_from_qpos(self, character: int, qpos: F64) -> None:
-        self.set_targets(character, np.asarray(qpos)[7:].reshape(NJ, 4))
-
     def set_targets_to_current(self) -> None:
         q = quat_normalize(self.world.data.qpos[self._qidx].reshape(self.n, 4))
         q = np.where(self._frozen[:, None], self.targets, q)
