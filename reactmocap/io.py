@@ -1,7 +1,7 @@
 """Atomic file writing: outputs are written to a temporary sibling and renamed into place, so a
-crash or an exception never leaves a half-written file; a path that cannot be written raises
-:class:`~reactmocap.errors.OutputError` naming it and why. Reading TOML input files with errors
-that name the file."""
+crash or an exception never leaves a half-written file (a set of files: :func:`staged_files`,
+all or none); a path that cannot be written raises :class:`~reactmocap.errors.OutputError`
+naming it and why. Reading TOML input files with errors that name the file."""
 
 from __future__ import annotations
 
@@ -22,6 +22,8 @@ __all__ = [
     "output_errors",
     "read_toml",
     "save_png",
+    "StagedFiles",
+    "staged_files",
     "unwritable_reason",
 ]
 
@@ -51,6 +53,49 @@ def atomic_write(path: str | Path, mode: str = "w") -> Iterator[IO]:  # type: ig
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+        raise
+
+
+class StagedFiles:
+    """The temporary siblings of a set of outputs (see :func:`staged_files`)."""
+
+    def __init__(self) -> None:
+        self.files: dict[Path, Path] = {}
+
+    def __call__(self, target: str | Path) -> Path:
+        """A new empty temporary file beside ``target`` to write ``target``'s content into."""
+        target = Path(target)
+        with output_errors(target):
+            target.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(
+                prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent
+            )
+        os.close(fd)
+        self.files[target] = Path(tmp)
+        return Path(tmp)
+
+    def rename(self, old: Path, new: Path) -> None:
+        """Move ``old``'s staged file to target ``new`` (a writer that chose another suffix)."""
+        self.files[new] = self.files.pop(old)
+
+
+@contextlib.contextmanager
+def staged_files() -> Iterator[StagedFiles]:
+    """Stage a set of outputs: ``stage(target)`` gives a temporary sibling to write; when the
+    block succeeds every one is renamed over its target, and on any error all are removed, so
+    a failure leaves none of the set behind."""
+    stage = StagedFiles()
+    try:
+        yield stage
+        mode = 0o666 & ~_umask()  # mkstemp makes 0600; honour the umask like open()
+        for target, tmp in stage.files.items():
+            with output_errors(target):
+                os.chmod(tmp, mode)
+                os.replace(tmp, target)
+    except BaseException:
+        for tmp in stage.files.values():
+            with contextlib.suppress(FileNotFoundError):
+                tmp.unlink()
         raise
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from reactmocap.cli import main
 from reactmocap.errors import OutputError, ReactMocapError
-from reactmocap.io import atomic_write_text, unwritable_reason
+from reactmocap.io import atomic_write_text, staged_files, unwritable_reason
 from reactmocap.library.bvh import read_bvh, write_bvh
 
 REPO = Path(__file__).resolve().parents[1]
@@ -27,6 +27,21 @@ def test_writing_under_a_file_is_a_typed_error_naming_it(tmp_path: Path) -> None
     with pytest.raises(OSError):  # callers that tolerate an OSError (the clip cache) still do
         atomic_write_text(blocker / "r.json", "{}")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+def test_staged_files_are_all_or_none(tmp_path: Path) -> None:
+    a, b = tmp_path / "a.txt", tmp_path / "sub" / "b.json"
+    with pytest.raises(RuntimeError), staged_files() as stage:
+        stage(a).write_text("A")
+        stage(b).write_text("B")
+        raise RuntimeError("the third output failed")
+    assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == []
+    with staged_files() as stage:
+        stage(a).write_text("A")
+        stage(b).write_text("B")
+        assert not a.exists()  # nothing in place before the block succeeds
+    assert (a.read_text(), b.read_text()) == ("A", "B")
+    assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == ["a.txt", "b.json"]
 
 
 def test_unwritable_reason(tmp_path: Path) -> None:

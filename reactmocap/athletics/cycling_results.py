@@ -4,12 +4,8 @@ all or nothing; :func:`bicycle_motion`, the bicycle's recorded motion as a BVH-r
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
-import os
-import tempfile
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -20,6 +16,7 @@ from numpy.typing import NDArray
 from reactmocap.athletics.bicycle import Bicycle
 from reactmocap.athletics.course import Route
 from reactmocap.athletics.cycling_scene import Obstacle
+from reactmocap.io import staged_files
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import BVHLayout, Skeleton
 from reactmocap.sim.rollout import RolloutResult
@@ -63,7 +60,7 @@ class CyclingResult:
 
         out = Path(out)
         written: dict[str, str] = {}
-        with _staging() as stage:
+        with staged_files() as stage:
             for k in range(len(self.team.riders)):
                 write_bvh(self.rider_motion(k), stage(out / f"rider{k}.bvh"))
                 write_bvh(self.bicycle_motion(k), stage(out / f"bicycle{k}.bvh"))
@@ -71,7 +68,7 @@ class CyclingResult:
             if plot is not None:
                 from reactmocap.athletics.cycling_plots import paths_plot
 
-                paths_plot(self, stage(Path(plot)))
+                paths_plot(self, stage(plot))
                 written["plot"] = str(plot)
             if video is not None:
                 from reactmocap.athletics.cycling_plots import ride_video
@@ -85,43 +82,9 @@ class CyclingResult:
                 written["video_renderer"] = renderer
             if report is not None:
                 self.report["outputs"] = written
-                Path(stage(Path(report))).write_text(self.report_json())
+                stage(report).write_text(self.report_json())
                 written["report"] = str(report)
         return written
-
-
-class _Stage:
-    def __init__(self) -> None:
-        self.files: dict[Path, Path] = {}
-
-    def __call__(self, target: Path) -> Path:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix,
-                                   dir=target.parent)  # fmt: skip
-        os.close(fd)
-        self.files[target] = Path(tmp)
-        return Path(tmp)
-
-    def rename(self, old: Path, new: Path) -> None:
-        self.files[new] = self.files.pop(old)
-
-
-@contextlib.contextmanager
-def _staging() -> Iterator[_Stage]:
-    """Temporary siblings renamed over their targets only if the block succeeds."""
-    st = _Stage()
-    try:
-        yield st
-    except BaseException:
-        for tmp in st.files.values():
-            with contextlib.suppress(FileNotFoundError):
-                tmp.unlink()
-        raise
-    mask = os.umask(0)
-    os.umask(mask)
-    for target, tmp in st.files.items():
-        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600; honour the umask like open()
-        os.replace(tmp, target)
 
 
 def _clean(value: Any) -> Any:

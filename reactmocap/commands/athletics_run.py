@@ -6,10 +6,7 @@ is written beside its destination and moved into place only when every one succe
 from __future__ import annotations
 
 import argparse
-import contextlib
 import math
-import os
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -152,6 +149,7 @@ def _write_all(
 ) -> dict[str, str]:  # fmt: skip
     """Write every requested file to a temporary sibling, then move them all into place; on
     any failure remove what was written and re-raise."""
+    from reactmocap.io import staged_files
     from reactmocap.library.bvh import write_bvh
 
     jobs: list[tuple[str, Path, Callable[[Path], Any]]] = [
@@ -163,35 +161,14 @@ def _write_all(
         if args.video.suffix.lower() not in (".mp4", ".gif"):
             raise ConfigError(f"--video must end in .mp4 or .gif, got {args.video}")
         jobs.append(("video", args.video, video))
-    staged: list[tuple[Path, Path]] = []
     notes: dict[str, str] = {}
-    try:
+    with staged_files() as stage:
         for name, dest, fn in jobs:
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            fd, name_tmp = tempfile.mkstemp(prefix=f".{dest.stem}.", suffix=dest.suffix,
-                                            dir=dest.parent)  # fmt: skip
-            os.close(fd)
-            staged.append((Path(name_tmp), dest))
-            got = fn(Path(name_tmp))
+            got = fn(stage(dest))
             if isinstance(got, str):
                 notes[name] = got
         if args.report is not None:
-            args.report.parent.mkdir(parents=True, exist_ok=True)
-            fd, name_tmp = tempfile.mkstemp(prefix=f".{args.report.stem}.", suffix=".json",
-                                            dir=args.report.parent)  # fmt: skip
-            with os.fdopen(fd, "w") as fh:
-                fh.write(report_json())
-            staged.append((Path(name_tmp), args.report))
-        mask = os.umask(0)
-        os.umask(mask)
-        for tmp, dest in staged:
-            os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600; honour the umask like open()
-            os.replace(tmp, dest)
-    except BaseException:
-        for tmp, _ in staged:
-            with contextlib.suppress(FileNotFoundError):
-                tmp.unlink()
-        raise
+            stage(args.report).write_text(report_json())
     written = {name: str(dest) for name, dest, _ in jobs}
     if args.report is not None:
         written["report"] = str(args.report)

