@@ -6,7 +6,6 @@ outside the measured supported range (:mod:`reactmocap.athletics.tables`) name t
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from collections.abc import Callable, Mapping
@@ -28,6 +27,7 @@ from reactmocap.athletics.report import (
     ground_force,
     joint_peaks,
     plausibility,
+    report_json,
     standing_balanced,
 )
 from reactmocap.athletics.scene import Slope, add_backpack, athletics_world, stand_angles
@@ -104,21 +104,7 @@ class AthleticsResult:
         return Path(path)
 
     def report_json(self) -> str:
-        return json.dumps(_clean(self.report), indent=2) + "\n"
-
-
-def _clean(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_clean(v) for v in value]
-    if isinstance(value, (np.floating, float)):
-        return None if not math.isfinite(float(value)) else round(float(value), 4)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    return value
+        return report_json(self.report)
 
 
 # ---------------------------------------------------------------------------------- running

@@ -4,8 +4,6 @@ all or nothing; :func:`bicycle_motion`, the bicycle's recorded motion as a BVH-r
 
 from __future__ import annotations
 
-import json
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -16,6 +14,7 @@ from numpy.typing import NDArray
 from reactmocap.athletics.bicycle import Bicycle
 from reactmocap.athletics.course import Route
 from reactmocap.athletics.cycling_scene import Obstacle
+from reactmocap.athletics.report import report_json
 from reactmocap.io import staged_files
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import BVHLayout, Skeleton
@@ -50,7 +49,7 @@ class CyclingResult:
         return bicycle_motion(self.rollout, self.team.bicycles[k], name=f"bicycle{k}")
 
     def report_json(self) -> str:
-        return json.dumps(_clean(self.report), indent=2) + "\n"
+        return report_json(self.report)
 
     def write(self, out: str | Path, *, report: str | Path | None = None,
               plot: str | Path | None = None, video: str | Path | None = None) -> dict[str, str]:  # fmt: skip
@@ -85,23 +84,6 @@ class CyclingResult:
                 stage(report).write_text(self.report_json())
                 written["report"] = str(report)
         return written
-
-
-def _clean(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {str(k): _clean(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_clean(v) for v in value]
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        return None if not math.isfinite(v) else round(v, 4)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, Path):
-        return str(value)
-    return value
 
 
 def bicycle_motion(res: RolloutResult, bike: Bicycle, name: str = "bicycle") -> Motion:

@@ -4,8 +4,12 @@ against a stated strength model (``docs/athletics.md`` cites it)."""
 
 from __future__ import annotations
 
+import json
+import math
 from collections.abc import Mapping
+from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,6 +24,7 @@ __all__ = [
     "ground_force",
     "joint_peaks",
     "plausibility",
+    "report_json",
     "standing_balanced",
 ]
 
@@ -38,6 +43,29 @@ FEMALE_STRENGTH: Mapping[str, float] = MappingProxyType({k: 0.8 * v for k, v in 
 FALL_HEIGHT = 0.5
 #: balanced: COM slower than this (m/s) and over the support area
 STILL_SPEED = 0.1
+
+
+def report_json(report: Mapping[str, Any]) -> str:
+    """An athletic run's report as JSON text: numpy scalars as Python's, floats rounded to 4
+    places (the figures' precision; a long float is noise in a diff), NaN and inf as null."""
+    return json.dumps(_jsonable(report), indent=2) + "\n"
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return None if not math.isfinite(v) else round(v, 4)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, Path):
+        return str(value)
+    return value
 
 
 def _kind(joint: str) -> str:

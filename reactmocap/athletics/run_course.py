@@ -6,7 +6,6 @@ wraps. How each figure is measured: ``docs/athletics.md``."""
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -16,10 +15,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.athletics.behaviours import _clean
 from reactmocap.athletics.bodies import athlete as make_athlete
 from reactmocap.athletics.paths import Course, Facing, Polyline, parse_course
-from reactmocap.athletics.report import FALL_HEIGHT
+from reactmocap.athletics.report import FALL_HEIGHT, report_json
 from reactmocap.athletics.running import (
     START_SPEED,
     Runner,
@@ -69,7 +67,7 @@ class RunResult:
     extra: dict[str, Any] = field(default_factory=dict)
 
     def report_json(self) -> str:
-        return json.dumps(_clean(self.report), indent=2) + "\n"
+        return report_json(self.report)
 
 
 def run_course(

@@ -17,7 +17,6 @@ figures: ``docs/athletics.md``."""
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -32,6 +31,7 @@ from reactmocap.athletics.balance import Balance, Posture
 from reactmocap.athletics.bodies import Athlete, athlete
 from reactmocap.athletics.land import Landing, LandingParams
 from reactmocap.athletics.machine import Context
+from reactmocap.athletics.report import report_json
 from reactmocap.athletics.sequencer import Sequencer
 from reactmocap.athletics.tumble import Tumble, TumbleParams
 from reactmocap.athletics.vault_control import Vault, VaultLog, _Logger
@@ -95,9 +95,7 @@ class VaultResult:
     params: VaultParams
 
     def report_json(self) -> str:
-        from reactmocap.athletics.behaviours import _clean
-
-        return json.dumps(_clean(self.report), indent=2) + "\n"
+        return report_json(self.report)
 
     def scene_video(self, path: str | Path, fps: float = 30.0) -> Path:
         """The vault as recorded, rendered with the board and horse (MuJoCo)."""
