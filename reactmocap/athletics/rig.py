@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.errors import ConfigError, UnknownKeyError
+from reactmocap.response.blend import smoothstep  # the one Hermite ease; re-exported here
 from reactmocap.rotations import quat_conj, quat_log, quat_mul, quat_rotate
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.world import World
@@ -50,12 +51,6 @@ def per_joint(values: Mapping[str, float], default: float = 0.0) -> F64:
         if key not in JOINT_KINDS:
             out[joint_index(key)] = v
     return out
-
-
-def smoothstep(s: F64) -> F64:
-    """Hermite blend 3 s^2 - 2 s^3 on [0, 1] (zero slope at both ends), clamped."""
-    s = np.clip(s, 0.0, 1.0)
-    return s * s * (3.0 - 2.0 * s)
 
 
 class Rig:
