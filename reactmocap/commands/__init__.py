@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+__all__ = ["output_dir", "output_file"]
+
 
 def output_file(text: str) -> Path:
     """argparse type of an output file option: refuses a folder, or a place no file can be

@@ -12,7 +12,7 @@ from reactmocap.commands import output_file
 from reactmocap.errors import ConfigError
 from reactmocap.progress import Progress
 
-__all__ = ["register"]
+__all__ = ["SimProgress", "register"]
 
 #: CLI flag -> (behaviour parameter, in degrees at the CLI)
 _FLAGS: dict[str, list[tuple[str, str, bool]]] = {
@@ -104,17 +104,17 @@ def _run(args: argparse.Namespace) -> int:
             ) from None
         params.update(com_offset_x=x, com_offset_y=y)
     body = str(args.body)
-    bar = _Bar(args.behaviour)
+    bar = SimProgress(args.behaviour)
     with bar:
         result = run(args.behaviour, body, on_tick=bar.tick, check_range=not args.any_range,
                      **params)  # fmt: skip
     out = args.out or Path(f"{args.behaviour}_{result.body}.bvh")
     from reactmocap.athletics.plots import run_plot
-    from reactmocap.commands.athletics_run import _motion_video, _write_all
+    from reactmocap.commands.athletics_run import motion_video, write_all
 
     # all or nothing, like the other athletics commands
-    written = _write_all(args, out, result.motion, result.report_json,
-                         lambda p: run_plot(result, p), lambda p: _motion_video(result.motion, p))  # fmt: skip
+    written = write_all(args, out, result.motion, result.report_json,
+                         lambda p: run_plot(result, p), lambda p: motion_video(result.motion, p))  # fmt: skip
     if "video" in written:
         print(f"video: {written['video']} ({written['video_renderer']})")
     _summary(result.report, out)
@@ -148,7 +148,7 @@ def _summary(r: dict[str, Any], out: Path) -> None:
         print("note: the athlete did not end balanced on its feet")
 
 
-class _Bar:
+class SimProgress:
     """Progress over the simulated fraction (quiet unless stderr is a terminal)."""
 
     def __init__(self, label: str) -> None:
@@ -160,7 +160,7 @@ class _Bar:
             self.bar = Progress(100, f"{self.label} (% simulated)")
         self.bar.update(round(100 * fraction) - self.bar.done)
 
-    def __enter__(self) -> _Bar:
+    def __enter__(self) -> SimProgress:
         return self
 
     def __exit__(self, *exc: object) -> None:

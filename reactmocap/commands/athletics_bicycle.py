@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from reactmocap.commands import output_dir, output_file
-from reactmocap.commands.athletics import _Bar
+from reactmocap.commands.athletics import SimProgress
 from reactmocap.errors import ConfigError
 
 __all__ = ["register"]
@@ -75,7 +75,7 @@ def _run_bicycle(args: argparse.Namespace) -> int:
 
     heading = None if args.heading is None else math.radians(args.heading)
     path = None if args.path is None else _points(args.path)
-    with _Bar("bicycle") as bar:
+    with SimProgress("bicycle") as bar:
         res = ride(args.speed, args.seconds, heading=heading, heading_at=args.heading_at,
                    path=path, grade=args.grade / 100.0, gear=args.gear, body=args.body,
                    fps=args.fps, on_tick=bar.tick)  # fmt: skip
@@ -96,7 +96,7 @@ def _run_group(args: argparse.Namespace) -> int:
     from reactmocap.athletics.cycling import group_ride
 
     course = load_course(args.course)
-    with _Bar("group") as bar:
+    with SimProgress("group") as bar:
         res = group_ride(course, args.riders, seconds=args.seconds, body=args.body, fps=args.fps,
                          on_tick=bar.tick)  # fmt: skip
     written = res.write(args.out, report=args.report, plot=args.plot, video=args.video)

@@ -86,10 +86,10 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
 
 def _maneuver(args: argparse.Namespace) -> int:
     from reactmocap.athletics.maneuvers import load_maneuver, run_maneuver
-    from reactmocap.commands.athletics import _Bar
+    from reactmocap.commands.athletics import SimProgress
 
     maneuver = load_maneuver(args.file)
-    with _Bar(maneuver.name) as bar:
+    with SimProgress(maneuver.name) as bar:
         result = run_maneuver(maneuver, args.body, on_tick=bar.tick, fps=args.fps)
     out: Path = args.out
     files = argparse.Namespace(**{**vars(args), "report": out / f"{maneuver.name}.json"})
@@ -99,9 +99,9 @@ def _maneuver(args: argparse.Namespace) -> int:
 
 def _somersault(args: argparse.Namespace) -> int:
     from reactmocap.athletics.routines import somersault
-    from reactmocap.commands.athletics import _Bar
+    from reactmocap.commands.athletics import SimProgress
 
-    with _Bar("somersault") as bar:
+    with SimProgress("somersault") as bar:
         result = somersault(args.position, args.direction, str(args.body), twist=args.twist,
                             backpack=args.backpack, on_tick=bar.tick, fps=args.fps)  # fmt: skip
     _finish(result, args, args.out or Path(f"{result.behaviour}_{result.body}.bvh"))
@@ -110,9 +110,9 @@ def _somersault(args: argparse.Namespace) -> int:
 
 def _dive(args: argparse.Namespace) -> int:
     from reactmocap.athletics.routines import dive
-    from reactmocap.commands.athletics import _Bar
+    from reactmocap.commands.athletics import SimProgress
 
-    with _Bar("dive") as bar:
+    with SimProgress("dive") as bar:
         result = dive(args.position, args.direction, str(args.body), height=args.height,
                       turns=args.turns, twist=args.twist, on_tick=bar.tick, fps=args.fps)  # fmt: skip
     _finish(result, args, args.out or Path(f"{result.behaviour}_{result.body}.bvh"))
@@ -121,9 +121,9 @@ def _dive(args: argparse.Namespace) -> int:
 
 def _handspring(args: argparse.Namespace) -> int:
     from reactmocap.athletics.routines import handspring
-    from reactmocap.commands.athletics import _Bar
+    from reactmocap.commands.athletics import SimProgress
 
-    with _Bar("handspring") as bar:
+    with SimProgress("handspring") as bar:
         result = handspring(str(args.body), on_tick=bar.tick, fps=args.fps)
     name = Path(f"{result.behaviour}_{result.body}.bvh")
     out: Path | None = args.out
@@ -139,10 +139,10 @@ def _handspring(args: argparse.Namespace) -> int:
 
 def _finish(result, args: argparse.Namespace, out: Path) -> None:  # type: ignore[no-untyped-def]
     """Write the BVH, the report and the video all or nothing, then say how it went."""
-    from reactmocap.commands.athletics_run import _motion_video, _write_all
+    from reactmocap.commands.athletics_run import motion_video, write_all
 
-    written = _write_all(args, out, result.motion, result.report_json, lambda _p: None,
-                         lambda p: _motion_video(result.motion, p))  # fmt: skip
+    written = write_all(args, out, result.motion, result.report_json, lambda _p: None,
+                         lambda p: motion_video(result.motion, p))  # fmt: skip
     if "video" in written:
         print(f"video: {written['video']} ({written['video_renderer']})")
     r = result.report

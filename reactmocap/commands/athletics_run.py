@@ -14,7 +14,7 @@ from typing import Any
 from reactmocap.commands import output_file
 from reactmocap.errors import ConfigError
 
-__all__ = ["register_run"]
+__all__ = ["motion_video", "output_args", "register_run", "write_all"]
 
 
 def register_run(inner: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
@@ -76,9 +76,9 @@ def _push(text: str | None) -> tuple[float, float, float] | None:
 
 def _run(args: argparse.Namespace) -> int:
     from reactmocap.athletics.run_course import run_course
-    from reactmocap.commands.athletics import _Bar
+    from reactmocap.commands.athletics import SimProgress
 
-    with _Bar("run") as bar:
+    with SimProgress("run") as bar:
         result = run_course(args.speed, seconds=args.seconds, path=args.path,
                             body=str(args.body), cloth=args.cloth,
                             cloth_feedback=args.cloth_feedback, push=_push(args.push),
@@ -99,19 +99,19 @@ def _run(args: argparse.Namespace) -> int:
                 render_cloth_video(result.cloth, path)
                 return "mujoco (cloth)"
             except RenderUnavailable as exc:
-                return _motion_video(result.motion, path, f"no cloth: {exc}")
-        return _motion_video(result.motion, path)
+                return motion_video(result.motion, path, f"no cloth: {exc}")
+        return motion_video(result.motion, path)
 
-    written = _write_all(args, out, result.motion, result.report_json, plot, video)
+    written = write_all(args, out, result.motion, result.report_json, plot, video)
     _summary(result.report, written)
     return 0
 
 
 def _vault(args: argparse.Namespace) -> int:
     from reactmocap.athletics.vault import vault
-    from reactmocap.commands.athletics import _Bar
+    from reactmocap.commands.athletics import SimProgress
 
-    with _Bar("vault") as bar:
+    with SimProgress("vault") as bar:
         result = vault(body=str(args.body), seconds=args.seconds, fps=args.fps, on_tick=bar.tick)
     out = args.out or Path(f"vault_{result.report['body']}.bvh")
 
@@ -121,14 +121,14 @@ def _vault(args: argparse.Namespace) -> int:
         vault_plot(result, path)
 
     def video(path: Path) -> str:
-        return _motion_video(result.motion, path, scene=result.scene_video)
+        return motion_video(result.motion, path, scene=result.scene_video)
 
-    written = _write_all(args, out, result.motion, result.report_json, plot, video)
+    written = write_all(args, out, result.motion, result.report_json, plot, video)
     _summary(result.report, written)
     return 0
 
 
-def _motion_video(motion: Any, path: Path, note: str = "", scene: Any = None) -> str:
+def motion_video(motion: Any, path: Path, note: str = "", scene: Any = None) -> str:
     from reactmocap.response.plots import stick_figure_video
     from reactmocap.response.render import RenderUnavailable, render_video
 
@@ -143,7 +143,7 @@ def _motion_video(motion: Any, path: Path, note: str = "", scene: Any = None) ->
         return f"stick figure ({exc})"
 
 
-def _write_all(
+def write_all(
     args: argparse.Namespace, out: Path, motion: Any, report_json: Callable[[], str],
     plot: Callable[[Path], Any], video: Callable[[Path], str],
 ) -> dict[str, str]:  # fmt: skip
