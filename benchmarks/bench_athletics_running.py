@@ -43,6 +43,7 @@ import numpy as np
 from reactmocap.athletics.run_course import run_course
 from reactmocap.athletics.running import TUNED_SPEEDS, RunParams
 from reactmocap.athletics.running_params import STEP_PARAMS
+from reactmocap.io import atomic_write_text
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT / ".." / "shared" / "mocap"
@@ -471,10 +472,8 @@ def tune_vault(iterations: int, seed: int, keys: str = "all", seconds: float | N
                   f"{rep['table1_outside']}, cleared {rep['cleared']}, landed {rep['landed']}",
                   flush=True)  # fmt: skip
             if out is not None:
-                tmp = out.with_suffix(".tmp")
-                tmp.write_text(json.dumps({"score": j, "params": fixed | x, "report": rep}, indent=1,
-                                          default=str))  # fmt: skip
-                tmp.replace(out)
+                atomic_write_text(out, json.dumps({"score": j, "params": fixed | x, "report": rep},
+                                                  indent=1, default=str))  # fmt: skip
         return j
 
     rng = np.random.default_rng(seed)

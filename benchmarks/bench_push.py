@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from reactmocap.io import atomic_write, atomic_write_text
 from reactmocap.library.motion import Motion
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -155,7 +156,9 @@ def plot(out: Path, runs: list[dict[str, Any]]) -> None:
         ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.28), fontsize=8)
     fig.suptitle("Largest survived chest push (N), directions relative to the heading")
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    with atomic_write(out, "wb") as fh:
+        fig.savefig(fh, format="png", dpi=110)
+    plt.close(fig)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -211,7 +214,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{key} {name} @ {at} s, {dur} s pushes ({took:.0f} s): "
               + ", ".join(f"{lab} {f:.0f} N" for lab, f in zip(LABELS, forces)))  # fmt: skip
     if args.json:
-        args.json.write_text(json.dumps(out, indent=2) + "\n")
+        atomic_write_text(args.json, json.dumps(out, indent=2) + "\n")
     if args.plot and not args.forces:
         plot(args.plot, [*earlier, out])
     return 0
