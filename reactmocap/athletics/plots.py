@@ -6,13 +6,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from reactmocap.athletics.report import ground_force
 from reactmocap.io import save_png
 from reactmocap.response.plots import _pyplot
+
+if TYPE_CHECKING:
+    from reactmocap.athletics.behaviours import AthleticsResult
 
 __all__ = ["commanded_plot", "run_plot", "series_plot"]
 
@@ -23,7 +26,7 @@ def _save(fig: Any, path: str | Path) -> Path:
     return save_png(fig, path)
 
 
-def run_plot(result, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
+def run_plot(result: AthleticsResult, path: str | Path) -> Path:
     """COM height and vertical ground force (body weights) over time, the state changes
     marked, for an :class:`~reactmocap.athletics.behaviours.AthleticsResult`."""
     plt = _pyplot()

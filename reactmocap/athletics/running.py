@@ -16,6 +16,7 @@ foot rolls about the ball. Design and measurements: ``docs/athletics.md``."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import mujoco
 import numpy as np
@@ -475,7 +476,7 @@ class Runner:
     def _states(self) -> list[State]:
         every = self.control_every
 
-        def law(fn) -> FunctionController:  # type: ignore[no-untyped-def]
+        def law(fn: Callable[[World, float], None]) -> FunctionController:
             return FunctionController(fn, every)
 
         def touching(_w: World, _t: float, _ti: float) -> bool:

@@ -8,11 +8,15 @@ import json
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from reactmocap.commands import output_file
 from reactmocap.errors import ConfigError
 from reactmocap.progress import Progress
+
+if TYPE_CHECKING:
+    from reactmocap.library.motion import Motion
+    from reactmocap.sim.tracking import TrackReport
 
 __all__ = ["register"]
 
@@ -121,7 +125,7 @@ def _common(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _read(path: Path):  # type: ignore[no-untyped-def]
+def _read(path: Path) -> Motion:
     from reactmocap.library.bvh import read_bvh
 
     return read_bvh(path)
@@ -132,7 +136,9 @@ def _read(path: Path):  # type: ignore[no-untyped-def]
 FEASIBILITY_NOTE_S = 0.1
 
 
-def _infeasible_seconds(clip, report, mass: float, tracked: float) -> float | None:  # type: ignore[no-untyped-def]
+def _infeasible_seconds(
+    clip: Motion, report: TrackReport, mass: float, tracked: float
+) -> float | None:
     """Seconds of the tracked span where the clip asks for more moment than a foot can give
     (``support_feasibility``, 2x its bound); None for clips too short to differentiate. A run
     that fell or diverged counts only the ``tracked`` seconds it ran."""
@@ -145,14 +151,16 @@ def _infeasible_seconds(clip, report, mass: float, tracked: float) -> float | No
     return check.infeasible_seconds(report.start, seconds)
 
 
-def _write_outputs(args: argparse.Namespace, clip, motion, report) -> None:  # type: ignore[no-untyped-def]
+def _write_outputs(
+    args: argparse.Namespace, clip: Motion, motion: Motion, report: TrackReport
+) -> None:
     from reactmocap.io import atomic_write_text
 
     if args.out is not None:
         from reactmocap.library.bvh import write_bvh
 
         write_bvh(motion, args.out)  # atomic: never a half-written output
-    data = report.to_dict()
+    data: dict[str, Any] = report.to_dict()
     infeasible = _infeasible_seconds(clip, report, args.mass, motion.duration)
     data["infeasible_single_support_s"] = infeasible
     if args.report is not None:

@@ -15,7 +15,7 @@ lower-case ``lfemur`` style of ASF-derived files. A TOML file can override them:
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -237,7 +237,12 @@ def map_body_parts(
     return BodyPartMap(skeleton, out)
 
 
-def _map_spine(skeleton: Skeleton, out: dict[str, int], find, used: set[int]) -> None:  # type: ignore[no-untyped-def]
+def _map_spine(
+    skeleton: Skeleton,
+    out: dict[str, int],
+    find: Callable[[str, str | None, set[int]], int | None],
+    used: set[int],
+) -> None:
     """Chest: by name, else the deepest common ancestor of the two upper arms. Waist: a spine
     joint strictly between pelvis and chest (by name first, else the first one on the path)."""
     if "chest" not in out:
