@@ -102,13 +102,13 @@ class Senses:
                     self.foot_point[k] += fn * d.contact.pos[i]
                 else:
                     others.add(SIM_BODIES[int(self._body[g])])
+        self.corners = sole_corners_world(d, self.soles, self._corners)
         for k in range(2):
             if self.foot_force[k] > 0:
                 self.foot_point[k] /= self.foot_force[k]
             elif self.foot_contact[k]:
-                self.foot_point[k] = sole_corners_world(d, self.soles, self._corners)[k].mean(0)
+                self.foot_point[k] = self.corners[k].mean(0)
         self.other_contact = tuple(sorted(others))
-        self.corners = sole_corners_world(d, self.soles, self._corners)
         rel = self.corners - d.geom_xpos[self.floor]
         self.clearance = float((rel @ self.floor_normal).min())
 
