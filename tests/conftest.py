@@ -44,11 +44,6 @@ def shared_mocap_dir() -> Path:
     return d
 
 
-@pytest.fixture(scope="session")
-def synthetic_dir() -> Path:
-    return SYNTHETIC
-
-
 @pytest.fixture(autouse=True)
 def _isolated_cache(
     tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch

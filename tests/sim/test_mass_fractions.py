@@ -27,7 +27,6 @@ from reactmocap.sim.reference_bodies import reference_part_masses
 PART_REL_TOL = 0.30
 PART_ABS_FLOOR = 0.005
 GROUP_REL_TOL = 0.15
-SIDED = ("upper_arm", "forearm", "hand", "thigh", "shin", "foot")
 GROUPS = {
     "trunk+head": ("pelvis", "waist", "chest", "head"),
     "arms": tuple(f"{s}_{p}" for s in "lr" for p in ("upper_arm", "forearm", "hand")),
