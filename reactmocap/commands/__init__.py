@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["output_dir", "output_file"]
+__all__ = ["numbers", "output_dir", "output_file"]
 
 
 def output_file(text: str) -> Path:
@@ -30,6 +32,22 @@ def output_dir(text: str) -> Path:
         raise argparse.ArgumentTypeError(f"{text!r} is a file; give a folder")
     _check_writable(path / "out")
     return path
+
+
+def numbers(count: int, form: str, units: str) -> Callable[[str], tuple[float, ...]]:
+    """argparse type of an option of ``count`` finite numbers separated by commas, written
+    ``form`` (``"X,Y"``) in ``units``: anything else is refused at parse time, naming both."""
+
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(v) for v in text.split(","))
+        except ValueError:
+            values = ()
+        if len(values) != count or not all(math.isfinite(v) for v in values):
+            raise argparse.ArgumentTypeError(f"expected {form} ({units}), got {text!r}")
+        return values
+
+    return parse
 
 
 def _check_writable(path: Path) -> None:

@@ -8,8 +8,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from reactmocap.commands import output_file
-from reactmocap.errors import ConfigError
+from reactmocap.commands import numbers, output_file
 from reactmocap.progress import Progress
 
 __all__ = ["SimProgress", "register"]
@@ -63,7 +62,8 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
             p.add_argument("--push", dest="push_off", choices=list(push.choices or ()),
                            default=None, help=f"{push.help} (default {push.default})")  # fmt: skip
         if name == "balance":
-            p.add_argument("--com-offset", help="desired COM offset X,Y (m) from the support")
+            p.add_argument("--com-offset", type=numbers(2, "X,Y", "m"),
+                           help="desired COM offset X,Y (m) from the support")  # fmt: skip
         p.add_argument("--out", type=output_file, help="BVH of the motion (default: NAME_BODY.bvh)")
         p.add_argument("--report", type=output_file, help="JSON report")
         p.add_argument("--plot", type=output_file, help="PNG of COM height and ground force")
@@ -96,12 +96,7 @@ def _run(args: argparse.Namespace) -> int:
     if getattr(args, "push_off", None):
         params["push"] = args.push_off
     if getattr(args, "com_offset", None):
-        try:
-            x, y = (float(v) for v in args.com_offset.split(","))
-        except ValueError:
-            raise ConfigError(
-                f"--com-offset must be X,Y in metres, got {args.com_offset!r}"
-            ) from None
+        x, y = args.com_offset
         params.update(com_offset_x=x, com_offset_y=y)
     body = str(args.body)
     bar = SimProgress(args.behaviour)

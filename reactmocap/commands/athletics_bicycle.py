@@ -10,9 +10,8 @@ import math
 from pathlib import Path
 from typing import Any
 
-from reactmocap.commands import output_dir, output_file
+from reactmocap.commands import numbers, output_dir, output_file
 from reactmocap.commands.athletics import SimProgress
-from reactmocap.errors import ConfigError
 
 __all__ = ["register"]
 
@@ -29,7 +28,8 @@ def register(inner: argparse._SubParsersAction) -> None:  # type: ignore[type-ar
     b.add_argument("--seconds", type=float, default=10.0, help="ride length (s; default 10)")
     way = b.add_mutually_exclusive_group()
     way.add_argument("--heading", type=float, help="turn to this heading (deg, 0 = +X, left > 0)")
-    way.add_argument("--path", nargs="+", metavar="X,Y", help="waypoints to follow (m)")
+    way.add_argument("--path", nargs="+", type=numbers(2, "X,Y", "m"), metavar="X,Y",
+                     help="waypoints to follow (m)")  # fmt: skip
     b.add_argument("--heading-at", type=float, default=1.0,
                    help="when the heading command starts (s; default 1)")  # fmt: skip
     b.add_argument("--grade", type=float, default=0.0, help="ground rise along +X (percent)")
@@ -59,22 +59,11 @@ def _common(p: argparse.ArgumentParser, out: str) -> None:
     p.add_argument("--fps", type=float, default=30.0, help="BVH frame rate (default 30)")
 
 
-def _points(raw: list[str]) -> list[tuple[float, float]]:
-    out = []
-    for item in raw:
-        try:
-            x, y = (float(v) for v in item.split(","))
-        except ValueError:
-            raise ConfigError(f"--path points must be X,Y in metres, got {item!r}") from None
-        out.append((x, y))
-    return out
-
-
 def _run_bicycle(args: argparse.Namespace) -> int:
     from reactmocap.athletics.cycling import ride
 
     heading = None if args.heading is None else math.radians(args.heading)
-    path = None if args.path is None else _points(args.path)
+    path = None if args.path is None else list(args.path)
     with SimProgress("bicycle") as bar:
         res = ride(args.speed, args.seconds, heading=heading, heading_at=args.heading_at,
                    path=path, grade=args.grade / 100.0, gear=args.gear, body=args.body,

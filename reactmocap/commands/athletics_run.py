@@ -11,7 +11,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from reactmocap.commands import output_file
+from reactmocap.commands import numbers, output_file
 from reactmocap.errors import ConfigError
 
 __all__ = ["motion_video", "output_args", "register_run", "write_all"]
@@ -37,8 +37,9 @@ def register_run(inner: argparse._SubParsersAction) -> None:  # type: ignore[typ
                    "the body; it does not act on the runner unless --cloth-feedback)")  # fmt: skip
     p.add_argument("--cloth-feedback", action="store_true",
                    help="the cloth's contact forces act on the runner")  # fmt: skip
-    p.add_argument("--push", help="a sideways push on the chest: TIME,IMPULSE (s, N s; "
-                   "> 0 to the runner's left) over 0.1 s")  # fmt: skip
+    p.add_argument("--push", type=numbers(2, "TIME,IMPULSE", "s, N s"),
+                   help="a sideways push on the chest: TIME,IMPULSE (s, N s; > 0 to the "
+                   "runner's left) over 0.1 s")  # fmt: skip
     output_args(p, "male")
     p.set_defaults(func=_run)
 
@@ -64,13 +65,11 @@ def output_args(p: argparse.ArgumentParser, body: str, *, plot: bool = True) -> 
     p.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
 
 
-def _push(text: str | None) -> tuple[float, float, float] | None:
-    if text is None:
+def _push(values: tuple[float, float] | None) -> tuple[float, float, float] | None:
+    """``--push``'s time and signed impulse as run_course's (time, impulse, direction)."""
+    if values is None:
         return None
-    try:
-        when, impulse = (float(x) for x in text.split(","))
-    except ValueError:
-        raise ConfigError(f"--push must be TIME,IMPULSE (s, N s), got {text!r}") from None
+    when, impulse = values
     return (when, abs(impulse), math.copysign(math.pi / 2, impulse))
 
 

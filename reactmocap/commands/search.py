@@ -8,20 +8,10 @@ import math
 import time
 from pathlib import Path
 
-from reactmocap.commands import output_file
+from reactmocap.commands import numbers, output_file
 from reactmocap.errors import ReactMocapError, SearchError
 
 __all__ = ["register"]
-
-
-def _shift(text: str) -> tuple[float, float]:
-    try:
-        parts = [float(v) for v in text.split(",")]
-    except ValueError:
-        parts = []
-    if len(parts) != 2 or not all(math.isfinite(v) for v in parts):
-        raise argparse.ArgumentTypeError(f"expected X,Y in metres (e.g. 1.5,-2), got {text!r}")
-    return parts[0], parts[1]
 
 
 def _degrees(text: str) -> float:
@@ -62,7 +52,8 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         "--frame", type=int, required=True, metavar="F", help="start frame (clip's own fps)"
     )
     q.add_argument("--yaw", type=_degrees, default=0.0, metavar="DEG")
-    q.add_argument("--shift", type=_shift, default=(0.0, 0.0), metavar="X,Y")
+    q.add_argument("--shift", type=numbers(2, "X,Y", "m; e.g. 1.5,-2"), default=(0.0, 0.0),
+                   metavar="X,Y")  # fmt: skip
     q.add_argument("--top", type=int, default=5, metavar="K")
     q.add_argument(
         "--library", type=Path, default=None, help="library folder (default: the one indexed)"

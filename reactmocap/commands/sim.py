@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from reactmocap.commands import output_file
+from reactmocap.commands import numbers, output_file
 from reactmocap.errors import ConfigError
 from reactmocap.progress import Progress
 
@@ -41,6 +41,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     push.add_argument(
         "--force",
         required=True,
+        type=numbers(3, "FX,FY,FZ", "N"),
         help="world force FX,FY,FZ in N (Z up); write --force=-300,0,0 for a leading minus",
     )
     push.add_argument("--duration", type=float, default=0.1, help="push duration (s)")
@@ -244,13 +245,7 @@ def _track(args: argparse.Namespace) -> int:
 def _push(args: argparse.Namespace) -> int:
     from reactmocap.sim.tracking import push_clip
 
-    try:
-        force = [float(x) for x in args.force.split(",")]
-    except ValueError:
-        raise ConfigError(f"--force must be FX,FY,FZ numbers, got {args.force!r}") from None
-    if len(force) != 3:
-        raise ConfigError(f"--force must have 3 components, got {len(force)}: {args.force!r}")
     return _simulate(
-        args, "push", push_clip, time=args.time, body=args.body, force=force,
+        args, "push", push_clip, time=args.time, body=args.body, force=list(args.force),
         duration=args.duration, seconds=args.seconds,
     )  # fmt: skip
