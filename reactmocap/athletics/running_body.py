@@ -35,7 +35,8 @@ _FOOT = (_BODY["l_foot"], _BODY["r_foot"])
 
 # ---------------------------------------------------------------------------------- small math
 # single quaternions at every tick: MuJoCo's C routines and closed forms instead of the
-# vectorised helpers (scipy), which cost 100-400 us a call and dominated the tick
+# vectorised numpy helpers of reactmocap.rotations, whose per-call overhead on one quaternion
+# dominated the tick (quat_mul 37 us against mju_mulQuat's 2.3 us, 2026-12-03 12:44 UTC)
 def _qmul(a: F64, b: F64) -> F64:
     out = np.empty(4)
     mujoco.mju_mulQuat(out, a, b)
