@@ -6,6 +6,7 @@ angles."""
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any, TypeVar, overload
 
@@ -31,6 +32,7 @@ __all__ = [
     "quat_yaw",
     "quat_from_yaw",
     "rotation_from_wxyz",
+    "wrap_angle",
     "wxyz_from_rotation",
 ]
 
@@ -294,8 +296,17 @@ def quat_yaw(q: ArrayLike) -> Floats:
     body axis onto the ground it stays defined when that axis is vertical (singular only for a
     half turn about a horizontal axis)."""
     arr = _floats(q)
-    yaw = 2.0 * np.arctan2(arr[..., 3], arr[..., 0])
-    return (yaw + np.pi) % (2 * np.pi) - np.pi
+    return wrap_angle(2.0 * np.arctan2(arr[..., 3], arr[..., 0]))
+
+
+@overload
+def wrap_angle(a: float) -> float: ...
+@overload
+def wrap_angle(a: NDArray[_F]) -> NDArray[_F]: ...
+def wrap_angle(a: float | Floats) -> float | Floats:
+    """Angle(s) ``a`` (radians) wrapped to ``[-pi, pi)``: a float stays a float (the control
+    ticks' scalars), an array keeps its dtype."""
+    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 @overload

@@ -190,3 +190,16 @@ def test_slerp_path_follows_a_spin_past_half_a_turn_where_framewise_slerp_jumps(
     np.testing.assert_allclose(quat_slerp_path(a, b, np.zeros(n)), a, atol=1e-12)
     small = quat_from_yaw(np.linspace(0.0, 1.0, n))
     np.testing.assert_allclose(quat_slerp_path(a, small, w), quat_slerp(a, small, w), atol=1e-12)
+
+
+def test_wrap_angle_keeps_floats_and_dtypes() -> None:
+    from reactmocap.rotations import wrap_angle
+
+    assert wrap_angle(3 * np.pi / 2) == -np.pi / 2 and isinstance(wrap_angle(4.0), float)
+    assert wrap_angle(np.pi) == -np.pi  # [-pi, pi)
+    a = np.linspace(-20.0, 20.0, 401)
+    w = wrap_angle(a)
+    assert w.dtype == np.float64 and np.all((w >= -np.pi) & (w < np.pi))
+    np.testing.assert_allclose(np.cos(w), np.cos(a), atol=1e-12)
+    np.testing.assert_allclose(np.sin(w), np.sin(a), atol=1e-12)
+    assert wrap_angle(a.astype(np.float32)).dtype == np.float32

@@ -29,6 +29,7 @@ from reactmocap.athletics.group import GroupGains, GroupRiding
 from reactmocap.athletics.rider import RIDER_WORLD, Rider, RiderMount, fit_bicycle
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
+from reactmocap.rotations import wrap_angle
 from reactmocap.sim.controllers.base import Controller
 from reactmocap.sim.rollout import RolloutResult, rollout
 from reactmocap.sim.world import World
@@ -209,9 +210,7 @@ def ride(
     window = t >= min(SPEED_SETTLE, 0.5 * seconds)
     err = log["speed"][window] - log["speed_cmd"][window]
     last = t >= t[-1] - 1.0 if t.size else window
-    herr = np.degrees(
-        np.abs((log["heading"][last] - log["heading_cmd"][last] + np.pi) % (2 * np.pi) - np.pi)
-    )
+    herr = np.degrees(np.abs(wrap_angle(log["heading"][last] - log["heading_cmd"][last])))
     fell = bool(not np.isnan(mon.fell_at[0]) or res.status != "ok")
     rep: dict[str, Any] = {
         "behaviour": "bicycle", "body": team.athlete.name, "speed_cmd_m_s": speed,

@@ -34,6 +34,7 @@ from reactmocap.athletics.course import Route
 from reactmocap.athletics.cycling_scene import Obstacle
 from reactmocap.athletics.rider import Rider
 from reactmocap.errors import ConfigError
+from reactmocap.rotations import wrap_angle
 from reactmocap.sim.world import World
 
 __all__ = ["GroupGains", "GroupRiding", "observe"]
@@ -211,7 +212,7 @@ class GroupRiding:
             rel = pos - pos[i]
             dist = np.linalg.norm(rel, axis=1)
             ang = np.arctan2(rel[:, 1], rel[:, 0]) - head[i]
-            ang = (ang + math.pi) % (2 * math.pi) - math.pi
+            ang = wrap_angle(ang)
             seen = (dist < gn.view) & (np.abs(ang) <= gn.fov / 2)
             seen[i] = False
             e = np.zeros(2)
@@ -227,7 +228,7 @@ class GroupRiding:
                 orel = self.obstacles[:, :2] - pos[i]
                 odist = np.linalg.norm(orel, axis=1)
                 oang = np.arctan2(orel[:, 1], orel[:, 0]) - head[i]
-                oang = (oang + math.pi) % (2 * math.pi) - math.pi
+                oang = wrap_angle(oang)
                 ok = (odist < gn.view) & (np.abs(oang) <= gn.fov / 2)
                 if ok.any():
                     steps = _pass_step(orel[ok], np.tile(-vel[i], (int(ok.sum()), 1)),

@@ -54,7 +54,7 @@ from reactmocap.athletics.rider_mount import (
     fit_bicycle,
 )
 from reactmocap.errors import ConfigError
-from reactmocap.rotations import quat_conj, quat_mul, quat_rotate
+from reactmocap.rotations import quat_conj, quat_mul, quat_rotate, wrap_angle
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.world import World
 
@@ -154,10 +154,6 @@ def _turn_pedals(pedals: F64, centre: F64, angle: float) -> F64:
     out[:, 0] = centre[0] + c * rel[:, 0] + s * rel[:, 2]
     out[:, 2] = centre[2] - s * rel[:, 0] + c * rel[:, 2]
     return out
-
-
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 class Rider:
@@ -376,21 +372,21 @@ class Rider:
         wn = min(sg.wn, sg.wn_per_speed * vv)  # slower lean servo at low speed: gains ~ 1/v^2
         lag = sg.lag * (sg.wn / wn) ** 1.5  # the lean servo's lag grows at low speed
         accel = max_rate / max(sg.turn_in, lag)
-        left = _wrap(self.heading_cmd - self._ref)
+        left = wrap_angle(self.heading_cmd - self._ref)
         # as fast as allowed, braking in time (sqrt(2 a e)); near the target a first-order
         # approach (the square root's gain is unbounded at zero: it would chatter)
         want = math.copysign(
             min(max_rate, math.sqrt(2.0 * accel * abs(left)), abs(left) / lag), left
         )
         self._ref_rate += min(max(want - self._ref_rate, -accel * h), accel * h)
-        self._ref = _wrap(self._ref + self._ref_rate * h)
+        self._ref = wrap_angle(self._ref + self._ref_rate * h)
         # the heading the bicycle can have by now: the reference through the lean's lag; the
         # feedback compares with it (no wind-up while the lean builds), the feed-forward is the
         # reference's own rate (the lean starts at once)
-        self._expected = _wrap(
-            self._expected + _wrap(self._ref - self._expected) * min(h / lag, 1.0)
+        self._expected = wrap_angle(
+            self._expected + wrap_angle(self._ref - self._expected) * min(h / lag, 1.0)
         )
-        rate = self._ref_rate + sg.k_yaw * _wrap(self._expected - b.yaw)
+        rate = self._ref_rate + sg.k_yaw * wrap_angle(self._expected - b.yaw)
         rate = min(max(rate, -max_rate), max_rate)
         roll_d = -math.atan(vv * rate / g)
         w = self._wheelbase

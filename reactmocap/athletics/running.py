@@ -57,7 +57,7 @@ from reactmocap.athletics.running_params import (
 )
 from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
-from reactmocap.rotations import quat_conj
+from reactmocap.rotations import quat_conj, wrap_angle
 from reactmocap.sim.bodies import SIM_PARENTS
 from reactmocap.sim.controllers.base import FunctionController
 from reactmocap.sim.controllers.machine import State, StateMachine, after
@@ -626,7 +626,7 @@ class Runner:
         # the facing turns at a limited rate whatever the course asks (an abrupt change of
         # facing throws the runner down)
         if self._steered:
-            step = (want - self.heading_d + math.pi) % (2 * math.pi) - math.pi
+            step = wrap_angle(want - self.heading_d)
             limit = self.k["turn_rate"] * self.control_every * world.timestep
             self.heading_d += _clamp(step, -limit, limit)
         else:

@@ -16,6 +16,7 @@ from reactmocap.errors import SearchError
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import Skeleton
+from reactmocap.rotations import wrap_angle
 from reactmocap.search.build import (
     EmbeddingWeights,
     embedding_weights,
@@ -421,10 +422,6 @@ def _pick(index: MotionIndex, starts: I64, dists: F64, n: int) -> I64:
     return np.asarray(picked, dtype=np.int64)
 
 
-def _wrap(a: float) -> float:
-    return float((a + np.pi) % (2 * np.pi) - np.pi)
-
-
 def _results(
     index: MotionIndex,
     qw: QueryWindow,
@@ -445,7 +442,7 @@ def _results(
     for rank, (s, ci, dist, row) in enumerate(zip(chosen, index.clip_of(chosen), d, br)):
         fi = int(s - index.clip_offsets[ci])
         t = fi / index.window.fps
-        yaw = _wrap(qw.heading - float(index.heading[s]))
+        yaw = float(wrap_angle(qw.heading - float(index.heading[s])))
         cy, sy = np.cos(yaw), np.sin(yaw)
         ox, oy = index.origin[s]
         tx = float(qw.origin[0] - (cy * ox - sy * oy))
