@@ -6,12 +6,17 @@ naming it and why. Reading TOML input files with errors that name the file."""
 from __future__ import annotations
 
 import contextlib
+import io
+import json
 import os
 import tempfile
 import tomllib
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
+
+import numpy as np
+from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, OutputError
 
@@ -19,6 +24,8 @@ __all__ = [
     "atomic_write",
     "atomic_write_bytes",
     "atomic_write_text",
+    "npz_bytes",
+    "npz_meta",
     "output_errors",
     "read_toml",
     "save_png",
@@ -131,6 +138,20 @@ def atomic_write_text(path: str | Path, text: str) -> None:
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     with atomic_write(path, "wb") as fh:
         fh.write(data)
+
+
+def npz_bytes(meta: Mapping[str, Any], arrays: Mapping[str, NDArray[Any]]) -> bytes:
+    """An ``.npz`` of ``arrays`` and ``meta`` as JSON text in a ``meta`` array: a file of
+    arrays with its own description and no pickle (the clip cache, the search index)."""
+    buf = io.BytesIO()
+    text = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    np.savez(buf, meta=text, **arrays)  # type: ignore[arg-type]  # the stub mixes in its bool options
+    return buf.getvalue()
+
+
+def npz_meta(npz: Any) -> Any:
+    """The ``meta`` of an ``.npz`` opened with ``np.load`` that :func:`npz_bytes` wrote."""
+    return json.loads(bytes(npz["meta"]).decode())
 
 
 def read_toml(path: str | Path, what: str) -> dict[str, Any]:

@@ -8,8 +8,6 @@ options and format version, so editing a file invalidates its entry automaticall
 from __future__ import annotations
 
 import hashlib
-import io
-import json
 import os
 from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -20,7 +18,7 @@ import numpy as np
 
 from reactmocap.conventions import UpAxis
 from reactmocap.errors import LibraryError, ReactMocapError
-from reactmocap.io import atomic_write_bytes
+from reactmocap.io import atomic_write_bytes, npz_bytes, npz_meta
 from reactmocap.library.bvh import read_bvh
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import BVHLayout, Skeleton
@@ -141,7 +139,6 @@ def _to_npz(m: Motion) -> bytes:
         "end_sites": {str(k): list(v) for k, v in s.layout.end_sites.items()},
     }
     arrays = {
-        "meta": np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8),
         "parents": s.parents,
         "offsets": s.offsets,
         "root_positions": m.root_positions,
@@ -149,14 +146,12 @@ def _to_npz(m: Motion) -> bytes:
     }
     if m.translations is not None:
         arrays["translations"] = m.translations
-    buf = io.BytesIO()
-    np.savez(buf, **arrays)  # type: ignore[arg-type]
-    return buf.getvalue()
+    return npz_bytes(meta, arrays)
 
 
 def _from_npz(path: Path) -> Motion:
     with np.load(path, allow_pickle=False) as z:
-        meta = json.loads(bytes(z["meta"]).decode())
+        meta = npz_meta(z)
         layout = BVHLayout(
             channels=tuple(tuple(c) for c in meta["channels"]),
             unit=meta["unit"],

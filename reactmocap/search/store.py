@@ -4,8 +4,6 @@ or the settings it was built from have changed."""
 
 from __future__ import annotations
 
-import io
-import json
 import zipfile
 from collections.abc import Mapping
 from pathlib import Path
@@ -14,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from reactmocap.errors import ReactMocapError, SearchError
-from reactmocap.io import atomic_write_bytes
+from reactmocap.io import atomic_write_bytes, npz_bytes, npz_meta
 from reactmocap.library.motion import Motion
 from reactmocap.search.build import build_index, clip_source
 from reactmocap.search.config import SearchWeights, WindowConfig
@@ -40,14 +38,9 @@ def save(index: MotionIndex, path: str | Path) -> Path:
         "settings_hash": index.settings_hash,
         "info": index.info,
     }
-    arrays = {
-        "meta": np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8),
-        **{name: getattr(index, name) for name in ARRAYS},
-    }
-    buf = io.BytesIO()
-    np.savez(buf, **arrays)
+    arrays = {name: getattr(index, name) for name in ARRAYS}
     try:
-        atomic_write_bytes(p, buf.getvalue())
+        atomic_write_bytes(p, npz_bytes(meta, arrays))
     except OSError as exc:
         raise SearchError(f"{p}: cannot write index: {exc}") from None
     return p
@@ -85,7 +78,7 @@ def load(
         with np.load(p, allow_pickle=False) as z:
             if "meta" not in z.files:
                 raise SearchError(f"{p}: not a reactmocap search index (no metadata)")
-            meta = json.loads(bytes(z["meta"]).decode())
+            meta = npz_meta(z)
             _check_version(p, meta)  # an older format lacks arrays: say which version it is
             missing = [a for a in ARRAYS if a not in z.files]
             if missing:
