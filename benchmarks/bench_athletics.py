@@ -370,7 +370,7 @@ def _polar_plot(res: dict[str, Any], out: Path) -> None:
             ax.set_ylabel(f"Y ({unit})")
     from reactmocap.athletics.plots import _save
 
-    _save(plt, fig, out / "fig7_5_7_7_balance.png")
+    _save(fig, out / "fig7_5_7_7_balance.png")
 
 
 def print_table(res: dict[str, Any]) -> None:
