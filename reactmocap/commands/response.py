@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from reactmocap.commands import output_dir
+from reactmocap.errors import ConfigError
 
 __all__ = ["register"]
 
@@ -93,4 +94,11 @@ def _respond(args: argparse.Namespace) -> int:
 
 
 def _demo(args: argparse.Namespace) -> int:
+    if not DEMO_SCENARIO.is_file():
+        # the demo's scenario and clips are the repository's, not the installed package's
+        raise ConfigError(
+            f"the demo scenario {DEMO_SCENARIO} is missing: `demo` runs from a source checkout "
+            "installed as the README says (pip install -e .); elsewhere run `respond "
+            "SCENARIO.toml --out DIR` on your own scenario"
+        )
     return _run(DEMO_SCENARIO, args.out, args.plot, args.video, args.strict)

@@ -181,6 +181,18 @@ def test_demo_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
     assert frames[0].std() > 1.0  # something was drawn
 
 
+def test_demo_outside_a_source_checkout_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from reactmocap.commands import response
+
+    monkeypatch.setattr(response, "DEMO_SCENARIO", tmp_path / "examples" / "front_kick.toml")
+    assert main(["demo", "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "source checkout" in err and "front_kick.toml" in err
+    assert not (tmp_path / "out").exists()
+
+
 def test_real_clips_end_to_end(shared_mocap_dir: Path, tmp_path: Path) -> None:
     lib = linked_library(tmp_path, shared_mocap_dir, SYNTHETIC)
     scenario = Scenario(
