@@ -208,6 +208,25 @@ def test_a_walk_pushed_sideways_places_only_the_step_the_push_starts(
     assert res.report.status == "ok"
 
 
+def test_a_walk_pushed_sideways_with_its_rate_following_the_lead_stays_up(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared left-curving walk pushed 350 N toward its left at the chest for 0.2 s at
+    1.5 s: with the defaults the sideways fall is caught, then the capture point runs 0.5 m
+    ahead of the clip's while the played-faster clip's rate (a speed ratio) is back near 1,
+    and the walk falls forward; with the rate also following the capture point's lead along
+    the walk (``warp_lead``, opt-in: lower while the body lags in the catch, higher once it
+    runs ahead) it stays up."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, 90.0, 350.0)
+
+    def push(params: dict[str, float]) -> TrackResult:
+        return push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
+                         seconds=2.7, params=params)  # fmt: skip
+
+    assert push({}).report.status == "fell"
+    assert push({"warp_lead": 0.5}).report.status == "ok"
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}

@@ -92,6 +92,7 @@ class AnchoredReference:
         place_deadband: float,
         place_height: float,
         warp_gain: float = 0.0,
+        warp_lead: float = 0.0,
         step_leg: float = 0.0,
         step_alternate: bool = False,
         step_short: float = 0.0,
@@ -174,9 +175,13 @@ class AnchoredReference:
         self.anchor_shift = np.zeros(2)
         self._turn = (0.0, _rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
         self.warp_gain = float(warp_gain)
+        self.warp_lead = float(warp_lead)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
+        #: set after a sideways walk's push: the rate then also follows the capture point's
+        #: lead along the walk (``warp_lead``)
+        self.leading = False
         #: the clip's playing rate (1: as captured)
         self.rate = 1.0
 
@@ -538,8 +543,9 @@ class AnchoredReference:
         """After a walk's push: the clip plays at a rate ``warp_gain`` of the way from 1 to
         the body's horizontal speed over the mocap's (centre of mass), so the steps come as
         fast as the pushed body needs them and the rate returns to 1 as the body slows to the
-        reference (which is always a little slower)."""
-        _, v, _ = self.com_reference(t)
+        reference (which is always a little slower); plus ``warp_lead`` per m the capture
+        point runs ahead of the mocap's along the walk (a body drifting ahead of its steps)."""
+        c, v, _ = self.com_reference(t)
         v_ref = v[:2] / self.rate
         n2 = float(v_ref @ v_ref)
         if n2 < 0.04:  # under 0.2 m/s: not walking
@@ -550,7 +556,14 @@ class AnchoredReference:
         # quicker steps too (the part along the walk drops then, and a clip slowed with it
         # lost the right pushes it survived: the rate never goes below 1)
         speed = float(np.linalg.norm(self.world.data.subtree_linvel[self._root][:2])) / ref
-        target = min(max(1.0 + self.warp_gain * (speed - 1.0), 1.0), _WARP_MAX)
+        target = 1.0 + self.warp_gain * (speed - 1.0)
+        if self.leading:
+            # the speed ratio forgets a position lead: after a caught sideways fall the body
+            # ran 0.2-0.4 m ahead at the clip's speed, its steps short, and fell forward
+            xi, omega = self.capture_point()
+            lead = float((xi - c[:2] - v[:2] / omega) @ v_ref) / ref
+            target += self.warp_lead * lead
+        target = min(max(target, 1.0), _WARP_MAX)
         self.rate += min(1.0, self._dt_slow / _WARP_TAU) * (target - self.rate)
         self.clock = replace(self.clock, start=self.clock.start + (self.rate - 1.0) * self._dt_slow)
 
@@ -570,7 +583,7 @@ class AnchoredReference:
         self._gone_down = False
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
-        self.rate, self.warping = 1.0, False
+        self.rate, self.warping, self.leading = 1.0, False, False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
 
@@ -585,12 +598,12 @@ class AnchoredReference:
                 self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
-                self._placed.copy(), self._gone_down)  # fmt: skip
+                self._placed.copy(), self._gone_down, self.leading)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
-         until, place_move, placed, gone_down) = memory  # fmt: skip
+         until, place_move, placed, gone_down, leading) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -607,3 +620,4 @@ class AnchoredReference:
         self._place_move[:] = place_move  # type: ignore[call-overload]
         self._placed[:] = placed  # type: ignore[call-overload]
         self._gone_down = bool(gone_down)
+        self.leading = bool(leading)

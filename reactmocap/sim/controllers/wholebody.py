@@ -182,6 +182,11 @@ class WholeBodyTracker(AnchoredReference):
             slower than 1), so the steps come as fast as the pushed body needs
             and, the clip a little slower than the body, the body sheds the extra speed and the
             rate comes back to 1 (0: off; ``docs/tracking.md``).
+        warp_lead: with ``warp_gain``, after a sideways walk's push (within 30 deg of the
+            side), the clip's rate also rises by ``warp_lead`` per m that the simulated capture
+            point runs ahead of the mocap's along the mocap's walk (falls by as much behind,
+            never below 1), so a body that drifts ahead after its sideways fall is caught gets
+            its next steps sooner (0: off; ``docs/tracking.md``).
         place_pushed: after a sideways walk's push (within 30 deg of the side), a swinging
             foot on the side the body falls to lands ``place_pushed`` times the sideways gap
             between the simulated and the mocap's capture point, grown to the mocap's landing
@@ -260,6 +265,7 @@ class WholeBodyTracker(AnchoredReference):
         place_deadband: float = 0.15,
         place_height: float = 0.03,
         warp_gain: float = 0.0,
+        warp_lead: float = 0.0,
         place_pushed: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
@@ -288,7 +294,8 @@ class WholeBodyTracker(AnchoredReference):
                 "step_short": step_short,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
-                "place_height": place_height, "warp_gain": warp_gain, "place_pushed": place_pushed,
+                "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
+                "place_pushed": place_pushed,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -397,7 +404,7 @@ class WholeBodyTracker(AnchoredReference):
             balance_margin=balance_margin, balance_tau=balance_tau, stepping=stepping,
             step_margin=step_margin, step_time=step_time, step_height=step_height,
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
-            warp_gain=warp_gain, step_leg=step_leg,
+            warp_gain=warp_gain, warp_lead=warp_lead, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
             place_pushed=place_pushed,
         )  # fmt: skip
@@ -682,7 +689,11 @@ class WholeBodyTracker(AnchoredReference):
             f = self._xfrc[:, :2].sum(axis=0)
             along = abs(np.cos(heading) * f[0] + np.sin(heading) * f[1])
             side = abs(np.cos(heading) * f[1] - np.sin(heading) * f[0])
-            self._start_placing(self.place_pushed > 0 and along < _PLACE_SIDE_TAN * side, t)
+            sideways = bool(along < _PLACE_SIDE_TAN * side)
+            self._start_placing(self.place_pushed > 0 and sideways, t)
+            # the rate follows a capture point running ahead (``warp_lead``) only after a
+            # sideways push: after a diagonal one it lost more pushes than it caught
+            self.leading = self.warping and self.warp_lead > 0 and sideways
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
                 self.kp[:3] = self._kp_root_pushed
