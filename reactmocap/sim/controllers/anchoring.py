@@ -14,7 +14,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.rotations import quat_from_yaw
+from reactmocap.rotations import quat_from_yaw, wrap_angle
 from reactmocap.sim.controllers.stepping import (
     Step,
     clamp_to_support,
@@ -514,7 +514,7 @@ class AnchoredReference:
         dyaw = 0.0
         if turn.any():
             yaw = np.arctan2(rot[turn, 1, 0], rot[turn, 0, 0]) - ref_yaw[turn] - self.anchor_yaw
-            dyaw = float(np.mean((yaw + np.pi) % (2 * np.pi) - np.pi))
+            dyaw = float(np.mean(wrap_angle(yaw)))
         # only what is beyond the dead band: a small offset is the tracking's own to correct
         db = self.anchor_deadband
         n = float(np.linalg.norm(err))
