@@ -173,7 +173,7 @@ class LeapParams:
     #: the "com" push also servos the whole-body roll (cartwheel) momentum about the heading's
     #: forward axis to zero by moving the push's weight shares between the feet (share per
     #: unit of momentum in m L^2 rad/s, at most ``ROLL_SHIFT``): a perturbed start's small
-    #: roll grew ~10 times over the push (the centre of pressure 2-4 cm to the side of the
+    #: roll grew ~10 times over the push (the centre of pressure 2-6 cm to the side of the
     #: COM), and the forward tuck touched down with the feet staggered and to the side of
     #: the COM, stood up on one foot and fell (docs/athletics.md); 0: off (as before)
     roll_gain: float = 0.0
