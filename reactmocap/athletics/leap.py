@@ -101,6 +101,8 @@ COM_PUSH_SPIN: Mapping[str, float] = MappingProxyType({"male": -2.0, "female": -
 ANKLE_KP, ANKLE_KV = 2.0, 0.5
 #: the largest hip roll and yaw offset (rad) the push's tilt feedback may make (tilt_gain)
 TILT_LIMIT = 0.3
+#: the most weight share the "com" push's roll feedback moves between the feet (roll_gain)
+ROLL_SHIFT = 0.5
 #: the tilt feedback's yaw gain as a multiple of its roll gain (tilt_gain): the yaw
 #: momentum is the smaller, and the one that told the female back tuck's landings apart
 TILT_YAW = 4.0
@@ -168,6 +170,13 @@ class LeapParams:
     #: ``TILT_LIMIT``): a take-off's yaw and cartwheel momentum twist a somersault's opening
     #: body; 0: off (as before)
     tilt_gain: float = 0.0
+    #: the "com" push also servos the whole-body roll (cartwheel) momentum about the heading's
+    #: forward axis to zero by moving the push's weight shares between the feet (share per
+    #: unit of momentum in m L^2 rad/s, at most ``ROLL_SHIFT``): a perturbed start's small
+    #: roll grew ~10 times over the push (the centre of pressure 2-6 cm to the side of the
+    #: COM), and the forward tuck touched down with the feet staggered and to the side of
+    #: the COM, stood up on one foot and fell (docs/athletics.md); 0: off (as before)
+    roll_gain: float = 0.0
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -175,7 +184,7 @@ class LeapParams:
                 self.stiffness, self.lean, self.crouch_side,
                 self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
                 self.push_ramp, self.push_limit, self.push_hip, self.push_ankle,
-                self.tilt_gain]  # fmt: skip
+                self.tilt_gain, self.roll_gain]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.0 < self.crouch_side <= 5.0:
@@ -201,6 +210,8 @@ class LeapParams:
             )
         if not 0.0 <= self.tilt_gain <= 100.0:
             raise ConfigError(f"leap tilt_gain must be in [0, 100] rad, got {self.tilt_gain}")
+        if not 0.0 <= self.roll_gain <= 100.0:
+            raise ConfigError(f"leap roll_gain must be in [0, 100], got {self.roll_gain}")
         if self.handover not in HANDOVERS:
             raise ConfigError(
                 f"leap handover must be one of {list(HANDOVERS)}, got {self.handover!r}"
@@ -226,6 +237,14 @@ def pitch_momentum(world: World, s: Senses) -> float:
     h = s.heading()
     axis = np.array([-math.sin(h), math.cos(h), 0.0])
     return float(world.data.subtree_angmom[s.root] @ axis)
+
+
+def roll_momentum(world: World, s: Senses) -> float:
+    """Whole-body angular momentum about the COM (kg m^2/s) about the heading frame's forward
+    axis (roll, cartwheel). ``mj_subtreeVel`` has run."""
+    h = s.heading()
+    lw = world.data.subtree_angmom[s.root]
+    return float(lw[0] * math.cos(h) + lw[1] * math.sin(h))
 
 
 class Leap(Basis):
@@ -306,9 +325,7 @@ class Leap(Basis):
             if p.tilt_gain > 0:
                 # roll and yaw momentum to zero, the hips tilting and turning the push about
                 # the COM as the pitch feedback above
-                h = s.heading()
-                lw = world.data.subtree_angmom[s.root]
-                tilt[:] = lw[0] * math.cos(h) + lw[1] * math.sin(h), lw[2]
+                tilt[:] = roll_momentum(world, s), world.data.subtree_angmom[s.root][2]
                 scale = spin_ramp * p.tilt_gain / unit
                 tilt[0] *= scale
                 tilt[1] *= TILT_YAW * scale
@@ -379,6 +396,12 @@ class Leap(Basis):
             goal[knees] = now[knees]
             rig.move(goal, 0.0, t, knees)
             bl._support(s)
+            if p.roll_gain > 0 and rig.support.all():
+                # the cartwheel (roll) momentum to zero: weight moved onto the foot whose
+                # push rolls the body back (the centre of pressure to that side of the COM)
+                roll = roll_momentum(world, s) / (ctx.athlete.mass * ctx.athlete.leg_length**2)
+                shift = float(np.clip(p.roll_gain * roll, -ROLL_SHIFT, ROLL_SHIFT))
+                rig.support[:] = np.clip(rig.support + (-shift, shift), 0.0, 1.0)
             if not memo["pushing"]:
                 rig.support_point = None
                 rig.support[:] = 0.0

@@ -82,8 +82,11 @@ PRESET_STARTS: Mapping[str, Phase] = MappingProxyType({
 #: floor as it began and left in two modes, +43 or +34); it stays tucked until the prediction
 #: reaches the full turn less 0.45 rad, so the legs reach the floor out, extending hips and
 #: knees 60% toward the landing pose first (thesis 8.5.1), and lands with the feet 4 cm ahead
-#: of the capture point, knees bent 0.5 rad (docs/athletics.md: about half the perturbed
-#: starts land at a tenth of the capture region's perturbation; the landing decides). The back
+#: of the capture point, knees bent 0.5 rad (docs/athletics.md). Since 2026-12-03 its push
+#: also moves the weight between the feet against the cartwheel momentum (the leap's
+#: ``roll_gain``) and its legs' sideways aim is taken from the pelvis's whole orientation
+#: (``aim_sideways``): a perturbed start's small roll grew over the push, and the feet touched
+#: down staggered and to one side of the COM; it stood up on one foot and fell. The back
 #: layout (inertia 18.5 kg m^2 against the tuck's 4.7) needs the leap at effort 0.9 aiming at
 #: -90 kg m^2/s with the hips allowed 1.5 rad (it gets -77.0, 1.2 m of COM rise); it holds the
 #: layout until the rotation predicted for the touchdown comes down to the turn less 0.96 rad
@@ -132,11 +135,12 @@ SOMERSAULT_PRESETS: Mapping[
         "forward": (MappingProxyType({"effort": 1.0, "push": "com", "rise": 0.85, "leg": 0.6,
                                       "pitch": 0.0, "lean": 0.0, "push_hip": 0.5,
                                       "push_ankle": 1.0, "spin": 49.0, "com_offset": 0.05,
-                                      "com_ease": True, "arms_back": -2.8, "arms": 0.0}),
+                                      "com_ease": True, "arms_back": -2.8, "arms": 0.0,
+                                      "roll_gain": 15.0}),
                     MappingProxyType({"lead": 0.45, "latest": 0.0, "extend": 0.6,
                                       "extend_lead": 0.15}),
                     MappingProxyType({"delta": 0.04, "knee": 0.5, "restore": 0.4,
-                                      "damping": 1.75})),
+                                      "damping": 1.75, "aim_sideways": True})),
     }),
     "female": MappingProxyType({
         "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0,

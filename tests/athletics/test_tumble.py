@@ -221,6 +221,34 @@ def test_the_forward_tuck_lands_with_2_and_4_kg_backpacks_untuned() -> None:
         assert int(np.sum(down[:-1] & ~down[1:])) == 1, kg  # the feet leave once
 
 
+def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> None:
+    """Start 2 of the capture region at full size (seed 0). Its "com" push let the start's
+    small roll grow to -5.8 kg m^2/s of cartwheel momentum: the feet touched down 12 cm to
+    the side of the COM, it stood up on one foot and fell. With the push's weight moved
+    between the feet against the roll (``roll_gain``) and the legs' sideways aim taken from
+    the pelvis's whole orientation (``aim_sideways``), the preset since 2026-12-03, it leaves
+    with under 1 kg m^2/s of roll and lands."""
+    start = full_starts(3)[2]
+    m = somersault_maneuver(direction="forward")
+    assert m.phases[1].params["roll_gain"] > 0 and m.phases[3].params["aim_sideways"] is True
+    r = run_maneuver(m, perturbation=start, fps=10.0)
+    assert r.report["landed"] and not r.report["fell"]
+    assert abs(r.report["rotation_deg"] - 360.0) <= 30.0
+    assert abs(_liftoff_momentum(r)[0]) < 2.0
+    leap = replace(m.phases[1], params={**m.phases[1].params, "roll_gain": 0.0})
+    land = replace(m.phases[3], params={**m.phases[3].params, "aim_sideways": False})
+    before = replace(m, phases=(m.phases[0], leap, m.phases[2], land, *m.phases[4:]))
+    r = run_maneuver(before, perturbation=start, fps=10.0)
+    assert r.report["fell"] and not r.report["landed"]
+    assert abs(_liftoff_momentum(r)[0]) > 4.0
+
+
+def test_the_leap_refuses_a_roll_gain_out_of_range() -> None:
+    for bad in (-1.0, 101.0, math.nan):
+        with pytest.raises(ConfigError, match="roll_gain|finite"):
+            LeapParams(roll_gain=bad)
+
+
 def test_the_back_pike_lands_on_more_momentum_than_the_tuck(back_tuck) -> None:  # type: ignore[no-untyped-def]
     r = somersault("pike", "backward", "male").report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
