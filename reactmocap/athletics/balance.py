@@ -289,10 +289,18 @@ STEP_SWING_CAP = 0.8
 STEP_PAUSE = 0.1
 #: seconds after a step within which a foot left hanging is brought down beside the other
 STEP_CLOSE = 1.0
+#: the least sideways distance (m) between the soles' middles a step leaves (left stays left)
+STEP_WIDTH = 0.12
+#: steps go sideways too (the capture point's way out of the soles' box in both axes)
+STEP_SIDEWAYS = True
 #: how much longer (m) the swing leg reaches than the standing ankle's height, by the end of
 #: the swing (without it the foot hovered 2-3 cm over the floor, the servo's sag)
 STEP_PRESS = 0.05
-#: the least seconds the stepped leg's knee takes back to the posture's
+#: time constant (s) of the swing hip's target's approach to its aim
+STEP_EASE = 0.05
+#: the longest the swing leg is made (fraction of the straight leg)
+STEP_REACH = 0.97
+#: the least seconds the knees take back to the posture's after a step
 STEP_SETTLE = 0.2
 BALANCE_GAINS = BalanceGains()
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
@@ -574,9 +582,11 @@ class Stepper:
         self._hips = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
         self._ankles = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]
         self.foot = -1  # the swinging foot (0 left, 1 right), -1 none
-        self._sign = 0.0  # the step's direction along the feet (+1 forward)
+        self._out: F64 | None = None  # the way out of the support (unit, heading frame); None: closing
         self._t0 = math.nan  # when the swing began
         self._t_end = -math.inf  # when the last step ended
+        self._t_last = math.nan  # the last tick of the swing
+        self._hip = np.zeros(3)  # the swing hip's eased target
         self._close = False  # a step ended: bring the foot it stood on down if it hangs
         self._stood = 0
         self._goal = np.full((NJ, 3), np.nan)
@@ -587,71 +597,107 @@ class Stepper:
         s = self.ctx.senses
         st = self.step
         rig = self.ctx.rig
-        com = s.local(s.com, h)
-        vel = s.local(s.com_vel, h)
-        feet = s.local(s.corners.mean(axis=1), h)[:, 0]  # each sole's middle along the feet
+        com = s.local(s.com, h)[:2]
+        vel = s.local(s.com_vel, h)[:2]
+        feet = s.local(s.corners.mean(axis=1), h)[:, :2]  # each sole's middle
         floor = float(s.corners[..., 2].min())  # a level floor: the lowest sole corner
         omega = math.sqrt(9.81 / max(float(s.com[2]) - floor, 0.3))  # LIPM, as the bow's
-        cp = float(com[0] + vel[0] / omega)
+        cp = com + vel / omega
         if self.foot < 0 and self._close and s.foot_contact.any():
             # after a step, the foot it stood on, if left hanging, is brought down beside the
             # stepped one (on the stepped foot alone the COM servo's hip offsets swung the
             # free leg up and over)
-            k = self._stood  # the foot the step stood on
+            k = self._stood
             self._close = t < self._t_end + STEP_CLOSE
             if self._close and s.foot_contact[1 - k] and not s.foot_contact[k]:
-                self.foot, self._sign, self._t0, self._close = k, 0.0, t, False
+                self.foot, self._out, self._t0, self._close = k, None, t, False
                 self.record.append({"t": t, "foot": float(k), "beyond_m": 0.0,
-                                    "from_m": float(feet[k] - feet[1 - k])})  # fmt: skip
+                                    "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
         if self.foot < 0:
             if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
                 return
             lo, hi = s.support_extent(h)
-            sign = 1.0 if cp > hi[0] else -1.0
-            beyond = (cp - float(hi[0])) if sign > 0 else (float(lo[0]) - cp)
-            if beyond <= st.margin or sign * float(vel[0]) <= 0.0:
+            # how far the capture point lies outside the soles' box (along the feet only
+            # unless sideways), and the way out
+            out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
+            if not STEP_SIDEWAYS:
+                out[1] = 0.0
+            beyond = float(np.hypot(*out))
+            if beyond <= st.margin or float(vel @ out) <= 0.0:
                 return
-            k = int(np.argmin(sign * feet))  # the foot farther from the capture point swings
+            # the farther foot swings; on a fall mostly sideways the foot on that side (the
+            # other would cross in front of it)
+            k = int(np.argmax(np.linalg.norm(feet - cp, axis=1)))
+            if abs(out[1]) > abs(out[0]):
+                k = 0 if out[1] > 0 else 1
             if not s.foot_contact[1 - k]:
                 return
-            self.foot, self._sign, self._t0 = k, sign, t
+            self.foot, self._out, self._t0 = k, out / beyond, t
             self.record.append({"t": t, "foot": float(k), "beyond_m": beyond,
-                                "from_m": float(feet[k] - feet[1 - k])})  # fmt: skip
+                                "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
         k = self.foot
+        if t == self._t0:  # the hip's eased target starts where the hip is
+            self._t_last = t
+            self._hip[:] = rig.current_angles()[_HIP[k]]
         u = (t - self._t0) / st.seconds
         if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
-            self.record[-1]["to_m"] = float(feet[k] - feet[1 - k])
+            self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
             self.record[-1]["s"] = t - self._t0
-            self.foot, self._t_end, self._close = -1, t, self._sign != 0.0
-            self._stood = 1 - k
-            # the knee on to the posture's with the other's (a stand-up under way: at once,
-            # the leg's push launched the body), the law's leveling on top
-            other = _KNEE[1 - k]
-            self._goal[_KNEE[k], 0] = rig.goal()[other, 0]
-            rig.move(self._goal, max(float(rig.time_left(t)[other]), STEP_SETTLE), t,
-                     _KNEE[k : k + 1])  # fmt: skip
+            self._close, self._stood = self._out is not None, 1 - k
+            self.foot, self._t_end = -1, t
+            # both knees on from where they are to the posture's, over what is left of its
+            # stand-up (at once, the stepped leg's push launched the body), the law's
+            # leveling on top
+            left = max(float(rig.time_left(t)[_KNEE].max()), STEP_SETTLE)
+            goal = rig.goal()[_KNEE, 0]
+            rig.move(rig.current_angles(), 0.0, t, _KNEE)
+            self._goal[_KNEE, 0] = goal
+            rig.move(self._goal, left, t, _KNEE)
             return
-        stand = float(feet[1 - k])
-        want = stand  # closing: beside the other
-        if self._sign:
-            want = float(np.clip(cp + self._sign * st.reach, stand - STEP_LONGEST,
-                                 stand + STEP_LONGEST))  # fmt: skip
         hip = d.xanchor[self._hips[k]]
+        at = s.local(hip, h)[:2]
+        stand = feet[1 - k]
+        if self._out is None:  # closing: beside the other, under its own hip
+            want = np.array([stand[0], at[1]])
+        else:  # past the capture point, the feet kept apart (left stays left)
+            want = cp + st.reach * self._out
+            want[0] = np.clip(want[0], stand[0] - STEP_LONGEST, stand[0] + STEP_LONGEST)
+            side = 1.0 - 2.0 * k  # +1: the left foot swings
+            want[1] = stand[1] + side * max(side * (want[1] - stand[1]), STEP_WIDTH)
+            if not STEP_SIDEWAYS:
+                want[1] = at[1]
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
         down = float(hip[2]) - float(d.xanchor[self._ankles[1 - k], 2])
         down += STEP_PRESS * min(max(2.0 * u - 1.0, 0.0), 1.0)  # pressed down as it ends
-        ahead = want - float(s.local(hip, h)[0])
+        ahead, aside = (float(x) for x in want - at)
         a = self.ctx.athlete
         ul, ll = float(a.thigh[k]), float(a.shin[k])
-        length = min(math.hypot(ahead, max(down, 0.2)), 0.995 * (ul + ll))
+        reach = STEP_REACH * (ul + ll)
+        # the standing knee bends as far as it takes the swing leg to reach the place
+        low = max(down - math.sqrt(max(reach * reach - ahead * ahead - aside * aside, 0.01)), 0.0)
+        if low > 0.0:
+            j = 1 - k
+            stand_leg = float(np.linalg.norm(d.xanchor[self._hips[j]] - d.xanchor[self._ankles[j]]))
+            bend = float(knee_for_length(a.thigh[j], a.shin[j], stand_leg - low)[0])
+            rig.offset[_KNEE[j], 0] = max(bend - float(rig.desired(t)[_KNEE[j], 0]),
+                                          float(rig.offset[_KNEE[j], 0]))  # fmt: skip
+            down -= low
+        length = min(math.sqrt(ahead * ahead + aside * aside + max(down, 0.2) ** 2), reach)
         swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
         knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
         knee += st.lift * math.sin(math.pi * min(max(u, 0.0), 1.0))
         # the leg aimed in the world at the place, whatever the pelvis's orientation (as the
         # landing's reach); the COM servo's offsets off it, its weight on the other foot
         self._thigh[0] = -swing + geom
-        self._goal[_HIP[k]] = hips_for_thighs(self.ctx, d, self._thigh[None], h)[0]
+        self._thigh[1] = math.asin(float(np.clip(aside / length, -0.5, 0.5)))
+        aim = hips_for_thighs(self.ctx, d, self._thigh[None], h)[0]
+        # the hip eased toward its aim (first order): a jump in its target kicked the pelvis
+        # back and the standing foot off the floor
+        ease = min(max(t - self._t_last, 0.0) / STEP_EASE, 1.0) if STEP_EASE > 0 else 1.0
+        self._t_last = t
+        self._hip += ease * (aim - self._hip)
+        self._goal[_HIP[k]] = self._hip
         self._goal[_KNEE[k], 0] = knee
         rig.move(self._goal, 0.0, t, (_HIP[k], _KNEE[k]))
         rig.offset[_HIP[k]] = 0.0
