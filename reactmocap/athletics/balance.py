@@ -625,11 +625,9 @@ class Stepper:
             beyond = float(np.hypot(*out))
             if beyond <= st.margin or float(vel @ out) <= 0.0:
                 return
-            # the farther foot swings; on a fall mostly sideways the foot on that side (the
-            # other would cross in front of it)
+            # the farther foot swings (on a sideways fall toward the standing foot it crosses
+            # over, see below)
             k = int(np.argmax(np.linalg.norm(feet - cp, axis=1)))
-            if abs(out[1]) > abs(out[0]):
-                k = 0 if out[1] > 0 else 1
             if not s.foot_contact[1 - k]:
                 return
             self.foot, self._out, self._t0 = k, out / beyond, t
@@ -659,11 +657,12 @@ class Stepper:
         stand = feet[1 - k]
         if self._out is None:  # closing: beside the other, under its own hip
             want = np.array([stand[0], at[1]])
-        else:  # past the capture point, the feet kept apart (left stays left)
+        else:  # past the capture point
             want = cp + st.reach * self._out
             want[0] = np.clip(want[0], stand[0] - STEP_LONGEST, stand[0] + STEP_LONGEST)
-            side = 1.0 - 2.0 * k  # +1: the left foot swings
-            want[1] = stand[1] + side * max(side * (want[1] - stand[1]), STEP_WIDTH)
+            # the feet kept STEP_WIDTH apart sideways, on whichever side the place lies
+            apart = want[1] - stand[1]
+            want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
             if not STEP_SIDEWAYS:
                 want[1] = at[1]
         # the leg as long as it takes to put the sole on the floor at the place (the stance
