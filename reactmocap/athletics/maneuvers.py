@@ -584,8 +584,9 @@ def run_maneuver(
     if "tumble_peak_rate" in ctx.handover:
         rep["peak_somersault_rate_rad_s"] = ctx.handover["tumble_peak_rate"]
         rep["tumble_min_inertia_kgm2"] = ctx.handover["tumble_min_inertia"]
-    if ctx.handover.get("steps"):  # the balance's steps (Step): when, how far past, the foot
-        rep["steps"] = [dict(r) for r in ctx.handover["steps"]]
+    steps = ctx.handover.get("steps")
+    if isinstance(steps, list) and steps:  # the balance's steps (Step): when, how far, the foot
+        rep["steps"] = [dict(r) for r in steps]
     if "unsettled_s" in ctx.handover:  # a balance phase timed out before it settled
         rep["unsettled_s"] = ctx.handover["unsettled_s"]
     if "tumble_twist_undone" in ctx.handover:  # when the tilt twist's throw was undone
