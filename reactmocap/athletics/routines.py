@@ -402,7 +402,8 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # falls a little short for it (spin_limit 1.3: -76 kg m^2/s), and his feet land farther
     # back; since 2026-12-03 (later) the landing steps once the capture point lies 5 cm past
     # the feet (LandingParams.step: 11/50 and 17/50 perturbed starts on seeds 0 and 1, from
-    # 10 and 15; docs/athletics.md). A list: a maneuver file's numbers load as one
+    # 10 and 15, held-out seed 2 15 from 13; docs/athletics.md). A list: a maneuver file's
+    # numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3}),
         "handspring": MappingProxyType({"aim": -3.42, "knees": 0.4}),
