@@ -10,6 +10,7 @@ User parameters: torso pitch, pelvis height and a COM offset (:class:`Posture`).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from types import MappingProxyType
 
@@ -23,6 +24,7 @@ from reactmocap.athletics.rig import joint_index, per_joint
 from reactmocap.errors import ConfigError
 from reactmocap.rotations import (
     quat_conj,
+    quat_exp,
     quat_from_euler,
     quat_from_yaw,
     quat_mul,
@@ -42,6 +44,8 @@ __all__ = [
     "BalanceGains",
     "BalanceLaw",
     "Posture",
+    "Step",
+    "Stepper",
     "knee_for_length",
 ]
 
@@ -113,6 +117,54 @@ class Posture:
             raise ConfigError(f"posture leg must be within [0.3, 1.0] of the leg, got {self.leg}")
         if len(self.com_offset) != 2 or not all(math.isfinite(v) for v in self.com_offset):
             raise ConfigError(f"posture com_offset must be 2 finite numbers, got {self.com_offset}")
+
+
+@dataclass(frozen=True)
+class Step:
+    """A step when the capture point leaves the feet (the balance's own ankles and hips cannot
+    bring back a COM whose capture point lies past the soles' edge).
+
+    Args:
+        margin: the step starts once the capture point (COM + velocity / omega, LIPM) lies
+            more than this (m) past the supporting soles' edge along the feet (fore-aft,
+            heading frame; :data:`STEP_SIDEWAYS`: across them too) while the COM moves that
+            way; the foot farther from the capture point swings.
+        reach: the swing foot is aimed this far (m) past the capture point (updated each
+            tick), at most :data:`STEP_LONGEST` from the standing foot; the swing leg is
+            made as long as it takes to reach the floor there (a level floor).
+        lift: knee flexion (rad) added to the swing leg over the swing (a half sine: the
+            foot clears the floor).
+        seconds: the swing's planned duration; the step ends when the swing foot touches
+            down after half of it (or at three times it).
+    """
+
+    margin: float = 0.05
+    reach: float = 0.1
+    lift: float = 0.3
+    seconds: float = 0.25
+
+    def __post_init__(self) -> None:
+        for name in ("margin", "reach", "lift", "seconds"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise ConfigError(f"step {name} must be a finite number >= 0, got {v!r}")
+        if not 0.05 <= self.seconds <= 2.0:
+            raise ConfigError(f"step seconds must be in [0.05, 2], got {self.seconds}")
+
+    @classmethod
+    def of(cls, values: Step | Sequence[float] | None) -> Step | None:
+        """A step from a parameter list ``[margin, reach, lift, seconds]`` (any leading
+        part; the rest default), or ``None`` for an empty one (off)."""
+        if values is None or isinstance(values, Step):
+            return values
+        v = tuple(values)
+        if not v:
+            return None
+        if len(v) > 4:
+            raise ConfigError(
+                f"step takes at most 4 numbers (margin, reach, lift, seconds), got {v}"
+            )
+        return cls(*(float(x) for x in v))
 
 
 @dataclass(frozen=True)
@@ -231,6 +283,29 @@ SETTLED = MappingProxyType({"share": 0.2, "tau": 0.05, "speed": 0.05, "offset": 
 WINDMILL_SLOPE = 0.05
 #: sideways gradient (tan of the slope) over which :attr:`BalanceGains.side_roll` comes in
 SIDE_SLOPE = 0.2
+#: :class:`Step`: the longest step (m, the swing foot's target from the standing foot along
+#: the feet), the most the swing leg swings from under its hip (sine, as the landing's
+#: ``swing_cap``), the seconds after a step before the next may start
+STEP_LONGEST = 0.7
+STEP_SWING_CAP = 0.8
+STEP_PAUSE = 0.1
+#: seconds after a step within which a foot left hanging is brought down beside the other
+STEP_CLOSE = 1.0
+#: the least sideways distance (m) between the soles' middles a step leaves
+STEP_WIDTH = 0.12
+#: steps go sideways too (the capture point's way out of the soles' box in both axes, a foot
+#: crossing over the other if it must); off: on the male back handspring's first 16 perturbed
+#: starts it stepped the landers that stand sideways and lost 1-2 of 5 (docs/athletics.md)
+STEP_SIDEWAYS = False
+#: how much longer (m) the swing leg reaches than the standing ankle's height, by the end of
+#: the swing (without it the foot hovered 2-3 cm over the floor, the servo's sag)
+STEP_PRESS = 0.05
+#: time constant (s) of the swing hip's target's approach to its aim
+STEP_EASE = 0.05
+#: the longest the swing leg is made (fraction of the straight leg)
+STEP_REACH = 0.97
+#: the least seconds the knees take back to the posture's after a step
+STEP_SETTLE = 0.2
 BALANCE_GAINS = BalanceGains()
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
@@ -266,6 +341,8 @@ class BalanceLaw:
         self._wind = [0.0, 0.0]
         self._wind_dir = [0.0, 0.0]
         self._t_wind = math.nan
+        #: a step when the capture point leaves the feet (:class:`Step`), or None
+        self.stepper: Stepper | None = None
         self._knee_standing = float(np.mean(knee_for_length(
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
 
@@ -409,6 +486,8 @@ class BalanceLaw:
         hang = self._plant(s, d, h) if self.posture.plant else None
         self._level_legs(d, desired, hang)
         self._support(s)
+        if self.stepper is not None:
+            self.stepper.control(self, d, h, t)
 
     def _windmill(
         self, k: int, cp: float, ahead: float, dt: float, level: bool, rate: float, margin: float
@@ -494,6 +573,160 @@ class BalanceLaw:
         rig.support[:] = (1.0 - w, w)
 
 
+class Stepper:
+    """:class:`Step` on a :class:`BalanceLaw`'s targets, after its own (one per run: the
+    landing's recovery hands it to the balance that follows, ``ctx.handover["stepper"]``, so
+    a swing under way goes on). Each step is recorded in ``ctx.handover["steps"]``."""
+
+    def __init__(self, ctx: Context, step: Step) -> None:
+        self.ctx = ctx
+        self.step = step
+        m = ctx.world.model
+        pre = ctx.rig.wc.prefix
+        self._hips = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
+        self._ankles = [m.joint(f"{pre}{s}_ankle").id for s in "lr"]
+        self.foot = -1  # the swinging foot (0 left, 1 right), -1 none
+        #: the way out of the support (unit, heading frame); None: a closing step
+        self._out: F64 | None = None
+        self._t0 = math.nan  # when the swing began
+        self._t_end = -math.inf  # when the last step ended
+        self._t_last = math.nan  # the last tick of the swing
+        self._hip = np.zeros(3)  # the swing hip's eased target
+        self._close = False  # a step ended: bring the foot it stood on down if it hangs
+        self._stood = 0
+        self._goal = np.full((NJ, 3), np.nan)
+        self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
+        steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
+        self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
+
+    def control(self, bl: BalanceLaw, d, h: float, t: float) -> None:  # type: ignore[no-untyped-def]
+        s = self.ctx.senses
+        st = self.step
+        rig = self.ctx.rig
+        com = s.local(s.com, h)[:2]
+        vel = s.local(s.com_vel, h)[:2]
+        feet = s.local(s.corners.mean(axis=1), h)[:, :2]  # each sole's middle
+        floor = float(s.corners[..., 2].min())  # a level floor: the lowest sole corner
+        omega = math.sqrt(9.81 / max(float(s.com[2]) - floor, 0.3))  # LIPM, as the bow's
+        cp = com + vel / omega
+        if self.foot < 0 and self._close and s.foot_contact.any():
+            # after a step, the foot it stood on, if left hanging, is brought down beside the
+            # stepped one (on the stepped foot alone the COM servo's hip offsets swung the
+            # free leg up and over)
+            k = self._stood
+            self._close = t < self._t_end + STEP_CLOSE
+            if self._close and s.foot_contact[1 - k] and not s.foot_contact[k]:
+                self.foot, self._out, self._t0, self._close = k, None, t, False
+                self.record.append({"t": t, "foot": float(k), "beyond_m": 0.0,
+                                    "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
+        if self.foot < 0:
+            if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
+                return
+            lo, hi = s.support_extent(h)
+            # how far the capture point lies outside the soles' box (along the feet only
+            # unless sideways), and the way out
+            out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
+            if not STEP_SIDEWAYS:
+                out[1] = 0.0
+            beyond = float(np.hypot(*out))
+            if beyond <= st.margin or float(vel @ out) <= 0.0:
+                return
+            # the farther foot swings (on a sideways fall toward the standing foot it crosses
+            # over, see below)
+            k = int(np.argmax(np.linalg.norm(feet - cp, axis=1)))
+            if not s.foot_contact[1 - k]:
+                return
+            self.foot, self._out, self._t0 = k, out / beyond, t
+            self.record.append({"t": t, "foot": float(k), "beyond_m": beyond,
+                                "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
+        k = self.foot
+        if t == self._t0:  # the hip's eased target starts where the hip is
+            self._t_last = t
+            self._hip[:] = rig.current_angles()[_HIP[k]]
+        u = (t - self._t0) / st.seconds
+        if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
+            self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
+            self.record[-1]["s"] = t - self._t0
+            self._close, self._stood = self._out is not None, 1 - k
+            self.foot, self._t_end = -1, t
+            # both knees on from where they are to the posture's, over what is left of its
+            # stand-up (at once, the stepped leg's push launched the body), the law's
+            # leveling on top
+            left = max(float(rig.time_left(t)[_KNEE].max()), STEP_SETTLE)
+            goal = rig.goal()[_KNEE, 0]
+            rig.move(rig.current_angles(), 0.0, t, _KNEE)
+            self._goal[_KNEE, 0] = goal
+            rig.move(self._goal, left, t, _KNEE)
+            return
+        hip = d.xanchor[self._hips[k]]
+        at = s.local(hip, h)[:2]
+        stand = feet[1 - k]
+        if self._out is None:  # closing: beside the other, under its own hip
+            want = np.array([stand[0], at[1]])
+        else:  # past the capture point
+            want = cp + st.reach * self._out
+            want[0] = np.clip(want[0], stand[0] - STEP_LONGEST, stand[0] + STEP_LONGEST)
+            # the feet kept STEP_WIDTH apart sideways, on whichever side the place lies
+            apart = want[1] - stand[1]
+            want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
+            if not STEP_SIDEWAYS:
+                want[1] = at[1]
+        # the leg as long as it takes to put the sole on the floor at the place (the stance
+        # ankle's height over the floor below the hip), its knee lifted over the swing
+        down = float(hip[2]) - float(d.xanchor[self._ankles[1 - k], 2])
+        down += STEP_PRESS * min(max(2.0 * u - 1.0, 0.0), 1.0)  # pressed down as it ends
+        ahead, aside = (float(x) for x in want - at)
+        a = self.ctx.athlete
+        ul, ll = float(a.thigh[k]), float(a.shin[k])
+        reach = STEP_REACH * (ul + ll)
+        # the standing knee bends as far as it takes the swing leg to reach the place
+        low = max(down - math.sqrt(max(reach * reach - ahead * ahead - aside * aside, 0.01)), 0.0)
+        if low > 0.0:
+            j = 1 - k
+            stand_leg = float(np.linalg.norm(d.xanchor[self._hips[j]] - d.xanchor[self._ankles[j]]))
+            bend = float(knee_for_length(a.thigh[j], a.shin[j], stand_leg - low)[0])
+            rig.offset[_KNEE[j], 0] = max(bend - float(rig.desired(t)[_KNEE[j], 0]),
+                                          float(rig.offset[_KNEE[j], 0]))  # fmt: skip
+            down -= low
+        length = min(math.sqrt(ahead * ahead + aside * aside + max(down, 0.2) ** 2), reach)
+        swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
+        knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
+        knee += st.lift * math.sin(math.pi * min(max(u, 0.0), 1.0))
+        # the leg aimed in the world at the place, whatever the pelvis's orientation (as the
+        # landing's reach); the COM servo's offsets off it, its weight on the other foot
+        self._thigh[0] = -swing + geom
+        self._thigh[1] = math.asin(float(np.clip(aside / length, -0.5, 0.5)))
+        aim = hips_for_thighs(self.ctx, d, self._thigh[None], h)[0]
+        # the hip eased toward its aim (first order): a jump in its target kicked the pelvis
+        # back and the standing foot off the floor
+        ease = min(max(t - self._t_last, 0.0) / STEP_EASE, 1.0) if STEP_EASE > 0 else 1.0
+        self._t_last = t
+        self._hip += ease * (aim - self._hip)
+        self._goal[_HIP[k]] = self._hip
+        self._goal[_KNEE[k], 0] = knee
+        rig.move(self._goal, 0.0, t, (_HIP[k], _KNEE[k]))
+        rig.offset[_HIP[k]] = 0.0
+        rig.offset[_ANKLE[k]] = 0.0
+        rig.offset[_KNEE[k]] = 0.0
+        rig.support[k] = 0.0
+        rig.support[1 - k] = 1.0
+
+
+def hips_for_thighs(  # type: ignore[no-untyped-def]
+    ctx: Context, d, thighs: np.ndarray, heading: float, ahead: np.ndarray | None = None
+) -> np.ndarray:
+    """``(2, 3)`` hip angles that give the thighs the world ``thighs`` ``(2, 3)`` (anatomical
+    pitch, roll, yaw in the heading frame) from where the pelvis is now, in all three axes,
+    or turned on by the world rotation vector ``ahead`` (the landing's ``twist_aim``)."""
+    pelvis = quat_mul(d.xquat[ctx.senses.root], quat_conj(ctx.athlete.neutral[0]))
+    if ahead is not None:
+        pelvis = quat_mul(quat_exp(ahead), pelvis)
+    want = quat_mul(quat_from_yaw(heading)[None], quat_from_euler(thighs, EULER_ORDER))
+    eul = quat_to_euler(quat_mul(quat_conj(pelvis)[None], want), EULER_ORDER)
+    eul[:, 2] = 0.0  # the hips' yaw targets stay 0, as elsewhere
+    return eul
+
+
 def hold_pelvis_and_feet(ctx: Context, d, pitch: float, heading: float, t: float) -> None:  # type: ignore[no-untyped-def]
     """Set the hips' targets so the pelvis has ``pitch`` (forward > 0; upright otherwise, at
     ``heading``) given where the thighs are, and the ankles' so the feet lie flat on the floor
@@ -571,7 +804,8 @@ class Balance(Basis):
     settled within that many seconds stays in the state ``unsettled`` (the sequence never
     goes on) and the time is in the hand-over dict (``"unsettled_s"``): a failure.
     ``settle_share``: the weight each foot must bear to count as settled (default
-    :data:`SETTLED`'s)."""
+    :data:`SETTLED`'s). ``step``: a step when the capture point leaves the feet
+    (:class:`Step`; None: off, unless a landing before it handed over its own)."""
 
     name = "balance"
     initial = "hold"
@@ -584,8 +818,10 @@ class Balance(Basis):
         until: Event | None = None,
         settle_within: float | None = None,
         settle_share: float | None = None,
+        step: Step | None = None,
     ) -> None:
         self.posture = posture or Posture()
+        self.step = step
         if seconds is not None and not (math.isfinite(seconds) and seconds >= 0):
             raise ConfigError(f"balance seconds must be >= 0, got {seconds!r}")
         if settle_within is not None and not (math.isfinite(settle_within) and settle_within > 0):
@@ -606,12 +842,17 @@ class Balance(Basis):
     def states(self, ctx: Context) -> list[State]:
         bl = BalanceLaw(ctx, self.gains)
         self.law = bl
+        if self.step is not None:
+            bl.stepper = Stepper(ctx, self.step)
 
         def enter(world: World, t: float) -> None:
             del world
             prev = ctx.handover.get("posture")
             if isinstance(prev, Posture):
                 bl.posture = prev
+            stepper = ctx.handover.get("stepper")
+            if bl.stepper is None and isinstance(stepper, Stepper):  # the landing's step goes on
+                bl.stepper = stepper
             bl.set_posture(self.posture, t)
 
         exits: list[tuple[Event, str]] = []
@@ -635,4 +876,4 @@ class Balance(Basis):
 
     def with_posture(self, **changes: object) -> Balance:
         return Balance(replace(self.posture, **changes), self.seconds, self.gains, self.until,  # type: ignore[arg-type]
-                       self.settle_within, self.settle_share)  # fmt: skip
+                       self.settle_within, self.settle_share, self.step)  # fmt: skip

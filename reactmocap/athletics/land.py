@@ -19,22 +19,16 @@ from reactmocap.athletics.balance import (
     BALANCE_GAINS,
     BalanceLaw,
     Posture,
+    Step,
+    Stepper,
+    hips_for_thighs,
     hold_pelvis_and_feet,
     knee_for_length,
 )
-from reactmocap.athletics.bodies import EULER_ORDER
 from reactmocap.athletics.leap import pitch_momentum
 from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
 from reactmocap.athletics.rig import joint_index, per_joint
 from reactmocap.errors import ConfigError
-from reactmocap.rotations import (
-    quat_conj,
-    quat_exp,
-    quat_from_euler,
-    quat_from_yaw,
-    quat_mul,
-    quat_to_euler,
-)
 from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import State, after
 from reactmocap.sim.world import World
@@ -182,6 +176,12 @@ class LandingParams:
             handspring's landing lands only within about 6 kg m^2/s of its -95 (a
             perturbed push leaves -69 to -116; docs/athletics.md). Measured about the
             left-right axis because the pelvis's heading flips as an inverted body turns.
+        step: a step when the capture point leaves the feet as the landing stands up
+            (``[margin, reach, lift, seconds]``, any leading part, :class:`~reactmocap.athletics.balance.Step`;
+            empty: off): from the recovery on, carried on by the balance that follows. Why:
+            the male back handspring's perturbed landings that fall are decided in the first
+            0.15 s on the feet by how far the capture point lies past them, which no
+            placement of the feet tried reached (docs/athletics.md).
     """
 
     knee: float = 0.6
@@ -210,8 +210,10 @@ class LandingParams:
     spin_ref: float = 0.0
     twist_arms: float = 0.0
     stance_push: bool = False
+    step: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
+        Step.of(self.step)  # checked here (ConfigError) though built per run
         for name in (
             "knee",
             "kp",
@@ -281,6 +283,9 @@ class Landing(Basis):
         bl = BalanceLaw(ctx, BALANCE_GAINS)
         memo: dict[str, float] = {}
         guard = np.zeros(2, dtype=bool)  # knees held out of hyperextension (knee_stop)
+        step = Step.of(p.step)
+        if step is not None:
+            bl.stepper = Stepper(ctx, step)
         m = ctx.world.model
         pre = rig.wc.prefix
         hip_joints = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
@@ -362,7 +367,7 @@ class Landing(Basis):
                     thighs[k] = (-swing + geom - servo[0], math.asin(side) + servo[1], 0.0)
             if p.aim_sideways:  # the roll from the pelvis's whole orientation; pitch as above
                 ahead = memo["lag"] * d.cvel[s.root, :3] if p.twist_aim else None
-                goal[_HIP, 1] = _hips_for_thighs(ctx, d, thighs, h, ahead)[:, 1]
+                goal[_HIP, 1] = hips_for_thighs(ctx, d, thighs, h, ahead)[:, 1]
             rig.move(goal, 0.0, t, _HIP)
             rig.offset[:] = 0.0
             for k in range(2):
@@ -475,6 +480,8 @@ class Landing(Basis):
         def done(world: World, t: float) -> None:
             del world
             ctx.handover["posture"] = bl.posture
+            if bl.stepper is not None:
+                ctx.handover["stepper"] = bl.stepper
             del t
 
         return [
@@ -485,21 +492,6 @@ class Landing(Basis):
                   ((settled, "done"), (after(1.0), "done"))),
             State("done", law(bl.control, every), done, ((after(0.0), NEXT),)),
         ]  # fmt: skip
-
-
-def _hips_for_thighs(  # type: ignore[no-untyped-def]
-    ctx: Context, d, thighs: np.ndarray, heading: float, ahead: np.ndarray | None = None
-) -> np.ndarray:
-    """``(2, 3)`` hip angles that give the thighs the world ``thighs`` ``(2, 3)`` (anatomical
-    pitch, roll, yaw in the heading frame) from where the pelvis is now, in all three axes,
-    or turned on by the world rotation vector ``ahead`` (``twist_aim``)."""
-    pelvis = quat_mul(d.xquat[ctx.senses.root], quat_conj(ctx.athlete.neutral[0]))
-    if ahead is not None:
-        pelvis = quat_mul(quat_exp(ahead), pelvis)
-    want = quat_mul(quat_from_yaw(heading)[None], quat_from_euler(thighs, EULER_ORDER))
-    eul = quat_to_euler(quat_mul(quat_conj(pelvis)[None], want), EULER_ORDER)
-    eul[:, 2] = 0.0  # the hips' yaw targets stay 0, as elsewhere
-    return eul
 
 
 def _stance_support(ctx: Context) -> None:

@@ -40,7 +40,7 @@ import numpy as np
 
 from reactmocap.athletics import tables
 from reactmocap.athletics.backdrop import Backdrop, backdrop_keyframes
-from reactmocap.athletics.balance import BALANCE_GAINS, STANDING_GAINS, Balance, Posture
+from reactmocap.athletics.balance import BALANCE_GAINS, STANDING_GAINS, Balance, Posture, Step
 from reactmocap.athletics.behaviours import (
     AthleticsResult,
     _landing,
@@ -140,6 +140,7 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
         raise ConfigError(
             f"balance settle_share applies to the exit 'settled' only, not {phase.exit!r}"
         )
+    step = Step.of(p.pop("step", ()))
     gains = p.pop("gains", "balance")
     if gains not in BALANCE_GAIN_SETS:
         raise ConfigError(
@@ -150,7 +151,7 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
     if phase.exit == "settled":
         within = phase.seconds if phase.seconds is not None else SETTLE_WITHIN
     return Balance(Posture(**p), seconds=seconds, gains=BALANCE_GAIN_SETS[gains],
-                   settle_within=within, settle_share=share)  # fmt: skip
+                   settle_within=within, settle_share=share, step=step)  # fmt: skip
 
 
 def _build_leap(phase: Phase, ath: Athlete) -> Basis:
@@ -201,7 +202,10 @@ def _build_land(phase: Phase, ath: Athlete) -> Basis:
     base = tables.landing_params(ath.name, 0.0, after_leap=True)
     if "delta" in phase.params:  # an explicit delta holds at every speed
         base = replace(base, deltas=())
-    return Landing(replace(base, **phase.params))
+    p = dict(phase.params)
+    if "step" in p:
+        p["step"] = tuple(p["step"])
+    return Landing(replace(base, **p))
 
 
 #: seconds a balance phase ending "settled" may take by default
@@ -215,8 +219,9 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
     "balance": BasisSpec(
         "balance", "stand balanced in a posture (thesis ch. 7); `settle_share`: the weight "
         "each foot must bear for the exit `settled` (default 0.2); `gains`: \"balance\" "
-        "(default) or \"standing\" (the hip and arm strategies against a fall as well)",
-        {**_kinds(Posture), "settle_share": "number", "gains": "string"},
+        "(default) or \"standing\" (the hip and arm strategies against a fall as well); "
+        "`step`: [margin, reach, lift, seconds], a step when the capture point leaves the feet",
+        {**_kinds(Posture), "settle_share": "number", "gains": "string", "step": "numbers"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
          "settled": "once standing still on both feet with the COM over them (a perturbed "
                     "start); not settled within `seconds` (default 2): the run fails there"},
@@ -579,6 +584,9 @@ def run_maneuver(
     if "tumble_peak_rate" in ctx.handover:
         rep["peak_somersault_rate_rad_s"] = ctx.handover["tumble_peak_rate"]
         rep["tumble_min_inertia_kgm2"] = ctx.handover["tumble_min_inertia"]
+    steps = ctx.handover.get("steps")
+    if isinstance(steps, list) and steps:  # the balance's steps (Step): when, how far, the foot
+        rep["steps"] = [dict(r) for r in steps]
     if "unsettled_s" in ctx.handover:  # a balance phase timed out before it settled
         rep["unsettled_s"] = ctx.handover["unsettled_s"]
     if "tumble_twist_undone" in ctx.handover:  # when the tilt twist's throw was undone

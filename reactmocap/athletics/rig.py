@@ -259,6 +259,10 @@ class Rig:
     def goal(self) -> F64:
         return self._goal.copy()
 
+    def time_left(self, t: float) -> F64:
+        """``(15,)`` seconds each joint's target still takes to reach its goal at ``t``."""
+        return np.maximum(self._t0 + self._dur - t, 0.0)
+
     def apply(self, t: float) -> None:
         """Write the servo's targets (smoothed angles plus :attr:`offset`) and feed-forward."""
         angles = self.desired(t) + self.offset

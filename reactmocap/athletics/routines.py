@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from types import MappingProxyType
+from typing import Any
 
 from reactmocap.athletics.behaviours import AthleticsResult
 from reactmocap.athletics.bodies import athlete
@@ -398,15 +399,20 @@ HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
 #: (hand-tuned 2026-12-02, narrow: docs/athletics.md) leaps harder with more hip feedback,
 #: and lands on feet placed farther behind her (the hip swing allowed past asin 0.9) with
 #: stiffer, more damped knees, which stop the legs bouncing her back into the air
-HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, float]]] = MappingProxyType({
+HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingProxyType({
     # the male's landing scales its delta by the spin the push left (LandingParams.spin_ref:
     # the spin at the nominal's release, 2026-12-03). Since 2026-12-03 his knees aim the
     # hands' contact at -196 deg (HandspringParams.aim) about a 0.4 rad bend, on a leap that
-    # falls a little short for it (spin_limit 1.3: -76 kg m^2/s), and his feet land farther back
+    # falls a little short for it (spin_limit 1.3: -76 kg m^2/s), and his feet land farther
+    # back; since 2026-12-03 (later) the landing steps once the capture point lies 5 cm past
+    # the feet (LandingParams.step: 11/50 and 17/50 perturbed starts on seeds 0 and 1, from
+    # 10 and 15, held-out seed 2 15 from 13; docs/athletics.md). A list: a maneuver file's
+    # numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3}),
         "handspring": MappingProxyType({"aim": -3.42, "knees": 0.4}),
-        "land": MappingProxyType({"delta": -0.55, "spin_ref": -96.8}),
+        "land": MappingProxyType({"delta": -0.55, "spin_ref": -96.8,
+                                  "step": [0.05, 0.1, 0.3, 0.25]}),
     }),
     "female": MappingProxyType({
         "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 2.0}),
@@ -429,7 +435,7 @@ def handspring_maneuver(body: str = "male") -> Maneuver:
     (the same spin rate); that is untuned and its report says what happened."""
     leap = dict(HANDSPRING_PRESET["leap"])
     hands = dict(HANDSPRING_PRESET["handspring"])
-    land = dict(HANDSPRING_PRESET["land"])
+    land: dict[str, Any] = dict(HANDSPRING_PRESET["land"])
     own = HANDSPRING_BODY_PRESET.get(body)
     if own is not None:
         leap.update(own.get("leap", {}))
