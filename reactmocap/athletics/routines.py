@@ -114,8 +114,10 @@ PRESET_STARTS: Mapping[str, Phase] = MappingProxyType({
 #: she stood up on one foot and fell sideways (docs/athletics.md). Since 2026-12-03 her push
 #: also servos the cartwheel and yaw momentum to zero (the leap's ``tilt_gain``): the
 #: take-off's yaw momentum told her landings apart. Since 2026-12-03 her arms spread in the
-#: reach against the twist the opening body makes (``twist_arms``), and her legs absorb the
-#: touchdown pushing from the feet that carry the weight (``stance_push``). Since 2026-12-03 her
+#: reach against the twist the opening body makes (``twist_arms``; 25 since 2026-12-03 12:48
+#: UTC, fully spread from 1.7 kg m^2/s: at 15 starts that still twisted fell sideways),
+#: and her legs absorb the touchdown pushing from the feet that carry the weight
+#: (``stance_push``). Since 2026-12-03 her
 #: feet land farther ahead after a weak take-off (``momentum_gain`` with ``momentum_side``):
 #: placed for her usual spin, they stopped a smaller one too hard and she fell forward.
 SOMERSAULT_PRESETS: Mapping[
@@ -148,7 +150,7 @@ SOMERSAULT_PRESETS: Mapping[
                                        "tilt_gain": 10.0}),
                      MappingProxyType({"lead": 3.6}),
                      MappingProxyType({"delta": -0.16, "spin_aim": True, "aim_sideways": True,
-                                       "twist_aim": True, "twist_arms": 15.0,
+                                       "twist_aim": True, "twist_arms": 25.0,
                                        "stance_push": True, "momentum_gain": 0.015,
                                        "momentum_ref": -23.0, "momentum_side": True})),
     }),

@@ -425,7 +425,8 @@ def test_perturbed_female_back_tucks_land_with_the_arms_out_against_the_twist() 
     spread against the twist in the reach (``twist_arms``) it twists about half that, and
     with the absorbing legs pushing from the foot that carries the weight (``stance_push``)
     both starts land (the preset since 2026-12-03); either alone, or neither, and start 9
-    falls."""
+    falls. The ablations spread the arms at ``twist_arms`` 15, as they were measured (at the
+    preset's 25, since 2026-12-03 too, start 9 lands without ``stance_push`` as well)."""
     starts = full_starts(17)
     m = somersault_maneuver(body="female")
     assert m.phases[3].params["twist_arms"] > 0 and m.phases[3].params["stance_push"]
@@ -435,7 +436,7 @@ def test_perturbed_female_back_tucks_land_with_the_arms_out_against_the_twist() 
         assert abs(r.report["rotation_deg"] + 360.0) <= 30.0, i
         assert abs(_air_twist(r)) < 70.0, i
     for off in (ARMS_OFF, {"twist_arms": 0.0}, {"stance_push": False}):
-        land = replace(m.phases[3], params={**m.phases[3].params, **off})
+        land = replace(m.phases[3], params={**m.phases[3].params, "twist_arms": 15.0, **off})
         r = run_maneuver(replace(m, phases=(*m.phases[:3], land, *m.phases[4:])),
                          perturbation=starts[9], fps=10.0)  # fmt: skip
         assert r.report["fell"] and not r.report["landed"], off
@@ -454,6 +455,17 @@ def test_a_weak_female_back_tuck_take_off_lands_with_the_feet_placed_for_its_spi
     m = somersault_maneuver(body="female")
     assert m.phases[3].params["momentum_side"] is True
     _land_only_with_the_landing_as_is(m, {"momentum_gain": 0.0}, [starts[14], starts[24]])
+
+
+def test_female_back_tucks_that_twisted_in_the_air_land_with_the_arms_spread_sooner() -> None:
+    """Starts 1 and 29 of the capture region at full size (seed 0), female. With the arms
+    spread against the twist at ``twist_arms`` 15 (the preset before; the full spread at 2.8
+    kg m^2/s about the long axis) both fell. With 25 (the preset since 2026-12-03; the full
+    spread from 1.7 kg m^2/s) both land."""
+    starts = full_starts(30)
+    m = somersault_maneuver(body="female")
+    assert m.phases[3].params["twist_arms"] == 25.0
+    _land_only_with_the_landing_as_is(m, {"twist_arms": 15.0}, [starts[1], starts[29]])
 
 
 def test_a_female_back_tuck_start_settles_with_the_hips_and_arms_against_its_fall() -> None:
