@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from types import MappingProxyType
 
 import mujoco
@@ -873,7 +873,3 @@ class Balance(Basis):
             (after(self.settle_within), "unsettled"),
         ]
         return [State("hold", hold, enter, tuple(exits)), State("unsettled", hold, timed_out)]
-
-    def with_posture(self, **changes: object) -> Balance:
-        return Balance(replace(self.posture, **changes), self.seconds, self.gains, self.until,  # type: ignore[arg-type]
-                       self.settle_within, self.settle_share, self.step)  # fmt: skip

@@ -14,6 +14,7 @@ import numpy as np
 
 from reactmocap.athletics.machine import NEXT, Basis, Context
 from reactmocap.errors import ConfigError
+from reactmocap.rotations import wrap_angle
 from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import State, StateMachine
 from reactmocap.sim.world import World
@@ -106,7 +107,7 @@ class Sequencer:
             self._trunk = somersault_pitch(trunk, ctx.heading0)
             self._t = t
         a = somersault_pitch(trunk, ctx.heading0)
-        ctx.rotation += (a - self._trunk + math.pi) % (2.0 * math.pi) - math.pi
+        ctx.rotation += wrap_angle(a - self._trunk)
         self._trunk = a
         ctx.twist += float(d.cvel[s.root, :3] @ trunk) * (t - self._t)
         self._t = t
