@@ -227,7 +227,8 @@ def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> No
     the side of the COM, it stood up on one foot and fell. With the push's weight moved
     between the feet against the roll (``roll_gain``) and the legs' sideways aim taken from
     the pelvis's whole orientation (``aim_sideways``), the preset since 2026-12-03, it leaves
-    with under 1 kg m^2/s of roll and lands."""
+    with under 1 kg m^2/s of roll and lands (the roll read as the world x momentum, see
+    :func:`_liftoff_momentum`)."""
     start = full_starts(3)[2]
     m = somersault_maneuver(direction="forward")
     assert m.phases[1].params["roll_gain"] > 0 and m.phases[3].params["aim_sideways"] is True
@@ -379,7 +380,10 @@ def test_perturbed_female_back_tucks_land_with_the_legs_aimed_where_the_pelvis_w
 
 
 def _liftoff_momentum(r: AthleticsResult) -> np.ndarray:
-    """The whole-body angular momentum (world, kg m^2/s) just after lift-off."""
+    """The whole-body angular momentum (world, kg m^2/s) just after lift-off. Its x is the
+    roll only while the heading is the start's (+X): a heading turned by a few degrees mixes
+    in part of the pitch momentum (the forward tuck's +50: start 0 reads +7.3 in the world,
+    -0.95 in its heading frame; docs/athletics.md, the forward tuck's roll traced)."""
     t = r.log["t"]
     k = min(int(np.searchsorted(t, r.report["time_to_liftoff_s"] + 0.02)), t.size - 1)
     return np.asarray(r.log["momentum"][k])
