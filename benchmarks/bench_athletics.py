@@ -350,9 +350,9 @@ def plots(res: dict[str, Any], grf_curves: dict[str, Any] | None, out: Path) -> 
 
 
 def _polar_plot(res: dict[str, Any], out: Path) -> None:
-    from reactmocap.response.plots import _pyplot
+    from reactmocap.response.plots import pyplot
 
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(9, 8), dpi=100)
     for row, body in enumerate(BODIES):
         for col, (key, unit) in enumerate((("offset", "m"), ("push", "N"))):

@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 
 from reactmocap.io import save_png
-from reactmocap.response.plots import _pyplot, write_video
+from reactmocap.response.plots import pyplot, write_video
 
 if TYPE_CHECKING:
     from reactmocap.athletics.cycling import CyclingResult
@@ -24,7 +24,7 @@ __all__ = ["paths_plot", "ride_video"]
 def paths_plot(result: CyclingResult, path: str | Path) -> Path:
     """Top view of the paths (obstacles as circles, the route dashed), and speed and heading
     over time against their commands (rider 0 bold)."""
-    plt = _pyplot()
+    plt = pyplot()
     fig = plt.figure(figsize=(11, 5), dpi=100)
     top = fig.add_subplot(1, 2, 1)
     sp = fig.add_subplot(2, 2, 2)
@@ -99,7 +99,7 @@ def ride_video(result: CyclingResult, path: str | Path, fps: float = 30.0,
 
 
 def _top_view(result: CyclingResult, path: Path, fps: float) -> Path:
-    plt = _pyplot()
+    plt = pyplot()
     logs = result.logs
     t_end = max(float(lg["t"][-1]) for lg in logs if lg["t"].size)
     times = np.arange(0.0, t_end, 1.0 / min(fps, 10.0))

@@ -12,7 +12,7 @@ import numpy as np
 
 from reactmocap.athletics.report import ground_force
 from reactmocap.io import save_png
-from reactmocap.response.plots import _pyplot
+from reactmocap.response.plots import pyplot
 
 if TYPE_CHECKING:
     from reactmocap.athletics.behaviours import AthleticsResult
@@ -29,7 +29,7 @@ def _save(fig: Any, path: str | Path) -> Path:
 def run_plot(result: AthleticsResult, path: str | Path) -> Path:
     """COM height and vertical ground force (body weights) over time, the state changes
     marked, for an :class:`~reactmocap.athletics.behaviours.AthleticsResult`."""
-    plt = _pyplot()
+    plt = pyplot()
     log = result.log
     t = log["t"]
     weight = result.report["mass_kg"] * 9.81
@@ -58,7 +58,7 @@ def commanded_plot(
 ) -> Path:
     """One panel per body: achieved against commanded (ours: dots; the thesis's where given:
     crosses), and the diagonal of a perfect performance (dashed), as Figs. 4.1 and 4.4."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(len(panels), 1, figsize=(5, 4 * len(panels)), dpi=100)
     axes = np.atleast_1d(axes)
     for ax, (name, (cmd, got)) in zip(axes, panels.items()):
@@ -91,7 +91,7 @@ def series_plot(
     hline: float | None = None,
 ) -> Path:
     """Labelled curves (ground forces over time, and the like)."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4), dpi=100)
     for label, (x, y) in curves.items():
         ax.plot(x, y, label=label, lw=1.2)

@@ -93,9 +93,9 @@ def phase_plot(curves: Mapping[str, tuple[F64, F64]], path: str | Path, title: s
     """Knee flexion against hip flexion (degrees), one panel per curve set (e.g.
     ``{"simulated": (hip, knee), "motion capture": (hip, knee)}``, each ``(T,)``), as
     Fig. 6 of Hodgins et al."""
-    from reactmocap.response.plots import _pyplot
+    from reactmocap.response.plots import pyplot
 
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(1, len(curves), figsize=(4.5 * len(curves), 4), dpi=100,
                              sharex=True, sharey=True)  # fmt: skip
     axes = np.atleast_1d(axes)
@@ -115,9 +115,9 @@ def run_plot(result: Any, path: str | Path) -> Path:
     """A run's figure: the ground track with the course, the speed over time (per stride and
     desired), and the hip-knee phase plot of its last strides."""
     from reactmocap.athletics.paths import Circle, Polyline
-    from reactmocap.response.plots import _pyplot
+    from reactmocap.response.plots import pyplot
 
-    plt = _pyplot()
+    plt = pyplot()
     log = result.log
     rep = result.report
     fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(14, 4.2), dpi=100)

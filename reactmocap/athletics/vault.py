@@ -298,9 +298,9 @@ def _report(ath: Athlete, p: VaultParams, log: dict[str, NDArray],
 def vault_plot(result: VaultResult, path: str | Path) -> Path:
     """COM path with the apparatus, and Table 1: ours against the human range and mean."""
     from reactmocap.io import save_png
-    from reactmocap.response.plots import _pyplot
+    from reactmocap.response.plots import pyplot
 
-    plt = _pyplot()
+    plt = pyplot()
     log = result.log
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 4.5), dpi=100)
     a1.plot(log["com"][:, 0], log["com"][:, 2], "k-", lw=1.2, label="COM")

@@ -18,8 +18,9 @@ import numpy as np
 
 from reactmocap.batch.results import QUALITY_METRICS, ResultStore
 from reactmocap.batch.sweep import AXES
-from reactmocap.errors import ConfigError, ReactMocapError
+from reactmocap.errors import ConfigError
 from reactmocap.io import save_png
+from reactmocap.response.plots import pyplot
 
 __all__ = ["ANGLE_AXES", "contact_sheet", "plot_axes", "plot_batch"]
 
@@ -27,17 +28,6 @@ __all__ = ["ANGLE_AXES", "contact_sheet", "plot_axes", "plot_batch"]
 ANGLE_AXES = ("facing_deg", "force_dir_deg")
 POLAR_METRICS = ("match_distance", "blend_joint_correction_max_rad", "blend_root_offset_max_m")
 LINE_METRICS = tuple(m for m in QUALITY_METRICS if m not in ("fell", "intended_fall"))
-
-
-def _pyplot() -> Any:
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise ReactMocapError("plots need matplotlib: pip install 'reactmocap[plot]'") from None
-    return plt
 
 
 def _load(results_dir: Path) -> tuple[list[dict[str, Any]], dict[str, list[Any]]]:
@@ -83,7 +73,7 @@ def plot_axes(results_dir: str | Path) -> list[Path]:
     bars for names."""
     d = Path(results_dir)
     rows, axes = _load(d)
-    plt = _pyplot()
+    plt = pyplot()
     written = []
     for axis, values in axes.items():
         if len(values) < 2:
@@ -159,7 +149,7 @@ def contact_sheet(
         return None
     pick = np.unique(np.linspace(0, len(saved) - 1, min(max_scenarios, len(saved))).round())
     chosen = [saved[int(i)] for i in pick]
-    plt = _pyplot()
+    plt = pyplot()
     fig, axs = plt.subplots(
         len(chosen), frames, figsize=(1.6 * frames, 1.9 * len(chosen)), dpi=100, squeeze=False
     )

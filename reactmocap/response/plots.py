@@ -18,10 +18,12 @@ from reactmocap.errors import ReactMocapError
 from reactmocap.io import atomic_write_bytes, save_png
 from reactmocap.library.motion import Motion
 
-__all__ = ["response_plot", "stick_figure_video", "write_video"]
+__all__ = ["pyplot", "response_plot", "stick_figure_video", "write_video"]
 
 
-def _pyplot():  # type: ignore[no-untyped-def]
+def pyplot():  # type: ignore[no-untyped-def]
+    """matplotlib's ``pyplot`` on the ``MPLBACKEND`` backend (Agg unless set), or a clear
+    error naming the extra to install."""
     try:
         import matplotlib
 
@@ -67,7 +69,7 @@ def response_plot(
     """Left: the horizontal chest path of each labelled motion seen from above ``(T, 2)``, with
     the hit as an arrow (``hit``: point and impulse, 0.02 m per N s); right: pelvis height over
     time (like the paper's Figure 1) with the impact and the transition marked."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, (top, ax) = plt.subplots(1, 2, figsize=(12, 4.5), dpi=100,
                                   gridspec_kw={"width_ratios": [1, 1.4]})  # fmt: skip
     styles = {"mocap before": "b-", "found clip": "g-", "final blend": "r-",
@@ -110,7 +112,7 @@ def stick_figure_video(
 ) -> Path:
     """Render motions as coloured stick figures from a fixed 3/4 view into a GIF or MP4
     (by ``path``'s suffix). Used when no GL context is available for MuJoCo's renderer."""
-    plt = _pyplot()
+    plt = pyplot()
     _imageio()  # fail before drawing if the writer is missing
     sampled = []
     n = 0
