@@ -164,8 +164,9 @@ class Polyline:
     def point_at(self, s: float) -> F64:
         if self.closed:
             s = s % self.total
-        s = float(np.clip(s, 0.0, self.total))
-        i = int(np.clip(np.searchsorted(self.cum, s, side="right") - 1, 0, len(self.len) - 1))
+        # builtin min/max: np.clip on one number cost 20 us, four times a tick
+        s = float(min(max(s, 0.0), self.total))
+        i = min(max(int(np.searchsorted(self.cum, s, side="right")) - 1, 0), len(self.len) - 1)
         u = (s - self.cum[i]) / self.len[i]
         return self.points[i] + u * self.seg[i]
 

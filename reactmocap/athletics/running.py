@@ -42,6 +42,7 @@ from reactmocap.athletics.running_body import (
     NJ,
     _clamp,
     _euler_yxz,
+    _pitch_yxz,
     _qconj,
     _qmul,
     _quat_yxz,
@@ -158,6 +159,23 @@ class Runner:
         self._neutral_conj = quat_conj(athlete.neutral)
         self._bodies = np.asarray(wc.body_ids)
         self._jacp = np.zeros((3, m.nv))
+        # the legs' joint pitches at every tick (_leg_pitches): each body a leg joint joins
+        # (pelvis, thighs, shins, feet) turned into its anatomical frame once, into buffers
+        # made here; the pitch-only column of the angles the laws read stays 0 elsewhere
+        child = [j + 1 for j in _LEG_JOINTS]
+        parent = [int(SIM_PARENTS[c]) for c in child]
+        parts = sorted(set(child) | set(parent))
+        self._anat_bodies = [(int(wc.body_ids[b]), b) for b in parts]
+        self._leg_pairs = [(j, parts.index(p), parts.index(c))
+                           for j, p, c in zip(_LEG_JOINTS, parent, child)]  # fmt: skip
+        self._anat_buf = np.empty((len(parts), 4))
+        self._q_inv = np.empty(4)
+        self._q_rel = np.empty(4)
+        self._angles = np.zeros((NJ, 3))
+        self._hip_rows = np.array(_HIP)
+        self._knee_rows = np.array(_KNEE)
+        self._attitude_kp = np.asarray(self.params.attitude_kp)
+        self._attitude_kv = np.asarray(self.params.attitude_kv)
         b = wc.ball_dof_start
         # the knee's and ankle's dofs of each leg
         self._leg_cols = [
@@ -168,6 +186,8 @@ class Runner:
         ]
         # heel-to-ball length l_f of eqs. 1-2: the sole box's length
         self.foot_length = 2.0 * float(m.geom_size[wc.sole_ids[0], 0])
+        # read once: World.timestep reads the model's options anew at every call
+        self._timestep = world.timestep
         self._base_stiffness = per_joint(self.params.stiffness)
         self.machine = StateMachine(self._states(), "flight", control_every)
         self._reset_state()
@@ -211,10 +231,7 @@ class Runner:
         self._reset_state()
         self.rig.reset()
         self.senses.time = -1.0
-        # the pitch of the legs' joints (the only joint angles the laws read)
-        angles = np.zeros((NJ, 3))
-        for j in _LEG_JOINTS:
-            angles[j, 0] = self._joint_pitch(j)
+        angles = self._leg_pitches()
         self.targets[:] = angles
         self.goal[:] = angles
         self.machine.reset(self.world)
@@ -232,7 +249,7 @@ class Runner:
 
     def _pitch(self, body: int, neutral: int, heading: float) -> float:
         """Anatomical pitch (rad) of a body in the heading frame (thigh forward < 0)."""
-        return _euler_yxz(_qmul(_qyaw(-heading), self._anat(body, neutral)))[0]
+        return _pitch_yxz(_qmul(_qyaw(-heading), self._anat(body, neutral)))
 
     def _joint_pitch(self, joint: int) -> float:
         """Anatomical pitch (rad) of a ball joint: its child's rotation relative to its
@@ -241,7 +258,22 @@ class Runner:
         parent = int(SIM_PARENTS[child])
         rel = _qmul(_qconj(self._anat(self._bodies[parent], parent)),
                     self._anat(self._bodies[child], child))  # fmt: skip
-        return _euler_yxz(rel)[0]
+        return _pitch_yxz(rel)
+
+    def _leg_pitches(self) -> F64:
+        """The pitch of the legs' joints (the only joint angles the laws read) in column 0
+        of the ``(NJ, 3)`` angles (a buffer reused every tick), as :meth:`_joint_pitch`:
+        MuJoCo's quaternion product on one quaternion at a time, since numpy's
+        vectorised products and arctan2 differ from it in the last bits."""
+        xquat, anat, conj = self.world.data.xquat, self._anat_buf, self._neutral_conj
+        for k, (body, part) in enumerate(self._anat_bodies):
+            mujoco.mju_mulQuat(anat[k], xquat[body], conj[part])
+        inv, rel, angles = self._q_inv, self._q_rel, self._angles
+        for j, p, c in self._leg_pairs:
+            mujoco.mju_negQuat(inv, anat[p])
+            mujoco.mju_mulQuat(rel, inv, anat[c])
+            angles[j, 0] = _pitch_yxz(rel)
+        return angles
 
     def trunk_euler(self) -> tuple[float, float, float]:
         """Chest pitch, roll and yaw (anatomical, heading frame, rad)."""
@@ -363,11 +395,10 @@ class Runner:
         axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
         local = axes @ err
         gain = self.inertia_unit * (
-            np.asarray(self.params.attitude_kp) * local
-            - np.asarray(self.params.attitude_kv) * (axes @ d.cvel[self._chest, :3])
+            self._attitude_kp * local - self._attitude_kv * (axes @ d.cvel[self._chest, :3])
         )
         if k["pitch_integral"] > 0:
-            dt = self.control_every * self.world.timestep
+            dt = self.control_every * self._timestep
             self.pitch_sum = _clamp(self.pitch_sum + local[1] * dt, -PITCH_SUM, PITCH_SUM)
             gain[1] += self.inertia_unit * k["pitch_integral"] * self.pitch_sum
         torque = axes.T @ gain
@@ -619,7 +650,7 @@ class Runner:
             # grows with the curvature and flips with it: integrated and applied in proportion
             # to the curvature, it carries over a figure eight's reversal (a plain integral
             # of the error was wrong-signed there and the runner fell)
-            dt = self.control_every * world.timestep
+            dt = self.control_every * self._timestep
             kap = self.curvature
             self.path_sum = _clamp(self.path_sum + self.cross_track * kap * dt, -PATH_SUM, PATH_SUM)
             want -= self.k["path_integral"] * self.path_sum * kap
@@ -627,14 +658,14 @@ class Runner:
         # facing throws the runner down)
         if self._steered:
             step = wrap_angle(want - self.heading_d)
-            limit = self.k["turn_rate"] * self.control_every * world.timestep
+            limit = self.k["turn_rate"] * self.control_every * self._timestep
             self.heading_d += _clamp(step, -limit, limit)
         else:
             self.heading_d, self._steered = want, True
         if self.speed < self.target:
             # the desired speed ramps up from the start's, and the tuning with it
             self.speed = min(
-                self.target, self.speed + self.accel * self.control_every * world.timestep
+                self.target, self.speed + self.accel * self.control_every * self._timestep
             )
             self.k = self.params.at(self.speed)
             self.thrust_force = self.k["thrust"] * self.mass * self.g
@@ -642,14 +673,11 @@ class Runner:
         # the frame the legs are placed and swung in: the desired facing, not the pelvis's
         # (which yaws back and forth with every stride)
         heading = self.heading_d if self.p_frame else self.heading()
-        # the pitch of the legs' joints (the only joint angles the laws read)
-        angles = np.zeros((NJ, 3))
-        for j in _LEG_JOINTS:
-            angles[j, 0] = self._joint_pitch(j)
+        angles = self._leg_pitches()
         self._idle(t, heading)
-        self._upper(angles[list(_HIP), 0])
+        self._upper(angles[self._hip_rows, 0])
         # eq. 6: the targets move smoothly toward the goals (first order, time constant)
-        dt = self.control_every * world.timestep
+        dt = self.control_every * self._timestep
         smoothing = self.k["smoothing"]
         self.targets += min(1.0, dt / smoothing if smoothing > 0 else 1.0) * (
             self.goal - self.targets
@@ -672,6 +700,6 @@ class Runner:
             t, s.com.copy(), s.com_vel.copy(), s.heading(),
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
-            angles[list(_HIP), 0], angles[list(_KNEE), 0], self.heading_d, self.cross_track,
+            angles[self._hip_rows, 0], angles[self._knee_rows, 0], self.heading_d, self.cross_track,
             self.trunk_euler()[0],
         ))  # fmt: skip

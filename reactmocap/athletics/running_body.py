@@ -63,16 +63,20 @@ def _quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
     return _qmul(_qmul(qy, qx), _qyaw(yaw))
 
 
+def _pitch_yxz(q: F64) -> float:
+    """The pitch of :func:`_euler_yxz` alone (what the leg joints' laws read)."""
+    w, x, y, z = q
+    return math.atan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y))
+
+
 def _euler_yxz(q: F64) -> tuple[float, float, float]:
     """Intrinsic Y-X-Z Euler angles (pitch, roll, yaw) of a quaternion: with
     ``R = Ry Rx Rz``, pitch = atan2(R02, R22), roll = asin(-R12), yaw = atan2(R10, R11)."""
     w, x, y, z = q
-    r02 = 2.0 * (x * z + w * y)
-    r22 = 1.0 - 2.0 * (x * x + y * y)
     r12 = 2.0 * (y * z - w * x)
     r10 = 2.0 * (x * y + w * z)
     r11 = 1.0 - 2.0 * (x * x + z * z)
-    return (math.atan2(r02, r22), math.asin(max(-1.0, min(1.0, -r12))), math.atan2(r10, r11))
+    return (_pitch_yxz(q), math.asin(max(-1.0, min(1.0, -r12))), math.atan2(r10, r11))
 
 
 def running_start(athlete: Athlete, speed: float, heading: float = 0.0) -> tuple[F64, F64]:

@@ -36,6 +36,7 @@ class Senses:
         self.mass = float(m.body_subtreemass[self.root])
         self.floor = int(m.geom("floor").id)
         self.feet, self.soles, self._corners = foot_soles(world, character, "athletics")
+        self._sole_side = {int(g): k for k, g in enumerate(self.soles)}
         self._ids = {b: int(i) for b, i in zip(SIM_BODIES, wc.body_ids)}
         #: joint ids of the ankles (left, right)
         self.ankle_joints = np.array([m.joint(f"{wc.prefix}{s}_ankle").id for s in "lr"])
@@ -83,23 +84,24 @@ class Senses:
         others: set[str] = set()
         n = d.ncon
         if n:
-            geoms = d.contact.geom[:n]
+            # the contact arrays' views made once (each attribute read makes a new one)
+            con = d.contact
+            geoms, frames, points = con.geom[:n], con.frame, con.pos
             hit = np.flatnonzero((geoms == self.floor).any(axis=1) & self._own[geoms].any(axis=1))
-            for i in hit:
+            for i in hit.tolist():
                 g1, g2 = int(geoms[i, 0]), int(geoms[i, 1])
                 g = g2 if g1 == self.floor else g1
-                mujoco.mj_contactForce(m, d, int(i), self._f6)
-                frame = d.contact.frame[i].reshape(3, 3)
-                f = frame.T @ self._f6[:3]  # world force on geom2 from geom1
+                mujoco.mj_contactForce(m, d, i, self._f6)
+                f = frames[i].reshape(3, 3).T @ self._f6[:3]  # world force on geom2 from geom1
                 if g == g1:
                     f = -f
                 self.grf += f
-                k = int(np.flatnonzero(self.soles == g)[0]) if g in self.soles else -1
+                k = self._sole_side.get(g, -1)
                 if k >= 0:
                     fn = abs(self._f6[0])
                     self.foot_contact[k] = True
                     self.foot_force[k] += fn
-                    self.foot_point[k] += fn * d.contact.pos[i]
+                    self.foot_point[k] += fn * points[i]
                 else:
                     others.add(SIM_BODIES[int(self._body[g])])
         self.corners = sole_corners_world(d, self.soles, self._corners)
