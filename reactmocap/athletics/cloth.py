@@ -208,7 +208,10 @@ class Cloth:
         self.wall_s = 0.0
         self.cpu_s = 0.0
         self._next_frame = 0.0
+        # the forces on the body's parts applied over the last step, and the next step's
+        # (two buffers that swap roles every step)
         self._applied = np.zeros((len(SIM_BODIES), 6))
+        self._force = np.zeros((len(SIM_BODIES), 6))
 
     # ------------------------------------------------------------------ building
     def _tube(self, side: str) -> F64:
@@ -668,23 +671,27 @@ class Cloth:
             self.penetration_mean = self._pen_sum / self._pen_n
         if not self.feedback:
             return
-        force = np.zeros((len(SIM_BODIES), 6))
-        f6 = np.zeros(6)
-        for i in np.flatnonzero(mine):
-            c = d.contact[i]
-            mujoco.mj_contactForce(m, d, int(i), f6)
-            fw = c.frame.reshape(3, 3).T @ f6[:3]  # on the second element from the first
-            on_body = fw if c.flex[0] >= 0 else -fw
-            part = int(self._geom_part[g[i]])
-            body = self.wc.body_ids[part]
-            arm = c.pos - world.data.xipos[body]
-            force[part, :3] += on_body
-            force[part, 3:] += np.cross(arm, on_body)
+        # MuJoCo gives a contact's force one contact at a time; the rest over the cloth's
+        # contacts at once (the stacked product, the cross product and the per-body sums in
+        # contact order give the bits the per-contact loop gave)
+        hit = np.flatnonzero(mine)
+        f6 = np.empty((hit.size, 6))
+        for k, i in enumerate(hit.tolist()):
+            mujoco.mj_contactForce(m, d, i, f6[k])
+        frames = con.frame[hit].reshape(-1, 3, 3)
+        fw = np.matmul(frames.transpose(0, 2, 1), f6[:, :3, None])[..., 0]  # on geom 2 from 1
+        on_body = np.where(con.flex[hit, :1] >= 0, fw, -fw)
+        part = self._geom_part[g[hit]]
+        arm = con.pos[hit] - world.data.xipos[self.wc.body_ids[part]]
+        force = self._force
+        force.fill(0.0)
+        np.add.at(force[:, :3], part, on_body)
+        np.add.at(force[:, 3:], part, np.cross(arm, on_body))
         xfrc = world.data.xfrc_applied
         ids = self.wc.body_ids
         xfrc[ids] -= self._applied
         xfrc[ids] += force
-        self._applied = force
+        self._applied, self._force = force, self._applied
 
     def _surface_depth(self) -> float:
         """How deep the drawn cloth (its triangles, sampled at the edge midpoints, the

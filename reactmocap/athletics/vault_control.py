@@ -74,6 +74,7 @@ class Vault(Basis):
         forearms = {SIM_BODIES.index(b) for b in ("l_forearm", "r_forearm")}
         hands = {SIM_BODIES.index(b) for b in ("l_hand", "r_hand")} | forearms
         f6 = np.zeros(6)
+        apparatus = np.array([board_geom, horse_geom])
         seen = {"board": 0, "horse": 0, "deepest": False, "blocked": False}
         # the geoms that must stay above the horse's top while over it: all but the arms'
         check = np.flatnonzero(own & ~np.isin(part, list(hands)))
@@ -90,23 +91,27 @@ class Vault(Basis):
             d = world.data
             fb = fh = 0.0
             on_b = on_h = on_f = on_fa = False
-            for i in range(d.ncon):
-                g1, g2 = int(d.contact.geom[i, 0]), int(d.contact.geom[i, 1])
-                other = g2 if own[g1] else g1 if own[g2] else -1
-                mine = g1 if own[g1] else g2
-                if other < 0 or other not in (board_geom, horse_geom, floor):
-                    continue
-                mujoco.mj_contactForce(m, d, i, f6)
-                fz = abs(float((d.contact.frame[i].reshape(3, 3).T @ f6[:3])[2]))
-                if other == board_geom:
-                    fb += fz
-                    on_b |= int(part[mine]) in feet
-                elif other == horse_geom:
-                    fh += fz
-                    on_h |= int(part[mine]) in hands
-                    on_fa |= int(part[mine]) in forearms
-                else:
-                    on_f = True
+            n = d.ncon
+            if n:
+                # the gymnast's contacts with the board, horse and floor picked out over all
+                # contacts at once; the forces then only for the board's and horse's few
+                con = d.contact
+                geoms, frames = con.geom[:n], con.frame
+                first = own[geoms[:, 0]]
+                other = np.where(first, geoms[:, 1], np.where(own[geoms[:, 1]], geoms[:, 0], -1))
+                mine = np.where(first, geoms[:, 0], geoms[:, 1])
+                on_f = bool((other == floor).any())
+                for i in np.flatnonzero(np.isin(other, apparatus)).tolist():
+                    mujoco.mj_contactForce(m, d, i, f6)
+                    fz = abs(float((frames[i].reshape(3, 3).T @ f6[:3])[2]))
+                    body = int(part[mine[i]])
+                    if other[i] == board_geom:
+                        fb += fz
+                        on_b |= body in feet
+                    else:
+                        fh += fz
+                        on_h |= body in hands
+                        on_fa |= body in forearms
             s = ctx.sense(t)
             # the body's lowest point while over the horse (only the hands may touch)
             xs = d.geom_xpos[check, 0]
