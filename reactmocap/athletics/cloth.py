@@ -20,9 +20,8 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from reactmocap.athletics.rider_kinematics import _cross
 from reactmocap.errors import ConfigError, ReactMocapError, SimulationError
-from reactmocap.rotations import quat_exp, quat_mul, quat_normalize, quat_to_matrix
+from reactmocap.rotations import cross_rows, quat_exp, quat_mul, quat_normalize, quat_to_matrix
 from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.world import World
 
@@ -510,7 +509,7 @@ class Cloth:
         pos, _ = self._poses()
         vel, omega = self._velocities(pos)
         x = self._vrest + self._xq
-        self._xv[:] = vel[0] + _cross(omega[0], x - pos[0])
+        self._xv[:] = vel[0] + cross_rows(omega[0], x - pos[0])
         self._record(0.0)
 
     def _poses(self) -> tuple[F64, F64]:
@@ -524,7 +523,7 @@ class Cloth:
         d = self.world.data
         cvel = d.cvel[self.wc.body_ids]
         omega = cvel[:, :3]
-        return cvel[:, 3:] + _cross(omega, pos - d.subtree_com[self._roots]), omega
+        return cvel[:, 3:] + cross_rows(omega, pos - d.subtree_com[self._roots]), omega
 
     def control(self, world: World, t: float) -> None:
         assert self.model is not None and self.data is not None
@@ -625,7 +624,7 @@ class Cloth:
         vel, omega = velocity
         for w, normal, g in zip(moved, normals, caps):
             b = part[g]
-            rel = self._xv[w] - (vel[b] + _cross(omega[b], x[w] - pos[b]))
+            rel = self._xv[w] - (vel[b] + cross_rows(omega[b], x[w] - pos[b]))
             vn = np.einsum("vi,vi->v", rel, normal)
             self._xv[w] -= np.minimum(vn, 0.0)[:, None] * normal
 

@@ -35,27 +35,32 @@ from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.rider_kinematics import (
     SIT_OFFSET,
     Posture,
-    _cross,
-    _minrot,
-    _qconj,
-    _qmul,
-    _qrot,
-    _quat_y,
-    _unit,
     ankle_pitch,
+    minrot,
+    qconj,
+    qmul,
+    qrot,
+    quat_y,
     trunk_pose,
     two_link,
 )
 from reactmocap.athletics.rider_mount import (
     RIDER_WORLD,
     RiderMount,
-    _ball_offset,
-    _hand_offset,
+    ball_offset,
     fit_bicycle,
+    hand_offset,
 )
 from reactmocap.errors import ConfigError
-from reactmocap.rotations import quat_conj, quat_mul, quat_rotate, wrap_angle
-from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
+from reactmocap.rotations import (
+    cross_rows,
+    quat_conj,
+    quat_mul,
+    quat_rotate,
+    unit_rows,
+    wrap_angle,
+)
+from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODY_INDEX, SIM_PARENTS
 from reactmocap.sim.world import World
 
 __all__ = [
@@ -72,7 +77,6 @@ __all__ = [
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
-_B = {b: i for i, b in enumerate(SIM_BODIES)}
 
 
 @dataclass(frozen=True)
@@ -134,9 +138,9 @@ class RiderLog:
 
 #: limb order of the inverse kinematics: left arm, right arm, left leg, right leg; the poles
 #: the elbows (out, back and down) and knees (forward) bend toward
-_UPPER = np.array([_B[b] for b in ("l_upper_arm", "r_upper_arm", "l_thigh", "r_thigh")])
-_LOWER = np.array([_B[b] for b in ("l_forearm", "r_forearm", "l_shin", "r_shin")])
-_HANDS = np.array([_B["l_hand"], _B["r_hand"]])
+_UPPER = np.array([SIM_BODY_INDEX[b] for b in ("l_upper_arm", "r_upper_arm", "l_thigh", "r_thigh")])
+_LOWER = np.array([SIM_BODY_INDEX[b] for b in ("l_forearm", "r_forearm", "l_shin", "r_shin")])
+_HANDS = np.array([SIM_BODY_INDEX["l_hand"], SIM_BODY_INDEX["r_hand"]])
 _POLES = np.array([[-0.5, 0.7, -0.5], [-0.5, -0.7, -0.5], [1.0, 0.1, 0.3], [1.0, -0.1, 0.3]])
 
 
@@ -214,16 +218,16 @@ class Rider:
         self._bpos = ch.body_pos  # (16, 3)
         self._neutral = athlete.neutral  # (16, 4)
         # the limbs' link vectors in the anatomical frame (neutral pose) and their lengths
-        self._ball = np.array([_ball_offset(athlete, s) for s in "lr"])  # in the foot frames
+        self._ball = np.array([ball_offset(athlete, s) for s in "lr"])  # in the foot frames
         links = []
-        for up, mid, end, extra in (("l_upper_arm", "l_forearm", "l_hand", _hand_offset(athlete, "l")),
-                                     ("r_upper_arm", "r_forearm", "r_hand", _hand_offset(athlete, "r")),
+        for up, mid, end, extra in (("l_upper_arm", "l_forearm", "l_hand", hand_offset(athlete, "l")),
+                                     ("r_upper_arm", "r_forearm", "r_hand", hand_offset(athlete, "r")),
                                      ("l_thigh", "l_shin", "l_foot", None),
                                      ("r_thigh", "r_shin", "r_foot", None)):  # fmt: skip
-            v1 = quat_rotate(self._neutral[_B[up]], self._bpos[_B[mid]])
-            v2 = quat_rotate(self._neutral[_B[mid]], self._bpos[_B[end]])
+            v1 = quat_rotate(self._neutral[SIM_BODY_INDEX[up]], self._bpos[SIM_BODY_INDEX[mid]])
+            v2 = quat_rotate(self._neutral[SIM_BODY_INDEX[mid]], self._bpos[SIM_BODY_INDEX[end]])
             if extra is not None:  # the grip point beyond the (straight) wrist
-                v2 = v2 + quat_rotate(self._neutral[_B[end]], extra)
+                v2 = v2 + quat_rotate(self._neutral[SIM_BODY_INDEX[end]], extra)
             links.append((v1, v2))
         self._v1 = np.array([a for a, _ in links])
         self._v2 = np.array([b for _, b in links])
@@ -246,14 +250,14 @@ class Rider:
                             for j in ("hip", "knee", "ankle")])
             for s in "lr"
         ]  # fmt: skip
-        self._feet = [int(wc.body_ids[_B[f"{s}_foot"]]) for s in "lr"]
+        self._feet = [int(wc.body_ids[SIM_BODY_INDEX[f"{s}_foot"]]) for s in "lr"]
         self._jac = np.zeros((3, m.nv))
         self._balls = wc.ball_dof_start + np.arange(3 * NJ)
         self._ff_rows = self.servo.character_indices.index(character) * NJ
-        self._d1 = _unit(self._v1)
-        self._d2 = _unit(self._v2)
-        self._bq_inv = _qconj(self._bq[1:])
-        self._foot_rows = np.array([_B["l_foot"], _B["r_foot"]])
+        self._d1 = unit_rows(self._v1)
+        self._d2 = unit_rows(self._v2)
+        self._bq_inv = qconj(self._bq[1:])
+        self._foot_rows = np.array([SIM_BODY_INDEX["l_foot"], SIM_BODY_INDEX["r_foot"]])
         self._trunk_cache: tuple[Posture, F64, F64] | None = None
         self._integral = 0.0
         self._torque = 0.0
@@ -284,26 +288,26 @@ class Rider:
         a = trunk.copy()
         bases = pelvis_pos + offsets
         turn = np.r_[math.cos(fork / 2), math.sin(fork / 2) * self._axis]
-        grips = self._head + _qrot(turn, self._grip0 - self._head)
-        a_foot = _quat_y(ankle_pitch(np.array([crank + math.pi, crank])))  # left, right
-        g_foot = _qmul(a_foot, self._neutral[self._foot_rows])
-        ankles = pedals - _qrot(g_foot, self._ball)
+        grips = self._head + qrot(turn, self._grip0 - self._head)
+        a_foot = quat_y(ankle_pitch(np.array([crank + math.pi, crank])))  # left, right
+        g_foot = qmul(a_foot, self._neutral[self._foot_rows])
+        ankles = pedals - qrot(g_foot, self._ball)
         u1, u2 = two_link(bases, np.vstack([grips, ankles]), self._l1, self._l2, _POLES)
-        a_up = _minrot(self._d1, u1)
-        a_low = _qmul(_minrot(_qrot(a_up, self._d2), u2), a_up)
+        a_up = minrot(self._d1, u1)
+        a_low = qmul(minrot(qrot(a_up, self._d2), u2), a_up)
         a[_UPPER] = a_up
         a[_LOWER] = a_low
         a[_HANDS] = a_low[:2]
         a[self._foot_rows] = a_foot
-        return _qmul(a, self._neutral)
+        return qmul(a, self._neutral)
 
     def joint_quats(self, g: F64) -> F64:
         """``(15, 4)`` ball-joint quaternions of body rotations ``g`` ``(16, 4)`` (any common
         frame): ``q = bq^-1 g_parent^-1 g_child``."""
-        return _qmul(self._bq_inv, _qmul(_qconj(g[SIM_PARENTS[1:]]), g[1:]))
+        return qmul(self._bq_inv, qmul(qconj(g[SIM_PARENTS[1:]]), g[1:]))
 
     def _local(self, origin: F64, quat: F64, points: F64) -> F64:
-        return _qrot(_qconj(quat), points - origin)
+        return qrot(qconj(quat), points - origin)
 
     def initial_qpos(self) -> F64:
         """``(67,)`` the rider's qpos sitting on the placed bicycle: sit bones on the saddle,
@@ -312,7 +316,7 @@ class Rider:
         o, q = self._frame()
         s = self._sites()
         seat = self._local(o, q, 0.5 * (d.site_xpos[s["l_seat"]] + d.site_xpos[s["r_seat"]]))
-        g_pelvis = quat_mul(_quat_y(self.posture.pelvis), self._neutral[0])
+        g_pelvis = quat_mul(quat_y(self.posture.pelvis), self._neutral[0])
         sit = quat_rotate(quat_conj(self._neutral[0]), np.array(SIT_OFFSET) * [1.0, 0.0, 1.0])
         pelvis_pos = seat - quat_rotate(g_pelvis, sit)
         pedals = self._local(o, q, d.site_xpos[[s["l_pedal"], s["r_pedal"]]])
@@ -445,7 +449,7 @@ class Rider:
         targets = self.joint_quats(now)
         self.servo.set_targets(self.character, targets)
         self._feedforward(torque, crank)
-        rel = _qmul(_qconj(targets[_LEG_JOINTS]), self.joint_quats(ahead)[_LEG_JOINTS])
+        rel = qmul(qconj(targets[_LEG_JOINTS]), self.joint_quats(ahead)[_LEG_JOINTS])
         w = 2.0 * rel[:, 1:] * np.sign(rel[:, :1]) / h
         inertia = self.servo.joint_inertia(self.character)[_LEG_JOINTS]
         ff = self.servo.feedforward[self._ff_rows : self._ff_rows + NJ]
@@ -471,7 +475,7 @@ class Rider:
             pedal = d.site_xpos[s[f"{side}_pedal"]]
             r = pedal - centre
             r = r - (r @ axis) * axis
-            tangent = _cross(axis, r) / max(float(np.linalg.norm(r)), 1e-9)
+            tangent = cross_rows(axis, r) / max(float(np.linalg.norm(r)), 1e-9)
             force = share * torque / arm * tangent  # the foot pushes the pedal with this
             mujoco.mj_jac(m, d, self._jac, None, d.site_xpos[s[f"{side}_ball"]], self._feet[k])
             cols = self._leg_cols[k]

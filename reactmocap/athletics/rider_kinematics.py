@@ -13,18 +13,27 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import Athlete
-from reactmocap.sim.bodies import SIM_BODIES, SIM_PARENTS
+from reactmocap.rotations import cross_rows, unit_rows
+from reactmocap.sim.bodies import SIM_BODY_INDEX, SIM_PARENTS
 
-__all__ = ["SIT_OFFSET", "Posture", "ankle_pitch", "trunk_pose", "two_link"]
+__all__ = [
+    "SIT_OFFSET",
+    "Posture",
+    "ankle_pitch",
+    "minrot",
+    "qconj",
+    "qmul",
+    "qrot",
+    "quat_y",
+    "trunk_pose",
+    "two_link",
+]
 
 F64 = NDArray[np.float64]
-_B = {b: i for i, b in enumerate(SIM_BODIES)}
 #: sit bones relative to the pelvis origin (anatomical frame: x forward, y left, z up; m)
 SIT_OFFSET = (-0.03, 0.06, -0.09)
-# small-array helpers for the control tick (numpy's cross and the general quaternion helpers
-# cost 25-40 us a call on (4, 3) arrays, these 5-10 us)
-_C1 = np.array([1, 2, 0])
-_C2 = np.array([2, 0, 1])
+# small-array quaternion helpers for the control tick (the general ones of
+# reactmocap.rotations cost 25-40 us a call on (4, 3) arrays, these 5-10 us)
 _HAMILTON = np.zeros((4, 4, 4))
 for _i, _j, _k, _s in ((0, 0, 0, 1), (0, 1, 1, -1), (0, 2, 2, -1), (0, 3, 3, -1),
                        (1, 0, 1, 1), (1, 1, 0, 1), (1, 2, 3, 1), (1, 3, 2, -1),
@@ -34,45 +43,38 @@ for _i, _j, _k, _s in ((0, 0, 0, 1), (0, 1, 1, -1), (0, 2, 2, -1), (0, 3, 3, -1)
 _HAMILTON_T = _HAMILTON.reshape(4, 16).T.copy()
 
 
-def _cross(a: F64, b: F64) -> F64:
-    """Row-wise cross product of ``(..., 3)`` arrays."""
-    return a.take(_C1, -1) * b.take(_C2, -1) - a.take(_C2, -1) * b.take(_C1, -1)
-
-
-def _qmul(a: F64, b: F64) -> F64:
+def qmul(a: F64, b: F64) -> F64:
     """Hamilton product of ``(n, 4)`` or ``(4,)`` quaternions (w, x, y, z), broadcast."""
     outer = a[..., :, None] * b[..., None, :]
     return outer.reshape(*outer.shape[:-2], 16) @ _HAMILTON_T
 
 
-def _qconj(q: F64) -> F64:
+def qconj(q: F64) -> F64:
+    """Conjugates of ``(..., 4)`` quaternions."""
     return q * np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def _qrot(q: F64, v: F64) -> F64:
+def qrot(q: F64, v: F64) -> F64:
     """Rotate ``(..., 3)`` vectors by ``(..., 4)`` unit quaternions."""
     u = q[..., 1:]
-    t = 2.0 * _cross(u, v)
-    return v + q[..., :1] * t + _cross(u, t)
+    t = 2.0 * cross_rows(u, v)
+    return v + q[..., :1] * t + cross_rows(u, t)
 
 
-def _minrot(u: F64, v: F64) -> F64:
+def minrot(u: F64, v: F64) -> F64:
     """``(n, 4)`` shortest-arc rotations taking unit vectors ``u`` to ``v`` ``(n, 3)``."""
     q = np.empty((u.shape[0], 4))
     q[:, 0] = 1.0 + np.einsum("ij,ij->i", u, v)
-    q[:, 1:] = _cross(u, v)
+    q[:, 1:] = cross_rows(u, v)
     bad = q[:, 0] < 1e-9
     if np.any(bad):  # opposite: any perpendicular axis
         q[bad, 0] = 0.0
-        q[bad, 1:] = _cross(u[bad], np.array([1.0, 0.0, 0.0]))
+        q[bad, 1:] = cross_rows(u[bad], np.array([1.0, 0.0, 0.0]))
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 
 
-def _unit(v: F64) -> F64:
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
-
-
-def _quat_y(angle: F64 | float) -> F64:
+def quat_y(angle: F64 | float) -> F64:
+    """``(..., 4)`` rotations by ``angle`` (rad) about +Y."""
     a = np.asarray(angle, dtype=np.float64)
     return np.stack([np.cos(a / 2), np.zeros_like(a), np.sin(a / 2), np.zeros_like(a)], axis=-1)
 
@@ -84,13 +86,13 @@ def two_link(base: F64, target: F64, l1: F64, l2: F64, pole: F64) -> tuple[F64, 
     d = target - base
     dist = np.linalg.norm(d, axis=1)
     dist = np.clip(dist, np.abs(l1 - l2) + 1e-6, (l1 + l2) * 0.9999)
-    dh = _unit(d)
+    dh = unit_rows(d)
     cos_a = np.clip((l1**2 + dist**2 - l2**2) / (2 * l1 * dist), -1.0, 1.0)
     n = pole - np.einsum("ij,ij->i", pole, dh)[:, None] * dh
-    n = _unit(n)
+    n = unit_rows(n)
     u1 = cos_a[:, None] * dh + np.sqrt(1.0 - cos_a**2)[:, None] * n
     elbow = base + l1[:, None] * u1
-    u2 = _unit(base + dist[:, None] * dh - elbow)
+    u2 = unit_rows(base + dist[:, None] * dh - elbow)
     return u1, u2
 
 
@@ -122,18 +124,18 @@ def trunk_pose(athlete: Athlete, posture: Posture) -> tuple[F64, F64, F64]:
     the sit bones' midpoint ``(3,)``."""
     n, bpos = athlete.neutral, athlete.character.body_pos
     a = np.tile([1.0, 0.0, 0.0, 0.0], (16, 1))
-    a[_B["pelvis"]] = _quat_y(posture.pelvis)
-    a[_B["waist"]] = _qmul(a[_B["pelvis"]], _quat_y(posture.waist))
-    a[_B["chest"]] = _qmul(a[_B["waist"]], _quat_y(posture.back))
-    a[_B["head"]] = _qmul(a[_B["chest"]], _quat_y(posture.neck))
-    g = _qmul(a, n)
+    a[SIM_BODY_INDEX["pelvis"]] = quat_y(posture.pelvis)
+    a[SIM_BODY_INDEX["waist"]] = qmul(a[SIM_BODY_INDEX["pelvis"]], quat_y(posture.waist))
+    a[SIM_BODY_INDEX["chest"]] = qmul(a[SIM_BODY_INDEX["waist"]], quat_y(posture.back))
+    a[SIM_BODY_INDEX["head"]] = qmul(a[SIM_BODY_INDEX["chest"]], quat_y(posture.neck))
+    g = qmul(a, n)
     pos = np.zeros((16, 3))
     for b in ("waist", "chest"):
-        i = _B[b]
-        pos[i] = pos[SIM_PARENTS[i]] + _qrot(g[SIM_PARENTS[i]], bpos[i])
+        i = SIM_BODY_INDEX[b]
+        pos[i] = pos[SIM_PARENTS[i]] + qrot(g[SIM_PARENTS[i]], bpos[i])
     bases = np.empty((4, 3))
     for k, b in enumerate(("l_upper_arm", "r_upper_arm", "l_thigh", "r_thigh")):
-        i = _B[b]
-        bases[k] = pos[SIM_PARENTS[i]] + _qrot(g[SIM_PARENTS[i]], bpos[i])
-    sit = _qrot(a[0], np.array([SIT_OFFSET[0], 0.0, SIT_OFFSET[2]]))
+        i = SIM_BODY_INDEX[b]
+        bases[k] = pos[SIM_PARENTS[i]] + qrot(g[SIM_PARENTS[i]], bpos[i])
+    sit = qrot(a[0], np.array([SIT_OFFSET[0], 0.0, SIT_OFFSET[2]]))
     return a, bases, sit

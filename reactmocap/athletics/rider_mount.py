@@ -16,12 +16,22 @@ from scipy.optimize import brentq
 
 from reactmocap.athletics.bicycle import Bicycle, BicycleParams, Fit
 from reactmocap.athletics.bodies import Athlete
-from reactmocap.athletics.rider_kinematics import _B, SIT_OFFSET, Posture, trunk_pose
+from reactmocap.athletics.rider_kinematics import SIT_OFFSET, Posture, trunk_pose
 from reactmocap.errors import ConfigError
 from reactmocap.rotations import quat_conj, quat_rotate
+from reactmocap.sim.bodies import SIM_BODY_INDEX
 from reactmocap.sim.world import World, WorldConfig
 
-__all__ = ["FOOT_SPRING", "HAND_SPRING", "RIDER_WORLD", "SEAT_SPRING", "RiderMount", "fit_bicycle"]
+__all__ = [
+    "FOOT_SPRING",
+    "HAND_SPRING",
+    "RIDER_WORLD",
+    "SEAT_SPRING",
+    "RiderMount",
+    "ball_offset",
+    "fit_bicycle",
+    "hand_offset",
+]
 
 F64 = NDArray[np.float64]
 #: the rider's world: 2 ms steps (the mounts are 10-20 ms spring-dampers, the wheels 4 ms
@@ -51,7 +61,7 @@ def fit_bicycle(params: BicycleParams, athlete: Athlete, *, knee_at_bottom: floa
     _, bases, sit = trunk_pose(athlete, pose)
     thigh, shin = float(athlete.thigh.mean()), float(athlete.shin.mean())
     leg = math.sqrt(thigh**2 + shin**2 + 2 * thigh * shin * math.cos(knee_at_bottom))
-    ball = _ball_offset(athlete)
+    ball = ball_offset(athlete)
     reach = math.hypot(leg + abs(float(ball[2])) * 0.5, float(ball[0]))  # hip to ball of foot
     bb = np.array([dt.bottom_bracket[0], 0.0, dt.bottom_bracket[1]])
     pedal = bb - [0.0, 0.0, dt.crank_length]
@@ -62,10 +72,14 @@ def fit_bicycle(params: BicycleParams, athlete: Athlete, *, knee_at_bottom: floa
     seat = bb + along * up
     shoulder = seat - sit + bases[0]
     v1 = quat_rotate(
-        athlete.neutral[_B["l_upper_arm"]], athlete.character.body_pos[_B["l_forearm"]]
+        athlete.neutral[SIM_BODY_INDEX["l_upper_arm"]],
+        athlete.character.body_pos[SIM_BODY_INDEX["l_forearm"]],
     )
-    v2 = quat_rotate(athlete.neutral[_B["l_forearm"]], athlete.character.body_pos[_B["l_hand"]])
-    v2 = v2 + quat_rotate(athlete.neutral[_B["l_hand"]], _hand_offset(athlete))
+    v2 = quat_rotate(
+        athlete.neutral[SIM_BODY_INDEX["l_forearm"]],
+        athlete.character.body_pos[SIM_BODY_INDEX["l_hand"]],
+    )
+    v2 = v2 + quat_rotate(athlete.neutral[SIM_BODY_INDEX["l_hand"]], hand_offset(athlete))
     l1, l2 = float(np.linalg.norm(v1)), float(np.linalg.norm(v2))
     arm = math.sqrt(l1**2 + l2**2 + 2 * l1 * l2 * math.cos(elbow))
     half = params.fit.grip_offset if params.fit else 0.25
@@ -77,13 +91,13 @@ def fit_bicycle(params: BicycleParams, athlete: Athlete, *, knee_at_bottom: floa
     return replace(params, fit=fit)
 
 
-def _ball_offset(athlete: Athlete, side: str = "l") -> F64:
+def ball_offset(athlete: Athlete, side: str = "l") -> F64:
     """The ball of the foot (the foot's patch geom) in that foot's frame."""
     m = athlete.character.model
     return m.geom_pos[m.geom(f"{side}_foot_ball").id].copy()
 
 
-def _hand_offset(athlete: Athlete, side: str = "l") -> F64:
+def hand_offset(athlete: Athlete, side: str = "l") -> F64:
     """The grip point (the hand's capsule centre) in that hand's frame."""
     m = athlete.character.model
     geoms = np.flatnonzero(m.geom_bodyid == m.body(f"{side}_hand").id)
@@ -129,7 +143,7 @@ class RiderMount:
                               name1=f"{pre}{side}_sit", name2=f"{bp}{side}_seat",
                               solref=list(SEAT_SPRING))  # fmt: skip
             hand = spec.body(f"{pre}{side}_hand")
-            hand.add_site(name=f"{pre}{side}_grip", pos=_hand_offset(ath, side).tolist())
+            hand.add_site(name=f"{pre}{side}_grip", pos=hand_offset(ath, side).tolist())
             gx, gz = fit.grips
             fork.add_site(name=f"{bp}{side}_grip",
                           pos=[gx - head[0], sign * fit.grip_offset, gz - head[2]])  # fmt: skip
@@ -137,7 +151,7 @@ class RiderMount:
                               name1=f"{pre}{side}_grip", name2=f"{bp}{side}_grip",
                               solref=list(HAND_SPRING))  # fmt: skip
             foot = spec.body(f"{pre}{side}_foot")
-            foot.add_site(name=f"{pre}{side}_ball", pos=_ball_offset(ath, side).tolist())
+            foot.add_site(name=f"{pre}{side}_ball", pos=ball_offset(ath, side).tolist())
             pedal = "left_pedal" if side == "l" else "right_pedal"
             spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_SITE,
                               name1=f"{pre}{side}_ball", name2=f"{bp}{pedal}",

@@ -26,27 +26,26 @@ from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.paths import Course, Straight
 from reactmocap.athletics.rig import Rig, per_joint
 from reactmocap.athletics.running_body import (
-    _ANKLE,
-    _BODY,
-    _ELBOW,
-    _FOOT,
-    _HIP,
-    _KNEE,
-    _LEG_JOINTS,
-    _NECK,
-    _SHIN,
-    _SHOULDER,
-    _SPINE,
-    _THIGH,
+    ANKLE,
+    ELBOW,
     F64,
+    FOOT,
+    HIP,
+    KNEE,
+    LEG_JOINTS,
+    NECK,
     NJ,
-    _clamp,
-    _euler_yxz,
-    _pitch_yxz,
-    _qconj,
-    _qmul,
-    _quat_yxz,
-    _qyaw,
+    SHIN,
+    SHOULDER,
+    SPINE,
+    THIGH,
+    clamp,
+    euler_yxz,
+    pitch_yxz,
+    qconj1,
+    qmul1,
+    quat_yxz,
+    qyaw,
     running_start,
 )
 from reactmocap.athletics.running_params import (
@@ -59,7 +58,7 @@ from reactmocap.athletics.running_params import (
 from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
 from reactmocap.rotations import quat_conj, wrap_angle
-from reactmocap.sim.bodies import SIM_PARENTS
+from reactmocap.sim.bodies import SIM_BODY_INDEX, SIM_PARENTS
 from reactmocap.sim.controllers.base import FunctionController
 from reactmocap.sim.controllers.machine import State, StateMachine, after
 from reactmocap.sim.world import World
@@ -151,10 +150,10 @@ class Runner:
         self._knees = [m.joint(wc.prefix + f"{s}_knee").id for s in "lr"]
         self._ankles = [m.joint(wc.prefix + f"{s}_ankle").id for s in "lr"]
         self._root = int(wc.body_ids[0])
-        self._chest = int(wc.body_ids[_BODY["chest"]])
-        self._thighs = wc.body_ids[list(_THIGH)]
-        self._shins = wc.body_ids[list(_SHIN)]
-        self._feet = wc.body_ids[list(_FOOT)]
+        self._chest = int(wc.body_ids[SIM_BODY_INDEX["chest"]])
+        self._thighs = wc.body_ids[list(THIGH)]
+        self._shins = wc.body_ids[list(SHIN)]
+        self._feet = wc.body_ids[list(FOOT)]
         self._neutral = athlete.neutral
         self._neutral_conj = quat_conj(athlete.neutral)
         self._bodies = np.asarray(wc.body_ids)
@@ -162,26 +161,24 @@ class Runner:
         # the legs' joint pitches at every tick (_leg_pitches): each body a leg joint joins
         # (pelvis, thighs, shins, feet) turned into its anatomical frame once, into buffers
         # made here; the pitch-only column of the angles the laws read stays 0 elsewhere
-        child = [j + 1 for j in _LEG_JOINTS]
+        child = [j + 1 for j in LEG_JOINTS]
         parent = [int(SIM_PARENTS[c]) for c in child]
         parts = sorted(set(child) | set(parent))
         self._anat_bodies = [(int(wc.body_ids[b]), b) for b in parts]
         self._leg_pairs = [(j, parts.index(p), parts.index(c))
-                           for j, p, c in zip(_LEG_JOINTS, parent, child)]  # fmt: skip
+                           for j, p, c in zip(LEG_JOINTS, parent, child)]  # fmt: skip
         self._anat_buf = np.empty((len(parts), 4))
         self._q_inv = np.empty(4)
         self._q_rel = np.empty(4)
         self._angles = np.zeros((NJ, 3))
-        self._hip_rows = np.array(_HIP)
-        self._knee_rows = np.array(_KNEE)
+        self._hip_rows = np.array(HIP)
+        self._knee_rows = np.array(KNEE)
         self._attitude_kp = np.asarray(self.params.attitude_kp)
         self._attitude_kv = np.asarray(self.params.attitude_kv)
         b = wc.ball_dof_start
         # the knee's and ankle's dofs of each leg
         self._leg_cols = [
-            np.r_[
-                b + 3 * _KNEE[k] : b + 3 * _KNEE[k] + 3, b + 3 * _ANKLE[k] : b + 3 * _ANKLE[k] + 3
-            ]
+            np.r_[b + 3 * KNEE[k] : b + 3 * KNEE[k] + 3, b + 3 * ANKLE[k] : b + 3 * ANKLE[k] + 3]
             for k in range(2)
         ]
         # heel-to-ball length l_f of eqs. 1-2: the sole box's length
@@ -245,20 +242,20 @@ class Runner:
 
     def _anat(self, body: int, neutral: int) -> F64:
         """A body's anatomical world rotation."""
-        return _qmul(self.world.data.xquat[body], self._neutral_conj[neutral])
+        return qmul1(self.world.data.xquat[body], self._neutral_conj[neutral])
 
     def _pitch(self, body: int, neutral: int, heading: float) -> float:
         """Anatomical pitch (rad) of a body in the heading frame (thigh forward < 0)."""
-        return _pitch_yxz(_qmul(_qyaw(-heading), self._anat(body, neutral)))
+        return pitch_yxz(qmul1(qyaw(-heading), self._anat(body, neutral)))
 
     def _joint_pitch(self, joint: int) -> float:
         """Anatomical pitch (rad) of a ball joint: its child's rotation relative to its
         parent's, both in their anatomical frames (as ``Athlete.joint_angles``)."""
         child = joint + 1
         parent = int(SIM_PARENTS[child])
-        rel = _qmul(_qconj(self._anat(self._bodies[parent], parent)),
+        rel = qmul1(qconj1(self._anat(self._bodies[parent], parent)),
                     self._anat(self._bodies[child], child))  # fmt: skip
-        return _pitch_yxz(rel)
+        return pitch_yxz(rel)
 
     def _leg_pitches(self) -> F64:
         """The pitch of the legs' joints (the only joint angles the laws read) in column 0
@@ -272,13 +269,13 @@ class Runner:
         for j, p, c in self._leg_pairs:
             mujoco.mju_negQuat(inv, anat[p])
             mujoco.mju_mulQuat(rel, inv, anat[c])
-            angles[j, 0] = _pitch_yxz(rel)
+            angles[j, 0] = pitch_yxz(rel)
         return angles
 
     def trunk_euler(self) -> tuple[float, float, float]:
         """Chest pitch, roll and yaw (anatomical, heading frame, rad)."""
-        chest = _BODY["chest"]
-        return _euler_yxz(_qmul(_qyaw(-self.heading()), self._anat(self._chest, chest)))
+        chest = SIM_BODY_INDEX["chest"]
+        return euler_yxz(qmul1(qyaw(-self.heading()), self._anat(self._chest, chest)))
 
     def _contacts(self) -> None:
         """Which feet touch with their heel (rear corners) and toe (front corners)."""
@@ -326,23 +323,23 @@ class Runner:
         vz = float(s.com_vel[2])
         low = float(s.sole_corners()[leg, :, 2].min())
         to_go = low / -vz if vz < -1e-3 else np.inf
-        fwd += k["speed_matching"] * _clamp(to_go / k["retract_time"], 0.0, 1.0)
+        fwd += k["speed_matching"] * clamp(to_go / k["retract_time"], 0.0, 1.0)
         fwd += 0.3 * lf  # the heel sits behind the ankle
         length = k["touchdown_leg"] * (self.athlete.thigh[leg] + self.athlete.shin[leg])
-        fwd = _clamp(fwd, -0.5 * length, 0.75 * length)
-        lat = _clamp(lat, -0.3 * length, 0.3 * length)
+        fwd = clamp(fwd, -0.5 * length, 0.75 * length)
+        lat = clamp(lat, -0.3 * length, 0.3 * length)
         down = math.sqrt(max(length * length - fwd * fwd - lat * lat, 0.04))
         swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
         roll = math.atan2(lat, math.hypot(fwd, down))
         knee, geom = knee_for_length(self.athlete.thigh[leg], self.athlete.shin[leg], length)
-        thigh = _qmul(_qyaw(heading), _quat_yxz(-swing + float(geom), roll, 0.0))
+        thigh = qmul1(qyaw(heading), quat_yxz(-swing + float(geom), roll, 0.0))
         pelvis = self._anat(self._root, 0)
-        hip_pitch, hip_roll, _ = _euler_yxz(_qmul(_qconj(pelvis), thigh))
-        self.goal[_HIP[leg]] = (hip_pitch, hip_roll, 0.0)
-        self.goal[_KNEE[leg]] = (float(knee), 0.0, 0.0)
+        hip_pitch, hip_roll, _ = euler_yxz(qmul1(qconj1(pelvis), thigh))
+        self.goal[HIP[leg]] = (hip_pitch, hip_roll, 0.0)
+        self.goal[KNEE[leg]] = (float(knee), 0.0, 0.0)
         self.knee_td = float(knee)
-        shin = self._pitch(self._shins[leg], _SHIN[leg], heading)
-        self.goal[_ANKLE[leg]] = (_clamp(-k["heel_up"] - shin, -0.5, 0.9), 0.0, 0.0)
+        shin = self._pitch(self._shins[leg], SHIN[leg], heading)
+        self.goal[ANKLE[leg]] = (clamp(-k["heel_up"] - shin, -0.5, 0.9), 0.0, 0.0)
 
     def _idle(self, t: float, heading: float) -> None:
         """The idle leg. In flight, eqs. 3-4: the idle thigh mirrors the active one's travel
@@ -355,42 +352,42 @@ class Runner:
         a, i = self.active, 1 - self.active
         knee = k["idle_knee"]
         if self.machine.current.name == "flight":
-            act = self._pitch(self._thighs[a], _THIGH[a], heading)
+            act = self._pitch(self._thighs[a], THIGH[a], heading)
             want = self.lo_pitch[i] - (act - self.lo_pitch[a])
         else:
             prog = (t - self.t_touchdown) / max(self.stance_estimate, 0.05)
-            sm = _clamp(prog, 0.0, 1.0)
+            sm = clamp(prog, 0.0, 1.0)
             want = self.td_pitch + (k["swing_ready"] - self.td_pitch) * sm * sm * (3.0 - 2.0 * sm)
-            late = _clamp(2.0 * prog - 1.0, 0.0, 1.0)
+            late = clamp(2.0 * prog - 1.0, 0.0, 1.0)
             knee += (k["reach_knee"] - k["idle_knee"]) * late * late * (3.0 - 2.0 * late)
-        hip = _clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
-        self.goal[_HIP[i]] = (hip, 0.03 * (1 - 2 * i), 0.0)
-        self.goal[_KNEE[i]] = (knee, 0.0, 0.0)
-        self.goal[_ANKLE[i]] = (-0.15, 0.0, 0.0)
+        hip = clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
+        self.goal[HIP[i]] = (hip, 0.03 * (1 - 2 * i), 0.0)
+        self.goal[KNEE[i]] = (knee, 0.0, 0.0)
+        self.goal[ANKLE[i]] = (-0.15, 0.0, 0.0)
 
     def _upper(self, hips: F64) -> None:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
         k = self.k
         for leg in range(2):
-            self.goal[_SHOULDER[leg]] = (k["arm_gain"] * hips[1 - leg] + k["arm_offset"],
+            self.goal[SHOULDER[leg]] = (k["arm_gain"] * hips[1 - leg] + k["arm_offset"],
                                          0.15 * (1 - 2 * leg), 0.0)  # fmt: skip
-            self.goal[_ELBOW[leg]] = (-k["elbow"], 0.0, 0.0)
-        for j in _SPINE:
+            self.goal[ELBOW[leg]] = (-k["elbow"], 0.0, 0.0)
+        for j in SPINE:
             self.goal[j] = 0.0
-        self.goal[_NECK] = (-0.1, 0.0, 0.0)
+        self.goal[NECK] = (-0.1, 0.0, 0.0)
 
     def _attitude_torque(self, heading: float) -> F64:
         """World torque on the trunk that servos its attitude toward the desired roll (a
         lean into the curve), pitch (slightly forward) and yaw (the desired facing)."""
         k = self.k
         lean = k["lean"] * math.atan(self.speed**2 * self.curvature / self.g)
-        want = _qmul(_qyaw(self.heading_d), _quat_yxz(k["pitch"], -lean, 0.0))
+        want = qmul1(qyaw(self.heading_d), quat_yxz(k["pitch"], -lean, 0.0))
         # the chest's attitude and rate: the pelvis alone is light and sits between two
         # servoed joints, and damping its rate explicitly at the control rate rings
         d = self.world.data
-        now = self._anat(self._chest, _BODY["chest"])
+        now = self._anat(self._chest, SIM_BODY_INDEX["chest"])
         err = np.empty(3)
-        mujoco.mju_quat2Vel(err, _qmul(want, _qconj(now)), 1.0)  # world rotation vector
+        mujoco.mju_quat2Vel(err, qmul1(want, qconj1(now)), 1.0)  # world rotation vector
         c, s = math.cos(heading), math.sin(heading)
         axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
         local = axes @ err
@@ -399,13 +396,13 @@ class Runner:
         )
         if k["pitch_integral"] > 0:
             dt = self.control_every * self._timestep
-            self.pitch_sum = _clamp(self.pitch_sum + local[1] * dt, -PITCH_SUM, PITCH_SUM)
+            self.pitch_sum = clamp(self.pitch_sum + local[1] * dt, -PITCH_SUM, PITCH_SUM)
             gain[1] += self.inertia_unit * k["pitch_integral"] * self.pitch_sum
         torque = axes.T @ gain
         if k["attitude_ramp"] > 0:
             # eased in after touchdown: the torque's reaction drives the thigh, and at once
             # it drove the heel into the ground (11-13 body weights) and it bounced off
-            ease = _clamp((self.world.data.time - self.t_touchdown) / k["attitude_ramp"], 0, 1)
+            ease = clamp((self.world.data.time - self.t_touchdown) / k["attitude_ramp"], 0, 1)
             torque *= ease * ease * (3.0 - 2.0 * ease)
         limit = k["attitude_limit"]
         if k["touchdown_limit"] > 0 and self.machine.current.name in ("loading", "heel"):
@@ -424,7 +421,7 @@ class Runner:
         axis /= max(float(np.linalg.norm(axis)), 1e-9)
         along = float(torque @ axis)
         limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
-        return torque - (along - _clamp(along, -limit, limit)) * axis
+        return torque - (along - clamp(along, -limit, limit)) * axis
 
     def _support_point(self, t: float) -> F64:
         """Where the stance foot bears on the ground (world): the heel until the ball is
@@ -439,7 +436,7 @@ class Runner:
         if state == "heel_toe":
             end = self.t_touchdown + self.k["toe_fraction"] * self.stance_estimate
             span = max(end - self.t_heel_toe, 1e-3)
-            frac = _clamp((t - self.t_heel_toe) / span, 0.0, 1.0)
+            frac = clamp((t - self.t_heel_toe) / span, 0.0, 1.0)
             return heel + frac * (ball - heel)
         return ball
 
@@ -496,11 +493,11 @@ class Runner:
         mujoco.mj_jac(self.world.model, d, self._jacp, None, point, self._feet[leg])
         tau = -self._jacp[:, self._leg_cols[leg]].T @ (force * u)
         ff = self.rig._ff
-        ff[_KNEE[leg]] += tau[0:3]
+        ff[KNEE[leg]] += tau[0:3]
         if state not in ("loading", "heel"):
-            ff[_ANKLE[leg]] += tau[3:6]
+            ff[ANKLE[leg]] += tau[3:6]
         # the knee's and ankle's servos keep no pitch stiffness of their own
-        for j in (_KNEE[leg], _ANKLE[leg]):
+        for j in (KNEE[leg], ANKLE[leg]):
             self.targets[j, 0] = self.goal[j, 0] = angles[j, 0]
 
     # ------------------------------------------------------------------ states
@@ -525,7 +522,7 @@ class Runner:
         def knee_extended(_w: World, t: float, t_in: float) -> bool:
             if self.step_stance:  # the commanded step lets go at its stance time
                 return t - self.t_touchdown >= self.step_stance
-            knee = self._joint_pitch(_KNEE[self.active])
+            knee = self._joint_pitch(KNEE[self.active])
             return t_in > 0.02 and knee <= self.knee_td + 0.05
 
         def left_ground(_w: World, _t: float, _ti: float) -> bool:
@@ -553,16 +550,16 @@ class Runner:
         self.rig.axis_gain[:, 0] = 1.0
         if stance:
             a = self.active
-            stiff[_HIP[a]] = 0.0
-            stiff[_KNEE[a]] = self.k["knee_hold"]
-            stiff[_ANKLE[a]] = self.k["ankle_hold"]
+            stiff[HIP[a]] = 0.0
+            stiff[KNEE[a]] = self.k["knee_hold"]
+            stiff[ANKLE[a]] = self.k["ankle_hold"]
         self.rig.set_stiffness(stiff)
 
     def _enter_flight(self, world: World, t: float) -> None:
         del world
         if self.machine.transitions:  # lift-off (not the first tick): swap the legs
             # smoothed: in turns the stance varies step to step and feeds the next placement
-            last = _clamp(t - self.t_touchdown, 0.12, 0.4)
+            last = clamp(t - self.t_touchdown, 0.12, 0.4)
             blend = self.k["stance_blend"]
             if blend < 1:
                 last = self.stance_estimate + blend * (last - self.stance_estimate)
@@ -570,7 +567,7 @@ class Runner:
             self.log.liftoffs.append((t, self.active))
             self.active = 1 - self.active
         h = self.heading()
-        self.lo_pitch = [self._pitch(self._thighs[j], _THIGH[j], h) for j in range(2)]
+        self.lo_pitch = [self._pitch(self._thighs[j], THIGH[j], h) for j in range(2)]
         self._set_stiffness(False)
 
     def _enter_loading(self, world: World, t: float) -> None:
@@ -584,7 +581,7 @@ class Runner:
         self.step_stance = self.k["step_stance"] if t >= STEP_AFTER else 0.0
         leg = self.active
         d = self.world.data
-        self.td_pitch = self._pitch(self._thighs[1 - leg], _THIGH[1 - leg], self.heading())
+        self.td_pitch = self._pitch(self._thighs[1 - leg], THIGH[1 - leg], self.heading())
         foot = d.xpos[self._feet[leg]]
         self.log.touchdowns.append((t, leg, float(foot[0]), float(foot[1])))
         self.steps += 1
@@ -601,8 +598,8 @@ class Runner:
                 # a step's error counts at most ERROR_CAP: a bias that grew 5 cm a step moved
                 # the feet back faster than the legs could follow, and the runner sank
                 cap = ERROR_CAP
-                bias = self.speed_bias + self.k["speed_integral"] * _clamp(err, -cap, cap)
-                self.speed_bias = _clamp(bias, -0.3, 0.3)
+                bias = self.speed_bias + self.k["speed_integral"] * clamp(err, -cap, cap)
+                self.speed_bias = clamp(bias, -0.3, 0.3)
         if switch:
             # the commanded step's correction starts at its steady value: built up from the
             # spring's, it took 6-8 s and the step ran up to 0.4 m/s slow meanwhile
@@ -630,7 +627,7 @@ class Runner:
         # about bending (roll and yaw held): their damping there took half the leg law's push
         hold = self.k["push_hold"] if self.machine.current.name in ("toe", "unloading") else 1.0
         a = self.active
-        self.rig.axis_gain[_KNEE[a], 0] = self.rig.axis_gain[_ANKLE[a], 0] = hold
+        self.rig.axis_gain[KNEE[a], 0] = self.rig.axis_gain[ANKLE[a], 0] = hold
         if not self.released and self.machine.current.name in ("toe", "unloading"):
             # the thrust stops once the body rises at the take-off speed wanted, or once its
             # rise slows (the take-off speed out of reach: pushing on to lift-off drove the
@@ -652,14 +649,14 @@ class Runner:
             # of the error was wrong-signed there and the runner fell)
             dt = self.control_every * self._timestep
             kap = self.curvature
-            self.path_sum = _clamp(self.path_sum + self.cross_track * kap * dt, -PATH_SUM, PATH_SUM)
+            self.path_sum = clamp(self.path_sum + self.cross_track * kap * dt, -PATH_SUM, PATH_SUM)
             want -= self.k["path_integral"] * self.path_sum * kap
         # the facing turns at a limited rate whatever the course asks (an abrupt change of
         # facing throws the runner down)
         if self._steered:
             step = wrap_angle(want - self.heading_d)
             limit = self.k["turn_rate"] * self.control_every * self._timestep
-            self.heading_d += _clamp(step, -limit, limit)
+            self.heading_d += clamp(step, -limit, limit)
         else:
             self.heading_d, self._steered = want, True
         if self.speed < self.target:
@@ -689,7 +686,7 @@ class Runner:
             # the stance hip makes the attitude torque on the trunk (its reaction is on the
             # thigh); then the leg spring adds the knee's and ankle's torques
             rot = world.data.xmat[self._thighs[self.active]].reshape(3, 3)
-            rig._ff[_HIP[self.active]] = -rot.T @ self._attitude_torque(heading)
+            rig._ff[HIP[self.active]] = -rot.T @ self._attitude_torque(heading)
             self._leg_spring(t, dt, angles)
         self._log(t, angles)
 

@@ -13,70 +13,96 @@ from numpy.typing import NDArray
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.rig import joint_index
 from reactmocap.rotations import quat_from_yaw, quat_mul
-from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
+from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODY_INDEX
 
-__all__ = ["running_start"]
+__all__ = [
+    "ANKLE",
+    "ELBOW",
+    "FOOT",
+    "HIP",
+    "KNEE",
+    "LEG_JOINTS",
+    "NECK",
+    "NJ",
+    "SHIN",
+    "SHOULDER",
+    "SPINE",
+    "THIGH",
+    "clamp",
+    "euler_yxz",
+    "pitch_yxz",
+    "qconj1",
+    "qmul1",
+    "quat_yxz",
+    "qyaw",
+    "running_start",
+]
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
-_HIP = (joint_index("l_hip"), joint_index("r_hip"))
-_KNEE = (joint_index("l_knee"), joint_index("r_knee"))
-_ANKLE = (joint_index("l_ankle"), joint_index("r_ankle"))
-_SHOULDER = (joint_index("l_shoulder"), joint_index("r_shoulder"))
-_ELBOW = (joint_index("l_elbow"), joint_index("r_elbow"))
-_SPINE = (joint_index("waist"), joint_index("back"))
-_NECK = joint_index("neck")
-_LEG_JOINTS = (*_HIP, *_KNEE, *_ANKLE)
-_BODY = {b: i for i, b in enumerate(SIM_BODIES)}
-_THIGH = (_BODY["l_thigh"], _BODY["r_thigh"])
-_SHIN = (_BODY["l_shin"], _BODY["r_shin"])
-_FOOT = (_BODY["l_foot"], _BODY["r_foot"])
+#: ball-joint indices (left, right) of the joints the laws set
+HIP = (joint_index("l_hip"), joint_index("r_hip"))
+KNEE = (joint_index("l_knee"), joint_index("r_knee"))
+ANKLE = (joint_index("l_ankle"), joint_index("r_ankle"))
+SHOULDER = (joint_index("l_shoulder"), joint_index("r_shoulder"))
+ELBOW = (joint_index("l_elbow"), joint_index("r_elbow"))
+SPINE = (joint_index("waist"), joint_index("back"))
+NECK = joint_index("neck")
+LEG_JOINTS = (*HIP, *KNEE, *ANKLE)
+#: body indices (left, right) of the leg segments
+THIGH = (SIM_BODY_INDEX["l_thigh"], SIM_BODY_INDEX["r_thigh"])
+SHIN = (SIM_BODY_INDEX["l_shin"], SIM_BODY_INDEX["r_shin"])
+FOOT = (SIM_BODY_INDEX["l_foot"], SIM_BODY_INDEX["r_foot"])
 
 
 # ---------------------------------------------------------------------------------- small math
 # single quaternions at every tick: MuJoCo's C routines and closed forms instead of the
 # vectorised numpy helpers of reactmocap.rotations, whose per-call overhead on one quaternion
 # dominated the tick (quat_mul 37 us against mju_mulQuat's 2.3 us, 2026-12-03 12:44 UTC)
-def _qmul(a: F64, b: F64) -> F64:
+def qmul1(a: F64, b: F64) -> F64:
+    """Hamilton product of two ``(4,)`` quaternions."""
     out = np.empty(4)
     mujoco.mju_mulQuat(out, a, b)
     return out
 
 
-def _clamp(x: float, lo: float, hi: float) -> float:
+def clamp(x: float, lo: float, hi: float) -> float:
+    """``x`` within ``[lo, hi]``."""
     return float(min(max(x, lo), hi))
 
 
-def _qconj(q: F64) -> F64:
+def qconj1(q: F64) -> F64:
+    """Conjugate of a ``(4,)`` quaternion."""
     return np.array([q[0], -q[1], -q[2], -q[3]])
 
 
-def _qyaw(yaw: float) -> F64:
+def qyaw(yaw: float) -> F64:
+    """Rotation by ``yaw`` (rad) about +Z."""
     return np.array([math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw)])
 
 
-def _quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
+def quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
     """Quaternion of intrinsic Y-X-Z Euler angles (:data:`~reactmocap.athletics.bodies.
     EULER_ORDER`)."""
     qy = np.array([math.cos(0.5 * pitch), 0.0, math.sin(0.5 * pitch), 0.0])
     qx = np.array([math.cos(0.5 * roll), math.sin(0.5 * roll), 0.0, 0.0])
-    return _qmul(_qmul(qy, qx), _qyaw(yaw))
+    return qmul1(qmul1(qy, qx), qyaw(yaw))
 
 
-def _pitch_yxz(q: F64) -> float:
-    """The pitch of :func:`_euler_yxz` alone (what the leg joints' laws read)."""
+def pitch_yxz(q: F64) -> float:
+    """The pitch of :func:`euler_yxz` alone (what the leg joints' laws read)."""
     w, x, y, z = q
     return math.atan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y))
 
 
-def _euler_yxz(q: F64) -> tuple[float, float, float]:
+def euler_yxz(q: F64) -> tuple[float, float, float]:
     """Intrinsic Y-X-Z Euler angles (pitch, roll, yaw) of a quaternion: with
     ``R = Ry Rx Rz``, pitch = atan2(R02, R22), roll = asin(-R12), yaw = atan2(R10, R11)."""
     w, x, y, z = q
     r12 = 2.0 * (y * z - w * x)
     r10 = 2.0 * (x * y + w * z)
     r11 = 1.0 - 2.0 * (x * x + z * z)
-    return (_pitch_yxz(q), math.asin(max(-1.0, min(1.0, -r12))), math.atan2(r10, r11))
+    return (pitch_yxz(q), math.asin(max(-1.0, min(1.0, -r12))), math.atan2(r10, r11))
 
 
 def running_start(athlete: Athlete, speed: float, heading: float = 0.0) -> tuple[F64, F64]:
@@ -84,15 +110,15 @@ def running_start(athlete: Athlete, speed: float, heading: float = 0.0) -> tuple
     ``heading``, its soles 5 cm up: the left leg reaching forward for touchdown, the right
     trailing with its knee bent."""
     angles = np.zeros((NJ, 3))
-    angles[_HIP[0]] = (-0.45, 0.0, 0.0)
-    angles[_KNEE[0]] = (0.25, 0.0, 0.0)
-    angles[_ANKLE[0]] = (-0.05, 0.0, 0.0)
-    angles[_HIP[1]] = (0.25, 0.0, 0.0)
-    angles[_KNEE[1]] = (1.2, 0.0, 0.0)
-    angles[_ANKLE[1]] = (0.2, 0.0, 0.0)
+    angles[HIP[0]] = (-0.45, 0.0, 0.0)
+    angles[KNEE[0]] = (0.25, 0.0, 0.0)
+    angles[ANKLE[0]] = (-0.05, 0.0, 0.0)
+    angles[HIP[1]] = (0.25, 0.0, 0.0)
+    angles[KNEE[1]] = (1.2, 0.0, 0.0)
+    angles[ANKLE[1]] = (0.2, 0.0, 0.0)
     for k in range(2):
-        angles[_SHOULDER[k]] = (0.9 * angles[_HIP[1 - k], 0] + 0.05, 0.15 * (1 - 2 * k), 0.0)
-        angles[_ELBOW[k]] = (-1.4, 0.0, 0.0)
+        angles[SHOULDER[k]] = (0.9 * angles[HIP[1 - k], 0] + 0.05, 0.15 * (1 - 2 * k), 0.0)
+        angles[ELBOW[k]] = (-1.4, 0.0, 0.0)
     q = athlete.standing_qpos(angles, pitch=0.08, clearance=0.05)
     if heading:
         q[3:7] = quat_mul(quat_from_yaw(heading), q[3:7])

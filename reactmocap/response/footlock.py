@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from reactmocap.library.bodyparts import BodyPartMap
 from reactmocap.library.motion import Motion
 from reactmocap.metrics import PLANT_HEIGHT_M, PLANT_SPEED_M_S
-from reactmocap.rotations import quat_conj, quat_mul, quat_normalize, quat_rotate
+from reactmocap.rotations import quat_conj, quat_mul, quat_normalize, quat_rotate, unit_rows
 
 __all__ = ["lock_feet", "place_ankles"]
 
@@ -37,10 +37,6 @@ def _arc(u: F64, v: F64) -> F64:
     w = 1.0 + np.sum(u * v, axis=-1, keepdims=True)
     q = np.concatenate([w, np.cross(u, v)], axis=-1)
     return quat_normalize(q)
-
-
-def _unit(v: F64) -> F64:
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 
 
 def _intervals(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
@@ -120,23 +116,23 @@ def place_ankles(motion: Motion, parts: BodyPartMap,
         la = np.linalg.norm(k - h, axis=-1)
         lb = np.linalg.norm(a - k, axis=-1)
         c = np.clip(np.linalg.norm(goal - h, axis=-1), np.abs(la - lb) + 1e-6, la + lb - 1e-6)
-        u = _unit(goal - h)
+        u = unit_rows(goal - h)
         bend = k - h
         if keep_bend:
             # the knee bends the way it bent (its offset from the hip-ankle line, made
             # perpendicular to the new one): a goal far from the ankle, passing under the hip,
             # does not flip it
-            u0 = _unit(a - h)
+            u0 = unit_rows(a - h)
             bend = bend - u0 * np.sum(bend * u0, axis=-1, keepdims=True)
         # knee stays in the plane of the bend
-        v = _unit(bend - u * np.sum(bend * u, axis=-1, keepdims=True))
+        v = unit_rows(bend - u * np.sum(bend * u, axis=-1, keepdims=True))
         cos_a = np.clip((la**2 + c**2 - lb**2) / (2 * la * c), -1.0, 1.0)
         knee_new = h + la[:, None] * (cos_a[:, None] * u + np.sqrt(1 - cos_a**2)[:, None] * v)
         # hip: turn the thigh onto the new knee; knee: turn the shin onto the goal
-        q_hip = quat_mul(_arc(_unit(k - h), _unit(knee_new - h)), rot[frames, hip])
+        q_hip = quat_mul(_arc(unit_rows(k - h), unit_rows(knee_new - h)), rot[frames, hip])
         a_moved = knee_new + quat_rotate(q_hip, quat_rotate(quat_conj(rot[frames, hip]), a - k))
         shin_rot = quat_mul(q_hip, quat_mul(quat_conj(rot[frames, hip]), rot[frames, knee]))
-        q_knee = quat_mul(_arc(_unit(a_moved - knee_new), _unit(goal - knee_new)), shin_rot)
+        q_knee = quat_mul(_arc(unit_rows(a_moved - knee_new), unit_rows(goal - knee_new)), shin_rot)
         parent = skel.parents[hip]
         g_parent = rot[frames, parent] if parent >= 0 else np.tile([1.0, 0, 0, 0], (frames.size, 1))
         local[frames, hip] = quat_mul(quat_conj(g_parent), q_hip)

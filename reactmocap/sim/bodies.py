@@ -7,7 +7,15 @@ from collections.abc import Mapping
 
 import numpy as np
 
-__all__ = ["BALL_JOINTS", "BODY_ALIASES", "JOINT_RANGE", "SIM_BODIES", "SIM_PARENTS", "TREE"]
+__all__ = [
+    "BALL_JOINTS",
+    "BODY_ALIASES",
+    "JOINT_RANGE",
+    "SIM_BODIES",
+    "SIM_BODY_INDEX",
+    "SIM_PARENTS",
+    "TREE",
+]
 
 # (body = part, parent body, ball joint name); preorder, which is MuJoCo's body/joint order.
 TREE: tuple[tuple[str, str | None, str | None], ...] = (
@@ -31,6 +39,8 @@ TREE: tuple[tuple[str, str | None, str | None], ...] = (
 SIM_BODIES: tuple[str, ...] = tuple(b for b, _, _ in TREE)
 BALL_JOINTS: tuple[str, ...] = tuple(j for _, _, j in TREE if j is not None)
 BODY_ALIASES: Mapping[str, str] = {"abdomen": "waist", "thorax": "chest", "neck": "head"}
+#: index in SIM_BODIES of each body name
+SIM_BODY_INDEX: Mapping[str, int] = {b: i for i, b in enumerate(SIM_BODIES)}
 #: parent body index of each of SIM_BODIES (-1 for the pelvis)
 SIM_PARENTS = np.array([-1 if p is None else SIM_BODIES.index(p) for _, p, _ in TREE])
 

@@ -10,7 +10,7 @@ import pytest
 
 from reactmocap.athletics.run_course import run_course
 from reactmocap.athletics.running import Runner, RunParams
-from reactmocap.athletics.running_body import _ANKLE, _KNEE
+from reactmocap.athletics.running_body import ANKLE, KNEE
 from reactmocap.athletics.running_params import STEP_PARAMS
 from reactmocap.errors import ConfigError
 
@@ -26,12 +26,12 @@ def _servo_bending(hold: float, monkeypatch: pytest.MonkeyPatch) -> tuple[float,
     def traced(self: Runner, world, t: float) -> None:  # type: ignore[no-untyped-def]
         _CONTROL(self, world, t)
         if self.machine.current.name in ("toe", "unloading"):
-            j = _KNEE[self.active]
+            j = KNEE[self.active]
             tau = self.world.servo.torques(self.character)[j]
             axes = self.rig._axes[j]  # rows: bending, roll, yaw (child frame)
             bend.append(abs(float(axes[0] @ tau)))
             other.append(float(np.linalg.norm(axes[1:] @ tau)))
-            assert self.rig.axis_gain[_ANKLE[self.active], 0] == hold
+            assert self.rig.axis_gain[ANKLE[self.active], 0] == hold
 
     monkeypatch.setattr(Runner, "control", traced)
     res = run_course(2.61, seconds=1.5, fps=10.0, params=RunParams(push_hold=hold))
