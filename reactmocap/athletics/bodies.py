@@ -37,6 +37,8 @@ __all__ = [
     "Athlete",
     "athlete",
     "athlete_of",
+    "joint_points",
+    "segment_inertials",
     "thesis_character",
     "thesis_skeleton",
 ]
@@ -82,7 +84,7 @@ _PARTS = {
 }  # fmt: skip
 
 
-def _joint_points(sex: str) -> dict[str, F64]:
+def joint_points(sex: str) -> dict[str, F64]:
     """World position (reference pose) of every listing joint, keyed by its body's name."""
     return {
         b.name: np.add(b.com, b.body_to_joint)
@@ -98,7 +100,7 @@ def thesis_skeleton(sex: str) -> tuple[Skeleton, BodyPartMap]:
     the finger tips and the toe tips (from the listing's segment extents)."""
     if sex not in BODIES:
         raise UnknownKeyError(f"unknown thesis body {sex!r}; valid bodies: {list(BODIES)}")
-    pts = _joint_points(sex)
+    pts = joint_points(sex)
     listing = {b.name: b for b in reference_listing(sex)}
     pts["hips"] = 0.5 * (pts["ULEGL"] + pts["ULEGR"])
     pts["head"] = np.asarray(listing["HEAD"].com)
@@ -123,7 +125,7 @@ def thesis_skeleton(sex: str) -> tuple[Skeleton, BodyPartMap]:
     return skel, parts
 
 
-def _inertials(sex: str) -> dict[str, SegmentInertia]:
+def segment_inertials(sex: str) -> dict[str, SegmentInertia]:
     """Listing bodies merged into the 16 sim bodies (toes into feet, spine segments and clavicle
     bodies into waist and chest) with the parallel-axis theorem, world frame."""
     groups: dict[str, list] = {b: [] for b in SIM_BODIES}
@@ -149,10 +151,10 @@ def thesis_character(sex: str) -> Character:
     listing (merged segments by the parallel-axis theorem), collision geometry from
     :func:`~reactmocap.sim.character.build_character` on the body's proportions."""
     skel, parts = thesis_skeleton(sex)
-    pts = _joint_points(sex)
+    pts = joint_points(sex)
     root = 0.5 * (pts["ULEGL"] + pts["ULEGR"])
     ref = Motion(skel, 30.0, root[None], np.tile([1.0, 0.0, 0.0, 0.0], (1, skel.num_joints, 1)))
-    return build_character(skel, parts, reference=ref, inertials=_inertials(sex))
+    return build_character(skel, parts, reference=ref, inertials=segment_inertials(sex))
 
 
 # ---------------------------------------------------------------------------------- athlete
@@ -207,9 +209,9 @@ class Athlete:
         n = self.neutral
         parent = n[SIM_PARENTS[1:]]
         bq = self.character.body_quat[1:]
-        # q_joint = left * r * right  (see joint_quats)
-        self._left = quat_mul(quat_conj(bq), quat_conj(parent))
-        self._right = n[1:]
+        #: q_joint = joint_left * r * joint_right (r the anatomical rotation; see joint_quats)
+        self.joint_left = quat_mul(quat_conj(bq), quat_conj(parent))
+        self.joint_right = n[1:]
 
     @property
     def mass(self) -> float:
@@ -223,11 +225,13 @@ class Athlete:
     def joint_quats(self, angles: F64) -> F64:
         """``(15, 4)`` MuJoCo ball-joint quaternions of anatomical angles ``(15, 3)``."""
         r = quat_from_euler(np.asarray(angles)[:, [0, 1, 2]], EULER_ORDER)
-        return quat_mul(self._left, quat_mul(r, self._right))
+        return quat_mul(self.joint_left, quat_mul(r, self.joint_right))
 
     def joint_angles(self, quats: F64) -> F64:
         """Inverse of :meth:`joint_quats`."""
-        r = quat_mul(quat_conj(self._left), quat_mul(np.asarray(quats), quat_conj(self._right)))
+        r = quat_mul(
+            quat_conj(self.joint_left), quat_mul(np.asarray(quats), quat_conj(self.joint_right))
+        )
         return quat_to_euler(quat_normalize(r), EULER_ORDER)
 
     def root_quat(self, pitch: float = 0.0, yaw: float = 0.0) -> F64:

@@ -16,7 +16,7 @@ from reactmocap.athletics.bodies import Athlete
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.response.blend import smoothstep  # the one Hermite ease; re-exported here
 from reactmocap.rotations import quat_conj, quat_log, quat_mul, quat_rotate
-from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
+from reactmocap.sim.bodies import BALL_JOINT_INDEX, BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.world import World
 
 __all__ = ["JOINT_KINDS", "Rig", "joint_index", "per_joint"]
@@ -35,8 +35,8 @@ SERVO_REFRESH = 8
 def joint_index(name: str) -> int:
     """Index of a ball joint (``"l_knee"``) in ``BALL_JOINTS``; unknown names list the valid."""
     try:
-        return BALL_JOINTS.index(name)
-    except ValueError:
+        return BALL_JOINT_INDEX[name]
+    except KeyError:
         raise UnknownKeyError(f"unknown joint {name!r}; joints are {list(BALL_JOINTS)}") from None
 
 
@@ -103,7 +103,9 @@ class Rig:
         self._kp = np.zeros(NJ)  # the servo's kp (1/s^2) per joint, as set_stiffness set it
         self.damping = np.zeros(NJ)
         rows = self.servo.character_indices.index(character) * NJ
-        self._ff = self.servo.feedforward[rows : rows + NJ]
+        #: this character's rows ``(15, 3)`` of the servo's feed-forward torques (child
+        #: frames): gravity compensation, and what the laws add for the step
+        self.feedforward = self.servo.feedforward[rows : rows + NJ]
         self._child = np.asarray(wc.body_ids[1:])
         self._balls = np.array([m.joint(wc.prefix + j).id for j in BALL_JOINTS])
         up = -np.asarray(m.opt.gravity, dtype=np.float64)
@@ -140,7 +142,7 @@ class Rig:
         # the anatomical axes (the Euler order's Y, X, Z) in each joint's child frame, where
         # the servo's error and MuJoCo's ball velocities live
         unit = np.eye(3)[[1, 0, 2]]
-        right = np.repeat(quat_conj(athlete._right)[:, None, :], 3, axis=1)
+        right = np.repeat(quat_conj(athlete.joint_right)[:, None, :], 3, axis=1)
         self._axes = quat_rotate(right, np.broadcast_to(unit, (NJ, 3, 3)))
         self._sent_gain = np.ones((NJ, 3))  # what the servo has (sent only when changed)
         self._gain_changed = np.zeros((NJ, 3), dtype=bool)
@@ -181,7 +183,9 @@ class Rig:
         than :meth:`current_angles`, for the per-tick laws."""
         q = self.world.data.qpos[self._knee_qpos].reshape(2, 4)
         a = self.athlete
-        r = quat_mul(quat_conj(a._left[self._knees]), quat_mul(q, quat_conj(a._right[self._knees])))
+        r = quat_mul(
+            quat_conj(a.joint_left[self._knees]), quat_mul(q, quat_conj(a.joint_right[self._knees]))
+        )
         return quat_log(r)[:, 1]
 
     def set_stiffness(self, values: F64) -> None:
@@ -274,7 +278,7 @@ class Rig:
         if self.gravity_compensation:
             self._feedforward()
         else:
-            self._ff[:] = 0.0
+            self.feedforward[:] = 0.0
 
     def _feedforward(self) -> None:
         m, d = self.world.model, self.world.data
@@ -283,8 +287,8 @@ class Rig:
         w = self._weight[:, None] * self._up
         tau = r[:, [1, 2, 0]] * w[:, [2, 0, 1]] - r[:, [2, 0, 1]] * w[:, [1, 2, 0]]  # r x w
         rot = d.xmat[self._child].reshape(NJ, 3, 3)
-        self._ff[:] = np.einsum("nji,nj->ni", rot, tau)
-        flat = self._ff.reshape(-1)
+        self.feedforward[:] = np.einsum("nji,nj->ni", rot, tau)
+        flat = self.feedforward.reshape(-1)
         for k in np.flatnonzero(self.support > 0):
             up = self._up if self.support_dir is None else self.support_dir
             force = self.support[k] * self.support_scale * self._weight_n * up

@@ -492,7 +492,7 @@ class Runner:
         self.leg_force = force
         mujoco.mj_jac(self.world.model, d, self._jacp, None, point, self._feet[leg])
         tau = -self._jacp[:, self._leg_cols[leg]].T @ (force * u)
-        ff = self.rig._ff
+        ff = self.rig.feedforward
         ff[KNEE[leg]] += tau[0:3]
         if state not in ("loading", "heel"):
             ff[ANKLE[leg]] += tau[3:6]
@@ -686,7 +686,7 @@ class Runner:
             # the stance hip makes the attitude torque on the trunk (its reaction is on the
             # thigh); then the leg spring adds the knee's and ankle's torques
             rot = world.data.xmat[self._thighs[self.active]].reshape(3, 3)
-            rig._ff[HIP[self.active]] = -rot.T @ self._attitude_torque(heading)
+            rig.feedforward[HIP[self.active]] = -rot.T @ self._attitude_torque(heading)
             self._leg_spring(t, dt, angles)
         self._log(t, angles)
 

@@ -34,7 +34,7 @@ from reactmocap.athletics.machine import Context
 from reactmocap.athletics.report import report_json
 from reactmocap.athletics.sequencer import Sequencer
 from reactmocap.athletics.tumble import Tumble, TumbleParams
-from reactmocap.athletics.vault_control import Vault, VaultLog, _Logger
+from reactmocap.athletics.vault_control import Vault, VaultLog, VaultLogger
 from reactmocap.athletics.vault_setup import (
     ALL_ROWS_VALUES,
     BOARD,
@@ -191,7 +191,7 @@ def vault(
         lean=p.land_lean,
     )
     seq = Sequencer(ctx, [basis, tumble, Landing(landing), stand])
-    logger = _Logger(basis, seq)
+    logger = VaultLogger(basis, seq)
     tick = None if on_tick is None else (lambda t: on_tick(min(t / duration, 1.0)))
     try:
         res = rollout(world, duration, controllers=[seq, logger], record_fps=fps,

@@ -16,14 +16,15 @@ from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.machine import NEXT, Basis, Context
 from reactmocap.athletics.rig import per_joint
 from reactmocap.athletics.sequencer import Sequencer
-from reactmocap.athletics.vault_setup import _J, HORSE, VaultParams
+from reactmocap.athletics.vault_setup import HORSE, VaultParams
 from reactmocap.rotations import quat_conj, quat_mul, quat_rotate
+from reactmocap.sim.bodies import BALL_JOINT_INDEX as _J  # short: the poses name many joints
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.base import FunctionController
 from reactmocap.sim.controllers.machine import State, after
 from reactmocap.sim.world import World
 
-__all__ = ["Vault", "VaultLog"]
+__all__ = ["Vault", "VaultLog", "VaultLogger"]
 
 NJ = len(BALL_JOINTS)
 
@@ -297,7 +298,7 @@ def _body_pitch(d: mujoco.MjData, chest: int, ath: Athlete) -> float:
     return float(math.atan2(up[0], up[2]))
 
 
-class _Logger:
+class VaultLogger:
     """Keeps logging the vault's rows through the landing (a controller after the sequencer)."""
 
     def __init__(self, vault: Vault, seq: Sequencer) -> None:

@@ -14,13 +14,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import Athlete
-from reactmocap.athletics.rig import joint_index
 from reactmocap.athletics.scene import ATHLETICS_WORLD, shins_off_floor
 from reactmocap.athletics.tumble import position_angles
 from reactmocap.athletics.vault_table1 import GYMNAST_HEIGHT, GYMNAST_MASS
 from reactmocap.errors import ConfigError
 from reactmocap.library.motion import Motion
-from reactmocap.sim.bodies import BALL_JOINTS
+from reactmocap.sim.bodies import BALL_JOINT_INDEX, BALL_JOINTS
 from reactmocap.sim.world import World
 
 __all__ = [
@@ -36,8 +35,6 @@ __all__ = [
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
-
-_J = {name: joint_index(name) for name in BALL_JOINTS}
 
 
 # ---------------------------------------------------------------------------------- apparatus
@@ -237,9 +234,9 @@ def vault_athlete(height: float = GYMNAST_HEIGHT, mass: float = GYMNAST_MASS) ->
     key = (round(height, 4), round(mass, 4))
     if key not in _ATHLETE:
         from reactmocap.athletics.bodies import (
-            _inertials,
-            _joint_points,
             athlete_of,
+            joint_points,
+            segment_inertials,
             thesis_skeleton,
         )
         from reactmocap.library.bodyparts import BodyPartMap
@@ -248,13 +245,13 @@ def vault_athlete(height: float = GYMNAST_HEIGHT, mass: float = GYMNAST_MASS) ->
 
         skel, parts = thesis_skeleton("female")
         s = height / 1.60  # the thesis female's height (Table 3.4)
-        inert = _inertials("female")
+        inert = segment_inertials("female")
         r = mass / sum(v.mass for v in inert.values())
         layout = replace(skel.layout, end_sites={j: tuple(float(x) * s for x in v)  # type: ignore[misc]
                                                  for j, v in skel.layout.end_sites.items()})  # fmt: skip
         scaled = Skeleton(skel.names, skel.parents, skel.offsets * s, layout)
         parts_s = BodyPartMap(scaled, dict(parts.joints))
-        pts = _joint_points("female")
+        pts = joint_points("female")
         root = 0.5 * (pts["ULEGL"] + pts["ULEGR"]) * s
         ref = Motion(
             scaled, 30.0, root[None], np.tile([1.0, 0.0, 0.0, 0.0], (1, scaled.num_joints, 1))
@@ -324,10 +321,10 @@ def vault_start(ath: Athlete, p: VaultParams) -> tuple[F64, F64]:
     ``start_clearance`` over the board's top."""
     angles = np.zeros((NJ, 3))
     for s in "lr":
-        angles[_J[f"{s}_hip"]] = (p.block, 0.0, 0.0)
-        angles[_J[f"{s}_knee"]] = (p.knee_touchdown, 0.0, 0.0)
-        angles[_J[f"{s}_ankle"]] = (-0.2, 0.0, 0.0)
-        angles[_J[f"{s}_shoulder"]] = (p.arms_board, 0.0, 0.0)
+        angles[BALL_JOINT_INDEX[f"{s}_hip"]] = (p.block, 0.0, 0.0)
+        angles[BALL_JOINT_INDEX[f"{s}_knee"]] = (p.knee_touchdown, 0.0, 0.0)
+        angles[BALL_JOINT_INDEX[f"{s}_ankle"]] = (-0.2, 0.0, 0.0)
+        angles[BALL_JOINT_INDEX[f"{s}_shoulder"]] = (p.arms_board, 0.0, 0.0)
     q = ath.standing_qpos(angles, pitch=p.start_pitch, clearance=p.start_clearance + BOARD.top)
     com = ath.com_of(q)
     q[0] += p.start_x - com[0]

@@ -18,7 +18,7 @@ from reactmocap.errors import ReactMocapError
 from reactmocap.io import atomic_write_bytes, save_png
 from reactmocap.library.motion import Motion
 
-__all__ = ["pyplot", "response_plot", "stick_figure_video", "write_video"]
+__all__ = ["imageio_v3", "pyplot", "response_plot", "stick_figure_video", "write_video"]
 
 
 def pyplot():  # type: ignore[no-untyped-def]
@@ -34,7 +34,7 @@ def pyplot():  # type: ignore[no-untyped-def]
     return plt
 
 
-def _imageio():  # type: ignore[no-untyped-def]
+def imageio_v3():  # type: ignore[no-untyped-def]
     try:
         import imageio.v3 as iio
     except ImportError:
@@ -45,7 +45,7 @@ def _imageio():  # type: ignore[no-untyped-def]
 def write_video(frames: NDArray[np.uint8], path: str | Path, fps: float) -> Path:
     """Write ``(T, H, W, 3)`` frames as a GIF or MP4 (by ``path``'s suffix), encoded in
     memory and written atomically: never a half-written video."""
-    iio = _imageio()
+    iio = imageio_v3()
     out = Path(path)
     ext = out.suffix.lower()
     if ext == ".gif":
@@ -113,7 +113,7 @@ def stick_figure_video(
     """Render motions as coloured stick figures from a fixed 3/4 view into a GIF or MP4
     (by ``path``'s suffix). Used when no GL context is available for MuJoCo's renderer."""
     plt = pyplot()
-    _imageio()  # fail before drawing if the writer is missing
+    imageio_v3()  # fail before drawing if the writer is missing
     sampled = []
     n = 0
     for motion, color in motions:

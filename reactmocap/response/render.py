@@ -19,7 +19,7 @@ import numpy as np
 
 from reactmocap.errors import ReactMocapError
 from reactmocap.library.motion import Motion
-from reactmocap.response.plots import _imageio, write_video
+from reactmocap.response.plots import imageio_v3, write_video
 from reactmocap.sim.character import build_character
 
 __all__ = ["RenderUnavailable", "offscreen_renderer", "render_video"]
@@ -86,7 +86,7 @@ def render_video(
     Raises RenderUnavailable if no GL context can be created, ReactMocapError if the video
     writer (imageio, the ``video`` extra) is missing.
     """
-    _imageio()  # fail before rendering if the writer is missing
+    imageio_v3()  # fail before rendering if the writer is missing
     items = list(motions) + ([ghost] if ghost is not None else [])
     if not items:
         raise ReactMocapError("render_video needs at least one motion")

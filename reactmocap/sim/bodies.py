@@ -9,6 +9,7 @@ import numpy as np
 
 __all__ = [
     "BALL_JOINTS",
+    "BALL_JOINT_INDEX",
     "BODY_ALIASES",
     "JOINT_RANGE",
     "SIM_BODIES",
@@ -39,6 +40,8 @@ TREE: tuple[tuple[str, str | None, str | None], ...] = (
 SIM_BODIES: tuple[str, ...] = tuple(b for b, _, _ in TREE)
 BALL_JOINTS: tuple[str, ...] = tuple(j for _, _, j in TREE if j is not None)
 BODY_ALIASES: Mapping[str, str] = {"abdomen": "waist", "thorax": "chest", "neck": "head"}
+#: index in BALL_JOINTS of each joint name
+BALL_JOINT_INDEX: Mapping[str, int] = {j: i for i, j in enumerate(BALL_JOINTS)}
 #: index in SIM_BODIES of each body name
 SIM_BODY_INDEX: Mapping[str, int] = {b: i for i, b in enumerate(SIM_BODIES)}
 #: parent body index of each of SIM_BODIES (-1 for the pelvis)
