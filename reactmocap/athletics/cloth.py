@@ -758,7 +758,7 @@ def render_cloth_video(cloth: Cloth, path: str | Path, size: tuple[int, int] = (
     geoms, the cloth as its flex). Raises :class:`~reactmocap.response.render.RenderUnavailable`
     where no GL context exists."""
     from reactmocap.response.plots import write_video
-    from reactmocap.response.render import offscreen_renderer
+    from reactmocap.response.render import free_camera, offscreen_renderer
 
     if cloth.model is None or not cloth.frames:
         raise ReactMocapError("the cloth has no recorded frames (run it first)")
@@ -766,9 +766,7 @@ def render_cloth_video(cloth: Cloth, path: str | Path, size: tuple[int, int] = (
     d = mujoco.MjData(m)
     width, height = size
     renderer = offscreen_renderer(m, size)
-    cam = mujoco.MjvCamera()
-    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-    cam.distance, cam.elevation, cam.azimuth = 3.2, -12.0, 120.0
+    cam = free_camera(3.2, -12.0, 120.0)
     frames = np.empty((len(cloth.frames), height, width, 3), dtype=np.uint8)
     try:
         for i, (verts, bodies) in enumerate(zip(cloth.frames, cloth.frame_bodies)):

@@ -14,6 +14,7 @@ import numpy as np
 
 from reactmocap.io import save_png
 from reactmocap.response.plots import pyplot, write_video
+from reactmocap.response.render import free_camera
 
 if TYPE_CHECKING:
     from reactmocap.athletics.cycling import CyclingResult
@@ -73,11 +74,9 @@ def ride_video(result: CyclingResult, path: str | Path, fps: float = 30.0,
             f"top-view animation (no GL: MUJOCO_GL={os.environ.get('MUJOCO_GL', 'unset')!r}, {exc})"
         )
     data = mujoco.MjData(model)
-    cam = mujoco.MjvCamera()
-    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
     n = len(result.team.riders)
-    cam.distance = 4.5 if n == 1 else 6.0 + 1.5 * math.sqrt(n)
-    cam.elevation = -20.0 if n == 1 else -35.0
+    # the azimuth follows the lead bicycle's heading (set every frame)
+    cam = free_camera(4.5 if n == 1 else 6.0 + 1.5 * math.sqrt(n), -20.0 if n == 1 else -35.0, 0.0)
     roots = [result.team.bicycles[k].qpos_adr for k in range(n)]
     frames = np.empty((len(q), size[1], size[0], 3), dtype=np.uint8)
     look = None

@@ -108,7 +108,7 @@ def render_world_video(res: RolloutResult, path: str | Path, fps: float = 30.0,
     camera following character 0 from the side. Raises RenderUnavailable without GL."""
 
     from reactmocap.response.plots import write_video
-    from reactmocap.response.render import offscreen_renderer
+    from reactmocap.response.render import free_camera, offscreen_renderer
 
     world = res.world
     m = world.model
@@ -118,9 +118,7 @@ def render_world_video(res: RolloutResult, path: str | Path, fps: float = 30.0,
     qpos = qpos[::step]
     width, height = size
     renderer = offscreen_renderer(m, size)
-    cam = mujoco.MjvCamera()
-    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-    cam.distance, cam.elevation, cam.azimuth = 5.0, -10.0, 90.0
+    cam = free_camera(5.0, -10.0, 90.0)
     frames = np.empty((len(qpos), height, width, 3), dtype=np.uint8)
     root = world.characters[0].qpos_adr
     try:

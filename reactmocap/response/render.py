@@ -22,7 +22,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.response.plots import imageio_v3, write_video
 from reactmocap.sim.character import build_character
 
-__all__ = ["RenderUnavailable", "offscreen_renderer", "render_video"]
+__all__ = ["RenderUnavailable", "free_camera", "offscreen_renderer", "render_video"]
 
 RGBA = tuple[float, float, float, float]
 
@@ -42,6 +42,15 @@ def offscreen_renderer(model: mujoco.MjModel, size: tuple[int, int]) -> mujoco.R
             f"MuJoCo offscreen rendering unavailable (MUJOCO_GL="
             f"{os.environ.get('MUJOCO_GL', 'unset')!r}): {exc}"
         ) from exc
+
+
+def free_camera(distance: float, elevation: float, azimuth: float) -> mujoco.MjvCamera:
+    """A free camera ``distance`` (m) from its look-at point, ``elevation`` and ``azimuth``
+    (deg); the caller moves its ``lookat``."""
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    cam.distance, cam.elevation, cam.azimuth = distance, elevation, azimuth
+    return cam
 
 
 def _scene(chars: Sequence[mujoco.MjSpec]) -> mujoco.MjModel:
@@ -103,9 +112,7 @@ def render_video(
         model.geom_rgba[np.isin(model.geom_bodyid, bodies)] = rgba
     width, height = size
     renderer = offscreen_renderer(model, size)
-    cam = mujoco.MjvCamera()
-    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-    cam.distance, cam.elevation, cam.azimuth = 4.0, -15.0, 135.0
+    cam = free_camera(4.0, -15.0, 135.0)
     pelvis = qpos[0][:, :3]
     # follow the recipient smoothly: the lookat is a 0.5 s moving average of its pelvis
     k = max(1, int(fps * 0.5))
