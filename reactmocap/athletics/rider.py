@@ -287,7 +287,7 @@ class Rider:
         trunk, offsets = self._trunk()
         a = trunk.copy()
         bases = pelvis_pos + offsets
-        turn = np.r_[math.cos(fork / 2), math.sin(fork / 2) * self._axis]
+        turn = np.concatenate(([math.cos(fork / 2)], math.sin(fork / 2) * self._axis))
         grips = self._head + qrot(turn, self._grip0 - self._head)
         a_foot = quat_y(ankle_pitch(np.array([crank + math.pi, crank])))  # left, right
         g_foot = qmul(a_foot, self._neutral[self._foot_rows])

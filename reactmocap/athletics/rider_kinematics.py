@@ -41,6 +41,7 @@ for _i, _j, _k, _s in ((0, 0, 0, 1), (0, 1, 1, -1), (0, 2, 2, -1), (0, 3, 3, -1)
                        (3, 0, 3, 1), (3, 1, 2, 1), (3, 2, 1, -1), (3, 3, 0, 1)):  # fmt: skip
     _HAMILTON[_i, _j, _k] = _s
 _HAMILTON_T = _HAMILTON.reshape(4, 16).T.copy()
+_CONJ = np.array([1.0, -1.0, -1.0, -1.0])
 
 
 def qmul(a: F64, b: F64) -> F64:
@@ -51,7 +52,7 @@ def qmul(a: F64, b: F64) -> F64:
 
 def qconj(q: F64) -> F64:
     """Conjugates of ``(..., 4)`` quaternions."""
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
+    return q * _CONJ
 
 
 def qrot(q: F64, v: F64) -> F64:
