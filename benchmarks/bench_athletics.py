@@ -368,9 +368,10 @@ def _polar_plot(res: dict[str, Any], out: Path) -> None:
             ax.set_title(f"{body}: largest {'COM offset' if key == 'offset' else 'push'} ({unit})")
             ax.set_xlabel(f"X ({unit})")
             ax.set_ylabel(f"Y ({unit})")
-    from reactmocap.athletics.plots import _save
+    from reactmocap.io import save_png
 
-    _save(fig, out / "fig7_5_7_7_balance.png")
+    fig.tight_layout()
+    save_png(fig, out / "fig7_5_7_7_balance.png")
 
 
 def print_table(res: dict[str, Any]) -> None:

@@ -31,7 +31,7 @@ from reactmocap.search.distance import (
 from reactmocap.search.features import calibrations_for, frame_features, get_feature_set
 from reactmocap.search.index import MotionIndex, valid_starts
 from reactmocap.search.types import (
-    _CHUNK,
+    CHUNK,
     COARSE_FRAMES,
     F32,
     F64,
@@ -224,7 +224,7 @@ def _interval_bounds(
     radius = np.zeros(K, dtype=np.float32)
     bound = np.zeros((K, P), dtype=np.float64)
     sizes = hi - lo + 1
-    chunk = max(1, _CHUNK // (2 * window.max_gap_frames))
+    chunk = max(1, CHUNK // (2 * window.max_gap_frames))
     for i in range(0, K, chunk):
         j = np.arange(i, min(K, i + chunk))
         a = int(lo[j[0]])
@@ -262,7 +262,7 @@ def _fit_pca(
         kept if kept.size <= PCA_SAMPLE else np.sort(rng.choice(kept, PCA_SAMPLE, replace=False))
     )
     x = np.concatenate(
-        [_embed_starts(fr, sample[i : i + _CHUNK], ew) for i in range(0, sample.size, _CHUNK)]
+        [_embed_starts(fr, sample[i : i + CHUNK], ew) for i in range(0, sample.size, CHUNK)]
     )
     mean = x.mean(axis=0, dtype=np.float64)
     de = x.shape[1]
@@ -359,7 +359,7 @@ def build_index(
             return np.asarray(rows, dtype=np.float32)
         return np.concatenate([rows, stance.columns(planted[starts])], axis=1)
 
-    proj = np.concatenate([project(kept[i : i + _CHUNK]) for i in range(0, kept.size, _CHUNK)])
+    proj = np.concatenate([project(kept[i : i + CHUNK]) for i in range(0, kept.size, CHUNK)])
     radius, bound = _interval_bounds(
         fr, kept, lo, hi, project, proj, weights, window, stance, planted
     )

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from reactmocap.search.distance import BREAKDOWN_TERMS
 
 __all__ = [
+    "CHUNK",
     "COARSE_FRAMES",
     "DEFAULT_EXACT",
     "DEFAULT_K",
@@ -33,7 +34,7 @@ __all__ = [
 FORMAT_VERSION = 4
 MIRROR_SUFFIX = "_mirror"
 #: windows embedded (or localised) per batch: bounds the temporary arrays
-_CHUNK = 4096
+CHUNK = 4096
 #: frames per window in the coarse pre-ranking of KD candidates
 COARSE_FRAMES = 10
 #: KD candidates, exactly re-ranked candidates, candidates whose interval is refined

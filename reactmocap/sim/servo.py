@@ -176,7 +176,7 @@ class PDServo:
         self._epoch = world.state_epoch
         self.set_gains(kp, kv)
         self.set_targets_to_current()
-        world._servo = self
+        world.attach_servo(self)
 
     # ------------------------------------------------------------------ configuration
     def set_gains(self, kp: float, kv: float | None = None, character: int | None = None) -> None:

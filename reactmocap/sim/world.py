@@ -445,6 +445,11 @@ class World:
         else:
             mujoco.mj_step(self.model, self.data, nstep=n)
 
+    def attach_servo(self, servo: PDServo) -> None:
+        """Make ``servo`` the world's (a PDServo registers itself when made): :meth:`step`
+        steps through it from now on."""
+        self._servo = servo
+
     @property
     def has_servo(self) -> bool:
         return self._servo is not None
