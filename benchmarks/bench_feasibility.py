@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 # the tracking benchmark's windows (this script's folder)
-from bench_sim import INFEASIBLE_SECONDS, _infeasible_seconds
+from bench_sim import INFEASIBLE_SECONDS, infeasible_seconds
 
 from reactmocap.library.bvh import read_bvh
 from reactmocap.library.motion import Motion
@@ -50,7 +50,7 @@ def report(motion: Motion, name: str) -> list[float]:
             f"    {a:5.2f}-{b:5.2f} s: r {np.nanmin(res[seg]):4.0f}-{np.nanmax(res[seg]):4.0f} "
             f"N m against cap {np.nanmin(cap[seg]):3.0f}-{np.nanmax(cap[seg]):3.0f} N m"
         )
-    return _infeasible_seconds(motion, check)
+    return infeasible_seconds(motion, check)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -157,7 +157,7 @@ def _windows(motion: Motion) -> list[float]:
 INFEASIBLE_SECONDS = 0.3
 
 
-def _infeasible_seconds(motion: Motion, check: SupportFeasibility | None = None) -> list[float]:
+def infeasible_seconds(motion: Motion, check: SupportFeasibility | None = None) -> list[float]:
     """Seconds of single support needing more than twice the foot's moment inside each of
     :func:`_windows` (``check``: the clip's :func:`support_feasibility`, computed if absent)."""
     check = support_feasibility(motion) if check is None else check
@@ -203,7 +203,7 @@ def bench_tracking(assist_gain: float, controllers: list[str], jobs: int) -> Non
     motions = {p: _read_bvh(p) for p in clips}
     windows = {p: _windows(m) for p, m in motions.items()}
     feasible = {
-        p: [x < INFEASIBLE_SECONDS for x in _infeasible_seconds(m)] for p, m in motions.items()
+        p: [x < INFEASIBLE_SECONDS for x in infeasible_seconds(m)] for p, m in motions.items()
     }
     print(f"\n(windows run in {jobs} processes: real-time factors are per process)")
     with ProcessPoolExecutor(max_workers=jobs) as pool:
