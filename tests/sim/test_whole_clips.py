@@ -162,6 +162,22 @@ def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> Non
     assert push({"hip_tilt_step": 0.0}) in ("fell", "unstable")
 
 
+def test_a_balance_step_eases_the_pelvis_down_and_back_up(shared_mocap_dir: Path) -> None:
+    """The third shared standing clip pushed 125 N forward at the chest for 0.25 s: the first
+    balance step catches the fall, but with the pelvis target jumping 0.18 m back up as it lands
+    (the plan asked 11 kN of the ground for a tick) and 0.2 m down as the second step begins (it
+    asked none) the body falls back over the front foot and the simulation diverges; eased in
+    and out over 0.1 s (the option ``step_ease``, off by default) it stays up."""
+    respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 125.0)
+
+    def push(params: dict[str, float]) -> str:
+        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
+                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
+
+    assert push({"step_ease": 0.1}) == "ok"
+    assert push({}) in ("fell", "unstable")
+
+
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip
