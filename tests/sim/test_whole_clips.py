@@ -162,12 +162,13 @@ def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> Non
     assert push({"hip_tilt_step": 0.0}) in ("fell", "unstable")
 
 
-def test_a_balance_step_eases_the_pelvis_down_and_back_up(shared_mocap_dir: Path) -> None:
+def test_a_landed_balance_step_eases_the_pelvis_back_up(shared_mocap_dir: Path) -> None:
     """The third shared standing clip pushed 125 N forward at the chest for 0.25 s: the first
-    balance step catches the fall, but with the pelvis target jumping 0.18 m back up as it lands
-    (the plan asked 11 kN of the ground for a tick) and 0.2 m down as the second step begins (it
-    asked none) the body falls back over the front foot and the simulation diverges; eased in
-    and out over 0.1 s (the option ``step_ease``, off by default) it stays up."""
+    balance step catches the fall, but with the lowered pelvis target jumping 0.18 m back up as
+    it lands (the plan asked 11 kN of the ground for a tick) the foot it landed rolls onto an
+    edge, the next step drops the target 0.2 m in one tick, the body falls back over the front
+    foot and the simulation diverges; brought back up over 0.1 s (the option ``step_ease``, off
+    by default) it stays up."""
     respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 125.0)
 
     def push(params: dict[str, float]) -> str:

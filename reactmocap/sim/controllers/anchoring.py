@@ -232,11 +232,12 @@ class AnchoredReference:
         return self.floor_z + max(reach, 0.6 * (self._z0 - self.floor_z))
 
     def _eased_drop(self, t: float, z: float) -> float:
-        """The balance step's drop of the pelvis target below the mocap's height ``z`` at
-        ``t``, eased toward :meth:`_step_pelvis_z`'s (0 without a step) with time constant
-        ``step_ease`` s: jumping 0.25 m down as a step began the plan asked for no ground force
-        (more than g down), and jumping back up as it landed, 11 kN for a tick, which threw the
-        capture point off the stance that had just caught the fall."""
+        """How far (m) the pelvis target is below the mocap's height ``z`` at ``t`` for
+        balance steps: :meth:`_step_pelvis_z`'s drop while a step is under way, and after it
+        lands back up to 0 with time constant ``step_ease`` s. Jumping back up as the step
+        landed, the plan asked the ground for 11 kN for a tick, the foot that had just caught
+        the fall rolled onto an edge and the next step, starting 0.05 s later, dropped the
+        target 0.2 m again in one tick (no ground force asked while it lifted off)."""
         want = 0.0
         if self.step is not None:
             want = max(0.0, z - self._step_pelvis_z(self.step.target[:2]))
@@ -244,6 +245,7 @@ class AnchoredReference:
             rate = min(1.0, (t - self._drop_t) / self.step_ease)
             self._drop += rate * (want - self._drop)
             self._drop_t = t
+        self._drop = max(self._drop, want)  # down at once: the step must reach the floor
         return self._drop
 
     def _sole_corners(self) -> F64:

@@ -170,10 +170,11 @@ class WholeBodyTracker(AnchoredReference):
             swings in proportionally less time (at least 0.4 of ``step_time``; 0: off):
             putting back down a foot that the wide stance after a step had lifted took the
             whole step time while the body fell toward it.
-        step_ease: with ``step_leg``, the pelvis target's drop for a balance step eases in
-            as the step begins and back out after it lands, with this time constant (s; 0:
-            it jumps, as before): the jump down asked the ground for no force as the step
-            began, the jump back up 11 kN for a tick as it landed (``docs/tracking.md``).
+        step_ease: with ``step_leg``, the pelvis target lowered for a balance step comes
+            back up after the step lands with this time constant (s; 0: in one tick, as
+            before), and the next step lowers it from there: the jump back up asked the
+            ground for 11 kN for a tick as the step landed and rolled the foot that had caught
+            the fall onto an edge (``docs/tracking.md``).
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
