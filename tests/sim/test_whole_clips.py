@@ -133,8 +133,10 @@ def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
     onto an edge and it steps (the other foot after a landing) to within 0.1 m of where it was.
     Swung in the time of a step that short (``step_short``, the whole-clip default) the body
     stays up; over the whole step time (0) it fell toward that foot and the simulation
-    diverged (with the trunk folded as far as without steps, ``hip_tilt_step`` 0: with the
-    earlier first step the body survives this push without ``step_short`` too)."""
+    diverged (with the trunk folded as far as without steps, ``hip_tilt_step`` 0, and the
+    pelvis target back up in one tick as the first step lands, ``step_ease`` 0: with the
+    earlier first step, or the eased one, the body survives this push without ``step_short``
+    too)."""
     byebye, force = _shared_push(shared_mocap_dir, "byebye_normal_001", 1.0, 90.0, 100.0)
 
     def push(params: dict[str, float]) -> str:
@@ -142,7 +144,10 @@ def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
                          seconds=2.75, params=params).report.status  # fmt: skip
 
     assert push({}) == "ok"
-    assert push({"step_short": 0.0, "hip_tilt_step": 0.0}) in ("fell", "unstable")
+    assert push({"step_short": 0.0, "hip_tilt_step": 0.0, "step_ease": 0.0}) in (
+        "fell",
+        "unstable",
+    )
 
 
 def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> None:
@@ -160,6 +165,23 @@ def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> Non
 
     assert push({}) == "ok"
     assert push({"hip_tilt_step": 0.0}) in ("fell", "unstable")
+
+
+def test_a_landed_balance_step_eases_the_pelvis_back_up(shared_mocap_dir: Path) -> None:
+    """The third shared standing clip pushed 125 N forward at the chest for 0.25 s: the first
+    balance step catches the fall, but with the lowered pelvis target jumping 0.18 m back up as
+    it lands (the plan asked 11 kN of the ground for a tick) the foot it landed rolls onto an
+    edge, the next step drops the target 0.2 m in one tick, the body falls back over the front
+    foot and the simulation diverges; brought back up over 0.1 s (``step_ease``, the whole-clip
+    default) it stays up."""
+    respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 125.0)
+
+    def push(params: dict[str, float]) -> str:
+        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
+                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
+
+    assert push({}) == "ok"
+    assert push({"step_ease": 0.0}) in ("fell", "unstable")
 
 
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:

@@ -269,6 +269,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("place_pushed", -1.0),
         ("warp_lead", -0.5),
         ("hip_tilt_step", -0.5),
+        ("step_ease", -0.1),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

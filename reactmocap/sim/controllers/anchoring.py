@@ -97,6 +97,7 @@ class AnchoredReference:
         step_alternate: bool = False,
         step_short: float = 0.0,
         place_pushed: float = 0.0,
+        step_ease: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -137,6 +138,10 @@ class AnchoredReference:
         self.step_leg = float(step_leg)
         self.step_alternate = bool(step_alternate)
         self.step_short = float(step_short)
+        self.step_ease = float(step_ease)
+        # how far (m) the pelvis target is down for a balance step (``step_ease``) and the
+        # rollout time it was last moved
+        self._drop, self._drop_t = 0.0, 0.0
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
         self.place_gain = float(place_gain)
@@ -203,7 +208,10 @@ class AnchoredReference:
             v[:2] = rot @ v[:2]  # free-joint angular velocity is local: unchanged
             a[:2] = rot @ a[:2]
         q[:2] += self.balance_shift
-        if self.step is not None and self.step_leg:
+        drop = self._eased_drop(t, q[2]) if self.step_ease and self.step_leg else 0.0
+        if self.step_ease and self.step_leg and (self.step is not None or drop):
+            q[2] -= drop
+        elif self.step is not None and self.step_leg:
             q[2] = min(q[2], self._step_pelvis_z(self.step.target[:2]))
         elif self.step_leg and self._place_move.any():
             # a pushed walk's foot placed further out reaches the floor the same way
@@ -222,6 +230,23 @@ class AnchoredReference:
         gap = target - self.world.data.qpos[self._z_adr - 2 : self._z_adr]
         reach = float(np.sqrt(max(leg * leg - float(gap @ gap), 0.0)))
         return self.floor_z + max(reach, 0.6 * (self._z0 - self.floor_z))
+
+    def _eased_drop(self, t: float, z: float) -> float:
+        """How far (m) the pelvis target is below the mocap's height ``z`` at ``t`` for
+        balance steps: :meth:`_step_pelvis_z`'s drop while a step is under way, and after it
+        lands back up to 0 with time constant ``step_ease`` s. Jumping back up as the step
+        landed, the plan asked the ground for 11 kN for a tick, the foot that had just caught
+        the fall rolled onto an edge and the next step, starting 0.05 s later, dropped the
+        target 0.2 m again in one tick (no ground force asked while it lifted off)."""
+        want = 0.0
+        if self.step is not None:
+            want = max(0.0, z - self._step_pelvis_z(self.step.target[:2]))
+        if t > self._drop_t:
+            rate = min(1.0, (t - self._drop_t) / self.step_ease)
+            self._drop += rate * (want - self._drop)
+            self._drop_t = t
+        self._drop = max(self._drop, want)  # down at once: the step must reach the floor
+        return self._drop
 
     def _sole_corners(self) -> F64:
         """``(2, 4, 3)`` the sole corners now (computed once per simulation time)."""
@@ -581,6 +606,7 @@ class AnchoredReference:
         self._step_ready = 0.0
         self._landed = (-1, -np.inf)
         self._gone_down = False
+        self._drop, self._drop_t = 0.0, 0.0
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping, self.leading = 1.0, False, False
@@ -598,12 +624,13 @@ class AnchoredReference:
                 self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
-                self._placed.copy(), self._gone_down, self.leading)  # fmt: skip
+                self._placed.copy(), self._gone_down, self.leading, self._drop,
+                self._drop_t)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
-         until, place_move, placed, gone_down, leading) = memory  # fmt: skip
+         until, place_move, placed, gone_down, leading, drop, drop_t) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -621,3 +648,4 @@ class AnchoredReference:
         self._placed[:] = placed  # type: ignore[call-overload]
         self._gone_down = bool(gone_down)
         self.leading = bool(leading)
+        self._drop, self._drop_t = float(drop), float(drop_t)  # type: ignore[arg-type]

@@ -161,7 +161,7 @@ WHOLE_CLIP: Mapping[str, Param] = MappingProxyType(
      "balance_margin": 0.05, "trunk_weight": 30.0, "trunk_give": 0.5, "kp_root": 50.0,
      "kp_root_pushed": 30.0, "hip_weight": 300.0, "hip_tilt_step": 0.5, "warp_gain": 0.8,
      "step_pushed": True, "step_leg": 0.9, "step_alternate": True, "step_short": 0.3,
-     "place_pushed": 1.0}
+     "place_pushed": 1.0, "step_ease": 0.1}
 )  # fmt: skip
 
 _REGISTRY: dict[str, ControllerSpec] = {

@@ -170,6 +170,11 @@ class WholeBodyTracker(AnchoredReference):
             swings in proportionally less time (at least 0.4 of ``step_time``; 0: off):
             putting back down a foot that the wide stance after a step had lifted took the
             whole step time while the body fell toward it.
+        step_ease: with ``step_leg``, the pelvis target lowered for a balance step comes
+            back up after the step lands with this time constant (s; 0: in one tick, as
+            before), and the next step lowers it from there: the jump back up asked the
+            ground for 11 kN for a tick as the step landed and rolled the foot that had caught
+            the fall onto an edge (``docs/tracking.md``).
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -259,6 +264,7 @@ class WholeBodyTracker(AnchoredReference):
         step_pushed: bool = False,
         step_alternate: bool = False,
         step_short: float = 0.0,
+        step_ease: float = 0.0,
         swing_weight: float = 10.0,
         kp_swing: float = 400.0,
         place_gain: float = 0.0,
@@ -291,7 +297,7 @@ class WholeBodyTracker(AnchoredReference):
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
-                "step_short": step_short,
+                "step_short": step_short, "step_ease": step_ease,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
@@ -406,7 +412,7 @@ class WholeBodyTracker(AnchoredReference):
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
             warp_gain=warp_gain, warp_lead=warp_lead, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
-            place_pushed=place_pushed,
+            place_pushed=place_pushed, step_ease=step_ease,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
