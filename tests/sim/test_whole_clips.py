@@ -227,6 +227,20 @@ def test_a_walk_pushed_sideways_with_its_rate_following_the_lead_stays_up(
     assert push({"warp_lead": 0.5}).report.status == "ok"
 
 
+def test_a_walk_pushed_sideways_with_its_clip_phase_following_the_body_stays_up(
+    shared_mocap_dir: Path,
+) -> None:
+    """The same 350 N push toward the left-curving walk's left: with the defaults, once the
+    sideways fall is caught the right foot lands 0.3 m behind the clip's landing along the
+    walk, re-anchoring the clip to it puts the clip's centre of mass 0.49 m behind the body,
+    and the walk falls forward; with the clip's clock moving on while the body is ahead
+    (``warp_phase``, opt-in) the clip stays with the body and the walk stays up."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, 90.0, 350.0)
+    res = push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
+                    seconds=2.7, params={"warp_phase": 1.0})  # fmt: skip
+    assert res.report.status == "ok"
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}
