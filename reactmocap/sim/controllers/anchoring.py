@@ -50,6 +50,9 @@ _WARP_TAU = 0.1
 # constant (s), at most this many times faster than real time
 _PHASE_TAU = 0.3
 _PHASE_MAX = 3.0
+# and only once the lead has passed this (m), until it is gone: catching every lead after a
+# push lost pushes the clip's own steps caught (``docs/tracking.md``)
+_PHASE_ON = 0.25
 # a pushed walk's placed foot lands at most this far (m) outside its stance foot, only while
 # the clip's centre of mass runs more than this fast (m/s) away from the fall's side, and only
 # for a capture-point error this many times more sideways than along the walk: wider steps,
@@ -182,6 +185,7 @@ class AnchoredReference:
         self.warp_gain = float(warp_gain)
         self.warp_lead = float(warp_lead)
         self.warp_phase = float(warp_phase)
+        self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -576,14 +580,14 @@ class AnchoredReference:
         self.clock = replace(self.clock, start=self.clock.start + (self.rate - 1.0) * self._dt_slow)
 
     def _catch_phase(self, t: float) -> None:
-        """After a walk's push (``warp_phase``): while the body's centre of mass is ahead of
-        the mocap's along the mocap's walk, the clip's clock moves on by ``warp_phase`` times
-        the clip time that closes the lead (time constant ``_PHASE_TAU``). Re-anchoring the
-        ground path to a foot that landed behind the clip's landing moves the clip's centre
-        of mass back behind the body (0.49 m in 0.13 s), and the next step then landed 0.7 m
-        behind the capture point: the clip's phase is re-anchored to where the body is, its
-        ground path still to the feet. Never back: a lagging body is the rate's
-        (:meth:`_warp`)."""
+        """After a walk's push (``warp_phase``): once the body's centre of mass is
+        ``_PHASE_ON`` ahead of the mocap's along the mocap's walk and until it no longer is,
+        the clip's clock moves on by ``warp_phase`` times the clip time that closes the lead
+        (time constant ``_PHASE_TAU``). Re-anchoring the ground path to a foot that landed
+        behind the clip's landing moved the clip's centre of mass back behind the body (0.49
+        m in 0.13 s), and the next step then landed 0.7 m behind the capture point: the
+        clip's phase is re-anchored to where the body is, its ground path still to the feet.
+        Never back: a lagging body is the rate's (:meth:`_warp`)."""
         c, v, _ = self.com_reference(t)
         v_ref = v[:2] / self.rate
         ref = float(np.linalg.norm(v_ref))
@@ -591,7 +595,11 @@ class AnchoredReference:
             return
         lead = float((self.world.data.subtree_com[self._root][:2] - c[:2]) @ (v_ref / ref))
         if lead <= 0:
+            self._catching = False
             return
+        if not (self._catching or lead >= _PHASE_ON):
+            return
+        self._catching = True
         k = min(1.0, self._dt_slow / _PHASE_TAU)
         ahead = min(self.warp_phase * k * lead / ref, _PHASE_MAX * self._dt_slow)
         self.clock = replace(self.clock, start=self.clock.start + ahead)
@@ -613,6 +621,7 @@ class AnchoredReference:
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping, self.leading = 1.0, False, False
+        self._catching = False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
 
@@ -627,12 +636,12 @@ class AnchoredReference:
                 self.place_shift.copy(), self.step, len(self.steps_taken), self._step_ready,
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
-                self._placed.copy(), self._gone_down, self.leading)  # fmt: skip
+                self._placed.copy(), self._gone_down, self.leading, self._catching)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
-         until, place_move, placed, gone_down, leading) = memory  # fmt: skip
+         until, place_move, placed, gone_down, leading, catching) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -650,3 +659,4 @@ class AnchoredReference:
         self._placed[:] = placed  # type: ignore[call-overload]
         self._gone_down = bool(gone_down)
         self.leading = bool(leading)
+        self._catching = bool(catching)
