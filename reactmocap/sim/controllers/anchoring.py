@@ -50,9 +50,6 @@ _WARP_TAU = 0.1
 # constant (s), at most this many times faster than real time
 _PHASE_TAU = 0.3
 _PHASE_MAX = 3.0
-# and only once the lead has passed this (m), until it is gone: catching every lead after a
-# push lost pushes the clip's own steps caught (``docs/tracking.md``)
-_PHASE_ON = 0.25
 # a pushed walk's placed foot lands at most this far (m) outside its stance foot, only while
 # the clip's centre of mass runs more than this fast (m/s) away from the fall's side, and only
 # for a capture-point error this many times more sideways than along the walk: wider steps,
@@ -581,13 +578,13 @@ class AnchoredReference:
 
     def _catch_phase(self, t: float) -> None:
         """After a walk's push (``warp_phase``): once the body's centre of mass is
-        ``_PHASE_ON`` ahead of the mocap's along the mocap's walk and until it no longer is,
-        the clip's clock moves on by ``warp_phase`` times the clip time that closes the lead
-        (time constant ``_PHASE_TAU``). Re-anchoring the ground path to a foot that landed
-        behind the clip's landing moved the clip's centre of mass back behind the body (0.49
-        m in 0.13 s), and the next step then landed 0.7 m behind the capture point: the
-        clip's phase is re-anchored to where the body is, its ground path still to the feet.
-        Never back: a lagging body is the rate's (:meth:`_warp`)."""
+        ``warp_phase`` m ahead of the mocap's along the mocap's walk and until it no longer
+        is, the clip's clock moves on by the clip time that closes the lead (time constant
+        ``_PHASE_TAU``). Re-anchoring the ground path to a foot that landed behind the clip's
+        landing moved the clip's centre of mass back behind the body (0.49 m in 0.13 s), and
+        the next step then landed 0.7 m behind the capture point: the clip's phase is
+        re-anchored to where the body is, its ground path still to the feet. Never back: a
+        lagging body is the rate's (:meth:`_warp`)."""
         c, v, _ = self.com_reference(t)
         v_ref = v[:2] / self.rate
         ref = float(np.linalg.norm(v_ref))
@@ -597,11 +594,13 @@ class AnchoredReference:
         if lead <= 0:
             self._catching = False
             return
-        if not (self._catching or lead >= _PHASE_ON):
+        # only a large lead: catching every lead after a push lost pushes the clip's own
+        # steps caught (``docs/tracking.md``)
+        if not (self._catching or lead >= self.warp_phase):
             return
         self._catching = True
         k = min(1.0, self._dt_slow / _PHASE_TAU)
-        ahead = min(self.warp_phase * k * lead / ref, _PHASE_MAX * self._dt_slow)
+        ahead = min(k * lead / ref, _PHASE_MAX * self._dt_slow)
         self.clock = replace(self.clock, start=self.clock.start + ahead)
 
     def reset_ground(self, world: World) -> None:

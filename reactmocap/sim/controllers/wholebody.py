@@ -188,10 +188,10 @@ class WholeBodyTracker(AnchoredReference):
             never below 1), so a body that drifts ahead after its sideways fall is caught gets
             its next steps sooner (0: off; ``docs/tracking.md``).
         warp_phase: with ``warp_gain``, after a walk's push (any direction), once the body's
-            centre of mass is 0.25 m ahead of the mocap's along the mocap's walk and until it
-            no longer is, the clip's clock moves on by ``warp_phase`` times the clip time that
-            closes that lead (time constant 0.3 s, never back), so the clip's phase follows
-            the body as its ground path follows the feet (0: off; ``docs/tracking.md``).
+            centre of mass is ``warp_phase`` m ahead of the mocap's along the mocap's walk and
+            until it no longer is, the clip's clock moves on by the clip time that closes that
+            lead (time constant 0.3 s, never back), so the clip's phase follows the body as
+            its ground path follows the feet (0: off; ``docs/tracking.md``).
         place_pushed: after a sideways walk's push (within 30 deg of the side), a swinging
             foot on the side the body falls to lands ``place_pushed`` times the sideways gap
             between the simulated and the mocap's capture point, grown to the mocap's landing
