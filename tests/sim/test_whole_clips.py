@@ -232,7 +232,7 @@ def test_a_walk_pushed_sideways_with_its_clip_phase_following_the_body_stays_up(
 ) -> None:
     """The same 350 N push toward the left-curving walk's left (it falls with the defaults,
     above): once the sideways fall is caught the right foot lands 0.3 m behind the clip's
-    landing along the walk, re-anchoring the clip to it puts the clip's centre of mass 0.49 m
+    landing along the walk, the balance shift toward it puts the clip's centre of mass 0.49 m
     behind the body, and the walk falls forward; with the clip's clock catching a body ahead
     of it by 0.01 m or more (``warp_phase``, opt-in) the clip stays with the body and the
     walk stays up."""

@@ -580,11 +580,11 @@ class AnchoredReference:
         """After a walk's push (``warp_phase``): once the body's centre of mass is
         ``warp_phase`` m ahead of the mocap's along the mocap's walk and until it no longer
         is, the clip's clock moves on by the clip time that closes the lead (time constant
-        ``_PHASE_TAU``). Re-anchoring the ground path to a foot that landed behind the clip's
-        landing moved the clip's centre of mass back behind the body (0.49 m in 0.13 s), and
-        the next step then landed 0.7 m behind the capture point: the clip's phase is
-        re-anchored to where the body is, its ground path still to the feet. Never back: a
-        lagging body is the rate's (:meth:`_warp`)."""
+        ``_PHASE_TAU``). After a foot landed behind the clip's landing, the balance shift and
+        the re-anchoring toward it moved the clip's centre of mass back behind the body (0.49
+        m in 0.13 s), and the next step then landed 0.7 m behind the capture point: the clip's
+        phase is re-anchored to where the body is, its ground path still to the feet. Never
+        back: a lagging body is the rate's (:meth:`_warp`)."""
         c, v, _ = self.com_reference(t)
         v_ref = v[:2] / self.rate
         ref = float(np.linalg.norm(v_ref))
