@@ -249,6 +249,37 @@ def test_a_walk_pushed_sideways_with_its_rate_following_the_lead_stays_up(
     assert push({"warp_lead": 0.5}).report.status == "ok"
 
 
+def test_a_walk_pushed_sideways_with_its_clip_phase_following_the_body_stays_up(
+    shared_mocap_dir: Path,
+) -> None:
+    """The same 350 N push toward the left-curving walk's left (it falls with the defaults,
+    above): once the sideways fall is caught the right foot lands 0.3 m behind the clip's
+    landing along the walk, the balance shift toward it puts the clip's centre of mass 0.49 m
+    behind the body, and the walk falls forward; with the clip's clock catching a body ahead
+    of it by 0.01 m or more (``warp_phase``, opt-in) the clip stays with the body and the
+    walk stays up."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, 90.0, 350.0)
+    res = push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
+                    seconds=2.7, params={"warp_phase": 0.01})  # fmt: skip
+    assert res.report.status == "ok"
+
+
+def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_stays_up(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared walk pushed 200 N toward its right at the chest for 0.2 s at 2.0 s falls
+    with the defaults; with the clip's clock catching a body 0.25 m or more ahead of it
+    (``warp_phase`` 0.25, the swept setting) it stays up."""
+    walk, force = _shared_push(shared_mocap_dir, "walk_normal_001", 2.0, -90.0, 200.0)
+
+    def push(params: dict[str, float]) -> TrackResult:
+        return push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
+                         seconds=2.7, params=params)  # fmt: skip
+
+    assert push({}).report.status == "fell"
+    assert push({"warp_phase": 0.25}).report.status == "ok"
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}

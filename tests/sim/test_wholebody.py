@@ -268,6 +268,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_short", -0.3),
         ("place_pushed", -1.0),
         ("warp_lead", -0.5),
+        ("warp_phase", -1.0),
         ("hip_tilt_step", -0.5),
         ("step_ease", -0.1),
     ],

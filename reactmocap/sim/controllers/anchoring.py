@@ -46,6 +46,10 @@ _DEADBAND_ARM = 0.5
 # this time constant (s): within a step the centre of mass's speed swings by ~20%
 _WARP_MAX = 1.8
 _WARP_TAU = 0.1
+# a pushed walk's clip clock catches a body ahead of it (``warp_phase``) with this time
+# constant (s), at most this many times faster than real time
+_PHASE_TAU = 0.3
+_PHASE_MAX = 3.0
 # a pushed walk's placed foot lands at most this far (m) outside its stance foot, only while
 # the clip's centre of mass runs more than this fast (m/s) away from the fall's side, and only
 # for a capture-point error this many times more sideways than along the walk: wider steps,
@@ -93,6 +97,7 @@ class AnchoredReference:
         place_height: float,
         warp_gain: float = 0.0,
         warp_lead: float = 0.0,
+        warp_phase: float = 0.0,
         step_leg: float = 0.0,
         step_alternate: bool = False,
         step_short: float = 0.0,
@@ -181,6 +186,8 @@ class AnchoredReference:
         self._turn = (0.0, _rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
         self.warp_gain = float(warp_gain)
         self.warp_lead = float(warp_lead)
+        self.warp_phase = float(warp_phase)
+        self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -563,6 +570,8 @@ class AnchoredReference:
             self.rebalance(t)
             if self.warping:
                 self._warp(t)
+                if self.warp_phase:
+                    self._catch_phase(t)
 
     def _warp(self, t: float) -> None:
         """After a walk's push: the clip plays at a rate ``warp_gain`` of the way from 1 to
@@ -592,6 +601,33 @@ class AnchoredReference:
         self.rate += min(1.0, self._dt_slow / _WARP_TAU) * (target - self.rate)
         self.clock = replace(self.clock, start=self.clock.start + (self.rate - 1.0) * self._dt_slow)
 
+    def _catch_phase(self, t: float) -> None:
+        """After a walk's push (``warp_phase``): once the body's centre of mass is
+        ``warp_phase`` m ahead of the mocap's along the mocap's walk and until it no longer
+        is, the clip's clock moves on by the clip time that closes the lead (time constant
+        ``_PHASE_TAU``). After a foot landed behind the clip's landing, the balance shift and
+        the re-anchoring toward it moved the clip's centre of mass back behind the body (0.49
+        m in 0.13 s), and the next step then landed 0.7 m behind the capture point: the clip's
+        phase is re-anchored to where the body is, its ground path still to the feet. Never
+        back: a lagging body is the rate's (:meth:`_warp`)."""
+        c, v, _ = self.com_reference(t)
+        v_ref = v[:2] / self.rate
+        ref = float(np.linalg.norm(v_ref))
+        if ref < 0.2:  # not walking
+            return
+        lead = float((self.world.data.subtree_com[self._root][:2] - c[:2]) @ (v_ref / ref))
+        if lead <= 0:
+            self._catching = False
+            return
+        # only a large lead: catching every lead after a push lost pushes the clip's own
+        # steps caught (``docs/tracking.md``)
+        if not (self._catching or lead >= self.warp_phase):
+            return
+        self._catching = True
+        k = min(1.0, self._dt_slow / _PHASE_TAU)
+        ahead = min(k * lead / ref, _PHASE_MAX * self._dt_slow)
+        self.clock = replace(self.clock, start=self.clock.start + ahead)
+
     def reset_ground(self, world: World) -> None:
         """Back to the captured path, no shift, no step (a rollout's start)."""
         self.anchor_yaw = 0.0
@@ -610,6 +646,7 @@ class AnchoredReference:
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping, self.leading = 1.0, False, False
+        self._catching = False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
 
@@ -625,12 +662,13 @@ class AnchoredReference:
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
-                self._drop_t)  # fmt: skip
+                self._drop_t, self._catching)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
-         until, place_move, placed, gone_down, leading, drop, drop_t) = memory  # fmt: skip
+         until, place_move, placed, gone_down, leading, drop, drop_t,
+         catching) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -649,3 +687,4 @@ class AnchoredReference:
         self._gone_down = bool(gone_down)
         self.leading = bool(leading)
         self._drop, self._drop_t = float(drop), float(drop_t)  # type: ignore[arg-type]
+        self._catching = bool(catching)

@@ -192,6 +192,11 @@ class WholeBodyTracker(AnchoredReference):
             point runs ahead of the mocap's along the mocap's walk (falls by as much behind,
             never below 1), so a body that drifts ahead after its sideways fall is caught gets
             its next steps sooner (0: off; ``docs/tracking.md``).
+        warp_phase: with ``warp_gain``, after a walk's push (any direction), once the body's
+            centre of mass is ``warp_phase`` m ahead of the mocap's along the mocap's walk and
+            until it no longer is, the clip's clock moves on by the clip time that closes that
+            lead (time constant 0.3 s, never back), so the clip's phase follows the body as
+            its ground path follows the feet (0: off; ``docs/tracking.md``).
         place_pushed: after a sideways walk's push (within 30 deg of the side), a swinging
             foot on the side the body falls to lands ``place_pushed`` times the sideways gap
             between the simulated and the mocap's capture point, grown to the mocap's landing
@@ -272,6 +277,7 @@ class WholeBodyTracker(AnchoredReference):
         place_height: float = 0.03,
         warp_gain: float = 0.0,
         warp_lead: float = 0.0,
+        warp_phase: float = 0.0,
         place_pushed: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
@@ -301,7 +307,7 @@ class WholeBodyTracker(AnchoredReference):
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
-                "place_pushed": place_pushed,
+                "warp_phase": warp_phase, "place_pushed": place_pushed,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -410,7 +416,7 @@ class WholeBodyTracker(AnchoredReference):
             balance_margin=balance_margin, balance_tau=balance_tau, stepping=stepping,
             step_margin=step_margin, step_time=step_time, step_height=step_height,
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
-            warp_gain=warp_gain, warp_lead=warp_lead, step_leg=step_leg,
+            warp_gain=warp_gain, warp_lead=warp_lead, warp_phase=warp_phase, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
             place_pushed=place_pushed, step_ease=step_ease,
         )  # fmt: skip
