@@ -189,6 +189,10 @@ class LandingParams:
             COM, ``aim_sideways``) had the hips right the trunk within ~0.1 s, and the
             reaction on the legs lifted one foot: it stood up on the other, which pivoted, and
             turned about the vertical and fell (docs/athletics.md).
+        roll_min: ``roll_ease`` only for a touchdown roll of at least this (rad); a smaller
+            one is righted at once, as without it. Why: the ease changed the fate of landings
+            touching down nearly level too, both ways (the forward tuck's 2 kg backpack
+            lands rolled 25 degrees, and lands only righted at once).
     """
 
     knee: float = 0.6
@@ -219,6 +223,7 @@ class LandingParams:
     stance_push: bool = False
     step: tuple[float, ...] = ()
     roll_ease: float = 0.0
+    roll_min: float = 0.0
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -242,6 +247,7 @@ class LandingParams:
             "spin_ref",
             "twist_arms",
             "roll_ease",
+            "roll_min",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -256,6 +262,8 @@ class LandingParams:
             raise ConfigError(f"landing pitch_ease must be >= 0 s, got {self.pitch_ease}")
         if not 0.0 <= self.roll_ease <= 0.9:  # the recovery hands over within 1 s anyway
             raise ConfigError(f"landing roll_ease must be in [0, 0.9] s, got {self.roll_ease}")
+        if not 0.0 <= self.roll_min <= 0.5 * math.pi:
+            raise ConfigError(f"landing roll_min must be in [0, pi/2] rad, got {self.roll_min}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
             raise ConfigError(f"landing swing_cap must be in (0, 1), got {self.swing_cap!r}")
         for row in self.deltas:
@@ -405,16 +413,18 @@ class Landing(Basis):
             memo["t_touch"] = t
             memo["pitch_touch"] = bl.pelvis_pitch() - bl._lean()
             memo["roll_touch"] = bl.pelvis_roll(ctx.sense(t).heading()) if p.roll_ease else 0.0
+            # eased only past roll_min (else as without: upright at once, no wait)
+            memo["roll_ease"] = p.roll_ease if abs(memo["roll_touch"]) >= p.roll_min else 0.0
 
         def roll_now(t: float) -> float:
             """The pelvis's roll target (see roll_ease): the touchdown's, eased to upright."""
-            if not p.roll_ease:
+            if not memo["roll_ease"]:
                 return 0.0
-            return max(0.0, 1.0 - (t - memo["t_touch"]) / p.roll_ease) * memo["roll_touch"]
+            return max(0.0, 1.0 - (t - memo["t_touch"]) / memo["roll_ease"]) * memo["roll_touch"]
 
         def stand(world: World, t: float) -> None:
             """The balance law, the pelvis's roll eased (roll_ease)."""
-            if p.roll_ease:
+            if memo["roll_ease"]:
                 bl.roll = roll_now(t)
             bl.control(world, t)
 
@@ -500,7 +510,7 @@ class Landing(Basis):
             vel = s.local(s.com_vel, h)
             passed = float(err @ vel) < 0.0  # moving away from the desired COM
             still = float(np.linalg.norm(vel)) < 0.05 and float(np.linalg.norm(err)) < 0.05
-            eased = t - memo["t_touch"] >= p.roll_ease  # the pelvis's roll upright first
+            eased = t - memo["t_touch"] >= memo["roll_ease"]  # the pelvis's roll upright first
             return t_in > 0.05 and (passed or still) and eased
 
         def done(world: World, t: float) -> None:
