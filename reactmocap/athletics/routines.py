@@ -88,7 +88,7 @@ PRESET_STARTS: Mapping[str, Phase] = MappingProxyType({
 #: ``roll_gain``) and its legs' sideways aim is taken from the pelvis's whole orientation
 #: (``aim_sideways``): a perturbed start's small roll grew over the push, and the feet touched
 #: down staggered and to one side of the COM; it stood up on one foot and fell. Since
-#: 2026-12-03 16:10 UTC its landing eases a pelvis rolled 0.5 rad or more at touchdown to
+#: 2026-12-03 16:04 UTC its landing eases a pelvis rolled 0.5 rad or more at touchdown to
 #: upright over 0.3 s (``roll_ease``, ``roll_min``): righted at once, the reaction lifted one
 #: foot and the body stood up on the other, turned about the vertical and fell. The back
 #: layout (inertia 18.5 kg m^2 against the tuck's 4.7) needs the leap at effort 0.9 aiming at
