@@ -343,6 +343,8 @@ class BalanceLaw:
         self._t_wind = math.nan
         #: a step when the capture point leaves the feet (:class:`Step`), or None
         self.stepper: Stepper | None = None
+        #: the pelvis's roll target (rad, heading frame; 0 upright): the landing's roll_ease
+        self.roll = 0.0
         self._knee_standing = float(np.mean(knee_for_length(
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
 
@@ -375,6 +377,13 @@ class BalanceLaw:
         # the commanded pitch starts from where the pelvis is (less the new posture's lean)
         self._pitch0 = self.pelvis_pitch() - self._lean()
         self._t_pitch = t
+
+    def pelvis_roll(self, heading: float) -> float:
+        """Current anatomical roll of the pelvis (rad) in the frame of ``heading``, as
+        :func:`hold_pelvis_and_feet` composes it."""
+        d = self.ctx.world.data
+        q = quat_mul(d.xquat[self.ctx.senses.root], quat_conj(self.athlete.neutral[0]))
+        return float(quat_to_euler(quat_mul(quat_conj(quat_from_yaw(heading)), q), EULER_ORDER)[1])
 
     def pelvis_pitch(self) -> float:
         """Current anatomical pitch of the pelvis (rad, forward > 0)."""
@@ -450,7 +459,7 @@ class BalanceLaw:
             cp_side = float(vel[1]) / omega - float(err[1])  # ... and left of it
         if g.bow is not None and bool(s.foot_contact.all()):
             pitch += self._bow(cp, float(vel[0]))
-        hold_pelvis_and_feet(ctx, d, pitch, h, t)
+        hold_pelvis_and_feet(ctx, d, pitch, h, t, self.roll)
         rig.offset[:] = 0.0
         for k in range(2):
             rig.offset[_ANKLE[k], 0] = -delta[0]
@@ -727,15 +736,17 @@ def hips_for_thighs(  # type: ignore[no-untyped-def]
     return eul
 
 
-def hold_pelvis_and_feet(ctx: Context, d, pitch: float, heading: float, t: float) -> None:  # type: ignore[no-untyped-def]
-    """Set the hips' targets so the pelvis has ``pitch`` (forward > 0; upright otherwise, at
-    ``heading``) given where the thighs are, and the ankles' so the feet lie flat on the floor
-    given where the shins are (the thesis's eqs. 7.3-7.4 and "the hips keep the pelvis
-    vertical"). Yaw targets stay 0."""
+def hold_pelvis_and_feet(  # type: ignore[no-untyped-def]
+    ctx: Context, d, pitch: float, heading: float, t: float, roll: float = 0.0
+) -> None:
+    """Set the hips' targets so the pelvis has ``pitch`` (forward > 0) and ``roll`` (upright
+    by default, at ``heading``) given where the thighs are, and the ankles' so the feet lie
+    flat on the floor given where the shins are (the thesis's eqs. 7.3-7.4 and "the hips keep
+    the pelvis vertical"). Yaw targets stay 0."""
     a = ctx.athlete
     rot = d.xquat[ctx.senses.leg_bodies]  # thighs, shins, feet (world)
     anat = quat_mul(rot, quat_conj(a.neutral[_LEG_NEUTRAL]))
-    pelvis = quat_mul(quat_from_yaw(heading), quat_from_euler([pitch, 0.0, 0.0], EULER_ORDER))
+    pelvis = quat_mul(quat_from_yaw(heading), quat_from_euler([pitch, roll, 0.0], EULER_ORDER))
     flat = _flat_feet(anat[4:6], ctx.senses.floor_normal)
     hips = quat_mul(quat_conj(pelvis)[None], anat[0:2])
     ankles = quat_mul(quat_conj(anat[2:4]), flat)

@@ -182,6 +182,17 @@ class LandingParams:
             the male back handspring's perturbed landings that fall are decided in the first
             0.15 s on the feet by how far the capture point lies past them, which no
             placement of the feet tried reached (docs/athletics.md).
+        roll_ease: seconds over which the pelvis's roll (sideways tilt) target goes from
+            where it was at touchdown to upright, through the absorption and the recovery
+            (which hands over no sooner); 0: upright at once (the default). Why: a forward
+            tuck touching down with the pelvis rolled 20-30 degrees (its legs aimed under the
+            COM, ``aim_sideways``) had the hips right the trunk within ~0.1 s, and the
+            reaction on the legs lifted one foot: it stood up on the other, which pivoted, and
+            turned about the vertical and fell (docs/athletics.md).
+        roll_min: ``roll_ease`` only for a touchdown roll of at least this (rad); a smaller
+            one is righted at once, as without it. Why: the ease changed the fate of landings
+            touching down nearly level too, both ways (the forward tuck's 2 kg backpack
+            lands rolled 25 degrees, and lands only righted at once).
     """
 
     knee: float = 0.6
@@ -211,6 +222,8 @@ class LandingParams:
     twist_arms: float = 0.0
     stance_push: bool = False
     step: tuple[float, ...] = ()
+    roll_ease: float = 0.0
+    roll_min: float = 0.0
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -233,6 +246,8 @@ class LandingParams:
             "momentum_ref",
             "spin_ref",
             "twist_arms",
+            "roll_ease",
+            "roll_min",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -245,6 +260,10 @@ class LandingParams:
             raise ConfigError(f"landing side_lead must be in [0, 2], got {self.side_lead!r}")
         if self.pitch_ease < 0:
             raise ConfigError(f"landing pitch_ease must be >= 0 s, got {self.pitch_ease}")
+        if not 0.0 <= self.roll_ease <= 0.9:  # the recovery hands over within 1 s anyway
+            raise ConfigError(f"landing roll_ease must be in [0, 0.9] s, got {self.roll_ease}")
+        if not 0.0 <= self.roll_min <= 0.5 * math.pi:
+            raise ConfigError(f"landing roll_min must be in [0, pi/2] rad, got {self.roll_min}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
             raise ConfigError(f"landing swing_cap must be in (0, 1), got {self.swing_cap!r}")
         for row in self.deltas:
@@ -393,6 +412,21 @@ class Landing(Basis):
             bl.posture = Posture(leg=_leg_fraction(ctx), lean=p.lean, settle=0.0)
             memo["t_touch"] = t
             memo["pitch_touch"] = bl.pelvis_pitch() - bl._lean()
+            memo["roll_touch"] = bl.pelvis_roll(ctx.sense(t).heading()) if p.roll_ease else 0.0
+            # eased only past roll_min (else as without: upright at once, no wait)
+            memo["roll_ease"] = p.roll_ease if abs(memo["roll_touch"]) >= p.roll_min else 0.0
+
+        def roll_now(t: float) -> float:
+            """The pelvis's roll target (see roll_ease): the touchdown's, eased to upright."""
+            if not memo["roll_ease"]:
+                return 0.0
+            return max(0.0, 1.0 - (t - memo["t_touch"]) / memo["roll_ease"]) * memo["roll_touch"]
+
+        def stand(world: World, t: float) -> None:
+            """The balance law, the pelvis's roll eased (roll_ease)."""
+            if memo["roll_ease"]:
+                bl.roll = roll_now(t)
+            bl.control(world, t)
 
         def knee_stop(t: float) -> None:
             """Hold a switched-off knee out of hyperextension (see KNEE_STOP): servo it to
@@ -416,7 +450,8 @@ class Landing(Basis):
             ease = 0.0
             if p.pitch_ease > 0:
                 ease = max(0.0, 1.0 - (t - memo["t_touch"]) / p.pitch_ease) * memo["pitch_touch"]
-            hold_pelvis_and_feet(ctx, world.data, ease + bl._lean(), s.heading(), t)
+            h = s.heading()
+            hold_pelvis_and_feet(ctx, world.data, ease + bl._lean(), h, t, roll_now(t))
             rig.offset[:] = 0.0
             _stance_support(ctx)
             damp = rig.damping.copy()
@@ -475,7 +510,8 @@ class Landing(Basis):
             vel = s.local(s.com_vel, h)
             passed = float(err @ vel) < 0.0  # moving away from the desired COM
             still = float(np.linalg.norm(vel)) < 0.05 and float(np.linalg.norm(err)) < 0.05
-            return t_in > 0.05 and (passed or still)
+            eased = t - memo["t_touch"] >= memo["roll_ease"]  # the pelvis's roll upright first
+            return t_in > 0.05 and (passed or still) and eased
 
         def done(world: World, t: float) -> None:
             del world
@@ -488,9 +524,9 @@ class Landing(Basis):
             State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),
             State("absorb", law(absorb, every), absorb_enter,
                   ((slowed, "recover"), (after(1.0), "recover"))),
-            State("recover", law(bl.control, every), recover_enter,
+            State("recover", law(stand, every), recover_enter,
                   ((settled, "done"), (after(1.0), "done"))),
-            State("done", law(bl.control, every), done, ((after(0.0), NEXT),)),
+            State("done", law(stand, every), done, ((after(0.0), NEXT),)),
         ]  # fmt: skip
 
 

@@ -87,7 +87,10 @@ PRESET_STARTS: Mapping[str, Phase] = MappingProxyType({
 #: also moves the weight between the feet against the cartwheel momentum (the leap's
 #: ``roll_gain``) and its legs' sideways aim is taken from the pelvis's whole orientation
 #: (``aim_sideways``): a perturbed start's small roll grew over the push, and the feet touched
-#: down staggered and to one side of the COM; it stood up on one foot and fell. The back
+#: down staggered and to one side of the COM; it stood up on one foot and fell. Since
+#: 2026-12-03 16:04 UTC its landing eases a pelvis rolled 0.5 rad or more at touchdown to
+#: upright over 0.3 s (``roll_ease``, ``roll_min``): righted at once, the reaction lifted one
+#: foot and the body stood up on the other, turned about the vertical and fell. The back
 #: layout (inertia 18.5 kg m^2 against the tuck's 4.7) needs the leap at effort 0.9 aiming at
 #: -90 kg m^2/s with the hips allowed 1.5 rad (it gets -77.0, 1.2 m of COM rise); it holds the
 #: layout until the rotation predicted for the touchdown comes down to the turn less 0.96 rad
@@ -143,7 +146,8 @@ SOMERSAULT_PRESETS: Mapping[
                     MappingProxyType({"lead": 0.45, "latest": 0.0, "extend": 0.6,
                                       "extend_lead": 0.15}),
                     MappingProxyType({"delta": 0.04, "knee": 0.5, "restore": 0.4,
-                                      "damping": 1.75, "aim_sideways": True})),
+                                      "damping": 1.75, "aim_sideways": True,
+                                      "roll_ease": 0.3, "roll_min": 0.5})),
     }),
     "female": MappingProxyType({
         "backward": (MappingProxyType({"effort": 0.6, "spin": -26.0, "spin_limit": 1.0,

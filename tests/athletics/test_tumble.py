@@ -14,6 +14,7 @@ import pytest
 from reactmocap.athletics import athlete
 from reactmocap.athletics.backdrop import arm_windmill
 from reactmocap.athletics.behaviours import AthleticsResult
+from reactmocap.athletics.land import LandingParams
 from reactmocap.athletics.leap import LeapParams
 from reactmocap.athletics.maneuvers import (
     CONTROLLERS,
@@ -627,3 +628,30 @@ def test_the_dive_pike_turns_well_clear_of_its_intermediate_axis() -> None:
         old = run_maneuver(tumble(hip=-2.0, lead=2.0), perturbation=starts[i], fps=10.0)
         assert not old.report["landed"], i
     assert not run_maneuver(tumble(lead=2.0), perturbation=starts[14], fps=10.0).report["landed"]
+
+
+def test_a_perturbed_forward_tuck_stands_up_on_both_feet_with_the_roll_eased() -> None:
+    """Start 8 of the capture region at full size (seed 0) touched down as the landers do
+    (+312 deg) but with the pelvis rolled (its left-right axis 23 deg out of the horizontal,
+    its anatomical roll -37 deg); the hips righted it at once, and the reaction lifted the
+    left foot: it stood up on the right one, which pivoted (the body turned about the
+    vertical), and ended on it, not balanced. With a roll of 0.5 rad or more eased to upright over 0.3 s (the
+    landing's ``roll_ease`` and ``roll_min``, the preset since 2026-12-03) it lands."""
+    start = full_starts(9)[8]
+    m = somersault_maneuver(direction="forward")
+    assert m.phases[3].params["roll_ease"] > 0
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+    land = replace(m.phases[3], params={**m.phases[3].params, "roll_ease": 0.0})
+    before = replace(m, phases=(*m.phases[:3], land, *m.phases[4:]))
+    r = run_maneuver(before, perturbation=start, fps=10.0).report
+    assert not r["landed"]
+
+
+def test_the_landing_refuses_a_roll_ease_or_roll_min_out_of_range() -> None:
+    for bad in (-0.1, 1.0, math.nan):
+        with pytest.raises(ConfigError, match="roll_ease|finite"):
+            LandingParams(roll_ease=bad)
+    for bad in (-0.1, 2.0, math.nan):
+        with pytest.raises(ConfigError, match="roll_min|finite"):
+            LandingParams(roll_min=bad)
