@@ -189,8 +189,9 @@ def test_a_second_step_started_while_the_pelvis_comes_back_up_eases_down(
 ) -> None:
     """The third shared standing clip pushed 200 N forward at the chest for 0.25 s: the
     second balance step starts while the eased pelvis target is still coming back up and drops
-    it 0.15 m in one tick; the body falls. Lowered over 0.05 s instead (``step_ease_in``,
-    opt-in: it lost pushes on the fixed-force sweep, ``docs/tracking.md``) it stays up."""
+    it in one tick (0.15 m as traced at 175 N); the body falls. Lowered over 0.05 s instead
+    (``step_ease_in``, opt-in: it lost pushes on the fixed-force sweep, ``docs/tracking.md``)
+    it stays up."""
     respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 200.0)
 
     def push(params: dict[str, float]) -> str:
