@@ -184,6 +184,24 @@ def test_a_landed_balance_step_eases_the_pelvis_back_up(shared_mocap_dir: Path) 
     assert push({"step_ease": 0.0}) in ("fell", "unstable")
 
 
+def test_a_second_step_started_while_the_pelvis_comes_back_up_eases_down(
+    shared_mocap_dir: Path,
+) -> None:
+    """The third shared standing clip pushed 200 N forward at the chest for 0.25 s: the
+    second balance step starts while the eased pelvis target is still coming back up and drops
+    it in one tick (0.15 m as traced at 175 N); the body falls. Lowered over 0.05 s instead
+    (``step_ease_in``, opt-in: it lost pushes on the fixed-force sweep, ``docs/tracking.md``)
+    it stays up."""
+    respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 200.0)
+
+    def push(params: dict[str, float]) -> str:
+        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
+                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
+
+    assert push({}) in ("fell", "unstable")
+    assert push({"step_ease_in": 0.05}) == "ok"
+
+
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip

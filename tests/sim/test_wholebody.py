@@ -271,6 +271,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("warp_phase", -1.0),
         ("hip_tilt_step", -0.5),
         ("step_ease", -0.1),
+        ("step_ease_in", -0.1),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

@@ -103,6 +103,7 @@ class AnchoredReference:
         step_short: float = 0.0,
         place_pushed: float = 0.0,
         step_ease: float = 0.0,
+        step_ease_in: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -147,6 +148,10 @@ class AnchoredReference:
         # how far (m) the pelvis target is down for a balance step (``step_ease``) and the
         # rollout time it was last moved
         self._drop, self._drop_t = 0.0, 0.0
+        self.step_ease_in = float(step_ease_in)
+        # the start time of the last balance step seen and whether its drop eases in
+        # (``step_ease_in``: it began while the target was still coming back up)
+        self._drop_step: tuple[float, bool] = (-np.inf, False)
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
         self.place_gain = float(place_gain)
@@ -248,11 +253,17 @@ class AnchoredReference:
         want = 0.0
         if self.step is not None:
             want = max(0.0, z - self._step_pelvis_z(self.step.target[:2]))
+            if self.step_ease_in and self.step.t0 != self._drop_step[0]:
+                self._drop_step = (self.step.t0, self._drop > 1e-3)
+        easing_in = self.step is not None and self._drop_step[1]
         if t > self._drop_t:
-            rate = min(1.0, (t - self._drop_t) / self.step_ease)
+            down = easing_in and want > self._drop
+            tau = self.step_ease_in if down else self.step_ease
+            rate = min(1.0, (t - self._drop_t) / tau)
             self._drop += rate * (want - self._drop)
             self._drop_t = t
-        self._drop = max(self._drop, want)  # down at once: the step must reach the floor
+        if not easing_in:
+            self._drop = max(self._drop, want)  # down at once: the step must reach the floor
         return self._drop
 
     def _sole_corners(self) -> F64:
@@ -643,6 +654,7 @@ class AnchoredReference:
         self._landed = (-1, -np.inf)
         self._gone_down = False
         self._drop, self._drop_t = 0.0, 0.0
+        self._drop_step = (-np.inf, False)
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping, self.leading = 1.0, False, False
@@ -662,13 +674,13 @@ class AnchoredReference:
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
-                self._drop_t, self._catching)  # fmt: skip
+                self._drop_t, self._catching, self._drop_step)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching) = memory  # fmt: skip
+         catching, drop_step) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -688,3 +700,4 @@ class AnchoredReference:
         self.leading = bool(leading)
         self._drop, self._drop_t = float(drop), float(drop_t)  # type: ignore[arg-type]
         self._catching = bool(catching)
+        self._drop_step = drop_step  # type: ignore[assignment]

@@ -175,6 +175,10 @@ class WholeBodyTracker(AnchoredReference):
             before), and the next step lowers it from there: the jump back up asked the
             ground for 11 kN for a tick as the step landed and rolled the foot that had caught
             the fall onto an edge (``docs/tracking.md``).
+        step_ease_in: with ``step_ease``, a balance step that starts while the target is
+            still coming back up lowers it with this time constant (s; 0: at once, as before);
+            a first step's drop stays instant (easing every drop lost directions at Wooten's
+            figure): a second step's one-tick drop left the plan asking no ground force.
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -270,6 +274,7 @@ class WholeBodyTracker(AnchoredReference):
         step_alternate: bool = False,
         step_short: float = 0.0,
         step_ease: float = 0.0,
+        step_ease_in: float = 0.0,
         swing_weight: float = 10.0,
         kp_swing: float = 400.0,
         place_gain: float = 0.0,
@@ -303,7 +308,7 @@ class WholeBodyTracker(AnchoredReference):
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
                 "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
-                "step_short": step_short, "step_ease": step_ease,
+                "step_short": step_short, "step_ease": step_ease, "step_ease_in": step_ease_in,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
@@ -418,7 +423,7 @@ class WholeBodyTracker(AnchoredReference):
             place_gain=place_gain, place_deadband=place_deadband, place_height=place_height,
             warp_gain=warp_gain, warp_lead=warp_lead, warp_phase=warp_phase, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
-            place_pushed=place_pushed, step_ease=step_ease,
+            place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self.sqrt_ws = float(np.sqrt(swing_weight))
