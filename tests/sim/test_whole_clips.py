@@ -79,6 +79,20 @@ def _shared_push(
     return motion, [newtons * np.cos(angle), newtons * np.sin(angle), 0.0]
 
 
+def _walk_pushed(walk: Motion, force: list[float], time: float, params: dict[str, float]) -> str:
+    """The status of a shared walk tracked from 0.5 s before a 0.2 s chest push at ``time``
+    to 2.7 s in, with the tracker's ``params``."""
+    return push_clip(walk, time=time, body="chest", force=force, duration=0.2,
+                     start=time - 0.5, seconds=2.7, params=params).report.status  # fmt: skip
+
+
+def _stand_pushed(standing: Motion, force: list[float], params: dict[str, float | bool]) -> str:
+    """The status of a shared standing clip tracked from 0.5 s to 2.75 s, pushed at the chest
+    for 0.25 s at 1.0 s, with the tracker's ``params``."""
+    return push_clip(standing, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
+                     seconds=2.75, params=params).report.status  # fmt: skip
+
+
 def test_a_pushed_standing_clip_turns_its_trunk_about_the_hips(shared_mocap_dir: Path) -> None:
     """The shared standing clip pushed 100 N (Wooten's sideways figure) to its left at the chest
     for 0.25 s: with the hip strategy (the whole-clip default) it stays up without a step;
@@ -106,14 +120,9 @@ def test_a_pushed_standing_clip_steps_and_stays_up(shared_mocap_dir: Path) -> No
     hip strategy has folded the trunk as far as it does without steps (``hip_tilt_step`` 0;
     with the earlier step, ``step_leg`` 0 survives this push too), it falls."""
     bye, force = _shared_push(shared_mocap_dir, "bye_normal_001", 1.0, 0.0, 200.0)
-
-    def push(params: dict[str, float | bool]) -> str:
-        return push_clip(bye, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
-                         seconds=2.75, params=params).report.status  # fmt: skip
-
-    assert push({}) == "ok"
-    assert push({"step_pushed": False}) == "fell"
-    assert push({"step_leg": 0.0, "hip_tilt_step": 0.0}) == "fell"
+    assert _stand_pushed(bye, force, {}) == "ok"
+    assert _stand_pushed(bye, force, {"step_pushed": False}) == "fell"
+    assert _stand_pushed(bye, force, {"step_leg": 0.0, "hip_tilt_step": 0.0}) == "fell"
 
 
 def test_a_diagonal_push_steps_with_the_foot_on_its_side(shared_mocap_dir: Path) -> None:
@@ -138,13 +147,10 @@ def test_a_foot_put_back_down_steps_quickly(shared_mocap_dir: Path) -> None:
     earlier first step, or the eased one, the body survives this push without ``step_short``
     too)."""
     byebye, force = _shared_push(shared_mocap_dir, "byebye_normal_001", 1.0, 90.0, 100.0)
-
-    def push(params: dict[str, float]) -> str:
-        return push_clip(byebye, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
-                         seconds=2.75, params=params).report.status  # fmt: skip
-
-    assert push({}) == "ok"
-    assert push({"step_short": 0.0, "hip_tilt_step": 0.0, "step_ease": 0.0}) in (
+    assert _stand_pushed(byebye, force, {}) == "ok"
+    assert _stand_pushed(
+        byebye, force, {"step_short": 0.0, "hip_tilt_step": 0.0, "step_ease": 0.0}
+    ) in (
         "fell",
         "unstable",
     )
@@ -158,13 +164,8 @@ def test_a_step_takes_over_before_the_trunk_folds(shared_mocap_dir: Path) -> Non
     (1.6 rad) the trunk folded 1.3 rad, straightening it as the step began threw the body
     forward past the step and it fell."""
     respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 100.0)
-
-    def push(params: dict[str, float]) -> str:
-        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
-                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
-
-    assert push({}) == "ok"
-    assert push({"hip_tilt_step": 0.0}) in ("fell", "unstable")
+    assert _stand_pushed(respond, force, {}) == "ok"
+    assert _stand_pushed(respond, force, {"hip_tilt_step": 0.0}) in ("fell", "unstable")
 
 
 def test_a_landed_balance_step_eases_the_pelvis_back_up(shared_mocap_dir: Path) -> None:
@@ -175,13 +176,8 @@ def test_a_landed_balance_step_eases_the_pelvis_back_up(shared_mocap_dir: Path) 
     foot and the simulation diverges; brought back up over 0.1 s (``step_ease``, the whole-clip
     default) it stays up."""
     respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 125.0)
-
-    def push(params: dict[str, float]) -> str:
-        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
-                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
-
-    assert push({}) == "ok"
-    assert push({"step_ease": 0.0}) in ("fell", "unstable")
+    assert _stand_pushed(respond, force, {}) == "ok"
+    assert _stand_pushed(respond, force, {"step_ease": 0.0}) in ("fell", "unstable")
 
 
 def test_a_second_step_started_while_the_pelvis_comes_back_up_eases_down(
@@ -193,13 +189,8 @@ def test_a_second_step_started_while_the_pelvis_comes_back_up_eases_down(
     (``step_ease_in``, opt-in: it lost pushes on the fixed-force sweep, ``docs/tracking.md``)
     it stays up."""
     respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 200.0)
-
-    def push(params: dict[str, float]) -> str:
-        return push_clip(respond, time=1.0, body="chest", force=force, duration=0.25,
-                         start=0.5, seconds=2.75, params=params).report.status  # fmt: skip
-
-    assert push({}) in ("fell", "unstable")
-    assert push({"step_ease_in": 0.05}) == "ok"
+    assert _stand_pushed(respond, force, {}) in ("fell", "unstable")
+    assert _stand_pushed(respond, force, {"step_ease_in": 0.05}) == "ok"
 
 
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
@@ -207,13 +198,8 @@ def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip
     default) it walks on; without (0) the steps keep the clip's pace and it falls forward."""
     walk, force = _shared_push(shared_mocap_dir, "walk_normal_001", 2.0, -45.0, 350.0)
-
-    def push(params: dict[str, float]) -> TrackResult:
-        return push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
-                         seconds=2.7, params=params)  # fmt: skip
-
-    assert push({}).report.status == "ok"
-    assert push({"warp_gain": 0.0}).report.status == "fell"
+    assert _walk_pushed(walk, force, 2.0, {}) == "ok"
+    assert _walk_pushed(walk, force, 2.0, {"warp_gain": 0.0}) == "fell"
 
 
 def test_a_walk_pushed_sideways_places_its_outer_foot_and_stays_up(
@@ -225,13 +211,8 @@ def test_a_walk_pushed_sideways_places_its_outer_foot_and_stays_up(
     where the clip puts it, 0.4-0.6 m inside the capture point, and the walk falls to the
     right."""
     walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, -90.0, 350.0)
-
-    def push(params: dict[str, float]) -> TrackResult:
-        return push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
-                         seconds=2.7, params=params)  # fmt: skip
-
-    assert push({}).report.status == "ok"
-    assert push({"place_pushed": 0.0}).report.status == "fell"
+    assert _walk_pushed(walk, force, 1.5, {}) == "ok"
+    assert _walk_pushed(walk, force, 1.5, {"place_pushed": 0.0}) == "fell"
 
 
 def test_a_walk_pushed_sideways_places_only_the_step_the_push_starts(
@@ -243,9 +224,7 @@ def test_a_walk_pushed_sideways_places_only_the_step_the_push_starts(
     0.5 s window), that step went out and back and the body fell forward over it; now the
     clip's step lands and the walk stays up."""
     walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 90.0, 300.0)
-    res = push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
-                    seconds=2.7, params={"place_pushed": 1.0})  # fmt: skip
-    assert res.report.status == "ok"
+    assert _walk_pushed(walk, force, 1.5, {"place_pushed": 1.0}) == "ok"
 
 
 def test_a_walk_pushed_sideways_with_its_rate_following_the_lead_stays_up(
@@ -258,13 +237,8 @@ def test_a_walk_pushed_sideways_with_its_rate_following_the_lead_stays_up(
     the walk (``warp_lead``, opt-in: lower while the body lags in the catch, higher once it
     runs ahead) it stays up."""
     walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, 90.0, 350.0)
-
-    def push(params: dict[str, float]) -> TrackResult:
-        return push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
-                         seconds=2.7, params=params)  # fmt: skip
-
-    assert push({}).report.status == "fell"
-    assert push({"warp_lead": 0.5}).report.status == "ok"
+    assert _walk_pushed(walk, force, 1.5, {}) == "fell"
+    assert _walk_pushed(walk, force, 1.5, {"warp_lead": 0.5}) == "ok"
 
 
 def test_a_walk_pushed_sideways_with_its_clip_phase_following_the_body_stays_up(
@@ -277,9 +251,7 @@ def test_a_walk_pushed_sideways_with_its_clip_phase_following_the_body_stays_up(
     of it by 0.01 m or more (``warp_phase``, opt-in) the clip stays with the body and the
     walk stays up."""
     walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, 90.0, 350.0)
-    res = push_clip(walk, time=1.5, body="chest", force=force, duration=0.2, start=1.0,
-                    seconds=2.7, params={"warp_phase": 0.01})  # fmt: skip
-    assert res.report.status == "ok"
+    assert _walk_pushed(walk, force, 1.5, {"warp_phase": 0.01}) == "ok"
 
 
 def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_stays_up(
@@ -289,13 +261,8 @@ def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_stays_up(
     with the defaults; with the clip's clock catching a body 0.25 m or more ahead of it
     (``warp_phase`` 0.25, the swept setting) it stays up."""
     walk, force = _shared_push(shared_mocap_dir, "walk_normal_001", 2.0, -90.0, 200.0)
-
-    def push(params: dict[str, float]) -> TrackResult:
-        return push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
-                         seconds=2.7, params=params)  # fmt: skip
-
-    assert push({}).report.status == "fell"
-    assert push({"warp_phase": 0.25}).report.status == "ok"
+    assert _walk_pushed(walk, force, 2.0, {}) == "fell"
+    assert _walk_pushed(walk, force, 2.0, {"warp_phase": 0.25}) == "ok"
 
 
 def test_convex_hull_and_distances() -> None:
