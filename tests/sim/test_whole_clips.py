@@ -193,6 +193,20 @@ def test_a_second_step_started_while_the_pelvis_comes_back_up_eases_down(
     assert _stand_pushed(respond, force, {"step_ease_in": 0.05}) == "ok"
 
 
+def test_a_balance_step_landing_softly_stays_up(shared_mocap_dir: Path) -> None:
+    """The third shared standing clip pushed 250 N forward at the chest for 0.25 s: each
+    balance step's landing asks the ground for 8-15 kN for about 20 ms and the body falls. With
+    the landed foot's no-slip rows coming in over 0.05 s and large ground forces costing more
+    meanwhile (``step_soft``, opt-in: ``docs/tracking.md``) it stays up, its feet on the floor."""
+    respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 250.0)
+    assert _stand_pushed(respond, force, {}) in ("fell", "unstable")
+    res = push_clip(respond, time=1.0, body="chest", force=force, duration=0.25, start=0.5,
+                    seconds=2.75, params={"step_soft": 0.05})  # fmt: skip
+    assert res.report.status == "ok"
+    pos, _ = res.rollout.body_transforms(0)
+    assert pos[-1, :, 2].min() < 0.2  # standing on the floor, not thrown into the air
+
+
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip

@@ -65,6 +65,7 @@ class _Support:
     gen: F64
     rows: F64
     bias: F64
+    nrows: tuple[int, ...] = ()  # per foot in ``feet``, its rows in ``rows``
 
 
 @dataclass(frozen=True)
@@ -179,6 +180,11 @@ class WholeBodyTracker(AnchoredReference):
             still coming back up lowers it with this time constant (s; 0: at once, as before);
             a first step's drop stays instant (easing every drop lost directions at Wooten's
             figure): a second step's one-tick drop left the plan asking no ground force.
+        step_soft, step_soft_reg: for ``step_soft`` s after a balance step lands (0: off),
+            the landed foot's no-slip rows come in linearly from a tick's share and the
+            ground forces' regulariser is ``step_soft_reg`` instead of ``force_reg`` (a soft
+            touchdown): a landing asked the ground for 11-14 kN over 20 ms
+            (``docs/tracking.md``).
         swing_weight, kp_swing: weight and stiffness (critically damped) of a stepping
             foot's position and tilt rows.
         place_gain, place_deadband, place_height: while a foot swings in the mocap (its sole
@@ -275,6 +281,8 @@ class WholeBodyTracker(AnchoredReference):
         step_short: float = 0.0,
         step_ease: float = 0.0,
         step_ease_in: float = 0.0,
+        step_soft: float = 0.0,
+        step_soft_reg: float = 1e-2,
         swing_weight: float = 10.0,
         kp_swing: float = 400.0,
         place_gain: float = 0.0,
@@ -309,6 +317,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
                 "step_short": step_short, "step_ease": step_ease, "step_ease_in": step_ease_in,
+                "step_soft": step_soft, "step_soft_reg": step_soft_reg,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
@@ -426,6 +435,9 @@ class WholeBodyTracker(AnchoredReference):
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
+        self._soft = float(step_soft)
+        self._soft_reg = float(np.sqrt(step_soft_reg))
+        self._dt_tick = self.control_every * world.timestep
         self.sqrt_ws = float(np.sqrt(swing_weight))
         self.kp_swing = float(kp_swing)
         self.kv_swing = critical_kv(kp_swing)
@@ -465,6 +477,7 @@ class WholeBodyTracker(AnchoredReference):
         pts: list[F64] = []
         rows: list[F64] = []
         bias: list[F64] = []
+        nrows: list[int] = []
         k0 = 0
         for f in range(2):
             if not planted[f]:
@@ -511,6 +524,7 @@ class WholeBodyTracker(AnchoredReference):
             owners.append(owner + k0)
             k0 += len(p_f)
             rows.append(jac[:still].reshape(-1, jac.shape[-1]))
+            nrows.append(3 * still + 2 * bool(patch_on[f]))
             rs = r[:still]
             w_old = d.cvel[body, :3]
             # w x (w' x r) = w' (w . r) - r (w . w')
@@ -539,6 +553,7 @@ class WholeBodyTracker(AnchoredReference):
             gen=np.concatenate(gens).T,
             rows=np.concatenate(rows),
             bias=np.concatenate(bias),
+            nrows=tuple(nrows),
         )
 
     def plan(self, t: float) -> WholeBodyPlan:
@@ -612,9 +627,13 @@ class WholeBodyTracker(AnchoredReference):
             # the tangential rows and a soft weight, joint accelerations missed the plan by
             # 100-350 rad/s^2 in double support
             jt = sup.rows
-            tasks.append(
-                (self.sqrt_wc * jt, -self.sqrt_wc * (sup.bias + self.contact_kv * (jt @ v)))
-            )
+            wc = self._landing_weights(t, sup) if self._soft else None
+            if wc is None:
+                tasks.append(
+                    (self.sqrt_wc * jt, -self.sqrt_wc * (sup.bias + self.contact_kv * (jt @ v)))
+                )
+            else:
+                tasks.append((wc[:, None] * jt, -wc * (sup.bias + self.contact_kv * (jt @ v))))
         # with nothing to push on, the pelvis follows momentum whatever the joints do: asking
         # the joints to steer it anyway made them whip and blew up falls (tumbling kicks)
         swing = self._swing_targets(t)
@@ -663,7 +682,10 @@ class WholeBodyTracker(AnchoredReference):
             if nb:
                 mt = x[:, :nb]
                 scale = float(np.sqrt((mt * mt).sum(axis=0).max())) or 1.0
-                lhs = np.concatenate([mt, self.sqrt_reg * scale * np.eye(nb)])
+                reg = self.sqrt_reg
+                if self._soft and 0.0 <= t - self._landed[1] < self._soft:
+                    reg = self._soft_reg  # a soft touchdown: large ground forces cost more
+                lhs = np.concatenate([mt, reg * scale * np.eye(nb)])
                 rhs = np.zeros(len(lhs))
                 rhs[: len(mt)] = -x[:, nb]
                 beta = self._nnls(lhs, rhs)
@@ -680,6 +702,19 @@ class WholeBodyTracker(AnchoredReference):
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
+
+    def _landing_weights(self, t: float, sup: _Support) -> F64 | None:
+        """The no-slip rows' square-root weights in the ``step_soft`` s after a balance
+        step lands: the landed foot's rise linearly from a tick's share, the others'
+        ``sqrt_wc`` (``None`` otherwise: all ``sqrt_wc``)."""
+        f, landed = self._landed
+        if f not in sup.feet or not 0.0 <= t - landed < self._soft:
+            return None
+        w = np.full(len(sup.rows), self.sqrt_wc)
+        k = sup.feet.index(f)
+        r0 = sum(sup.nrows[:k])
+        w[r0 : r0 + sup.nrows[k]] *= (t - landed + self._dt_tick) / (self._soft + self._dt_tick)
+        return w
 
     def _push_response(self, t: float) -> float:
         """Follows pushes and returns the trunk rows' weight at ``t``: while the mocap stands,
