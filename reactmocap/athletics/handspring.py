@@ -82,6 +82,9 @@ class HandspringParams:
             :data:`TWIST_LIMIT` each way: the hands' floor forces along the travel then make a
             vertical moment against the twist (the hands are the only thing that can change
             it once in the air); 0: off (as before).
+        twist_above: the twist feedback acts only in a run whose hands meet the floor with
+            more than this vertical momentum (kg m^2/s, either way): a small one is no harm,
+            and the split disturbs the push.
     """
 
     arms: float = -2.9
@@ -103,6 +106,7 @@ class HandspringParams:
     aim_height: float = 1.03
     aim_knees: float = 0.9
     twist_gain: float = 0.0
+    twist_above: float = 0.0
 
     def __post_init__(self) -> None:
         for name, v in vars(self).items():
@@ -116,8 +120,11 @@ class HandspringParams:
             raise ConfigError(
                 f"handspring aim must be in [-2 pi, 0] rad (backward < 0; 0: off), got {self.aim}"
             )
-        if not 0.0 <= self.twist_gain <= 100.0:
-            raise ConfigError(f"handspring twist_gain must be in [0, 100], got {self.twist_gain}")
+        if not (0.0 <= self.twist_gain <= 100.0 and self.twist_above >= 0.0):
+            raise ConfigError(
+                f"handspring twist_gain must be in [0, 100] and twist_above >= 0, got "
+                f"{self.twist_gain}, {self.twist_above}"
+            )
         if self.aim_gain < 0 or not 0.3 <= self.aim_height <= 2.0 or not 0 < self.aim_knees <= 2.0:
             raise ConfigError(
                 f"handspring aim_gain must be >= 0, aim_height in [0.3, 2] (of the standing "
@@ -206,7 +213,10 @@ class Handspring(Basis):
             rig.move(pose(p.arms, p.arch, p.hips, p.knees, p.neck), p.entry, t, moving)
 
         def support_enter(world: World, t: float) -> None:
-            del world
+            # (the momentum read only with the feedback on: off, the run is as before)
+            memo["twist"] = p.twist_gain > 0 and (
+                abs(float(world.data.subtree_angmom[ctx.sense(t).root][2])) > p.twist_above
+            )
             memo["contact"] = t
             memo["pushed"] = False
             rig.set_stiffness(per_joint(SUPPORT_STIFFNESS))
@@ -224,7 +234,7 @@ class Handspring(Basis):
 
         def support(world: World, t: float) -> None:
             hands = watch(t)
-            if p.twist_gain > 0:
+            if memo["twist"]:
                 # the vertical momentum against a fore-aft split of the hands' push
                 lz = float(world.data.subtree_angmom[ctx.sense(t).root][2]) if hands else 0.0
                 off = float(np.clip(p.twist_gain * lz / unit, -TWIST_LIMIT, TWIST_LIMIT))
