@@ -38,6 +38,8 @@ HANDS = frozenset({"l_hand", "r_hand"})
 #: joint stiffness while the hands carry the body (m g L N m/rad): arms as struts
 SUPPORT_STIFFNESS = {**TUMBLE_STIFFNESS, "shoulder": 3.0, "elbow": 3.0, "wrist": 1.0,
                      "waist": 3.0, "back": 3.0, "hip": 3.0}  # fmt: skip
+#: the largest shoulder pitch offset (rad) the hands' twist feedback may make (twist_gain)
+TWIST_LIMIT = 0.5
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,15 @@ class HandspringParams:
         aim_height: the COM height at hand contact the prediction falls to, as a fraction of
             the standing COM height.
         aim_knees: the most knee flexion the aim may ask for (rad).
+        twist_gain: while the hands are on the floor, the shoulders' pitch is moved apart
+            (one arm pushes on toward the front, the other back) by this many rad per unit of
+            the whole-body vertical angular momentum (in m L^2 rad/s), at most
+            :data:`TWIST_LIMIT` each way: the hands' floor forces along the travel then make a
+            vertical moment against the twist (the hands are the only thing that can change
+            it once in the air); 0: off (as before).
+        twist_above: the twist feedback acts only in a run whose hands meet the floor with
+            more than this vertical momentum (kg m^2/s, either way): a small one is no harm,
+            and the split disturbs the push.
     """
 
     arms: float = -2.9
@@ -94,6 +105,8 @@ class HandspringParams:
     aim_gain: float = 4.0
     aim_height: float = 1.03
     aim_knees: float = 0.9
+    twist_gain: float = 0.0
+    twist_above: float = 0.0
 
     def __post_init__(self) -> None:
         for name, v in vars(self).items():
@@ -106,6 +119,11 @@ class HandspringParams:
         if not -2.0 * math.pi <= self.aim <= 0.0:
             raise ConfigError(
                 f"handspring aim must be in [-2 pi, 0] rad (backward < 0; 0: off), got {self.aim}"
+            )
+        if not (0.0 <= self.twist_gain <= 100.0 and self.twist_above >= 0.0):
+            raise ConfigError(
+                f"handspring twist_gain must be in [0, 100] and twist_above >= 0, got "
+                f"{self.twist_gain}, {self.twist_above}"
             )
         if self.aim_gain < 0 or not 0.3 <= self.aim_height <= 2.0 or not 0 < self.aim_knees <= 2.0:
             raise ConfigError(
@@ -195,7 +213,10 @@ class Handspring(Basis):
             rig.move(pose(p.arms, p.arch, p.hips, p.knees, p.neck), p.entry, t, moving)
 
         def support_enter(world: World, t: float) -> None:
-            del world
+            # (the momentum read only with the feedback on: off, the run is as before)
+            memo["twist"] = p.twist_gain > 0 and (
+                abs(float(world.data.subtree_angmom[ctx.sense(t).root][2])) > p.twist_above
+            )
             memo["contact"] = t
             memo["pushed"] = False
             rig.set_stiffness(per_joint(SUPPORT_STIFFNESS))
@@ -207,9 +228,17 @@ class Handspring(Basis):
                     goal, max(p.push_after, 0.02), t, [joint_index(f"{s}_elbow") for s in "lr"]
                 )
 
+        shoulders = [joint_index(f"{s}_shoulder") for s in "lr"]
+        apart = np.array([1.0, -1.0])  # left and right shoulders' share of the twist offset
+        unit = ctx.athlete.mass * ctx.athlete.leg_length**2
+
         def support(world: World, t: float) -> None:
-            del world
-            watch(t)
+            hands = watch(t)
+            if memo["twist"]:
+                # the vertical momentum against a fore-aft split of the hands' push
+                lz = float(world.data.subtree_angmom[ctx.sense(t).root][2]) if hands else 0.0
+                off = float(np.clip(p.twist_gain * lz / unit, -TWIST_LIMIT, TWIST_LIMIT))
+                rig.offset[shoulders, 0] = off * apart
             if not memo["pushed"] and t - memo["contact"] >= p.push_after:
                 memo["pushed"] = True
                 rec["push"] = t
