@@ -106,6 +106,9 @@ ROLL_SHIFT = 0.5
 #: the tilt feedback's yaw gain as a multiple of its roll gain (tilt_gain): the yaw
 #: momentum is the smaller, and the one that told the female back tuck's landings apart
 TILT_YAW = 4.0
+#: the most the "com" push's yaw feedback tilts each foot's ground force fore or aft (a
+#: fraction of the force; yaw_gain): 0.15 at 2.5 kN a foot 20 cm apart is a 75 N m couple
+YAW_TILT = 0.15
 #: stiffness in the air (the legs only position themselves)
 FLIGHT_STIFFNESS = {
     "waist": 2.0, "back": 2.0, "neck": 0.3, "shoulder": 0.3, "elbow": 0.15, "wrist": 0.05,
@@ -177,6 +180,18 @@ class LeapParams:
     #: COM), and the forward tuck touched down with the feet staggered and to the side of
     #: the COM, stood up on one foot and fell (docs/athletics.md); 0: off (as before)
     roll_gain: float = 0.0
+    #: the "com" push keeps a weight share on a foot off the floor (both feet's shares from
+    #: where the COM lies between the sole centres while only one foot is down): a perturbed
+    #: start whose other foot was unloaded pushed on the one foot alone, to the side of the
+    #: COM, and left with 12-100 kg m^2/s of roll; the lifted leg's share presses it back
+    #: down. False: off (as before)
+    push_both: bool = False
+    #: the "com" push also servos the whole-body momentum about the vertical (yaw, twist) to
+    #: zero by tilting the feet's ground forces fore and aft in opposite senses, a couple about
+    #: the vertical (tilt per unit of momentum in m L^2 rad/s, at most ``YAW_TILT``): the
+    #: forward tuck's take-off yaw became the pelvis's roll at touchdown (r = +0.74), and the
+    #: hips' yaw (``tilt_gain``'s way) put a cartwheel in; 0: off (as before)
+    yaw_gain: float = 0.0
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -184,7 +199,7 @@ class LeapParams:
                 self.stiffness, self.lean, self.crouch_side,
                 self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
                 self.push_ramp, self.push_limit, self.push_hip, self.push_ankle,
-                self.tilt_gain, self.roll_gain]  # fmt: skip
+                self.tilt_gain, self.roll_gain, self.yaw_gain]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.0 < self.crouch_side <= 5.0:
@@ -212,6 +227,8 @@ class LeapParams:
             raise ConfigError(f"leap tilt_gain must be in [0, 100] rad, got {self.tilt_gain}")
         if not 0.0 <= self.roll_gain <= 100.0:
             raise ConfigError(f"leap roll_gain must be in [0, 100], got {self.roll_gain}")
+        if not 0.0 <= self.yaw_gain <= 100.0:
+            raise ConfigError(f"leap yaw_gain must be in [0, 100], got {self.yaw_gain}")
         if self.handover not in HANDOVERS:
             raise ConfigError(
                 f"leap handover must be one of {list(HANDOVERS)}, got {self.handover!r}"
@@ -265,6 +282,7 @@ class Leap(Basis):
         ankles = [joint_index(f"{k}_ankle") for k in "lr"]
         hips = [joint_index(f"{k}_hip") for k in "lr"]
         tilt = np.zeros(2)  # the tilt feedback's roll and yaw momentum (tilt_gain)
+        dirs = np.zeros((2, 3))  # each foot's ground force direction (yaw_gain)
 
         def crouch(world: World, t: float) -> None:
             del world
@@ -396,6 +414,12 @@ class Leap(Basis):
             goal[knees] = now[knees]
             rig.move(goal, 0.0, t, knees)
             bl._support(s)
+            if p.push_both and memo["pushing"] and s.foot_contact.sum() == 1:
+                # the shares by where the COM lies between the sole centres, not the contacts
+                soles = s.corners.mean(axis=1)[:, :2]
+                ab = soles[1] - soles[0]
+                w = float(np.clip((s.com[:2] - soles[0]) @ ab / max(float(ab @ ab), 1e-9), 0, 1))
+                rig.support[:] = (1.0 - w, w)
             if p.roll_gain > 0 and rig.support.all():
                 # the cartwheel (roll) momentum to zero: weight moved onto the foot whose
                 # push rolls the body back (the centre of pressure to that side of the COM)
@@ -433,6 +457,20 @@ class Leap(Basis):
             size = float(np.linalg.norm(force))
             rig.support_scale = size / g
             rig.support_dir = force / max(size, 1e-9)
+            if p.yaw_gain > 0:
+                # the momentum about the vertical to zero: the feet's ground forces tilted
+                # fore and aft in opposite senses (a couple about the vertical; the roll and
+                # pitch untouched)
+                yaw = world.data.subtree_angmom[s.root][2] / (
+                    ctx.athlete.mass * ctx.athlete.leg_length**2
+                )
+                c = float(np.clip(p.yaw_gain * yaw, -YAW_TILT, YAW_TILT))
+                # left foot's force tilted forward, the right's back, for a positive yaw
+                dirs[:] = force / max(size, 1e-9)
+                dirs[:, 0] += (c * math.cos(h), -c * math.cos(h))
+                dirs[:, 1] += (c * math.sin(h), -c * math.sin(h))
+                dirs[:] /= np.linalg.norm(dirs, axis=1, keepdims=True)
+                rig.support_dir = dirs
             # the force acts on each foot under the COM (not through the ankle, where it
             # passed behind the COM and pitched the body forward), moved ahead or back by the
             # whole-body pitch momentum's error: the centre of pressure steers the momentum

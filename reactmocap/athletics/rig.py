@@ -125,7 +125,8 @@ class Rig:
         #: the vertical ground force the supporting legs make, in body weights (1: hold the body
         #: up; more: decelerate a fall)
         self.support_scale = 1.0
-        #: direction (world, unit) of that ground force; None: against gravity
+        #: direction (world, unit) of that ground force, or one per foot (``(2, 3)``); None:
+        #: against gravity
         self.support_dir: F64 | None = None
         #: where on each foot (world, ``(2, 3)``) that force acts; None: through the ankle
         self.support_point: F64 | None = None
@@ -291,6 +292,8 @@ class Rig:
         flat = self.feedforward.reshape(-1)
         for k in np.flatnonzero(self.support > 0):
             up = self._up if self.support_dir is None else self.support_dir
+            if up.ndim == 2:  # one direction per foot
+                up = up[k]
             force = self.support[k] * self.support_scale * self._weight_n * up
             at = d.xanchor[self._ankles[k]] if self.support_point is None else self.support_point[k]
             mujoco.mj_jac(m, d, self._jacp, None, at, self._feet[k])

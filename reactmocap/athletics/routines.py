@@ -142,7 +142,7 @@ SOMERSAULT_PRESETS: Mapping[
                                       "pitch": 0.0, "lean": 0.0, "push_hip": 0.5,
                                       "push_ankle": 1.0, "spin": 49.0, "com_offset": 0.05,
                                       "com_ease": True, "arms_back": -2.8, "arms": 0.0,
-                                      "roll_gain": 15.0}),
+                                      "roll_gain": 15.0, "push_both": True}),
                     MappingProxyType({"lead": 0.45, "latest": 0.0, "extend": 0.6,
                                       "extend_lead": 0.15}),
                     MappingProxyType({"delta": 0.04, "knee": 0.5, "restore": 0.4,

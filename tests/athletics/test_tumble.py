@@ -655,3 +655,44 @@ def test_the_landing_refuses_a_roll_ease_or_roll_min_out_of_range() -> None:
     for bad in (-0.1, 2.0, math.nan):
         with pytest.raises(ConfigError, match="roll_min|finite"):
             LandingParams(roll_min=bad)
+
+
+def test_a_perturbed_forward_tuck_keeps_both_feet_pushing_and_lands() -> None:
+    """Start 21 of the capture region at full size (seed 0): in its "com" push's last ticks
+    one foot left the floor before the other, which took the whole planned force alone and
+    rolled the body (-3.2 kg m^2/s of cartwheel at lift-off, heading frame); it stood up on
+    one foot and fell. With a share kept on a foot off the floor (``push_both``, the preset
+    since 2026-12-03) it leaves with little roll and lands."""
+    start = full_starts(22)[21]
+    m = somersault_maneuver(direction="forward")
+    assert m.phases[1].params["push_both"] is True
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+    leap = replace(m.phases[1], params={**m.phases[1].params, "push_both": False})
+    before = replace(m, phases=(m.phases[0], leap, *m.phases[2:]))
+    assert not run_maneuver(before, perturbation=start, fps=10.0).report["landed"]
+
+
+def test_a_perturbed_forward_tuck_pushes_off_without_yaw_with_the_yaw_gain() -> None:
+    """Start 22 of the capture region at full size (seed 0) takes off with -1.9 kg m^2/s of
+    momentum about the vertical, touches down with the pelvis rolled -38 deg and falls. The
+    "com" push's ``yaw_gain`` (an option, off in the preset: 29/50 against 32/50 at full size,
+    docs/athletics.md) tilts the feet's ground forces fore and aft against the yaw: it leaves
+    with under 1.2 and lands."""
+    start = full_starts(23)[22]
+    m = somersault_maneuver(direction="forward")
+    r = run_maneuver(m, perturbation=start, fps=10.0)
+    assert not r.report["landed"]
+    assert abs(_liftoff_momentum(r)[2]) > 1.5
+    leap = replace(m.phases[1], params={**m.phases[1].params, "yaw_gain": 3.0})
+    r = run_maneuver(replace(m, phases=(m.phases[0], leap, *m.phases[2:])), perturbation=start,
+                     fps=10.0)  # fmt: skip
+    assert r.report["landed"] and not r.report["fell"]
+    assert abs(r.report["rotation_deg"] - 360.0) <= 30.0
+    assert abs(_liftoff_momentum(r)[2]) < 1.2
+
+
+def test_the_leap_refuses_a_yaw_gain_out_of_range() -> None:
+    for bad in (-1.0, 101.0, math.nan):
+        with pytest.raises(ConfigError, match="yaw_gain|finite"):
+            LeapParams(yaw_gain=bad)
