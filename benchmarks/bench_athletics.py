@@ -9,6 +9,8 @@ the thesis-style plots and a JSON of every figure.
     python benchmarks/bench_athletics.py --capture --json docs/athletics/capture.json  # issue 19
 
 ``--workers N`` runs simulations in N processes (the figures do not depend on it).
+``--contact NAME`` runs the experiments, ``--leaps`` or ``--capture`` on another athletics
+contact model (``scene.CONTACT_MODELS``, e.g. ``elliptic``); the tables stay the default's.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ import numpy as np
 from reactmocap.athletics import calibrate, run, tables
 from reactmocap.athletics.plots import commanded_plot, series_plot
 from reactmocap.athletics.report import ground_force
+from reactmocap.athletics.scene import CONTACT_MODELS, DEFAULT_CONTACT
 
 BODIES = ("male", "female")
 ROOT = Path(__file__).resolve().parents[1]
@@ -215,50 +218,56 @@ def _largest(ok: Any, lo: float, hi: float, step: float) -> float:
     return a
 
 
-def _pool(fn: Any, body: str, dirs: list[float], workers: int) -> list[float]:
-    """``fn(body, direction)`` for each direction, in ``workers`` processes."""
+def _pool(
+    fn: Any, body: str, dirs: list[float], workers: int, contact: str = DEFAULT_CONTACT
+) -> list[float]:
+    """``fn(body, direction, contact)`` for each direction, in ``workers`` processes."""
     if workers <= 1:
-        return [fn(body, d) for d in dirs]
+        return [fn(body, d, contact) for d in dirs]
     from concurrent.futures import ProcessPoolExecutor
 
     with ProcessPoolExecutor(workers) as ex:
-        return list(ex.map(fn, [body] * len(dirs), dirs))
+        return list(ex.map(fn, [body] * len(dirs), dirs, [contact] * len(dirs)))
 
 
-def _slope_limit(body: str, direction: float) -> float:
+def _slope_limit(body: str, direction: float, contact: str = DEFAULT_CONTACT) -> float:
     def ok(deg: float) -> bool:
         r = run("balance", body, check_range=False, seconds=3.0, slope=math.radians(deg),
-                slope_dir=math.radians(direction))  # fmt: skip
+                slope_dir=math.radians(direction), contact=contact)  # fmt: skip
         return bool(r.report["balanced"])
 
     return _largest(ok, 0.0, 45.0, 0.5)
 
 
-def _slope_limits(body: str, workers: int) -> dict[str, float]:
+def _slope_limits(body: str, workers: int, contact: str = DEFAULT_CONTACT) -> dict[str, float]:
     dirs = {"+X": 0.0, "-X": 180.0, "Y": 90.0}
-    return dict(zip(dirs, _pool(_slope_limit, body, list(dirs.values()), workers)))
+    return dict(zip(dirs, _pool(_slope_limit, body, list(dirs.values()), workers, contact)))
 
 
-def _push_limit(body: str, direction: float) -> float:
+def _push_limit(body: str, direction: float, contact: str = DEFAULT_CONTACT) -> float:
     return _largest(lambda f: bool(run("balance", body, check_range=False, seconds=3.0, push=f,
-                                       push_dir=math.radians(direction)).report["balanced"]),
+                                       push_dir=math.radians(direction),
+                                       contact=contact).report["balanced"]),
                     0.0, 600.0, 5.0)  # fmt: skip
 
 
-def _offset_limit(body: str, direction: float) -> float:
+def _offset_limit(body: str, direction: float, contact: str = DEFAULT_CONTACT) -> float:
     a = math.radians(direction)
     return _largest(lambda m: bool(run("balance", body, check_range=False, seconds=3.0,
-                                       com_offset_x=m * math.cos(a), com_offset_y=m * math.sin(a)
-                                       ).report["balanced"]), 0.0, 0.3, 0.005)  # fmt: skip
+                                       com_offset_x=m * math.cos(a), com_offset_y=m * math.sin(a),
+                                       contact=contact).report["balanced"]),
+                    0.0, 0.3, 0.005)  # fmt: skip
 
 
 # ---------------------------------------------------------------------------------- experiments
 def _leap_experiments(body: str, workers: int, res: dict[str, Any], panels: dict[str, Any],
-                      grf_curves: dict[str, Any]) -> list[tuple[float, float]]:  # fmt: skip
+                      grf_curves: dict[str, Any], contact: str = DEFAULT_CONTACT,
+                      ) -> list[tuple[float, float]]:  # fmt: skip
     """Fig. 4.1 and 4.2 for one body into ``res`` (``leap_<body>``, ``leap05_<body>``);
     returns the runs' real-time factors (wall, CPU)."""
     commands = [round(x, 2) for x in np.linspace(0.1, 1.0, 10)]
-    rows = calibrate.sweep("leap", body, [{"height": h} for h in commands], workers)
+    rows = calibrate.sweep("leap", body, [{"height": h, "contact": contact} for h in commands],
+                           workers)  # fmt: skip
     speeds = [(r["realtime_factor"], r["realtime_factor_cpu"]) for r in rows]
     got = [r["achieved_height_m"] for r in rows]
     err = [abs(g - c) for g, c in zip(got, commands)]
@@ -270,29 +279,32 @@ def _leap_experiments(body: str, workers: int, res: dict[str, Any], panels: dict
         "peak_joint_power_w": [r["peak_joint_power_w"] for r in rows],
     }  # fmt: skip
     panels[body] = (commands, got)
-    half = calibrate.sweep("leap", body, [{"height": 0.5}], 1)[0]
+    half = calibrate.sweep("leap", body, [{"height": 0.5, "contact": contact}], 1)[0]
     res[f"leap05_{body}"] = {k: half[k] for k in ("time_to_liftoff_s", "peak_grf_bw",
                                                    "achieved_height_m", "landed")}  # fmt: skip
     for h in (0.2, 0.5, 0.8):
-        r = run("leap", body, height=h, check_range=False)
+        r = run("leap", body, height=h, check_range=False, contact=contact)
         t, force = ground_force(r.log, r.report["mass_kg"], np.array([0.0, 0.0, -9.81]))
         grf_curves[f"{body} {h} m"] = (t, force[:, 2] / (r.report["mass_kg"] * 9.81))
     return speeds
 
 
-def experiments(out: Path | None, workers: int) -> dict[str, Any]:
+def experiments(out: Path | None, workers: int, contact: str = DEFAULT_CONTACT) -> dict[str, Any]:
     res: dict[str, Any] = {"date": datetime.date.today().isoformat()}
+    if contact != DEFAULT_CONTACT:
+        res["contact"] = contact
+    c = {"contact": contact}
     speeds: list[tuple[float, float]] = []
     panels: dict[str, Any] = {}
     grf_curves: dict[str, Any] = {}
     for body in BODIES:
-        speeds += _leap_experiments(body, workers, res, panels, grf_curves)
+        speeds += _leap_experiments(body, workers, res, panels, grf_curves, contact)
         # broad jump: commanded over the table's span, and the longest landed jump
         btable = tables.BROAD_TABLES.get(body, ())
         if btable:
             span = np.linspace(btable[0][1], btable[-1][1], 6)
-            brows = calibrate.sweep("broad-jump", body, [{"distance": float(d)} for d in span],
-                                    workers)  # fmt: skip
+            brows = calibrate.sweep("broad-jump", body,
+                                    [{"distance": float(d), **c} for d in span], workers)  # fmt: skip
             bgot = [r["achieved_distance_m"] for r in brows]
             landed = [_landed(r) for r in brows]
             # the longest jump that landed (the table's end is the longest that lifted off)
@@ -303,26 +315,26 @@ def experiments(out: Path | None, workers: int) -> dict[str, Any]:
                                                       default=None)}  # fmt: skip
         # landing
         drops = np.round(np.arange(0.1, 2.51, 0.1), 2)
-        dr = calibrate.sweep("land", body, [{"drop": float(d)} for d in drops], workers)
+        dr = calibrate.sweep("land", body, [{"drop": float(d), **c} for d in drops], workers)
         rng = calibrate.contiguous_range(drops, [_landed(r) for r in dr], 0.1)
         res[f"drop_{body}"] = {"max_landed": rng[1] if rng else None,
                                "landed": {float(d): _landed(r) for d, r in zip(drops, dr)}}  # fmt: skip
         drop = _drop_for_com(body, 1.25)
         vxs = np.round(np.arange(-2.0, 4.01, 0.25), 2)
-        vr = calibrate.sweep("land", body, [{"drop": drop, "vx": float(v)} for v in vxs],
+        vr = calibrate.sweep("land", body, [{"drop": drop, "vx": float(v), **c} for v in vxs],
                              workers)  # fmt: skip
         rng = calibrate.contiguous_range(vxs, [_landed(r) for r in vr], 0.0)
         res[f"vx_{body}"] = {"range": rng, "drop_m": drop,
                              "landed": {float(v): _landed(r) for v, r in zip(vxs, vr)}}  # fmt: skip
         # balance
         dirs = [0, 45, 90, 135, 180, 225, 270, 315]
-        res[f"push_{body}"] = dict(zip(dirs, _pool(_push_limit, body, dirs, workers)))
-        res[f"offset_{body}"] = dict(zip(dirs, _pool(_offset_limit, body, dirs, workers)))
-        res[f"slope_{body}"] = _slope_limits(body, workers)
+        res[f"push_{body}"] = dict(zip(dirs, _pool(_push_limit, body, dirs, workers, contact)))
+        res[f"offset_{body}"] = dict(zip(dirs, _pool(_offset_limit, body, dirs, workers, contact)))
+        res[f"slope_{body}"] = _slope_limits(body, workers, contact)
     # backpack (female, no re-tuning): horizontal-velocity landings with 2 and 4 kg
     drop = _drop_for_com("female", 1.25)
     for kg in (2.0, 4.0):
-        rows = calibrate.sweep("land", "female", [{"drop": drop, "vx": v, "backpack": kg}
+        rows = calibrate.sweep("land", "female", [{"drop": drop, "vx": v, "backpack": kg, **c}
                                                   for v in (-1.0, 0.0, 1.0, 2.0, 3.0)], workers)  # fmt: skip
         res[f"backpack_{int(kg)}kg"] = {v: _landed(r) for v, r in
                                         zip((-1.0, 0.0, 1.0, 2.0, 3.0), rows)}  # fmt: skip
@@ -403,7 +415,7 @@ def print_table(res: dict[str, Any]) -> None:
           f"{res['speed']['cpu_median']:.2f}x (CPU time); thesis 70x slower")  # fmt: skip
 
 
-def capture(workers: int, starts: int = 50) -> dict[str, Any]:
+def capture(workers: int, starts: int = 50, contact: str = DEFAULT_CONTACT) -> dict[str, Any]:
     """Issue 19's capture regions: each working maneuver from ``starts`` perturbed starts
     (``Perturbation.sample``: 3 deg per joint axis, 2 deg pelvis pitch, 0.05 m/s, 0.1 rad/s;
     and the same at a tenth of that), success = landed and not fell."""
@@ -418,7 +430,7 @@ def capture(workers: int, starts: int = 50) -> dict[str, Any]:
             sd = {"joint_sd": math.radians(3.0) * scale, "pitch_sd": math.radians(2.0) * scale,
                   "velocity_sd": 0.05 * scale, "spin_sd": 0.1 * scale}  # fmt: skip
             t0 = time.time()
-            r = capture_region(m, starts=starts, workers=workers, **sd)
+            r = capture_region(m, starts=starts, workers=workers, contact=contact, **sd)
             out[f"{name}_{label}"] = r
             print(f"capture {name} ({label} perturbation): landed {r['landed']}/{starts} "
                   f"({100 * r['success_rate']:.0f}%; thesis: not measured; goal >= 90%) "
@@ -430,7 +442,9 @@ def capture(workers: int, starts: int = 50) -> dict[str, Any]:
     return out
 
 
-def _leaps_only(workers: int, path: Path | None, out: Path | None) -> int:
+def _leaps_only(
+    workers: int, path: Path | None, out: Path | None, contact: str = DEFAULT_CONTACT
+) -> int:
     """``--leaps``: Fig. 4.1 and 4.2 only. An existing ``--json`` file keeps its other
     figures (its ``leap_*`` entries are replaced and dated ``leaps_date``); ``--out`` redraws
     those two plots."""
@@ -438,7 +452,7 @@ def _leaps_only(workers: int, path: Path | None, out: Path | None) -> int:
     res: dict[str, Any] = {}
     grf_curves: dict[str, Any] = {}
     for body in BODIES:
-        _leap_experiments(body, workers, res, {}, grf_curves)
+        _leap_experiments(body, workers, res, {}, grf_curves, contact)
         row, half = res[f"leap_{body}"], res[f"leap05_{body}"]
         print(f"{body}: achieved {np.round(row['achieved'], 3).tolist()}, landed "
               f"{sum(row['landed'])}/10 {row['landed']}; 0.5 m: {half}")  # fmt: skip
@@ -475,14 +489,19 @@ def main() -> int:
     ap.add_argument("--replot", type=Path, help="redraw the plots from a --json file into --out")
     ap.add_argument("--leaps", action="store_true",
                     help="only Fig. 4.1 and 4.2 (the vertical leaps), both bodies, into --json")  # fmt: skip
+    ap.add_argument("--contact", choices=list(CONTACT_MODELS), default=DEFAULT_CONTACT,
+                    help="athletics contact model of every run (not with --tables: the "
+                         "tables are the default's)")  # fmt: skip
     args = ap.parse_args()
+    if args.tables and args.contact != DEFAULT_CONTACT:
+        ap.error(f"--tables builds the default ({DEFAULT_CONTACT}) contact model's tables")
     if args.leaps:
-        return _leaps_only(args.workers, args.json, args.out)
+        return _leaps_only(args.workers, args.json, args.out, args.contact)
     if args.tables:
         build_tables(args.workers, tuple(args.parts.split(",")))
         return 0
     if args.capture:
-        res = capture(args.workers)
+        res = capture(args.workers, contact=args.contact)
         if args.json is not None:
             from reactmocap.io import atomic_write_text
 
@@ -496,7 +515,7 @@ def main() -> int:
         plots(res, None, args.out or args.replot.parent)
         print_table(res)
         return 0
-    res = experiments(args.out, args.workers)
+    res = experiments(args.out, args.workers, args.contact)
     print_table(res)
     if args.json is not None:
         from reactmocap.io import atomic_write_text

@@ -30,7 +30,14 @@ from reactmocap.athletics.report import (
     report_json,
     standing_balanced,
 )
-from reactmocap.athletics.scene import Slope, add_backpack, athletics_world, stand_angles
+from reactmocap.athletics.scene import (
+    CONTACT_MODELS,
+    DEFAULT_CONTACT,
+    Slope,
+    add_backpack,
+    athletics_world,
+    stand_angles,
+)
 from reactmocap.athletics.sequencer import Sequencer
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.library.motion import Motion
@@ -215,7 +222,7 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
         from dataclasses import replace
 
         params = replace(params, spin=float(p["spin"]))
-    world = athletics_world(ath, backpack=float(p.get("backpack") or 0.0))
+    world = athletics_world(ath, backpack=float(p.get("backpack") or 0.0), contact=p["contact"])
     landing = tables.landing_params(ath.name, 0.0, after_leap=True, vertical=not broad,
                                     broad=broad, push=params.push, effort=s)  # fmt: skip
     bases = [Balance(Posture(), seconds=LEAD_IN), Leap(params), Landing(landing),
@@ -269,7 +276,7 @@ def _run_land(
     ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None
 ) -> AthleticsResult:
     drop, vx = float(p["drop"]), float(p["vx"])
-    world = athletics_world(ath)
+    world = athletics_world(ath, contact=p["contact"])
     add_backpack(world, ath, float(p["backpack"]))
     q = ath.standing_qpos(stand_angles(ath, LANDING_LEG), clearance=drop)
     v = np.zeros(world.model.nv)
@@ -295,7 +302,7 @@ LANDING_LEG = 0.92
 def _run_balance(
     ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] | None
 ) -> AthleticsResult:
-    world = athletics_world(ath, backpack=float(p["backpack"]))
+    world = athletics_world(ath, backpack=float(p["backpack"]), contact=p["contact"])
     leg = STANDING_LEG
     if p.get("pelvis_height") is not None:
         ankle = float(np.mean(_ankle_heights(world)))
@@ -358,6 +365,8 @@ def _com_offsets(ctx: Context) -> np.ndarray:
 # ---------------------------------------------------------------------------------- registry
 _FPS = Param("fps", 60.0, "1/s", "output frame rate", minimum=1.0)
 _BACKPACK = Param("backpack", 0.0, "kg", "backpack mass on the chest", minimum=0.0)
+_CONTACT = Param("contact", DEFAULT_CONTACT, "", "athletics contact model (scene.CONTACT_MODELS; "
+                 "the measured tables are the default's)", choices=tuple(CONTACT_MODELS))  # fmt: skip
 BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
     "balance": Behaviour(
         "balance", "stand balanced (thesis ch. 7): optional push, slope, posture, backpack",
@@ -373,7 +382,7 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
          Param("pelvis_height", None, "m", "hip joint height above the ground"),
          Param("com_offset_x", 0.0, "m", "desired COM ahead of the support centre"),
          Param("com_offset_y", 0.0, "m", "desired COM left of the support centre"),
-         _BACKPACK, _FPS),
+         _BACKPACK, _CONTACT, _FPS),
         lambda a, p, cb: _run_balance(a, p, cb), ("push", "slope")),
     "leap": Behaviour(
         "leap", "vertical leap to a COM rise, land, balance (thesis ch. 4, 6, 8.1)",
@@ -383,7 +392,7 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
          Param("spin", None, "kg m^2/s", "take-off angular momentum (pitch) to aim for"),
          Param("push", "com", "", "push-off: 'com' (a servo on the COM, ground force "
                "planned) or 'timed' (the thesis's joints on fixed timing)", choices=PUSHES),
-         _BACKPACK, _FPS),
+         _BACKPACK, _CONTACT, _FPS),
         lambda a, p, cb: _run_leap(a, p, cb), ("height",), variant="push"),
     "broad-jump": Behaviour(
         "broad-jump", "standing broad jump to a COM travel, land, balance (ch. 4.2, 8.2)",
@@ -391,14 +400,14 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
          Param("effort", None, "", "jump effort 0-1 instead of a distance", minimum=0.0,
                maximum=1.0),
          Param("spin", None, "kg m^2/s", "take-off angular momentum (pitch) to aim for"),
-         _BACKPACK, _FPS),
+         _BACKPACK, _CONTACT, _FPS),
         lambda a, p, cb: _run_leap(a, p, cb, broad=True), ("distance",)),
     "land": Behaviour(
         "land", "fall from a height (optionally moving) and land (thesis ch. 6)",
         (Param("drop", None, "m", "height of the soles above the ground at release",
                minimum=0.0),
          Param("vx", 0.0, "m/s", "horizontal COM velocity at release (forward > 0)"),
-         _BACKPACK, _FPS),
+         _BACKPACK, _CONTACT, _FPS),
         lambda a, p, cb: _run_land(a, p, cb), ("drop", "vx")),
 })  # fmt: skip
 
@@ -481,4 +490,7 @@ def run(
     ath = athlete(body)
     key = ath.name if ath.name in BODIES else "custom"
     p = _params(b, params, check_range, key)
-    return b.runner(ath, p, on_tick)
+    result = b.runner(ath, p, on_tick)
+    if p["contact"] != DEFAULT_CONTACT:  # (the default's report is as before the option)
+        result.report["contact"] = p["contact"]
+    return result

@@ -55,7 +55,7 @@ from reactmocap.athletics.handspring import Handspring, HandspringParams, handsp
 from reactmocap.athletics.land import Landing, LandingParams
 from reactmocap.athletics.leap import Leap, LeapParams
 from reactmocap.athletics.machine import Basis
-from reactmocap.athletics.scene import athletics_world, stand_angles
+from reactmocap.athletics.scene import DEFAULT_CONTACT, athletics_world, stand_angles
 from reactmocap.athletics.tumble import POSITIONS, Tumble, TumbleParams
 from reactmocap.errors import ConfigError
 from reactmocap.io import read_toml
@@ -465,14 +465,16 @@ class Perturbation:
 
 
 def capture_region(
-    maneuver: Maneuver, starts: int = 50, seed: int = 0, workers: int = 1, **sd: float
-) -> dict[str, Any]:
-    """Run ``maneuver`` from ``starts`` perturbed starts (:meth:`Perturbation.sample`, seeded)
+    maneuver: Maneuver, starts: int = 50, seed: int = 0, workers: int = 1,
+    contact: str = DEFAULT_CONTACT, **sd: float,
+) -> dict[str, Any]:  # fmt: skip
+    """Run ``maneuver`` from ``starts`` perturbed starts (:meth:`Perturbation.sample`, seeded;
+    ``contact``: the athletics contact model, :data:`~reactmocap.athletics.scene.CONTACT_MODELS`)
     and report the success rate (``landed`` and not ``fell``) and, per perturbation, its size
     (RMS joint offset, pelvis pitch, horizontal speed, pitch spin) and whether it landed."""
     rng = np.random.default_rng(seed)
     perts = [Perturbation.sample(rng, **sd) for _ in range(starts)]
-    jobs = [(maneuver, p) for p in perts]
+    jobs = [(maneuver, p, contact) for p in perts]
     if workers > 1:
         from concurrent.futures import ProcessPoolExecutor
 
@@ -518,9 +520,9 @@ def capture_summary(rows: list[dict[str, Any]]) -> dict[str, dict[str, float | N
     return out
 
 
-def _capture_one(job: tuple[Maneuver, Perturbation]) -> tuple[bool, float]:
-    m, p = job
-    r = run_maneuver(m, perturbation=p, fps=10.0).report
+def _capture_one(job: tuple[Maneuver, Perturbation, str]) -> tuple[bool, float]:
+    m, p, contact = job
+    r = run_maneuver(m, perturbation=p, fps=10.0, contact=contact).report
     return bool(r["landed"] and not r["fell"] and r["status"] == "ok"), float(r["rotation_deg"])
 
 
@@ -531,18 +533,20 @@ def run_maneuver(
     on_tick: Callable[[float], None] | None = None,
     fps: float = 60.0,
     perturbation: Perturbation | None = None,
+    contact: str = DEFAULT_CONTACT,
 ) -> AthleticsResult:
     """Simulate ``maneuver`` (on ``body`` instead of the maneuver's own, if given). The
     report: ``rotation_deg`` (the somersault rotation at the end, the trunk's pitch in the
     take-off plane unwrapped, backward < 0), ``rotation_at_touchdown_deg``, ``twist_deg``,
     ``landed``, ``fell``, the take-off angular momentum and its drift in the air, the peak
     somersault angular velocity, the phases' transitions. ``perturbation`` starts it from a
-    perturbed pose and velocity (:class:`Perturbation`; the capture regions)."""
+    perturbed pose and velocity (:class:`Perturbation`; the capture regions). ``contact``: the
+    athletics contact model (:data:`~reactmocap.athletics.scene.CONTACT_MODELS`)."""
     phases = [check_phase(p, f"{maneuver.name}: phase[{i + 1}]")
               for i, p in enumerate(maneuver.phases)]  # fmt: skip
     ath = athlete(body if body is not None else maneuver.body)
     bases = [CONTROLLERS[p.controller].build(p, ath) for p in phases]
-    world = athletics_world(ath, backpack=maneuver.backpack)
+    world = athletics_world(ath, backpack=maneuver.backpack, contact=contact)
     if perturbation is not None:
         perturbation.apply(world, ath)
     high = maneuver.platform
@@ -599,5 +603,7 @@ def run_maneuver(
         if any(p.controller == "handspring" for p in phases):  # the hands' contacts are no fall
             rep.update(handspring_report(ctx, log, pelvis0))
     rep.update(_plausible(ctx, ath, 0.0, np.inf))
+    if contact != DEFAULT_CONTACT:  # (the default's report is as before the option)
+        rep["contact"] = contact
     result = _result(maneuver.name, ath, ctx, seq, res, rep)
     return result

@@ -14,6 +14,7 @@ from reactmocap.athletics.behaviours import AthleticsResult
 from reactmocap.athletics.bodies import athlete
 from reactmocap.athletics.dive import PLATFORM_MAX, stretch_angles
 from reactmocap.athletics.maneuvers import Maneuver, Phase, run_maneuver
+from reactmocap.athletics.scene import DEFAULT_CONTACT
 from reactmocap.athletics.tumble import POSITIONS, somersault_inertia
 from reactmocap.errors import ConfigError, UnknownKeyError
 
@@ -257,8 +258,10 @@ def somersault(
     backpack: float = 0.0,
     on_tick: Callable[[float], None] | None = None,
     fps: float = 60.0,
+    contact: str = DEFAULT_CONTACT,
 ) -> AthleticsResult:
-    """A standing somersault (:func:`somersault_maneuver`). ``twist`` (turns) is built only
+    """A standing somersault (:func:`somersault_maneuver`; ``contact``: the athletics contact
+    model, :data:`~reactmocap.athletics.scene.CONTACT_MODELS`). ``twist`` (turns) is built only
     where :data:`TWIST_SOMERSAULT_PRESETS` has an entry (the male back layout with one twist);
     anything else is refused with the reason. With a twist the report adds
     ``twist_error_deg`` (``|twist_deg|`` against the commanded turns) and ``twist_stopped``
@@ -266,7 +269,7 @@ def somersault(
     if not (math.isfinite(backpack) and backpack >= 0):
         raise ConfigError(f"backpack must be >= 0 kg, got {backpack!r}")
     m = somersault_maneuver(position, direction, body, backpack, twist)
-    result = run_maneuver(m, on_tick=on_tick, fps=fps)
+    result = run_maneuver(m, on_tick=on_tick, fps=fps, contact=contact)
     rep = result.report
     rep.update(position=position, direction=direction, twist_turns=twist)
     if twist:
@@ -467,9 +470,11 @@ def handspring(
     *,
     on_tick: Callable[[float], None] | None = None,
     fps: float = 60.0,
+    contact: str = DEFAULT_CONTACT,
 ) -> AthleticsResult:
-    """A standing back handspring (:func:`handspring_maneuver`). The report adds
+    """A standing back handspring (:func:`handspring_maneuver`; ``contact`` as
+    :func:`somersault`). The report adds
     ``hands_contact_s`` (time the hands were on the floor), the hands' first and last contact
     and the push's time; ``fell`` ignores the hands' own contacts
     (:func:`~reactmocap.athletics.handspring.handspring_report`)."""
-    return run_maneuver(handspring_maneuver(body), on_tick=on_tick, fps=fps)
+    return run_maneuver(handspring_maneuver(body), on_tick=on_tick, fps=fps, contact=contact)

@@ -4,6 +4,10 @@ an optional backpack (mass added to the chest) and a floor that tilts into a slo
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from types import MappingProxyType
+from typing import Literal
 
 import mujoco
 import numpy as np
@@ -12,7 +16,7 @@ from numpy.typing import NDArray
 from reactmocap.athletics.balance import STANDING_LEG, knee_for_length
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.rig import joint_index
-from reactmocap.errors import ConfigError
+from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.rotations import quat_conj, quat_from_euler, quat_from_yaw, quat_mul, quat_rotate
 from reactmocap.sim.bodies import SIM_BODIES
 from reactmocap.sim.world import World, WorldConfig
@@ -20,9 +24,14 @@ from reactmocap.sim.world import World, WorldConfig
 __all__ = [
     "ATHLETICS_WORLD",
     "BACKPACK_OFFSET",
+    "CONTACT_MODELS",
+    "DEFAULT_CONTACT",
+    "SOLE_TORSION",
+    "ContactModel",
     "Slope",
     "add_backpack",
     "athletics_world",
+    "contact_model",
     "shins_off_floor",
     "stand_angles",
 ]
@@ -33,6 +42,45 @@ F64 = NDArray[np.float64]
 #: bounced the body back up at 0.8 m/s), where a foot's heel pad and sole give a little; the
 #: thesis's ground was springs and dampers too (section 3.1.1)
 ATHLETICS_WORLD = WorldConfig(contact_solref=(0.02, 1.0))
+
+
+@dataclass(frozen=True)
+class ContactModel:
+    """An athletics contact model: MuJoCo's friction cone for every contact (``"pyramidal"``,
+    its default, approximates Coulomb's circular cone by a pyramid; ``"elliptic"`` is the
+    exact cone, same coefficient) and the sole boxes' torsional friction (m; 0: none,
+    ``condim`` 3 as every other geom)."""
+
+    cone: Literal["pyramidal", "elliptic"]
+    sole_torsion: float = 0.0
+
+
+#: a sole corner contact's torsional friction (m). MuJoCo's torsional coefficient is a length:
+#: the largest torque about the contact normal is it times the normal force. A disc of radius
+#: a under even pressure resists up to (2/3) mu a N; a corner contact standing for a heel or
+#: forefoot pad of a ~3 cm radius at the sliding coefficient 1.0 gives 0.02 m
+SOLE_TORSION = 0.02
+#: the athletics contact models by name (:func:`athletics_world`, ``run(..., contact=)``,
+#: ``run_maneuver(..., contact=)``, the CLI's and the benchmark's ``--contact``). Only the
+#: default's figures are the measured tables' (docs/athletics.md, "The elliptic cone, opt-in")
+CONTACT_MODELS: Mapping[str, ContactModel] = MappingProxyType({
+    "pyramidal": ContactModel("pyramidal"),
+    "elliptic": ContactModel("elliptic"),
+    "elliptic+torsion": ContactModel("elliptic", SOLE_TORSION),
+})  # fmt: skip
+DEFAULT_CONTACT = "pyramidal"
+
+
+def contact_model(name: str) -> ContactModel:
+    """The contact model ``name`` (:data:`CONTACT_MODELS`)."""
+    try:
+        return CONTACT_MODELS[name]
+    except (KeyError, TypeError):
+        raise UnknownKeyError(
+            f"unknown athletics contact model {name!r}; valid models are {list(CONTACT_MODELS)}"
+        ) from None
+
+
 #: where a backpack's mass sits relative to the chest's centre of mass (m, chest frame of the
 #: neutral pose: 0.15 m behind the back)
 BACKPACK_OFFSET = (-0.15, 0.0, 0.0)
@@ -144,12 +192,22 @@ def shins_off_floor(world: World, character: int = 0) -> None:
         m.geom_conaffinity[geoms] = 0
 
 
-def athletics_world(athlete: Athlete, *, backpack: float = 0.0) -> World:
-    """A World holding ``athlete`` standing on level ground (:data:`ATHLETICS_WORLD`). The
-    shins do not collide with the floor: their capsules end at the ankle joint, a loaded sole
-    sinks a little into the soft contact, and a shin touching the floor under a flat foot is a
-    rigid stop that threw landing athletes back into the air (a real shin is well clear)."""
-    world = World(athlete.character, ATHLETICS_WORLD)
+def athletics_world(
+    athlete: Athlete, *, backpack: float = 0.0, contact: str = DEFAULT_CONTACT
+) -> World:
+    """A World holding ``athlete`` standing on level ground (:data:`ATHLETICS_WORLD`, its
+    contacts as the :data:`CONTACT_MODELS` entry ``contact``). The shins do not collide with
+    the floor: their capsules end at the ankle joint, a loaded sole sinks a little into the
+    soft contact, and a shin touching the floor under a flat foot is a rigid stop that threw
+    landing athletes back into the air (a real shin is well clear)."""
+    model = contact_model(contact)
+    world = World(athlete.character, replace(ATHLETICS_WORLD, cone=model.cone))
+    if model.sole_torsion > 0:
+        # condim 4 on the soles: a contact takes the larger condim and coefficients of its
+        # two geoms, so the floor's contacts with the soles get the torsion
+        soles = world.characters[0].sole_ids
+        world.model.geom_condim[soles] = 4
+        world.model.geom_friction[soles, 1] = model.sole_torsion
     shins_off_floor(world)
     add_backpack(world, athlete, backpack)
     world.set_pose(0, athlete.standing_qpos(stand_angles(athlete), clearance=0.0005))

@@ -11,7 +11,7 @@ from typing import Any
 from reactmocap.commands import numbers, output_file
 from reactmocap.progress import Progress
 
-__all__ = ["SimProgress", "register"]
+__all__ = ["SimProgress", "contact_arg", "register"]
 
 #: CLI flag -> (behaviour parameter, in degrees at the CLI)
 _FLAGS: dict[str, list[tuple[str, str, bool]]] = {
@@ -32,6 +32,15 @@ _HELP = {
     "land": "drop from a height (m), optionally moving, and land",
     "balance": "stand balanced; optional push, slope, posture and backpack",
 }
+
+
+def contact_arg(p: argparse.ArgumentParser) -> None:
+    """``--contact NAME``: the athletics contact model (``scene.CONTACT_MODELS``)."""
+    from reactmocap.athletics.scene import CONTACT_MODELS, DEFAULT_CONTACT
+
+    p.add_argument("--contact", choices=list(CONTACT_MODELS), default=DEFAULT_CONTACT,
+                   help=f"contact model (default {DEFAULT_CONTACT}; the measured tables and "
+                   "supported ranges are the default's)")  # fmt: skip
 
 
 def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
@@ -69,6 +78,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         p.add_argument("--plot", type=output_file, help="PNG of COM height and ground force")
         p.add_argument("--video", type=output_file, help="MP4 (or GIF) of the motion")
         p.add_argument("--fps", type=float, default=60.0, help="BVH frame rate")
+        contact_arg(p)
         p.add_argument("--any-range", action="store_true",
                        help="run outside the measured supported range (reported honestly)")  # fmt: skip
         p.set_defaults(func=_run, flags=flags)
@@ -88,7 +98,7 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
 def _run(args: argparse.Namespace) -> int:
     from reactmocap.athletics.behaviours import run
 
-    params: dict[str, Any] = {"fps": args.fps}
+    params: dict[str, Any] = {"fps": args.fps, "contact": args.contact}
     for flag, key, deg in args.flags:
         v = getattr(args, flag.lstrip("-").replace("-", "_"))
         if v is not None:

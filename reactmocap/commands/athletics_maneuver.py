@@ -21,6 +21,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     from reactmocap.athletics.maneuvers import describe
     from reactmocap.athletics.routines import DIRECTIONS
     from reactmocap.athletics.tumble import POSITIONS
+    from reactmocap.commands.athletics import contact_arg
     from reactmocap.commands.athletics_run import output_args
 
     m = inner.add_parser(
@@ -35,6 +36,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
     m.add_argument("--body", help="male, female or a BVH file (default: the file's body)")
     m.add_argument("--video", type=output_file, help="MP4 (or GIF) of the motion")
     m.add_argument("--fps", type=float, default=60.0, help="BVH frame rate (default 60)")
+    contact_arg(m)
     m.set_defaults(func=_maneuver)
 
     s = inner.add_parser(
@@ -51,6 +53,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
                    "tilt twist, thesis 5.2); anything else is refused with the reason")  # fmt: skip
     s.add_argument("--backpack", type=float, default=0.0, help="kg on the chest (thesis 8.5.2)")
     output_args(s, "male", plot=False)
+    contact_arg(s)
     s.set_defaults(func=_somersault)
 
     from reactmocap.athletics.routines import DIVE_DIRECTIONS, PLATFORM_MAX
@@ -81,6 +84,7 @@ def register_maneuvers(inner: argparse._SubParsersAction) -> None:  # type: igno
         "folder (anything not ending in .bvh) for back_handspring_BODY.bvh.",
     )  # fmt: skip
     output_args(h, "male", plot=False)
+    contact_arg(h)
     h.set_defaults(func=_handspring)
 
 
@@ -90,7 +94,8 @@ def _maneuver(args: argparse.Namespace) -> int:
 
     maneuver = load_maneuver(args.file)
     with SimProgress(maneuver.name) as bar:
-        result = run_maneuver(maneuver, args.body, on_tick=bar.tick, fps=args.fps)
+        result = run_maneuver(maneuver, args.body, on_tick=bar.tick, fps=args.fps,
+                              contact=args.contact)  # fmt: skip
     out: Path = args.out
     files = argparse.Namespace(**{**vars(args), "report": out / f"{maneuver.name}.json"})
     _finish(result, files, out / f"{maneuver.name}.bvh")
@@ -103,7 +108,8 @@ def _somersault(args: argparse.Namespace) -> int:
 
     with SimProgress("somersault") as bar:
         result = somersault(args.position, args.direction, str(args.body), twist=args.twist,
-                            backpack=args.backpack, on_tick=bar.tick, fps=args.fps)  # fmt: skip
+                            backpack=args.backpack, on_tick=bar.tick, fps=args.fps,
+                            contact=args.contact)  # fmt: skip
     _finish(result, args, args.out or Path(f"{result.behaviour}_{result.body}.bvh"))
     return 0
 
@@ -124,7 +130,7 @@ def _handspring(args: argparse.Namespace) -> int:
     from reactmocap.commands.athletics import SimProgress
 
     with SimProgress("handspring") as bar:
-        result = handspring(str(args.body), on_tick=bar.tick, fps=args.fps)
+        result = handspring(str(args.body), on_tick=bar.tick, fps=args.fps, contact=args.contact)
     name = Path(f"{result.behaviour}_{result.body}.bvh")
     out: Path | None = args.out
     if out is None:
