@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from reactmocap.athletics.bodies import EULER_ORDER, Athlete
 from reactmocap.athletics.machine import NEXT, Basis, Context, law
 from reactmocap.athletics.rig import joint_index, per_joint
+from reactmocap.athletics.senses import Senses
 from reactmocap.errors import ConfigError
 from reactmocap.rotations import (
     quat_conj,
@@ -30,7 +31,7 @@ from reactmocap.rotations import (
     quat_mul,
     quat_to_euler,
 )
-from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES
+from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODY_INDEX
 from reactmocap.sim.controllers.machine import Event, State, after
 from reactmocap.sim.world import World
 
@@ -61,7 +62,6 @@ _KNEE = [joint_index(f"{s}_knee") for s in "lr"]
 _ANKLE = [joint_index(f"{s}_ankle") for s in "lr"]
 _SPINE = [joint_index(j) for j in ("waist", "back")]
 _SHOULDER = np.array([joint_index(f"{s}_shoulder") for s in "lr"])
-_BODY = {b: i for i, b in enumerate(SIM_BODIES)}
 
 
 def knee_for_length(thigh: F64 | float, shin: F64 | float, length: F64 | float) -> F64:
@@ -375,7 +375,7 @@ class BalanceLaw:
         moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
         rig.move(goal, posture.settle, t, moving)
         # the commanded pitch starts from where the pelvis is (less the new posture's lean)
-        self._pitch0 = self.pelvis_pitch() - self._lean()
+        self._pitch0 = self.pelvis_pitch() - self.lean()
         self._t_pitch = t
 
     def pelvis_roll(self, heading: float) -> float:
@@ -391,7 +391,8 @@ class BalanceLaw:
         q = quat_mul(d.xquat[self.ctx.senses.root], quat_conj(self.athlete.neutral[0]))
         return float(quat_to_euler(q, EULER_ORDER)[0])
 
-    def _lean(self) -> float:
+    def lean(self) -> float:
+        """Forward trunk lean (rad) the posture adds for the knees' bend past standing."""
         if not self.posture.lean:
             return 0.0
         knee = float(np.mean(self.ctx.rig.knee_flexion()))
@@ -451,7 +452,7 @@ class BalanceLaw:
         delta = g.kp * err - g.kv * vel
         delta[1] *= g.side
         np.clip(delta, -g.max_offset, g.max_offset, out=delta)
-        pitch = self._pitch_now(t) + self._lean()
+        pitch = self._pitch_now(t) + self.lean()
         cp = cp_side = 0.0
         if any(x is not None for x in (g.bow, g.arms, g.windmill, g.windmill_side)):
             omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
@@ -494,7 +495,7 @@ class BalanceLaw:
             rig.offset[_ANKLE[k], 0] += float(np.clip(total, lo, hi)) - total
         hang = self._plant(s, d, h) if self.posture.plant else None
         self._level_legs(d, desired, hang)
-        self._support(s)
+        self.support(s)
         if self.stepper is not None:
             self.stepper.control(self, d, h, t)
 
@@ -566,7 +567,7 @@ class BalanceLaw:
             level = length + 0.5 * float(z[1 - k] - z[k])
             self.ctx.rig.offset[_KNEE[k], 0] = float(knee_for_length(ul, ll, level)[0]) - knee
 
-    def _support(self, s) -> None:  # type: ignore[no-untyped-def]
+    def support(self, s: Senses) -> None:
         """Weight shares of the feet in contact (by where the COM lies between them)."""
         rig = self.ctx.rig
         rig.support[:] = 0.0
@@ -758,7 +759,9 @@ def hold_pelvis_and_feet(  # type: ignore[no-untyped-def]
     ctx.rig.move(goal, 0.0, t, _HIP + _ANKLE)
 
 
-_LEG_NEUTRAL = [_BODY[b] for b in ("l_thigh", "r_thigh", "l_shin", "r_shin", "l_foot", "r_foot")]
+_LEG_NEUTRAL = [
+    SIM_BODY_INDEX[b] for b in ("l_thigh", "r_thigh", "l_shin", "r_shin", "l_foot", "r_foot")
+]
 
 
 def _flat_feet(foot_now: F64, normal: F64) -> F64:

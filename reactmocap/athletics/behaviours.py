@@ -115,13 +115,15 @@ class AthleticsResult:
 
 
 # ---------------------------------------------------------------------------------- running
-def _simulate(
+def simulate(
     ath: Athlete, world: World, bases: list, duration: float, *, behaviour: str,
     impacts: tuple[Impact, ...] = (), extra: tuple[Controller, ...] = (),
     on_tick: Callable[[float], None] | None = None, fps: float = 60.0,
     extra_from_ctx: Callable[[Context], Controller] | None = None,
     energy_limit_per_kg: float = 100.0,
 ) -> tuple[Context, Sequencer, RolloutResult]:  # fmt: skip
+    """Roll ``bases`` out on ``world`` for ``duration`` s: the run's context, sequencer and
+    rollout (the rig released afterwards)."""
     ctx = Context.make(world, ath, control_every=CONTROL_EVERY)
     seq = Sequencer(ctx, bases)
     if extra_from_ctx is not None:  # a controller that needs the run's context (a platform)
@@ -139,10 +141,11 @@ def _simulate(
     return ctx, seq, res
 
 
-def _result(
+def athletics_result(
     name: str, ath: Athlete, ctx: Context, seq: Sequencer, res: RolloutResult,
     report: dict[str, Any],
 ) -> AthleticsResult:  # fmt: skip
+    """The run's :class:`AthleticsResult`, its report completed with timing and status."""
     report = {"behaviour": name, "body": ath.name, "mass_kg": round(ath.mass, 2), **report,
               "simulated_s": round(res.seconds, 3), "wall_s": round(res.wall_s, 3),
               "realtime_factor": round(res.seconds / max(res.wall_s, 1e-9), 2),
@@ -160,13 +163,14 @@ def _result(
     return AthleticsResult(name, ath.name, motion, report, res, ctx.log.arrays(), trans)
 
 
-def _standing(ctx: Context) -> tuple[float, float]:
+def standing_heights(ctx: Context) -> tuple[float, float]:
     """COM height and pelvis height at the first tick (standing)."""
     log = ctx.log
     return float(log.rows[0][1][2]), float(log.pelvis[0])
 
 
-def _plausible(ctx: Context, ath: Athlete, start: float, end: float) -> dict[str, Any]:
+def plausibility_report(ctx: Context, ath: Athlete, start: float, end: float) -> dict[str, Any]:
+    """Peak joint torques and powers over ``[start, end]`` s against the strength model."""
     peaks = joint_peaks(ctx, start, end)
     ok, over = plausibility(peaks, ath.mass, female=ath.name == "female")
     return {"peak_joint_torque_nm": {k: v["torque_nm"] for k, v in peaks.items()},
@@ -174,7 +178,9 @@ def _plausible(ctx: Context, ath: Athlete, start: float, end: float) -> dict[str
             "human_plausible": ok, "strength_exceeded": over}  # fmt: skip
 
 
-def _landing(ctx: Context, log: dict[str, np.ndarray], standing_pelvis: float) -> dict[str, Any]:
+def landing_report(
+    ctx: Context, log: dict[str, np.ndarray], standing_pelvis: float
+) -> dict[str, Any]:
     td = ctx.touchdown_time
     weight = ctx.athlete.mass * float(np.linalg.norm(ctx.world.model.opt.gravity))
     t = log["t"]
@@ -229,10 +235,10 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
              Balance(STAND_UP)]  # fmt: skip
     # the run lasts until well after touchdown: the flight time of the expected height
     reach = target if table and p.get("effort") is None and not broad else MAX_APEX
-    ctx, seq, res = _simulate(ath, world, bases, _leap_duration(reach, params),
+    ctx, seq, res = simulate(ath, world, bases, _leap_duration(reach, params),
                               behaviour="leap", on_tick=on_tick, fps=p["fps"])  # fmt: skip
     log = ctx.log.arrays()
-    com0, pelvis0 = _standing(ctx)
+    com0, pelvis0 = standing_heights(ctx)
     t = log["t"]
     thrust = next((tr.time for tr in seq.transitions if tr.target == "leap.thrust"), None)
     lift = ctx.liftoff_time
@@ -267,9 +273,9 @@ def _run_leap(ath: Athlete, p: dict[str, Any], on_tick: Callable[[float], None] 
     rep["peak_grf_bw"] = float(np.linalg.norm(force[push], axis=1).max() / weight) \
         if push.any() else None  # fmt: skip
     rep["liftoff_pitch_momentum"] = ctx.handover.get("liftoff_pitch_momentum")
-    rep.update(_landing(ctx, log, pelvis0))
-    rep.update(_plausible(ctx, ath, thrust or 0.0, lift if lift is not None else np.inf))
-    return _result("broad-jump" if broad else "leap", ath, ctx, seq, res, rep)
+    rep.update(landing_report(ctx, log, pelvis0))
+    rep.update(plausibility_report(ctx, ath, thrust or 0.0, lift if lift is not None else np.inf))
+    return athletics_result("broad-jump" if broad else "leap", ath, ctx, seq, res, rep)
 
 
 def _run_land(
@@ -284,15 +290,15 @@ def _run_land(
     world.set_pose(0, q, v[world.characters[0].qvel_slice])
     lp = tables.landing_params(ath.name, vx)
     fall = math.sqrt(2.0 * max(drop, 0.0) / 9.81)
-    ctx, seq, res = _simulate(ath, world, [Landing(lp), Balance(STAND_UP)], fall + LANDED_AFTER + 0.3,
+    ctx, seq, res = simulate(ath, world, [Landing(lp), Balance(STAND_UP)], fall + LANDED_AFTER + 0.3,
                               behaviour="land", on_tick=on_tick, fps=p["fps"])  # fmt: skip
     log = ctx.log.arrays()
     standing_pelvis = float(ath.standing_qpos(stand_angles(ath))[2])
     rep: dict[str, Any] = {"drop_m": drop, "vx_mps": vx, "backpack_kg": float(p["backpack"]),
                            "foot_servo_delta_m": lp.delta}  # fmt: skip
-    rep.update(_landing(ctx, log, standing_pelvis))
-    rep.update(_plausible(ctx, ath, 0.0, np.inf))
-    return _result("land", ath, ctx, seq, res, rep)
+    rep.update(landing_report(ctx, log, standing_pelvis))
+    rep.update(plausibility_report(ctx, ath, 0.0, np.inf))
+    return athletics_result("land", ath, ctx, seq, res, rep)
 
 
 #: hip-to-ankle length (fraction of the leg) of the pose a drop starts in
@@ -330,10 +336,10 @@ def _run_balance(
                           duration=float(p["push_duration"])),)  # fmt: skip
     seconds = float(p["seconds"]) + ramp
     stand = Balance(posture, gains=STANDING_GAINS)  # the COM target moves uphill on a slope
-    ctx, seq, res = _simulate(ath, world, [stand], seconds, behaviour="balance",
+    ctx, seq, res = simulate(ath, world, [stand], seconds, behaviour="balance",
                               impacts=impacts, extra=tuple(extra), on_tick=on_tick, fps=p["fps"])  # fmt: skip
     log = ctx.log.arrays()
-    _, pelvis0 = _standing(ctx)
+    _, pelvis0 = standing_heights(ctx)
     offsets = _com_offsets(ctx)
     went_down = fell(ctx, pelvis0)
     rep: dict[str, Any] = {
@@ -344,7 +350,7 @@ def _run_balance(
         "max_com_offset_m": float(offsets.max()) if offsets.size else 0.0,
     }  # fmt: skip
     del log
-    return _result("balance", ath, ctx, seq, res, rep)
+    return athletics_result("balance", ath, ctx, seq, res, rep)
 
 
 #: seconds over which a slope comes in under a balancing athlete

@@ -411,7 +411,7 @@ class Landing(Basis):
             guard[:] = False
             bl.posture = Posture(leg=_leg_fraction(ctx), lean=p.lean, settle=0.0)
             memo["t_touch"] = t
-            memo["pitch_touch"] = bl.pelvis_pitch() - bl._lean()
+            memo["pitch_touch"] = bl.pelvis_pitch() - bl.lean()
             memo["roll_touch"] = bl.pelvis_roll(ctx.sense(t).heading()) if p.roll_ease else 0.0
             # eased only past roll_min (else as without: upright at once, no wait)
             memo["roll_ease"] = p.roll_ease if abs(memo["roll_touch"]) >= p.roll_min else 0.0
@@ -451,7 +451,7 @@ class Landing(Basis):
             if p.pitch_ease > 0:
                 ease = max(0.0, 1.0 - (t - memo["t_touch"]) / p.pitch_ease) * memo["pitch_touch"]
             h = s.heading()
-            hold_pelvis_and_feet(ctx, world.data, ease + bl._lean(), h, t, roll_now(t))
+            hold_pelvis_and_feet(ctx, world.data, ease + bl.lean(), h, t, roll_now(t))
             rig.offset[:] = 0.0
             _stance_support(ctx)
             damp = rig.damping.copy()

@@ -326,7 +326,7 @@ class Leap(Basis):
 
         def push(world: World, t: float) -> None:
             s = ctx.sense(t)
-            bl._support(s)
+            bl.support(s)
             ramp = min(1.0, (t - memo["t_thrust"]) / STIFFNESS_RAMP)
             if memo.get("ramp", -1.0) < 1.0:  # the push's stiffness comes in smoothly
                 memo["ramp"] = ramp
@@ -413,7 +413,7 @@ class Leap(Basis):
             goal = np.full((NJ, 3), np.nan)
             goal[knees] = now[knees]
             rig.move(goal, 0.0, t, knees)
-            bl._support(s)
+            bl.support(s)
             if p.push_both and memo["pushing"] and s.foot_contact.sum() == 1:
                 # the shares by where the COM lies between the sole centres, not the contacts
                 soles = s.corners.mean(axis=1)[:, :2]

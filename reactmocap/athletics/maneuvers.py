@@ -43,11 +43,11 @@ from reactmocap.athletics.backdrop import Backdrop, backdrop_keyframes
 from reactmocap.athletics.balance import BALANCE_GAINS, STANDING_GAINS, Balance, Posture, Step
 from reactmocap.athletics.behaviours import (
     AthleticsResult,
-    _landing,
-    _plausible,
-    _result,
-    _simulate,
-    _standing,
+    athletics_result,
+    landing_report,
+    plausibility_report,
+    simulate,
+    standing_heights,
 )
 from reactmocap.athletics.bodies import BODIES, Athlete, athlete
 from reactmocap.athletics.dive import PLATFORM_MAX, Platform, Stretch, entry_report
@@ -552,11 +552,11 @@ def run_maneuver(
     high = maneuver.platform
     platform = (lambda c: Platform(c, high)) if high > 0 else None
     # a dive's fall reaches 10-13 m/s: above the rollout's default kinetic-energy check
-    ctx, seq, res = _simulate(ath, world, bases, maneuver.seconds, behaviour=maneuver.name,
+    ctx, seq, res = simulate(ath, world, bases, maneuver.seconds, behaviour=maneuver.name,
                               on_tick=on_tick, fps=fps, extra_from_ctx=platform,
                               energy_limit_per_kg=400.0 if high > 0 else 100.0)  # fmt: skip
     log = ctx.log.arrays()
-    _, pelvis0 = _standing(ctx)
+    _, pelvis0 = standing_heights(ctx)
     t = log["t"]
     td, lift = ctx.touchdown_time, ctx.liftoff_time
     rot = log["rotation"]
@@ -599,11 +599,11 @@ def run_maneuver(
         rep.update(entry_report(ctx, high, res.status == "ok"))
         rep["touchdown_s"] = None
     else:
-        rep.update(_landing(ctx, log, pelvis0))
+        rep.update(landing_report(ctx, log, pelvis0))
         if any(p.controller == "handspring" for p in phases):  # the hands' contacts are no fall
             rep.update(handspring_report(ctx, log, pelvis0))
-    rep.update(_plausible(ctx, ath, 0.0, np.inf))
+    rep.update(plausibility_report(ctx, ath, 0.0, np.inf))
     if contact != DEFAULT_CONTACT:  # (the default's report is as before the option)
         rep["contact"] = contact
-    result = _result(maneuver.name, ath, ctx, seq, res, rep)
+    result = athletics_result(maneuver.name, ath, ctx, seq, res, rep)
     return result
