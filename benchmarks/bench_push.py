@@ -9,6 +9,13 @@ SIMBICON's 350 N diagonal push while walking (Yin et al. 2007).
 Survival is not monotonic in the force once the tracker steps (a harder push can land a better
 step), so a bisection's answer is a value that was survived with every tested force below it
 that the search probed, not a guaranteed threshold; ``--forces`` sweeps fixed forces instead.
+
+"Upright to the window's end" counts a body still stepping, still falling or thrown into the
+air when the window ends. ``--still`` also judges each push by the body's state at the window's
+end (:func:`reactmocap.sim.end_state`: the centre of mass slower than 0.3 m/s, its capture point
+within 5 cm of the feet on the floor, a sole within 5 cm of the floor): a sweep then prints ``x``
+settled, ``m`` upright but still moving, ``A`` upright with no foot on the floor, ``.`` fell, and
+counts both verdicts from the same runs; a bisection searches the settled verdict.
 """
 
 from __future__ import annotations
@@ -53,11 +60,16 @@ def heading(motion: Motion, time_s: float) -> float:
     return float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum()))
 
 
-def survives(job: tuple[str, float, float, float, float, float, dict[str, Any], float]) -> bool:
-    """Upright to the window's end; with ``settled`` > 0 also the pelvis within that many m of
-    the mocap's there (a body still tumbling when the window ends is not a recovery)."""
-    name, at, angle, force, duration, after, params, settled = job
-    from reactmocap.sim import push_clip
+Job = tuple[str, float, float, float, float, float, dict[str, Any], float, bool]
+
+
+def verdict(job: Job) -> str:
+    """One push's mark: "." fell; "x" upright to the window's end (with ``settled`` > 0 also
+    the pelvis within that many m of the mocap's there); with ``still`` "x" only when settled
+    at the window's end (:func:`reactmocap.sim.end_state`), "A" upright with no foot on the
+    floor, "m" upright but still moving."""
+    name, at, angle, force, duration, after, params, settled, still = job
+    from reactmocap.sim import end_state, push_clip
 
     motion = _clip(name)
     start = max(0.0, at - 0.5)
@@ -66,35 +78,44 @@ def survives(job: tuple[str, float, float, float, float, float, dict[str, Any], 
         motion, time=at, body="chest", force=[force * np.cos(angle), force * np.sin(angle), 0.0],
         duration=duration, start=start, seconds=seconds, params=params,
     )  # fmt: skip
-    if settled > 0 and res.report.status == "ok":
-        return bool(res.errors.root[-1] < settled)
-    return res.report.status == "ok"
+    if res.report.status != "ok" or (settled > 0 and res.errors.root[-1] >= settled):
+        return "."
+    if not still:
+        return "x"
+    end = end_state(res)
+    return "x" if end.settled else "A" if end.lowest_sole > 0.05 else "m"
+
+
+def survives(job: Job) -> bool:
+    """Upright to the window's end (see :func:`verdict`; with ``still`` also settled there)."""
+    return verdict(job) == "x"
 
 
 def largest(
-    job: tuple[str, float, float, float, float, dict[str, Any], float, int, float],
+    job: tuple[str, float, float, float, float, dict[str, Any], float, int, float, bool],
 ) -> float:
     """Bisection on the force in ``[0, hi]`` (``steps`` halvings)."""
-    name, at, angle, duration, after, params, hi, steps, settled = job
-    if survives((name, at, angle, hi, duration, after, params, settled)):
+    name, at, angle, duration, after, params, hi, steps, settled, still = job
+    if survives((name, at, angle, hi, duration, after, params, settled, still)):
         return hi
     lo = 0.0
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
-        if survives((name, at, angle, mid, duration, after, params, settled)):
+        if survives((name, at, angle, mid, duration, after, params, settled, still)):
             lo = mid
         else:
             hi = mid
     return lo
 
 
-def sweep(job: tuple[str, float, float, float, float, dict[str, Any], list[float], float]) -> str:
-    """One direction at each fixed force: "x" survived, "." fell (a bisection reports whichever
-    path it took where survival is not monotonic in the force)."""
-    name, at, angle, duration, after, params, forces, settled = job
+def sweep(
+    job: tuple[str, float, float, float, float, dict[str, Any], list[float], float, bool],
+) -> str:
+    """One direction at each fixed force: a :func:`verdict` mark per force (a bisection
+    reports whichever path it took where survival is not monotonic in the force)."""
+    name, at, angle, duration, after, params, forces, settled, still = job
     return "".join(
-        "x" if survives((name, at, angle, f, duration, after, params, settled)) else "."
-        for f in forces
+        verdict((name, at, angle, f, duration, after, params, settled, still)) for f in forces
     )
 
 
@@ -102,19 +123,19 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
     motion = _clip(name)
     yaw = heading(motion, at)
     params = json.loads(args.params)
-    if not survives((name, at, yaw, 0.0, duration, args.after, params, args.settled)):
+    if not survives((name, at, yaw, 0.0, duration, args.after, params, args.settled, args.still)):
         # a clip that falls unpushed in the window measures the tracker, not the push
         print(f"{name} falls unpushed within {args.after} s after {at} s: choose another clip")
         return [float("nan")] * 8
     dirs = [k for k in range(8) if LABELS[k] in args.dirs]
     if args.forces:
         sweeps = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.forces,
-                   args.settled) for k in dirs]  # fmt: skip
+                   args.settled, args.still) for k in dirs]  # fmt: skip
         with ProcessPoolExecutor(max_workers=args.jobs) as pool:
             marks = dict(zip(dirs, pool.map(sweep, sweeps)))
         return [marks.get(k, "") for k in range(8)]
     jobs = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.max_force,
-             args.steps, args.settled) for k in dirs]  # fmt: skip
+             args.steps, args.settled, args.still) for k in dirs]  # fmt: skip
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         found = dict(zip(dirs, pool.map(largest, jobs)))
     return [found.get(k, float("nan")) for k in range(8)]
@@ -172,6 +193,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--settled", type=float, default=0.0,
                     help="also require the pelvis within this many m of the mocap's at the "
                          "window's end (0: upright is enough)")  # fmt: skip
+    ap.add_argument("--still", action="store_true",
+                    help="also require the body settled at the window's end (COM slower than "
+                         "0.3 m/s, capture point over the feet on the floor, a foot down): "
+                         "sweeps print x settled, m still moving, A in the air, . fell")  # fmt: skip
     ap.add_argument("--forces", type=float, nargs="+",
                     help="instead of the bisection, try each of these forces (N) in each "
                          "direction and print x (survived) or . (fell) per force")  # fmt: skip
@@ -202,13 +227,18 @@ def main(argv: list[str] | None = None) -> int:
         forces = measure(name, float(at), dur, args)
         took = time.perf_counter() - t0
         if args.forces:
-            n = sum(m.count("x") for m in forces)
             total = sum(len(m) for m in forces)
+            upright = ["".join("." if c == "." else "x" for c in m) for m in forces]
+            n = sum(m.count("x") for m in upright)
             out[key] = {"clip": name, "time_s": float(at), "duration_s": dur,
-                        "forces_n": args.forces, "survived": forces}  # fmt: skip
+                        "forces_n": args.forces, "survived": upright}  # fmt: skip
+            counts = f"; survived {n}/{total}"
+            if args.still:
+                out[key]["settled"] = forces
+                counts += f" upright, settled {sum(m.count('x') for m in forces)}/{total}"
             print(f"{key} {name} @ {at} s, {dur} s pushes at {args.forces} N ({took:.0f} s): "
                   + ", ".join(f"{lab} {m}" for lab, m in zip(LABELS, forces) if m)
-                  + f"; survived {n}/{total}")  # fmt: skip
+                  + counts)  # fmt: skip
             continue
         out[key] = {"clip": name, "time_s": float(at), "duration_s": dur, "max_force_n": forces}
         print(f"{key} {name} @ {at} s, {dur} s pushes ({took:.0f} s): "
