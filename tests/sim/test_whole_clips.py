@@ -137,6 +137,7 @@ def test_a_pushed_standing_clip_turns_its_trunk_about_the_hips(shared_mocap_dir:
     res = push({"step_pushed": False})
     # recovered, not still falling when the window ends: the pelvis back over the mocap's
     assert res.report.status == "ok" and res.errors.root[-1] < 0.1
+    assert end_state(res).settled, end_state(res).why
     assert push({"hip_weight": 0.0, "step_pushed": False}).report.status == "fell"
 
 
