@@ -9,6 +9,16 @@ SIMBICON's 350 N diagonal push while walking (Yin et al. 2007).
 Survival is not monotonic in the force once the tracker steps (a harder push can land a better
 step), so a bisection's answer is a value that was survived with every tested force below it
 that the search probed, not a guaranteed threshold; ``--forces`` sweeps fixed forces instead.
+
+"Upright to the window's end" counts a body still stepping, still falling or thrown into the
+air when the window ends. ``--still`` also judges each push by the body's state at the window's
+end (:func:`reactmocap.sim.end_state`: the centre of mass slower than 0.3 m/s, its capture point
+within 5 cm of the feet on the floor, a sole within 5 cm of the floor): a sweep then prints ``x``
+settled, ``m`` upright but still moving, ``A`` upright with no foot on the floor, ``.`` fell, and
+counts both verdicts from the same runs; a bisection searches the settled verdict.
+``--still-more`` tracks the pushes not settled at the window's end longer, up to the clip's end
+(the clips end 0-2.4 s after the 2 s window), to tell a body still stepping toward a stand
+("s") from one still falling ("f", "m").
 """
 
 from __future__ import annotations
@@ -17,6 +27,7 @@ import argparse
 import json
 import time
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -53,68 +64,106 @@ def heading(motion: Motion, time_s: float) -> float:
     return float(np.arctan2(np.sin(yaw).sum(), np.cos(yaw).sum()))
 
 
-def survives(job: tuple[str, float, float, float, float, float, dict[str, Any], float]) -> bool:
-    """Upright to the window's end; with ``settled`` > 0 also the pelvis within that many m of
-    the mocap's there (a body still tumbling when the window ends is not a recovery)."""
-    name, at, angle, force, duration, after, params, settled = job
-    from reactmocap.sim import push_clip
+@dataclass(frozen=True)
+class Judge:
+    """What counts as a recovered push: upright to the window's end; ``settled`` > 0: the
+    pelvis within that many m of the mocap's there; ``still``: settled there
+    (:func:`reactmocap.sim.end_state`); ``more`` > 0: a push upright but not settled there is
+    tracked up to that many s longer (not past the clip's end) to see whether it settles."""
+
+    settled: float = 0.0
+    still: bool = False
+    more: float = 0.0
+
+
+Job = tuple[str, float, float, float, float, float, dict[str, Any], Judge]
+
+
+def verdict(job: Job) -> str:
+    """One push's mark: "." fell in the window, "x" recovered (see :class:`Judge`); with
+    ``still``, of the upright but not settled: "A" no foot on the floor, "m" still moving,
+    and with ``more``: "s" settled later, "f" fell later."""
+    name, at, angle, force, duration, after, params, judge = job
+    from reactmocap.sim import end_state, push_clip
 
     motion = _clip(name)
     start = max(0.0, at - 0.5)
-    seconds = min(motion.duration - start, at - start + duration + after)
-    res = push_clip(
-        motion, time=at, body="chest", force=[force * np.cos(angle), force * np.sin(angle), 0.0],
-        duration=duration, start=start, seconds=seconds, params=params,
-    )  # fmt: skip
-    if settled > 0 and res.report.status == "ok":
-        return bool(res.errors.root[-1] < settled)
-    return res.report.status == "ok"
+    window = at - start + duration + after
+
+    def run(seconds: float) -> Any:
+        return push_clip(
+            motion, time=at, body="chest",
+            force=[force * np.cos(angle), force * np.sin(angle), 0.0], duration=duration,
+            start=start, seconds=min(motion.duration - start, seconds), params=params,
+        )  # fmt: skip
+
+    res = run(window)
+    if res.report.status != "ok" or (judge.settled > 0 and res.errors.root[-1] >= judge.settled):
+        return "."
+    if not judge.still:
+        return "x"
+    end = end_state(res)
+    if end.settled:
+        return "x"
+    mark = "A" if end.lowest_sole > 0.05 else "m"
+    if judge.more > 0 and motion.duration - start > res.report.seconds + 1e-6:
+        later = run(window + judge.more)
+        if later.report.status != "ok":
+            return "f"
+        mark = "s" if end_state(later).settled else mark
+    return mark
+
+
+def survives(job: Job) -> bool:
+    """Recovered by the job's :class:`Judge` (a push that settles only after the window, "s",
+    is not)."""
+    return verdict(job) == "x"
 
 
 def largest(
-    job: tuple[str, float, float, float, float, dict[str, Any], float, int, float],
+    job: tuple[str, float, float, float, float, dict[str, Any], float, int, Judge],
 ) -> float:
     """Bisection on the force in ``[0, hi]`` (``steps`` halvings)."""
-    name, at, angle, duration, after, params, hi, steps, settled = job
-    if survives((name, at, angle, hi, duration, after, params, settled)):
+    name, at, angle, duration, after, params, hi, steps, judge = job
+    if survives((name, at, angle, hi, duration, after, params, judge)):
         return hi
     lo = 0.0
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
-        if survives((name, at, angle, mid, duration, after, params, settled)):
+        if survives((name, at, angle, mid, duration, after, params, judge)):
             lo = mid
         else:
             hi = mid
     return lo
 
 
-def sweep(job: tuple[str, float, float, float, float, dict[str, Any], list[float], float]) -> str:
-    """One direction at each fixed force: "x" survived, "." fell (a bisection reports whichever
-    path it took where survival is not monotonic in the force)."""
-    name, at, angle, duration, after, params, forces, settled = job
-    return "".join(
-        "x" if survives((name, at, angle, f, duration, after, params, settled)) else "."
-        for f in forces
-    )
+def sweep(
+    job: tuple[str, float, float, float, float, dict[str, Any], list[float], Judge],
+) -> str:
+    """One direction at each fixed force: a :func:`verdict` mark per force (a bisection
+    reports whichever path it took where survival is not monotonic in the force)."""
+    name, at, angle, duration, after, params, forces, judge = job
+    return "".join(verdict((name, at, angle, f, duration, after, params, judge)) for f in forces)
 
 
 def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> list[Any]:
     motion = _clip(name)
     yaw = heading(motion, at)
     params = json.loads(args.params)
-    if not survives((name, at, yaw, 0.0, duration, args.after, params, args.settled)):
+    judge = Judge(args.settled, args.still, args.still_more)
+    if not survives((name, at, yaw, 0.0, duration, args.after, params, judge)):
         # a clip that falls unpushed in the window measures the tracker, not the push
         print(f"{name} falls unpushed within {args.after} s after {at} s: choose another clip")
         return [float("nan")] * 8
     dirs = [k for k in range(8) if LABELS[k] in args.dirs]
     if args.forces:
         sweeps = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.forces,
-                   args.settled) for k in dirs]  # fmt: skip
+                   judge) for k in dirs]  # fmt: skip
         with ProcessPoolExecutor(max_workers=args.jobs) as pool:
             marks = dict(zip(dirs, pool.map(sweep, sweeps)))
         return [marks.get(k, "") for k in range(8)]
     jobs = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.max_force,
-             args.steps, args.settled) for k in dirs]  # fmt: skip
+             args.steps, judge) for k in dirs]  # fmt: skip
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         found = dict(zip(dirs, pool.map(largest, jobs)))
     return [found.get(k, float("nan")) for k in range(8)]
@@ -172,6 +221,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--settled", type=float, default=0.0,
                     help="also require the pelvis within this many m of the mocap's at the "
                          "window's end (0: upright is enough)")  # fmt: skip
+    ap.add_argument("--still", action="store_true",
+                    help="also require the body settled at the window's end (COM slower than "
+                         "0.3 m/s, capture point over the feet on the floor, a foot down): "
+                         "sweeps print x settled, m still moving, A in the air, . fell")  # fmt: skip
+    ap.add_argument("--still-more", type=float, default=0.0,
+                    help="with --still, track a push upright but not settled up to this many s "
+                         "longer (not past the clip's end): s settled then, f fell")  # fmt: skip
     ap.add_argument("--forces", type=float, nargs="+",
                     help="instead of the bisection, try each of these forces (N) in each "
                          "direction and print x (survived) or . (fell) per force")  # fmt: skip
@@ -202,13 +258,21 @@ def main(argv: list[str] | None = None) -> int:
         forces = measure(name, float(at), dur, args)
         took = time.perf_counter() - t0
         if args.forces:
-            n = sum(m.count("x") for m in forces)
             total = sum(len(m) for m in forces)
+            upright = ["".join("." if c == "." else "x" for c in m) for m in forces]
+            n = sum(m.count("x") for m in upright)
             out[key] = {"clip": name, "time_s": float(at), "duration_s": dur,
-                        "forces_n": args.forces, "survived": forces}  # fmt: skip
+                        "forces_n": args.forces, "survived": upright}  # fmt: skip
+            counts = f"; survived {n}/{total}"
+            if args.still:
+                out[key]["settled"] = forces
+                counts += f" upright, settled {sum(m.count('x') for m in forces)}/{total}"
+                if args.still_more > 0:
+                    later = sum(m.count("s") for m in forces)
+                    counts += f" (+{later} settled up to {args.still_more} s later)"
             print(f"{key} {name} @ {at} s, {dur} s pushes at {args.forces} N ({took:.0f} s): "
                   + ", ".join(f"{lab} {m}" for lab, m in zip(LABELS, forces) if m)
-                  + f"; survived {n}/{total}")  # fmt: skip
+                  + counts)  # fmt: skip
             continue
         out[key] = {"clip": name, "time_s": float(at), "duration_s": dur, "max_force_n": forces}
         print(f"{key} {name} @ {at} s, {dur} s pushes ({took:.0f} s): "

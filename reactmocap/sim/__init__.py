@@ -44,9 +44,11 @@ from reactmocap.sim.retarget import Retargeter, retarget
 from reactmocap.sim.rollout import ContactLog, RolloutResult, rollout
 from reactmocap.sim.servo import PDServo, critical_kv
 from reactmocap.sim.tracking import (
+    EndState,
     TrackErrors,
     TrackReport,
     TrackResult,
+    end_state,
     push_clip,
     track_clip,
     tracking_errors,
@@ -66,6 +68,7 @@ __all__ = [
     "ContactReport",
     "Controller",
     "ControllerSpec",
+    "EndState",
     "FunctionController",
     "Group",
     "Impact",
@@ -98,6 +101,7 @@ __all__ = [
     "controller_spec",
     "critical_kv",
     "first_contact",
+    "end_state",
     "push_clip",
     "qvel_from_qpos",
     "reference_path",

@@ -8,6 +8,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
+import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
@@ -22,6 +23,8 @@ from reactmocap.sim.controllers.registry import (
     build,
     controller_spec,
 )
+from reactmocap.sim.controllers.stepping import outside_distance
+from reactmocap.sim.feet import foot_soles, sole_corners_world
 from reactmocap.sim.impacts import Impact
 from reactmocap.sim.reference import reference_path
 from reactmocap.sim.rollout import RolloutResult, rollout
@@ -29,9 +32,11 @@ from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World, WorldConfig
 
 __all__ = [
+    "EndState",
     "TrackErrors",
     "TrackReport",
     "TrackResult",
+    "end_state",
     "push_clip",
     "track_clip",
     "tracking_errors",
@@ -269,3 +274,76 @@ def push_clip(
         duration=duration,
     )
     return track_clip(motion, start=s0, seconds=seconds, impacts=[impact], **kwargs)
+
+
+@dataclass(frozen=True)
+class EndState:
+    """How character 0 stands when a tracking run ends (:func:`end_state`): ``upright`` (the
+    run's status ``ok``), ``com_speed`` the centre of mass's horizontal speed over the last
+    ``over`` s (m/s), ``capture_outside`` how far its capture point lies outside the hull of the
+    sole corners within ``touch`` of the floor (m; negative inside, inf with none down),
+    ``lowest_sole`` the lowest sole corner's height (m), and ``settled``: upright, slower than
+    ``speed``, the capture point within ``margin`` of the support, a foot within ``air`` of
+    the floor."""
+
+    upright: bool
+    com_speed: float
+    capture_outside: float
+    lowest_sole: float
+    settled: bool
+
+    @property
+    def why(self) -> str:
+        """What keeps it from being settled ("" when it is)."""
+        if self.settled:
+            return ""
+        if not self.upright:
+            return "not upright"
+        return (
+            f"COM {self.com_speed:.2f} m/s, capture point {self.capture_outside:+.2f} m "
+            f"outside the support, lowest sole {self.lowest_sole:.2f} m up"
+        )
+
+
+def end_state(
+    result: TrackResult,
+    *,
+    speed: float = 0.3,
+    margin: float = 0.05,
+    touch: float = 0.02,
+    air: float = 0.05,
+    over: float = 0.1,
+) -> EndState:
+    """Whether ``result``'s body has recovered at its last recorded frame, not merely stayed
+    upright: a body still stepping, still falling toward the floor or thrown into the air
+    is upright but not settled (see :class:`EndState` for the criteria)."""
+    ro = result.rollout
+    times, q = ro.frames()
+    k = int(np.searchsorted(times, times[-1] - over - 1e-9))
+    if k >= times.size - 1:
+        raise ConfigError(f"end_state needs more than {over} s of recorded frames")
+    world = ro.world
+    m = world.model
+    d = mujoco.MjData(m)
+    root = world.characters[0].body_ids[0]
+    com = np.empty((2, 3))
+    for i, row in enumerate((k, times.size - 1)):  # two states of a finished run
+        d.qpos[:] = q[row]
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        com[i] = d.subtree_com[root]
+    vel = (com[1, :2] - com[0, :2]) / (times[-1] - times[k])
+    floor_z = float(d.geom_xpos[m.geom("floor").id, 2])
+    _, sole, corners = foot_soles(world, 0, "end_state")
+    pts = sole_corners_world(d, sole, corners).reshape(-1, 3)
+    height = pts[:, 2] - floor_z
+    # the capture point of a linear inverted pendulum at the COM's height over the floor
+    omega = np.sqrt(abs(float(m.opt.gravity[2])) / max(com[1, 2] - floor_z, 1e-3))
+    capture = com[1, :2] + vel / omega
+    down = height < touch
+    outside = outside_distance(capture, pts[down, :2]) if down.any() else float("inf")
+    upright = result.report.status == "ok"
+    com_speed = float(np.linalg.norm(vel))
+    lowest = float(height.min())
+    settled = upright and com_speed < speed and outside <= margin and lowest <= air
+    return EndState(upright, com_speed, float(outside), lowest, bool(settled))
