@@ -16,7 +16,7 @@ from reactmocap.progress import Progress
 
 if TYPE_CHECKING:
     from reactmocap.library.motion import Motion
-    from reactmocap.sim.tracking import TrackReport
+    from reactmocap.sim.tracking import TrackReport, TrackResult
 
 __all__ = ["register"]
 
@@ -152,8 +152,31 @@ def _infeasible_seconds(
     return check.infeasible_seconds(report.start, seconds)
 
 
+def _at_end(result: TrackResult) -> dict[str, Any] | None:
+    """How the pushed body stands at the run's end (:func:`~reactmocap.sim.end_state`): upright
+    is not recovered while it still moves or its capture point is off the feet."""
+    from reactmocap.sim.tracking import end_state
+
+    try:
+        state = end_state(result)
+    except ConfigError:  # a run too short to judge (under 0.1 s recorded)
+        return None
+    outside = state.capture_outside
+    return {
+        "standing_still": state.settled,
+        "com_speed_m_s": round(state.com_speed, 3),
+        "capture_outside_m": round(outside, 3) if math.isfinite(outside) else None,
+        "lowest_sole_m": round(state.lowest_sole, 3),
+        "why": state.why,
+    }
+
+
 def _write_outputs(
-    args: argparse.Namespace, clip: Motion, motion: Motion, report: TrackReport
+    args: argparse.Namespace,
+    clip: Motion,
+    motion: Motion,
+    report: TrackReport,
+    at_end: dict[str, Any] | None = None,
 ) -> None:
     from reactmocap.io import atomic_write_text
 
@@ -164,6 +187,8 @@ def _write_outputs(
     data: dict[str, Any] = report.to_dict()
     infeasible = _infeasible_seconds(clip, report, args.mass, motion.duration)
     data["infeasible_single_support_s"] = infeasible
+    if at_end is not None:
+        data["at_end"] = at_end
     if args.report is not None:
         clean = {
             k: (None if isinstance(v, float) and not math.isfinite(v) else v)
@@ -180,6 +205,13 @@ def _write_outputs(
         f"mean joint error {data['mean_joint_error_rad']:.3f} rad, root error "
         f"{data['root_error_m']:.3f} m, {data['realtime_factor']:.2f}x real time"
     )
+    if at_end is not None and data["status"] == "ok":
+        if at_end["standing_still"]:
+            print("at the end: standing still, the capture point over the feet")
+        else:
+            print(f"at the end: NOT standing still ({at_end['why']}): upright is not recovered "
+                  "yet; a standing clip may still fall, a walking one may be walking on "
+                  "(--seconds to run longer)")  # fmt: skip
     if infeasible is not None and infeasible >= FEASIBILITY_NOTE_S:
         print(
             f"note: for {infeasible:.2f} s of this span the clip asks for more moment than one "
@@ -232,7 +264,8 @@ def _simulate(args: argparse.Namespace, label: str, run: Callable[..., Any], **c
     parts = parts_for(motion.skeleton, load_rules(args.parts)) if args.parts else None
     with _SimProgress(label) as tick:
         result = run(motion, on_tick=tick, parts=parts, **call, **_kwargs(args))
-    _write_outputs(args, motion, result.motion, result.report)
+    at_end = _at_end(result) if label == "push" else None
+    _write_outputs(args, motion, result.motion, result.report, at_end)
     return 3 if args.strict and result.report.status != "ok" else 0
 
 

@@ -141,7 +141,9 @@ def bvh_clip(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
-def test_cli_track_and_push(bvh_clip: Path, tmp_path: Path) -> None:
+def test_cli_track_and_push(
+    bvh_clip: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     from reactmocap.cli import main
 
     out, report = tmp_path / "t.bvh", tmp_path / "t.json"
@@ -175,11 +177,19 @@ def test_cli_track_and_push(bvh_clip: Path, tmp_path: Path) -> None:
                 "0.6",
                 "--out",
                 str(pushed),
+                "--report",
+                str(report),
             ]
         )
         == 0
     )
     assert pushed.stat().st_size > 0
+    # the push's report says how the body stands at the end, not only that it is upright
+    at_end = json.loads(report.read_text())["at_end"]
+    assert isinstance(at_end["standing_still"], bool)
+    assert at_end["com_speed_m_s"] >= 0.0 and at_end["lowest_sole_m"] < 0.05
+    assert (at_end["why"] == "") == at_end["standing_still"]
+    assert "at the end: " in capsys.readouterr().out
     assert (
         main(
             [
