@@ -33,9 +33,6 @@ F64 = NDArray[np.float64]
 # ever has: a body flung head over heels by a 2000 N push came round upright in the air and
 # stepped with a foot 0.9 m up until the simulation blew up
 _STEP_TILT_COS = float(np.cos(np.radians(35.0)))
-# ``step_regain``: the pelvis height (of its starting height) above which a body whose pelvis
-# has tilted back within the limit steps again
-_REGAIN_HEIGHT = 0.85
 # ``step_hold``: how far (m) the capture point may lie outside the feet before a body nearly at
 # rest steps again (``end_state``'s settled margin)
 _HOLD_MARGIN = 0.05
@@ -111,7 +108,6 @@ class AnchoredReference:
         step_ease: float = 0.0,
         step_ease_in: float = 0.0,
         step_hold: float = 0.0,
-        step_regain: bool = False,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -163,7 +159,6 @@ class AnchoredReference:
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
         self.step_hold = float(step_hold)
-        self.step_regain = bool(step_regain)
         self.place_gain = float(place_gain)
         self.place_deadband = float(place_deadband)
         self.place_height = float(place_height)
@@ -479,11 +474,7 @@ class AnchoredReference:
             return
         i = self.clock.nearest(t)
         up = d.xmat[self._root].reshape(3, 3)[:, 2]
-        tilted = bool(up @ self._root_up0 < _STEP_TILT_COS)
-        if self.step_regain and self._gone_down and not tilted:
-            # back upright after a lunge: a later slow topple still needs a step
-            self._gone_down = d.qpos[self._z_adr] < _REGAIN_HEIGHT * self._z0
-        self._gone_down |= tilted
+        self._gone_down |= bool(up @ self._root_up0 < _STEP_TILT_COS)
         if self._gone_down or d.qpos[self._z_adr] < 0.75 * self._z0:
             return  # already going down: a step would only flail
         ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
