@@ -237,6 +237,20 @@ def test_a_balance_step_landing_softly_stays_up(shared_mocap_dir: Path) -> None:
     assert end_state(res).settled, end_state(res).why
 
 
+def test_a_body_nearly_at_rest_after_a_step_holds_instead_of_stepping_again(
+    shared_mocap_dir: Path,
+) -> None:
+    """The third shared standing clip pushed 100 N (Wooten's sideways figure) to its left at
+    the chest for 0.25 s: the first balance step catches the body, but further steps start at
+    2 cm out of the feet while it is nearly at rest (0.05-0.2 m/s), each lifts a foot and
+    relaunches it, and it is still stepping when the window ends. Holding such a body on both
+    feet unless its capture point is 5 cm out (``step_hold`` 0.3 m/s, ``docs/tracking.md``) it
+    settles."""
+    respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 90.0, 100.0)
+    assert _stand_pushed(respond, force, {}) == "moving"
+    assert _stand_pushed(respond, force, {"step_hold": 0.3}) == "ok"
+
+
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
     """The shared walk pushed 350 N (SIMBICON's figure) front-right at the chest for 0.2 s at
     2.0 s: with its clip played faster while the body is faster (``warp_gain``, the whole-clip

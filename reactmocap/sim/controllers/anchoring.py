@@ -33,6 +33,9 @@ F64 = NDArray[np.float64]
 # ever has: a body flung head over heels by a 2000 N push came round upright in the air and
 # stepped with a foot 0.9 m up until the simulation blew up
 _STEP_TILT_COS = float(np.cos(np.radians(35.0)))
+# ``step_hold``: how far (m) the capture point may lie outside the feet before a body nearly at
+# rest steps again (``end_state``'s settled margin)
+_HOLD_MARGIN = 0.05
 # a fall nearer a diagonal than the heading (22.5 deg) steps with the foot on its side: a
 # front-right push stepped the left foot 0.43 m ahead and pitched over the right toes
 _SIDE_STEP_TAN = float(np.tan(np.radians(22.5)))
@@ -104,6 +107,7 @@ class AnchoredReference:
         place_pushed: float = 0.0,
         step_ease: float = 0.0,
         step_ease_in: float = 0.0,
+        step_hold: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -154,6 +158,7 @@ class AnchoredReference:
         self._drop_step: tuple[float, bool] = (-np.inf, False)
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
+        self.step_hold = float(step_hold)
         self.place_gain = float(place_gain)
         self.place_deadband = float(place_deadband)
         self.place_height = float(place_height)
@@ -479,7 +484,15 @@ class AnchoredReference:
             return
         xi, omega = self.capture_point()
         support = np.concatenate(feet)
-        if outside_distance(xi, support) <= self.step_margin:
+        margin = self.step_margin
+        if self.step_hold and self._landed[0] >= 0:
+            speed = float(np.linalg.norm(d.subtree_linvel[self._root][:2]))
+            if speed < self.step_hold:
+                # a body nearly at rest after a step: a capture point at the edge is the
+                # ankles' and hips' to bring back; a further step lifted a foot and
+                # relaunched it
+                margin = max(margin, _HOLD_MARGIN)
+        if outside_distance(xi, support) <= margin:
             return
         rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
         centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half

@@ -180,6 +180,10 @@ class WholeBodyTracker(AnchoredReference):
             still coming back up lowers it with this time constant (s; 0: at once, as before);
             a first step's drop stays instant (easing every drop lost directions at Wooten's
             figure): a second step's one-tick drop left the plan asking no ground force.
+        step_hold: after a balance step has landed, a body whose centre of mass is slower
+            than ``step_hold`` m/s (0: off) steps again only when its capture point is more
+            than 5 cm outside the feet (not ``step_margin``): the steps started at the edge
+            from near rest each lifted a foot and relaunched the body (``docs/tracking.md``).
         step_soft, step_soft_reg: for ``step_soft`` s after a balance step lands (0: off),
             the landed foot's no-slip rows come in linearly from a tick's share and the
             ground forces' regulariser is ``step_soft_reg`` instead of ``force_reg`` (a soft
@@ -281,6 +285,7 @@ class WholeBodyTracker(AnchoredReference):
         step_short: float = 0.0,
         step_ease: float = 0.0,
         step_ease_in: float = 0.0,
+        step_hold: float = 0.0,
         step_soft: float = 0.0,
         step_soft_reg: float = 1e-2,
         swing_weight: float = 10.0,
@@ -317,6 +322,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
                 "step_short": step_short, "step_ease": step_ease, "step_ease_in": step_ease_in,
+                "step_hold": step_hold,
                 "step_soft": step_soft, "step_soft_reg": step_soft_reg,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
@@ -433,6 +439,7 @@ class WholeBodyTracker(AnchoredReference):
             warp_gain=warp_gain, warp_lead=warp_lead, warp_phase=warp_phase, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
+            step_hold=step_hold,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
