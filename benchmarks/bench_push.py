@@ -310,22 +310,21 @@ def main(argv: list[str] | None = None) -> int:
             counts = f"; survived {n}/{total}"
             motion = _clip(name)
             start = max(0.0, float(at) - 0.5)
-            ran = min(motion.duration - start, float(at) - start + dur + args.after)
-            if ran < float(at) - start + dur + args.after - 1e-9:
-                counts += (
-                    f" (window cut at the clip's end: {ran - (float(at) - start):.2f} s "
-                    "after the push)"
-                )
+            full = float(at) - start + dur + args.after
+            # notes printed after the counts: a cut window, pushes judged on a held clip pose
+            notes = ""
+            if motion.duration - start < full - 1e-9:
+                notes += f" (window cut at the clip's end, {motion.duration - float(at):.2f} s after the push)"
             ran_out = sum(sum(c in "XM:" for c in m) for m in forces)
-            if ran_out:
+            if ran_out:  # upper-case marks and ":": never counted walking
                 out[key]["clip_ran_out"] = ran_out
-                counts += f"; {ran_out} reached the clip's last frame inside the window"
+                notes += f"; {ran_out} reached the clip's last frame inside the window (X M :)"
             if args.still and key == "walking":
                 out[key]["walking"] = forces
                 counts += f" upright, walking {sum(m.count('x') for m in forces)}/{total}"
                 print(f"{key} {name} @ {at} s, {dur} s pushes at {args.forces} N ({took:.0f} s): "
                       + ", ".join(f"{lab} {m}" for lab, m in zip(LABELS, forces) if m)
-                      + counts)  # fmt: skip
+                      + counts + notes)  # fmt: skip
                 continue
             if args.still:
                 out[key]["settled"] = forces
@@ -333,6 +332,7 @@ def main(argv: list[str] | None = None) -> int:
                 if args.still_more > 0:
                     later = sum(m.count("s") for m in forces)
                     counts += f" (+{later} settled up to {args.still_more} s later)"
+            counts += notes
             print(f"{key} {name} @ {at} s, {dur} s pushes at {args.forces} N ({took:.0f} s): "
                   + ", ".join(f"{lab} {m}" for lab, m in zip(LABELS, forces) if m)
                   + counts)  # fmt: skip
