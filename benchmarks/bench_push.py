@@ -119,7 +119,9 @@ _REACHED = [float("inf")]
 def verdict(job: Job) -> str:
     """One push's mark: "." fell in the window, "x" recovered (see :class:`Judge`); with
     ``still``, of the upright but not settled: "A" no foot on the floor, "m" still moving,
-    and with ``more``: "s" settled later, "f" fell later."""
+    and with ``more``: "s" settled later, "f" fell later; a walk (``judge.walk``): "x" walking
+    as the clip does (:func:`reactmocap.sim.walk_state`), "m" not; upper-case ("X", "M") and
+    ":" for a fall: the clip reached its last frame inside the window (a held clip pose)."""
     name, at, angle, force, duration, after, params, judge = job
     from reactmocap.sim import end_state, push_clip, walk_state
 

@@ -307,6 +307,14 @@ class EndState:
         )
 
 
+def _com_xyz(m: mujoco.MjModel, d: mujoco.MjData, root: int, qpos: F64) -> F64:
+    """Character 0's centre of mass (world) at ``qpos``."""
+    d.qpos[:] = qpos
+    mujoco.mj_kinematics(m, d)
+    mujoco.mj_comPos(m, d)
+    return d.subtree_com[root].copy()
+
+
 def end_state(
     result: TrackResult,
     *,
@@ -328,12 +336,8 @@ def end_state(
     m = world.model
     d = mujoco.MjData(m)
     root = world.characters[0].body_ids[0]
-    com = np.empty((2, 3))
-    for i, row in enumerate((k, times.size - 1)):  # two states of a finished run
-        d.qpos[:] = q[row]
-        mujoco.mj_kinematics(m, d)
-        mujoco.mj_comPos(m, d)
-        com[i] = d.subtree_com[root]
+    # two states of a finished run (d holds the last one for the soles below)
+    com = np.stack([_com_xyz(m, d, root, q[row]) for row in (k, times.size - 1)])
     vel = (com[1, :2] - com[0, :2]) / (times[-1] - times[k])
     floor_z = float(d.geom_xpos[m.geom("floor").id, 2])
     _, sole, corners = foot_soles(world, 0, "end_state")
@@ -382,14 +386,6 @@ class WalkState:
             f"{np.degrees(self.heading_error):.0f} deg, capture point "
             f"{self.capture_outside:+.2f} m outside the support, {self.feet_down} feet down"
         )
-
-
-def _com_xyz(m: mujoco.MjModel, d: mujoco.MjData, root: int, qpos: F64) -> F64:
-    """Character 0's centre of mass (world) at ``qpos``."""
-    d.qpos[:] = qpos
-    mujoco.mj_kinematics(m, d)
-    mujoco.mj_comPos(m, d)
-    return d.subtree_com[root].copy()
 
 
 def walk_state(
