@@ -19,6 +19,15 @@ counts both verdicts from the same runs; a bisection searches the settled verdic
 ``--still-more`` tracks the pushes not settled at the window's end longer, up to the clip's end
 (the clips end 0-2.4 s after the 2 s window), to tell a body still stepping toward a stand
 ("s") from one still falling ("f", "m").
+
+A walk is never still: ``--still`` judges a walking push by :func:`reactmocap.sim.walk_state`
+instead (upright and walking as the clip does over the window's last 0.6 s: the centre of
+mass's speed within 30% of the clip's, its heading within 30 deg, the capture point within
+0.6 m of the feet on the floor, each foot down in it): ``x`` walking, ``m`` upright but not.
+A walking push whose clip (played faster after a push, ``warp_gain``) reaches its last frame
+before the window ends is judged on a held clip pose: its mark is upper-case (``X``, ``M``, and
+``:`` for a fall) and it is counted apart, never as recovered by the walking verdict. A window
+past the clip's end is cut at it (at rate 1) and the sweep prints the window it ran.
 """
 
 from __future__ import annotations
@@ -44,6 +53,8 @@ LABELS = ("front", "front-left", "left", "back-left", "back", "back-right", "rig
 WOOTEN_STANDING_N = (200.0, 141.0, 100.0, 141.0, 200.0, 141.0, 100.0, 141.0)
 #: SIMBICON's walking figure (Yin et al. 2007): 350 N for 0.2 s, diagonal, survived
 SIMBICON_WALKING_N = 350.0
+#: the walking pushes' duration (s), SIMBICON's
+WALK_PUSH_S = 0.2
 
 
 def _clip(name: str) -> Motion:
@@ -74,17 +85,45 @@ class Judge:
     settled: float = 0.0
     still: bool = False
     more: float = 0.0
+    #: judge ``still`` by :func:`reactmocap.sim.walk_state` (a walk), not by ``end_state``
+    walk: bool = False
 
 
 Job = tuple[str, float, float, float, float, float, dict[str, Any], Judge]
 
 
+def _clip_end_reached() -> list[float]:
+    """Record, in this process, the earliest rollout time at which the anchored tracker's clip
+    clock (which a pushed walk plays faster) reaches the clip's last frame: ``[inf]`` until
+    it does; reset it to ``[inf]`` before each run. The tracker keeps its clock to itself, so
+    its slow tick is wrapped here (a benchmark's probe, not the package's behaviour)."""
+    from reactmocap.sim.controllers.anchoring import AnchoredReference
+
+    reached = _REACHED
+    if not getattr(AnchoredReference.update_ground, "_records_clip_end", False):
+        plain = AnchoredReference.update_ground
+
+        def update_ground(self: AnchoredReference, t: float) -> None:
+            plain(self, t)
+            if self.clock.frame(t) >= self.path.num_frames - 1 - 1e-9:
+                reached[0] = min(reached[0], t)
+
+        update_ground._records_clip_end = True  # type: ignore[attr-defined]
+        setattr(AnchoredReference, "update_ground", update_ground)  # noqa: B010
+    return reached
+
+
+_REACHED = [float("inf")]
+
+
 def verdict(job: Job) -> str:
     """One push's mark: "." fell in the window, "x" recovered (see :class:`Judge`); with
     ``still``, of the upright but not settled: "A" no foot on the floor, "m" still moving,
-    and with ``more``: "s" settled later, "f" fell later."""
+    and with ``more``: "s" settled later, "f" fell later; a walk (``judge.walk``): "x" walking
+    as the clip does (:func:`reactmocap.sim.walk_state`), "m" not; upper-case ("X", "M") and
+    ":" for a fall: the clip reached its last frame inside the window (a held clip pose)."""
     name, at, angle, force, duration, after, params, judge = job
-    from reactmocap.sim import end_state, push_clip
+    from reactmocap.sim import end_state, push_clip, walk_state
 
     motion = _clip(name)
     start = max(0.0, at - 0.5)
@@ -97,11 +136,18 @@ def verdict(job: Job) -> str:
             start=start, seconds=min(motion.duration - start, seconds), params=params,
         )  # fmt: skip
 
+    reached = _clip_end_reached()
+    reached[0] = float("inf")
     res = run(window)
+    # the clip held before the run's last frame (at rate 1 it reaches it only at the end)
+    ran_out = reached[0] < res.report.seconds - 1.0 / motion.fps
     if res.report.status != "ok" or (judge.settled > 0 and res.errors.root[-1] >= judge.settled):
-        return "."
+        return ":" if ran_out else "."
     if not judge.still:
-        return "x"
+        return "X" if ran_out else "x"
+    if judge.walk:
+        mark = "x" if walk_state(res).walking else "m"
+        return mark.upper() if ran_out else mark
     end = end_state(res)
     if end.settled:
         return "x"
@@ -150,7 +196,7 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
     motion = _clip(name)
     yaw = heading(motion, at)
     params = json.loads(args.params)
-    judge = Judge(args.settled, args.still, args.still_more)
+    judge = Judge(args.settled, args.still, args.still_more, walk=duration == WALK_PUSH_S)
     if not survives((name, at, yaw, 0.0, duration, args.after, params, judge)):
         # a clip that falls unpushed in the window measures the tracker, not the push
         print(f"{name} falls unpushed within {args.after} s after {at} s: choose another clip")
@@ -250,7 +296,7 @@ def main(argv: list[str] | None = None) -> int:
             plot(args.plot, earlier)
         return 0
     out: dict[str, Any] = {"labels": LABELS, "params": json.loads(args.params)}
-    for key, dur in (("standing", 0.25), ("walking", 0.2)):
+    for key, dur in (("standing", 0.25), ("walking", WALK_PUSH_S)):
         if args.only and key != args.only:
             continue
         name, at = getattr(args, key).split(":")
@@ -259,17 +305,36 @@ def main(argv: list[str] | None = None) -> int:
         took = time.perf_counter() - t0
         if args.forces:
             total = sum(len(m) for m in forces)
-            upright = ["".join("." if c == "." else "x" for c in m) for m in forces]
+            upright = ["".join("." if c in ".:" else "x" for c in m) for m in forces]
             n = sum(m.count("x") for m in upright)
             out[key] = {"clip": name, "time_s": float(at), "duration_s": dur,
                         "forces_n": args.forces, "survived": upright}  # fmt: skip
             counts = f"; survived {n}/{total}"
+            motion = _clip(name)
+            start = max(0.0, float(at) - 0.5)
+            full = float(at) - start + dur + args.after
+            # notes printed after the counts: a cut window, pushes judged on a held clip pose
+            notes = ""
+            if motion.duration - start < full - 1e-9:
+                notes += f" (window cut at the clip's end, {motion.duration - float(at):.2f} s after the push)"
+            ran_out = sum(sum(c in "XM:" for c in m) for m in forces)
+            if ran_out:  # upper-case marks and ":": never counted walking
+                out[key]["clip_ran_out"] = ran_out
+                notes += f"; {ran_out} reached the clip's last frame inside the window (X M :)"
+            if args.still and key == "walking":
+                out[key]["walking"] = forces
+                counts += f" upright, walking {sum(m.count('x') for m in forces)}/{total}"
+                print(f"{key} {name} @ {at} s, {dur} s pushes at {args.forces} N ({took:.0f} s): "
+                      + ", ".join(f"{lab} {m}" for lab, m in zip(LABELS, forces) if m)
+                      + counts + notes)  # fmt: skip
+                continue
             if args.still:
                 out[key]["settled"] = forces
                 counts += f" upright, settled {sum(m.count('x') for m in forces)}/{total}"
                 if args.still_more > 0:
                     later = sum(m.count("s") for m in forces)
                     counts += f" (+{later} settled up to {args.still_more} s later)"
+            counts += notes
             print(f"{key} {name} @ {at} s, {dur} s pushes at {args.forces} N ({took:.0f} s): "
                   + ", ".join(f"{lab} {m}" for lab, m in zip(LABELS, forces) if m)
                   + counts)  # fmt: skip

@@ -48,10 +48,12 @@ from reactmocap.sim.tracking import (
     TrackErrors,
     TrackReport,
     TrackResult,
+    WalkState,
     end_state,
     push_clip,
     track_clip,
     tracking_errors,
+    walk_state,
 )
 from reactmocap.sim.world import PREFIXES, World, WorldCharacter, WorldConfig
 
@@ -89,6 +91,7 @@ __all__ = [
     "TrackErrors",
     "TrackReport",
     "TrackResult",
+    "WalkState",
     "WholeBodyPlan",
     "WholeBodyTracker",
     "World",
@@ -110,4 +113,5 @@ __all__ = [
     "support_feasibility",
     "track_clip",
     "tracking_errors",
+    "walk_state",
 ]

@@ -36,10 +36,12 @@ __all__ = [
     "TrackErrors",
     "TrackReport",
     "TrackResult",
+    "WalkState",
     "end_state",
     "push_clip",
     "track_clip",
     "tracking_errors",
+    "walk_state",
 ]
 
 F64 = NDArray[np.float64]
@@ -305,6 +307,14 @@ class EndState:
         )
 
 
+def _com_xyz(m: mujoco.MjModel, d: mujoco.MjData, root: int, qpos: F64) -> F64:
+    """Character 0's centre of mass (world) at ``qpos``."""
+    d.qpos[:] = qpos
+    mujoco.mj_kinematics(m, d)
+    mujoco.mj_comPos(m, d)
+    return d.subtree_com[root].copy()
+
+
 def end_state(
     result: TrackResult,
     *,
@@ -326,12 +336,8 @@ def end_state(
     m = world.model
     d = mujoco.MjData(m)
     root = world.characters[0].body_ids[0]
-    com = np.empty((2, 3))
-    for i, row in enumerate((k, times.size - 1)):  # two states of a finished run
-        d.qpos[:] = q[row]
-        mujoco.mj_kinematics(m, d)
-        mujoco.mj_comPos(m, d)
-        com[i] = d.subtree_com[root]
+    # two states of a finished run (d holds the last one for the soles below)
+    com = np.stack([_com_xyz(m, d, root, q[row]) for row in (k, times.size - 1)])
     vel = (com[1, :2] - com[0, :2]) / (times[-1] - times[k])
     floor_z = float(d.geom_xpos[m.geom("floor").id, 2])
     _, sole, corners = foot_soles(world, 0, "end_state")
@@ -347,3 +353,99 @@ def end_state(
     lowest = float(height.min())
     settled = upright and com_speed < speed and outside <= margin and lowest <= air
     return EndState(upright, com_speed, float(outside), lowest, bool(settled))
+
+
+@dataclass(frozen=True)
+class WalkState:
+    """How character 0 walks when a tracking run of a walk ends (:func:`walk_state`):
+    ``upright`` (the run's status ``ok``); over the last ``over`` s, ``speed_ratio`` the centre
+    of mass's mean horizontal speed over the clip's (its own centre of mass over the same clip
+    times at rate 1) and ``heading_error`` the angle between the two velocities (rad);
+    ``capture_outside`` how far the capture point (from the last 0.1 s) lies outside the hull
+    of the sole corners within ``touch`` of the floor at the last frame (m; inf with none
+    down); ``feet_down`` how many feet touched the floor in the window; ``walking``: upright,
+    the speed ratio within ``1 +- speed``, the heading within ``heading``, the capture point
+    within ``reach`` of the support, and both feet down at some time in the window."""
+
+    upright: bool
+    speed_ratio: float
+    heading_error: float
+    capture_outside: float
+    feet_down: int
+    walking: bool
+
+    @property
+    def why(self) -> str:
+        """What keeps it from walking as the clip does ("" when it does)."""
+        if self.walking:
+            return ""
+        if not self.upright:
+            return "not upright"
+        return (
+            f"speed {self.speed_ratio:.2f} of the clip's, heading off by "
+            f"{np.degrees(self.heading_error):.0f} deg, capture point "
+            f"{self.capture_outside:+.2f} m outside the support, {self.feet_down} feet down"
+        )
+
+
+def walk_state(
+    result: TrackResult,
+    *,
+    speed: float = 0.3,
+    heading: float = np.radians(30.0),
+    reach: float = 0.6,
+    touch: float = 0.02,
+    over: float = 0.6,
+) -> WalkState:
+    """Whether ``result``'s walk has recovered at its last recorded frame: upright and walking
+    as its clip does again, not merely upright (a walk is never still, so :func:`end_state`'s
+    stillness does not apply). Compares the body with its clip over the last ``over`` s (about
+    a stride's half: each foot lands in it); see :class:`WalkState` for the criteria."""
+    ro = result.rollout
+    motion = ro.references[0] if ro.references else None
+    if motion is None:
+        raise ConfigError("walk_state needs the run's clip (a tracking run records it)")
+    times, q = ro.frames()
+    k = int(np.searchsorted(times, times[-1] - over - 1e-9))
+    j = int(np.searchsorted(times, times[-1] - 0.1 - 1e-9))
+    if k >= times.size - 1:
+        raise ConfigError(f"walk_state needs more than {over} s of recorded frames")
+    world = ro.world
+    m = world.model
+    d = mujoco.MjData(m)
+    root = world.characters[0].body_ids[0]
+    floor_z = float(world.data.geom_xpos[m.geom("floor").id, 2])
+    _, sole, corners = foot_soles(world, 0, "walk_state")
+    down = np.zeros(2, dtype=bool)
+    for row in range(k, times.size):  # once per recorded frame of a finished run
+        d.qpos[:] = q[row]
+        mujoco.mj_kinematics(m, d)
+        height = sole_corners_world(d, sole, corners)[..., 2] - floor_z
+        down |= height.min(axis=1) < touch
+    com_k, com_j = _com_xyz(m, d, root, q[k]), _com_xyz(m, d, root, q[j])
+    com = _com_xyz(m, d, root, q[-1])
+    vel = (com[:2] - com_k[:2]) / (times[-1] - times[k])
+    # the clip's own centre of mass over the same clip times at rate 1
+    path = reference_path(world, 0, motion)
+    assert path.com is not None
+    t0 = ro.reference_starts[0] if ro.reference_starts else 0.0
+    rows = np.clip(np.round((t0 + times[[k, -1]]) * path.fps).astype(int), 0, path.num_frames - 1)
+    clip_vel = (path.com[rows[1], :2] - path.com[rows[0], :2]) / (times[-1] - times[k])
+    clip_speed = float(np.linalg.norm(clip_vel))
+    ratio = float(np.linalg.norm(vel)) / max(clip_speed, 1e-6)
+    cross = clip_vel[0] * vel[1] - clip_vel[1] * vel[0]
+    angle = abs(float(np.arctan2(cross, float(clip_vel @ vel))))
+    pts = sole_corners_world(d, sole, corners).reshape(-1, 3)  # d holds the last frame
+    low = pts[:, 2] - floor_z < touch
+    omega = np.sqrt(abs(float(m.opt.gravity[2])) / max(com[2] - floor_z, 1e-3))
+    capture = com[:2] + (com[:2] - com_j[:2]) / (times[-1] - times[j]) / omega
+    outside = outside_distance(capture, pts[low, :2]) if low.any() else float("inf")
+    upright = result.report.status == "ok"
+    walking = (
+        upright
+        and abs(ratio - 1.0) <= speed
+        and angle <= heading
+        and outside <= reach
+        and bool(down.all())
+    )
+    return WalkState(upright, ratio, angle, float(outside), int(down.sum()), bool(walking))

@@ -11,7 +11,14 @@ import numpy as np
 import pytest
 
 from reactmocap.library.motion import Motion
-from reactmocap.sim import World, build_character, end_state, push_clip, track_clip
+from reactmocap.sim import (
+    World,
+    build_character,
+    end_state,
+    push_clip,
+    track_clip,
+    walk_state,
+)
 from reactmocap.sim.controllers.registry import controller_spec
 from reactmocap.sim.controllers.stepping import (
     Step,
@@ -108,9 +115,13 @@ def _shared_push(
 
 def _walk_pushed(walk: Motion, force: list[float], time: float, params: dict[str, float]) -> str:
     """The status of a shared walk tracked from 0.5 s before a 0.2 s chest push at ``time``
-    to 2.7 s in, with the tracker's ``params``."""
-    return push_clip(walk, time=time, body="chest", force=force, duration=0.2,
-                     start=time - 0.5, seconds=2.7, params=params).report.status  # fmt: skip
+    to 2.7 s in, with the tracker's ``params``: "ok" only when also walking as the clip does
+    at the window's end (:func:`walk_state`), "moving" when upright but not."""
+    res = push_clip(walk, time=time, body="chest", force=force, duration=0.2,
+                    start=time - 0.5, seconds=2.7, params=params)  # fmt: skip
+    if res.report.status == "ok" and not walk_state(res).walking:
+        return "moving"
+    return res.report.status
 
 
 def _stand_pushed(standing: Motion, force: list[float], params: dict[str, float | bool]) -> str:
@@ -260,16 +271,36 @@ def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None
     assert _walk_pushed(walk, force, 2.0, {"warp_gain": 0.0}) == "fell"
 
 
-def test_a_walk_pushed_sideways_places_its_outer_foot_and_stays_up(
+def test_a_pushed_walk_still_falling_is_not_walking(shared_mocap_dir: Path) -> None:
+    """The shared walk pushed 200 N toward its back-left at the chest for 0.2 s at 2.0 s is
+    upright at the window's end but its centre of mass runs 1.3 times the clip's speed with
+    its capture point 1.2 m outside its feet: not walking; tracked 1.5 s on, it falls at
+    2.8 s. Unpushed it walks as the clip does."""
+    walk, force = _shared_push(shared_mocap_dir, "walk_normal_001", 2.0, 135.0, 200.0)
+    res = push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
+                    seconds=2.7)  # fmt: skip
+    state = walk_state(res)
+    assert state.upright and not state.walking, state
+    assert state.speed_ratio > 1.3 and state.capture_outside > 0.6, state
+    later = push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
+                      seconds=4.2)  # fmt: skip
+    assert later.report.status == "fell"
+    calm = walk_state(push_clip(walk, time=2.0, body="chest", force=[0.0, 0.0, 0.0],
+                                duration=0.2, start=1.5, seconds=2.7))  # fmt: skip
+    assert calm.walking and abs(calm.speed_ratio - 1.0) < 0.15 and calm.feet_down == 2, calm
+
+
+def test_a_walk_pushed_sideways_places_its_outer_foot_and_falls_later(
     shared_mocap_dir: Path,
 ) -> None:
     """The shared left-curving walk pushed 350 N (SIMBICON's figure) toward its right at the
     chest for 0.2 s at 1.5 s: with its outer (right) swing foot placed out from the capture
-    point (``place_pushed``, the whole-clip default) it stays up; without (0), that foot lands
-    where the clip puts it, 0.4-0.6 m inside the capture point, and the walk falls to the
-    right."""
+    point (``place_pushed``, the whole-clip default) it is upright at the window's end but not
+    walking (1.68 times the clip's speed; tracked on it falls at 2.77 s, 2026-12-03); without
+    (0), that foot lands where the clip puts it, 0.4-0.6 m inside the capture point, and the
+    walk falls to the right inside the window."""
     walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, -90.0, 350.0)
-    assert _walk_pushed(walk, force, 1.5, {}) == "ok"
+    assert _walk_pushed(walk, force, 1.5, {}) == "moving"
     assert _walk_pushed(walk, force, 1.5, {"place_pushed": 0.0}) == "fell"
 
 
@@ -280,9 +311,10 @@ def test_a_walk_pushed_sideways_places_only_the_step_the_push_starts(
     1.5 s: its first step after the push crosses over (no placement), the next, 0.7 s after
     the push starts, is the clip's own wide left step. Placed too (before the placement's
     0.5 s window), that step went out and back and the body fell forward over it; now the
-    clip's step lands and the walk stays up."""
+    clip's step lands and the walk is upright at the window's end, but not walking (55 deg
+    off the clip's heading, capture point 0.82 m out; tracked on it falls at 3.17 s)."""
     walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 90.0, 300.0)
-    assert _walk_pushed(walk, force, 1.5, {"place_pushed": 1.0}) == "ok"
+    assert _walk_pushed(walk, force, 1.5, {"place_pushed": 1.0}) == "moving"
 
 
 def test_a_walk_pushed_sideways_with_its_rate_following_the_lead_stays_up(
@@ -312,15 +344,17 @@ def test_a_walk_pushed_sideways_with_its_clip_phase_following_the_body_stays_up(
     assert _walk_pushed(walk, force, 1.5, {"warp_phase": 0.01}) == "ok"
 
 
-def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_stays_up(
+def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_only_falls_later(
     shared_mocap_dir: Path,
 ) -> None:
     """The shared walk pushed 200 N toward its right at the chest for 0.2 s at 2.0 s falls
     with the defaults; with the clip's clock catching a body 0.25 m or more ahead of it
-    (``warp_phase`` 0.25, the swept setting) it stays up."""
+    (``warp_phase`` 0.25, the swept setting) it is upright at the window's end but not
+    walking (1.32 times the clip's speed, capture point 1.18 m out; tracked on it falls at
+    2.75 s)."""
     walk, force = _shared_push(shared_mocap_dir, "walk_normal_001", 2.0, -90.0, 200.0)
     assert _walk_pushed(walk, force, 2.0, {}) == "fell"
-    assert _walk_pushed(walk, force, 2.0, {"warp_phase": 0.25}) == "ok"
+    assert _walk_pushed(walk, force, 2.0, {"warp_phase": 0.25}) == "moving"
 
 
 def test_convex_hull_and_distances() -> None:
