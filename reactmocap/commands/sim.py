@@ -152,23 +152,42 @@ def _infeasible_seconds(
     return check.infeasible_seconds(report.start, seconds)
 
 
-def _at_end(result: TrackResult) -> dict[str, Any] | None:
-    """How the pushed body stands at the run's end (:func:`~reactmocap.sim.end_state`): upright
-    is not recovered while it still moves or its capture point is off the feet."""
-    from reactmocap.sim.tracking import end_state
+#: a clip whose root moves faster than this (m/s) over the judged span is judged as a walk
+WALKING_CLIP_SPEED = 0.3
 
+
+def _at_end(result: TrackResult, clip: Motion) -> dict[str, Any] | None:
+    """Whether the pushed body has recovered at the run's end, not only stayed upright: a
+    standing clip must stand still over its feet (:func:`~reactmocap.sim.end_state`), a walking
+    one walk as its clip does (:func:`~reactmocap.sim.walk_state`)."""
+    import numpy as np
+
+    from reactmocap.sim.tracking import WalkState, end_state, walk_state
+
+    rep = result.report
+    over = 0.6  # walk_state's span: about half a stride
+    # the joints' mean, not the root: some skeletons carry the travel below a fixed root
+    ends = clip.sample([rep.start + rep.seconds - over, rep.start + rep.seconds])
+    mid = ends.global_positions().mean(axis=1)
+    walks = float(np.linalg.norm(mid[1, :2] - mid[0, :2])) / over > WALKING_CLIP_SPEED
     try:
-        state = end_state(result)
-    except ConfigError:  # a run too short to judge (under 0.1 s recorded)
+        state = walk_state(result) if walks else end_state(result)
+    except ConfigError:  # a run too short to judge
         return None
     outside = state.capture_outside
-    return {
-        "standing_still": state.settled,
-        "com_speed_m_s": round(state.com_speed, 3),
+    out: dict[str, Any] = {
+        "judged_as": "walk" if walks else "stand",
+        "recovered": state.walking if isinstance(state, WalkState) else state.settled,
         "capture_outside_m": round(outside, 3) if math.isfinite(outside) else None,
-        "lowest_sole_m": round(state.lowest_sole, 3),
         "why": state.why,
     }
+    if isinstance(state, WalkState):
+        out["speed_ratio"] = round(state.speed_ratio, 3)
+        out["heading_error_rad"] = round(state.heading_error, 3)
+    else:
+        out["com_speed_m_s"] = round(state.com_speed, 3)
+        out["lowest_sole_m"] = round(state.lowest_sole, 3)
+    return out
 
 
 def _write_outputs(
@@ -206,12 +225,12 @@ def _write_outputs(
         f"{data['root_error_m']:.3f} m, {data['realtime_factor']:.2f}x real time"
     )
     if at_end is not None and data["status"] == "ok":
-        if at_end["standing_still"]:
-            print("at the end: standing still, the capture point over the feet")
+        done = "walking as the clip does" if at_end["judged_as"] == "walk" else "standing still"
+        if at_end["recovered"]:
+            print(f"at the end: recovered, {done}")
         else:
-            print(f"at the end: NOT standing still ({at_end['why']}): upright is not recovered "
-                  "yet; a standing clip may still fall, a walking one may be walking on "
-                  "(--seconds to run longer)")  # fmt: skip
+            print(f"at the end: NOT recovered, upright but not {done} ({at_end['why']}); it "
+                  "may still fall (--seconds to run longer)")  # fmt: skip
     if infeasible is not None and infeasible >= FEASIBILITY_NOTE_S:
         print(
             f"note: for {infeasible:.2f} s of this span the clip asks for more moment than one "
@@ -264,7 +283,7 @@ def _simulate(args: argparse.Namespace, label: str, run: Callable[..., Any], **c
     parts = parts_for(motion.skeleton, load_rules(args.parts)) if args.parts else None
     with _SimProgress(label) as tick:
         result = run(motion, on_tick=tick, parts=parts, **call, **_kwargs(args))
-    at_end = _at_end(result) if label == "push" else None
+    at_end = _at_end(result, motion) if label == "push" else None
     _write_outputs(args, motion, result.motion, result.report, at_end)
     return 3 if args.strict and result.report.status != "ok" else 0
 

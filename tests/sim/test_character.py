@@ -186,9 +186,9 @@ def test_cli_track_and_push(
     assert pushed.stat().st_size > 0
     # the push's report says how the body stands at the end, not only that it is upright
     at_end = json.loads(report.read_text())["at_end"]
-    assert isinstance(at_end["standing_still"], bool)
+    assert at_end["judged_as"] == "stand"  # the guard clip stands
     assert at_end["com_speed_m_s"] >= 0.0 and at_end["lowest_sole_m"] < 0.05
-    assert (at_end["why"] == "") == at_end["standing_still"]
+    assert (at_end["why"] == "") == at_end["recovered"]
     assert "at the end: " in capsys.readouterr().out
     assert (
         main(
@@ -207,3 +207,21 @@ def test_cli_track_and_push(
         )
         == 2
     )
+
+
+def test_cli_push_judges_a_walk_by_its_clip(shared_mocap_dir: Path, tmp_path: Path) -> None:
+    """A pushed walk's report judges it by walking as its clip does at the end, not by standing
+    still (a walk is never still)."""
+    from reactmocap.cli import main
+
+    clip = shared_mocap_dir / "dataset-1_walk_normal_001.bvh"
+    if not clip.is_file():
+        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
+    report = tmp_path / "w.json"
+    args = ["push", str(clip), "--time", "2.0", "--body", "chest", "--force=0,200,0"]
+    args += ["--duration", "0.2", "--seconds", "3.0", "--out", str(tmp_path / "w.bvh")]
+    assert main([*args, "--report", str(report)]) == 0
+    at_end = json.loads(report.read_text())["at_end"]
+    assert at_end["judged_as"] == "walk"
+    assert 0.5 < at_end["speed_ratio"] < 1.5  # a walk tracked on, not a stand
+    assert (at_end["why"] == "") == at_end["recovered"]
