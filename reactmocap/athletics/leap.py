@@ -192,6 +192,11 @@ class LeapParams:
     #: forward tuck's take-off yaw became the pelvis's roll at touchdown (r = +0.74), and the
     #: hips' yaw (``tilt_gain``'s way) put a cartwheel in; 0: off (as before)
     yaw_gain: float = 0.0
+    #: the crouch plants both feet (:attr:`Posture.plant`: the COM target the middle of both
+    #: soles, not of those in contact, and a hanging foot brought down): a perturbed start's
+    #: crouch that lost one foot's contact servoed the COM over the other and the push began
+    #: on one foot (docs/athletics.md). False: off (as before)
+    crouch_plant: bool = False
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -292,7 +297,7 @@ class Leap(Basis):
                 ctx.standing_com = float(s.com[2])
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
-                        arms=p.arms_back, settle=p.crouch, lean=p.lean), t,
+                        arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant), t,
                 ease_com=p.com_ease)  # fmt: skip
 
         def thrust(world: World, t: float) -> None:

@@ -696,3 +696,19 @@ def test_the_leap_refuses_a_yaw_gain_out_of_range() -> None:
     for bad in (-1.0, 101.0, math.nan):
         with pytest.raises(ConfigError, match="yaw_gain|finite"):
             LeapParams(yaw_gain=bad)
+
+
+def test_a_perturbed_forward_tuck_crouches_onto_both_feet_with_crouch_plant() -> None:
+    """Start 12 of the capture region at full size (seed 0): its COM went 10 cm over the left
+    foot before the crouch, the balance's COM target followed the foot in contact, the right
+    foot hung 3-4 cm up through the crouch and the push ran on one foot; it fell. The leap's
+    ``crouch_plant`` (an option, off in the preset: 31/50 against 32/50 at full size,
+    docs/athletics.md) aims the crouch's COM at both soles' middle and brings the hanging
+    foot down: both feet carry weight at the thrust and it lands."""
+    start = full_starts(13)[12]
+    m = somersault_maneuver(direction="forward")
+    assert not run_maneuver(m, perturbation=start, fps=10.0).report["landed"]
+    leap = replace(m.phases[1], params={**m.phases[1].params, "crouch_plant": True})
+    r = run_maneuver(replace(m, phases=(m.phases[0], leap, *m.phases[2:])), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
