@@ -152,28 +152,17 @@ def _infeasible_seconds(
     return check.infeasible_seconds(report.start, seconds)
 
 
-#: a clip whose root moves faster than this (m/s) over the judged span is judged as a walk
-WALKING_CLIP_SPEED = 0.3
+def _at_end(result: TrackResult) -> dict[str, Any] | None:
+    """Whether the pushed body has recovered at the run's end, not only stayed upright
+    (:func:`~reactmocap.sim.recovery`: a standing clip stands still over its feet, a walking
+    one walks as its clip does)."""
+    from reactmocap.sim.tracking import WalkState, recovery
 
-
-def _at_end(result: TrackResult, clip: Motion) -> dict[str, Any] | None:
-    """Whether the pushed body has recovered at the run's end, not only stayed upright: a
-    standing clip must stand still over its feet (:func:`~reactmocap.sim.end_state`), a walking
-    one walk as its clip does (:func:`~reactmocap.sim.walk_state`)."""
-    import numpy as np
-
-    from reactmocap.sim.tracking import WalkState, end_state, walk_state
-
-    rep = result.report
-    over = 0.6  # walk_state's span: about half a stride
-    # the joints' mean, not the root: some skeletons carry the travel below a fixed root
-    ends = clip.sample([rep.start + rep.seconds - over, rep.start + rep.seconds])
-    mid = ends.global_positions().mean(axis=1)
-    walks = float(np.linalg.norm(mid[1, :2] - mid[0, :2])) / over > WALKING_CLIP_SPEED
     try:
-        state = walk_state(result) if walks else end_state(result)
+        state = recovery(result)
     except ConfigError:  # a run too short to judge
         return None
+    walks = isinstance(state, WalkState)
     outside = state.capture_outside
     out: dict[str, Any] = {
         "judged_as": "walk" if walks else "stand",
@@ -283,7 +272,7 @@ def _simulate(args: argparse.Namespace, label: str, run: Callable[..., Any], **c
     parts = parts_for(motion.skeleton, load_rules(args.parts)) if args.parts else None
     with _SimProgress(label) as tick:
         result = run(motion, on_tick=tick, parts=parts, **call, **_kwargs(args))
-    at_end = _at_end(result, motion) if label == "push" else None
+    at_end = _at_end(result) if label == "push" else None
     _write_outputs(args, motion, result.motion, result.report, at_end)
     return 3 if args.strict and result.report.status != "ok" else 0
 

@@ -39,6 +39,7 @@ __all__ = [
     "WalkState",
     "end_state",
     "push_clip",
+    "recovery",
     "track_clip",
     "tracking_errors",
     "walk_state",
@@ -315,6 +316,18 @@ def _com_xyz(m: mujoco.MjModel, d: mujoco.MjData, root: int, qpos: F64) -> F64:
     return d.subtree_com[root].copy()
 
 
+def _capture_outside(
+    m: mujoco.MjModel, com: F64, vel: F64, pts: F64, floor_z: float, touch: float
+) -> float:
+    """How far (m) the capture point of a linear inverted pendulum at the COM's height lies
+    outside the hull of the sole corners ``pts`` within ``touch`` of the floor (inf: none)."""
+    omega = np.sqrt(abs(float(m.opt.gravity[2])) / max(float(com[2]) - floor_z, 1e-3))
+    down = pts[:, 2] - floor_z < touch
+    if not down.any():
+        return float("inf")
+    return float(outside_distance(com[:2] + vel / omega, pts[down, :2]))
+
+
 def end_state(
     result: TrackResult,
     *,
@@ -343,11 +356,7 @@ def end_state(
     _, sole, corners = foot_soles(world, 0, "end_state")
     pts = sole_corners_world(d, sole, corners).reshape(-1, 3)
     height = pts[:, 2] - floor_z
-    # the capture point of a linear inverted pendulum at the COM's height over the floor
-    omega = np.sqrt(abs(float(m.opt.gravity[2])) / max(com[1, 2] - floor_z, 1e-3))
-    capture = com[1, :2] + vel / omega
-    down = height < touch
-    outside = outside_distance(capture, pts[down, :2]) if down.any() else float("inf")
+    outside = _capture_outside(m, com[1], vel, pts, floor_z, touch)
     upright = result.report.status == "ok"
     com_speed = float(np.linalg.norm(vel))
     lowest = float(height.min())
@@ -436,10 +445,8 @@ def walk_state(
     cross = clip_vel[0] * vel[1] - clip_vel[1] * vel[0]
     angle = abs(float(np.arctan2(cross, float(clip_vel @ vel))))
     pts = sole_corners_world(d, sole, corners).reshape(-1, 3)  # d holds the last frame
-    low = pts[:, 2] - floor_z < touch
-    omega = np.sqrt(abs(float(m.opt.gravity[2])) / max(com[2] - floor_z, 1e-3))
-    capture = com[:2] + (com[:2] - com_j[:2]) / (times[-1] - times[j]) / omega
-    outside = outside_distance(capture, pts[low, :2]) if low.any() else float("inf")
+    vel_end = (com[:2] - com_j[:2]) / (times[-1] - times[j])
+    outside = _capture_outside(m, com, vel_end, pts, floor_z, touch)
     upright = result.report.status == "ok"
     walking = (
         upright
@@ -449,3 +456,26 @@ def walk_state(
         and bool(down.all())
     )
     return WalkState(upright, ratio, angle, float(outside), int(down.sum()), bool(walking))
+
+
+#: a clip whose centre of mass moves faster than this (m/s) over :func:`recovery`'s span is
+#: judged as a walk
+WALKING_CLIP_SPEED = 0.3
+
+
+def recovery(result: TrackResult, *, over: float = 0.6) -> EndState | WalkState:
+    """The verdict that fits ``result``'s clip at the run's end: :func:`walk_state` where the
+    clip's own centre of mass moves faster than :data:`WALKING_CLIP_SPEED` over the last
+    ``over`` s of clip time, :func:`end_state` (standing still) otherwise."""
+    ro = result.rollout
+    times, _ = ro.frames()
+    motion = ro.references[0] if ro.references else None
+    if motion is None or times.size < 2:
+        return end_state(result)
+    path = reference_path(ro.world, 0, motion)
+    assert path.com is not None
+    t0 = ro.reference_starts[0] if ro.reference_starts else 0.0
+    span = np.array([times[-1] - over, times[-1]]) + t0
+    rows = np.clip(np.round(span * path.fps).astype(int), 0, path.num_frames - 1)
+    speed = float(np.linalg.norm(path.com[rows[1], :2] - path.com[rows[0], :2])) / over
+    return walk_state(result, over=over) if speed > WALKING_CLIP_SPEED else end_state(result)
