@@ -262,19 +262,19 @@ def test_a_body_nearly_at_rest_after_a_step_holds_instead_of_stepping_again(
     assert _stand_pushed(respond, force, {"step_hold": 0.3}) == "ok"
 
 
-def test_a_capture_point_leaving_fast_steps_again_despite_the_hold(
+def test_a_hold_limited_to_just_after_a_landing_keeps_the_step_that_catches(
     shared_mocap_dir: Path,
 ) -> None:
     """The second shared standing clip pushed 125 N toward its back-right at the chest for
-    0.25 s: with the defaults a second balance step, started from near rest (0.11 m/s) with
-    the capture point 2 cm out, catches the body and it settles. Held (``step_hold`` 0.3) the
-    capture point drifts out to 5 cm and a longer step starts a new chain: still stepping at
-    the window's end. Held only while the capture point leaves the feet slower than 0.3 m/s
-    (``step_hold_rate``, ``docs/tracking.md``) the step comes once it speeds up and the body
-    settles."""
+    0.25 s: with the defaults a second balance step, started 0.35 s after the first landed,
+    from near rest (0.11 m/s) with the capture point 2 cm out, catches the body and it
+    settles. Held (``step_hold`` 0.3) the capture point drifts out to 6 cm and a 0.48 m step
+    starts a new chain: still stepping at the window's end. Held only in the 0.5 s after a
+    landing (``step_hold_for``, ``docs/tracking.md``) the step starts as the hold lapses, 5 cm
+    out, lands 0.44 m away and the body settles (a fragile gain: 30 ms later it did not)."""
     byebye, force = _shared_push(shared_mocap_dir, "byebye_normal_001", 1.0, 225.0, 125.0)
     assert _stand_pushed(byebye, force, {"step_hold": 0.3}) == "moving"
-    assert _stand_pushed(byebye, force, {"step_hold": 0.3, "step_hold_rate": 0.3}) == "ok"
+    assert _stand_pushed(byebye, force, {"step_hold": 0.3, "step_hold_for": 0.5}) == "ok"
 
 
 def test_a_pushed_walk_steps_faster_and_stays_up(shared_mocap_dir: Path) -> None:
