@@ -273,7 +273,6 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_ease", -0.1),
         ("step_ease_in", -0.1),
         ("step_hold", -0.3),
-        ("step_hold_rate", -0.3),
         ("step_hold_for", -0.5),
         ("step_soft", -0.05),
         ("step_soft_reg", -1e-2),

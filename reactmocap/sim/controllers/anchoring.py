@@ -36,9 +36,6 @@ _STEP_TILT_COS = float(np.cos(np.radians(35.0)))
 # ``step_hold``: how far (m) the capture point may lie outside the feet before a body nearly at
 # rest steps again (``end_state``'s settled margin)
 _HOLD_MARGIN = 0.05
-# ``step_hold_rate``: the time constant (s) smoothing the capture point's outward speed (its
-# finite difference over one decision period jumps with the ground forces tick to tick)
-_HOLD_RATE_TAU = 0.03
 # a fall nearer a diagonal than the heading (22.5 deg) steps with the foot on its side: a
 # front-right push stepped the left foot 0.43 m ahead and pitched over the right toes
 _SIDE_STEP_TAN = float(np.tan(np.radians(22.5)))
@@ -111,7 +108,6 @@ class AnchoredReference:
         step_ease: float = 0.0,
         step_ease_in: float = 0.0,
         step_hold: float = 0.0,
-        step_hold_rate: float = 0.0,
         step_hold_for: float = 0.0,
     ) -> None:
         m = world.model
@@ -164,12 +160,7 @@ class AnchoredReference:
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
         self.step_hold = float(step_hold)
-        self.step_hold_rate = float(step_hold_rate)
         self.step_hold_for = float(step_hold_for)
-        # the capture point at the last step decision (rollout time, (2,)) and its smoothed
-        # outward speed (m/s; ``step_hold_rate``)
-        self._xi_last: tuple[float, F64] = (-np.inf, np.zeros(2))
-        self._xi_rate = 0.0
         self.place_gain = float(place_gain)
         self.place_deadband = float(place_deadband)
         self.place_height = float(place_height)
@@ -498,7 +489,10 @@ class AnchoredReference:
         margin = self.step_margin
         if self.step_hold and self._landed[0] >= 0:
             speed = float(np.linalg.norm(d.subtree_linvel[self._root][:2]))
-            if speed < self.step_hold and self._hold_still(t, xi, support):
+            # ``step_hold_for``: a body left at the edge longer after a landing drifts out and
+            # the later, longer step started a new chain
+            soon = not self.step_hold_for or t - self._landed[1] <= self.step_hold_for
+            if speed < self.step_hold and soon:
                 # a body nearly at rest after a step: a capture point at the edge is the
                 # ankles' and hips' to bring back; a further step lifted a foot and
                 # relaunched it
@@ -536,27 +530,6 @@ class AnchoredReference:
         self.step = Step(foot, t, duration, centre[foot].copy(),
                          np.r_[target, self.floor_z], self.step_height)  # fmt: skip
         self.steps_taken.append(t)
-
-    def _hold_still(self, t: float, xi: F64, support: F64) -> bool:
-        """Whether ``step_hold`` may hold a body nearly at rest on its feet at ``t``: always,
-        but for ``step_hold_for`` (only that long after the last landing) and
-        ``step_hold_rate`` (only while the capture point ``xi`` leaves the ``support`` points
-        slower than that: one the ankles and hips hold creeps out, one leaving fast needs the
-        step)."""
-        if self.step_hold_for and t - self._landed[1] > self.step_hold_for:
-            return False
-        if not self.step_hold_rate:
-            return True
-        t_last, xi_last = self._xi_last
-        self._xi_last = (t, xi.copy())
-        dt = t - t_last
-        if dt > 2.5 * self._dt_slow:  # no decision just before (a step, a lifted foot)
-            self._xi_rate = 0.0
-            return True
-        fall = xi - support.mean(axis=0)
-        out = float((xi - xi_last) @ fall) / (dt * max(float(np.linalg.norm(fall)), 1e-9))
-        self._xi_rate += min(1.0, dt / _HOLD_RATE_TAU) * (out - self._xi_rate)
-        return self._xi_rate < self.step_hold_rate
 
     def rebalance(self, t: float) -> None:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
@@ -700,7 +673,6 @@ class AnchoredReference:
         self._gone_down = False
         self._drop, self._drop_t = 0.0, 0.0
         self._drop_step = (-np.inf, False)
-        self._xi_last, self._xi_rate = (-np.inf, np.zeros(2)), 0.0
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping, self.leading = 1.0, False, False
@@ -720,14 +692,13 @@ class AnchoredReference:
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
-                self._drop_t, self._catching, self._drop_step, self._xi_last,
-                self._xi_rate)  # fmt: skip
+                self._drop_t, self._catching, self._drop_step)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching, drop_step, xi_last, xi_rate) = memory  # fmt: skip
+         catching, drop_step) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -748,5 +719,3 @@ class AnchoredReference:
         self._drop, self._drop_t = float(drop), float(drop_t)  # type: ignore[arg-type]
         self._catching = bool(catching)
         self._drop_step = drop_step  # type: ignore[assignment]
-        self._xi_last = xi_last  # type: ignore[assignment]
-        self._xi_rate = float(xi_rate)  # type: ignore[arg-type]

@@ -184,11 +184,9 @@ class WholeBodyTracker(AnchoredReference):
             than ``step_hold`` m/s (0: off) steps again only when its capture point is more
             than 5 cm outside the feet (not ``step_margin``): the steps started at the edge
             from near rest each lifted a foot and relaunched the body (``docs/tracking.md``).
-        step_hold_rate, step_hold_for: with ``step_hold``, hold such a body only while its
-            capture point leaves the feet slower than ``step_hold_rate`` m/s (smoothed over
-            0.03 s; 0: any speed, as ``step_hold`` alone) and only for ``step_hold_for`` s
-            after the last landing (0: any time): held, a capture point drifting out ended
-            in a longer step that started a new chain (``docs/tracking.md``).
+        step_hold_for: with ``step_hold``, hold such a body only for ``step_hold_for`` s after
+            the last landing (0: any time): held longer, a capture point drifting out ended in
+            a longer step that started a new chain (``docs/tracking.md``).
         step_soft, step_soft_reg: for ``step_soft`` s after a balance step lands (0: off),
             the landed foot's no-slip rows come in linearly from a tick's share and the
             ground forces' regulariser is ``step_soft_reg`` instead of ``force_reg`` (a soft
@@ -291,7 +289,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ease: float = 0.0,
         step_ease_in: float = 0.0,
         step_hold: float = 0.0,
-        step_hold_rate: float = 0.0,
         step_hold_for: float = 0.0,
         step_soft: float = 0.0,
         step_soft_reg: float = 1e-2,
@@ -329,8 +326,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_height": step_height, "step_leg": step_leg,
                 "step_pushed": step_pushed, "step_alternate": step_alternate,
                 "step_short": step_short, "step_ease": step_ease, "step_ease_in": step_ease_in,
-                "step_hold": step_hold, "step_hold_rate": step_hold_rate,
-                "step_hold_for": step_hold_for,
+                "step_hold": step_hold, "step_hold_for": step_hold_for,
                 "step_soft": step_soft, "step_soft_reg": step_soft_reg,
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
@@ -447,7 +443,7 @@ class WholeBodyTracker(AnchoredReference):
             warp_gain=warp_gain, warp_lead=warp_lead, warp_phase=warp_phase, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
-            step_hold=step_hold, step_hold_rate=step_hold_rate, step_hold_for=step_hold_for,
+            step_hold=step_hold, step_hold_for=step_hold_for,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
