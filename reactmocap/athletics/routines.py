@@ -35,6 +35,7 @@ __all__ = [
     "HANDSPRING_BODY_PRESET",
     "HANDSPRING_PRESET",
     "HANDSPRING_SECONDS",
+    "HANDSPRING_STARTS",
     "handspring",
     "handspring_maneuver",
     "somersault",
@@ -57,7 +58,8 @@ SETTLED_START = Phase("balance", "settled", MappingProxyType({"plant": True}), 3
 SETTLED_START_STANDING = Phase("balance", "settled",
                                MappingProxyType({"plant": True, "gains": "standing"}), 3.0)  # fmt: skip
 #: the timed start: the next phase begins 0.3 s into the start, settled or not (the dives, the
-#: handspring and the timed entries of :data:`PRESET_STARTS`)
+#: handspring but the male's (:data:`HANDSPRING_STARTS`) and the timed entries of
+#: :data:`PRESET_STARTS`)
 TIMED_START = Phase("balance", "after", MappingProxyType({}), 0.3)
 #: seconds a somersault is simulated: from :data:`TIMED_START` 5.5; from :data:`SETTLED_START`
 #: 2.7 more, what the settle may take beyond 0.3 s (8.2, as ``back_somersault.toml``)
@@ -418,7 +420,7 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # 10 and 15, held-out seed 2 15 from 13; docs/athletics.md). A list: a maneuver file's
     # numbers load as one
     "male": MappingProxyType({
-        "leap": MappingProxyType({"spin_limit": 1.3}),
+        "leap": MappingProxyType({"spin_limit": 1.3, "hold": 0.22}),
         "handspring": MappingProxyType({"aim": -3.42, "knees": 0.4}),
         "land": MappingProxyType({"delta": -0.55, "spin_ref": -96.8,
                                   "step": [0.05, 0.1, 0.3, 0.25]}),
@@ -432,8 +434,14 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
 
 
 #: seconds a body's handspring is simulated (others 5.0): the male's aimed contact touches
-#: down later and stands up ~0.4 s later (2026-12-03)
-HANDSPRING_SECONDS: Mapping[str, float] = MappingProxyType({"male": 5.5})
+#: down later and stands up ~0.4 s later (2026-12-03: 5.5), and he starts settled (8.2)
+HANDSPRING_SECONDS: Mapping[str, float] = MappingProxyType({"male": 8.2})
+#: a body's handspring start (others :data:`TIMED_START`): since 2026-12-03 the male settles
+#: first (:data:`SETTLED_START`; his seconds 2.7 more, what the settle may take beyond 0.3 s)
+#: and holds his crouch 0.22 s (the leap's ``hold``; at 0.15 the nominal, settled at 0.23 s,
+#: fell back): perturbed starts crouched on one foot and left the leap turning about the
+#: vertical (docs/athletics.md)
+HANDSPRING_STARTS: Mapping[str, Phase] = MappingProxyType({"male": SETTLED_START})
 
 
 def handspring_maneuver(body: str = "male") -> Maneuver:
@@ -456,7 +464,7 @@ def handspring_maneuver(body: str = "male") -> Maneuver:
         )
         leap["spin"] = round(leap["spin"] * ratio, 1)
     phases = (
-        TIMED_START,
+        HANDSPRING_STARTS.get(body, TIMED_START),
         Phase("leap", "liftoff", leap),
         Phase("handspring", "released", hands),
         Phase("land", "settled", land),

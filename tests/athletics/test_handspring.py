@@ -16,7 +16,12 @@ import pytest
 from reactmocap.athletics.handspring import HandspringParams
 from reactmocap.athletics.land import LandingParams
 from reactmocap.athletics.maneuvers import Maneuver, Perturbation, load_maneuver, run_maneuver
-from reactmocap.athletics.routines import handspring, handspring_maneuver
+from reactmocap.athletics.routines import (
+    SETTLED_START,
+    TIMED_START,
+    handspring,
+    handspring_maneuver,
+)
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError
 from reactmocap.library.bvh import read_bvh
@@ -124,6 +129,14 @@ def _with(m: Maneuver, controller: str, params: dict[str, float]) -> Maneuver:
     return replace(m, phases=phases)
 
 
+def _timed_start(m: Maneuver) -> Maneuver:
+    """``m`` as the file was before its settled start (2026-12-03 22:13 UTC): the leap 0.3 s
+    into the start (:data:`TIMED_START`), its crouch held the default 0.15 s, 5.5 s."""
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    m = _with(m, "leap", {k: v for k, v in leap.items() if k != "hold"})
+    return replace(m, phases=(TIMED_START, *m.phases[1:]), seconds=5.5)
+
+
 #: the file as it was before the knees' aim (2026-12-03): the leap's feedback allowed 1.5 rad,
 #: the knees straight in the air, the feet 45 cm behind the capture point, 5.0 s
 BEFORE_AIM = {
@@ -141,7 +154,7 @@ def test_the_landing_places_the_feet_by_the_spin_the_push_left() -> None:
     scaled by the spin measured as the landing begins (``spin_ref``) the feet land farther
     back and it stands."""
     start = _starts(0.1, 4)[3]
-    m = replace(load_maneuver(EXAMPLE), seconds=5.0)
+    m = replace(_timed_start(load_maneuver(EXAMPLE)), seconds=5.0)
     for controller, params in BEFORE_AIM.items():
         m = _with(m, controller, params)
     land = next(i for i, p in enumerate(m.phases) if p.controller == "land")
@@ -160,7 +173,7 @@ def test_the_knees_aim_the_hands_contact_at_the_rotation_the_push_needs() -> Non
     at contact (``aim``, the file since 2026-12-03) start 2 straightens them, start 12 bends
     them, both meet the floor within 15 deg of the aimed -196 deg and land."""
     starts = _starts(1.0, 13)
-    m = load_maneuver(EXAMPLE)
+    m = _timed_start(load_maneuver(EXAMPLE))  # as measured then
     hands = next(p for p in m.phases if p.controller == "handspring").params
     assert hands["aim"] == -3.42
     held = _with(m, "handspring", {k: v for k, v in hands.items() if k != "aim"})
@@ -183,7 +196,7 @@ def test_the_hands_split_their_push_against_the_twist_and_off_changes_nothing() 
     leave with less than a fifth of that; ``twist_gain`` 0, or the feedback gated off by
     ``twist_above``, is the file's run to the bit."""
     start = _starts(1.0, 8)[7]
-    m = load_maneuver(EXAMPLE)
+    m = _timed_start(load_maneuver(EXAMPLE))  # as measured then
     hands = next(p for p in m.phases if p.controller == "handspring").params
 
     def lz_as_hands_leave(params: dict[str, float]) -> tuple[float, float]:
@@ -199,3 +212,26 @@ def test_the_hands_split_their_push_against_the_twist_and_off_changes_nothing() 
     assert abs(on) < 0.2 * off[0]
     # gated off above the momentum the hands meet the floor with (+5.5): the file's run
     assert lz_as_hands_leave({**hands, "twist_gain": 3.0, "twist_above": 6.0}) == off
+
+
+def test_the_male_handspring_starts_settled_and_a_start_that_crouched_turning_lands() -> None:
+    """Since 2026-12-03 the male handspring starts settled onto both feet (as the back tuck)
+    and holds its crouch 0.22 s; the female keeps the timed start. Full-size start 13 (seed 0)
+    crouched 0.3 s into the start with its pelvis turning (+9 deg) and left the leap with +2.8
+    kg m^2/s about the vertical, turned on over its feet and fell; settled first it leaves with
+    under 2 and lands."""
+    m = load_maneuver(EXAMPLE)
+    assert handspring_maneuver("male") == m and m.phases[0] == SETTLED_START
+    assert handspring_maneuver("female").phases[0] == TIMED_START
+    start = _starts(1.0, 14)[13]
+
+    def run(man: Maneuver) -> tuple[bool, float]:
+        r = run_maneuver(man, perturbation=start, fps=10.0)
+        t, lz = r.log["t"], r.log["momentum"][:, 2]
+        i = min(int(np.searchsorted(t, r.report["time_to_liftoff_s"])), t.size - 1)
+        return bool(r.report["landed"] and not r.report["fell"]), float(lz[i])
+
+    landed, lz = run(m)
+    assert landed and abs(lz) < 2.0
+    landed, lz = run(_timed_start(m))
+    assert not landed and lz > 2.0
