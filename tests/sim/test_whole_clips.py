@@ -344,6 +344,32 @@ def test_a_walk_pushed_sideways_with_its_clip_phase_following_the_body_stays_up(
     assert _walk_pushed(walk, force, 1.5, {"warp_phase": 0.01}) == "ok"
 
 
+def test_a_walk_pushed_back_with_a_firm_pelvis_servo_walks_on(shared_mocap_dir: Path) -> None:
+    """The shared right-curving walk pushed 300 N straight back at the chest for 0.2 s at
+    1.5 s: with the softer pelvis servo after a walk's push (``kp_root_pushed`` 30, the
+    whole-clip default) it trails its clip at the window's end, upright but not walking (0.07
+    of the clip's speed, its steps landing on its capture point; 2026-12-03); with the servo
+    kept at ``kp_root`` after a push against the walk (``kp_root_against`` 50, opt-in) it
+    walks as its clip does."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 180.0, 300.0)
+    assert _walk_pushed(walk, force, 1.5, {}) == "moving"
+    assert _walk_pushed(walk, force, 1.5, {"kp_root_against": 50.0}) == "ok"
+
+
+def test_a_walk_pushed_back_right_with_its_rate_back_to_one_walks_on(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared right-curving walk pushed 400 N back and to its right at the chest for 0.2 s
+    at 1.5 s: with the defaults it is upright at the window's end but not walking (0.94 of
+    the clip's speed, capture point 0.65 m out; tracked on it falls at 3.02 s, 2026-12-03:
+    the body, slowed by the push, speeds up again and the played-faster clip's rate follows
+    it up); with the rate following the body only for 1.5 s after the push (``warp_for``,
+    opt-in) it walks as its clip does."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, -135.0, 400.0)
+    assert _walk_pushed(walk, force, 1.5, {}) == "moving"
+    assert _walk_pushed(walk, force, 1.5, {"warp_for": 1.5}) == "ok"
+
+
 def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_only_falls_later(
     shared_mocap_dir: Path,
 ) -> None:
