@@ -290,15 +290,17 @@ def test_a_pushed_walk_still_falling_is_not_walking(shared_mocap_dir: Path) -> N
     """The shared walk pushed 200 N toward its back-left at the chest for 0.2 s at 2.0 s is
     upright at the window's end but its centre of mass runs 1.3 times the clip's speed with
     its capture point 1.2 m outside its feet: not walking; tracked 1.5 s on, it falls at
-    2.8 s. Unpushed it walks as the clip does."""
+    2.8 s. Unpushed it walks as the clip does. (With the clip's rate back to 1 1.5 s after
+    the push, ``warp_for`` 1.5, the whole-clip default since 2026-12-03 22:20 UTC, this fall
+    comes inside the window: measured here with the rate following the body throughout.)"""
     walk, force = _shared_push(shared_mocap_dir, "walk_normal_001", 2.0, 135.0, 200.0)
     res = push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
-                    seconds=2.7)  # fmt: skip
+                    seconds=2.7, params={"warp_for": 0.0})  # fmt: skip
     state = walk_state(res)
     assert state.upright and not state.walking, state
     assert state.speed_ratio > 1.3 and state.capture_outside > 0.6, state
     later = push_clip(walk, time=2.0, body="chest", force=force, duration=0.2, start=1.5,
-                      seconds=4.2)  # fmt: skip
+                      seconds=4.2, params={"warp_for": 0.0})  # fmt: skip
     assert later.report.status == "fell"
     calm = walk_state(push_clip(walk, time=2.0, body="chest", force=[0.0, 0.0, 0.0],
                                 duration=0.2, start=1.5, seconds=2.7))  # fmt: skip
@@ -313,10 +315,14 @@ def test_a_walk_pushed_sideways_places_its_outer_foot_and_falls_later(
     point (``place_pushed``, the whole-clip default) it is upright at the window's end but not
     walking (1.68 times the clip's speed; tracked on it falls at 2.77 s, 2026-12-03); without
     (0), that foot lands where the clip puts it, 0.4-0.6 m inside the capture point, and the
-    walk falls to the right inside the window."""
+    walk falls to the right inside the window. Both with the clip's rate following the body
+    throughout (``warp_for`` 0); with it back to 1 1.5 s after the push (``warp_for`` 1.5, the
+    whole-clip default since 2026-12-03 22:20 UTC) the placed walk's fall comes inside the
+    window too."""
     walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, -90.0, 350.0)
-    assert _walk_pushed(walk, force, 1.5, {}) == "moving"
-    assert _walk_pushed(walk, force, 1.5, {"place_pushed": 0.0}) == "fell"
+    assert _walk_pushed(walk, force, 1.5, {"warp_for": 0.0}) == "moving"
+    assert _walk_pushed(walk, force, 1.5, {"warp_for": 0.0, "place_pushed": 0.0}) == "fell"
+    assert _walk_pushed(walk, force, 1.5, {}) == "fell"
 
 
 def test_a_walk_pushed_sideways_places_only_the_step_the_push_starts(
@@ -357,6 +363,32 @@ def test_a_walk_pushed_sideways_with_its_clip_phase_following_the_body_stays_up(
     walk stays up."""
     walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, 90.0, 350.0)
     assert _walk_pushed(walk, force, 1.5, {"warp_phase": 0.01}) == "ok"
+
+
+def test_a_walk_pushed_back_with_a_firm_pelvis_servo_walks_on(shared_mocap_dir: Path) -> None:
+    """The shared right-curving walk pushed 300 N straight back at the chest for 0.2 s at
+    1.5 s: with the softer pelvis servo after every walk's push (``kp_root_pushed`` 30,
+    ``kp_root_against`` 0) it trails its clip at the window's end, upright but not walking
+    (0.07 of the clip's speed, its steps landing on its capture point; 2026-12-03); with the
+    servo kept at ``kp_root`` after a push against the walk (``kp_root_against`` 50, the
+    whole-clip default since 2026-12-03) it walks as its clip does."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 180.0, 300.0)
+    assert _walk_pushed(walk, force, 1.5, {"kp_root_against": 0.0}) == "moving"
+    assert _walk_pushed(walk, force, 1.5, {}) == "ok"
+
+
+def test_a_walk_pushed_back_right_with_its_rate_back_to_one_walks_on(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared right-curving walk pushed 400 N back and to its right at the chest for 0.2 s
+    at 1.5 s: without ``warp_for`` it is upright at the window's end but not walking (0.94 of
+    the clip's speed, capture point 0.65 m out; tracked on it falls at 3.02 s, 2026-12-03:
+    the body, slowed by the push, speeds up again and the played-faster clip's rate follows
+    it up); with the rate following the body only for 1.5 s after the push (``warp_for`` 1.5,
+    the whole-clip default since 2026-12-03) it walks as its clip does."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, -135.0, 400.0)
+    assert _walk_pushed(walk, force, 1.5, {"warp_for": 0.0}) == "moving"
+    assert _walk_pushed(walk, force, 1.5, {}) == "ok"
 
 
 def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_only_falls_later(

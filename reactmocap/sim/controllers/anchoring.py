@@ -109,6 +109,7 @@ class AnchoredReference:
         step_ease_in: float = 0.0,
         step_hold: float = 0.0,
         step_hold_for: float = 0.0,
+        warp_for: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -199,6 +200,9 @@ class AnchoredReference:
         self.warp_gain = float(warp_gain)
         self.warp_lead = float(warp_lead)
         self.warp_phase = float(warp_phase)
+        self.warp_for = float(warp_for)
+        #: rollout time after which a pushed walk's clip plays back at rate 1 (``warp_for``)
+        self.warp_until = np.inf
         self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
@@ -626,6 +630,10 @@ class AnchoredReference:
             xi, omega = self.capture_point()
             lead = float((xi - c[:2] - v[:2] / omega) @ v_ref) / ref
             target += self.warp_lead * lead
+        if t > self.warp_until:
+            # a body the push slowed, speeding up again 1-2 s later, drove the rate up with
+            # it, the faster clip drove the body faster, and it ran ahead of its feet and fell
+            target = 1.0
         target = min(max(target, 1.0), _WARP_MAX)
         self.rate += min(1.0, self._dt_slow / _WARP_TAU) * (target - self.rate)
         self.clock = replace(self.clock, start=self.clock.start + (self.rate - 1.0) * self._dt_slow)
@@ -676,6 +684,7 @@ class AnchoredReference:
         self._slow_next = 0.0
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping, self.leading = 1.0, False, False
+        self.warp_until = np.inf
         self._catching = False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
@@ -692,13 +701,13 @@ class AnchoredReference:
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
-                self._drop_t, self._catching, self._drop_step)  # fmt: skip
+                self._drop_t, self._catching, self._drop_step, self.warp_until)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching, drop_step) = memory  # fmt: skip
+         catching, drop_step, warp_until) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -719,3 +728,4 @@ class AnchoredReference:
         self._drop, self._drop_t = float(drop), float(drop_t)  # type: ignore[arg-type]
         self._catching = bool(catching)
         self._drop_step = drop_step  # type: ignore[assignment]
+        self.warp_until = float(warp_until)  # type: ignore[arg-type]

@@ -148,7 +148,9 @@ _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: feet (0.1 s), the targets keeping the capture point 5 cm inside them (0.1 s) and the chest's
 #: world turn held as tracked (weight 30, as the pelvis; after a push they give while the mocap
 #: stands and the capture point is off, back over 0.5 s: the hip strategy a standing body
-#: needs), the pelvis position servo at half stiffness (50 1/s^2; 30 once a walk is pushed),
+#: needs), the pelvis position servo at half stiffness (50 1/s^2; 30 once a walk is pushed,
+#: but for a push against the walk: ``kp_root_against``), a pushed walk's clip played faster
+#: for 1.5 s (``warp_gain``, ``warp_for``),
 #: and after a push while the mocap stands a hip strategy (``hip_weight``) near the feet's edge
 #: and balance steps once the capture point leaves them (``step_pushed``; the pelvis lowered so
 #: the step reaches the floor, the next step by the other foot or by one lifted off the floor,
@@ -161,7 +163,7 @@ WHOLE_CLIP: Mapping[str, Param] = MappingProxyType(
      "balance_margin": 0.05, "trunk_weight": 30.0, "trunk_give": 0.5, "kp_root": 50.0,
      "kp_root_pushed": 30.0, "hip_weight": 300.0, "hip_tilt_step": 0.5, "warp_gain": 0.8,
      "step_pushed": True, "step_leg": 0.9, "step_alternate": True, "step_short": 0.3,
-     "place_pushed": 1.0, "step_ease": 0.1}
+     "place_pushed": 1.0, "step_ease": 0.1, "kp_root_against": 50.0, "warp_for": 1.5}
 )  # fmt: skip
 
 _REGISTRY: dict[str, ControllerSpec] = {

@@ -40,6 +40,10 @@ _UP = np.array([[0.0], [0.0], [1.0]])
 _SWING_ACC = 100.0
 # a walk's push within this angle of sideways (tan 30 deg) places its swing feet
 _PLACE_SIDE_TAN = float(np.tan(np.radians(30.0)))
+# a walk's push within this angle of straight against the walk is one ``kp_root_against``
+# answers (back alone of the push benchmark's eight directions: with back-left and
+# back-right too it lost more pushes than it caught)
+_AGAINST_COS = float(np.cos(np.radians(30.0)))
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
 # r @ _LEVI_CIVITA, reshaped (3, 3), is -[r]x (the cross-product matrix's negative)
 _LEVI_CIVITA = np.array(
@@ -116,6 +120,10 @@ class WholeBodyTracker(AnchoredReference):
             sideways); a walk keeps them (it fell under smaller pushes without them).
         kp_root_pushed: with ``trunk_give``, a push that starts while the mocap does not stand
             sets ``kp_root`` to this for the rest of the rollout (0: unchanged).
+        kp_root_against: with ``kp_root_pushed``, a walk's push within 30 deg of straight
+            against the walk sets ``kp_root`` to this instead (0: ``kp_root_pushed``): slowed
+            by the softer servo, such a walk trailed its clip for 1-2 s, its steps landing on
+            its capture point (``docs/tracking.md``).
         hip_weight, hip_gain, hip_free, hip_margin, hip_back, hip_tilt: a hip strategy after
             a push while the mocap stands (0: off): while the simulated capture point is
             within ``hip_margin`` m of the feet's edge or beyond, rows of weight ``hip_weight``
@@ -209,6 +217,9 @@ class WholeBodyTracker(AnchoredReference):
             point runs ahead of the mocap's along the mocap's walk (falls by as much behind,
             never below 1), so a body that drifts ahead after its sideways fall is caught gets
             its next steps sooner (0: off; ``docs/tracking.md``).
+        warp_for: with ``warp_gain``, the clip's rate follows the body only this long (s)
+            after the walk's push starts, then goes back to 1 (0: for the rest of the
+            rollout; ``docs/tracking.md``).
         warp_phase: with ``warp_gain``, after a walk's push (any direction), once the body's
             centre of mass is ``warp_phase`` m ahead of the mocap's along the mocap's walk and
             until it no longer is, the clip's clock moves on by the clip time that closes that
@@ -256,6 +267,7 @@ class WholeBodyTracker(AnchoredReference):
         trunk_give: float = 0.0,
         trunk_band: float = 0.1,
         kp_root_pushed: float = 0.0,
+        kp_root_against: float = 0.0,
         hip_weight: float = 0.0,
         hip_gain: float = 2.0,
         hip_free: float = 0.3,
@@ -300,6 +312,7 @@ class WholeBodyTracker(AnchoredReference):
         warp_gain: float = 0.0,
         warp_lead: float = 0.0,
         warp_phase: float = 0.0,
+        warp_for: float = 0.0,
         place_pushed: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
@@ -314,7 +327,7 @@ class WholeBodyTracker(AnchoredReference):
                 "kp_root": kp_root, "kp_rot": kp_rot, "kp_joint": kp_joint,
                 "root_weight": root_weight, "trunk_weight": trunk_weight, "contact_weight": contact_weight,
                 "trunk_give": trunk_give, "trunk_band": trunk_band,
-                "kp_root_pushed": kp_root_pushed, "hip_weight": hip_weight, "hip_gain": hip_gain,
+                "kp_root_pushed": kp_root_pushed, "kp_root_against": kp_root_against, "hip_weight": hip_weight, "hip_gain": hip_gain,
                 "hip_free": hip_free, "hip_margin": hip_margin, "hip_back": hip_back,
                 "hip_tilt": hip_tilt, "hip_tilt_step": hip_tilt_step,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
@@ -331,7 +344,7 @@ class WholeBodyTracker(AnchoredReference):
                 "swing_weight": swing_weight, "kp_swing": kp_swing,
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
-                "warp_phase": warp_phase, "place_pushed": place_pushed,
+                "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -372,6 +385,7 @@ class WholeBodyTracker(AnchoredReference):
         self._give = float(trunk_give)
         self._give_band = float(trunk_band)
         self._kp_root_pushed = float(kp_root_pushed)
+        self._kp_root_against = float(kp_root_against)
         self._step_pushed = bool(step_pushed)
         self._pushed = False  # an external force has acted on the body
         self._pushing = False  # one acts now
@@ -443,7 +457,7 @@ class WholeBodyTracker(AnchoredReference):
             warp_gain=warp_gain, warp_lead=warp_lead, warp_phase=warp_phase, step_leg=step_leg,
             step_alternate=step_alternate, step_short=step_short,
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
-            step_hold=step_hold, step_hold_for=step_hold_for,
+            step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
@@ -746,6 +760,8 @@ class WholeBodyTracker(AnchoredReference):
         if pushing and not self._pushed and not standing:
             # a walk pushed: its clip follows the body's speed (``warp_gain``)
             self.warping = self.warp_gain > 0
+            if self.warp_for:
+                self.warp_until = t + self.warp_for
             # and a sideways push places its swing feet (``place_pushed``): placing them after
             # a diagonal one lost more front-right pushes than it caught
             heading = self.sole_heading()
@@ -759,8 +775,12 @@ class WholeBodyTracker(AnchoredReference):
             self.leading = self.warping and self.warp_lead > 0 and sideways
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
-                self.kp[:3] = self._kp_root_pushed
-                self.kv[:3] = critical_kv(self._kp_root_pushed)
+                kp = self._kp_root_pushed
+                ahead = np.cos(heading) * f[0] + np.sin(heading) * f[1]
+                if self._kp_root_against and ahead < -_AGAINST_COS * np.hypot(f[0], f[1]):
+                    kp = self._kp_root_against
+                self.kp[:3] = kp
+                self.kv[:3] = critical_kv(kp)
         if pushing and not self._pushed and standing and self._step_pushed:
             self.stepping = True  # a standing body pushed steps when it must
         self._pushed |= pushing
