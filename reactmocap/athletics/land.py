@@ -28,6 +28,7 @@ from reactmocap.athletics.balance import (
 from reactmocap.athletics.leap import pitch_momentum
 from reactmocap.athletics.machine import NEXT, Basis, Context, law, touchdown
 from reactmocap.athletics.rig import joint_index, per_joint
+from reactmocap.athletics.tumble import time_to_height
 from reactmocap.errors import ConfigError
 from reactmocap.sim.bodies import BALL_JOINTS
 from reactmocap.sim.controllers.machine import State, after
@@ -193,6 +194,20 @@ class LandingParams:
             one is righted at once, as without it. Why: the ease changed the fate of landings
             touching down nearly level too, both ways (the forward tuck's 2 kg backpack
             lands rolled 25 degrees, and lands only righted at once).
+        turn_gain: how much farther ahead (m) the feet go per radian that the somersault
+            rotation predicted at touchdown lies past ``turn_ref`` (> 0: forward; the rotation
+            now plus its rate, measured over the last control tick, times the time the COM
+            takes to fall by the soles' clearance), updated each tick in the reach's last
+            ``turn_window`` seconds; 0: off. Why: the male back layout's touchdown spreads
+            over -297..-308 degrees with the opening's 4 ms tick (one tick moves it 3-5
+            degrees, the window that lands is 4-5 wide): touching down less turned the
+            ground stopped the spin too hard and it fell forward, more turned it went on
+            backward; 100 ms before touchdown the rotation already differs by its final
+            amount (docs/athletics.md).
+        turn_ref: the touchdown rotation (rad, backward < 0) at which ``turn_gain`` moves
+            nothing.
+        turn_window: the predicted time to touchdown (s) below which ``turn_gain`` acts (the
+            prediction, a straight line, runs ahead of the reach's slowing turn before).
     """
 
     knee: float = 0.6
@@ -224,6 +239,9 @@ class LandingParams:
     step: tuple[float, ...] = ()
     roll_ease: float = 0.0
     roll_min: float = 0.0
+    turn_gain: float = 0.0
+    turn_ref: float = 0.0
+    turn_window: float = 0.1
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -248,6 +266,8 @@ class LandingParams:
             "twist_arms",
             "roll_ease",
             "roll_min",
+            "turn_gain",
+            "turn_ref",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -262,6 +282,8 @@ class LandingParams:
             raise ConfigError(f"landing pitch_ease must be >= 0 s, got {self.pitch_ease}")
         if not 0.0 <= self.roll_ease <= 0.9:  # the recovery hands over within 1 s anyway
             raise ConfigError(f"landing roll_ease must be in [0, 0.9] s, got {self.roll_ease}")
+        if not 0.0 < self.turn_window <= 1.0:
+            raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
             raise ConfigError(f"landing roll_min must be in [0, pi/2] rad, got {self.roll_min}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
@@ -337,6 +359,7 @@ class Landing(Basis):
                 up = max(float(sn.com_vel @ sn.floor_normal), 0.0)
                 g = float(np.linalg.norm(world.model.opt.gravity))
                 memo["fall"] = max(float(soles.min()), 0.0) + up * up / (2.0 * g)
+            memo["rot_prev"], memo["t_prev"] = ctx.rotation, t  # turn_gain's rate
 
         def reach(world: World, t: float) -> None:
             s = ctx.sense(t)
@@ -357,6 +380,15 @@ class Landing(Basis):
             if p.momentum_gain:  # the feet also stop the rotation (see momentum_gain)
                 spin = memo["spin"] if p.momentum_side else pitch_momentum(world, s)
                 want[0] += p.momentum_gain * (spin - p.momentum_ref)
+            if p.turn_gain:  # the feet moved by the touchdown's predicted rotation (turn_gain)
+                rate = (ctx.rotation - memo["rot_prev"]) / max(t - memo["t_prev"], 1e-9)
+                memo["rot_prev"], memo["t_prev"] = ctx.rotation, t
+                corners = s.sole_corners() - d.geom_xpos[s.floor]
+                clearance = max(float((corners @ s.floor_normal).min()), 0.0)
+                t_td = time_to_height(ctx, float(s.com[2]) - clearance)
+                if t_td <= p.turn_window:
+                    turn = ctx.rotation + rate * t_td - p.turn_ref
+                    want[0] += p.turn_gain * turn
             # eq. 6.1 as a correction on top of the geometric placement below
             x = s.local(feet - s.com, h)
             xd = s.local(fvel - s.com_vel, h)

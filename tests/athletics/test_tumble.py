@@ -294,7 +294,10 @@ def test_the_back_layout_opens_by_the_reach_s_turn_over_its_time() -> None:
     assert tumble.controller == "tumble" and tumble.params["open_delay"] > 0.0
     old = replace(tumble, params={**tumble.params, "lead": 0.0, "open_inertia": 8.0,
                                   "open_delay": 0.0})  # fmt: skip
-    before = replace(m, phases=(*m.phases[:2], old, *m.phases[3:]))
+    # the landing as it was then too: its turn_gain (since 2026-12-03 22:00) lands a touchdown
+    # at -305.5 (the next test)
+    land = replace(m.phases[3], params={**m.phases[3].params, "turn_gain": 0.0})
+    before = replace(m, phases=(*m.phases[:2], old, land, *m.phases[4:]))
     for i in (28, 42):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
         assert -305.0 < r["rotation_at_touchdown_deg"] < -301.0, (i, r["rotation_at_touchdown_deg"])
@@ -712,3 +715,34 @@ def test_a_perturbed_forward_tuck_crouches_onto_both_feet_with_crouch_plant() ->
     r = run_maneuver(replace(m, phases=(m.phases[0], leap, *m.phases[2:])), perturbation=start,
                      fps=10.0).report  # fmt: skip
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+
+
+def test_the_back_layout_moves_its_feet_by_the_rotation_predicted_at_touchdown() -> None:
+    """Start 6 of ``back_layout.toml``'s capture region at a tenth (seed 0) opens a tick
+    early and, the feet placed as the nominal's (``turn_gain`` 0, before 2026-12-03 22:00),
+    touches down at -305.4 deg still turning backward and falls over backward. The landing's
+    ``turn_gain`` (the file's 0.3 m/rad in the reach's last 50 ms) sees the touchdown
+    predicted past ``turn_ref`` and puts the feet farther behind: the ground stops the spin
+    and it lands."""
+    rng = np.random.default_rng(0)
+    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
+             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
+    start = [Perturbation.sample(rng, **tenth) for _ in range(7)][6]
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = m.phases[3]
+    assert land.controller == "land" and land.params["turn_gain"] > 0.0
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    off = replace(land, params={**land.params, "turn_gain": 0.0})
+    r = run_maneuver(replace(m, phases=(*m.phases[:3], off, *m.phases[4:])), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["rotation_at_touchdown_deg"] < -305.0, r["rotation_at_touchdown_deg"]
+    assert not (r["landed"] and not r["fell"])
+
+
+def test_the_landing_refuses_a_turn_window_out_of_range() -> None:
+    for bad in (0.0, -0.1, 1.5, math.nan):
+        with pytest.raises(ConfigError, match="turn_window"):
+            LandingParams(turn_window=bad)
+    with pytest.raises(ConfigError, match="turn_gain"):
+        LandingParams(turn_gain=math.inf)
