@@ -724,7 +724,7 @@ def test_a_perturbed_forward_tuck_waits_in_the_crouch_with_crouch_until() -> Non
     m = somersault_maneuver(direction="forward")
     before = run_maneuver(m, perturbation=start, fps=10.0).report
     assert not before["landed"] or before["fell"]
-    leap = replace(m.phases[1], params={**m.phases[1].params, "crouch_until": (0.02, 0.05, 0.3)})
+    leap = replace(m.phases[1], params={**m.phases[1].params, "crouch_until": [0.02, 0.05, 0.3]})
     r = run_maneuver(replace(m, phases=(m.phases[0], leap, *m.phases[2:])), perturbation=start,
                      fps=10.0).report  # fmt: skip
     assert r["time_to_liftoff_s"] > before["time_to_liftoff_s"] + 0.05
