@@ -197,6 +197,14 @@ class LeapParams:
     #: crouch that lost one foot's contact servoed the COM over the other and the push began
     #: on one foot (docs/athletics.md). False: off (as before)
     crouch_plant: bool = False
+    #: the crouch ends on the body's state, not at ``crouch + hold``: ``(side_m,
+    #: side_speed_m_s, cap_s)``: from ``crouch + hold`` on it waits until both feet are down
+    #: and the COM lies within ``side_m`` sideways of the soles' middle (both soles, as
+    #: ``crouch_plant``'s target) moving sideways under ``side_speed_m_s``, at most ``cap_s``
+    #: more (then it thrusts as before): a perturbed start's crouch ended over one foot or
+    #: moving sideways and the push began on one foot (docs/athletics.md). ``()``: off (as
+    #: before)
+    crouch_until: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -234,6 +242,16 @@ class LeapParams:
             raise ConfigError(f"leap roll_gain must be in [0, 100], got {self.roll_gain}")
         if not 0.0 <= self.yaw_gain <= 100.0:
             raise ConfigError(f"leap yaw_gain must be in [0, 100], got {self.yaw_gain}")
+        if self.crouch_until and not (
+            len(self.crouch_until) == 3
+            and all(isinstance(v, (int, float)) and math.isfinite(v) for v in self.crouch_until)
+            and min(self.crouch_until[:2]) > 0.0
+            and self.crouch_until[2] >= 0.0
+        ):
+            raise ConfigError(
+                f"leap crouch_until must be () or (side_m > 0, side_speed_m_s > 0, cap_s >= 0), "
+                f"got {self.crouch_until}"
+            )
         if self.handover not in HANDOVERS:
             raise ConfigError(
                 f"leap handover must be one of {list(HANDOVERS)}, got {self.handover!r}"
@@ -496,13 +514,26 @@ class Leap(Basis):
             ctx.rig.support_dir = None
             ctx.rig.support_point = None
 
+        def crouch_settled(_w: World, t: float, t_in: float) -> bool:
+            # crouch_until: both feet down, the COM over the soles' middle sideways and still
+            side, speed, cap = p.crouch_until
+            if t_in < p.crouch + p.hold - 1e-12:
+                return False
+            if t_in >= p.crouch + p.hold + cap - 1e-12:
+                return True
+            s = ctx.sense(t)
+            if not s.foot_contact.all():
+                return False
+            h = s.heading()
+            off = s.local(s.com - s.support_center(h, both=True), h)
+            return bool(abs(off[1]) < side and abs(s.local(s.com_vel, h)[1]) < speed)
+
+        crouch_exit: Event = crouch_settled if p.crouch_until else after(p.crouch + p.hold)
         at_apex = p.handover == "apex" or (p.handover == "auto" and not p.broad)
         flight_exit: Event = apex(ctx) if at_apex else after(0.0)
         com = p.push == "com" and not p.broad
         return [
-            State(
-                "crouch", law(bl.control, every), crouch, ((after(p.crouch + p.hold), "thrust"),)
-            ),
+            State("crouch", law(bl.control, every), crouch, ((crouch_exit, "thrust"),)),
             State(
                 "thrust",
                 law(com_push, every) if com else law(push, every),

@@ -164,8 +164,9 @@ def _build_leap(phase: Phase, ath: Athlete) -> Basis:
                 else tables.leap_params(float(effort)))  # fmt: skip
     else:
         base = LeapParams(broad=broad)
-    if "timing" in p:
-        p["timing"] = tuple(p["timing"])
+    for key in ("timing", "crouch_until"):
+        if key in p:
+            p[key] = tuple(p[key])
     return Leap(replace(base, handover=phase.exit, **p))
 
 

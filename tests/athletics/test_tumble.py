@@ -746,3 +746,26 @@ def test_the_landing_refuses_a_turn_window_out_of_range() -> None:
             LandingParams(turn_window=bad)
     with pytest.raises(ConfigError, match="turn_gain"):
         LandingParams(turn_gain=math.inf)
+
+
+def test_a_perturbed_forward_tuck_waits_in_the_crouch_with_crouch_until() -> None:
+    """Start 45 of the capture region at full size (seed 0): its crouch ended at the fixed
+    time with the COM over one foot, the other unloaded, and it fell. The leap's
+    ``crouch_until`` (an option, off in the preset, docs/athletics.md) holds the crouch until
+    both feet are down and the COM is within 2 cm of the soles' middle sideways, moving
+    sideways under 0.05 m/s (at most 0.3 s more): it thrusts later and lands."""
+    start = full_starts(46)[45]
+    m = somersault_maneuver(direction="forward")
+    before = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert not before["landed"] or before["fell"]
+    leap = replace(m.phases[1], params={**m.phases[1].params, "crouch_until": [0.02, 0.05, 0.3]})
+    r = run_maneuver(replace(m, phases=(m.phases[0], leap, *m.phases[2:])), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["time_to_liftoff_s"] > before["time_to_liftoff_s"] + 0.05
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+
+
+def test_the_leap_refuses_a_bad_crouch_until() -> None:
+    for bad in ((0.02, 0.05), (0.0, 0.05, 0.3), (0.02, 0.05, -0.1), (0.02, math.nan, 0.3)):
+        with pytest.raises(ConfigError, match="crouch_until"):
+            LeapParams(crouch_until=bad)
