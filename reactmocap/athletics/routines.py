@@ -36,6 +36,7 @@ __all__ = [
     "HANDSPRING_PRESET",
     "HANDSPRING_SECONDS",
     "HANDSPRING_STARTS",
+    "SETTLE_SECONDS",
     "handspring",
     "handspring_maneuver",
     "somersault",
@@ -61,9 +62,12 @@ SETTLED_START_STANDING = Phase("balance", "settled",
 #: handspring but the male's (:data:`HANDSPRING_STARTS`) and the timed entries of
 #: :data:`PRESET_STARTS`)
 TIMED_START = Phase("balance", "after", MappingProxyType({}), 0.3)
+#: seconds a run from :data:`SETTLED_START` is simulated beyond one from :data:`TIMED_START`:
+#: what the settle may take beyond the timed start's 0.3 s
+SETTLE_SECONDS = 2.7
 #: seconds a somersault is simulated: from :data:`TIMED_START` 5.5; from :data:`SETTLED_START`
-#: 2.7 more, what the settle may take beyond 0.3 s (8.2, as ``back_somersault.toml``)
-SOMERSAULT_SECONDS = MappingProxyType({"after": 5.5, "settled": 8.2})
+#: :data:`SETTLE_SECONDS` more (8.2, as ``back_somersault.toml``)
+SOMERSAULT_SECONDS = MappingProxyType({"after": 5.5, "settled": 5.5 + SETTLE_SECONDS})
 #: the :data:`SOMERSAULT_PRESETS` entries (``body/key``) that do not start from
 #: :data:`SETTLED_START`, and their start. The male forward tuck still leaps 0.3 s into the
 #: start: settled first, it sinks its landing's crouch 3 mm further, below the fall line, and
@@ -437,11 +441,12 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
 })  # fmt: skip
 
 
-#: seconds a body's handspring is simulated (others 5.0): the male's aimed contact touches
-#: down later and stands up ~0.4 s later (2026-12-03: 5.5), and he starts settled (8.2)
-HANDSPRING_SECONDS: Mapping[str, float] = MappingProxyType({"male": 8.2})
+#: seconds a body's handspring is simulated from :data:`TIMED_START` (others 5.0; from
+#: :data:`SETTLED_START` :data:`SETTLE_SECONDS` more): the male's aimed contact touches down
+#: later and stands up ~0.4 s later (2026-12-03)
+HANDSPRING_SECONDS: Mapping[str, float] = MappingProxyType({"male": 5.5})
 #: a body's handspring start (others :data:`TIMED_START`): since 2026-12-03 the male settles
-#: first (:data:`SETTLED_START`; his seconds 2.7 more, what the settle may take beyond 0.3 s)
+#: first (:data:`SETTLED_START`)
 #: and holds his crouch 0.22 s (the leap's ``hold``; at 0.15 the nominal, settled at 0.23 s,
 #: fell back): perturbed starts crouched on one foot and left the leap turning about the
 #: vertical (docs/athletics.md)
@@ -467,14 +472,18 @@ def handspring_maneuver(body: str = "male") -> Maneuver:
             athlete("male"), "layout"
         )
         leap["spin"] = round(leap["spin"] * ratio, 1)
+    start = HANDSPRING_STARTS.get(body, TIMED_START)
+    seconds = HANDSPRING_SECONDS.get(body, 5.0) + (
+        SETTLE_SECONDS if start is SETTLED_START else 0.0
+    )
     phases = (
-        HANDSPRING_STARTS.get(body, TIMED_START),
+        start,
         Phase("leap", "liftoff", leap),
         Phase("handspring", "released", hands),
         Phase("land", "settled", land),
         Phase("balance", "never", {"settle": 2.0}),
     )
-    return Maneuver("back_handspring", phases, body, HANDSPRING_SECONDS.get(body, 5.0))
+    return Maneuver("back_handspring", phases, body, seconds)
 
 
 def handspring(
