@@ -621,6 +621,8 @@ class AnchoredReference:
             return err
         u = v[:2] / ref
         along = float(err @ u)
+        # the velocity ``_warp`` computed at the last slow tick (8 ms old at most): enough
+        # for a gate over 0.7 s, and the swept figures are with it
         body = self.world.data.subtree_linvel[self._root][:2]
         ahead = float(body @ u)
         if along >= 0.0 or ahead > _LAG_COS * float(np.hypot(body[0], body[1])):
