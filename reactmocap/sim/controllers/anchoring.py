@@ -621,7 +621,9 @@ class AnchoredReference:
             return err
         u = v[:2] / ref
         along = float(err @ u)
-        # the velocity ``_warp`` computed at the last slow tick (8 ms old at most): enough
+        if not self.warping:
+            mujoco.mj_subtreeVel(self.world.model, self.world.data)
+        # else the velocity ``_warp`` computed at the last slow tick (8 ms old at most): enough
         # for a gate over 0.7 s, and the swept figures are with it
         body = self.world.data.subtree_linvel[self._root][:2]
         ahead = float(body @ u)
