@@ -391,6 +391,21 @@ def test_a_walk_pushed_back_right_with_its_rate_back_to_one_walks_on(
     assert _walk_pushed(walk, force, 1.5, {}) == "ok"
 
 
+def test_a_walk_pushed_off_its_way_with_its_path_held_ahead_walks_on(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared left-curving walk pushed 350 N (SIMBICON's figure) back and to its right at
+    the chest for 0.2 s at 1.5 s: with the defaults it is upright at the window's end but
+    not walking (0.60 of the clip's speed, 74 deg off its way, each step landing on the
+    capture point while the re-anchoring drags the clip's path after the feet; 2026-12-04);
+    with the path held up to 0.3 m ahead of the lagging feet for 0.7 s after the push
+    (``anchor_lag`` 0.3, opt-in) the clip's pelvis pulls the body back to its speed and way
+    and it walks as its clip does."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, -135.0, 350.0)
+    assert _walk_pushed(walk, force, 1.5, {}) == "moving"
+    assert _walk_pushed(walk, force, 1.5, {"anchor_lag": 0.3}) == "ok"
+
+
 def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_only_falls_later(
     shared_mocap_dir: Path,
 ) -> None:

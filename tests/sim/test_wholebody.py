@@ -276,6 +276,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_hold_for", -0.5),
         ("step_soft", -0.05),
         ("step_soft_reg", -1e-2),
+        ("anchor_lag", -0.3),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

@@ -64,6 +64,14 @@ _PLACE_SIDEWAYS = 3.0
 # and only this long (s) after the push starts: a later swing is the clip's own step, which
 # already lands out (placing it too lost a walk's pushes toward the side its clip walks from)
 _PLACE_WINDOW = 0.5
+# ``anchor_lag``: the ground path lags the feet only this long (s) after a walk's push starts
+# (held longer, the path ahead drove bodies back up to speed past their feet: they fell
+# forward), only while the centre of mass moves more than this far (cos 45 deg) off the
+# clip's walk (a body slowed straight back is ``kp_root_against``'s), and by all of
+# ``anchor_lag`` only at this fraction of the clip's speed or less, by none at its speed
+_LAG_FOR = 0.7
+_LAG_COS = float(np.cos(np.radians(45.0)))
+_LAG_SLOW = 0.5
 
 
 def _rot2(yaw: float) -> F64:
@@ -110,6 +118,7 @@ class AnchoredReference:
         step_hold: float = 0.0,
         step_hold_for: float = 0.0,
         warp_for: float = 0.0,
+        anchor_lag: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -203,6 +212,10 @@ class AnchoredReference:
         self.warp_for = float(warp_for)
         #: rollout time after which a pushed walk's clip plays back at rate 1 (``warp_for``)
         self.warp_until = np.inf
+        self.anchor_lag = float(anchor_lag)
+        #: rollout time until which a pushed walk's ground path lags its feet along the walk
+        #: (``anchor_lag``; -inf: not pushed)
+        self.lag_until = -np.inf
         self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
@@ -405,6 +418,8 @@ class AnchoredReference:
         ``placing``) for ``_PLACE_WINDOW`` s."""
         self.placing = placing
         self._place_until = t + _PLACE_WINDOW
+        if self.anchor_lag:
+            self.lag_until = t + _LAG_FOR
 
     def _place_walk(self, t: float) -> None:
         """After a sideways walk's push (``place_pushed``): a swinging foot lands where the
@@ -575,6 +590,8 @@ class AnchoredReference:
         ref = ref[on, :2] @ _rot2(self.anchor_yaw).T + self.anchor_shift
         centre = sim.mean(axis=0)
         err = centre - ref.mean(axis=0)
+        if t <= self.lag_until:
+            err = self._lag(t, err)
         turn = on & ~self.path.pivoting[i]  # a pivoting foot's heading is the clip's own turn
         dyaw = 0.0
         if turn.any():
@@ -591,6 +608,29 @@ class AnchoredReference:
         # and slowly back toward the captured path, which the gait then follows step by step
         self.anchor_yaw -= self._return_rate * self.anchor_yaw
         self.anchor_shift -= self._return_rate * self.anchor_shift
+
+    def _lag(self, t: float, err: F64) -> F64:
+        """After a walk's push (``anchor_lag``): the feet's position error ``err`` (2,) less
+        up to ``anchor_lag`` m of their lag behind the path along the clip's walk. A body the
+        push had slowed and turned off the walk dragged the path after its feet (1-3 m in 2 s),
+        so the clip's pelvis never asked it back to the clip's speed and way; the path held
+        ahead does (``docs/tracking.md``)."""
+        _, v, _ = self.com_reference(t)
+        ref = float(np.hypot(v[0], v[1]))
+        if ref < 0.2:  # not walking
+            return err
+        u = v[:2] / ref
+        along = float(err @ u)
+        if not self.warping:
+            mujoco.mj_subtreeVel(self.world.model, self.world.data)
+        # else the velocity ``_warp`` computed at the last slow tick (8 ms old at most): enough
+        # for a gate over 0.7 s, and the swept figures are with it
+        body = self.world.data.subtree_linvel[self._root][:2]
+        ahead = float(body @ u)
+        if along >= 0.0 or ahead > _LAG_COS * float(np.hypot(body[0], body[1])):
+            return err
+        lag = self.anchor_lag * min(1.0, max(0.0, (1.0 - ahead / ref) / _LAG_SLOW))
+        return err + (min(0.0, along + lag) - along) * u
 
     def update_ground(self, t: float) -> None:
         """The slow part of a control tick: the balance step decision, the ground path and
@@ -685,6 +725,7 @@ class AnchoredReference:
         self.clock = replace(self._clock0, until=self.clock.until)
         self.rate, self.warping, self.leading = 1.0, False, False
         self.warp_until = np.inf
+        self.lag_until = -np.inf
         self._catching = False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
@@ -701,13 +742,14 @@ class AnchoredReference:
                 self._slow_next, self.clock, self.rate, self.warping, self._landed,
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
-                self._drop_t, self._catching, self._drop_step, self.warp_until)  # fmt: skip
+                self._drop_t, self._catching, self._drop_step, self.warp_until,
+                self.lag_until)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching, drop_step, warp_until) = memory  # fmt: skip
+         catching, drop_step, warp_until, lag_until) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -729,3 +771,4 @@ class AnchoredReference:
         self._catching = bool(catching)
         self._drop_step = drop_step  # type: ignore[assignment]
         self.warp_until = float(warp_until)  # type: ignore[arg-type]
+        self.lag_until = float(lag_until)  # type: ignore[arg-type]

@@ -232,6 +232,12 @@ class WholeBodyTracker(AnchoredReference):
             only past ``place_deadband``, while the clip walks away from that side and the
             capture point is past the stance foot, and only in the 0.5 s after the push
             starts; the pelvis lowered so the leg reaches; 0: off; ``docs/tracking.md``).
+        anchor_lag: for 0.7 s after a walk's push starts, while the body's centre of mass
+            moves more than 45 deg off the clip's walk, the mocap's ground path follows the
+            feet only where they lag it along the walk by more than this (m; all of it at half
+            the clip's speed or slower, none at its speed; 0: off), so the clip's pelvis pulls
+            the body back to the clip's speed and way: re-anchored to the feet, the path of a
+            body slowed and turned off its walk was dragged after them (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -314,6 +320,7 @@ class WholeBodyTracker(AnchoredReference):
         warp_phase: float = 0.0,
         warp_for: float = 0.0,
         place_pushed: float = 0.0,
+        anchor_lag: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -345,6 +352,7 @@ class WholeBodyTracker(AnchoredReference):
                 "place_gain": place_gain, "place_deadband": place_deadband,
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
                 "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
+                "anchor_lag": anchor_lag,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -458,6 +466,7 @@ class WholeBodyTracker(AnchoredReference):
             step_alternate=step_alternate, step_short=step_short,
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
             step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
+            anchor_lag=anchor_lag,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
@@ -747,7 +756,7 @@ class WholeBodyTracker(AnchoredReference):
         ``trunk_band`` m from the mocap's; back linearly over ``trunk_give`` s after. A walk
         pushed gets the softer pelvis servo (``kp_root_pushed``)."""
         if not ((self._w_trunk and self._give) or self._w_hip or self.warp_gain
-                or self._step_pushed or self.place_pushed):  # fmt: skip
+                or self._step_pushed or self.place_pushed or self.anchor_lag):  # fmt: skip
             return self._w_trunk
         # into a buffer: this runs every control tick
         np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
