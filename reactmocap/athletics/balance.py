@@ -198,7 +198,8 @@ class BalanceGains:
     bow: tuple[float, float, float, float] | None = None
     #: with a foot up the bow eases out over this many seconds (first order) instead of
     #: dropping at once (with a step, the trunk snapping upright as the swing foot lifted
-    #: kicked the standing foot off the floor, docs/athletics.md); ``None``: at once
+    #: kicked the standing foot off the floor; eased only while a foot swings, the female's
+    #: sideways step ended on one foot, docs/athletics.md); ``None``: at once
     bow_ease: float | None = None
     #: arm strategy ``(gain, margin, limit)``: while the capture point lies more than
     #: ``margin`` m behind the COM target and the support centre along the feet, both arms are

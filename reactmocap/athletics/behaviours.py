@@ -360,11 +360,12 @@ def _run_balance(
         "max_com_offset_m": float(offsets.max()) if offsets.size else 0.0,
     }  # fmt: skip
     if step is not None:
-        # a step counts only if it ends on both feet (else a body still on one foot, still
-        # over it, would pass as balanced)
+        # a run that stepped counts only if it ends on both feet (a step held on one foot is
+        # no recovery; without a step the judge is the default's)
         steps = ctx.handover.get("steps")
         rep["steps"] = [dict(r) for r in steps] if isinstance(steps, list) else []
-        rep["balanced"] = bool(rep["balanced"] and ctx.senses.foot_contact.all())
+        if rep["steps"]:
+            rep["balanced"] = bool(rep["balanced"] and ctx.senses.foot_contact.all())
     del log
     return athletics_result("balance", ath, ctx, seq, res, rep)
 
