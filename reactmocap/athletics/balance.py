@@ -40,7 +40,10 @@ __all__ = [
     "SETTLED",
     "BALANCE_GAINS",
     "STANDING_GAINS",
+    "STANDING_BEND_RATE",
+    "STANDING_BOW_EASE",
     "STANDING_LEG",
+    "STANDING_STEP",
     "Balance",
     "BalanceGains",
     "BalanceLaw",
@@ -193,6 +196,11 @@ class BalanceGains:
     #: trunk's rotation moves the hips back against the fall (angular momentum about the COM;
     #: on one foot it cost the female's diagonal push 5 N, docs/athletics.md); ``None``: off
     bow: tuple[float, float, float, float] | None = None
+    #: with a foot up the bow eases out over this many seconds (first order) instead of
+    #: dropping at once (with a step, the trunk snapping upright as the swing foot lifted
+    #: kicked the standing foot off the floor; eased only while a foot swings, the female's
+    #: sideways step ended on one foot, docs/athletics.md); ``None``: at once
+    bow_ease: float | None = None
     #: arm strategy ``(gain, margin, limit)``: while the capture point lies more than
     #: ``margin`` m behind the COM target and the support centre along the feet, both arms are
     #: raised forward by ``gain`` rad per metre beyond the target's margin, at most ``limit``
@@ -236,6 +244,8 @@ class BalanceGains:
                 f"balance bow must be 4 finite numbers >= 0 (gain rad/m, margin m, forward "
                 f"and back limits rad), got {b!r}"
             )
+        if self.bow_ease is not None and not (math.isfinite(self.bow_ease) and self.bow_ease > 0):
+            raise ConfigError(f"balance bow_ease must be > 0 s, got {self.bow_ease!r}")
         if not (math.isfinite(self.side) and 0.0 < self.side <= 5.0):
             raise ConfigError(
                 f"balance side must be in (0, 5] (a multiple of kp, kv), got {self.side!r}"
@@ -320,6 +330,12 @@ BALANCE_GAINS = BalanceGains()
 STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
                               bow=(20.0, 0.05, 1.0, 0.35), arms=(40.0, 0.05, 2.0),
                               windmill=(8.0, 0.05))  # fmt: skip
+#: the ``balance`` behaviour's opt-in step (``step="on"``; :class:`Stepper`'s ``standing``),
+#: with :attr:`BalanceGains.bow_ease` this many seconds, the standing knee bending at most
+#: :data:`STANDING_BEND_RATE` (rad/s) for the swing leg's reach
+STANDING_STEP = Step()
+STANDING_BOW_EASE = 0.15
+STANDING_BEND_RATE = 1.5
 
 
 class BalanceLaw:
@@ -341,6 +357,9 @@ class BalanceLaw:
         self._wind = [0.0, 0.0]
         self._wind_dir = [0.0, 0.0]
         self._t_wind = math.nan
+        #: :attr:`BalanceGains.bow_ease`: the bow applied last, its tick
+        self._bow_now = 0.0
+        self._t_bow = math.nan
         #: a step when the capture point leaves the feet (:class:`Step`), or None
         self.stepper: Stepper | None = None
         #: the pelvis's roll target (rad, heading frame; 0 upright): the landing's roll_ease
@@ -458,7 +477,9 @@ class BalanceLaw:
             omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
             cp = float(vel[0]) / omega - float(err[0])  # capture point ahead of the target
             cp_side = float(vel[1]) / omega - float(err[1])  # ... and left of it
-        if g.bow is not None and bool(s.foot_contact.all()):
+        if g.bow is not None and g.bow_ease is not None:
+            pitch += self._bow_eased(cp, float(vel[0]), bool(s.foot_contact.all()), t)
+        elif g.bow is not None and bool(s.foot_contact.all()):
             pitch += self._bow(cp, float(vel[0]))
         hold_pelvis_and_feet(ctx, d, pitch, h, t, self.roll)
         rig.offset[:] = 0.0
@@ -522,6 +543,17 @@ class BalanceLaw:
                 nxt, self._wind_dir[k] = end, 0.0
         self._wind[k] = nxt
         return nxt
+
+    def _bow_eased(self, cp: float, vel: float, both: bool, t: float) -> float:
+        """:meth:`_bow` on both feet; with a foot up, the last one easing out over
+        :attr:`BalanceGains.bow_ease` s (first order) instead of at once."""
+        dt = 0.0 if math.isnan(self._t_bow) else max(t - self._t_bow, 0.0)
+        self._t_bow = t
+        if both:
+            self._bow_now = self._bow(cp, vel)
+        else:
+            self._bow_now *= math.exp(-dt / max(self.gains.bow_ease or 0.0, 1e-9))
+        return self._bow_now
 
     def _bow(self, cp: float, vel: float) -> float:
         """:attr:`BalanceGains.bow`'s pitch (rad, forward > 0) for the capture point ``cp``
@@ -588,9 +620,16 @@ class Stepper:
     landing's recovery hands it to the balance that follows, ``ctx.handover["stepper"]``, so
     a swing under way goes on). Each step is recorded in ``ctx.handover["steps"]``."""
 
-    def __init__(self, ctx: Context, step: Step) -> None:
+    def __init__(self, ctx: Context, step: Step, standing: bool = False) -> None:
         self.ctx = ctx
         self.step = step
+        #: the standing balance's step (the ``balance`` behaviour's ``step="on"``): across the
+        #: feet too, a step along them under its own hip, the standing knee's bend for the
+        #: swing leg's reach growing at most :data:`STANDING_BEND_RATE`, and no closing step
+        #: (the stance kept as it landed); docs/athletics.md
+        self.standing = standing
+        self.sideways = STEP_SIDEWAYS or standing
+        self._bend = 0.0  # the standing knee's bend so far (standing)
         m = ctx.world.model
         pre = ctx.rig.wc.prefix
         self._hips = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
@@ -636,7 +675,7 @@ class Stepper:
             # how far the capture point lies outside the soles' box (along the feet only
             # unless sideways), and the way out
             out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
-            if not STEP_SIDEWAYS:
+            if not self.sideways:
                 out[1] = 0.0
             beyond = float(np.hypot(*out))
             if beyond <= st.margin or float(vel @ out) <= 0.0:
@@ -652,12 +691,13 @@ class Stepper:
         k = self.foot
         if t == self._t0:  # the hip's eased target starts where the hip is
             self._t_last = t
+            self._bend = 0.0
             self._hip[:] = rig.current_angles()[_HIP[k]]
         u = (t - self._t0) / st.seconds
         if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
             self.record[-1]["s"] = t - self._t0
-            self._close, self._stood = self._out is not None, 1 - k
+            self._close, self._stood = self._out is not None and not self.standing, 1 - k
             self.foot, self._t_end = -1, t
             # both knees on from where they are to the posture's, over what is left of its
             # stand-up (at once, the stepped leg's push launched the body), the law's
@@ -679,7 +719,7 @@ class Stepper:
             # the feet kept STEP_WIDTH apart sideways, on whichever side the place lies
             apart = want[1] - stand[1]
             want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
-            if not STEP_SIDEWAYS:
+            if not self.sideways or (self.standing and self._out[1] == 0.0):
                 want[1] = at[1]
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
@@ -695,8 +735,11 @@ class Stepper:
             j = 1 - k
             stand_leg = float(np.linalg.norm(d.xanchor[self._hips[j]] - d.xanchor[self._ankles[j]]))
             bend = float(knee_for_length(a.thigh[j], a.shin[j], stand_leg - low)[0])
-            rig.offset[_KNEE[j], 0] = max(bend - float(rig.desired(t)[_KNEE[j], 0]),
-                                          float(rig.offset[_KNEE[j], 0]))  # fmt: skip
+            bend -= float(rig.desired(t)[_KNEE[j], 0])
+            if self.standing:  # from straight, at once it pulled the standing foot up
+                bend = min(bend, self._bend + STANDING_BEND_RATE * max(t - self._t_last, 0.0))
+                self._bend = max(bend, 0.0)
+            rig.offset[_KNEE[j], 0] = max(bend, float(rig.offset[_KNEE[j], 0]))
             down -= low
         length = min(math.sqrt(ahead * ahead + aside * aside + max(down, 0.2) ** 2), reach)
         swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
@@ -819,7 +862,8 @@ class Balance(Basis):
     goes on) and the time is in the hand-over dict (``"unsettled_s"``): a failure.
     ``settle_share``: the weight each foot must bear to count as settled (default
     :data:`SETTLED`'s). ``step``: a step when the capture point leaves the feet
-    (:class:`Step`; None: off, unless a landing before it handed over its own)."""
+    (:class:`Step`; None: off, unless a landing before it handed over its own);
+    ``standing_step``: the standing balance's kind of step (:class:`Stepper`)."""
 
     name = "balance"
     initial = "hold"
@@ -833,9 +877,11 @@ class Balance(Basis):
         settle_within: float | None = None,
         settle_share: float | None = None,
         step: Step | None = None,
+        standing_step: bool = False,
     ) -> None:
         self.posture = posture or Posture()
         self.step = step
+        self.standing_step = standing_step
         if seconds is not None and not (math.isfinite(seconds) and seconds >= 0):
             raise ConfigError(f"balance seconds must be >= 0, got {seconds!r}")
         if settle_within is not None and not (math.isfinite(settle_within) and settle_within > 0):
@@ -857,7 +903,7 @@ class Balance(Basis):
         bl = BalanceLaw(ctx, self.gains)
         self.law = bl
         if self.step is not None:
-            bl.stepper = Stepper(ctx, self.step)
+            bl.stepper = Stepper(ctx, self.step, self.standing_step)
 
         def enter(world: World, t: float) -> None:
             del world

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -17,7 +17,14 @@ from typing import Any
 import numpy as np
 
 from reactmocap.athletics import tables
-from reactmocap.athletics.balance import STANDING_GAINS, STANDING_LEG, Balance, Posture
+from reactmocap.athletics.balance import (
+    STANDING_BOW_EASE,
+    STANDING_GAINS,
+    STANDING_LEG,
+    STANDING_STEP,
+    Balance,
+    Posture,
+)
 from reactmocap.athletics.bodies import BODIES, Athlete, athlete
 from reactmocap.athletics.land import Landing
 from reactmocap.athletics.leap import PUSHES, Leap, LeapParams, com_push
@@ -335,7 +342,10 @@ def _run_balance(
         impacts = (Impact("chest", force=force, start=float(p["push_time"]) + ramp,
                           duration=float(p["push_duration"])),)  # fmt: skip
     seconds = float(p["seconds"]) + ramp
-    stand = Balance(posture, gains=STANDING_GAINS)  # the COM target moves uphill on a slope
+    # the COM target moves uphill on a slope; the step (opt-in) across the feet too
+    step = STANDING_STEP if p["step"] == "on" else None
+    gains = STANDING_GAINS if step is None else replace(STANDING_GAINS, bow_ease=STANDING_BOW_EASE)
+    stand = Balance(posture, gains=gains, step=step, standing_step=True)
     ctx, seq, res = simulate(ath, world, [stand], seconds, behaviour="balance",
                               impacts=impacts, extra=tuple(extra), on_tick=on_tick, fps=p["fps"])  # fmt: skip
     log = ctx.log.arrays()
@@ -349,6 +359,13 @@ def _run_balance(
         "balanced": bool(not went_down and standing_balanced(ctx)),
         "max_com_offset_m": float(offsets.max()) if offsets.size else 0.0,
     }  # fmt: skip
+    if step is not None:
+        # a run that stepped counts only if it ends on both feet (a step held on one foot is
+        # no recovery; without a step the judge is the default's)
+        steps = ctx.handover.get("steps")
+        rep["steps"] = [dict(r) for r in steps] if isinstance(steps, list) else []
+        if rep["steps"]:
+            rep["balanced"] = bool(rep["balanced"] and ctx.senses.foot_contact.all())
     del log
     return athletics_result("balance", ath, ctx, seq, res, rep)
 
@@ -388,6 +405,9 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
          Param("pelvis_height", None, "m", "hip joint height above the ground"),
          Param("com_offset_x", 0.0, "m", "desired COM ahead of the support centre"),
          Param("com_offset_y", 0.0, "m", "desired COM left of the support centre"),
+         Param("step", "off", "", "a balance step when the capture point leaves the soles "
+               "(balance.STANDING_STEP; opt-in, our own: the thesis's balance has none)",
+               choices=("off", "on")),
          _BACKPACK, _CONTACT, _FPS),
         lambda a, p, cb: _run_balance(a, p, cb), ("push", "slope")),
     "leap": Behaviour(

@@ -73,6 +73,8 @@ def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
         if name == "balance":
             p.add_argument("--com-offset", type=numbers(2, "X,Y", "m"),
                            help="desired COM offset X,Y (m) from the support")  # fmt: skip
+            p.add_argument("--step", action="store_true",
+                           help=f"{params['step'].help}; the report lists the steps taken")  # fmt: skip
         p.add_argument("--out", type=output_file, help="BVH of the motion (default: NAME_BODY.bvh)")
         p.add_argument("--report", type=output_file, help="JSON report")
         p.add_argument("--plot", type=output_file, help="PNG of COM height and ground force")
@@ -105,6 +107,8 @@ def _run(args: argparse.Namespace) -> int:
             params[key] = math.radians(v) if deg else v
     if getattr(args, "push_off", None):
         params["push"] = args.push_off
+    if getattr(args, "step", False):
+        params["step"] = "on"
     if getattr(args, "com_offset", None):
         x, y = args.com_offset
         params.update(com_offset_x=x, com_offset_y=y)
@@ -139,6 +143,8 @@ def _summary(r: dict[str, Any], out: Path) -> None:
             bits.append(f"{key}={r[key]}")
     if r.get("peak_grf_bw") is not None:
         bits.append(f"push-off peak {r['peak_grf_bw']:.1f} BW")
+    if "steps" in r:
+        bits.append(f"steps {len(r['steps'])}")
     if "max_com_offset_m" in r:
         bits.append(f"max COM offset {r['max_com_offset_m']:.3f} m")
     bits.append(f"{r['realtime_factor_cpu']:.1f}x real time ({r['realtime_factor']:.1f}x wall)")

@@ -198,3 +198,19 @@ def test_a_step_moves_a_foot_toward_the_capture_point_and_off_changes_nothing() 
         Step(margin=-0.1)
     with pytest.raises(ConfigError, match="step"):
         Step.of([0.1, 0.1, 0.3, 0.25, 1.0])
+
+
+def test_a_sideways_push_past_the_feet_is_taken_by_a_balance_step() -> None:
+    # the balance behaviour's opt-in step (step="on", balance.STANDING_STEP): 110 N to the
+    # female's left for 0.25 s falls with the feet in place (her limit 75 N, 2026-12-03); with
+    # the step she steps and stands still on both feet at the end (2026-12-04)
+    push = {"check_range": False, "seconds": 3.0, "push": 110.0, "push_dir": math.pi / 2}
+    r = run("balance", "female", step="on", **push)
+    assert r.report["balanced"] and not r.report["fell"]
+    steps = r.report["steps"]
+    assert steps and all(s["beyond_m"] > 0.05 for s in steps)
+    assert int(r.log["feet"][-1]) == 2 and np.linalg.norm(r.log["com_vel"][-1]) < 0.1
+    off = run("balance", "female", **push)
+    assert off.report["fell"] and "steps" not in off.report
+    with pytest.raises(ConfigError, match="step"):
+        run("balance", "female", step="yes", **push)

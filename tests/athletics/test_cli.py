@@ -15,6 +15,7 @@ from reactmocap.library.bvh import read_bvh
     ("args", "keys"),
     [
         (["balance", "--seconds", "0.5", "--push", "30"], ["fell", "max_com_offset_m"]),
+        (["balance", "--seconds", "0.5", "--step"], ["balanced", "steps"]),
         (["land", "--drop", "0.2", "--body", "female"], ["landed", "fell"]),
         (["leap", "--effort", "0.3"],
          ["achieved_height_m", "fell", "landed", "peak_grf_bw", "time_to_liftoff_s",
