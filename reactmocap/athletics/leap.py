@@ -205,6 +205,16 @@ class LeapParams:
     #: moving sideways and the push began on one foot (docs/athletics.md). ``()``: off (as
     #: before)
     crouch_until: tuple[float, ...] = ()
+    #: from the crouch's end on (the hold, ``hold``), the COM target's forward offset is
+    #: where the COM stands then, not ``com_offset``: the COM lagged the eased target over
+    #: the crouch and then went on past it through the hold, and a later thrust left with
+    #: more pitch (docs/athletics.md). False: off (as before)
+    hold_com: bool = False
+    #: the "com" push's pitch aim (``spin``) lowered by ``gain`` kg m^2/s per metre that the
+    #: COM lies ahead of the soles' middle at the thrust beyond ``ref`` m: ``(gain, ref)``;
+    #: a crouch whose COM crept forward left with more pitch (docs/athletics.md). ``()``:
+    #: off (as before)
+    spin_ahead: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -251,6 +261,13 @@ class LeapParams:
             raise ConfigError(
                 f"leap crouch_until must be () or (side_m > 0, side_speed_m_s > 0, cap_s >= 0), "
                 f"got {self.crouch_until}"
+            )
+        if self.spin_ahead and not (
+            len(self.spin_ahead) == 2
+            and all(isinstance(v, (int, float)) and math.isfinite(v) for v in self.spin_ahead)
+        ):
+            raise ConfigError(
+                f"leap spin_ahead must be () or (gain kg m^2/s per m, ref m), got {self.spin_ahead}"
             )
         if self.handover not in HANDOVERS:
             raise ConfigError(
@@ -311,12 +328,25 @@ class Leap(Basis):
             del world
             s = ctx.sense(t)
             memo["z_stand"] = float(s.com[2])
+            memo["t_crouch"] = t
+            memo.pop("held", None)
             if ctx.standing_com is None:
                 ctx.standing_com = float(s.com[2])
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
                         arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant), t,
                 ease_com=p.com_ease)  # fmt: skip
+
+        def crouch_hold(world: World, t: float) -> None:
+            # hold_com: at the crouch's end the COM target's forward offset stays where the
+            # COM stands (the balance law reads its posture's offset every tick)
+            if "held" not in memo and t - memo["t_crouch"] >= p.crouch - 1e-12:
+                s = ctx.sense(t)
+                h = s.heading()
+                now = s.local(s.com - s.support_center(h, both=p.crouch_plant), h)
+                memo["held"] = float(now[0])
+                bl.set_com_offset((memo["held"], bl.posture.com_offset[1]))
+            bl.control(world, t)
 
         def thrust(world: World, t: float) -> None:
             del world
@@ -398,7 +428,11 @@ class Leap(Basis):
             memo.pop("az_prev", None)
             memo.update(gain=1.0, t_thrust=t, t_prev=t, v_end=v_end, pushing=True, z_end=z_end,
                         z_stand=z_stand, acc=v_end**2 / (2.0 * max(z_end - z0, 0.05)),
-                        com0=s.com.copy())  # fmt: skip
+                        com0=s.com.copy(), spin=p.spin)  # fmt: skip
+            if p.spin_ahead:  # a COM that crept ahead in the crouch: less pitch asked
+                gain, ref = p.spin_ahead
+                ahead = s.local(s.com - s.corners.mean(axis=(0, 1)), s.heading())[0]
+                memo["spin"] = p.spin - gain * (float(ahead) - ref)
             goal = np.full((NJ, 3), np.nan)
             dur = v_end / memo["acc"]
             arms = [joint_index(f"{k}_shoulder") for k in "lr"]
@@ -499,7 +533,7 @@ class Leap(Basis):
             # whole-body pitch momentum's error: the centre of pressure steers the momentum
             fwd = np.array([math.cos(h), math.sin(h), 0.0])
             mid = s.corners.mean(axis=1)  # (2, 3) sole centres
-            err_l = (pitch_momentum(world, s) - p.spin) / (
+            err_l = (pitch_momentum(world, s) - memo["spin"]) / (
                 ctx.athlete.mass * ctx.athlete.leg_length**2
             )
             ahead = np.clip((s.com - mid) @ fwd + COP_GAIN * err_l, *COP_RANGE)
@@ -533,7 +567,12 @@ class Leap(Basis):
         flight_exit: Event = apex(ctx) if at_apex else after(0.0)
         com = p.push == "com" and not p.broad
         return [
-            State("crouch", law(bl.control, every), crouch, ((crouch_exit, "thrust"),)),
+            State(
+                "crouch",
+                law(crouch_hold if p.hold_com else bl.control, every),
+                crouch,
+                ((crouch_exit, "thrust"),),
+            ),
             State(
                 "thrust",
                 law(com_push, every) if com else law(push, every),
