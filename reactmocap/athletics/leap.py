@@ -210,11 +210,6 @@ class LeapParams:
     #: the crouch and then went on past it through the hold, and a later thrust left with
     #: more pitch (docs/athletics.md). False: off (as before)
     hold_com: bool = False
-    #: the "com" push's pitch aim (``spin``) lowered by ``gain`` kg m^2/s per metre that the
-    #: COM lies ahead of the soles' middle at the thrust beyond ``ref`` m: ``(gain, ref)``;
-    #: a crouch whose COM crept forward left with more pitch (docs/athletics.md). ``()``:
-    #: off (as before)
-    spin_ahead: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -261,13 +256,6 @@ class LeapParams:
             raise ConfigError(
                 f"leap crouch_until must be () or (side_m > 0, side_speed_m_s > 0, cap_s >= 0), "
                 f"got {self.crouch_until}"
-            )
-        if self.spin_ahead and not (
-            len(self.spin_ahead) == 2
-            and all(isinstance(v, (int, float)) and math.isfinite(v) for v in self.spin_ahead)
-        ):
-            raise ConfigError(
-                f"leap spin_ahead must be () or (gain kg m^2/s per m, ref m), got {self.spin_ahead}"
             )
         if self.handover not in HANDOVERS:
             raise ConfigError(
@@ -428,11 +416,7 @@ class Leap(Basis):
             memo.pop("az_prev", None)
             memo.update(gain=1.0, t_thrust=t, t_prev=t, v_end=v_end, pushing=True, z_end=z_end,
                         z_stand=z_stand, acc=v_end**2 / (2.0 * max(z_end - z0, 0.05)),
-                        com0=s.com.copy(), spin=p.spin)  # fmt: skip
-            if p.spin_ahead:  # a COM that crept ahead in the crouch: less pitch asked
-                gain, ref = p.spin_ahead
-                ahead = s.local(s.com - s.corners.mean(axis=(0, 1)), s.heading())[0]
-                memo["spin"] = p.spin - gain * (float(ahead) - ref)
+                        com0=s.com.copy())  # fmt: skip
             goal = np.full((NJ, 3), np.nan)
             dur = v_end / memo["acc"]
             arms = [joint_index(f"{k}_shoulder") for k in "lr"]
@@ -533,7 +517,7 @@ class Leap(Basis):
             # whole-body pitch momentum's error: the centre of pressure steers the momentum
             fwd = np.array([math.cos(h), math.sin(h), 0.0])
             mid = s.corners.mean(axis=1)  # (2, 3) sole centres
-            err_l = (pitch_momentum(world, s) - memo["spin"]) / (
+            err_l = (pitch_momentum(world, s) - p.spin) / (
                 ctx.athlete.mass * ctx.athlete.leg_length**2
             )
             ahead = np.clip((s.com - mid) @ fwd + COP_GAIN * err_l, *COP_RANGE)
