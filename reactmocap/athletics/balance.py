@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import MappingProxyType
 
 import mujoco
@@ -396,6 +396,12 @@ class BalanceLaw:
         # the commanded pitch starts from where the pelvis is (less the new posture's lean)
         self._pitch0 = self.pelvis_pitch() - self.lean()
         self._t_pitch = t
+
+    def set_com_offset(self, offset: tuple[float, float]) -> None:
+        """The COM target's offset from the support centre (m, heading frame) from now on, at
+        once (any ease of :meth:`set_posture`'s ``ease_com`` ends)."""
+        self.posture = replace(self.posture, com_offset=offset)
+        self._com0 = None
 
     def pelvis_roll(self, heading: float) -> float:
         """Current anatomical roll of the pelvis (rad) in the frame of ``heading``, as

@@ -205,6 +205,11 @@ class LeapParams:
     #: moving sideways and the push began on one foot (docs/athletics.md). ``()``: off (as
     #: before)
     crouch_until: tuple[float, ...] = ()
+    #: from the crouch's end on (the hold, ``hold``), the COM target's forward offset is
+    #: where the COM stands then, not ``com_offset``: the COM lagged the eased target over
+    #: the crouch and then went on past it through the hold, and a later thrust left with
+    #: more pitch (docs/athletics.md). False: off (as before)
+    hold_com: bool = False
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -311,12 +316,25 @@ class Leap(Basis):
             del world
             s = ctx.sense(t)
             memo["z_stand"] = float(s.com[2])
+            memo["t_crouch"] = t
+            memo.pop("held", None)
             if ctx.standing_com is None:
                 ctx.standing_com = float(s.com[2])
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
                         arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant), t,
                 ease_com=p.com_ease)  # fmt: skip
+
+        def crouch_hold(world: World, t: float) -> None:
+            # hold_com: at the crouch's end the COM target's forward offset stays where the
+            # COM stands (the balance law reads its posture's offset every tick)
+            if "held" not in memo and t - memo["t_crouch"] >= p.crouch - 1e-12:
+                s = ctx.sense(t)
+                h = s.heading()
+                now = s.local(s.com - s.support_center(h, both=p.crouch_plant), h)
+                memo["held"] = float(now[0])
+                bl.set_com_offset((memo["held"], bl.posture.com_offset[1]))
+            bl.control(world, t)
 
         def thrust(world: World, t: float) -> None:
             del world
@@ -533,7 +551,12 @@ class Leap(Basis):
         flight_exit: Event = apex(ctx) if at_apex else after(0.0)
         com = p.push == "com" and not p.broad
         return [
-            State("crouch", law(bl.control, every), crouch, ((crouch_exit, "thrust"),)),
+            State(
+                "crouch",
+                law(crouch_hold if p.hold_com else bl.control, every),
+                crouch,
+                ((crouch_exit, "thrust"),),
+            ),
             State(
                 "thrust",
                 law(com_push, every) if com else law(push, every),
