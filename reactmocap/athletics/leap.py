@@ -205,6 +205,11 @@ class LeapParams:
     #: moving sideways and the push began on one foot (docs/athletics.md). ``()``: off (as
     #: before)
     crouch_until: tuple[float, ...] = ()
+    #: the crouch's COM target lies over the middle of both soles sideways, along the feet
+    #: as before (:attr:`Posture.side_both`): a settled back handspring start crouched onto
+    #: one foot, its target following the loaded sole, and ``crouch_plant``'s whole target
+    #: made it fall back (docs/athletics.md). False: off (as before)
+    crouch_middle: bool = False
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -315,8 +320,8 @@ class Leap(Basis):
                 ctx.standing_com = float(s.com[2])
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
-                        arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant), t,
-                ease_com=p.com_ease)  # fmt: skip
+                        arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant,
+                        side_both=p.crouch_middle), t, ease_com=p.com_ease)  # fmt: skip
 
         def thrust(world: World, t: float) -> None:
             del world
