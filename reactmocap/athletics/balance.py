@@ -99,6 +99,9 @@ class Posture:
             :data:`PLANT_GAIN` per metre that a standing sole's heel rises above its toes (or
             they above it) past :data:`PLANT_DEADBAND` (an offset past what the foot can
             push stood the body on its toes or heels).
+        side_both: the COM target's sideways part (heading frame) is the middle of both
+            soles (``plant``'s), along the feet that of the soles in contact (the target
+            stays between the feet while one is unloaded; no ankle give, no foot lowered).
     """
 
     pitch: float = 0.0
@@ -108,10 +111,13 @@ class Posture:
     settle: float = 0.5
     lean: float = 0.5
     plant: bool = False
+    side_both: bool = False
 
     def __post_init__(self) -> None:
-        if not isinstance(self.plant, bool):
-            raise ConfigError(f"posture plant must be true or false, got {self.plant!r}")
+        for name in ("plant", "side_both"):
+            v = getattr(self, name)
+            if not isinstance(v, bool):
+                raise ConfigError(f"posture {name} must be true or false, got {v!r}")
         for name in ("pitch", "leg", "arms", "settle", "lean"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -446,6 +452,12 @@ class BalanceLaw:
         h = s.heading()
         self.heading = h
         centre = s.support_center(h, both=self.posture.plant)
+        c, sn = math.cos(h), math.sin(h)
+        if self.posture.side_both and not self.posture.plant:
+            # across the feet the middle of both soles, along them the soles in contact
+            across = float((s.support_center(h, both=True) - centre)[:2] @ (-sn, c))
+            centre[0] -= sn * across
+            centre[1] += c * across
         ox, oy = self.posture.com_offset
         if self._com0 is not None:  # set_posture's ease_com
             w = self._eased(t)
@@ -453,7 +465,6 @@ class BalanceLaw:
                 self._com0[0] + (ox - self._com0[0]) * w,
                 self._com0[1] + (oy - self._com0[1]) * w,
             )
-        c, sn = math.cos(h), math.sin(h)
         target = centre.copy()
         target[0] += c * ox - sn * oy
         target[1] += sn * ox + c * oy

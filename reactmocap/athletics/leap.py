@@ -210,6 +210,11 @@ class LeapParams:
     #: the crouch and then went on past it through the hold, and a later thrust left with
     #: more pitch (docs/athletics.md). False: off (as before)
     hold_com: bool = False
+    #: the crouch's COM target lies over the middle of both soles sideways, along the feet
+    #: as before (:attr:`Posture.side_both`): a settled back handspring start crouched onto
+    #: one foot, its target following the loaded sole, and ``crouch_plant``'s whole target
+    #: made it fall back (docs/athletics.md). False: off (as before)
+    crouch_middle: bool = False
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -322,8 +327,8 @@ class Leap(Basis):
                 ctx.standing_com = float(s.com[2])
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
-                        arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant), t,
-                ease_com=p.com_ease)  # fmt: skip
+                        arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant,
+                        side_both=p.crouch_middle), t, ease_com=p.com_ease)  # fmt: skip
 
         def crouch_hold(world: World, t: float) -> None:
             # hold_com: at the crouch's end the COM target's forward offset stays where the

@@ -235,3 +235,24 @@ def test_the_male_handspring_starts_settled_and_a_start_that_crouched_turning_la
     assert landed and abs(lz) < 2.0
     landed, lz = run(_timed_start(m))
     assert not landed and lz > 2.0
+
+
+def test_the_crouch_keeps_its_com_between_the_feet_and_off_changes_nothing() -> None:
+    """Full-size start 3 (seed 0) settles on both feet, then crouches onto its right foot (the
+    left off the floor at the crouch's end, the COM 4.8 cm to the right): the crouch's COM
+    target follows the soles in contact. With it over the middle of both soles sideways
+    (``crouch_middle``) the crouch ends on both feet. While both feet stay down (the nominal)
+    the option is the file's run to the bit."""
+    m = load_maneuver(EXAMPLE)
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    mid = _with(m, "leap", {**leap, "crouch_middle": True})
+    nominal = run_maneuver(m, fps=10.0).report["rotation_deg"]
+    assert run_maneuver(mid, fps=10.0).report["rotation_deg"] == nominal
+    start = _starts(1.0, 4)[3]
+
+    def feet_at_crouch_end(man: Maneuver) -> int:
+        log = run_maneuver(man, perturbation=start, fps=10.0).log
+        return int(log["feet"][np.flatnonzero(log["state"] == "leap.crouch")[-1]])
+
+    assert feet_at_crouch_end(m) == 1
+    assert feet_at_crouch_end(mid) == 2
