@@ -208,6 +208,14 @@ class LandingParams:
             nothing.
         turn_window: the predicted time to touchdown (s) below which ``turn_gain`` acts (the
             prediction, a straight line, runs ahead of the reach's slowing turn before).
+        late_delta: ``(seconds, offset m, delta m)``: ``seconds`` into the reach, if the feet's
+            horizontal distance from the COM exceeds ``offset``, the foot-servo delta is
+            ``delta`` for the rest of the landing (instead of ``delta`` / ``deltas``); empty:
+            off. Why: on the male back layout the starts that touch down too little turned
+            (-296..-301.5 deg) have their feet already well past the COM early in the reach
+            (it opened a tick late in the legs' swing: 0.21-0.35 m 24 ms in, against at most
+            0.085 on the others), and they land with the feet farther ahead from the reach's
+            start, which the others do not (docs/athletics.md).
     """
 
     knee: float = 0.6
@@ -242,6 +250,7 @@ class LandingParams:
     turn_gain: float = 0.0
     turn_ref: float = 0.0
     turn_window: float = 0.1
+    late_delta: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -284,6 +293,16 @@ class LandingParams:
             raise ConfigError(f"landing roll_ease must be in [0, 0.9] s, got {self.roll_ease}")
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
+        if self.late_delta and not (
+            len(self.late_delta) == 3
+            and all(isinstance(x, (int, float)) and math.isfinite(x) for x in self.late_delta)
+            and 0.0 <= self.late_delta[0] <= 1.0
+            and self.late_delta[1] > 0.0
+        ):
+            raise ConfigError(
+                "landing late_delta must be (seconds in [0, 1], offset > 0 m, delta m), "
+                f"got {self.late_delta!r}"
+            )
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
             raise ConfigError(f"landing roll_min must be in [0, pi/2] rad, got {self.roll_min}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
@@ -360,6 +379,7 @@ class Landing(Basis):
                 g = float(np.linalg.norm(world.model.opt.gravity))
                 memo["fall"] = max(float(soles.min()), 0.0) + up * up / (2.0 * g)
             memo["rot_prev"], memo["t_prev"] = ctx.rotation, t  # turn_gain's rate
+            memo["reach_t"], memo["late"] = t, -1.0  # late_delta: not yet decided (-1)
 
         def reach(world: World, t: float) -> None:
             s = ctx.sense(t)
@@ -375,7 +395,11 @@ class Landing(Basis):
             tau = math.sqrt(max(float(s.com @ s.floor_normal), 0.3) / g)
             lead = p.lead * tau
             side = lead if p.side_lead is None else p.side_lead * tau
-            want = np.array([lead * v[0] + p.delta_at(float(v[0])) * memo["scale"], side * v[1]])
+            x = s.local(feet - s.com, h)
+            if p.late_delta and memo["late"] < 0 and t - memo["reach_t"] >= p.late_delta[0]:
+                memo["late"] = float(np.hypot(*x) > p.late_delta[1])  # decided once (late_delta)
+            delta = p.late_delta[2] if memo["late"] > 0 else p.delta_at(float(v[0]))
+            want = np.array([lead * v[0] + delta * memo["scale"], side * v[1]])
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
             if p.momentum_gain:  # the feet also stop the rotation (see momentum_gain)
                 spin = memo["spin"] if p.momentum_side else pitch_momentum(world, s)
@@ -390,7 +414,6 @@ class Landing(Basis):
                     turn = ctx.rotation + rate * t_td - p.turn_ref
                     want[0] += p.turn_gain * turn
             # eq. 6.1 as a correction on top of the geometric placement below
-            x = s.local(feet - s.com, h)
             xd = s.local(fvel - s.com_vel, h)
             servo = np.clip(p.kp * (want - x) - p.kv * xd, -0.3, 0.3)
             # each leg aimed in the world at its foot's place, whatever the pelvis's pitch

@@ -814,3 +814,33 @@ def test_a_perturbed_forward_tuck_holds_its_crouch_without_the_creep_with_hold_c
                      fps=10.0).report  # fmt: skip
     assert r["liftoff_pitch_momentum"] < 51.0
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+
+
+def test_a_late_back_layout_touchdown_lands_with_the_feet_ahead_from_the_reach_s_start() -> None:
+    """Start 5 of ``back_layout.toml``'s capture region at a tenth (seed 0) opens a tick late
+    in the legs' swing: 24 ms into the reach its feet are 0.21 m from the COM (at most 0.085
+    on the starts that touch down in the window), it touches down too little turned (the late
+    class, -296..-301.5 deg) and falls forward. With ``late_delta`` (0.024 s, 0.15 m, -0.11 m,
+    the file since 2026-12-04) the feet go 2 cm farther ahead for the rest of the reach and it
+    lands."""
+    rng = np.random.default_rng(0)
+    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
+             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
+    start = [Perturbation.sample(rng, **tenth) for _ in range(6)][5]
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = m.phases[3]
+    assert land.controller == "land" and land.params["late_delta"] == [0.024, 0.15, -0.11]
+    params = {k: v for k, v in land.params.items() if k != "late_delta"}
+    off = replace(m, phases=(*m.phases[:3], replace(land, params=params), *m.phases[4:]))
+    r = run_maneuver(off, perturbation=start, fps=10.0).report
+    assert -301.5 < r["rotation_at_touchdown_deg"] < -296.0, r["rotation_at_touchdown_deg"]
+    assert not (r["landed"] and not r["fell"])
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+
+
+def test_the_landing_refuses_a_bad_late_delta() -> None:
+    for bad in ((0.024, 0.15), (0.024, 0.0, -0.11), (-0.1, 0.15, -0.11), (0.024, math.nan, 0.1)):
+        with pytest.raises(ConfigError, match="late_delta"):
+            LandingParams(late_delta=bad)
+    assert LandingParams(late_delta=(0.024, 0.15, -0.11)).late_delta[2] == -0.11
