@@ -358,6 +358,9 @@ def _run_balance(
         "backpack_kg": float(p["backpack"]), "fell": went_down,
         "balanced": bool(not went_down and standing_balanced(ctx)),
         "max_com_offset_m": float(offsets.max()) if offsets.size else 0.0,
+        # at the last tick: ``balanced`` allows a still body on one foot, which the report
+        # says rather than hides (docs/athletics.md, Fig. 7.7)
+        "on_both_feet": bool(ctx.senses.foot_contact.all()),
     }  # fmt: skip
     if step is not None:
         # a run that stepped counts only if it ends on both feet (a step held on one foot is
@@ -365,7 +368,7 @@ def _run_balance(
         steps = ctx.handover.get("steps")
         rep["steps"] = [dict(r) for r in steps] if isinstance(steps, list) else []
         if rep["steps"]:
-            rep["balanced"] = bool(rep["balanced"] and ctx.senses.foot_contact.all())
+            rep["balanced"] = bool(rep["balanced"] and rep["on_both_feet"])
     del log
     return athletics_result("balance", ath, ctx, seq, res, rep)
 

@@ -155,8 +155,10 @@ def _summary(r: dict[str, Any], out: Path) -> None:
         over = ", ".join(f"{k} {v:.2f}x" for k, v in r.get("strength_exceeded", {}).items())
         print(f"note: this needs more joint torque than the strength model allows ({over}); "
               "a person could not do it (docs/athletics.md)")  # fmt: skip
-    if r.get("landed") is False or r.get("fell"):
+    if r.get("landed") is False or r.get("balanced") is False or r.get("fell"):
         print("note: the athlete did not end balanced on its feet")
+    elif r.get("on_both_feet") is False:
+        print("note: the athlete ended still but on one foot, the other in the air")
 
 
 class SimProgress:

@@ -14,7 +14,7 @@ from reactmocap.library.bvh import read_bvh
 @pytest.mark.parametrize(
     ("args", "keys"),
     [
-        (["balance", "--seconds", "0.5", "--push", "30"], ["fell", "max_com_offset_m"]),
+        (["balance", "--seconds", "0.5", "--push", "30"], ["fell", "max_com_offset_m", "on_both_feet"]),
         (["balance", "--seconds", "0.5", "--step"], ["balanced", "steps"]),
         (["land", "--drop", "0.2", "--body", "female"], ["landed", "fell"]),
         (["leap", "--effort", "0.3"],
