@@ -134,7 +134,7 @@ PRESET_STARTS: Mapping[str, Phase] = MappingProxyType({
 #: feet land farther ahead after a weak take-off (``momentum_gain`` with ``momentum_side``):
 #: placed for her usual spin, they stopped a smaller one too hard and she fell forward.
 SOMERSAULT_PRESETS: Mapping[
-    str, Mapping[str, tuple[Mapping[str, float | str], Mapping[str, float], Mapping[str, float]]]
+    str, Mapping[str, tuple[Mapping[str, float | str], Mapping[str, float], Mapping[str, float | list[float]]]]
 ] = MappingProxyType({
     "male": MappingProxyType({
         "backward": (MappingProxyType({"effort": 0.6, "spin": -55.0, "spin_limit": 1.0}),
@@ -147,7 +147,14 @@ SOMERSAULT_PRESETS: Mapping[
         "backward/layout": (MappingProxyType({"effort": 0.9, "spin": -90.0, "spin_limit": 1.5}),
                             MappingProxyType({"lead": -0.96, "open_inertia": 4.0,
                                               "open_delay": 0.217}),
-                            MappingProxyType({"delta": -0.13, "knee": 1.0})),
+                            # a start whose feet are over 0.15 m from the COM 24 ms into
+                            # the reach touches down too little turned and puts them 2 cm
+                            # farther ahead (LandingParams.late_delta, as back_layout.toml:
+                            # a tenth 24 -> 29 and 17 -> 28 of 50 on seeds 0 and 1, full
+                            # size 5 -> 5, 2026-12-04; docs/athletics.md). A list: a
+                            # maneuver file's numbers load as one
+                            MappingProxyType({"delta": -0.13, "knee": 1.0,
+                                              "late_delta": [0.024, 0.15, -0.11]})),
         "forward": (MappingProxyType({"effort": 1.0, "push": "com", "rise": 0.85, "leg": 0.6,
                                       "pitch": 0.0, "lean": 0.0, "push_hip": 0.5,
                                       "push_ankle": 1.0, "spin": 49.0, "com_offset": 0.05,
@@ -237,6 +244,7 @@ def somersault_maneuver(
             f"unknown somersault position {position!r}; valid positions are {sorted(POSITIONS)}"
         )
     leap: Mapping[str, float | str]
+    land: Mapping[str, float | list[float]]
     if twist:
         leap, tumble, land = _twist_preset(position, direction, body, twist)
         start = TIMED_START

@@ -844,3 +844,24 @@ def test_the_landing_refuses_a_bad_late_delta() -> None:
         with pytest.raises(ConfigError, match="late_delta"):
             LandingParams(late_delta=bad)
     assert LandingParams(late_delta=(0.024, 0.15, -0.11)).late_delta[2] == -0.11
+
+
+def test_the_layout_preset_puts_a_late_start_s_feet_ahead() -> None:
+    """The command's preset (settled start) carries the file's ``late_delta`` since
+    2026-12-04 (a tenth 24 -> 29 and 17 -> 28 of 50 on seeds 0 and 1): start 6 of its capture
+    region at a tenth (seed 1) falls without it and lands with it."""
+    rng = np.random.default_rng(1)
+    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
+             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
+    start = [Perturbation.sample(rng, **tenth) for _ in range(7)][6]
+    m = somersault_maneuver("layout")
+    i = next(k for k, ph in enumerate(m.phases) if ph.controller == "land")
+    assert m.phases[i].params["late_delta"] == [0.024, 0.15, -0.11]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    params = {k: v for k, v in m.phases[i].params.items() if k != "late_delta"}
+    off = replace(
+        m, phases=(*m.phases[:i], replace(m.phases[i], params=params), *m.phases[i + 1 :])
+    )
+    r = run_maneuver(off, perturbation=start, fps=10.0).report
+    assert not (r["landed"] and not r["fell"])
