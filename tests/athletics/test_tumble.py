@@ -222,6 +222,26 @@ def test_the_forward_tuck_lands_with_2_and_4_kg_backpacks_untuned() -> None:
         assert int(np.sum(down[:-1] & ~down[1:])) == 1, kg  # the feet leave once
 
 
+#: the benchmark's perturbations at a tenth of full size (``bench_athletics.capture``)
+_TENTH = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
+          "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
+
+
+def _tenth_start(seed: int, i: int) -> Perturbation:
+    """Start ``i`` of ``capture_region``'s draw at a tenth on ``seed``."""
+    rng = np.random.default_rng(seed)
+    return [Perturbation.sample(rng, **_TENTH) for _ in range(i + 1)][i]
+
+
+def _without_land_param(m: Maneuver, key: str) -> Maneuver:
+    """``m`` with ``key`` taken out of its landing phase's parameters."""
+    i = next(k for k, ph in enumerate(m.phases) if ph.controller == "land")
+    params = {k: v for k, v in m.phases[i].params.items() if k != key}
+    return replace(
+        m, phases=(*m.phases[:i], replace(m.phases[i], params=params), *m.phases[i + 1 :])
+    )
+
+
 def _forward_hold_015() -> Maneuver:
     """The forward preset with its crouch's hold at 0.15 s, as before 2026-12-03 22:45 UTC
     (since then 0.25): the tests of the push's and the landing's options below were
@@ -733,10 +753,7 @@ def test_the_back_layout_moves_its_feet_by_the_rotation_predicted_at_touchdown()
     ``turn_gain`` (the file's 0.3 m/rad in the reach's last 50 ms) sees the touchdown
     predicted past ``turn_ref`` and puts the feet farther behind: the ground stops the spin
     and it lands."""
-    rng = np.random.default_rng(0)
-    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
-             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
-    start = [Perturbation.sample(rng, **tenth) for _ in range(7)][6]
+    start = _tenth_start(0, 6)
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = m.phases[3]
     assert land.controller == "land" and land.params["turn_gain"] > 0.0
@@ -801,10 +818,7 @@ def test_a_perturbed_forward_tuck_holds_its_crouch_without_the_creep_with_hold_c
     falls after touchdown. The leap's ``hold_com`` (an option, off in the preset,
     docs/athletics.md) holds the COM target where the COM stands at the crouch's end: it
     takes off with less pitch and lands."""
-    rng = np.random.default_rng(0)
-    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
-             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
-    start = [Perturbation.sample(rng, **tenth) for _ in range(3)][2]
+    start = _tenth_start(0, 2)
     m = somersault_maneuver(direction="forward")
     assert not m.phases[1].params.get("hold_com", False)
     before = run_maneuver(m, perturbation=start, fps=10.0).report
@@ -823,16 +837,11 @@ def test_a_late_back_layout_touchdown_lands_with_the_feet_ahead_from_the_reach_s
     class, -296..-301.5 deg) and falls forward. With ``late_delta`` (0.024 s, 0.15 m, -0.11 m,
     the file since 2026-12-04) the feet go 2 cm farther ahead for the rest of the reach and it
     lands."""
-    rng = np.random.default_rng(0)
-    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
-             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
-    start = [Perturbation.sample(rng, **tenth) for _ in range(6)][5]
+    start = _tenth_start(0, 5)
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = m.phases[3]
     assert land.controller == "land" and land.params["late_delta"] == [0.024, 0.15, -0.11]
-    params = {k: v for k, v in land.params.items() if k != "late_delta"}
-    off = replace(m, phases=(*m.phases[:3], replace(land, params=params), *m.phases[4:]))
-    r = run_maneuver(off, perturbation=start, fps=10.0).report
+    r = run_maneuver(_without_land_param(m, "late_delta"), perturbation=start, fps=10.0).report
     assert -301.5 < r["rotation_at_touchdown_deg"] < -296.0, r["rotation_at_touchdown_deg"]
     assert not (r["landed"] and not r["fell"])
     r = run_maneuver(m, perturbation=start, fps=10.0).report
@@ -850,18 +859,11 @@ def test_the_layout_preset_puts_a_late_start_s_feet_ahead() -> None:
     """The command's preset (settled start) carries the file's ``late_delta`` since
     2026-12-04 (a tenth 24 -> 29 and 17 -> 28 of 50 on seeds 0 and 1): start 6 of its capture
     region at a tenth (seed 1) falls without it and lands with it."""
-    rng = np.random.default_rng(1)
-    tenth = {"joint_sd": math.radians(0.3), "pitch_sd": math.radians(0.2),
-             "velocity_sd": 0.005, "spin_sd": 0.01}  # fmt: skip
-    start = [Perturbation.sample(rng, **tenth) for _ in range(7)][6]
+    start = _tenth_start(1, 6)
     m = somersault_maneuver("layout")
     i = next(k for k, ph in enumerate(m.phases) if ph.controller == "land")
     assert m.phases[i].params["late_delta"] == [0.024, 0.15, -0.11]
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
-    params = {k: v for k, v in m.phases[i].params.items() if k != "late_delta"}
-    off = replace(
-        m, phases=(*m.phases[:i], replace(m.phases[i], params=params), *m.phases[i + 1 :])
-    )
-    r = run_maneuver(off, perturbation=start, fps=10.0).report
+    r = run_maneuver(_without_land_param(m, "late_delta"), perturbation=start, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
