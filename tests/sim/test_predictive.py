@@ -22,6 +22,9 @@ from reactmocap.sim import (
     rollout,
     track_clip,
 )
+from reactmocap.sim.controllers.predictive import CAPTURE_SCALE
+from reactmocap.sim.controllers.registry import WHOLE_CLIP, build
+from reactmocap.sim.controllers.stepping import outside_distance
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "mocap"
 
@@ -152,3 +155,39 @@ def test_bad_control_every_rejected_before_anything_runs(step_forward: Motion) -
     with pytest.raises(ConfigError, match="control_every"):
         track_clip(step_forward, seconds=0.1, controller="predictive",
                    params={"control_every": 0})  # fmt: skip
+
+
+def test_whole_clip_option_steers_the_whole_clip_tracker(step_forward: Motion) -> None:
+    world = World(build_character(step_forward, frame=0))
+    window = build("predictive", world, step_forward)
+    whole = build("predictive", world, step_forward, {"whole_clip": True, "horizon": 0.3})
+    assert isinstance(window, PredictiveTracker) and isinstance(whole, PredictiveTracker)
+    # without it the window tracker (the captured world path, every touching corner)
+    assert window.tracker.touch == 0.0 and window.tracker.kp[0] == 100.0
+    assert whole.tracker.touch == WHOLE_CLIP["touch"]
+    assert whole.tracker.kp[0] == WHOLE_CLIP["kp_root"]
+    assert whole.tracker.step_leg == WHOLE_CLIP["step_leg"] and window.tracker.step_leg == 0.0
+    assert whole._horizon_steps == round(0.3 / world.timestep)  # its own options still apply
+
+
+def test_capture_term_costs_a_capture_point_outside_the_feet(step_forward: Motion) -> None:
+    world, _, pt = _predictive(step_forward, 0, capture_weight=2.0)
+    t = 0.05
+    tracker = pt.tracker
+
+    def costs() -> tuple[float, float]:
+        mujoco.mj_forward(world.model, world.data)
+        pt.capture_weight = 2.0
+        with_term = pt.cost(t)
+        pt.capture_weight = 0.0
+        return with_term, pt.cost(t)
+
+    with_term, without = costs()
+    assert with_term == without  # standing: the capture point is over the feet
+    world.data.qvel[tracker.wc.qvel_slice.start] = 3.0  # the pelvis thrown forward at 3 m/s
+    with_term, without = costs()
+    corners = tracker.sole_corners().reshape(-1, 3)
+    down = corners[:, 2] - tracker.floor_z < 0.02
+    out = outside_distance(tracker.capture_point()[0], corners[down, :2])
+    assert out > 0.2
+    assert with_term - without == pytest.approx(2.0 * (out / CAPTURE_SCALE) ** 2)

@@ -290,7 +290,7 @@ class AnchoredReference:
             self._drop = max(self._drop, want)  # down at once: the step must reach the floor
         return self._drop
 
-    def _sole_corners(self) -> F64:
+    def sole_corners(self) -> F64:
         """``(2, 4, 3)`` the sole corners now (computed once per simulation time)."""
         d = self.world.data
         key = (float(d.time), d.geom_xpos[self.sole].tobytes())
@@ -336,7 +336,7 @@ class AnchoredReference:
         centre-of-pressure range; empty for a foot in the air."""
         d = self.world.data
         planted = self.planted_now(t)
-        corners = self._sole_corners()
+        corners = self.sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
         out: list[F64] = []
         for f in range(2):  # two feet
@@ -432,7 +432,7 @@ class AnchoredReference:
         the fall's side, and only for ``_PLACE_WINDOW`` s after the push starts
         (``docs/tracking.md``)."""
         d = self.world.data
-        low = self._sole_corners()[:, :, 2].min(axis=1) - self.floor_z
+        low = self.sole_corners()[:, :, 2].min(axis=1) - self.floor_z
         self._placed &= low >= self.anchor_touch  # landed
         self._place_move[:] = 0.0
         if t > self._place_until:
@@ -485,7 +485,7 @@ class AnchoredReference:
                 self.place_shift = self.place_gain * miss * min(1.0, 0.4 / n)
         if self.step is not None:
             s = self.step
-            corners = self._sole_corners()
+            corners = self.sole_corners()
             down = corners[s.foot, :, 2].min() - self.floor_z < self.anchor_touch
             if (s.phase(t) >= 0.6 and down) or t > s.t0 + 1.5 * s.duration:
                 self.step = None
@@ -580,7 +580,7 @@ class AnchoredReference:
             return
         d = self.world.data
         i = self.clock.nearest(t)
-        corners = self._sole_corners()
+        corners = self.sole_corners()
         on = self.planted_now(t) & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
         if not on.any():
             return

@@ -104,10 +104,12 @@ def _predictive(
     world: World, c: int, ref: Reference, start: float, p: dict[str, Any]
 ) -> Controller:
     wb = {k: p.pop(k) for k in ("kp", "kv", "servo_kv", "control_every")}
+    # ``whole_clip``: steer the whole-clip tracker (``WHOLE_CLIP``), not the window one
+    options: dict[str, Any] = dict(WHOLE_CLIP) if p.pop("whole_clip", False) else {}
     tracker = WholeBodyTracker(
         world, c, ref, start, kp_joint=wb["kp"], kv_joint=wb["kv"],
         servo_kv=wb["servo_kv"], control_every=wb["control_every"],
-        hold_balance=p.pop("hold_balance", False),
+        hold_balance=p.pop("hold_balance", False), **options,
     )  # fmt: skip
     return PredictiveTracker(tracker, **p)
 
@@ -179,7 +181,7 @@ _REGISTRY: dict[str, ControllerSpec] = {
     "predictive": ControllerSpec(
         "predictive", "the whole-body tracker steered by predictive sampling (looks 0.5 s "
         "ahead; ~40x slower)", _WHOLEBODY, _predictive,
-        (*_options(PredictiveTracker), "hold_balance")),
+        (*_options(PredictiveTracker), "hold_balance", "whole_clip")),
     "passive": ControllerSpec(
         "passive", "no control: the servo off, joint damping and limits only (a ragdoll)",
         {"control_every": 10}, _passive),

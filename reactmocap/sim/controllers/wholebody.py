@@ -500,7 +500,7 @@ class WholeBodyTracker(AnchoredReference):
         the mocap holds down (``held`` ``(2, 4)``), or the ball patch of a pivoting foot, of
         the feet planted in the mocap."""
         m = self.world.model
-        corners = self._sole_corners()
+        corners = self.sole_corners()
         patch_on = self.world.foot_patch_on(self.character)
         sl = self._dofs
         qdot = d.qvel[sl]
