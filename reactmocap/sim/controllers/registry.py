@@ -159,7 +159,8 @@ _WHOLEBODY = {"kp": 1000.0, "kv": None, "servo_kv": 20.0, "control_every": 4}
 #: a short step quicker).
 #: Without them
 #: the tracker follows the captured world path, as the 1 s benchmark windows, predictive
-#: sampling and the response pipeline's physical mode expect.
+#: sampling and the response pipeline's physical mode expect; ``"predictive"`` steers the
+#: tracker with them when asked (``whole_clip``: ``docs/tracking.md``, "Twelfth pass").
 WHOLE_CLIP: Mapping[str, Param] = MappingProxyType(
     {"touch": 0.003, "slide_speed": 0.5, "roll_band": 0.02, "anchor_tau": 0.1, "balance_tau": 0.1,
      "balance_margin": 0.05, "trunk_weight": 30.0, "trunk_give": 0.5, "kp_root": 50.0,
