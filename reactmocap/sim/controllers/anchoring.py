@@ -75,10 +75,6 @@ _LAG_SLOW = 0.5
 # ``anchor_lag_heading``: a body's heading counts only above this speed (m/s): a body the push
 # has nearly stopped moves every way
 _LAG_MOVING = 0.2
-# ``place_ahead``: a pushed walk's landings are moved forward from this long (s) after the push
-# starts (the first landing is ``place_pushed``'s) and at most this far (m)
-_AHEAD_FROM = _PLACE_WINDOW
-_AHEAD_MAX = 0.3
 
 
 def _rot2(yaw: float) -> F64:
@@ -127,7 +123,6 @@ class AnchoredReference:
         warp_for: float = 0.0,
         anchor_lag: float = 0.0,
         anchor_lag_heading: float = 0.0,
-        place_ahead: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -228,10 +223,6 @@ class AnchoredReference:
         self.anchor_lag_heading = float(anchor_lag_heading)
         self._lag_end_cos = float(np.cos(np.radians(self.anchor_lag_heading)))
         self._lag_acted = False  # the path has lagged the feet since the push
-        self.place_ahead = float(place_ahead)
-        #: rollout time from which a pushed walk's landings may be moved forward
-        #: (``place_ahead``; inf: not pushed)
-        self.ahead_from = np.inf
         self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
@@ -438,8 +429,6 @@ class AnchoredReference:
             # ``anchor_lag_heading``: until the body is back on its way, however long that takes
             self.lag_until = np.inf if self.anchor_lag_heading else t + _LAG_FOR
             self._lag_acted = False
-        if self.place_ahead:
-            self.ahead_from = t + _AHEAD_FROM
 
     def _place_walk(self, t: float) -> None:
         """After a sideways walk's push (``place_pushed``): a swinging foot lands where the
@@ -487,55 +476,6 @@ class AnchoredReference:
                 self._place_land[f] = land + self._place_move[f]
                 self._placed[f] = True
 
-    def _place_ahead(self, t: float) -> None:
-        """After a walk's push (``place_ahead``): a swinging foot whose landing the simulated
-        capture point, grown to the mocap's landing about the stance foot (a linear inverted
-        pendulum), would pass along the walk by more than the clip's own capture point passes
-        its landed foot then (its margin: +0.32 to +0.49 m for a heel-first landing) plus
-        ``place_deadband``, lands ``place_ahead`` times that excess further forward (at most
-        ``_AHEAD_MAX`` m), kept until the foot is down. A body the clip's pelvis pulled back
-        up to speed ran past its feet, each landing short of its capture point, and fell
-        (class B, ``docs/tracking.md``)."""
-        assert self.path.sole is not None
-        d = self.world.data
-        low = self._sole_corners()[:, :, 2].min(axis=1) - self.floor_z
-        self._placed &= low >= self.anchor_touch  # landed
-        if self.placing and t <= self._place_until:
-            return  # ``place_pushed``'s window
-        self._place_move[:] = 0.0
-        _, v_ref, _ = self.com_reference(t)
-        ref = float(np.hypot(v_ref[0], v_ref[1]))
-        if ref < 0.2 * self.rate:  # not walking
-            return
-        u = v_ref[:2] / ref
-        xi, omega = self.capture_point()
-        i = self.clock.nearest(t)
-        ahead = self.path.sole[i : i + round(0.5 * self.path.fps), :, 2] - self.floor_z
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
-        turn = _rot2(self.anchor_yaw)
-        for f in range(2):  # two feet
-            if low[f] < self.anchor_touch or self._mocap_swing(t, f) is None:
-                continue
-            down = ahead[:, f] < self.place_height
-            if not down.any():
-                continue
-            k = int(np.argmax(down))  # the mocap's landing
-            j = i + k
-            c = self._com[j]
-            om = float(np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3)))
-            # the clip's own capture point past its landed sole
-            own = c[:2] + self._com_v[j, :2] / om - self.path.sole[j, f, :2]
-            margin = float((turn @ own) @ u)
-            land = turn @ self.path.sole[j, f, :2] + self.anchor_shift
-            stance = centre[1 - f, :2]
-            grown = stance + (xi - stance) * np.exp(omega * k / (self.path.fps * self.rate))
-            excess = float((grown - land) @ u) - margin - self.place_deadband
-            if excess > 0.0:
-                self._place_move[f] = min(self.place_ahead * excess, _AHEAD_MAX) * u
-                self._place_land[f] = land + self._place_move[f]
-                self._placed[f] = True
-
     def _update_step(self, t: float) -> None:
         """End a balance step that has landed; start one when the capture point has left both
         feet's support by ``step_margin`` while the mocap keeps both feet planted; update
@@ -544,8 +484,6 @@ class AnchoredReference:
         self.place_shift = np.zeros(2)
         if self.placing:
             self._place_walk(t)
-        if t >= self.ahead_from:
-            self._place_ahead(t)
         if self.place_gain and not self.path.planted[self.clock.nearest(t)].all():
             xi, omega = self.capture_point()
             c_ref, cv_ref, _ = self.com_reference(t)
@@ -805,7 +743,6 @@ class AnchoredReference:
         self.warp_until = np.inf
         self.lag_until = -np.inf
         self._lag_acted = False
-        self.ahead_from = np.inf
         self._catching = False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
@@ -823,13 +760,13 @@ class AnchoredReference:
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
-                self.lag_until, self._lag_acted, self.ahead_from)  # fmt: skip
+                self.lag_until, self._lag_acted)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching, drop_step, warp_until, lag_until, lag_acted, ahead_from) = memory  # fmt: skip
+         catching, drop_step, warp_until, lag_until, lag_acted) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -853,4 +790,3 @@ class AnchoredReference:
         self.warp_until = float(warp_until)  # type: ignore[arg-type]
         self.lag_until = float(lag_until)  # type: ignore[arg-type]
         self._lag_acted = bool(lag_acted)
-        self.ahead_from = float(ahead_from)  # type: ignore[arg-type]

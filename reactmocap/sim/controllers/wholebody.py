@@ -242,12 +242,6 @@ class WholeBodyTracker(AnchoredReference):
             until the body's centre of mass, having moved more than 45 deg off the clip's walk,
             moves within this many deg of it again (above 0.2 m/s; 0: the fixed 0.7 s;
             ``docs/tracking.md``).
-        place_ahead: from 0.5 s after a walk's push starts, a swinging foot lands
-            ``place_ahead`` times further forward along the clip's walk than the mocap's
-            landing by how far the simulated capture point, grown to that landing about the
-            stance foot (a linear inverted pendulum), would pass it by more than the clip's own
-            capture point passes its landed foot then plus ``place_deadband`` (at most 0.3 m;
-            0: off; ``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -332,7 +326,6 @@ class WholeBodyTracker(AnchoredReference):
         place_pushed: float = 0.0,
         anchor_lag: float = 0.0,
         anchor_lag_heading: float = 0.0,
-        place_ahead: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -365,7 +358,6 @@ class WholeBodyTracker(AnchoredReference):
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
                 "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
-                "place_ahead": place_ahead,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -479,7 +471,7 @@ class WholeBodyTracker(AnchoredReference):
             step_alternate=step_alternate, step_short=step_short,
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
             step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
-            anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading, place_ahead=place_ahead,
+            anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
@@ -769,8 +761,7 @@ class WholeBodyTracker(AnchoredReference):
         ``trunk_band`` m from the mocap's; back linearly over ``trunk_give`` s after. A walk
         pushed gets the softer pelvis servo (``kp_root_pushed``)."""
         if not ((self._w_trunk and self._give) or self._w_hip or self.warp_gain
-                or self._step_pushed or self.place_pushed or self.anchor_lag
-                or self.place_ahead):  # fmt: skip
+                or self._step_pushed or self.place_pushed or self.anchor_lag):  # fmt: skip
             return self._w_trunk
         # into a buffer: this runs every control tick
         np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
