@@ -406,6 +406,20 @@ def test_a_walk_pushed_off_its_way_with_its_path_held_ahead_walks_on(
     assert _walk_pushed(walk, force, 1.5, {"anchor_lag": 0.3}) == "ok"
 
 
+def test_a_walk_pushed_back_with_its_path_held_ahead_only_until_back_on_its_way_walks_on(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared right-curving walk pushed 400 N back at the chest for 0.2 s at 1.5 s walks
+    on with the defaults but falls with its ground path held ahead of its lagging feet for 0.7
+    s after the push (``anchor_lag`` 0.3: the clip's pelvis pulls the body back up to speed
+    and it runs past its feet, class B; 2026-12-04); with the held path ended once the body
+    moves within 30 deg of the clip's walk again (``anchor_lag_heading`` 30, opt-in) it walks
+    as its clip does."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 180.0, 400.0)
+    assert _walk_pushed(walk, force, 1.5, {"anchor_lag": 0.3}) == "fell"
+    assert _walk_pushed(walk, force, 1.5, {"anchor_lag": 0.3, "anchor_lag_heading": 30.0}) == "ok"
+
+
 def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_only_falls_later(
     shared_mocap_dir: Path,
 ) -> None:

@@ -72,6 +72,9 @@ _PLACE_WINDOW = 0.5
 _LAG_FOR = 0.7
 _LAG_COS = float(np.cos(np.radians(45.0)))
 _LAG_SLOW = 0.5
+# ``anchor_lag_heading``: a body's heading counts only above this speed (m/s): a body the push
+# has nearly stopped moves every way
+_LAG_MOVING = 0.2
 
 
 def _rot2(yaw: float) -> F64:
@@ -119,6 +122,7 @@ class AnchoredReference:
         step_hold_for: float = 0.0,
         warp_for: float = 0.0,
         anchor_lag: float = 0.0,
+        anchor_lag_heading: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -216,6 +220,9 @@ class AnchoredReference:
         #: rollout time until which a pushed walk's ground path lags its feet along the walk
         #: (``anchor_lag``; -inf: not pushed)
         self.lag_until = -np.inf
+        self.anchor_lag_heading = float(anchor_lag_heading)
+        self._lag_end_cos = float(np.cos(np.radians(self.anchor_lag_heading)))
+        self._lag_acted = False  # the path has lagged the feet since the push
         self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
@@ -419,7 +426,9 @@ class AnchoredReference:
         self.placing = placing
         self._place_until = t + _PLACE_WINDOW
         if self.anchor_lag:
-            self.lag_until = t + _LAG_FOR
+            # ``anchor_lag_heading``: until the body is back on its way, however long that takes
+            self.lag_until = np.inf if self.anchor_lag_heading else t + _LAG_FOR
+            self._lag_acted = False
 
     def _place_walk(self, t: float) -> None:
         """After a sideways walk's push (``place_pushed``): a swinging foot lands where the
@@ -627,8 +636,15 @@ class AnchoredReference:
         # for a gate over 0.7 s, and the swept figures are with it
         body = self.world.data.subtree_linvel[self._root][:2]
         ahead = float(body @ u)
-        if along >= 0.0 or ahead > _LAG_COS * float(np.hypot(body[0], body[1])):
+        speed = float(np.hypot(body[0], body[1]))
+        if self.anchor_lag_heading and self._lag_acted and speed > _LAG_MOVING:
+            if ahead >= self._lag_end_cos * speed:
+                # back on its way: held further, the path ahead drove the body past its feet
+                self.lag_until = t
+                return err
+        if along >= 0.0 or ahead > _LAG_COS * speed:
             return err
+        self._lag_acted = True
         lag = self.anchor_lag * min(1.0, max(0.0, (1.0 - ahead / ref) / _LAG_SLOW))
         return err + (min(0.0, along + lag) - along) * u
 
@@ -726,6 +742,7 @@ class AnchoredReference:
         self.rate, self.warping, self.leading = 1.0, False, False
         self.warp_until = np.inf
         self.lag_until = -np.inf
+        self._lag_acted = False
         self._catching = False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
@@ -743,13 +760,13 @@ class AnchoredReference:
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
-                self.lag_until)  # fmt: skip
+                self.lag_until, self._lag_acted)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching, drop_step, warp_until, lag_until) = memory  # fmt: skip
+         catching, drop_step, warp_until, lag_until, lag_acted) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -772,3 +789,4 @@ class AnchoredReference:
         self._drop_step = drop_step  # type: ignore[assignment]
         self.warp_until = float(warp_until)  # type: ignore[arg-type]
         self.lag_until = float(lag_until)  # type: ignore[arg-type]
+        self._lag_acted = bool(lag_acted)
