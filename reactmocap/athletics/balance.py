@@ -342,36 +342,6 @@ STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
 STANDING_STEP = Step()
 STANDING_BOW_EASE = 0.15
 STANDING_BEND_RATE = 1.5
-#: the standing step planned once, at its start, for the capture point the LIPM predicts at
-#: touchdown (the stance sole's point nearest the capture point as the centre of pressure,
-#: :attr:`Step.seconds` ahead), not aimed tick by tick at the moving one
-STANDING_PLAN = False
-#: the standing step's swing lasts its full :attr:`Step.seconds` (not ended at the first touch)
-STANDING_FIXED = False
-#: the arms held where they are while the standing step's foot swings
-STANDING_ARMS_STILL = False
-#: the standing step's planned place across the feet at the predicted capture point too (not
-#: under its own hip), at least :data:`STEP_WIDTH` beside the standing sole
-STANDING_PLAN_SIDE = True
-#: the hip strategy's bow kept eased out (the trunk upright) this many seconds after a standing
-#: step ends, not only while the foot swings (its return tipped the body on over the new stance)
-STANDING_UPRIGHT = 0.0
-#: the hip strategy's bow held where it is while a standing step swings (eased out after):
-#: easing it out during the swing kicked the swing thigh forward (the hip lagging the pelvis)
-STANDING_BOW_HOLD = False
-#: after a standing step, a foot left hanging is brought down beside the other once the COM
-#: moves slower than this (m/s, horizontal): a still body on one foot is no recovery; None: off
-STANDING_CLOSE_SPEED: float | None = None
-#: ... and once it has hung this many seconds (a foot lifted for a moment comes down itself)
-STANDING_CLOSE_HANG = 0.2
-#: plan only the steps along the feet (a sideways step still aimed tick by tick)
-STANDING_PLAN_ALONG = False
-#: a standing step along the feet fires too once the hip strategy's bow reaches this (rad)
-#: while the COM moves on that way (before the bow perches); None: off
-STANDING_BOW_FIRE: float | None = None
-#: the standing step fires on the capture point predicted this many seconds ahead (its
-#: velocity, finite differences over the control ticks); 0: the capture point now
-STANDING_AHEAD = 0.0
 
 
 class BalanceLaw:
@@ -398,8 +368,6 @@ class BalanceLaw:
         self._t_bow = math.nan
         #: a step when the capture point leaves the feet (:class:`Step`), or None
         self.stepper: Stepper | None = None
-        #: the shoulders' offsets held while a standing step swings (:data:`STANDING_ARMS_STILL`)
-        self._arms_held = np.zeros((2, 3))
         #: the pelvis's roll target (rad, heading frame; 0 upright): the landing's roll_ease
         self.roll = 0.0
         self._knee_standing = float(np.mean(knee_for_length(
@@ -527,14 +495,7 @@ class BalanceLaw:
             cp = float(vel[0]) / omega - float(err[0])  # capture point ahead of the target
             cp_side = float(vel[1]) / omega - float(err[1])  # ... and left of it
         if g.bow is not None and g.bow_ease is not None:
-            both = bool(s.foot_contact.all())
-            if self.stepper is not None and both:
-                both = not self.stepper.upright(t)
-            if self.stepper is not None and self.stepper.holds_bow():
-                self._t_bow = t
-            else:
-                self._bow_eased(cp, float(vel[0]), both, t)
-            pitch += self._bow_now
+            pitch += self._bow_eased(cp, float(vel[0]), bool(s.foot_contact.all()), t)
         elif g.bow is not None and bool(s.foot_contact.all()):
             pitch += self._bow(cp, float(vel[0]))
         hold_pelvis_and_feet(ctx, d, pitch, h, t, self.roll)
@@ -544,16 +505,12 @@ class BalanceLaw:
             rig.offset[_ANKLE[k], 1] = roll[0] * delta[1]
             rig.offset[_HIP[k], 0] = 0.5 * delta[0]
             rig.offset[_HIP[k], 1] = roll[1] * delta[1]
-        held = self.stepper is not None and self.stepper.holds_arms()
-        if held:  # the arms still while the foot swings: their reaction tips the stance
-            rig.offset[_SHOULDER] = self._arms_held
-            self._t_wind = t
-        if g.arms is not None and not held:
+        if g.arms is not None:
             gain, margin, limit = g.arms
             # behind the support centre too: a COM on its way to a target moved ahead is left be
             behind = cp + ahead < -margin
             rig.offset[_SHOULDER, 0] = -min(gain * max(-cp - margin, 0.0), limit) * behind
-        if (g.windmill is not None or g.windmill_side is not None) and not held:
+        if g.windmill is not None or g.windmill_side is not None:
             n = s.floor_normal
             level = math.hypot(float(n[0]), float(n[1])) < WINDMILL_SLOPE * float(n[2])
             dt = 0.0 if math.isnan(self._t_wind) else max(t - self._t_wind, 0.0)
@@ -569,8 +526,6 @@ class BalanceLaw:
                 spin = self._windmill(1, across, -left, dt, level, rate, margin)
                 rig.offset[_SHOULDER, 1] += spin
                 rig.offset[_SHOULDER, 0] -= lean * (self._wind_dir[1] != 0.0)
-        if self.stepper is not None and not held:
-            self._arms_held[:] = rig.offset[_SHOULDER]
         lo, hi = ANKLE_LIMITS
         desired = rig.desired(t)
         for k in range(2):
@@ -707,72 +662,8 @@ class Stepper:
         self._stood = 0
         self._goal = np.full((NJ, 3), np.nan)
         self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
-        #: the planned place (world, on the floor; :data:`STANDING_PLAN`)
-        self._place = np.zeros(3)
-        self._planned = False
-        self._t_hang = math.inf  # since when one foot alone has been down
-        #: the last tick's capture point and time (:data:`STANDING_AHEAD`)
-        self._cp_last = np.full(2, np.nan)
-        self._t_cp = math.nan
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
-
-    def holds_arms(self) -> bool:
-        """Whether the balance holds the arms still now (a standing step swinging)."""
-        return self.standing and STANDING_ARMS_STILL and self.foot >= 0
-
-    def holds_bow(self) -> bool:
-        """Whether the balance holds the bow still now (:data:`STANDING_BOW_HOLD`)."""
-        return self.standing and STANDING_BOW_HOLD and self.foot >= 0
-
-    def upright(self, t: float) -> bool:
-        """Whether the balance keeps the trunk upright now (:data:`STANDING_UPRIGHT`)."""
-        return (
-            self.standing
-            and STANDING_UPRIGHT > 0.0
-            and (self.foot >= 0 or t < self._t_end + STANDING_UPRIGHT)
-        )
-
-    def _ahead(self, cp: F64, t: float) -> F64:
-        """The capture point :data:`STANDING_AHEAD` s ahead (its velocity from the last tick)."""
-        dt = t - self._t_cp
-        ahead = cp.copy()
-        if dt > 0.0 and not np.isnan(self._cp_last).any():
-            ahead += STANDING_AHEAD * (cp - self._cp_last) / dt
-        self._cp_last[:] = cp
-        self._t_cp = t
-        return ahead
-
-    def _aim(self, cp: F64, stand: F64, at: F64) -> F64:
-        """Where the swing foot goes (heading frame) for the capture point ``cp``, the
-        standing sole's middle ``stand`` and the swing hip ``at``."""
-        assert self._out is not None
-        want = cp + self.step.reach * self._out
-        want[0] = np.clip(want[0], stand[0] - STEP_LONGEST, stand[0] + STEP_LONGEST)
-        # the feet kept STEP_WIDTH apart sideways, on whichever side the place lies
-        apart = want[1] - stand[1]
-        want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
-        if not self.sideways or (self.standing and self._out[1] == 0.0):
-            want[1] = at[1]
-        return want
-
-    def _plan(self, d, k: int, cp: F64, omega: float, h: float) -> None:  # type: ignore[no-untyped-def]
-        """Fix the place for the capture point predicted at touchdown: the LIPM's
-        ``cp(T) = p + (cp - p) exp(omega T)`` about the standing sole's point ``p`` nearest it."""
-        s = self.ctx.senses
-        sole = s.local(s.corners[1 - k], h)
-        p = np.clip(cp, sole.min(axis=0), sole.max(axis=0))
-        cp_t = p + (cp - p) * math.exp(omega * self.step.seconds)
-        stand = sole.mean(axis=0)
-        at = s.local(d.xanchor[self._hips[k]], h)[:2]
-        want = self._aim(cp_t, stand, at)
-        if STANDING_PLAN_SIDE and self._out[1] == 0.0:
-            # a step along the feet: across them at the predicted capture point, on the
-            # swing foot's own side (single support lets the COM fall toward it)
-            side = math.copysign(1.0, float(at[1] - stand[1]))
-            want[1] = stand[1] + side * max(side * float(cp_t[1] - stand[1]), STEP_WIDTH)
-        c, sn = math.cos(h), math.sin(h)
-        self._place[:] = (c * want[0] - sn * want[1], sn * want[0] + c * want[1], 0.0)
 
     def control(self, bl: BalanceLaw, d, h: float, t: float) -> None:  # type: ignore[no-untyped-def]
         s = self.ctx.senses
@@ -794,33 +685,16 @@ class Stepper:
                 self.foot, self._out, self._t0, self._close = k, None, t, False
                 self.record.append({"t": t, "foot": float(k), "beyond_m": 0.0,
                                     "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
-        one = int(s.foot_contact.sum()) == 1
-        if not one or not math.isfinite(self._t_hang):
-            self._t_hang = t if one else math.inf
-        if (self.foot < 0 and self.standing and STANDING_CLOSE_SPEED is not None
-                and t >= self._t_end + STEP_PAUSE and one
-                and t >= self._t_hang + STANDING_CLOSE_HANG
-                and float(np.hypot(*vel)) < STANDING_CLOSE_SPEED):  # fmt: skip
-            k = int(np.argmin(s.foot_contact))  # the hanging foot, beside the other
-            self.foot, self._out, self._t0 = k, None, t
-            self.record.append({"t": t, "foot": float(k), "beyond_m": 0.0,
-                                "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
         if self.foot < 0:
             if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
                 return
             lo, hi = s.support_extent(h)
-            # how far the capture point (a standing step's: predicted) lies outside the soles'
-            # box (along the feet only unless sideways), and the way out
-            fire = self._ahead(cp, t) if self.standing and STANDING_AHEAD > 0.0 else cp
-            out = np.maximum(fire - hi[:2], 0.0) - np.maximum(lo[:2] - fire, 0.0)
+            # how far the capture point lies outside the soles' box (along the feet only
+            # unless sideways), and the way out
+            out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
             if not self.sideways:
                 out[1] = 0.0
             beyond = float(np.hypot(*out))
-            bow = bl._bow_now if STANDING_BOW_FIRE is not None and self.standing else 0.0
-            if beyond <= st.margin and abs(bow) >= (STANDING_BOW_FIRE or 0.0) > 0.0:
-                # the bow deep: step along the feet the way it leans, the margin counted met
-                out[:] = (math.copysign(1.0, bow), 0.0)
-                beyond = st.margin + 1e-9
             if beyond <= st.margin or float(vel @ out) <= 0.0:
                 return
             # the farther foot swings (on a sideways fall toward the standing foot it crosses
@@ -831,19 +705,13 @@ class Stepper:
             self.foot, self._out, self._t0 = k, out / beyond, t
             self.record.append({"t": t, "foot": float(k), "beyond_m": beyond,
                                 "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
-            self._planned = self.standing and STANDING_PLAN
-            if STANDING_PLAN_ALONG and self._out[1] != 0.0:
-                self._planned = False
-            if self._planned:
-                self._plan(d, k, cp, omega, h)
         k = self.foot
         if t == self._t0:  # the hip's eased target starts where the hip is
             self._t_last = t
             self._bend = 0.0
             self._hip[:] = rig.current_angles()[_HIP[k]]
         u = (t - self._t0) / st.seconds
-        touch = 1.0 if self.standing and STANDING_FIXED else 0.5
-        if (u >= touch and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
+        if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
             self.record[-1]["s"] = t - self._t0
             self._close, self._stood = self._out is not None and not self.standing, 1 - k
@@ -862,10 +730,14 @@ class Stepper:
         stand = feet[1 - k]
         if self._out is None:  # closing: beside the other, under its own hip
             want = np.array([stand[0], at[1]])
-        elif self._planned:  # the place planned at the start
-            want = s.local(self._place, h)
         else:  # past the capture point
-            want = self._aim(cp, stand, at)
+            want = cp + st.reach * self._out
+            want[0] = np.clip(want[0], stand[0] - STEP_LONGEST, stand[0] + STEP_LONGEST)
+            # the feet kept STEP_WIDTH apart sideways, on whichever side the place lies
+            apart = want[1] - stand[1]
+            want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
+            if not self.sideways or (self.standing and self._out[1] == 0.0):
+                want[1] = at[1]
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
         down = float(hip[2]) - float(d.xanchor[self._ankles[1 - k], 2])
