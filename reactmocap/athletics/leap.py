@@ -101,12 +101,6 @@ COM_PUSH_SPIN: Mapping[str, float] = MappingProxyType({"male": -2.0, "female": -
 ANKLE_KP, ANKLE_KV = 2.0, 0.5
 #: the largest hip roll and yaw offset (rad) the push's tilt feedback may make (tilt_gain)
 TILT_LIMIT = 0.3
-#: the momentum about the vertical (kg m^2/s) the timed thrust makes per radian of both hips'
-#: yaw offset (twist_ff; measured on the male back handspring's perturbed starts,
-#: docs/athletics.md)
-HIP_YAW_LZ = -6.6
-#: the largest hip yaw offset (rad) twist_ff may make
-TWIST_LIMIT = 0.3
 #: the most weight share the "com" push's roll feedback moves between the feet (roll_gain)
 ROLL_SHIFT = 0.5
 #: the tilt feedback's yaw gain as a multiple of its roll gain (tilt_gain): the yaw
@@ -221,14 +215,6 @@ class LeapParams:
     #: one foot, its target following the loaded sole, and ``crouch_plant``'s whole target
     #: made it fall back (docs/athletics.md). False: off (as before)
     crouch_middle: bool = False
-    #: the timed thrust's hips turn by a yaw offset sized once at the crouch's end to cancel
-    #: the momentum about the vertical the thrust would make from the COM's sideways offset
-    #: there: ``(bias, per_m)``, the lift-off's ``Lz`` = bias + per_m x side (kg m^2/s, side
-    #: in m, left > 0, from the middle of both soles), cancelled through
-    #: :data:`HIP_YAW_LZ` (at most ``TWIST_LIMIT``): a settled back handspring start that
-    #: crouched onto one foot left the floor twisting (docs/athletics.md). ``()``: off (as
-    #: before)
-    twist_ff: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -275,13 +261,6 @@ class LeapParams:
             raise ConfigError(
                 f"leap crouch_until must be () or (side_m > 0, side_speed_m_s > 0, cap_s >= 0), "
                 f"got {self.crouch_until}"
-            )
-        if self.twist_ff and not (
-            len(self.twist_ff) == 2
-            and all(isinstance(v, (int, float)) and math.isfinite(v) for v in self.twist_ff)
-        ):
-            raise ConfigError(
-                f"leap twist_ff must be () or (bias, per_m), finite, got {self.twist_ff}"
             )
         if self.handover not in HANDOVERS:
             raise ConfigError(
@@ -373,17 +352,6 @@ class Leap(Basis):
             memo["stiff1"] = stiff
             rig.move(rig.desired(t) + rig.offset, 0.0, t)
             rig.offset[:] = 0.0
-            if p.twist_ff:
-                # the twist the thrust would make from the COM's sideways offset (from the
-                # middle of the two sole centres) cancelled by the hips' yaw, sized once: a
-                # feedback on the heading turned the thrust itself into twist
-                now = ctx.sense(t)
-                h = now.heading()
-                side = float(now.local(now.com - now.corners.mean(axis=(0, 1)), h)[1])
-                bias, per_m = p.twist_ff
-                yaw = -(bias + per_m * side) / HIP_YAW_LZ
-                memo["twist"] = float(np.clip(yaw, -TWIST_LIMIT, TWIST_LIMIT))
-                rig.offset[hips, 2] = memo["twist"]
             hip_t, knee_t, ankle_t = p.timing
             goal = np.full((NJ, 3), np.nan)
             dur = np.zeros(NJ)
@@ -425,8 +393,6 @@ class Leap(Basis):
                 scale = spin_ramp * p.tilt_gain / unit
                 tilt[0] *= scale
                 tilt[1] *= TILT_YAW * scale
-                if p.twist_ff:
-                    tilt[1] += memo["twist"]
                 ctx.rig.offset[hips, 1:] = np.clip(tilt, -TILT_LIMIT, TILT_LIMIT)
 
         g = float(np.linalg.norm(ctx.world.model.opt.gravity))

@@ -164,7 +164,7 @@ def _build_leap(phase: Phase, ath: Athlete) -> Basis:
                 else tables.leap_params(float(effort)))  # fmt: skip
     else:
         base = LeapParams(broad=broad)
-    for key in ("timing", "crouch_until", "twist_ff"):
+    for key in ("timing", "crouch_until"):
         if key in p:
             p[key] = tuple(p[key])
     return Leap(replace(base, handover=phase.exit, **p))
