@@ -220,8 +220,8 @@ class LandingParams:
             momentum (:func:`~reactmocap.athletics.leap.pitch_momentum`, > 0 forward) exceeds
             this (kg m^2/s); 0: off (it hands over when the COM stops near its target or moves
             away from it). Why: a male back layout standing over its feet but still turning
-            forward (+8..+10 kg m^2/s, the COM creeping on at 0.02-0.11 m/s) never met either
-            and fell forward after the recovery's 1 s; the balance takes such momentum down
+            forward (+8..+10 kg m^2/s, the COM creeping on at 0.02-0.11 m/s) met neither, stayed
+            in the recovery 0.5 s and fell forward; the balance takes such momentum down
             (docs/athletics.md).
     """
 

@@ -879,8 +879,8 @@ def test_the_layout_preset_puts_a_late_start_s_feet_ahead() -> None:
 def test_a_back_layout_turning_forward_over_its_feet_hands_over_on_the_pitch_momentum() -> None:
     """Start 39 of ``back_layout.toml``'s capture region at a tenth (seed 0) touches down in
     the window and stands with the COM 2-3 cm from the feet, creeping on, its pitch momentum
-    at +8..+10 kg m^2/s: the recovery never sees the COM stop or move away, stays in for its
-    full 1 s and falls forward. With ``recover_spin`` 5 (an option, off in the file;
+    at +8..+10 kg m^2/s: the recovery never sees the COM stop or move away, stays in it for
+    0.5 s and falls forward. With ``recover_spin`` 5 (an option, off in the file;
     docs/athletics.md) it hands over on that momentum within 0.07 s and the balance lands it."""
     start = _tenth_start(0, 39)
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
