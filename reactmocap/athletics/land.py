@@ -216,6 +216,13 @@ class LandingParams:
             (it opened a tick late in the legs' swing: 0.21-0.35 m 24 ms in, against at most
             0.085 on the others), and they land with the feet farther ahead from the reach's
             start, which the others do not (docs/athletics.md).
+        recover_spin: the recovery also hands over to the balance once the whole-body pitch
+            momentum (:func:`~reactmocap.athletics.leap.pitch_momentum`, > 0 forward) exceeds
+            this (kg m^2/s); 0: off (it hands over when the COM stops near its target or moves
+            away from it). Why: a male back layout standing over its feet but still turning
+            forward (+8..+10 kg m^2/s, the COM creeping on at 0.02-0.11 m/s) met neither, stayed
+            in the recovery 0.5 s and fell forward; the balance takes such momentum down
+            (docs/athletics.md).
     """
 
     knee: float = 0.6
@@ -251,6 +258,7 @@ class LandingParams:
     turn_ref: float = 0.0
     turn_window: float = 0.1
     late_delta: tuple[float, ...] = ()
+    recover_spin: float = 0.0
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -277,6 +285,7 @@ class LandingParams:
             "roll_min",
             "turn_gain",
             "turn_ref",
+            "recover_spin",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -303,6 +312,8 @@ class LandingParams:
                 "landing late_delta must be (seconds in [0, 1], offset > 0 m, delta m), "
                 f"got {self.late_delta!r}"
             )
+        if self.recover_spin < 0:
+            raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
             raise ConfigError(f"landing roll_min must be in [0, pi/2] rad, got {self.roll_min}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
@@ -558,7 +569,6 @@ class Landing(Basis):
             bl.set_posture(Posture(leg=max(leg, 0.5), lean=p.lean, settle=0.3), t)
 
         def settled(world: World, t: float, t_in: float) -> bool:
-            del world
             s = ctx.sense(t)
             h = s.heading()
             err = s.local(bl.com_target - s.com, h)
@@ -566,7 +576,9 @@ class Landing(Basis):
             passed = float(err @ vel) < 0.0  # moving away from the desired COM
             still = float(np.linalg.norm(vel)) < 0.05 and float(np.linalg.norm(err)) < 0.05
             eased = t - memo["t_touch"] >= memo["roll_ease"]  # the pelvis's roll upright first
-            return t_in > 0.05 and (passed or still) and eased
+            # pitching forward on feet it stands over: the balance takes that down (recover_spin)
+            spin = p.recover_spin > 0 and pitch_momentum(world, s) > p.recover_spin
+            return t_in > 0.05 and (passed or still or spin) and eased
 
         def done(world: World, t: float) -> None:
             del world

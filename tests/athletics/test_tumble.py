@@ -4,8 +4,10 @@ on the simulated motion."""
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -236,7 +238,12 @@ def _tenth_start(seed: int, i: int) -> Perturbation:
 def _without_land_param(m: Maneuver, key: str) -> Maneuver:
     """``m`` with ``key`` taken out of its landing phase's parameters."""
     i = next(k for k, ph in enumerate(m.phases) if ph.controller == "land")
-    params = {k: v for k, v in m.phases[i].params.items() if k != key}
+    return _with_land_params(m, {k: v for k, v in m.phases[i].params.items() if k != key})
+
+
+def _with_land_params(m: Maneuver, params: Mapping[str, Any]) -> Maneuver:
+    """``m`` with its landing phase's parameters replaced by ``params``."""
+    i = next(k for k, ph in enumerate(m.phases) if ph.controller == "land")
     return replace(
         m, phases=(*m.phases[:i], replace(m.phases[i], params=params), *m.phases[i + 1 :])
     )
@@ -867,3 +874,27 @@ def test_the_layout_preset_puts_a_late_start_s_feet_ahead() -> None:
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
     r = run_maneuver(_without_land_param(m, "late_delta"), perturbation=start, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
+
+
+def test_a_back_layout_turning_forward_over_its_feet_hands_over_on_the_pitch_momentum() -> None:
+    """Start 39 of ``back_layout.toml``'s capture region at a tenth (seed 0) touches down in
+    the window and stands with the COM 2-3 cm from the feet, creeping on, its pitch momentum
+    at +8..+10 kg m^2/s: the recovery never sees the COM stop or move away, stays in it for
+    0.5 s and falls forward. With ``recover_spin`` 5 (an option, off in the file;
+    docs/athletics.md) it hands over on that momentum within 0.07 s and the balance lands it."""
+    start = _tenth_start(0, 39)
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = m.phases[3]
+    assert land.controller == "land" and "recover_spin" not in land.params
+    res = run_maneuver(m, perturbation=start, fps=10.0)
+    held = [t for t, _, c in res.transitions if str(c) in ("land.recover", "land.done")]
+    assert held[1] - held[0] > 0.4, held
+    assert not (res.report["landed"] and not res.report["fell"])
+    res = run_maneuver(_with_land_params(m, {**land.params, "recover_spin": 5.0}),
+                       perturbation=start, fps=10.0)  # fmt: skip
+    held = [t for t, _, c in res.transitions if str(c) in ("land.recover", "land.done")]
+    assert held[1] - held[0] < 0.1, held
+    r = res.report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    with pytest.raises(ConfigError, match="recover_spin"):
+        LandingParams(recover_spin=-1.0)
