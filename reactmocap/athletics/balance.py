@@ -342,21 +342,14 @@ STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
 STANDING_STEP = Step()
 STANDING_BOW_EASE = 0.15
 STANDING_BEND_RATE = 1.5
-#: issue 18's tries (2026-12-04, docs/athletics.md; all off: step="on" as before): a swing on a
-#: world path (minimum jerk, STANDING_CLEAR m up, each joint's goal a servo lag ahead, the hip's
-#: from the pelvis turned on by its rate, the swing leg STANDING_SWING_STIFF times stiffer, the
-#: place clipped to the leg's reach); a foot hanging over a COM slower than
-#: STANDING_CLOSE_SPEED for STANDING_CLOSE_HANG s closed by a swing (putting the posture's
-#: plant on after it: STANDING_CLOSE_PLANT) or by the plant alone (STANDING_HANG_PLANT)
-STANDING_PATH = False
-STANDING_CLEAR = 0.06
-STANDING_LEAD = 1.0
-STANDING_SWING_STIFF = 1.0
-STANDING_REACH_CLIP = False
-STANDING_CLOSE_SPEED = 0.0
-STANDING_CLOSE_HANG = 0.2
-STANDING_CLOSE_PLANT = False
-STANDING_HANG_PLANT = False
+#: the standing step's end: once one foot alone has been down for :data:`STANDING_HANG` s
+#: (no step for :data:`STEP_PAUSE`) with the COM slower than :data:`STANDING_STILL` m/s, the
+#: posture's :attr:`~Posture.plant` goes on (the COM target the middle of both feet, the
+#: hanging foot's leg lengthened): the foot comes down and stays loaded (both feet required,
+#: the 16 pushes' limits 2165 -> 2255 N, none lower; a closing swing put the foot down and it
+#: lifted again; docs/athletics.md)
+STANDING_HANG = 0.2
+STANDING_STILL = 0.08
 
 
 class BalanceLaw:
@@ -678,9 +671,6 @@ class Stepper:
         self._stood = 0
         self._goal = np.full((NJ, 3), np.nan)
         self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
-        #: :data:`STANDING_PATH`: the swing ankle's start (world) and its offset from the
-        #: sole's middle (heading frame), set at lift-off
-        self._path: tuple[F64, F64] | None = None
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
 
@@ -704,23 +694,8 @@ class Stepper:
                 self.foot, self._out, self._t0, self._close = k, None, t, False
                 self.record.append({"t": t, "foot": float(k), "beyond_m": 0.0,
                                     "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
-        if self.foot < 0 and self.standing and STANDING_CLOSE_SPEED > 0.0:
-            one = int(s.foot_contact.sum()) == 1
-            if not one:
-                self._t_hang = math.inf
-            elif not math.isfinite(self._t_hang):
-                self._t_hang = t
-            if (one and t >= self._t_end + STEP_PAUSE and t >= self._t_hang + STANDING_CLOSE_HANG
-                    and float(np.hypot(*vel)) < STANDING_CLOSE_SPEED):  # fmt: skip
-                # a foot left hanging over a still COM is put down beside the other (standing
-                # still on one foot is no rest, docs/athletics.md)
-                if STANDING_HANG_PLANT:
-                    bl.posture = replace(bl.posture, plant=True)
-                else:
-                    k = int(np.argmin(s.foot_contact))
-                    self.foot, self._out, self._t0 = k, None, t
-                    self.record.append({"t": t, "foot": float(k), "beyond_m": 0.0,
-                                        "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
+        if self.foot < 0 and self.standing and not bl.posture.plant:
+            self._plant_if_hanging(bl, float(np.hypot(*vel)), t)
         if self.foot < 0:
             if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
                 return
@@ -744,21 +719,12 @@ class Stepper:
         k = self.foot
         if t == self._t0:  # the hip's eased target starts where the hip is
             self._t_last = t
-            self._path = None
             self._bend = 0.0
             self._hip[:] = rig.current_angles()[_HIP[k]]
-            if self.standing and STANDING_PATH and STANDING_SWING_STIFF != 1.0:
-                stiff = bl.gains.stiffness_array()
-                stiff[[_HIP[k], _KNEE[k]]] *= STANDING_SWING_STIFF
-                rig.set_stiffness(stiff)
         u = (t - self._t0) / st.seconds
         if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
-            if self.standing and STANDING_PATH and STANDING_SWING_STIFF != 1.0:
-                rig.set_stiffness(bl.gains.stiffness_array())
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
             self.record[-1]["s"] = t - self._t0
-            if self.standing and self._out is None and STANDING_CLOSE_PLANT:
-                bl.posture = replace(bl.posture, plant=True)
             self._close, self._stood = self._out is not None and not self.standing, 1 - k
             self.foot, self._t_end = -1, t
             # both knees on from where they are to the posture's, over what is left of its
@@ -803,25 +769,22 @@ class Stepper:
                 self._bend = max(bend, 0.0)
             rig.offset[_KNEE[j], 0] = max(bend, float(rig.offset[_KNEE[j], 0]))
             down -= low
-        if self.standing and STANDING_PATH:
-            self._swing_on_path(d, h, t, want, k, reach)
-        else:
-            length = min(math.sqrt(ahead * ahead + aside * aside + max(down, 0.2) ** 2), reach)
-            swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
-            knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
-            knee += st.lift * math.sin(math.pi * min(max(u, 0.0), 1.0))
-            # the leg aimed in the world at the place, whatever the pelvis's orientation (as
-            # the landing's reach); the COM servo's offsets off it, its weight on the other foot
-            self._thigh[0] = -swing + geom
-            self._thigh[1] = math.asin(float(np.clip(aside / length, -0.5, 0.5)))
-            aim = hips_for_thighs(self.ctx, d, self._thigh[None], h)[0]
-            # the hip eased toward its aim (first order): a jump in its target kicked the
-            # pelvis back and the standing foot off the floor
-            ease = min(max(t - self._t_last, 0.0) / STEP_EASE, 1.0) if STEP_EASE > 0 else 1.0
-            self._t_last = t
-            self._hip += ease * (aim - self._hip)
-            self._goal[_HIP[k]] = self._hip
-            self._goal[_KNEE[k], 0] = knee
+        length = min(math.sqrt(ahead * ahead + aside * aside + max(down, 0.2) ** 2), reach)
+        swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
+        knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
+        knee += st.lift * math.sin(math.pi * min(max(u, 0.0), 1.0))
+        # the leg aimed in the world at the place, whatever the pelvis's orientation (as the
+        # landing's reach); the COM servo's offsets off it, its weight on the other foot
+        self._thigh[0] = -swing + geom
+        self._thigh[1] = math.asin(float(np.clip(aside / length, -0.5, 0.5)))
+        aim = hips_for_thighs(self.ctx, d, self._thigh[None], h)[0]
+        # the hip eased toward its aim (first order): a jump in its target kicked the pelvis
+        # back and the standing foot off the floor
+        ease = min(max(t - self._t_last, 0.0) / STEP_EASE, 1.0) if STEP_EASE > 0 else 1.0
+        self._t_last = t
+        self._hip += ease * (aim - self._hip)
+        self._goal[_HIP[k]] = self._hip
+        self._goal[_KNEE[k], 0] = knee
         rig.move(self._goal, 0.0, t, (_HIP[k], _KNEE[k]))
         rig.offset[_HIP[k]] = 0.0
         rig.offset[_ANKLE[k]] = 0.0
@@ -829,90 +792,18 @@ class Stepper:
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
 
-    def _swing_on_path(self, d, h: float, t: float, want: F64, k: int, reach: float) -> None:  # type: ignore[no-untyped-def]
-        """:data:`STANDING_PATH`: the swing hip's and knee's goals that put the ankle on its
-        world path (:meth:`_path_point`), solved from the pelvis's current pose, each
-        joint's a servo lag ahead (:meth:`Rig.lag`): its point that much later on the path,
-        the hip's from the pelvis turned on by its angular velocity over that lag (as the
-        landing's ``twist_aim``): a pelvis pitching back under a lagging hip carried the
-        thigh forward and the foot 0.25 m past its place (docs/athletics.md)."""
-        rig = self.ctx.rig
-        a = self.ctx.athlete
-        ul, ll = float(a.thigh[k]), float(a.shin[k])
-        hip = d.xanchor[self._hips[k]]
-        u = (t - self._t0) / self.step.seconds
-        if self._path is None:
-            # the leg's solution for where the ankle is, against its angles: the model's knee
-            # is bent at 0 and its thigh off the hip-ankle line (the law of cosines' knee
-            # reads 0.08 rad more), so the path is solved relative to lift-off's pose
-            self._fix = np.zeros(4)
-            self._path_point(d, h, 0.0, want, k)
-            self._fix[1:] = self._leg(d, h, 0.0, 0.0, want, k, reach)
-            now = rig.current_angles()
-            self._fix[1:3] -= now[_HIP[k], :2]
-            self._fix[3] -= now[_KNEE[k], 0]
-        lag = rig.lag((_HIP[k], _KNEE[k])) * STANDING_LEAD
-        self._goal[_HIP[k], :2], self._goal[_HIP[k], 2] = (
-            self._leg(d, h, u, float(lag[0]), want, k, reach)[:2] - self._fix[1:3],
-            0.0,
-        )
-        self._goal[_KNEE[k], 0] = (
-            self._leg(d, h, u, float(lag[1]), want, k, reach)[2] - self._fix[3]
-        )
-
-    def _leg(self, d, h: float, u: float, lead: float, want: F64, k: int, reach: float) -> F64:  # type: ignore[no-untyped-def]
-        """The swing leg's hip pitch, roll and knee that put its ankle on the path ``lead`` s
-        after ``u`` (the pelvis turned on by its angular velocity over ``lead``)."""
-        a = self.ctx.athlete
-        ul, ll = float(a.thigh[k]), float(a.shin[k])
-        hip = d.xanchor[self._hips[k]]
-        rel = self._path_point(d, h, u + lead / self.step.seconds, want, k) - hip
-        fwd, side = (float(x) for x in self.ctx.senses.local(rel, h))
-        length = min(float(np.linalg.norm(rel)), reach)
-        knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
-        swing = math.asin(float(np.clip(fwd / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
-        self._thigh[0] = -swing + geom
-        self._thigh[1] = math.asin(float(np.clip(side / length, -0.5, 0.5)))
-        spin = lead * d.cvel[self.ctx.senses.root, :3]
-        out = hips_for_thighs(self.ctx, d, self._thigh[None], h, spin)[0]
-        out[2] = knee
-        return out
-
-    def _path_point(self, d, h: float, u: float, want: F64, k: int) -> F64:  # type: ignore[no-untyped-def]
-        """The swing ankle's point (world) on its path at ``u`` (of the swing's duration):
-        from where the ankle lifted off to as high above the place ``want`` (the sole's
-        middle, heading frame; followed as it moves), minimum-jerk along the floor, a half sine of
-        :data:`STANDING_CLEAR` up, and pressed :data:`STEP_PRESS` into the floor by its end
-        (the servo's sag left a foot hovering)."""
-        s = self.ctx.senses
-        c, sn = math.cos(h), math.sin(h)
-        if self._path is None:  # lift-off: the path starts where the ankle is
-            ankle = d.xanchor[self._ankles[k]]
-            self._path = (ankle.copy(), s.local(ankle - s.corners[k].mean(axis=0), h))
-        start, off = self._path
-        x, y = float(want[0] + off[0]), float(want[1] + off[1])  # the ankle over the place
-        if STANDING_REACH_CLIP:
-            hip = s.local(d.xanchor[self._hips[k]], h)
-            far = math.sqrt(
-                max(
-                    (STEP_REACH * float(self.ctx.athlete.leg_length)) ** 2
-                    - (float(d.xanchor[self._hips[k], 2]) - float(start[2])) ** 2,
-                    0.0,
-                )
-            )
-            gap = np.array([x - hip[0], y - hip[1]])
-            n = float(np.hypot(*gap))
-            if n > far:
-                x, y = (float(v) for v in hip[:2] + gap * (far / n))
-        w = min(max(u, 0.0), 1.0)
-        along = w * w * w * (10.0 - 15.0 * w + 6.0 * w * w)  # minimum jerk
-        z = (
-            float(start[2])
-            + STANDING_CLEAR * math.sin(math.pi * w)
-            - STEP_PRESS * min(max(2.0 * u - 1.0, 0.0), 1.0)
-        )
-        return np.array([start[0] + along * (c * x - sn * y - start[0]),
-                         start[1] + along * (sn * x + c * y - start[1]), z])  # fmt: skip
+    def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
+        """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough
+        over a COM slower than :data:`STANDING_STILL` (standing still on one foot is no rest)."""
+        if int(self.ctx.senses.foot_contact.sum()) != 1:
+            self._t_hang = math.inf
+            return
+        self._t_hang = min(self._t_hang, t)
+        if (
+            t >= max(self._t_hang + STANDING_HANG, self._t_end + STEP_PAUSE)
+            and speed < STANDING_STILL
+        ):
+            bl.posture = replace(bl.posture, plant=True)
 
 
 def hips_for_thighs(  # type: ignore[no-untyped-def]

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reactmocap.athletics import behaviours, run
+from reactmocap.athletics import balance, behaviours, run
 from reactmocap.athletics.balance import STANDING_GAINS, BalanceGains, BalanceLaw, Step
 from reactmocap.athletics.behaviours import AthleticsResult
 from reactmocap.athletics.maneuvers import Maneuver, Perturbation, Phase, run_maneuver
@@ -232,3 +232,18 @@ def test_a_push_kept_standing_on_one_foot_is_reported_as_such(
     args = ["athletics", "balance", "--push", "155", "--push-dir", "135", "--out", str(out)]
     assert main(args) == 0
     assert "on one foot" in capsys.readouterr().out
+
+
+def test_a_foot_left_hanging_is_put_down_by_the_standing_step(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # step="on" (issue 18, 2026-12-04): the male's 155 N back-left push ends still with one
+    # foot in the air and no step taken; once a foot has hung STANDING_HANG s over a COM
+    # slower than STANDING_STILL the posture's plant goes on and he ends on both feet
+    push = {"check_range": False, "seconds": 3.0, "push": 155.0,
+            "push_dir": math.radians(135.0), "step": "on"}  # fmt: skip
+    r = run("balance", "male", **push).report
+    assert r["balanced"] and r["on_both_feet"] and not r["steps"]
+    monkeypatch.setattr(balance, "STANDING_STILL", 0.0)  # the option before: never planted
+    r = run("balance", "male", **push).report
+    assert r["balanced"] and not r["on_both_feet"] and not r["steps"]
