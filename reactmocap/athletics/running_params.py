@@ -107,6 +107,19 @@ class RunParams:
             held in full (1: all, as tuned). Their damping there took about half the push
             (the knee -85 N m against the law's 179 at 2.61 m/s). The whole stance free (0
             throughout) fell within 2 s: the landing needs the servos' give.
+        push_feed: in a commanded stance's toe state, the share (0-1) of the stance knee's and
+            ankle's servo torque that opposes the leg law's (the last physics step's, along
+            the law's torque, at most the law's own) added to the law's torque, so the law's
+            force reaches the ground (0: off). Traced at 2.61 m/s the servos took up to 198 of
+            the knee's 237 N m in the push and the body left at 0.43 m/s upward against the
+            0.835 commanded.
+        land_hold: in a commanded stance's landing (the loading, heel and heel-and-toe
+            states), the share (0-1) of the stance knee's and ankle's servo gains kept about
+            bending (1: all, off). Traced, their damping stopped a 0.96 m/s fall within 0.06 s
+            (3-4 body weights) while the law asked about none.
+        land_damping: in a commanded stance's landing, the leg law's force is at least this
+            many body weights per m/s of the leg's shortening (a damper on its length; 0:
+            off), the give the eased servos no longer make.
         idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
             by the end of the stance ready for touchdown (rad).
         swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
@@ -162,6 +175,9 @@ class RunParams:
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
     push_hold: float | Speeds = 1.0
+    push_feed: float | Speeds = 0.0
+    land_hold: float | Speeds = 1.0
+    land_damping: float | Speeds = 0.0
     idle_knee: float | Speeds = (2.182, 1.813, 1.692)
     reach_knee: float | Speeds = (1.192, 1.066, 1.102)
     swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
@@ -196,9 +212,10 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
-        hold = self.push_hold if isinstance(self.push_hold, tuple) else (self.push_hold,)
-        if not all(0.0 <= b <= 1.0 for b in hold):
-            raise ConfigError(f"push_hold must be in [0, 1], got {self.push_hold}")
+        for name in ("push_hold", "push_feed", "land_hold"):
+            v = getattr(self, name)
+            if not all(0.0 <= b <= 1.0 for b in (v if isinstance(v, tuple) else (v,))):
+                raise ConfigError(f"{name} must be in [0, 1], got {v}")
         lo, hi = SPEED_RANGE
         for speed in (lo, hi):
             r = self.at(speed)
@@ -223,6 +240,8 @@ class RunParams:
                 )
             if not 0 < r["step_placement"] <= 2:
                 raise ConfigError(f"step_placement must be in (0, 2], got {self.step_placement}")
+            if r["land_damping"] < 0:
+                raise ConfigError(f"land_damping must be >= 0, got {self.land_damping}")
             if not -0.3 <= r["step_bias"] <= 0.3:
                 raise ConfigError(f"step_bias must be in [-0.3, 0.3] m, got {self.step_bias}")
         steps = self.step_stance if isinstance(self.step_stance, tuple) else (self.step_stance,)
