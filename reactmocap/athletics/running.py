@@ -644,12 +644,16 @@ class Runner:
         self._placement(self.active, self.heading_d if self.p_frame else self.heading())
 
     def _stance(self, world: World, t: float) -> None:
-        del world, t
+        del world
         # in the push the stance knee's and ankle's servos keep only a share of their gains
         # about bending (roll and yaw held): their damping there took half the leg law's push
         state = self.machine.current.name
         if state in ("toe", "unloading"):
             hold = self.k["push_hold"]
+            if self.step_stance and self.k["push_ramp"] > 0:
+                # eased out over the push, as the leg's speed (and the servos' damping) grows
+                done = clamp((t - self.t_touchdown) / self.step_stance, 0.0, 1.0)
+                hold *= 1.0 - self.k["push_ramp"] * done
         else:  # the landing: eased in a commanded stance with land_hold
             hold = self.k["land_hold"] if self.step_stance else 1.0
         a = self.active

@@ -113,6 +113,10 @@ class RunParams:
             force reaches the ground (0: off). Traced at 2.61 m/s the servos took up to 198 of
             the knee's 237 N m in the push and the body left at 0.43 m/s upward against the
             0.835 commanded.
+        push_ramp: in a commanded stance's push, ``push_hold`` falls linearly with the time
+            since touchdown, to ``(1 - push_ramp)`` of itself at the stance's end (0: off):
+            traced, the ground force fell from 1.5 to 0.5 body weights over the push's last
+            0.06 s while the law asked 2, the servos' damping growing with the leg's speed.
         land_hold: in a commanded stance's landing (the loading, heel and heel-and-toe
             states), the share (0-1) of the stance knee's and ankle's servo gains kept about
             bending (1: all, off). Traced, their damping stopped a 0.96 m/s fall within 0.06 s
@@ -176,6 +180,7 @@ class RunParams:
     ankle_hold: float | Speeds = 1.0
     push_hold: float | Speeds = 1.0
     push_feed: float | Speeds = 0.0
+    push_ramp: float | Speeds = 0.0
     land_hold: float | Speeds = 1.0
     land_damping: float | Speeds = 0.0
     idle_knee: float | Speeds = (2.182, 1.813, 1.692)
@@ -212,7 +217,7 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
-        for name in ("push_hold", "push_feed", "land_hold"):
+        for name in ("push_hold", "push_feed", "push_ramp", "land_hold"):
             v = getattr(self, name)
             if not all(0.0 <= b <= 1.0 for b in (v if isinstance(v, tuple) else (v,))):
                 raise ConfigError(f"{name} must be in [0, 1], got {v}")
