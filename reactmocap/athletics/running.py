@@ -482,12 +482,8 @@ class Runner:
         stiff = k["leg_stiffness"] * self.mass * self.g / self.athlete.leg_length
         damp = 2.0 * k["leg_damping"] * math.sqrt(stiff * self.mass)
         state = self.machine.current.name
-        landing = state in ("loading", "heel", "heel_toe")
         if self.step_stance:
             force = self._step_force(t, float(u[2]))
-            if landing and k["land_damping"] > 0 and self.senses.foot_contact[leg]:
-                # the landing's give: a damper on the leg's length, as the servos' was
-                force = max(force, k["land_damping"] * self.mass * self.g * -rate)
         else:
             force = stiff * (self.leg_rest - length) - damp * rate
             if state in ("toe", "unloading") and not self.released:
@@ -496,8 +492,6 @@ class Runner:
         self.leg_force = force
         mujoco.mj_jac(self.world.model, d, self._jacp, None, point, self._feet[leg])
         tau = -self._jacp[:, self._leg_cols[leg]].T @ (force * u)
-        if self.step_stance and state == "toe" and k["push_feed"] > 0:
-            tau += k["push_feed"] * self._servo_opposition(tau, leg)
         ff = self.rig.feedforward
         ff[KNEE[leg]] += tau[0:3]
         if state not in ("loading", "heel"):
@@ -505,22 +499,6 @@ class Runner:
         # the knee's and ankle's servos keep no pitch stiffness of their own
         for j in (KNEE[leg], ANKLE[leg]):
             self.targets[j, 0] = self.goal[j, 0] = angles[j, 0]
-
-    def _servo_opposition(self, tau: F64, leg: int) -> F64:
-        """The part of the stance knee's and ankle's servo torques (the last physics step's)
-        that opposes the leg law's ``tau`` (knee's three then ankle's), turned around and at
-        most the law's own per joint: what, added to the law, lets its push reach the
-        ground."""
-        law = tau.reshape(2, 3)
-        norm = np.maximum(np.linalg.norm(law, axis=1), 1e-9)
-        along = (
-            np.einsum(
-                "ij,ij->i", self.world.data.qfrc_actuator[self._leg_cols[leg]].reshape(2, 3), law
-            )
-            / norm
-        )
-        back = np.minimum(np.maximum(-along, 0.0), norm)
-        return (law * (back / norm)[:, None]).reshape(6)
 
     # ------------------------------------------------------------------ states
     def _states(self) -> list[State]:
@@ -648,14 +626,13 @@ class Runner:
         # in the push the stance knee's and ankle's servos keep only a share of their gains
         # about bending (roll and yaw held): their damping there took half the leg law's push
         state = self.machine.current.name
+        hold = 1.0
         if state in ("toe", "unloading"):
             hold = self.k["push_hold"]
             if self.step_stance and self.k["push_ramp"] > 0:
                 # eased out over the push, as the leg's speed (and the servos' damping) grows
                 done = clamp((t - self.t_touchdown) / self.step_stance, 0.0, 1.0)
                 hold *= 1.0 - self.k["push_ramp"] * done
-        else:  # the landing: eased in a commanded stance with land_hold
-            hold = self.k["land_hold"] if self.step_stance else 1.0
         a = self.active
         self.rig.axis_gain[KNEE[a], 0] = self.rig.axis_gain[ANKLE[a], 0] = hold
         if not self.released and state in ("toe", "unloading"):

@@ -107,23 +107,13 @@ class RunParams:
             held in full (1: all, as tuned). Their damping there took about half the push
             (the knee -85 N m against the law's 179 at 2.61 m/s). The whole stance free (0
             throughout) fell within 2 s: the landing needs the servos' give.
-        push_feed: in a commanded stance's toe state, the share (0-1) of the stance knee's and
-            ankle's servo torque that opposes the leg law's (the last physics step's, along
-            the law's torque, at most the law's own) added to the law's torque, so the law's
-            force reaches the ground (0: off). Traced at 2.61 m/s the servos took up to 198 of
-            the knee's 237 N m in the push and the body left at 0.43 m/s upward against the
-            0.835 commanded.
         push_ramp: in a commanded stance's push, ``push_hold`` falls linearly with the time
             since touchdown, to ``(1 - push_ramp)`` of itself at the stance's end (0: off):
             traced, the ground force fell from 1.5 to 0.5 body weights over the push's last
             0.06 s while the law asked 2, the servos' damping growing with the leg's speed.
-        land_hold: in a commanded stance's landing (the loading, heel and heel-and-toe
-            states), the share (0-1) of the stance knee's and ankle's servo gains kept about
-            bending (1: all, off). Traced, their damping stopped a 0.96 m/s fall within 0.06 s
-            (3-4 body weights) while the law asked about none.
-        land_damping: in a commanded stance's landing, the leg law's force is at least this
-            many body weights per m/s of the leg's shortening (a damper on its length; 0:
-            off), the give the eased servos no longer make.
+            With ``STEP_PARAMS`` 0.3 lengthened the flight (lift-off 0.52 m/s upward against
+            0.435) but fell at 2.5 m/s: an opt-in lever, not in the set (``docs/athletics.md``,
+            the eleventh round).
         idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
             by the end of the stance ready for touchdown (rad).
         swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
@@ -179,10 +169,7 @@ class RunParams:
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
     push_hold: float | Speeds = 1.0
-    push_feed: float | Speeds = 0.0
     push_ramp: float | Speeds = 0.0
-    land_hold: float | Speeds = 1.0
-    land_damping: float | Speeds = 0.0
     idle_knee: float | Speeds = (2.182, 1.813, 1.692)
     reach_knee: float | Speeds = (1.192, 1.066, 1.102)
     swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
@@ -217,7 +204,7 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
-        for name in ("push_hold", "push_feed", "push_ramp", "land_hold"):
+        for name in ("push_hold", "push_ramp"):
             v = getattr(self, name)
             if not all(0.0 <= b <= 1.0 for b in (v if isinstance(v, tuple) else (v,))):
                 raise ConfigError(f"{name} must be in [0, 1], got {v}")
@@ -245,8 +232,6 @@ class RunParams:
                 )
             if not 0 < r["step_placement"] <= 2:
                 raise ConfigError(f"step_placement must be in (0, 2], got {self.step_placement}")
-            if r["land_damping"] < 0:
-                raise ConfigError(f"land_damping must be >= 0, got {self.land_damping}")
             if not -0.3 <= r["step_bias"] <= 0.3:
                 raise ConfigError(f"step_bias must be in [-0.3, 0.3] m, got {self.step_bias}")
         steps = self.step_stance if isinstance(self.step_stance, tuple) else (self.step_stance,)
