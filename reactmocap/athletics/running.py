@@ -622,13 +622,20 @@ class Runner:
         self._placement(self.active, self.heading_d if self.p_frame else self.heading())
 
     def _stance(self, world: World, t: float) -> None:
-        del world, t
+        del world
         # in the push the stance knee's and ankle's servos keep only a share of their gains
         # about bending (roll and yaw held): their damping there took half the leg law's push
-        hold = self.k["push_hold"] if self.machine.current.name in ("toe", "unloading") else 1.0
+        state = self.machine.current.name
+        hold = 1.0
+        if state in ("toe", "unloading"):
+            hold = self.k["push_hold"]
+            if self.step_stance and self.k["push_ramp"] > 0:
+                # eased out over the push, as the leg's speed (and the servos' damping) grows
+                done = clamp((t - self.t_touchdown) / self.step_stance, 0.0, 1.0)
+                hold *= 1.0 - self.k["push_ramp"] * done
         a = self.active
         self.rig.axis_gain[KNEE[a], 0] = self.rig.axis_gain[ANKLE[a], 0] = hold
-        if not self.released and self.machine.current.name in ("toe", "unloading"):
+        if not self.released and state in ("toe", "unloading"):
             # the thrust stops once the body rises at the take-off speed wanted, or once its
             # rise slows (the take-off speed out of reach: pushing on to lift-off drove the
             # body forward into a long flight and a hard landing far ahead)

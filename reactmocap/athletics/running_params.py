@@ -107,6 +107,13 @@ class RunParams:
             held in full (1: all, as tuned). Their damping there took about half the push
             (the knee -85 N m against the law's 179 at 2.61 m/s). The whole stance free (0
             throughout) fell within 2 s: the landing needs the servos' give.
+        push_ramp: in a commanded stance's push, ``push_hold`` falls linearly with the time
+            since touchdown, to ``(1 - push_ramp)`` of itself at the stance's end (0: off):
+            traced, the ground force fell from 1.5 to 0.5 body weights over the push's last
+            0.06 s while the law asked 2, the servos' damping growing with the leg's speed.
+            With ``STEP_PARAMS`` 0.3 lengthened the flight (lift-off 0.52 m/s upward against
+            0.435) but fell at 2.5 m/s: an opt-in lever, not in the set (``docs/athletics.md``,
+            the eleventh round).
         idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
             by the end of the stance ready for touchdown (rad).
         swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
@@ -162,6 +169,7 @@ class RunParams:
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
     push_hold: float | Speeds = 1.0
+    push_ramp: float | Speeds = 0.0
     idle_knee: float | Speeds = (2.182, 1.813, 1.692)
     reach_knee: float | Speeds = (1.192, 1.066, 1.102)
     swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
@@ -196,9 +204,10 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
-        hold = self.push_hold if isinstance(self.push_hold, tuple) else (self.push_hold,)
-        if not all(0.0 <= b <= 1.0 for b in hold):
-            raise ConfigError(f"push_hold must be in [0, 1], got {self.push_hold}")
+        for name in ("push_hold", "push_ramp"):
+            v = getattr(self, name)
+            if not all(0.0 <= b <= 1.0 for b in (v if isinstance(v, tuple) else (v,))):
+                raise ConfigError(f"{name} must be in [0, 1], got {v}")
         lo, hi = SPEED_RANGE
         for speed in (lo, hi):
             r = self.at(speed)
