@@ -125,6 +125,7 @@ class AnchoredReference:
         anchor_lag_heading: float = 0.0,
         anchor_lag_return: float = 0.0,
         warp_lag_end: bool = False,
+        anchor_lag_speed: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -233,6 +234,8 @@ class AnchoredReference:
         # (``anchor_lag_return``: let go slowly once the lag stops acting)
         self._lag_held = 0.0
         self.warp_lag_end = bool(warp_lag_end)
+        # ``anchor_lag_speed``: the lag acts only below this fraction of the clip's speed
+        self._lag_speed = float(anchor_lag_speed) if anchor_lag_speed else np.inf
         self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
@@ -655,7 +658,7 @@ class AnchoredReference:
                 # back on its way: held further, the path ahead drove the body past its feet
                 self.lag_until = t
                 return self._let_go(err, u, along)
-        if along >= 0.0 or ahead > _LAG_COS * speed:
+        if along >= 0.0 or ahead > _LAG_COS * speed or speed > self._lag_speed * ref:
             return self._let_go(err, u, along)
         self._lag_acted = True
         lag = self.anchor_lag * min(1.0, max(0.0, (1.0 - ahead / ref) / _LAG_SLOW))

@@ -253,6 +253,9 @@ class WholeBodyTracker(AnchoredReference):
             walk's ``kp_root`` to this (0: unchanged; ``docs/tracking.md``).
         warp_lag_end: with ``anchor_lag`` and ``warp_gain``, once a lag that acted has ended
             the clip's rate goes back to 1, as after ``warp_for`` (``docs/tracking.md``).
+        anchor_lag_speed: with ``anchor_lag``, the path lags the feet only while the body's
+            centre of mass moves slower than this fraction of the clip's speed (0: at any
+            speed): a body slowed less, held ahead, ran past its feet (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -340,6 +343,7 @@ class WholeBodyTracker(AnchoredReference):
         anchor_lag_return: float = 0.0,
         kp_root_lag_end: float = 0.0,
         warp_lag_end: bool = False,
+        anchor_lag_speed: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -373,7 +377,7 @@ class WholeBodyTracker(AnchoredReference):
                 "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
                 "anchor_lag_return": anchor_lag_return, "kp_root_lag_end": kp_root_lag_end,
-                "warp_lag_end": warp_lag_end,
+                "warp_lag_end": warp_lag_end, "anchor_lag_speed": anchor_lag_speed,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -492,6 +496,7 @@ class WholeBodyTracker(AnchoredReference):
             step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
             anchor_lag_return=anchor_lag_return, warp_lag_end=warp_lag_end,
+            anchor_lag_speed=anchor_lag_speed,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
