@@ -123,8 +123,6 @@ class AnchoredReference:
         warp_for: float = 0.0,
         anchor_lag: float = 0.0,
         anchor_lag_heading: float = 0.0,
-        anchor_lag_return: float = 0.0,
-        warp_lag_end: bool = False,
         anchor_lag_speed: float = 0.0,
     ) -> None:
         m = world.model
@@ -226,14 +224,6 @@ class AnchoredReference:
         self.anchor_lag_heading = float(anchor_lag_heading)
         self._lag_end_cos = float(np.cos(np.radians(self.anchor_lag_heading)))
         self._lag_acted = False  # the path has lagged the feet since the push
-        self.anchor_lag_return = float(anchor_lag_return)
-        self._let_go_keep = (
-            1.0 - min(1.0, dt_slow / anchor_lag_return) if anchor_lag_return else 0.0
-        )
-        # how far (m) the path was last held ahead of the feet along the walk
-        # (``anchor_lag_return``: let go slowly once the lag stops acting)
-        self._lag_held = 0.0
-        self.warp_lag_end = bool(warp_lag_end)
         # ``anchor_lag_speed``: the lag acts only below this fraction of the clip's speed
         self._lag_speed = float(anchor_lag_speed) if anchor_lag_speed else np.inf
         self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
@@ -442,7 +432,6 @@ class AnchoredReference:
             # ``anchor_lag_heading``: until the body is back on its way, however long that takes
             self.lag_until = np.inf if self.anchor_lag_heading else t + _LAG_FOR
             self._lag_acted = False
-            self._lag_held = 0.0
 
     def _place_walk(self, t: float) -> None:
         """After a sideways walk's push (``place_pushed``): a swinging foot lands where the
@@ -613,7 +602,7 @@ class AnchoredReference:
         ref = ref[on, :2] @ _rot2(self.anchor_yaw).T + self.anchor_shift
         centre = sim.mean(axis=0)
         err = centre - ref.mean(axis=0)
-        if t <= self.lag_until or self._lag_held:
+        if t <= self.lag_until:
             err = self._lag(t, err)
         turn = on & ~self.path.pivoting[i]  # a pivoting foot's heading is the clip's own turn
         dyaw = 0.0
@@ -644,8 +633,6 @@ class AnchoredReference:
             return err
         u = v[:2] / ref
         along = float(err @ u)
-        if t > self.lag_until:  # the lag over: only its held part let go (``_let_go``)
-            return self._let_go(err, u, along)
         if not self.warping:
             mujoco.mj_subtreeVel(self.world.model, self.world.data)
         # else the velocity ``_warp`` computed at the last slow tick (8 ms old at most): enough
@@ -657,25 +644,12 @@ class AnchoredReference:
             if ahead >= self._lag_end_cos * speed:
                 # back on its way: held further, the path ahead drove the body past its feet
                 self.lag_until = t
-                return self._let_go(err, u, along)
+                return err
         if along >= 0.0 or ahead > _LAG_COS * speed or speed > self._lag_speed * ref:
-            return self._let_go(err, u, along)
+            return err
         self._lag_acted = True
         lag = self.anchor_lag * min(1.0, max(0.0, (1.0 - ahead / ref) / _LAG_SLOW))
-        held = min(0.0, along + lag) - along
-        if self._let_go_keep:
-            self._lag_held = held
-        return err + held * u
-
-    def _let_go(self, err: F64, u: F64, along: float) -> F64:
-        """``anchor_lag_return``: once the lag stops acting, the path held ahead of the feet
-        along the walk ``u`` (2,) comes back to them with that time constant, never past
-        them (``along``: the feet's error ``err`` (2,) along ``u``): let go at once (in
-        ``anchor_tau``), the clip's pelvis stopped pulling a slowed body up to speed."""
-        if not self._lag_held:
-            return err
-        self._lag_held = min(max(0.0, -along), self._let_go_keep * self._lag_held)
-        return err + self._lag_held * u
+        return err + (min(0.0, along + lag) - along) * u
 
     def update_ground(self, t: float) -> None:
         """The slow part of a control tick: the balance step decision, the ground path and
@@ -715,11 +689,9 @@ class AnchoredReference:
             xi, omega = self.capture_point()
             lead = float((xi - c[:2] - v[:2] / omega) @ v_ref) / ref
             target += self.warp_lead * lead
-        if t > self.warp_until or (self.warp_lag_end and self._lag_acted and t > self.lag_until):
+        if t > self.warp_until:
             # a body the push slowed, speeding up again 1-2 s later, drove the rate up with
             # it, the faster clip drove the body faster, and it ran ahead of its feet and fell
-            # (``warp_lag_end``: also once the lag has ended, as its path ahead no longer
-            # pulls the body to the clip's speed)
             target = 1.0
         target = min(max(target, 1.0), _WARP_MAX)
         self.rate += min(1.0, self._dt_slow / _WARP_TAU) * (target - self.rate)
@@ -774,7 +746,6 @@ class AnchoredReference:
         self.warp_until = np.inf
         self.lag_until = -np.inf
         self._lag_acted = False
-        self._lag_held = 0.0
         self._catching = False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
@@ -792,13 +763,13 @@ class AnchoredReference:
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
-                self.lag_until, self._lag_acted, self._lag_held)  # fmt: skip
+                self.lag_until, self._lag_acted)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching, drop_step, warp_until, lag_until, lag_acted, lag_held) = memory  # fmt: skip
+         catching, drop_step, warp_until, lag_until, lag_acted) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -822,4 +793,3 @@ class AnchoredReference:
         self.warp_until = float(warp_until)  # type: ignore[arg-type]
         self.lag_until = float(lag_until)  # type: ignore[arg-type]
         self._lag_acted = bool(lag_acted)
-        self._lag_held = float(lag_held)  # type: ignore[arg-type]

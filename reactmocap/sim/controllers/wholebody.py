@@ -44,9 +44,6 @@ _PLACE_SIDE_TAN = float(np.tan(np.radians(30.0)))
 # answers (back alone of the push benchmark's eight directions: with back-left and
 # back-right too it lost more pushes than it caught)
 _AGAINST_COS = float(np.cos(np.radians(30.0)))
-# ``kp_root_lag_end``: the pelvis servo eases to it over this long (s): a step change of its
-# stiffness jolts the pelvis target's pull at once
-_ROOT_EASE = 0.5
 # the patch's centre-of-pressure corners along the foot's (x, y) axes
 # r @ _LEVI_CIVITA, reshaped (3, 3), is -[r]x (the cross-product matrix's negative)
 _LEVI_CIVITA = np.array(
@@ -245,17 +242,10 @@ class WholeBodyTracker(AnchoredReference):
             until the body's centre of mass, having moved more than 45 deg off the clip's walk,
             moves within this many deg of it again (above 0.2 m/s; 0: the fixed 0.7 s;
             ``docs/tracking.md``).
-        anchor_lag_return: with ``anchor_lag``, once the lag stops acting (its end, or a gate
-            off) the path held ahead of the feet comes back to them with this time constant
-            (s) rather than in ``anchor_tau`` (0: at once; ``docs/tracking.md``).
-        kp_root_lag_end: with ``anchor_lag`` and ``kp_root_pushed``, once a lag that acted
-            has ended the pelvis's position servo eases linearly over 0.5 s from the pushed
-            walk's ``kp_root`` to this (0: unchanged; ``docs/tracking.md``).
-        warp_lag_end: with ``anchor_lag`` and ``warp_gain``, once a lag that acted has ended
-            the clip's rate goes back to 1, as after ``warp_for`` (``docs/tracking.md``).
         anchor_lag_speed: with ``anchor_lag``, the path lags the feet only while the body's
             centre of mass moves slower than this fraction of the clip's speed (0: at any
-            speed): a body slowed less, held ahead, ran past its feet (``docs/tracking.md``).
+            speed): a body slowed less, its path held ahead, was pulled back up to speed past
+            its feet and fell (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -340,9 +330,6 @@ class WholeBodyTracker(AnchoredReference):
         place_pushed: float = 0.0,
         anchor_lag: float = 0.0,
         anchor_lag_heading: float = 0.0,
-        anchor_lag_return: float = 0.0,
-        kp_root_lag_end: float = 0.0,
-        warp_lag_end: bool = False,
         anchor_lag_speed: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
@@ -376,8 +363,7 @@ class WholeBodyTracker(AnchoredReference):
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
                 "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
-                "anchor_lag_return": anchor_lag_return, "kp_root_lag_end": kp_root_lag_end,
-                "warp_lag_end": warp_lag_end, "anchor_lag_speed": anchor_lag_speed,
+                "anchor_lag_speed": anchor_lag_speed,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -419,9 +405,6 @@ class WholeBodyTracker(AnchoredReference):
         self._give_band = float(trunk_band)
         self._kp_root_pushed = float(kp_root_pushed)
         self._kp_root_against = float(kp_root_against)
-        self._kp_root_lag_end = float(kp_root_lag_end)
-        self._kp_root_hit = 0.0  # the pushed walk's ``kp_root`` (``kp_root_lag_end``)
-        self._root_eased = 0.0  # how far the pelvis servo has eased after the lag (0-1)
         self._step_pushed = bool(step_pushed)
         self._pushed = False  # an external force has acted on the body
         self._pushing = False  # one acts now
@@ -495,7 +478,6 @@ class WholeBodyTracker(AnchoredReference):
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
             step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
-            anchor_lag_return=anchor_lag_return, warp_lag_end=warp_lag_end,
             anchor_lag_speed=anchor_lag_speed,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
@@ -820,10 +802,6 @@ class WholeBodyTracker(AnchoredReference):
                     kp = self._kp_root_against
                 self.kp[:3] = kp
                 self.kv[:3] = critical_kv(kp)
-                self._kp_root_hit = kp
-        if self._kp_root_lag_end and self._kp_root_hit and self._root_eased < 1.0:
-            if self._lag_acted and t > self.lag_until:
-                self._ease_root(t)
         if pushing and not self._pushed and standing and self._step_pushed:
             self.stepping = True  # a standing body pushed steps when it must
         self._pushed |= pushing
@@ -836,16 +814,6 @@ class WholeBodyTracker(AnchoredReference):
             if pushing or np.linalg.norm(xi - c[:2] - v[:2] / omega) > self._give_band:
                 self._back_from = t
         return self._w_trunk * min(1.0, max(0.0, t - self._back_from) / self._give)
-
-    def _ease_root(self, t: float) -> None:
-        """``kp_root_lag_end``: the pelvis's position servo eased linearly over
-        ``_ROOT_EASE`` s from the pushed walk's stiffness to ``kp_root_lag_end`` once the path
-        held ahead of the feet is let go: still pulled to the clip's pelvis, a body back up to
-        speed ran past its feet (class B, ``docs/tracking.md``)."""
-        self._root_eased = min(1.0, (t - self.lag_until) / _ROOT_EASE)
-        kp = self._kp_root_hit + self._root_eased * (self._kp_root_lag_end - self._kp_root_hit)
-        self.kp[:3] = kp
-        self.kv[:3] = critical_kv(kp)
 
     def _hip_strength(self, t: float) -> float:
         """The hip strategy (``hip_weight``) after :meth:`_push_response` at ``t``: while a
