@@ -420,6 +420,23 @@ def test_a_walk_pushed_back_with_its_path_held_ahead_only_until_back_on_its_way_
     assert _walk_pushed(walk, force, 1.5, {"anchor_lag": 0.3, "anchor_lag_heading": 30.0}) == "ok"
 
 
+def test_a_walk_pushed_back_left_with_its_path_held_ahead_only_while_slow_walks_on(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared right-curving walk pushed 400 N back and to its left at the chest for 0.2 s
+    at 1.5 s falls with its ground path held ahead of its lagging feet (``anchor_lag`` 0.3:
+    pulled back up to speed, the body runs past its feet, class B; 2026-12-04); with the path
+    held only while the body moves slower than 0.45 of the clip's speed (``anchor_lag_speed``,
+    opt-in) it walks as its clip does, and the push the held path turns to walking (class A:
+    the left-curving walk pushed 350 N back and to its right) still walks."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 135.0, 400.0)
+    held = {"anchor_lag": 0.3}
+    assert _walk_pushed(walk, force, 1.5, held) == "fell"
+    assert _walk_pushed(walk, force, 1.5, {**held, "anchor_lag_speed": 0.45}) == "ok"
+    walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, -135.0, 350.0)
+    assert _walk_pushed(walk, force, 1.5, {**held, "anchor_lag_speed": 0.45}) == "ok"
+
+
 def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_only_falls_later(
     shared_mocap_dir: Path,
 ) -> None:

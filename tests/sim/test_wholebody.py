@@ -278,6 +278,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_soft_reg", -1e-2),
         ("anchor_lag", -0.3),
         ("anchor_lag_heading", -30.0),
+        ("anchor_lag_speed", -0.45),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

@@ -123,6 +123,7 @@ class AnchoredReference:
         warp_for: float = 0.0,
         anchor_lag: float = 0.0,
         anchor_lag_heading: float = 0.0,
+        anchor_lag_speed: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -223,6 +224,8 @@ class AnchoredReference:
         self.anchor_lag_heading = float(anchor_lag_heading)
         self._lag_end_cos = float(np.cos(np.radians(self.anchor_lag_heading)))
         self._lag_acted = False  # the path has lagged the feet since the push
+        # ``anchor_lag_speed``: the lag acts only below this fraction of the clip's speed
+        self._lag_speed = float(anchor_lag_speed) if anchor_lag_speed else np.inf
         self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
@@ -642,7 +645,7 @@ class AnchoredReference:
                 # back on its way: held further, the path ahead drove the body past its feet
                 self.lag_until = t
                 return err
-        if along >= 0.0 or ahead > _LAG_COS * speed:
+        if along >= 0.0 or ahead > _LAG_COS * speed or speed > self._lag_speed * ref:
             return err
         self._lag_acted = True
         lag = self.anchor_lag * min(1.0, max(0.0, (1.0 - ahead / ref) / _LAG_SLOW))

@@ -242,6 +242,10 @@ class WholeBodyTracker(AnchoredReference):
             until the body's centre of mass, having moved more than 45 deg off the clip's walk,
             moves within this many deg of it again (above 0.2 m/s; 0: the fixed 0.7 s;
             ``docs/tracking.md``).
+        anchor_lag_speed: with ``anchor_lag``, the path lags the feet only while the body's
+            centre of mass moves slower than this fraction of the clip's speed (0: at any
+            speed): a body slowed less, its path held ahead, was pulled back up to speed past
+            its feet and fell (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -326,6 +330,7 @@ class WholeBodyTracker(AnchoredReference):
         place_pushed: float = 0.0,
         anchor_lag: float = 0.0,
         anchor_lag_heading: float = 0.0,
+        anchor_lag_speed: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -358,6 +363,7 @@ class WholeBodyTracker(AnchoredReference):
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
                 "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
+                "anchor_lag_speed": anchor_lag_speed,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -472,6 +478,7 @@ class WholeBodyTracker(AnchoredReference):
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
             step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
+            anchor_lag_speed=anchor_lag_speed,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
