@@ -225,9 +225,6 @@ class LeapParams:
     #: handspring crouch whose feet stayed down (``com_ramp``) rolled the pelvis 8 deg, and the
     #: thrust's extension about a rolled pelvis twists the body (docs/athletics.md); 0: off
     crouch_level: float = 0.0
-    #: ``crouch_level`` only from the crouch's end on (the hold, ``hold``), not while the
-    #: crouch goes down. False: the whole crouch
-    level_hold: bool = False
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -344,24 +341,19 @@ class Leap(Basis):
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
                         arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant,
-                        side_both=p.crouch_middle,
-                        level_hips=0.0 if p.level_hold else p.crouch_level),
+                        side_both=p.crouch_middle, level_hips=p.crouch_level),
                 t, ease_com=p.com_ease or p.com_ramp > 0,
                 com_over=p.com_ramp if p.com_ramp > 0 else None)  # fmt: skip
 
         def crouch_hold(world: World, t: float) -> None:
-            # at the crouch's end: hold_com keeps the COM target's forward offset where the
-            # COM stands (the balance law reads its posture's offset every tick), level_hold
-            # starts the hips' levelling
+            # hold_com: at the crouch's end the COM target's forward offset stays where the
+            # COM stands (the balance law reads its posture's offset every tick)
             if "held" not in memo and t - memo["t_crouch"] >= p.crouch - 1e-12:
-                memo["held"] = True
-                if p.hold_com:
-                    s = ctx.sense(t)
-                    h = s.heading()
-                    now = s.local(s.com - s.support_center(h, both=p.crouch_plant), h)
-                    bl.set_com_offset((float(now[0]), bl.posture.com_offset[1]))
-                if p.level_hold:
-                    bl.posture = replace(bl.posture, level_hips=p.crouch_level)
+                s = ctx.sense(t)
+                h = s.heading()
+                now = s.local(s.com - s.support_center(h, both=p.crouch_plant), h)
+                memo["held"] = float(now[0])
+                bl.set_com_offset((memo["held"], bl.posture.com_offset[1]))
             bl.control(world, t)
 
         def thrust(world: World, t: float) -> None:
@@ -581,7 +573,7 @@ class Leap(Basis):
         return [
             State(
                 "crouch",
-                law(crouch_hold if p.hold_com or p.level_hold else bl.control, every),
+                law(crouch_hold if p.hold_com else bl.control, every),
                 crouch,
                 ((crouch_exit, "thrust"),),
             ),

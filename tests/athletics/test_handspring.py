@@ -256,3 +256,28 @@ def test_the_crouch_keeps_its_com_between_the_feet_and_off_changes_nothing() -> 
 
     assert feet_at_crouch_end(m) == 1
     assert feet_at_crouch_end(mid) == 2
+
+
+def test_the_crouch_eases_its_com_target_in_and_levels_the_hips() -> None:
+    """Full-size start 3 (seed 0): the crouch's COM target steps 10 cm back at once and both
+    feet leave the floor in its first 0.1 s (the file). Eased in over 0.2 s (``com_ramp``)
+    both feet stay down through the crouch, but the pelvis rolls as it goes down and the feet
+    leave with over 3 kg m^2/s about the vertical; with the legs also levelling the hips
+    (``crouch_level`` 10) under 2. Neither lands more starts (docs/athletics.md), so both
+    are off in the file."""
+    m = replace(load_maneuver(EXAMPLE), seconds=2.2)  # past the lift-off (1.94 s)
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    start = _starts(1.0, 4)[3]
+
+    def crouch_feet_and_lz(man: Maneuver) -> tuple[int, float]:
+        """The fewest feet down in the crouch and ``Lz`` at the thrust's last tick."""
+        log = run_maneuver(man, perturbation=start, fps=10.0).log
+        crouch = np.flatnonzero(log["state"] == "leap.crouch")
+        thrust = np.flatnonzero(log["state"] == "leap.thrust")
+        return int(log["feet"][crouch].min()), float(log["momentum"][thrust[-1], 2])
+
+    assert crouch_feet_and_lz(m)[0] == 0
+    feet, lz = crouch_feet_and_lz(_with(m, "leap", {**leap, "com_ramp": 0.2}))
+    assert feet == 2 and lz > 3.0
+    _, lz = crouch_feet_and_lz(_with(m, "leap", {**leap, "com_ramp": 0.2, "crouch_level": 10.0}))
+    assert abs(lz) < 2.0
