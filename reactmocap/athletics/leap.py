@@ -144,7 +144,8 @@ class LeapParams:
     #: the crouch moves the COM target to ``com_offset`` over this many seconds (Hermite), not
     #: at once: the 10 cm step of the back handspring's target stepped the ankles 0.2 rad in
     #: one tick, 4.3 kN a foot, and hopped both feet off the floor for ~0.1 s, and a perturbed
-    #: start came down on one foot (docs/athletics.md); 0: off (as before; ``com_ease`` eases
+    #: start came down on one foot. 0.2 s keeps them down, but the handspring, tuned on the
+    #: hop, then landed fewer starts (docs/athletics.md); 0: off (as before; ``com_ease`` eases
     #: over the whole crouch instead)
     com_ramp: float = 0.0
     #: the crouch's sideways COM servo gains as a multiple of the balance's
@@ -222,8 +223,9 @@ class LeapParams:
     #: made it fall back (docs/athletics.md). False: off (as before)
     crouch_middle: bool = False
     #: the crouch's legs servo the hips level (:attr:`Posture.level_hips`, this gain): a back
-    #: handspring crouch whose feet stayed down (``com_ramp``) rolled the pelvis 8 deg, and the
-    #: thrust's extension about a rolled pelvis twists the body (docs/athletics.md); 0: off
+    #: handspring crouch whose feet stayed down (``com_ramp``) rolled the pelvis 8 deg and the
+    #: feet left turning about the vertical; 10 took that within +-1.2 kg m^2/s in 7 of 8
+    #: starts, yet landed none of them (docs/athletics.md); 0: off
     crouch_level: float = 0.0
 
     def __post_init__(self) -> None:
