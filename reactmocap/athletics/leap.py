@@ -144,9 +144,9 @@ class LeapParams:
     #: the crouch moves the COM target to ``com_offset`` over this many seconds (Hermite), not
     #: at once: the 10 cm step of the back handspring's target stepped the ankles 0.2 rad in
     #: one tick, 4.3 kN a foot, and hopped both feet off the floor for ~0.1 s, and a perturbed
-    #: start came down on one foot. 0.2 s keeps them down, but the handspring, tuned on the
-    #: hop, then landed fewer starts (docs/athletics.md); 0: off (as before; ``com_ease`` eases
-    #: over the whole crouch instead)
+    #: start came down on one foot. 0.2 s keeps them down (the male back handspring's since
+    #: 2026-12-04, with its landing re-tuned: docs/athletics.md); 0: off (as before;
+    #: ``com_ease`` eases over the whole crouch instead)
     com_ramp: float = 0.0
     #: the crouch's sideways COM servo gains as a multiple of the balance's
     #: (:attr:`BalanceGains.side`): on feet yawed apart by a perturbed start the crouch's knees
