@@ -102,6 +102,11 @@ class Posture:
         side_both: the COM target's sideways part (heading frame) is the middle of both
             soles (``plant``'s), along the feet that of the soles in contact (the target
             stays between the feet while one is unloaded; no ankle give, no foot lowered).
+        level_hips: the legs' lengths also servo the hips' heights level (each leg
+            lengthened by this times half the height by which its hip lies below the other's;
+            0 off): a back handspring crouch on both feet rolled the pelvis 8 deg with the
+            knees alike, and the thrust's extension about a rolled pelvis twists the body
+            (docs/athletics.md).
     """
 
     pitch: float = 0.0
@@ -112,13 +117,14 @@ class Posture:
     lean: float = 0.5
     plant: bool = False
     side_both: bool = False
+    level_hips: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("plant", "side_both"):
             v = getattr(self, name)
             if not isinstance(v, bool):
                 raise ConfigError(f"posture {name} must be true or false, got {v!r}")
-        for name in ("pitch", "leg", "arms", "settle", "lean"):
+        for name in ("pitch", "leg", "arms", "settle", "lean", "level_hips"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"posture {name} must be a finite number, got {v!r}")
@@ -126,6 +132,8 @@ class Posture:
             raise ConfigError(f"posture leg must be within [0.3, 1.0] of the leg, got {self.leg}")
         if len(self.com_offset) != 2 or not all(math.isfinite(v) for v in self.com_offset):
             raise ConfigError(f"posture com_offset must be 2 finite numbers, got {self.com_offset}")
+        if not 0.0 <= self.level_hips <= 20.0:
+            raise ConfigError(f"posture level_hips must be in [0, 20], got {self.level_hips}")
 
 
 @dataclass(frozen=True)
@@ -364,8 +372,10 @@ class BalanceLaw:
         a = self.athlete
         self.heading = 0.0
         self.com_target = np.zeros(3)
-        #: the COM offset eased from (set_posture's ease_com), or None
+        #: the COM offset eased from (set_posture's ease_com), or None, and over how many
+        #: seconds (None: the posture's settle)
         self._com0: tuple[float, float] | None = None
+        self._com_over: float | None = None
         #: :attr:`BalanceGains.windmill` (index 0, pitch) and ``windmill_side`` (1, roll): the
         #: arms' circle (rad), its sense; the last tick
         self._wind = [0.0, 0.0]
@@ -382,13 +392,15 @@ class BalanceLaw:
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
 
     def set_posture(
-        self, posture: Posture, t: float, gains: bool = True, ease_com: bool = False
-    ) -> None:
+        self, posture: Posture, t: float, gains: bool = True, ease_com: bool = False,
+        com_over: float | None = None,
+    ) -> None:  # fmt: skip
         """Move the knees, spine and arms toward ``posture`` over ``posture.settle`` s;
         ``ease_com``: the COM target's offset too, from the last posture's (a step in it
         steps the COM servo's ankle offsets: a broad jump's 17 cm hopped the body off the
-        floor as its crouch began)."""
+        floor as its crouch began), over ``com_over`` s if given (else ``posture.settle``)."""
         self._com0 = self.posture.com_offset if ease_com else None
+        self._com_over = com_over
         self.posture = posture
         rig = self.ctx.rig
         if gains:
@@ -437,12 +449,14 @@ class BalanceLaw:
         knee = float(np.mean(self.ctx.rig.knee_flexion()))
         return self.posture.lean * max(0.0, knee - self._knee_standing)
 
-    def _eased(self, t: float) -> float:
-        """How far (0-1, Hermite, as the pitch) the posture set last has come (the pitch
-        keeps its own sum's operation order: the figures were measured on it)."""
+    def _eased(self, t: float, over: float | None = None) -> float:
+        """How far (0-1, Hermite, as the pitch) the posture set last has come, or an ease of
+        ``over`` s begun with it (the pitch keeps its own sum's operation order: the figures
+        were measured on it)."""
         if not hasattr(self, "_t_pitch"):
             return 1.0
-        s = min(max((t - self._t_pitch) / max(self.posture.settle, 1e-9), 0.0), 1.0)
+        span = self.posture.settle if over is None else over
+        s = min(max((t - self._t_pitch) / max(span, 1e-9), 0.0), 1.0)
         return s * s * (3 - 2 * s)
 
     def _pitch_now(self, t: float) -> float:
@@ -468,7 +482,7 @@ class BalanceLaw:
             centre[1] += c * across
         ox, oy = self.posture.com_offset
         if self._com0 is not None:  # set_posture's ease_com
-            w = self._eased(t)
+            w = self._eased(t, self._com_over)
             ox, oy = (
                 self._com0[0] + (ox - self._com0[0]) * w,
                 self._com0[1] + (oy - self._com0[1]) * w,
@@ -617,6 +631,9 @@ class BalanceLaw:
         z = -(xy @ n[:2]) / max(float(n[2]), 1e-6)  # the floor plane's height, up to a constant
         if hang is not None:
             z = z - hang
+        if self.posture.level_hips:
+            # a hip standing higher than the other counts as floor that much higher under it
+            z = z + self.posture.level_hips * d.xpos[s.leg_bodies[:2], 2]
         for k in range(2):
             knee = float(desired[_KNEE[k], 0])
             ul, ll = float(a.thigh[k]), float(a.shin[k])

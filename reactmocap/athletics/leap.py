@@ -141,6 +141,13 @@ class LeapParams:
     #: step kicks the ankles: the broad jump's 17 cm hopped the body off the floor and a
     #: perturbed start came down on one foot); off by default: the tables were measured so
     com_ease: bool = False
+    #: the crouch moves the COM target to ``com_offset`` over this many seconds (Hermite), not
+    #: at once: the 10 cm step of the back handspring's target stepped the ankles 0.2 rad in
+    #: one tick, 4.3 kN a foot, and hopped both feet off the floor for ~0.1 s, and a perturbed
+    #: start came down on one foot. 0.2 s keeps them down (the male back handspring's since
+    #: 2026-12-04, with its landing re-tuned: docs/athletics.md); 0: off (as before;
+    #: ``com_ease`` eases over the whole crouch instead)
+    com_ramp: float = 0.0
     #: the crouch's sideways COM servo gains as a multiple of the balance's
     #: (:attr:`BalanceGains.side`): on feet yawed apart by a perturbed start the crouch's knees
     #: carried the COM sideways and the broad jump left at up to 0.5 m/s sideways; 1: as the
@@ -215,6 +222,11 @@ class LeapParams:
     #: one foot, its target following the loaded sole, and ``crouch_plant``'s whole target
     #: made it fall back (docs/athletics.md). False: off (as before)
     crouch_middle: bool = False
+    #: the crouch's legs servo the hips level (:attr:`Posture.level_hips`, this gain): a back
+    #: handspring crouch whose feet stayed down (``com_ramp``) rolled the pelvis 8 deg and the
+    #: feet left turning about the vertical; 10 took that within +-1.2 kg m^2/s in 7 of 8
+    #: starts, yet landed none of them (docs/athletics.md); 0: off
+    crouch_level: float = 0.0
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -222,7 +234,8 @@ class LeapParams:
                 self.stiffness, self.lean, self.crouch_side,
                 self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
                 self.push_ramp, self.push_limit, self.push_hip, self.push_ankle,
-                self.tilt_gain, self.roll_gain, self.yaw_gain]  # fmt: skip
+                self.tilt_gain, self.roll_gain, self.yaw_gain, self.com_ramp,
+                self.crouch_level]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.0 < self.crouch_side <= 5.0:
@@ -246,6 +259,8 @@ class LeapParams:
                 f"leap push_hip and push_ankle must be in [0, 10] m g L/rad, got "
                 f"{self.push_hip}, {self.push_ankle}"
             )
+        if not 0.0 <= self.com_ramp <= 5.0:
+            raise ConfigError(f"leap com_ramp must be in [0, 5] s, got {self.com_ramp}")
         if not 0.0 <= self.tilt_gain <= 100.0:
             raise ConfigError(f"leap tilt_gain must be in [0, 100] rad, got {self.tilt_gain}")
         if not 0.0 <= self.roll_gain <= 100.0:
@@ -328,7 +343,9 @@ class Leap(Basis):
             bl.set_posture(
                 Posture(pitch=p.pitch, leg=p.leg, com_offset=(p.com_offset, 0.0),
                         arms=p.arms_back, settle=p.crouch, lean=p.lean, plant=p.crouch_plant,
-                        side_both=p.crouch_middle), t, ease_com=p.com_ease)  # fmt: skip
+                        side_both=p.crouch_middle, level_hips=p.crouch_level),
+                t, ease_com=p.com_ease or p.com_ramp > 0,
+                com_over=p.com_ramp if p.com_ramp > 0 else None)  # fmt: skip
 
         def crouch_hold(world: World, t: float) -> None:
             # hold_com: at the crouch's end the COM target's forward offset stays where the

@@ -129,9 +129,20 @@ def _with(m: Maneuver, controller: str, params: dict[str, float]) -> Maneuver:
     return replace(m, phases=phases)
 
 
+def _hopping(m: Maneuver) -> Maneuver:
+    """``m`` as the file was before its ramped crouch (2026-12-04): the crouch's COM target 10
+    cm back at once (the step that hops the feet off the floor), the feet landing 55 cm back."""
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    land = next(p for p in m.phases if p.controller == "land").params
+    m = _with(m, "leap", {**{k: v for k, v in leap.items() if k != "com_ramp"},
+                          "com_offset": -0.1})  # fmt: skip
+    return _with(m, "land", {**land, "delta": -0.55})
+
+
 def _timed_start(m: Maneuver) -> Maneuver:
     """``m`` as the file was before its settled start (2026-12-03 22:13 UTC): the leap 0.3 s
     into the start (:data:`TIMED_START`), its crouch held the default 0.15 s, 5.5 s."""
+    m = _hopping(m)
     leap = next(p for p in m.phases if p.controller == "leap").params
     m = _with(m, "leap", {k: v for k, v in leap.items() if k != "hold"})
     return replace(m, phases=(TIMED_START, *m.phases[1:]), seconds=5.5)
@@ -220,8 +231,9 @@ def test_the_male_handspring_starts_settled_and_a_start_that_crouched_turning_la
     crouched 0.3 s into the start with its pelvis turning (+9 deg) and left the leap with +2.8
     kg m^2/s about the vertical, turned on over its feet and fell; settled first it leaves with
     under 2 and lands."""
-    m = load_maneuver(EXAMPLE)
-    assert handspring_maneuver("male") == m and m.phases[0] == SETTLED_START
+    assert handspring_maneuver("male") == load_maneuver(EXAMPLE)
+    m = _hopping(load_maneuver(EXAMPLE))  # as measured then
+    assert m.phases[0] == SETTLED_START
     assert handspring_maneuver("female").phases[0] == TIMED_START
     start = _starts(1.0, 14)[13]
 
@@ -243,7 +255,7 @@ def test_the_crouch_keeps_its_com_between_the_feet_and_off_changes_nothing() -> 
     target follows the soles in contact. With it over the middle of both soles sideways
     (``crouch_middle``) the crouch ends on both feet. While both feet stay down (the nominal)
     the option is the file's run to the bit."""
-    m = load_maneuver(EXAMPLE)
+    m = _hopping(load_maneuver(EXAMPLE))  # as measured then
     leap = next(p for p in m.phases if p.controller == "leap").params
     mid = _with(m, "leap", {**leap, "crouch_middle": True})
     nominal = run_maneuver(m, fps=10.0).report["rotation_deg"]
@@ -256,3 +268,28 @@ def test_the_crouch_keeps_its_com_between_the_feet_and_off_changes_nothing() -> 
 
     assert feet_at_crouch_end(m) == 1
     assert feet_at_crouch_end(mid) == 2
+
+
+def test_the_crouch_eases_its_com_target_in_and_levels_the_hips() -> None:
+    """Full-size start 3 (seed 0): the crouch's COM target steps 10 cm back at once and both
+    feet leave the floor in its first 0.1 s (the file before 2026-12-04). Eased in over 0.2 s (``com_ramp``)
+    both feet stay down through the crouch, but the pelvis rolls as it goes down and the feet
+    leave with over 3 kg m^2/s about the vertical; with the legs also levelling the hips
+    (``crouch_level`` 10) under 2. The file ramps its crouch since 2026-12-04 (with the COM
+    13 cm back and the feet landing 60 cm back: docs/athletics.md); the levelling is off."""
+    m = replace(_hopping(load_maneuver(EXAMPLE)), seconds=2.2)  # past the lift-off (1.94 s)
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    start = _starts(1.0, 4)[3]
+
+    def crouch_feet_and_lz(man: Maneuver) -> tuple[int, float]:
+        """The fewest feet down in the crouch and ``Lz`` at the thrust's last tick."""
+        log = run_maneuver(man, perturbation=start, fps=10.0).log
+        crouch = np.flatnonzero(log["state"] == "leap.crouch")
+        thrust = np.flatnonzero(log["state"] == "leap.thrust")
+        return int(log["feet"][crouch].min()), float(log["momentum"][thrust[-1], 2])
+
+    assert crouch_feet_and_lz(m)[0] == 0
+    feet, lz = crouch_feet_and_lz(_with(m, "leap", {**leap, "com_ramp": 0.2}))
+    assert feet == 2 and lz > 3.0
+    _, lz = crouch_feet_and_lz(_with(m, "leap", {**leap, "com_ramp": 0.2, "crouch_level": 10.0}))
+    assert abs(lz) < 2.0
