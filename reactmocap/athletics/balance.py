@@ -350,15 +350,6 @@ STANDING_BEND_RATE = 1.5
 #: lifted again; docs/athletics.md)
 STANDING_HANG = 0.2
 STANDING_STILL = 0.08
-#: issue 18's try (2026-12-04, docs/athletics.md; 0: off, step="on" as before): the standing
-#: step's place clipped to what a swing leg this long (fraction of the straight leg) reaches
-#: from the unlowered hip, the standing knee not bent for reach
-STANDING_AIM_REACH = 0.0
-#: with it, a step along the feet aimed sideways at the capture point (the feet kept
-#: STEP_WIDTH apart), not under its own hip
-STANDING_AIM_SIDE = False
-#: the clip only on steps along the feet (a sideways step as before)
-STANDING_AIM_ALONG = False
 
 
 class BalanceLaw:
@@ -757,11 +748,7 @@ class Stepper:
             apart = want[1] - stand[1]
             want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
             if not self.sideways or (self.standing and self._out[1] == 0.0):
-                if self.standing and STANDING_AIM_SIDE:
-                    side = math.copysign(1.0, float(at[1] - stand[1]))  # no crossing over
-                    want[1] = stand[1] + side * max(side * float(cp[1] - stand[1]), STEP_WIDTH)
-                else:
-                    want[1] = at[1]
+                want[1] = at[1]
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
         down = float(hip[2]) - float(d.xanchor[self._ankles[1 - k], 2])
@@ -770,20 +757,8 @@ class Stepper:
         a = self.ctx.athlete
         ul, ll = float(a.thigh[k]), float(a.shin[k])
         reach = STEP_REACH * (ul + ll)
-        along = self._out is not None and self._out[1] == 0.0
-        clip = self.standing and STANDING_AIM_REACH > 0.0 and (along or not STANDING_AIM_ALONG)
-        if clip:
-            # the place pulled in toward the hip to within the reach of an unlowered hip
-            most = STANDING_AIM_REACH * (ul + ll)
-            far = math.sqrt(max(most * most - down * down, 0.0))
-            away = math.hypot(ahead, aside)
-            if away > far:
-                ahead, aside = ahead * far / away, aside * far / away
-            reach = max(reach, most)
         # the standing knee bends as far as it takes the swing leg to reach the place
         low = max(down - math.sqrt(max(reach * reach - ahead * ahead - aside * aside, 0.01)), 0.0)
-        if clip:
-            low = 0.0
         if low > 0.0:
             j = 1 - k
             stand_leg = float(np.linalg.norm(d.xanchor[self._hips[j]] - d.xanchor[self._ankles[j]]))
