@@ -331,8 +331,9 @@ def test_the_back_layout_opens_by_the_reach_s_turn_over_its_time() -> None:
     old = replace(tumble, params={**tumble.params, "lead": 0.0, "open_inertia": 8.0,
                                   "open_delay": 0.0})  # fmt: skip
     # the landing as it was then too: its turn_gain (since 2026-12-03 22:00) lands a touchdown
-    # at -305.5 (the next test)
-    land = replace(m.phases[3], params={**m.phases[3].params, "turn_gain": 0.0})
+    # at -305.5 (the next test), and its recover_spin (since 2026-12-04 11:30) lands start 28
+    land = replace(m.phases[3], params={**m.phases[3].params, "turn_gain": 0.0,
+                                        "recover_spin": 0.0})  # fmt: skip
     before = replace(m, phases=(*m.phases[:2], old, land, *m.phases[4:]))
     for i in (28, 42):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
@@ -879,19 +880,19 @@ def test_the_layout_preset_puts_a_late_start_s_feet_ahead() -> None:
 def test_a_back_layout_turning_forward_over_its_feet_hands_over_on_the_pitch_momentum() -> None:
     """Start 39 of ``back_layout.toml``'s capture region at a tenth (seed 0) touches down in
     the window and stands with the COM 2-3 cm from the feet, creeping on, its pitch momentum
-    at +8..+10 kg m^2/s: the recovery never sees the COM stop or move away, stays in it for
-    0.5 s and falls forward. With ``recover_spin`` 5 (an option, off in the file;
-    docs/athletics.md) it hands over on that momentum within 0.07 s and the balance lands it."""
+    at +8..+10 kg m^2/s: with ``recover_spin`` 0 (before 2026-12-04 11:30 UTC) the recovery
+    never sees the COM stop or move away, stays in it for 0.5 s and falls forward. The file's
+    ``recover_spin`` 5 hands over on that momentum within 0.07 s and the balance lands it."""
     start = _tenth_start(0, 39)
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = m.phases[3]
-    assert land.controller == "land" and "recover_spin" not in land.params
-    res = run_maneuver(m, perturbation=start, fps=10.0)
+    assert land.controller == "land" and land.params["recover_spin"] == 5.0
+    res = run_maneuver(_with_land_params(m, {**land.params, "recover_spin": 0.0}),
+                       perturbation=start, fps=10.0)  # fmt: skip
     held = [t for t, _, c in res.transitions if str(c) in ("land.recover", "land.done")]
     assert held[1] - held[0] > 0.4, held
     assert not (res.report["landed"] and not res.report["fell"])
-    res = run_maneuver(_with_land_params(m, {**land.params, "recover_spin": 5.0}),
-                       perturbation=start, fps=10.0)  # fmt: skip
+    res = run_maneuver(m, perturbation=start, fps=10.0)
     held = [t for t, _, c in res.transitions if str(c) in ("land.recover", "land.done")]
     assert held[1] - held[0] < 0.1, held
     r = res.report
