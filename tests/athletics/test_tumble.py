@@ -331,8 +331,10 @@ def test_the_back_layout_opens_by_the_reach_s_turn_over_its_time() -> None:
     old = replace(tumble, params={**tumble.params, "lead": 0.0, "open_inertia": 8.0,
                                   "open_delay": 0.0})  # fmt: skip
     # the landing as it was then too: its turn_gain (since 2026-12-03 22:00) lands a touchdown
-    # at -305.5 (the next test)
-    land = replace(m.phases[3], params={**m.phases[3].params, "turn_gain": 0.0})
+    # at -305.5 (the next test), its recover_spin (since 2026-12-04 11:30) lands start 28 and
+    # its lean 0.8 (since 13:12) start 42
+    land = replace(m.phases[3], params={**m.phases[3].params, "turn_gain": 0.0,
+                                        "recover_spin": 0.0, "lean": 0.5})  # fmt: skip
     before = replace(m, phases=(*m.phases[:2], old, land, *m.phases[4:]))
     for i in (28, 42):
         r = run_maneuver(m, perturbation=starts[i], fps=10.0).report
@@ -766,7 +768,8 @@ def test_the_back_layout_moves_its_feet_by_the_rotation_predicted_at_touchdown()
     assert land.controller == "land" and land.params["turn_gain"] > 0.0
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
-    off = replace(land, params={**land.params, "turn_gain": 0.0})
+    # lean as it was then too (0.8 since 2026-12-04 13:12 lands it without turn_gain)
+    off = replace(land, params={**land.params, "turn_gain": 0.0, "lean": 0.5})
     r = run_maneuver(replace(m, phases=(*m.phases[:3], off, *m.phases[4:])), perturbation=start,
                      fps=10.0).report  # fmt: skip
     assert r["rotation_at_touchdown_deg"] < -305.0, r["rotation_at_touchdown_deg"]
@@ -879,22 +882,39 @@ def test_the_layout_preset_puts_a_late_start_s_feet_ahead() -> None:
 def test_a_back_layout_turning_forward_over_its_feet_hands_over_on_the_pitch_momentum() -> None:
     """Start 39 of ``back_layout.toml``'s capture region at a tenth (seed 0) touches down in
     the window and stands with the COM 2-3 cm from the feet, creeping on, its pitch momentum
-    at +8..+10 kg m^2/s: the recovery never sees the COM stop or move away, stays in it for
-    0.5 s and falls forward. With ``recover_spin`` 5 (an option, off in the file;
-    docs/athletics.md) it hands over on that momentum within 0.07 s and the balance lands it."""
+    at +8..+10 kg m^2/s: with ``recover_spin`` 0 (before 2026-12-04 11:30 UTC) the recovery
+    never sees the COM stop or move away, stays in it for 0.5 s and falls forward. The file's
+    ``recover_spin`` 5 hands over on that momentum within 0.07 s and the balance lands it."""
     start = _tenth_start(0, 39)
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = m.phases[3]
-    assert land.controller == "land" and "recover_spin" not in land.params
-    res = run_maneuver(m, perturbation=start, fps=10.0)
+    assert land.controller == "land" and land.params["recover_spin"] == 5.0
+    # lean as it was then too (0.5; the file's 0.8 since 2026-12-04 13:12)
+    res = run_maneuver(_with_land_params(m, {**land.params, "recover_spin": 0.0, "lean": 0.5}),
+                       perturbation=start, fps=10.0)  # fmt: skip
     held = [t for t, _, c in res.transitions if str(c) in ("land.recover", "land.done")]
     assert held[1] - held[0] > 0.4, held
     assert not (res.report["landed"] and not res.report["fell"])
-    res = run_maneuver(_with_land_params(m, {**land.params, "recover_spin": 5.0}),
-                       perturbation=start, fps=10.0)  # fmt: skip
+    res = run_maneuver(m, perturbation=start, fps=10.0)
     held = [t for t, _, c in res.transitions if str(c) in ("land.recover", "land.done")]
     assert held[1] - held[0] < 0.1, held
     r = res.report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
     with pytest.raises(ConfigError, match="recover_spin"):
         LandingParams(recover_spin=-1.0)
+
+
+def test_a_back_layout_falling_forward_off_its_absorption_leans_into_it() -> None:
+    """Start 42 of ``back_layout.toml``'s capture region at full size (seed 0) stands up
+    from the absorption with its capture point past the feet and, the trunk pitched 0.5 rad
+    per radian of knee flexion (the default ``lean``, before 2026-12-04 13:12 UTC), falls.
+    The file's ``lean`` 0.8 pitches the trunk farther forward as the knees bend (the trunk
+    takes forward pitch momentum from the legs): it lands."""
+    start = full_starts(43)[42]
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = m.phases[3]
+    assert land.controller == "land" and land.params["lean"] == 0.8
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+    r = run_maneuver(_without_land_param(m, "lean"), perturbation=start, fps=10.0).report
+    assert not (r["landed"] and not r["fell"])
