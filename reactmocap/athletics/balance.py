@@ -662,16 +662,9 @@ class Stepper:
     landing's recovery hands it to the balance that follows, ``ctx.handover["stepper"]``, so
     a swing under way goes on). Each step is recorded in ``ctx.handover["steps"]``."""
 
-    def __init__(
-        self, ctx: Context, step: Step, standing: bool = False, auto: bool = True
-    ) -> None:
+    def __init__(self, ctx: Context, step: Step, standing: bool = False) -> None:
         self.ctx = ctx
         self.step = step
-        #: steps when the capture point leaves the feet; False: only those :meth:`begin` starts
-        self.auto = auto
-        #: :meth:`begin`'s place for the swing foot (world x, y), held over the swing; None: aimed
-        #: past the capture point each tick
-        self._target: F64 | None = None
         #: the standing balance's step (the ``balance`` behaviour's ``step="on"``): across the
         #: feet too, a step along them under its own hip, the standing knee's bend for the
         #: swing leg's reach growing at most :data:`STANDING_BEND_RATE`, and no closing step
@@ -721,7 +714,7 @@ class Stepper:
         if self.foot < 0 and self.standing and not bl.posture.plant:
             self._plant_if_hanging(bl, float(np.hypot(*vel)), t)
         if self.foot < 0:
-            if not self.auto or t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
+            if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
                 return
             lo, hi = s.support_extent(h)
             # how far the capture point lies outside the soles' box (along the feet only
@@ -750,7 +743,7 @@ class Stepper:
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
             self.record[-1]["s"] = t - self._t0
             self._close, self._stood = self._out is not None and not self.standing, 1 - k
-            self.foot, self._t_end, self._target = -1, t, None
+            self.foot, self._t_end = -1, t
             # both knees on from where they are to the posture's, over what is left of its
             # stand-up (at once, the stepped leg's push launched the body), the law's
             # leveling on top
@@ -763,18 +756,15 @@ class Stepper:
         hip = d.xanchor[self._hips[k]]
         at = s.local(hip, h)[:2]
         stand = feet[1 - k]
-        fixed = self._target is not None
         if self._out is None:  # closing: beside the other, under its own hip
             want = np.array([stand[0], at[1]])
-        elif self._target is not None:  # begin's place, in the world (the heading may turn)
-            want = s.local(np.array([*self._target, 0.0]), h)
         else:  # past the capture point
             want = cp + st.reach * self._out
             want[0] = np.clip(want[0], stand[0] - STEP_LONGEST, stand[0] + STEP_LONGEST)
             # the feet kept STEP_WIDTH apart sideways, on whichever side the place lies
             apart = want[1] - stand[1]
             want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
-            if not fixed and (not self.sideways or (self.standing and self._out[1] == 0.0)):
+            if not self.sideways or (self.standing and self._out[1] == 0.0):
                 want[1] = at[1]
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
@@ -818,25 +808,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-
-    def begin(self, target: F64, t: float, foot: int | None = None) -> bool:
-        """A step at once, the swing foot put at the world point ``target`` (x, y; held there,
-        not re-aimed): ``foot`` (0 left, 1 right; None: the one farther from it) swings while
-        the other is down; False (no step) while a step is under way or that foot is off the
-        floor."""
-        s = self.ctx.senses
-        feet = s.corners.mean(axis=1)[:, :2]
-        k = int(np.argmax(np.linalg.norm(feet - target, axis=1))) if foot is None else foot
-        if self.foot >= 0 or not s.foot_contact[1 - k]:
-            return False
-        way = target - feet.mean(axis=0)
-        h = s.heading()
-        out = s.local(np.array([*way, 0.0]), h)
-        self.foot, self._out, self._t0 = k, out / max(float(np.hypot(*out)), 1e-9), t
-        self._target = np.asarray(target, dtype=np.float64)
-        self.record.append({"t": t, "foot": float(k), "beyond_m": float(np.hypot(*way)),
-                            "from_m": float(s.local(feet[k] - feet[1 - k], h)[0])})  # fmt: skip
-        return True
 
     def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
         """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough

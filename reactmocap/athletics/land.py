@@ -223,16 +223,6 @@ class LandingParams:
             forward (+8..+10 kg m^2/s, the COM creeping on at 0.02-0.11 m/s) met neither, stayed
             in the recovery 0.5 s and fell forward; the balance takes such momentum down
             (docs/athletics.md).
-        step_out: ``(offset m, gain)``: a step out of the absorption, at the hand-over to the
-            balance, if the capture point (the COM plus its horizontal velocity times
-            ``sqrt(z / g)``) lies more than ``offset`` from the middle of the feet: the foot
-            farther from it is put at the feet's middle plus ``gain`` times that offset (in the
-            world, held over the swing; :meth:`~reactmocap.athletics.balance.Stepper.begin`),
-            carried on by the balance that follows; empty: off. Why: the male back layout's
-            forward fallers hand over with the capture point 0.13-0.57 m from the feet
-            (landers 0.05-0.10), and ``step``'s stepper, aimed in the pelvis's heading
-            frame, which turns 0.5-1.2 rad as the crouched body stands up, did not catch them
-            (docs/athletics.md).
     """
 
     knee: float = 0.6
@@ -269,7 +259,6 @@ class LandingParams:
     turn_window: float = 0.1
     late_delta: tuple[float, ...] = ()
     recover_spin: float = 0.0
-    step_out: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -323,15 +312,6 @@ class LandingParams:
                 "landing late_delta must be (seconds in [0, 1], offset > 0 m, delta m), "
                 f"got {self.late_delta!r}"
             )
-        if self.step_out and not (
-            len(self.step_out) == 2
-            and all(isinstance(x, (int, float)) and math.isfinite(x) for x in self.step_out)
-            and self.step_out[0] > 0.0
-            and 0.0 < self.step_out[1] <= 3.0
-        ):
-            raise ConfigError(
-                f"landing step_out must be (offset > 0 m, gain in (0, 3]), got {self.step_out!r}"
-            )
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
@@ -377,8 +357,6 @@ class Landing(Basis):
         step = Step.of(p.step)
         if step is not None:
             bl.stepper = Stepper(ctx, step)
-        elif p.step_out:  # only the step out of the absorption (step_out)
-            bl.stepper = Stepper(ctx, Step(), auto=False)
         m = ctx.world.model
         pre = rig.wc.prefix
         hip_joints = [m.joint(f"{pre}{s}_hip").id for s in "lr"]
@@ -604,17 +582,6 @@ class Landing(Basis):
 
         def done(world: World, t: float) -> None:
             del world
-            if p.step_out and bl.stepper is not None:  # see step_out
-                s = ctx.sense(t)
-                feet = s.sole_corners().mean(axis=1)[:, :2]
-                z = float(s.com[2] - s.sole_corners()[..., 2].min())
-                g = float(np.linalg.norm(ctx.world.model.opt.gravity))
-                cp = (s.com + s.com_vel * math.sqrt(max(z, 0.3) / g))[:2]
-                off = cp - feet.mean(axis=0)
-                if float(np.hypot(*off)) > p.step_out[0]:
-                    # the foot nearer the capture point moves by the offset (no crossing over)
-                    k = int(np.argmin(np.linalg.norm(feet - cp, axis=1)))
-                    bl.stepper.begin(feet[k] + p.step_out[1] * off, t, k)
             ctx.handover["posture"] = bl.posture
             if bl.stepper is not None:
                 ctx.handover["stepper"] = bl.stepper
