@@ -358,15 +358,6 @@ STANDING_BEND_RATE = 1.5
 #: lifted again; docs/athletics.md)
 STANDING_HANG = 0.2
 STANDING_STILL = 0.08
-#: issue 18's tries on the balance after a standing step's touchdown (all off; not kept,
-#: docs/athletics.md): the posture's plant on (the COM target between both feet where they
-#: landed), the bow kept easing out this many seconds, each leg shortened so a hip at one
-#: height reaches both split feet (a lunge), the COM target the capture point clipped into
-#: the new soles' box less this margin (m)
-STANDING_LAND_PLANT = False
-STANDING_LAND_UPRIGHT = 0.0
-STANDING_LAND_LUNGE = False
-STANDING_LAND_CP: float | None = None
 
 
 class BalanceLaw:
@@ -393,10 +384,6 @@ class BalanceLaw:
         #: :attr:`BalanceGains.bow_ease`: the bow applied last, its tick
         self._bow_now = 0.0
         self._t_bow = math.nan
-        #: STANDING_LAND_*: the bow eased out until, the lunge on, the capture-point target on
-        self._bow_off = -math.inf
-        self._lunge = False
-        self._cpt = False
         #: a step when the capture point leaves the feet (:class:`Step`), or None
         self.stepper: Stepper | None = None
         #: the pelvis's roll target (rad, heading frame; 0 upright): the landing's roll_ease
@@ -517,15 +504,6 @@ class BalanceLaw:
             if g.side_roll is not None:
                 w = min(abs(float(grad[1])) / SIDE_SLOPE, 1.0)
                 roll = (1.0 + w * (g.side_roll[0] - 1.0), -0.5 + w * (g.side_roll[1] + 0.5))
-        if self._cpt and STANDING_LAND_CP is not None and s.foot_contact.all():  # STANDING_LAND_*
-            lo, hi = s.support_extent(h)
-            om = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))
-            cpl = s.local(s.com, h)[:2] + s.local(s.com_vel, h)[:2] / om
-            a0, a1 = lo[:2] + STANDING_LAND_CP, hi[:2] - STANDING_LAND_CP
-            mid = 0.5 * (lo[:2] + hi[:2])
-            tl = np.where(a0 < a1, np.clip(cpl, a0, a1), mid)
-            target[0] = c * tl[0] - sn * tl[1]
-            target[1] = sn * tl[0] + c * tl[1]
         self.com_target = target
         err = s.local(target - s.com, h)
         vel = s.local(s.com_vel, h)
@@ -610,7 +588,7 @@ class BalanceLaw:
         :attr:`BalanceGains.bow_ease` s (first order) instead of at once."""
         dt = 0.0 if math.isnan(self._t_bow) else max(t - self._t_bow, 0.0)
         self._t_bow = t
-        if both and t >= self._bow_off:
+        if both:
             self._bow_now = self._bow(cp, vel)
         else:
             self._bow_now *= math.exp(-dt / max(self.gains.bow_ease or 0.0, 1e-9))
@@ -656,17 +634,11 @@ class BalanceLaw:
         if self.posture.level_hips:
             # a hip standing higher than the other counts as floor that much higher under it
             z = z + self.posture.level_hips * d.xpos[s.leg_bodies[:2], 2]
-        if self._lunge:  # STANDING_LAND_*
-            hips = d.xpos[s.leg_bodies[:2], :2]
-            far = np.linalg.norm(d.xanchor[s.ankle_joints, :2] - hips, axis=1)
         for k in range(2):
             knee = float(desired[_KNEE[k], 0])
             ul, ll = float(a.thigh[k]), float(a.shin[k])
             length = math.sqrt(ul * ul + ll * ll + 2.0 * ul * ll * math.cos(knee))
             level = length + 0.5 * float(z[1 - k] - z[k])
-            if self._lunge:  # the hip at the height where the farther foot is at this length
-                dm = min(float(far.max()), 0.9 * length)
-                level -= length - math.sqrt(length * length - dm * dm + float(far[k]) ** 2)
             self.ctx.rig.offset[_KNEE[k], 0] = float(knee_for_length(ul, ll, level)[0]) - knee
 
     def support(self, s: Senses) -> None:
@@ -771,12 +743,6 @@ class Stepper:
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
             self.record[-1]["s"] = t - self._t0
             self._close, self._stood = self._out is not None and not self.standing, 1 - k
-            if self.standing and self._out is not None:  # STANDING_LAND_*
-                if STANDING_LAND_PLANT:
-                    bl.posture = replace(bl.posture, plant=True)
-                bl._bow_off = t + STANDING_LAND_UPRIGHT
-                bl._lunge = STANDING_LAND_LUNGE
-                bl._cpt = True
             self.foot, self._t_end = -1, t
             # both knees on from where they are to the posture's, over what is left of its
             # stand-up (at once, the stepped leg's push launched the body), the law's
