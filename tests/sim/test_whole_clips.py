@@ -450,6 +450,25 @@ def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_only_falls_later(
     assert _walk_pushed(walk, force, 2.0, {"warp_phase": 0.25}) == "moving"
 
 
+def test_a_walk_pushed_back_steps_from_double_support_and_walks_on(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared right-curving walk pushed 450 N straight back at the chest for 0.2 s at
+    1.5 s is upright but not walking at the window's end with the defaults; with a step taken
+    from the clip's double support once the capture point passes the front foot by the
+    clip's own largest lead there (``step_ahead`` 1, opt-in; 2026-12-04) it walks as its clip
+    does. Unpushed, the option changes nothing, frame for frame."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 180.0, 450.0)
+    assert _walk_pushed(walk, force, 1.5, {}) == "moving"
+    assert _walk_pushed(walk, force, 1.5, {"step_ahead": 1.0}) == "ok"
+    runs = [
+        push_clip(walk, time=1.5, body="chest", force=[0.0, 0.0, 0.0], duration=0.2,
+                  start=1.0, seconds=1.2, params=params).rollout.frames()[1]
+        for params in ({}, {"step_ahead": 1.0})
+    ]  # fmt: skip
+    assert np.array_equal(runs[0], runs[1])
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}

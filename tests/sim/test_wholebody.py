@@ -279,6 +279,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("anchor_lag", -0.3),
         ("anchor_lag_heading", -30.0),
         ("anchor_lag_speed", -0.45),
+        ("step_ahead", -1.0),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

@@ -124,6 +124,7 @@ class AnchoredReference:
         anchor_lag: float = 0.0,
         anchor_lag_heading: float = 0.0,
         anchor_lag_speed: float = 0.0,
+        step_ahead: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -227,6 +228,11 @@ class AnchoredReference:
         # ``anchor_lag_speed``: the lag acts only below this fraction of the clip's speed
         self._lag_speed = float(anchor_lag_speed) if anchor_lag_speed else np.inf
         self._catching = False  # the clip's clock catching a body ahead (``warp_phase``)
+        # ``step_ahead``: the capture point's largest lead past the front foot in the clip's
+        # own double supports (m), and whether a walk's push has armed the step
+        self.step_ahead = float(step_ahead)
+        self._ahead_margin = self._clip_ahead_margin() if self.step_ahead else np.inf
+        self._ahead_armed = False
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -503,13 +509,13 @@ class AnchoredReference:
                 self.step = None
                 self._step_ready = t + 0.05
                 self._landed = (s.foot, t)
+        if self._ahead_armed and self.step is None and t >= self._step_ready:
+            self._step_ahead(t)
         if self.step is not None or not self.stepping or t < self._step_ready:
             return
         i = self.clock.nearest(t)
-        up = d.xmat[self._root].reshape(3, 3)[:, 2]
-        self._gone_down |= bool(up @ self._root_up0 < _STEP_TILT_COS)
-        if self._gone_down or d.qpos[self._z_adr] < 0.75 * self._z0:
-            return  # already going down: a step would only flail
+        if self._going_down():
+            return  # a step would only flail
         ahead = self.path.planted[i : i + max(1, round(self.step_time * self.path.fps))]
         feet = self._footprint(t)
         down = [len(f) > 0 for f in feet]
@@ -559,6 +565,70 @@ class AnchoredReference:
             short = float(np.linalg.norm(target - centre[foot, :2])) / self.step_short
             duration *= min(1.0, max(_SHORT_STEP_MIN, short))
         self.step = Step(foot, t, duration, centre[foot].copy(),
+                         np.r_[target, self.floor_z], self.step_height)  # fmt: skip
+        self.steps_taken.append(t)
+
+    def _going_down(self) -> bool:
+        """The pelvis has tilted past the balance steps' limit (now or before) or sunk below
+        0.75 of its starting height: the body is already going down."""
+        d = self.world.data
+        up = d.xmat[self._root].reshape(3, 3)[:, 2]
+        self._gone_down |= bool(up @ self._root_up0 < _STEP_TILT_COS)
+        return self._gone_down or bool(d.qpos[self._z_adr] < 0.75 * self._z0)
+
+    def _clip_ahead_margin(self) -> float:
+        """``step_ahead``'s base: the clip's own capture point's largest lead (m) past its
+        front foot along its walk over the frames where both feet are planted and it walks
+        (0.2 m/s or faster); 0 for a clip that never does."""
+        assert self.path.sole is not None
+        c, v = self._com, self._com_v
+        speed = np.hypot(v[:, 0], v[:, 1])
+        both = self.path.planted.all(axis=1) & (speed > 0.2)
+        if not both.any():
+            return 0.0
+        u = v[both, :2] / speed[both, None]
+        omega = np.sqrt(-self._gravity[2] / np.maximum(c[both, 2] - self.floor_z, 0.3))
+        xi = c[both, :2] + v[both, :2] / omega[:, None]
+        sole = self.path.sole[both, :, :2]
+        front = np.einsum("kfi,ki->kf", sole, u).max(axis=1)
+        return float(max(0.0, (np.einsum("ki,ki->k", xi, u) - front).max()))
+
+    def _step_ahead(self, t: float) -> None:
+        """After a walk's push (``step_ahead``): while the clip holds both feet planted and
+        both are on the floor, a capture point more than the clip's own largest lead
+        (:meth:`_clip_ahead_margin`) times ``step_ahead`` past the front foot along the
+        clip's walk starts a balance step of the rear foot (:func:`step_target`); the clip
+        plays on as it would (its clock moved on to that foot's own step lost more pushes).
+        A body that ran past its feet in a double support of the clip's got its next step
+        too late (``docs/tracking.md``)."""
+        d = self.world.data
+        i = self.clock.nearest(t)
+        if not self.path.planted[i].all():
+            return
+        feet = self._footprint(t)
+        if not all(len(f) for f in feet):
+            return
+        if self._going_down():
+            return
+        _, v, _ = self.com_reference(t)
+        ref = float(np.hypot(v[0], v[1]))
+        if ref < 0.2:  # not walking
+            return
+        u = v[:2] / ref
+        xi, omega = self.capture_point()
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
+        front = int(np.argmax(centre[:, :2] @ u))
+        if float((xi - centre[front, :2]) @ u) <= self._ahead_margin * self.step_ahead:
+            return
+        foot = 1 - front
+        heading = self.sole_heading()
+        left = np.array([-np.sin(heading), np.cos(heading)])
+        target = step_target(
+            xi, centre[front, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
+            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
+        )  # fmt: skip
+        self.step = Step(foot, t, self.step_time, centre[foot].copy(),
                          np.r_[target, self.floor_z], self.step_height)  # fmt: skip
         self.steps_taken.append(t)
 
@@ -747,6 +817,7 @@ class AnchoredReference:
         self.lag_until = -np.inf
         self._lag_acted = False
         self._catching = False
+        self._ahead_armed = False
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
 
@@ -763,13 +834,13 @@ class AnchoredReference:
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
-                self.lag_until, self._lag_acted)  # fmt: skip
+                self.lag_until, self._lag_acted, self._ahead_armed)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching, drop_step, warp_until, lag_until, lag_acted) = memory  # fmt: skip
+         catching, drop_step, warp_until, lag_until, lag_acted, ahead_armed) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -793,3 +864,4 @@ class AnchoredReference:
         self.warp_until = float(warp_until)  # type: ignore[arg-type]
         self.lag_until = float(lag_until)  # type: ignore[arg-type]
         self._lag_acted = bool(lag_acted)
+        self._ahead_armed = bool(ahead_armed)

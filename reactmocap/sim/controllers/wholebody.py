@@ -246,6 +246,13 @@ class WholeBodyTracker(AnchoredReference):
             centre of mass moves slower than this fraction of the clip's speed (0: at any
             speed): a body slowed less, its path held ahead, was pulled back up to speed past
             its feet and fell (``docs/tracking.md``).
+        step_ahead: after a walk's push within 60 deg of straight back, while the clip
+            holds both feet planted, a capture point past the front foot along the clip's walk
+            by more than ``step_ahead`` times the clip's own largest such lead in its double
+            supports starts a balance step of the rear foot
+            (:func:`~reactmocap.sim.controllers.stepping.step_target`; 0: off): a body that
+            ran past its feet in a double support of the clip's stepped too late
+            (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -331,6 +338,7 @@ class WholeBodyTracker(AnchoredReference):
         anchor_lag: float = 0.0,
         anchor_lag_heading: float = 0.0,
         anchor_lag_speed: float = 0.0,
+        step_ahead: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -363,7 +371,7 @@ class WholeBodyTracker(AnchoredReference):
                 "place_height": place_height, "warp_gain": warp_gain, "warp_lead": warp_lead,
                 "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
-                "anchor_lag_speed": anchor_lag_speed,
+                "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -478,7 +486,7 @@ class WholeBodyTracker(AnchoredReference):
             place_pushed=place_pushed, step_ease=step_ease, step_ease_in=step_ease_in,
             step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
-            anchor_lag_speed=anchor_lag_speed,
+            anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
@@ -768,7 +776,8 @@ class WholeBodyTracker(AnchoredReference):
         ``trunk_band`` m from the mocap's; back linearly over ``trunk_give`` s after. A walk
         pushed gets the softer pelvis servo (``kp_root_pushed``)."""
         if not ((self._w_trunk and self._give) or self._w_hip or self.warp_gain
-                or self._step_pushed or self.place_pushed or self.anchor_lag):  # fmt: skip
+                or self._step_pushed or self.place_pushed or self.anchor_lag
+                or self.step_ahead):  # fmt: skip
             return self._w_trunk
         # into a buffer: this runs every control tick
         np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
@@ -794,10 +803,14 @@ class WholeBodyTracker(AnchoredReference):
             # the rate follows a capture point running ahead (``warp_lead``) only after a
             # sideways push: after a diagonal one it lost more pushes than it caught
             self.leading = self.warping and self.warp_lead > 0 and sideways
+            ahead = np.cos(heading) * f[0] + np.sin(heading) * f[1]
+            # ``step_ahead`` only after a push within 60 deg of straight back: after a forward
+            # push the clip played faster (``warp_gain``) and after a sideways one the placed
+            # foot (``place_pushed``) caught what a step from double support lost
+            self._ahead_armed = self.step_ahead > 0 and ahead <= -0.5 * np.hypot(f[0], f[1])
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
                 kp = self._kp_root_pushed
-                ahead = np.cos(heading) * f[0] + np.sin(heading) * f[1]
                 if self._kp_root_against and ahead < -_AGAINST_COS * np.hypot(f[0], f[1]):
                     kp = self._kp_root_against
                 self.kp[:3] = kp
