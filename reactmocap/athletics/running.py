@@ -94,8 +94,6 @@ PITCH_SUM = 0.1
 STEP_FORCE = 4.0
 #: the commanded step takes over from the leg spring at the first touchdown after this (s)
 STEP_AFTER = 2.0
-#: the most ``knee_timing`` raises the swing knee's stiffness by (times)
-KNEE_BOOST = 6.0
 #: the path correction integrates from this time on (s; the start from the set pose strays)
 PATH_AFTER = 3.0
 #: the most the path correction's integral (cross-track times curvature) holds (s)
@@ -187,7 +185,6 @@ class Runner:
         self.foot_length = 2.0 * float(m.geom_size[wc.sole_ids[0], 0])
         # read once: World.timestep reads the model's options anew at every call
         self._timestep = world.timestep
-        self._tick = control_every * self._timestep
         self._base_stiffness = per_joint(self.params.stiffness)
         self.machine = StateMachine(self._states(), "flight", control_every)
         self._reset_state()
@@ -201,11 +198,6 @@ class Runner:
         self.t_heel_toe = 0.0
         self.stance_estimate = k["stance_time"]
         self.vz_touchdown = 0.0
-        #: the COM's height at the last touchdown (m; the flight's predicted end)
-        self.z_touchdown = math.nan
-        self.foot_prev = math.nan
-        self.sole_prev = math.nan
-        self.sole_to_go = math.inf
         #: the stance the commanded step lasts (s; 0: the leg spring's stance)
         self.step_stance = 0.0
         self.targets = np.zeros((NJ, 3))
@@ -331,11 +323,6 @@ class Runner:
         vz = float(s.com_vel[2])
         low = float(s.sole_corners()[leg, :, 2].min())
         to_go = low / -vz if vz < -1e-3 else np.inf
-        # the sole's own descent (the leg extends as the body falls: a touchdown came up to
-        # 30 ms before the COM was back at its last touchdown's height)
-        fall = (self.sole_prev - low) / self._tick if math.isfinite(self.sole_prev) else 0.0
-        self.sole_prev = low
-        self.sole_to_go = low / fall if fall > 1e-3 else math.inf
         fwd += k["speed_matching"] * clamp(to_go / k["retract_time"], 0.0, 1.0)
         fwd += 0.3 * lf  # the heel sits behind the ankle
         length = k["touchdown_leg"] * (self.athlete.thigh[leg] + self.athlete.shin[leg])
@@ -352,46 +339,7 @@ class Runner:
         self.goal[KNEE[leg]] = (float(knee), 0.0, 0.0)
         self.knee_td = float(knee)
         shin = self._pitch(self._shins[leg], SHIN[leg], heading)
-        if k["knee_timing"] > 0 and self.step_stance:  # past eq. 6's smoothing: no time
-            self.targets[KNEE[leg], 0] = float(knee)
-        lead = k["foot_lead"]
-        if lead > 0 and self.step_stance:
-            # the sole's world pitch servoed to the heel strike's with its rate damped over
-            # the flight's last moments: the knee's late straightening swung the foot toes-up
-            # into the strike with the ankle at its bound
-            foot = self._pitch(self._feet[leg], FOOT[leg], heading)
-            rate = (foot - self.foot_prev) / self._tick if math.isfinite(self.foot_prev) else 0.0
-            self.foot_prev = foot
-            if self._touchdown_in() <= lead:
-                now = self._joint_pitch(ANKLE[leg])
-                ankle = clamp(now - k["heel_up"] - foot - rate * lead, -0.5, 0.9)
-                self.goal[ANKLE[leg], 0] = self.targets[ANKLE[leg], 0] = ankle
-                return
         self.goal[ANKLE[leg]] = (clamp(-k["heel_up"] - shin, -0.5, 0.9), 0.0, 0.0)
-
-    def _touchdown_in(self) -> float:
-        """The predicted time (s) to touchdown: the sooner of the COM's fall, ballistic, to
-        its height at the last touchdown (0 once below it) and the sole's at its present
-        rate (inf for neither)."""
-        if not math.isfinite(self.z_touchdown):
-            return self.sole_to_go
-        h = float(self.senses.com[2]) - self.z_touchdown
-        vz = float(self.senses.com_vel[2])
-        com = max((vz + math.sqrt(max(vz * vz + 2.0 * self.g * h, 0.0))) / self.g, 0.0)
-        return min(com, self.sole_to_go)
-
-    def _time_knee(self) -> None:
-        """At lift-off: the swing knee's servo stiffened so that it settles (2.5 lags, five
-        time constants) ``knee_timing`` s before the predicted touchdown (raised only, at
-        most :data:`KNEE_BOOST` times): after a short stance it lifted off at 1.6 rad, not
-        1.47, and still straightened into the strike (the foot's toes rising)."""
-        leg = self.active
-        free = max(self._touchdown_in() - self.k["knee_timing"], 0.02)
-        lag = float(self.rig.lag([KNEE[leg]])[0])
-        if 2.5 * lag > free:
-            stiff = self.rig.stiffness.copy()
-            stiff[KNEE[leg]] *= min((2.5 * lag / free) ** 2, KNEE_BOOST)
-            self.rig.set_stiffness(stiff)
 
     def _idle(self, t: float, heading: float) -> None:
         """The idle leg. In flight, eqs. 3-4: the idle thigh mirrors the active one's travel
@@ -620,12 +568,7 @@ class Runner:
             self.active = 1 - self.active
         h = self.heading()
         self.lo_pitch = [self._pitch(self._thighs[j], THIGH[j], h) for j in range(2)]
-        self.foot_prev = math.nan
-        self.sole_prev = math.nan
-        self.sole_to_go = math.inf
         self._set_stiffness(False)
-        if self.k["knee_timing"] > 0 and self.step_stance:
-            self._time_knee()
 
     def _enter_loading(self, world: World, t: float) -> None:
         del world
@@ -633,7 +576,6 @@ class Runner:
         self.released = False
         self.vz_peak = -math.inf
         self.vz_touchdown = float(self.senses.com_vel[2])
-        self.z_touchdown = float(self.senses.com[2])
         # the start runs on the leg spring: from the set pose the commanded step fell
         switch = not self.step_stance and t >= STEP_AFTER and self.k["step_stance"] > 0
         self.step_stance = self.k["step_stance"] if t >= STEP_AFTER else 0.0

@@ -170,8 +170,6 @@ class RunParams:
     ankle_hold: float | Speeds = 1.0
     push_hold: float | Speeds = 1.0
     push_ramp: float | Speeds = 0.0
-    foot_lead: float | Speeds = 0.0
-    knee_timing: float | Speeds = 0.0
     idle_knee: float | Speeds = (2.182, 1.813, 1.692)
     reach_knee: float | Speeds = (1.192, 1.066, 1.102)
     swing_ready: float | Speeds = (-0.3643, -0.369, -0.407)
@@ -206,10 +204,6 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
-        for name in ("foot_lead", "knee_timing"):
-            v = getattr(self, name)
-            if not all(0.0 <= b <= 0.2 for b in (v if isinstance(v, tuple) else (v,))):
-                raise ConfigError(f"{name} must be in [0, 0.2] s (0: off), got {v}")
         for name in ("push_hold", "push_ramp"):
             v = getattr(self, name)
             if not all(0.0 <= b <= 1.0 for b in (v if isinstance(v, tuple) else (v,))):
