@@ -111,9 +111,9 @@ class RunParams:
             since touchdown, to ``(1 - push_ramp)`` of itself at the stance's end (0: off):
             traced, the ground force fell from 1.5 to 0.5 body weights over the push's last
             0.06 s while the law asked 2, the servos' damping growing with the leg's speed.
-            With ``STEP_PARAMS`` 0.3 lengthened the flight (lift-off 0.52 m/s upward against
-            0.435) but fell at 2.5 m/s: an opt-in lever, not in the set (``docs/athletics.md``,
-            the eleventh round).
+            0.3 lengthened the flight (lift-off 0.52 m/s upward against 0.435) but alone fell
+            at 2.5 m/s (``docs/athletics.md``, the eleventh round); :data:`STEP_PARAMS` has
+            0.218 with ``attitude_ramp`` (the fourteenth round).
         idle_knee, reach_knee: knee flexion of the shortened idle leg, and what it opens to
             by the end of the stance ready for touchdown (rad).
         swing_ready: thigh pitch (rad, forward < 0) the idle leg reaches by lift-off.
@@ -257,18 +257,21 @@ class RunParams:
 #: per-axis (roll, pitch, yaw) values, not per-speed
 _AXES = ("attitude_kp", "attitude_kv")
 
-#: an opt-in: the commanded step with the push let through, for the shared run clip's speed
-#: (2.61 m/s: its cadence and stride within 10%, at the edge); it held 30 s at 2.5-2.7 m/s, but
-#: moved by 2% its values mostly fell (``docs/athletics.md``, the tenth round)
+#: an opt-in: the commanded step with the push let through and ramped out, the attitude torque
+#: eased in after touchdown, for the shared run clip's speed (2.61 m/s: cadence 1.065x, stride
+#: 0.939x the clip's); it held 30 s at 2.5-2.7 and 3.0 m/s and 15 of 16 moves of 4-7%, but falls
+#: from 3.25 m/s (``docs/athletics.md``, the fourteenth round)
 STEP_PARAMS = RunParams(
     step_stance=0.226,
     step_takeoff=0.835,
     step_placement=0.84,
     step_gain=27.0,
-    step_bias=-0.08,
+    step_bias=-0.097,
     speed_integral=(0.03, 0.0, 0.03),
     toe_fraction=(0.562, 0.42, 0.3199),
     push_hold=0.836,
+    push_ramp=0.218,
+    attitude_ramp=(0.073, 0.0, 0.02),
 )
 
 

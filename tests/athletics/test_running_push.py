@@ -114,6 +114,7 @@ def test_the_push_ramp_eases_the_servos_out_and_the_body_leaves_faster(
             shares.append(float(self.rig.axis_gain[KNEE[self.active], 0]))
 
     ramped = dataclasses.replace(STEP_PARAMS, push_ramp=0.3)
+    unramped = dataclasses.replace(STEP_PARAMS, push_ramp=0.0)
     with monkeypatch.context() as patch:
         patch.setattr(Runner, "control", traced)
         run_course(2.61, seconds=2.8, fps=10.0, params=ramped)
@@ -121,7 +122,7 @@ def test_the_push_ramp_eases_the_servos_out_and_the_body_leaves_faster(
     assert isinstance(hold, float) and len(shares) > 10
     assert max(shares) < hold and min(shares) > 0.7 * hold - 1e-9
     assert min(shares) < 0.75 * hold  # near the stance's end
-    base = _liftoff_vz(STEP_PARAMS, 3.5)
+    base = _liftoff_vz(unramped, 3.5)
     eased = _liftoff_vz(ramped, 3.5)
     assert len(base) >= 2 and len(eased) >= 2
     assert np.mean(eased) > np.mean(base) + 0.06, (base, eased)
