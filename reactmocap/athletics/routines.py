@@ -436,11 +436,13 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # 10 and 15, held-out seed 2 15 from 13; docs/athletics.md). Since 2026-12-04 his crouch's
     # COM target goes 13 cm back over 0.2 s (LeapParams.com_ramp; the 10 cm step hopped every
     # start off the floor) and his feet land 60 cm back (18/50 and 23/50 on seeds 0 and 1,
-    # from 17 and 20). A list: a maneuver file's numbers load as one
+    # from 17 and 20); since 2026-12-04 (later) the knees' aim is centred on that crouch's
+    # nominal (-186 deg, 0.9 rad, up to 1.3: about 0.4 rad the knees sat at their clip). A
+    # list: a maneuver file's numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3, "hold": 0.22, "com_offset": -0.13,
                                   "com_ramp": 0.2}),
-        "handspring": MappingProxyType({"aim": -3.42, "knees": 0.4}),
+        "handspring": MappingProxyType({"aim": -3.25, "knees": 0.9, "aim_knees": 1.3}),
         "land": MappingProxyType({"delta": -0.6, "spin_ref": -96.8,
                                   "step": [0.05, 0.1, 0.3, 0.25]}),
     }),

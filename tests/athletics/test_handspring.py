@@ -129,13 +129,22 @@ def _with(m: Maneuver, controller: str, params: dict[str, float]) -> Maneuver:
     return replace(m, phases=phases)
 
 
+def _aimed_at_196(m: Maneuver) -> Maneuver:
+    """``m`` with the knees' aim as it was before it was centred on the ramped crouch
+    (2026-12-04): -196 deg at contact about 0.4 rad, clipped at the default 0.9."""
+    hands = next(p for p in m.phases if p.controller == "handspring").params
+    return _with(m, "handspring", {**{k: v for k, v in hands.items() if k != "aim_knees"},
+                                   "aim": -3.42, "knees": 0.4})  # fmt: skip
+
+
 def _hopping(m: Maneuver) -> Maneuver:
     """``m`` as the file was before its ramped crouch (2026-12-04): the crouch's COM target 10
-    cm back at once (the step that hops the feet off the floor), the feet landing 55 cm back."""
+    cm back at once (the step that hops the feet off the floor), the feet landing 55 cm back,
+    the knees' aim at -196 deg."""
     leap = next(p for p in m.phases if p.controller == "leap").params
     land = next(p for p in m.phases if p.controller == "land").params
-    m = _with(m, "leap", {**{k: v for k, v in leap.items() if k != "com_ramp"},
-                          "com_offset": -0.1})  # fmt: skip
+    m = _with(_aimed_at_196(m), "leap", {**{k: v for k, v in leap.items() if k != "com_ramp"},
+                                         "com_offset": -0.1})  # fmt: skip
     return _with(m, "land", {**land, "delta": -0.55})
 
 
@@ -293,3 +302,22 @@ def test_the_crouch_eases_its_com_target_in_and_levels_the_hips() -> None:
     assert feet == 2 and lz > 3.0
     _, lz = crouch_feet_and_lz(_with(m, "leap", {**leap, "com_ramp": 0.2, "crouch_level": 10.0}))
     assert abs(lz) < 2.0
+
+
+def test_the_knees_aim_is_centred_on_the_ramped_crouch() -> None:
+    """Since the crouch is ramped (2026-12-04) the nominal meets the floor at -186 deg, and the
+    knees aimed at -196 deg about 0.4 rad sat at their 0.9 rad clip. Centred there (aim -3.25
+    rad about 0.9, up to 1.3: the file) the nominal lands as before, with its knees inside
+    the range; full-size start 5 (seed 0) leaps high (0.67 m), and with the knees straightened
+    further it meets the floor earlier and lands, where it fell with the old aim."""
+    m = load_maneuver(EXAMPLE)
+    old = _aimed_at_196(m)
+    nominal = run_maneuver(m, fps=10.0).report
+    assert nominal["landed"] and 0.5 < nominal["handspring_aim_knees"] < 1.3
+    assert run_maneuver(old, fps=10.0).report["handspring_aim_knees"] == 0.9
+    start = _starts(1.0, 6)[5]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 45.0
+    before = run_maneuver(old, perturbation=start, fps=10.0).report
+    assert before["fell"] and not before["landed"]
+    assert before["handspring_aim_knees"] > r["handspring_aim_knees"]
