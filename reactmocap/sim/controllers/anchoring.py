@@ -77,6 +77,11 @@ _LAG_SLOW = 0.5
 _LAG_MOVING = 0.2
 
 
+def _left_of(heading: float) -> F64:
+    """The unit vector (2,) to the left of ``heading`` (rad) in the floor plane."""
+    return np.array([-np.sin(heading), np.cos(heading)])
+
+
 def _rot2(yaw: float) -> F64:
     c, s = np.cos(yaw), np.sin(yaw)
     return np.array([[c, -s], [s, c]])
@@ -449,7 +454,6 @@ class AnchoredReference:
         point past the stance foot (no crossing step), only while the clip walks away from
         the fall's side, and only for ``_PLACE_WINDOW`` s after the push starts
         (``docs/tracking.md``)."""
-        d = self.world.data
         low = self.sole_corners()[:, :, 2].min(axis=1) - self.floor_z
         self._placed &= low >= self.anchor_touch  # landed
         self._place_move[:] = 0.0
@@ -460,12 +464,10 @@ class AnchoredReference:
         c_ref, v_ref, _ = self.com_reference(t)
         # the push's part only: a walk's own capture point runs ahead of its stance foot
         miss = xi - c_ref[:2] - v_ref[:2] / omega
-        heading = self.sole_heading()
-        left = np.array([-np.sin(heading), np.cos(heading)])
+        left = _left_of(self.sole_heading())
         i = self.clock.nearest(t)
         ahead = self.path.sole[i : i + round(0.5 * self.path.fps), :, 2] - self.floor_z
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
+        centre = self._sole_centres()
         for f in range(2):  # two feet
             if low[f] < self.anchor_touch or self._mocap_swing(t, f) is None:
                 continue
@@ -536,10 +538,8 @@ class AnchoredReference:
                 margin = max(margin, _HOLD_MARGIN)
         if outside_distance(xi, support) <= margin:
             return
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
-        heading = float(np.arctan2(rot[:, 1, 0].sum(), rot[:, 0, 0].sum()))
-        left = np.array([-np.sin(heading), np.cos(heading)])
+        centre = self._sole_centres()
+        left = _left_of(self.sole_heading())
         fall = xi - convex_hull(support).mean(axis=0)
         side = float(fall @ left)
         if abs(side) > _SIDE_STEP_TAN * abs(float(fall @ np.array([left[1], -left[0]]))):
@@ -554,12 +554,21 @@ class AnchoredReference:
             # the foot that just landed carries the body: stepping it again pivoted the body
             # over the foot left behind
             foot = 1 - self._landed[0]
+        self._start_step(t, foot, centre, xi, omega, left, shorten=True)
+
+    def _start_step(
+        self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64, shorten: bool
+    ) -> None:
+        """Start a balance step of ``foot`` (sole centres ``centre``, ``(2, 3)``) to
+        :func:`step_target` for capture point ``xi``; ``left`` is the soles' unit left
+        vector. ``shorten``: after a landed step, a short step (``step_short``) takes less
+        than the whole step time. The one step start of both step triggers."""
         target = step_target(
             xi, centre[1 - foot, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
             max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
         )  # fmt: skip
         duration = self.step_time
-        if self.step_short and self._landed[0] >= 0:
+        if shorten and self.step_short and self._landed[0] >= 0:
             # after a step has landed, a short one (a foot put back down) need not take the
             # whole step time
             short = float(np.linalg.norm(target - centre[foot, :2])) / self.step_short
@@ -567,6 +576,12 @@ class AnchoredReference:
         self.step = Step(foot, t, duration, centre[foot].copy(),
                          np.r_[target, self.floor_z], self.step_height)  # fmt: skip
         self.steps_taken.append(t)
+
+    def _sole_centres(self) -> F64:
+        """The simulated soles' centres, ``(2, 3)`` (m)."""
+        d = self.world.data
+        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
+        return d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
 
     def _going_down(self) -> bool:
         """The pelvis has tilted past the balance steps' limit (now or before) or sunk below
@@ -601,7 +616,6 @@ class AnchoredReference:
         plays on as it would (its clock moved on to that foot's own step lost more pushes).
         A body that ran past its feet in a double support of the clip's got its next step
         too late (``docs/tracking.md``)."""
-        d = self.world.data
         i = self.clock.nearest(t)
         if not self.path.planted[i].all():
             return
@@ -616,21 +630,12 @@ class AnchoredReference:
             return
         u = v[:2] / ref
         xi, omega = self.capture_point()
-        rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
-        centre = d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
+        centre = self._sole_centres()
         front = int(np.argmax(centre[:, :2] @ u))
         if float((xi - centre[front, :2]) @ u) <= self._ahead_margin * self.step_ahead:
             return
-        foot = 1 - front
-        heading = self.sole_heading()
-        left = np.array([-np.sin(heading), np.cos(heading)])
-        target = step_target(
-            xi, centre[front, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
-            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
-        )  # fmt: skip
-        self.step = Step(foot, t, self.step_time, centre[foot].copy(),
-                         np.r_[target, self.floor_z], self.step_height)  # fmt: skip
-        self.steps_taken.append(t)
+        self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
+                         shorten=False)  # fmt: skip
 
     def rebalance(self, t: float) -> None:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
