@@ -143,6 +143,8 @@ def run_course(
     if res.status != "ok":
         report["fell"] = True
         report["reason"] = res.reason
+    # the engine stopped the run: a fall in the log before it has its own time, else none
+    report["unstable_at_s"] = round(res.seconds, 3) if res.status == "unstable" else None
     if dress is not None:
         report.update(dress.report())
     report.update({
@@ -225,9 +227,14 @@ def run_metrics(
 def _notes(r: dict[str, Any]) -> list[str]:
     """Plain statements of where a run missed its goals."""
     notes = []
-    if r.get("fell"):
-        at = r.get("fell_at_s")
-        notes.append("the runner fell" + (f" at {at:.2f} s" if at is not None else ""))
+    at, unstable = r.get("fell_at_s"), r.get("unstable_at_s")
+    if at is not None:
+        notes.append(f"the runner fell at {at:.2f} s")
+    if unstable is not None:
+        notes.append(f"the simulation went unstable at {unstable:.2f} s and was stopped "
+                     f"(counted as a fall)")  # fmt: skip
+    elif r.get("fell") and at is None:
+        notes.append("the runner fell")
     err = r.get("speed_error_m_s")
     if err is not None and err > SPEED_TOLERANCE:
         notes.append(f"poor speed control: RMS stride-speed error {err:.2f} m/s "

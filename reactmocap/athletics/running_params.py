@@ -122,10 +122,15 @@ class RunParams:
             the leg's force making the body's vertical speed go from its touchdown value to
             ``step_takeoff`` (m/s) along a half-cosine, with ``step_gain`` (1/s) on the speed's
             error; eqs. 1-2 take ``step_placement`` times it as ``t_s``. Given at every speed or
-            none. The leg spring's stance is about 0.17 s at 2.6 m/s whatever its values; a
-            human's (the shared run clip's) about 0.2 s with a flight of 0.17-0.22 s. An
+            none (``step_until`` switches it off above a speed). The leg spring's stance is
+            about 0.17 s at 2.6 m/s whatever its values; a human's (the shared run clip's)
+            about 0.2 s with a flight of 0.17-0.22 s. An
             opt-in for the clip's speed (:data:`STEP_PARAMS`, with ``push_hold``): it is not
             robust (``docs/athletics.md``, the eighth to tenth rounds).
+        step_until: the commanded step only up to this desired speed (m/s, within
+            :data:`SPEED_RANGE`; 0: at every speed): above it ``step_stance`` is 0 and
+            ``push_hold`` 1, the leg spring's push as tuned, the other values as given. One
+            stance time for every speed did not run at 3.25-5 m/s (the fourteenth round).
         step_bias: at the switch into the commanded step, the placement's slow correction
             (``speed_integral``'s sum, m) starts from this, the step's steady value (-0.08 m
             at 2.5-2.7 m/s), rather than from the spring's: built up step by step it took
@@ -181,6 +186,7 @@ class RunParams:
     step_gain: float | Speeds = 20.0
     step_placement: float | Speeds = 0.7
     step_bias: float | Speeds = 0.0
+    step_until: float = 0.0
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
@@ -237,12 +243,18 @@ class RunParams:
         steps = self.step_stance if isinstance(self.step_stance, tuple) else (self.step_stance,)
         if 0 in steps and any(steps):
             raise ConfigError(
-                f"step_stance must be given at every speed or none (0), got {self.step_stance}"
+                f"step_stance must be given at every speed or none (0) (step_until switches it "
+                f"off above a speed), got {self.step_stance}"
+            )
+        if self.step_until and not (any(steps) and lo <= self.step_until <= hi):
+            raise ConfigError(
+                f"step_until must be 0 (off) or a speed in {lo:g}-{hi:g} m/s with step_stance "
+                f"given, got {self.step_until} (step_stance {self.step_stance})"
             )
 
     def at(self, speed: float) -> dict[str, float]:
         """Every scalar tuning value at ``speed`` (triples interpolated, clamped to the
-        range)."""
+        range; the commanded step off above ``step_until``)."""
         out = {}
         for f in fields(self):
             if f.name in _AXES or f.name == "stiffness":
@@ -251,6 +263,11 @@ class RunParams:
             out[f.name] = (
                 float(np.interp(speed, TUNED_SPEEDS, v)) if isinstance(v, tuple) else float(v)
             )
+        if self.step_until and speed > self.step_until:
+            # the step off and its push held again, as the spring was tuned: with the push let
+            # through the spring fell in the start at 3.2 m/s (docs, the fifteenth round)
+            out["step_stance"] = 0.0
+            out["push_hold"] = 1.0
         return out
 
 
@@ -259,10 +276,12 @@ _AXES = ("attitude_kp", "attitude_kv")
 
 #: an opt-in: the commanded step with the push let through and ramped out, the attitude torque
 #: eased in after touchdown, for the shared run clip's speed (2.61 m/s: cadence 1.065x, stride
-#: 0.939x the clip's); it held 30 s at 2.5-2.7 and 3.0 m/s and 15 of 16 moves of 4-7%, but falls
-#: from 3.25 m/s (``docs/athletics.md``, the fourteenth round)
+#: 0.939x the clip's); it held 30 s at 2.5-2.7 and 3.0 m/s and 15 of 16 moves of 4-7%; above 3
+#: m/s the leg spring (``step_until``), with the step it fell from 3.25 m/s
+#: (``docs/athletics.md``, the fourteenth and fifteenth rounds)
 STEP_PARAMS = RunParams(
     step_stance=0.226,
+    step_until=3.0,
     step_takeoff=0.835,
     step_placement=0.84,
     step_gain=27.0,
