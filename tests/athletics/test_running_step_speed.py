@@ -14,13 +14,15 @@ from reactmocap.errors import ConfigError
 
 
 def test_step_until_switches_the_commanded_step_off_above_its_speed() -> None:
-    """``STEP_PARAMS`` runs the commanded step up to 3 m/s and the leg spring above: at 3.5
-    m/s it runs 4 s on the spring's stances (under 0.2 s) without falling, where the same set
-    with the step at every speed (``step_until`` 0, the set before) fell at 3.18 s, just after
-    the step took over (2 s). Bad values are ConfigErrors naming the field."""
+    """``STEP_PARAMS`` runs the commanded step up to 3 m/s and the leg spring (its push held
+    as tuned) above: at 3.5 m/s it runs 4 s on the spring's stances (under 0.2 s) without
+    falling, where the same set with the step at every speed (``step_until`` 0, the set before)
+    fell at 3.18 s, just after the step took over (2 s). Bad values are ConfigErrors naming the
+    field."""
     assert STEP_PARAMS.step_until == 3.0
     assert STEP_PARAMS.at(3.0)["step_stance"] == STEP_PARAMS.step_stance
-    assert STEP_PARAMS.at(3.01)["step_stance"] == 0.0
+    assert STEP_PARAMS.at(3.0)["push_hold"] == STEP_PARAMS.push_hold < 1.0
+    assert STEP_PARAMS.at(3.01)["step_stance"] == 0.0 and STEP_PARAMS.at(3.01)["push_hold"] == 1.0
     kept = run_course(3.5, seconds=4.0, fps=10.0, params=STEP_PARAMS)
     assert not kept.report["fell"], kept.report["notes"]
     log = kept.runner.log
