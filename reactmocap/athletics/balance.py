@@ -153,36 +153,20 @@ class Step:
             foot clears the floor).
         seconds: the swing's planned duration; the step ends when the swing foot touches
             down after half of it (or at three times it).
-        carry: 0-1, how much of the lift's knee bend the hip carries along the hip-to-place
-            line (1: the lifted ankle stays on that line from the first tick, rising toward
-            the hip, instead of swinging back under the knee first); 0: off.
-        ahead: the step starts on the capture point predicted this many seconds on at its
-            rate (low-passed over :data:`STEP_RATE_TAU`), not where it is now; 0: off.
-        past: the step ends at a touch only once the swing foot's middle lies past the
-            standing foot's along the way out (a foot set down short of it swings on).
     """
 
     margin: float = 0.05
     reach: float = 0.1
     lift: float = 0.3
     seconds: float = 0.25
-    carry: float = 0.0
-    ahead: float = 0.0
-    past: bool = False
 
     def __post_init__(self) -> None:
-        for name in ("margin", "reach", "lift", "seconds", "carry", "ahead"):
+        for name in ("margin", "reach", "lift", "seconds"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise ConfigError(f"step {name} must be a finite number >= 0, got {v!r}")
         if not 0.05 <= self.seconds <= 2.0:
             raise ConfigError(f"step seconds must be in [0.05, 2], got {self.seconds}")
-        if self.carry > 1.0:
-            raise ConfigError(f"step carry must be in [0, 1], got {self.carry}")
-        if self.ahead > 1.0:
-            raise ConfigError(f"step ahead must be in [0, 1] s, got {self.ahead}")
-        if not isinstance(self.past, bool):
-            raise ConfigError(f"step past must be a bool, got {self.past!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -346,8 +330,6 @@ STEP_EASE = 0.05
 STEP_REACH = 0.97
 #: the least seconds the knees take back to the posture's after a step
 STEP_SETTLE = 0.2
-#: time constant (s) of the low-pass on the capture point's rate (:attr:`Step.ahead`)
-STEP_RATE_TAU = 0.03
 BALANCE_GAINS = BalanceGains()
 #: standing on its own (the ``balance`` behaviour: pushes and slopes): the COM target moved
 #: 0.07 m per unit gradient uphill across the feet and 0.03 m downhill along them (the
@@ -706,10 +688,6 @@ class Stepper:
         self._stood = 0
         self._goal = np.full((NJ, 3), np.nan)
         self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
-        #: :attr:`Step.ahead`: the capture point last tick, its tick, its low-passed rate
-        self._cp_last = np.zeros(2)
-        self._t_cp = math.nan
-        self._cp_rate = np.zeros(2)
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
 
@@ -723,9 +701,6 @@ class Stepper:
         floor = float(s.corners[..., 2].min())  # a level floor: the lowest sole corner
         omega = math.sqrt(9.81 / max(float(s.com[2]) - floor, 0.3))  # LIPM, as the bow's
         cp = com + vel / omega
-        seen = cp
-        if st.ahead:
-            seen = cp + st.ahead * self._rate(cp, t)
         if self.foot < 0 and self._close and s.foot_contact.any():
             # after a step, the foot it stood on, if left hanging, is brought down beside the
             # stepped one (on the stepped foot alone the COM servo's hip offsets swung the
@@ -744,7 +719,7 @@ class Stepper:
             lo, hi = s.support_extent(h)
             # how far the capture point lies outside the soles' box (along the feet only
             # unless sideways), and the way out
-            out = np.maximum(seen - hi[:2], 0.0) - np.maximum(lo[:2] - seen, 0.0)
+            out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
             if not self.sideways:
                 out[1] = 0.0
             beyond = float(np.hypot(*out))
@@ -752,7 +727,7 @@ class Stepper:
                 return
             # the farther foot swings (on a sideways fall toward the standing foot it crosses
             # over, see below)
-            k = int(np.argmax(np.linalg.norm(feet - seen, axis=1)))
+            k = int(np.argmax(np.linalg.norm(feet - cp, axis=1)))
             if not s.foot_contact[1 - k]:
                 return
             self.foot, self._out, self._t0 = k, out / beyond, t
@@ -764,10 +739,7 @@ class Stepper:
             self._bend = 0.0
             self._hip[:] = rig.current_angles()[_HIP[k]]
         u = (t - self._t0) / st.seconds
-        down_ok = u >= 0.5 and bool(s.foot_contact[k])
-        if down_ok and st.past and self._out is not None:  # short of the standing foot: on
-            down_ok = float((feet[k] - feet[1 - k]) @ self._out) > 0.0
-        if down_ok or u >= 3.0:  # down: balance on both feet
+        if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
             self.record[-1]["s"] = t - self._t0
             self._close, self._stood = self._out is not None and not self.standing, 1 - k
@@ -818,9 +790,6 @@ class Stepper:
         swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
         knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
         knee += st.lift * math.sin(math.pi * min(max(u, 0.0), 1.0))
-        if st.carry:  # the thigh aimed so the lifted ankle stays on the hip-to-place line
-            lifted = math.sqrt(ul * ul + ll * ll + 2.0 * ul * ll * math.cos(knee))
-            geom += st.carry * (float(knee_for_length(ul, ll, lifted)[1]) - geom)
         # the leg aimed in the world at the place, whatever the pelvis's orientation (as the
         # landing's reach); the COM servo's offsets off it, its weight on the other foot
         self._thigh[0] = -swing + geom
@@ -839,17 +808,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-
-    def _rate(self, cp: F64, t: float) -> F64:
-        """The capture point's rate (m/s, heading frame), low-passed over
-        :data:`STEP_RATE_TAU` (:attr:`Step.ahead`)."""
-        if not math.isnan(self._t_cp) and t > self._t_cp:
-            dt = t - self._t_cp
-            w = min(dt / STEP_RATE_TAU, 1.0)
-            self._cp_rate += w * ((cp - self._cp_last) / dt - self._cp_rate)
-        self._cp_last[:] = cp
-        self._t_cp = t
-        return self._cp_rate
 
     def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
         """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough
