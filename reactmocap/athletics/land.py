@@ -223,6 +223,17 @@ class LandingParams:
             forward (+8..+10 kg m^2/s, the COM creeping on at 0.02-0.11 m/s) met neither, stayed
             in the recovery 0.5 s and fell forward; the balance takes such momentum down
             (docs/athletics.md).
+        recover_push: in the recovery, while the pelvis pitches forward, the stance legs
+            push down with this much more than one body weight (body weights, vertical, as
+            the absorption's push); 0: off. Why: the trunk's forward pitch takes the forward
+            speed off a male back layout's standing up, and its reaction through the hips
+            lifted the feet (docs/athletics.md).
+        recover_knee: the knees' stiffness in the recovery as a fraction of the balance's
+            (a softer stand-up); 1: off.
+        carry_pitch: the balance after the landing starts its pelvis pitch target from the
+            recovery's last target (its lean eased from there), not from the pelvis's pitch;
+            off: the target drops to the pelvis's pitch at the hand-over (0.44 rad on a male
+            back layout with ``lean`` 0.8).
     """
 
     knee: float = 0.6
@@ -259,6 +270,9 @@ class LandingParams:
     turn_window: float = 0.1
     late_delta: tuple[float, ...] = ()
     recover_spin: float = 0.0
+    recover_push: float = 0.0
+    recover_knee: float = 1.0
+    carry_pitch: bool = False
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -286,6 +300,8 @@ class LandingParams:
             "turn_gain",
             "turn_ref",
             "recover_spin",
+            "recover_push",
+            "recover_knee",
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -314,6 +330,13 @@ class LandingParams:
             )
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
+        if not 0.0 <= self.recover_push <= MAX_SUPPORT - 1.0:
+            raise ConfigError(
+                f"landing recover_push must be in [0, {MAX_SUPPORT - 1.0:g}] body weights, "
+                f"got {self.recover_push}"
+            )
+        if not 0.0 < self.recover_knee <= 1.0:
+            raise ConfigError(f"landing recover_knee must be in (0, 1], got {self.recover_knee}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
             raise ConfigError(f"landing roll_min must be in [0, pi/2] rad, got {self.roll_min}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
@@ -567,6 +590,18 @@ class Landing(Basis):
             leg = _leg_fraction(ctx)
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
             bl.set_posture(Posture(leg=max(leg, 0.5), lean=p.lean, settle=0.3), t)
+            if p.recover_knee < 1.0:  # a softer stand-up (recover_knee)
+                stiff = rig.stiffness.copy()
+                stiff[_KNEE] *= p.recover_knee
+                rig.set_stiffness(stiff)
+
+        def recover(world: World, t: float) -> None:
+            """The balance law; the legs push harder while the trunk pitches forward."""
+            if p.recover_push:  # (see recover_push)
+                s = ctx.sense(t)
+                rate = float(world.data.cvel[s.root, :3] @ s.side_axis())
+                rig.support_scale = 1.0 + p.recover_push * (rate > 0.0)
+            stand(world, t)
 
         def settled(world: World, t: float, t_in: float) -> bool:
             s = ctx.sense(t)
@@ -582,16 +617,18 @@ class Landing(Basis):
 
         def done(world: World, t: float) -> None:
             del world
+            rig.support_scale = 1.0  # recover_push ends here
             ctx.handover["posture"] = bl.posture
             if bl.stepper is not None:
                 ctx.handover["stepper"] = bl.stepper
-            del t
+            if p.carry_pitch:  # the balance's pitch target starts from ours (carry_pitch)
+                ctx.handover["pitch"] = bl.pitch_target(t)
 
         return [
             State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),
             State("absorb", law(absorb, every), absorb_enter,
                   ((slowed, "recover"), (after(1.0), "recover"))),
-            State("recover", law(stand, every), recover_enter,
+            State("recover", law(recover, every), recover_enter,
                   ((settled, "done"), (after(1.0), "done"))),
             State("done", law(stand, every), done, ((after(0.0), NEXT),)),
         ]  # fmt: skip

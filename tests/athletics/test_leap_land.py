@@ -187,6 +187,15 @@ def test_landing_twist_arms_must_be_in_range() -> None:
             LandingParams(twist_arms=bad)
 
 
+def test_landing_recovery_options_must_be_in_range() -> None:
+    for bad in (-0.1, 5.5, float("nan")):
+        with pytest.raises(ConfigError, match="recover_push"):
+            LandingParams(recover_push=bad)
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(ConfigError, match="recover_knee"):
+            LandingParams(recover_knee=bad)
+
+
 def test_flight_conserves_angular_momentum() -> None:
     # a leap with pitch momentum; in the air only internal torques act
     r = run("leap", "male", effort=0.4, spin=15.0, push="timed")
