@@ -388,11 +388,6 @@ class BalanceLaw:
         self.stepper: Stepper | None = None
         #: the pelvis's roll target (rad, heading frame; 0 upright): the landing's roll_ease
         self.roll = 0.0
-        #: a landing's recover_push: extra body weights pushed down by the stance legs while
-        #: the pelvis pitches forward, until when (s); or None
-        self.push: tuple[float, float] | None = None
-        #: a landing's recover_knee: the knees' stiffness scale, until when (s); or None
-        self.soft_knees: tuple[float, float] | None = None
         self._knee_standing = float(np.mean(knee_for_length(
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
 
@@ -428,14 +423,6 @@ class BalanceLaw:
         # the commanded pitch starts from where the pelvis is (less the new posture's lean)
         self._pitch0 = (self.pelvis_pitch() if pitch_from is None else pitch_from) - self.lean()
         self._t_pitch = t
-
-    def soften_knees(self, scale: float, until: float) -> None:
-        """The knees' stiffness times ``scale`` until ``until`` (s), then the gains' again."""
-        rig = self.ctx.rig
-        stiff = rig.stiffness.copy()
-        stiff[_KNEE] *= scale
-        rig.set_stiffness(stiff)
-        self.soft_knees = (scale, until)
 
     def set_com_offset(self, offset: tuple[float, float]) -> None:
         """The COM target's offset from the support centre (m, heading frame) from now on, at
@@ -574,16 +561,6 @@ class BalanceLaw:
         hang = self._plant(s, d, h) if self.posture.plant else None
         self._level_legs(d, desired, hang)
         self.support(s)
-        if self.push is not None:
-            extra, until = self.push
-            forward = float(d.cvel[s.root, :3] @ s.side_axis()) > 0.0
-            rig.support_scale = 1.0 + extra * forward if t < until else 1.0
-            self.push = self.push if t < until else None
-        if self.soft_knees is not None and t >= self.soft_knees[1]:
-            stiff = rig.stiffness.copy()
-            stiff[_KNEE] = self.gains.stiffness_array()[_KNEE]
-            rig.set_stiffness(stiff)
-            self.soft_knees = None
         if self.stepper is not None:
             self.stepper.control(self, d, h, t)
 
@@ -999,15 +976,9 @@ class Balance(Basis):
             stepper = ctx.handover.get("stepper")
             if bl.stepper is None and isinstance(stepper, Stepper):  # the landing's step goes on
                 bl.stepper = stepper
-            push = ctx.handover.pop("push", None)  # a landing's recover_push goes on
-            if isinstance(push, tuple):
-                bl.push = push
             # a landing's last pitch target, carried on (LandingParams.carry_pitch)
             pitch = ctx.handover.pop("pitch", None)
             bl.set_posture(self.posture, t, pitch_from=pitch if isinstance(pitch, float) else None)
-            soft = ctx.handover.pop("soft_knees", None)  # a landing's recover_knee goes on
-            if isinstance(soft, tuple):
-                bl.soften_knees(*soft)
 
         exits: list[tuple[Event, str]] = []
         if self.until is not None:

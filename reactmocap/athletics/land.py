@@ -223,15 +223,6 @@ class LandingParams:
             forward (+8..+10 kg m^2/s, the COM creeping on at 0.02-0.11 m/s) met neither, stayed
             in the recovery 0.5 s and fell forward; the balance takes such momentum down
             (docs/athletics.md).
-        recover_push: ``(body weights, seconds)``: from the recovery's start, for that long
-            (carried on by the balance that follows), while the pelvis pitches forward the
-            stance legs push down with that much more than one body weight (vertical);
-            empty: off. Why: the trunk's forward pitch takes the forward speed off a male
-            back layout's standing up, and its reaction through the hips lifted the feet
-            (docs/athletics.md).
-        recover_knee: ``(fraction, seconds)``: from the recovery's start, for that long
-            (carried on by the balance that follows), the knees' stiffness is that fraction
-            of the balance's (a softer stand-up); empty: off.
         carry_pitch: the balance after the landing starts its pelvis pitch target from the
             recovery's last target (its lean eased from there), not from the pelvis's pitch;
             off: the target drops to the pelvis's pitch at the hand-over (0.44 rad on a male
@@ -272,8 +263,6 @@ class LandingParams:
     turn_window: float = 0.1
     late_delta: tuple[float, ...] = ()
     recover_spin: float = 0.0
-    recover_push: tuple[float, ...] = ()
-    recover_knee: tuple[float, ...] = ()
     carry_pitch: bool = False
 
     def __post_init__(self) -> None:
@@ -328,28 +317,12 @@ class LandingParams:
                 "landing late_delta must be (seconds in [0, 1], offset > 0 m, delta m), "
                 f"got {self.late_delta!r}"
             )
+        if not isinstance(self.carry_pitch, bool):
+            raise ConfigError(
+                f"landing carry_pitch must be true or false, got {self.carry_pitch!r}"
+            )
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
-        if self.recover_push and not (
-            len(self.recover_push) == 2
-            and all(isinstance(x, (int, float)) and math.isfinite(x) for x in self.recover_push)
-            and 0.0 < self.recover_push[0] <= MAX_SUPPORT - 1.0
-            and 0.0 < self.recover_push[1] <= 2.0
-        ):
-            raise ConfigError(
-                f"landing recover_push must be (body weights in (0, {MAX_SUPPORT - 1.0:g}], "
-                f"seconds in (0, 2]), got {self.recover_push!r}"
-            )
-        if self.recover_knee and not (
-            len(self.recover_knee) == 2
-            and all(isinstance(x, (int, float)) and math.isfinite(x) for x in self.recover_knee)
-            and 0.0 < self.recover_knee[0] < 1.0
-            and 0.0 < self.recover_knee[1] <= 2.0
-        ):
-            raise ConfigError(
-                "landing recover_knee must be (fraction in (0, 1), seconds in (0, 2]), "
-                f"got {self.recover_knee!r}"
-            )
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
             raise ConfigError(f"landing roll_min must be in [0, pi/2] rad, got {self.roll_min}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
@@ -603,10 +576,6 @@ class Landing(Basis):
             leg = _leg_fraction(ctx)
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
             bl.set_posture(Posture(leg=max(leg, 0.5), lean=p.lean, settle=0.3), t)
-            if p.recover_knee:  # a softer stand-up (recover_knee)
-                bl.soften_knees(p.recover_knee[0], t + p.recover_knee[1])
-            if p.recover_push:  # (see recover_push)
-                bl.push = (p.recover_push[0], t + p.recover_push[1])
 
         def settled(world: World, t: float, t_in: float) -> bool:
             s = ctx.sense(t)
@@ -625,10 +594,6 @@ class Landing(Basis):
             ctx.handover["posture"] = bl.posture
             if bl.stepper is not None:
                 ctx.handover["stepper"] = bl.stepper
-            if bl.push is not None:  # the push goes on (recover_push)
-                ctx.handover["push"] = bl.push
-            if bl.soft_knees is not None:  # (recover_knee)
-                ctx.handover["soft_knees"] = bl.soft_knees
             if p.carry_pitch:  # the balance's pitch target starts from ours (carry_pitch)
                 ctx.handover["pitch"] = bl.pitch_target(t)
 

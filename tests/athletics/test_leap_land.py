@@ -187,13 +187,9 @@ def test_landing_twist_arms_must_be_in_range() -> None:
             LandingParams(twist_arms=bad)
 
 
-def test_landing_recovery_options_must_be_in_range() -> None:
-    for bad in ((0.5,), (-0.1, 0.3), (5.5, 0.3), (0.5, 0.0), (0.5, 3.0), (float("nan"), 0.3)):
-        with pytest.raises(ConfigError, match="recover_push"):
-            LandingParams(recover_push=bad)
-    for bad in ((0.5,), (0.0, 0.3), (1.0, 0.3), (0.5, 0.0), (float("nan"), 0.3)):
-        with pytest.raises(ConfigError, match="recover_knee"):
-            LandingParams(recover_knee=bad)
+def test_landing_carry_pitch_must_be_a_bool() -> None:
+    with pytest.raises(ConfigError, match="carry_pitch"):
+        LandingParams(carry_pitch=1)  # type: ignore[arg-type]
 
 
 def test_flight_conserves_angular_momentum() -> None:
