@@ -393,12 +393,13 @@ class BalanceLaw:
 
     def set_posture(
         self, posture: Posture, t: float, gains: bool = True, ease_com: bool = False,
-        com_over: float | None = None,
+        com_over: float | None = None, pitch_from: float | None = None,
     ) -> None:  # fmt: skip
         """Move the knees, spine and arms toward ``posture`` over ``posture.settle`` s;
         ``ease_com``: the COM target's offset too, from the last posture's (a step in it
         steps the COM servo's ankle offsets: a broad jump's 17 cm hopped the body off the
-        floor as its crouch began), over ``com_over`` s if given (else ``posture.settle``)."""
+        floor as its crouch began), over ``com_over`` s if given (else ``posture.settle``);
+        ``pitch_from``: the pelvis pitch target (rad) to start from, else the pelvis's pitch."""
         self._com0 = self.posture.com_offset if ease_com else None
         self._com_over = com_over
         self.posture = posture
@@ -420,7 +421,7 @@ class BalanceLaw:
         moving = [j for j in range(NJ) if not np.isnan(goal[j]).all()]
         rig.move(goal, posture.settle, t, moving)
         # the commanded pitch starts from where the pelvis is (less the new posture's lean)
-        self._pitch0 = self.pelvis_pitch() - self.lean()
+        self._pitch0 = (self.pelvis_pitch() if pitch_from is None else pitch_from) - self.lean()
         self._t_pitch = t
 
     def set_com_offset(self, offset: tuple[float, float]) -> None:
@@ -464,6 +465,10 @@ class BalanceLaw:
             return self.posture.pitch
         s = min(max((t - self._t_pitch) / max(self.posture.settle, 1e-9), 0.0), 1.0)
         return self._pitch0 + (self.posture.pitch - self._pitch0) * s * s * (3 - 2 * s)
+
+    def pitch_target(self, t: float) -> float:
+        """The pelvis pitch target (rad, forward > 0) at ``t``, as :meth:`control` commands it."""
+        return self._pitch_now(t) + self.lean()
 
     def control(self, world: World, t: float) -> None:
         ctx = self.ctx
@@ -510,7 +515,7 @@ class BalanceLaw:
         delta = g.kp * err - g.kv * vel
         delta[1] *= g.side
         np.clip(delta, -g.max_offset, g.max_offset, out=delta)
-        pitch = self._pitch_now(t) + self.lean()
+        pitch = self.pitch_target(t)
         cp = cp_side = 0.0
         if any(x is not None for x in (g.bow, g.arms, g.windmill, g.windmill_side)):
             omega = math.sqrt(9.81 / max(float(s.com[2] - centre[2]), 0.3))  # LIPM
@@ -971,7 +976,9 @@ class Balance(Basis):
             stepper = ctx.handover.get("stepper")
             if bl.stepper is None and isinstance(stepper, Stepper):  # the landing's step goes on
                 bl.stepper = stepper
-            bl.set_posture(self.posture, t)
+            # a landing's last pitch target, carried on (LandingParams.carry_pitch)
+            pitch = ctx.handover.pop("pitch", None)
+            bl.set_posture(self.posture, t, pitch_from=pitch if isinstance(pitch, float) else None)
 
         exits: list[tuple[Event, str]] = []
         if self.until is not None:

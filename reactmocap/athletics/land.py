@@ -223,6 +223,10 @@ class LandingParams:
             forward (+8..+10 kg m^2/s, the COM creeping on at 0.02-0.11 m/s) met neither, stayed
             in the recovery 0.5 s and fell forward; the balance takes such momentum down
             (docs/athletics.md).
+        carry_pitch: the balance after the landing starts its pelvis pitch target from the
+            recovery's last target (its lean eased from there), not from the pelvis's pitch;
+            off: the target drops to the pelvis's pitch at the hand-over (0.44 rad on a male
+            back layout with ``lean`` 0.8).
     """
 
     knee: float = 0.6
@@ -259,6 +263,7 @@ class LandingParams:
     turn_window: float = 0.1
     late_delta: tuple[float, ...] = ()
     recover_spin: float = 0.0
+    carry_pitch: bool = False
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -311,6 +316,10 @@ class LandingParams:
             raise ConfigError(
                 "landing late_delta must be (seconds in [0, 1], offset > 0 m, delta m), "
                 f"got {self.late_delta!r}"
+            )
+        if not isinstance(self.carry_pitch, bool):
+            raise ConfigError(
+                f"landing carry_pitch must be true or false, got {self.carry_pitch!r}"
             )
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
@@ -585,7 +594,8 @@ class Landing(Basis):
             ctx.handover["posture"] = bl.posture
             if bl.stepper is not None:
                 ctx.handover["stepper"] = bl.stepper
-            del t
+            if p.carry_pitch:  # the balance's pitch target starts from ours (carry_pitch)
+                ctx.handover["pitch"] = bl.pitch_target(t)
 
         return [
             State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),

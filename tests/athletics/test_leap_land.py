@@ -187,6 +187,11 @@ def test_landing_twist_arms_must_be_in_range() -> None:
             LandingParams(twist_arms=bad)
 
 
+def test_landing_carry_pitch_must_be_a_bool() -> None:
+    with pytest.raises(ConfigError, match="carry_pitch"):
+        LandingParams(carry_pitch=1)  # type: ignore[arg-type]
+
+
 def test_flight_conserves_angular_momentum() -> None:
     # a leap with pitch momentum; in the air only internal torques act
     r = run("leap", "male", effort=0.4, spin=15.0, push="timed")

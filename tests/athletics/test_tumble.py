@@ -918,3 +918,23 @@ def test_a_back_layout_falling_forward_off_its_absorption_leans_into_it() -> Non
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
     r = run_maneuver(_without_land_param(m, "lean"), perturbation=start, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
+
+
+def test_a_back_layout_carrying_its_pitch_target_leans_on_past_the_hand_over() -> None:
+    """``back_layout.toml``'s landing leans the trunk 0.8 rad per radian of knee flexion, the
+    balance after it 0.5: at the hand-over its pelvis pitch target dropped to the pelvis's
+    pitch (0.44 rad on a perturbed start). With ``carry_pitch`` the balance starts from the
+    landing's last target, so the trunk leans farther forward over the next 0.15 s."""
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = next(ph for ph in m.phases if ph.controller == "land")
+
+    def lean_after_hand_over(carry: bool) -> float:
+        r = run_maneuver(_with_land_params(m, {**land.params, "carry_pitch": carry}), fps=10.0)
+        t0 = next(t for t, a, _ in r.transitions if a == "land.done")
+        t = r.log["t"]
+        window = (t >= t0) & (t <= t0 + 0.15)
+        assert window.sum() > 10 and r.report["landed"]
+        # the pelvis-to-head line's angle from the vertical, at its largest
+        return float(np.arccos(np.clip(r.log["trunk"][window, 2], -1.0, 1.0)).max())
+
+    assert lean_after_hand_over(True) > lean_after_hand_over(False) + 0.03
