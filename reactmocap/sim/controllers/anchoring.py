@@ -75,6 +75,9 @@ _LAG_SLOW = 0.5
 # ``anchor_lag_heading``: a body's heading counts only above this speed (m/s): a body the push
 # has nearly stopped moves every way
 _LAG_MOVING = 0.2
+# ``step_ahead_horizon``: the capture point's speed is smoothed with this time constant (s):
+# a landing's impact moves it by metres per second for a tick
+_AHEAD_RATE_TAU = 0.03
 
 
 def _left_of(heading: float) -> F64:
@@ -130,6 +133,8 @@ class AnchoredReference:
         anchor_lag_heading: float = 0.0,
         anchor_lag_speed: float = 0.0,
         step_ahead: float = 0.0,
+        step_ahead_horizon: float = 0.0,
+        step_ahead_reach: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -238,6 +243,12 @@ class AnchoredReference:
         self.step_ahead = float(step_ahead)
         self._ahead_margin = self._clip_ahead_margin() if self.step_ahead else np.inf
         self._ahead_armed = False
+        # ``step_ahead_horizon``: the lead predicted this far ahead (s) by the capture point's
+        # smoothed velocity (2,), from its last slow tick's time and position
+        self.step_ahead_horizon = float(step_ahead_horizon)
+        self.step_ahead_reach = float(step_ahead_reach)
+        self._xi_rate = np.zeros(2)
+        self._xi_last: tuple[float, F64] = (-np.inf, np.zeros(2))
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -511,6 +522,8 @@ class AnchoredReference:
                 self.step = None
                 self._step_ready = t + 0.05
                 self._landed = (s.foot, t)
+        if self._ahead_armed and self.step_ahead_horizon:
+            self._track_capture_rate(t)
         if self._ahead_armed and self.step is None and t >= self._step_ready:
             self._step_ahead(t)
         if self.step is not None or not self.stepping or t < self._step_ready:
@@ -557,15 +570,17 @@ class AnchoredReference:
         self._start_step(t, foot, centre, xi, omega, left, shorten=True)
 
     def _start_step(
-        self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64, shorten: bool
-    ) -> None:
+        self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64, shorten: bool,
+        reach: float = 0.6,
+    ) -> None:  # fmt: skip
         """Start a balance step of ``foot`` (sole centres ``centre``, ``(2, 3)``) to
         :func:`step_target` for capture point ``xi``; ``left`` is the soles' unit left
         vector. ``shorten``: after a landed step, a short step (``step_short``) takes less
-        than the whole step time. The one step start of both step triggers."""
+        than the whole step time; ``reach``: the step's longest (m) from the stance foot. The
+        one step start of both step triggers."""
         target = step_target(
             xi, centre[1 - foot, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
-            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
+            max_length=reach, min_width=0.12, lateral=left if foot == 0 else -left,
         )  # fmt: skip
         duration = self.step_time
         if shorten and self.step_short and self._landed[0] >= 0:
@@ -632,10 +647,28 @@ class AnchoredReference:
         xi, omega = self.capture_point()
         centre = self._sole_centres()
         front = int(np.argmax(centre[:, :2] @ u))
-        if float((xi - centre[front, :2]) @ u) <= self._ahead_margin * self.step_ahead:
+        lead = float((xi - centre[front, :2]) @ u)
+        limit = self._ahead_margin * self.step_ahead
+        # ``step_ahead_horizon``: the lead as its growth will have it a short time ahead
+        grown = lead + self.step_ahead_horizon * float(self._xi_rate @ u)
+        if max(lead, grown) <= limit:
             return
+        # a step the growth started before the lead would may reach further
+        reach = self.step_ahead_reach if self.step_ahead_reach and lead <= limit else 0.6
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False)  # fmt: skip
+                         shorten=False, reach=reach)  # fmt: skip
+
+    def _track_capture_rate(self, t: float) -> None:
+        """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
+        change since the last slow tick, smoothed (``_AHEAD_RATE_TAU``); restarted after a
+        gap."""
+        xi, _ = self.capture_point()
+        t0, xi0 = self._xi_last
+        dt = t - t0
+        if 0 < dt <= 2.5 * self._dt_slow:
+            k = min(1.0, dt / _AHEAD_RATE_TAU)
+            self._xi_rate += k * ((xi - xi0) / dt - self._xi_rate)
+        self._xi_last = (t, xi.copy())
 
     def rebalance(self, t: float) -> None:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
@@ -823,6 +856,8 @@ class AnchoredReference:
         self._lag_acted = False
         self._catching = False
         self._ahead_armed = False
+        self._xi_rate = np.zeros(2)
+        self._xi_last = (-np.inf, np.zeros(2))
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
 
