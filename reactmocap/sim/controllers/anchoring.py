@@ -247,6 +247,11 @@ class AnchoredReference:
         # smoothed velocity (2,), from its last slow tick's time and position
         self.step_ahead_horizon = float(step_ahead_horizon)
         self.step_ahead_reach = float(step_ahead_reach)
+        # against the clip's own lead grown the same way: a walk's capture point runs ahead
+        # at its speed in every double support
+        self._grown_margin = (
+            self._clip_ahead_margin(self.step_ahead_horizon) if self.step_ahead_horizon else np.inf
+        )
         self._xi_rate = np.zeros(2)
         self._xi_last: tuple[float, F64] = (-np.inf, np.zeros(2))
         self._dt_slow = float(dt_slow)
@@ -606,12 +611,13 @@ class AnchoredReference:
         self._gone_down |= bool(up @ self._root_up0 < _STEP_TILT_COS)
         return self._gone_down or bool(d.qpos[self._z_adr] < 0.75 * self._z0)
 
-    def _clip_ahead_margin(self) -> float:
+    def _clip_ahead_margin(self, horizon: float = 0.0) -> float:
         """``step_ahead``'s base: the clip's own capture point's largest lead (m) past its
         front foot along its walk over the frames where both feet are planted and it walks
-        (0.2 m/s or faster); 0 for a clip that never does."""
+        (0.2 m/s or faster), grown by its speed over ``horizon`` s (``step_ahead_horizon``);
+        0 for a clip that never does."""
         assert self.path.sole is not None
-        c, v = self._com, self._com_v
+        c, v, a = self._com, self._com_v, self._com_a
         speed = np.hypot(v[:, 0], v[:, 1])
         both = self.path.planted.all(axis=1) & (speed > 0.2)
         if not both.any():
@@ -619,6 +625,8 @@ class AnchoredReference:
         u = v[both, :2] / speed[both, None]
         omega = np.sqrt(-self._gravity[2] / np.maximum(c[both, 2] - self.floor_z, 0.3))
         xi = c[both, :2] + v[both, :2] / omega[:, None]
+        if horizon:  # and its velocity, v + a / omega, over the horizon
+            xi += horizon * (v[both, :2] + a[both, :2] / omega[:, None])
         sole = self.path.sole[both, :, :2]
         front = np.einsum("kfi,ki->kf", sole, u).max(axis=1)
         return float(max(0.0, (np.einsum("ki,ki->k", xi, u) - front).max()))
@@ -651,7 +659,7 @@ class AnchoredReference:
         limit = self._ahead_margin * self.step_ahead
         # ``step_ahead_horizon``: the lead as its growth will have it a short time ahead
         grown = lead + self.step_ahead_horizon * float(self._xi_rate @ u)
-        if max(lead, grown) <= limit:
+        if lead <= limit and grown <= self._grown_margin * self.step_ahead:
             return
         # a step the growth started before the lead would may reach further
         reach = self.step_ahead_reach if self.step_ahead_reach and lead <= limit else 0.6
