@@ -75,9 +75,10 @@ _LAG_SLOW = 0.5
 # ``anchor_lag_heading``: a body's heading counts only above this speed (m/s): a body the push
 # has nearly stopped moves every way
 _LAG_MOVING = 0.2
-# ``step_ahead_horizon``: the capture point's speed is smoothed with this time constant (s):
-# a landing's impact moves it by metres per second for a tick
-_AHEAD_RATE_TAU = 0.03
+# ``step_ahead_horizon``: the capture point's velocity is smoothed with this time constant
+# (s): a landing's impact moves it by metres per second for a tick (0.03 s lost 2 walking
+# pushes of 42 that 0.1 s keeps)
+_AHEAD_RATE_TAU = 0.1
 
 
 def _left_of(heading: float) -> F64:
@@ -134,7 +135,6 @@ class AnchoredReference:
         anchor_lag_speed: float = 0.0,
         step_ahead: float = 0.0,
         step_ahead_horizon: float = 0.0,
-        step_ahead_reach: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -246,7 +246,6 @@ class AnchoredReference:
         # ``step_ahead_horizon``: the lead predicted this far ahead (s) by the capture point's
         # smoothed velocity (2,), from its last slow tick's time and position
         self.step_ahead_horizon = float(step_ahead_horizon)
-        self.step_ahead_reach = float(step_ahead_reach)
         # against the clip's own lead grown the same way: a walk's capture point runs ahead
         # at its speed in every double support
         self._grown_margin = (
@@ -575,17 +574,15 @@ class AnchoredReference:
         self._start_step(t, foot, centre, xi, omega, left, shorten=True)
 
     def _start_step(
-        self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64, shorten: bool,
-        reach: float = 0.6,
-    ) -> None:  # fmt: skip
+        self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64, shorten: bool
+    ) -> None:
         """Start a balance step of ``foot`` (sole centres ``centre``, ``(2, 3)``) to
         :func:`step_target` for capture point ``xi``; ``left`` is the soles' unit left
         vector. ``shorten``: after a landed step, a short step (``step_short``) takes less
-        than the whole step time; ``reach``: the step's longest (m) from the stance foot. The
-        one step start of both step triggers."""
+        than the whole step time. The one step start of both step triggers."""
         target = step_target(
             xi, centre[1 - foot, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
-            max_length=reach, min_width=0.12, lateral=left if foot == 0 else -left,
+            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
         )  # fmt: skip
         duration = self.step_time
         if shorten and self.step_short and self._landed[0] >= 0:
@@ -661,10 +658,8 @@ class AnchoredReference:
         grown = lead + self.step_ahead_horizon * float(self._xi_rate @ u)
         if lead <= limit and grown <= self._grown_margin * self.step_ahead:
             return
-        # a step the growth started before the lead would may reach further
-        reach = self.step_ahead_reach if self.step_ahead_reach and lead <= limit else 0.6
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False, reach=reach)  # fmt: skip
+                         shorten=False)  # fmt: skip
 
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
