@@ -611,7 +611,7 @@ class AnchoredReference:
     def _clip_ahead_margin(self, horizon: float = 0.0) -> float:
         """``step_ahead``'s base: the clip's own capture point's largest lead (m) past its
         front foot along its walk over the frames where both feet are planted and it walks
-        (0.2 m/s or faster), grown by its speed over ``horizon`` s (``step_ahead_horizon``);
+        (0.2 m/s or faster), grown by its velocity over ``horizon`` s (``step_ahead_horizon``);
         0 for a clip that never does."""
         assert self.path.sole is not None
         c, v, a = self._com, self._com_v, self._com_a
@@ -632,8 +632,9 @@ class AnchoredReference:
         """After a walk's push (``step_ahead``): while the clip holds both feet planted and
         both are on the floor, a capture point more than the clip's own largest lead
         (:meth:`_clip_ahead_margin`) times ``step_ahead`` past the front foot along the
-        clip's walk starts a balance step of the rear foot (:func:`step_target`); the clip
-        plays on as it would (its clock moved on to that foot's own step lost more pushes).
+        clip's walk starts a balance step of the rear foot (:func:`step_target`), and so
+        does a lead grown over ``step_ahead_horizon`` s past the clip's own grown the same
+        way; the clip plays on as it would (its clock moved on to that foot's own step lost more pushes).
         A body that ran past its feet in a double support of the clip's got its next step
         too late (``docs/tracking.md``)."""
         i = self.clock.nearest(t)
