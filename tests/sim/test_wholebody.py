@@ -280,12 +280,21 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("anchor_lag_heading", -30.0),
         ("anchor_lag_speed", -0.45),
         ("step_ahead", -1.0),
+        ("step_ahead_horizon", -0.1),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match=key):
         _tracker(world, guard, 0.0, **{key: value})
+
+
+def test_step_ahead_growth_needs_its_step(guard: Motion) -> None:
+    """The lead's growth (``step_ahead_horizon``) only extends ``step_ahead``'s trigger:
+    alone it is refused."""
+    world = World(build_character(guard, frame=0))
+    with pytest.raises(ConfigError, match="step_ahead_horizon"):
+        _tracker(world, guard, 0.0, step_ahead_horizon=0.1)
 
 
 def test_unknown_character_rejected(guard: Motion) -> None:

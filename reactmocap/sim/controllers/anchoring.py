@@ -75,6 +75,10 @@ _LAG_SLOW = 0.5
 # ``anchor_lag_heading``: a body's heading counts only above this speed (m/s): a body the push
 # has nearly stopped moves every way
 _LAG_MOVING = 0.2
+# ``step_ahead_horizon``: the capture point's velocity is smoothed with this time constant
+# (s): a landing's impact moves it by metres per second for a tick (0.03 s lost 2 walking
+# pushes of 42 that 0.1 s keeps)
+_AHEAD_RATE_TAU = 0.1
 
 
 def _left_of(heading: float) -> F64:
@@ -130,6 +134,7 @@ class AnchoredReference:
         anchor_lag_heading: float = 0.0,
         anchor_lag_speed: float = 0.0,
         step_ahead: float = 0.0,
+        step_ahead_horizon: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -238,6 +243,16 @@ class AnchoredReference:
         self.step_ahead = float(step_ahead)
         self._ahead_margin = self._clip_ahead_margin() if self.step_ahead else np.inf
         self._ahead_armed = False
+        # ``step_ahead_horizon``: the lead predicted this far ahead (s) by the capture point's
+        # smoothed velocity (2,), from its last slow tick's time and position
+        self.step_ahead_horizon = float(step_ahead_horizon)
+        # against the clip's own lead grown the same way: a walk's capture point runs ahead
+        # at its speed in every double support
+        self._grown_margin = (
+            self._clip_ahead_margin(self.step_ahead_horizon) if self.step_ahead_horizon else np.inf
+        )
+        self._xi_rate = np.zeros(2)
+        self._xi_last: tuple[float, F64] = (-np.inf, np.zeros(2))
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -511,6 +526,8 @@ class AnchoredReference:
                 self.step = None
                 self._step_ready = t + 0.05
                 self._landed = (s.foot, t)
+        if self._ahead_armed and self.step_ahead_horizon:
+            self._track_capture_rate(t)
         if self._ahead_armed and self.step is None and t >= self._step_ready:
             self._step_ahead(t)
         if self.step is not None or not self.stepping or t < self._step_ready:
@@ -591,12 +608,13 @@ class AnchoredReference:
         self._gone_down |= bool(up @ self._root_up0 < _STEP_TILT_COS)
         return self._gone_down or bool(d.qpos[self._z_adr] < 0.75 * self._z0)
 
-    def _clip_ahead_margin(self) -> float:
+    def _clip_ahead_margin(self, horizon: float = 0.0) -> float:
         """``step_ahead``'s base: the clip's own capture point's largest lead (m) past its
         front foot along its walk over the frames where both feet are planted and it walks
-        (0.2 m/s or faster); 0 for a clip that never does."""
+        (0.2 m/s or faster), grown by its velocity over ``horizon`` s (``step_ahead_horizon``);
+        0 for a clip that never does."""
         assert self.path.sole is not None
-        c, v = self._com, self._com_v
+        c, v, a = self._com, self._com_v, self._com_a
         speed = np.hypot(v[:, 0], v[:, 1])
         both = self.path.planted.all(axis=1) & (speed > 0.2)
         if not both.any():
@@ -604,6 +622,8 @@ class AnchoredReference:
         u = v[both, :2] / speed[both, None]
         omega = np.sqrt(-self._gravity[2] / np.maximum(c[both, 2] - self.floor_z, 0.3))
         xi = c[both, :2] + v[both, :2] / omega[:, None]
+        if horizon:  # and its velocity, v + a / omega, over the horizon
+            xi += horizon * (v[both, :2] + a[both, :2] / omega[:, None])
         sole = self.path.sole[both, :, :2]
         front = np.einsum("kfi,ki->kf", sole, u).max(axis=1)
         return float(max(0.0, (np.einsum("ki,ki->k", xi, u) - front).max()))
@@ -612,8 +632,9 @@ class AnchoredReference:
         """After a walk's push (``step_ahead``): while the clip holds both feet planted and
         both are on the floor, a capture point more than the clip's own largest lead
         (:meth:`_clip_ahead_margin`) times ``step_ahead`` past the front foot along the
-        clip's walk starts a balance step of the rear foot (:func:`step_target`); the clip
-        plays on as it would (its clock moved on to that foot's own step lost more pushes).
+        clip's walk starts a balance step of the rear foot (:func:`step_target`), and so
+        does a lead grown over ``step_ahead_horizon`` s past the clip's own grown the same
+        way; the clip plays on as it would (its clock moved on to that foot's own step lost more pushes).
         A body that ran past its feet in a double support of the clip's got its next step
         too late (``docs/tracking.md``)."""
         i = self.clock.nearest(t)
@@ -632,10 +653,26 @@ class AnchoredReference:
         xi, omega = self.capture_point()
         centre = self._sole_centres()
         front = int(np.argmax(centre[:, :2] @ u))
-        if float((xi - centre[front, :2]) @ u) <= self._ahead_margin * self.step_ahead:
+        lead = float((xi - centre[front, :2]) @ u)
+        limit = self._ahead_margin * self.step_ahead
+        # ``step_ahead_horizon``: the lead as its growth will have it a short time ahead
+        grown = lead + self.step_ahead_horizon * float(self._xi_rate @ u)
+        if lead <= limit and grown <= self._grown_margin * self.step_ahead:
             return
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
                          shorten=False)  # fmt: skip
+
+    def _track_capture_rate(self, t: float) -> None:
+        """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
+        change since the last slow tick, smoothed (``_AHEAD_RATE_TAU``); restarted after a
+        gap."""
+        xi, _ = self.capture_point()
+        t0, xi0 = self._xi_last
+        dt = t - t0
+        if 0 < dt <= 2.5 * self._dt_slow:
+            k = min(1.0, dt / _AHEAD_RATE_TAU)
+            self._xi_rate += k * ((xi - xi0) / dt - self._xi_rate)
+        self._xi_last = (t, xi.copy())
 
     def rebalance(self, t: float) -> None:
         """Move :attr:`balance_shift` a step (``balance_tau``) toward what brings the mocap's
@@ -823,6 +860,8 @@ class AnchoredReference:
         self._lag_acted = False
         self._catching = False
         self._ahead_armed = False
+        self._xi_rate = np.zeros(2)
+        self._xi_last = (-np.inf, np.zeros(2))
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
 

@@ -253,6 +253,10 @@ class WholeBodyTracker(AnchoredReference):
             (:func:`~reactmocap.sim.controllers.stepping.step_target`; 0: off): a body that
             ran past its feet in a double support of the clip's stepped too late
             (``docs/tracking.md``).
+        step_ahead_horizon: with ``step_ahead``, the step also starts when the lead grown
+            by the capture point's present velocity over this many s passes the clip's own
+            largest lead in its double supports grown the same way (0: the lead now only),
+            so a lead growing fast starts it earlier (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -339,6 +343,7 @@ class WholeBodyTracker(AnchoredReference):
         anchor_lag_heading: float = 0.0,
         anchor_lag_speed: float = 0.0,
         step_ahead: float = 0.0,
+        step_ahead_horizon: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -372,6 +377,7 @@ class WholeBodyTracker(AnchoredReference):
                 "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
                 "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
+                "step_ahead_horizon": step_ahead_horizon,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -385,6 +391,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_leg must be 0 (off) or in [0.5, 1.5] (a leg over the pelvis's height), "
                 f"got {step_leg!r}"
+            )
+        if step_ahead_horizon and not step_ahead:
+            raise ConfigError(
+                f"step_ahead_horizon ({step_ahead_horizon!r}) only extends step_ahead's "
+                f"trigger: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -487,6 +498,7 @@ class WholeBodyTracker(AnchoredReference):
             step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
             anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
+            step_ahead_horizon=step_ahead_horizon,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
