@@ -297,6 +297,19 @@ def test_step_ahead_growth_needs_its_step(guard: Motion) -> None:
         _tracker(world, guard, 0.0, step_ahead_horizon=0.1)
 
 
+def test_a_look_ahead_restores_the_lead_growths_state(guard: Motion) -> None:
+    """``step_ahead_horizon``'s smoothed capture-point velocity is tick-to-tick state: a
+    predictive look ahead (:meth:`memory` / :meth:`restore`) must put it back."""
+    world = World(build_character(guard, frame=0))
+    tracker = _tracker(world, guard, 0.0, step_ahead=1.0, step_ahead_horizon=0.1)
+    memory = tracker.memory()
+    tracker._xi_rate += (0.5, -0.2)  # in place, as the slow tick updates it
+    tracker._xi_last = (1.0, np.ones(2))
+    tracker.restore(memory)
+    assert np.array_equal(tracker._xi_rate, np.zeros(2))
+    assert tracker._xi_last[0] == -np.inf
+
+
 def test_unknown_character_rejected(guard: Motion) -> None:
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="character 2"):

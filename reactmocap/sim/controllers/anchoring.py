@@ -634,7 +634,8 @@ class AnchoredReference:
         (:meth:`_clip_ahead_margin`) times ``step_ahead`` past the front foot along the
         clip's walk starts a balance step of the rear foot (:func:`step_target`), and so
         does a lead grown over ``step_ahead_horizon`` s past the clip's own grown the same
-        way; the clip plays on as it would (its clock moved on to that foot's own step lost more pushes).
+        way; the clip plays on as it would (its clock moved on to that foot's own step lost
+        more pushes).
         A body that ran past its feet in a double support of the clip's got its next step
         too late (``docs/tracking.md``)."""
         i = self.clock.nearest(t)
@@ -878,13 +879,15 @@ class AnchoredReference:
                 self.placing, self._place_until, self._place_move.copy(),
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
-                self.lag_until, self._lag_acted, self._ahead_armed)  # fmt: skip
+                self.lag_until, self._lag_acted, self._ahead_armed, self._xi_rate.copy(),
+                self._xi_last)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
-         catching, drop_step, warp_until, lag_until, lag_acted, ahead_armed) = memory  # fmt: skip
+         catching, drop_step, warp_until, lag_until, lag_acted, ahead_armed, xi_rate,
+         xi_last) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -909,3 +912,5 @@ class AnchoredReference:
         self.lag_until = float(lag_until)  # type: ignore[arg-type]
         self._lag_acted = bool(lag_acted)
         self._ahead_armed = bool(ahead_armed)
+        self._xi_rate = np.array(xi_rate)
+        self._xi_last = xi_last  # type: ignore[assignment]
