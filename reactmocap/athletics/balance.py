@@ -153,27 +153,18 @@ class Step:
             foot clears the floor).
         seconds: the swing's planned duration; the step ends when the swing foot touches
             down after half of it (or at three times it).
-        near: opt-in (``None``: off) early trigger: the step also starts once the capture
-            point has lain within this far (m) of the soles' edge (inside it, or past it by
-            no more than ``margin``) for ``dwell`` s in a row, the COM moving toward that edge.
-        dwell: how long (s) the capture point must stay ``near`` the edge.
     """
 
     margin: float = 0.05
     reach: float = 0.1
     lift: float = 0.3
     seconds: float = 0.25
-    near: float | None = None
-    dwell: float = 0.1
 
     def __post_init__(self) -> None:
-        for name in ("margin", "reach", "lift", "seconds", "dwell"):
+        for name in ("margin", "reach", "lift", "seconds"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise ConfigError(f"step {name} must be a finite number >= 0, got {v!r}")
-        n = self.near
-        if n is not None and not (isinstance(n, (int, float)) and 0.0 <= n <= 0.1):
-            raise ConfigError(f"step near must be None or within [0, 0.1] m, got {n!r}")
         if not 0.05 <= self.seconds <= 2.0:
             raise ConfigError(f"step seconds must be in [0.05, 2], got {self.seconds}")
 
@@ -671,10 +662,6 @@ class BalanceLaw:
         rig.support[:] = (1.0 - w, w)
 
 
-#: the soles' box's ways out, front, left, back, right (heading frame): Step.near
-_WAYS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
-
-
 class Stepper:
     """:class:`Step` on a :class:`BalanceLaw`'s targets, after its own (one per run: the
     landing's recovery hands it to the balance that follows, ``ctx.handover["stepper"]``, so
@@ -701,8 +688,6 @@ class Stepper:
         self._t_end = -math.inf  # when the last step ended
         self._t_last = math.nan  # the last tick of the swing
         self._t_hang = math.inf  # since when one foot alone has been down (standing)
-        self._t_near = math.inf  # since when the capture point has lain Step.near the edge
-        self._way = _WAYS[0]  # ... and the way out there
         self._hip = np.zeros(3)  # the swing hip's eased target
         self._close = False  # a step ended: bring the foot it stood on down if it hangs
         self._stood = 0
@@ -743,18 +728,14 @@ class Stepper:
             if not self.sideways:
                 out[1] = 0.0
             beyond = float(np.hypot(*out))
-            early = False
             if beyond <= st.margin or float(vel @ out) <= 0.0:
-                if st.near is None or not self._near(cp, vel, lo, hi, t):
-                    return
-                early = True
-            self._t_near = math.inf
+                return
             # the farther foot swings (on a sideways fall toward the standing foot it crosses
             # over, see below)
             k = int(np.argmax(np.linalg.norm(feet - cp, axis=1)))
             if not s.foot_contact[1 - k]:
                 return
-            self.foot, self._out, self._t0 = k, self._way if early else out / beyond, t
+            self.foot, self._out, self._t0 = k, out / beyond, t
             self.record.append({"t": t, "foot": float(k), "beyond_m": beyond,
                                 "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
         k = self.foot
@@ -832,21 +813,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-
-    def _near(self, cp: F64, vel: F64, lo: F64, hi: F64, t: float) -> bool:
-        """:attr:`Step.near`: whether the capture point has lain that close to the soles'
-        nearest edge for :attr:`Step.dwell` s in a row, the COM moving toward it (the way
-        out in ``self._way``)."""
-        gaps = np.concatenate([hi[:2] - cp, cp - lo[:2]])  # to the front, left, back, right
-        if not self.sideways:
-            gaps[[1, 3]] = math.inf
-        i = int(np.argmin(gaps))
-        self._way = _WAYS[i]
-        if gaps[i] >= (self.step.near or 0.0) or float(vel @ self._way) <= 0.0:
-            self._t_near = math.inf
-            return False
-        self._t_near = min(self._t_near, t)
-        return t >= self._t_near + self.step.dwell
 
     def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
         """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough
