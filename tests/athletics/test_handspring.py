@@ -15,6 +15,7 @@ import pytest
 
 from reactmocap.athletics.handspring import HandspringParams
 from reactmocap.athletics.land import LandingParams
+from reactmocap.athletics.leap import LeapParams
 from reactmocap.athletics.maneuvers import Maneuver, Perturbation, load_maneuver, run_maneuver
 from reactmocap.athletics.routines import (
     SETTLED_START,
@@ -53,6 +54,9 @@ def test_bad_handspring_parameters_are_config_errors() -> None:
         HandspringParams(twist_gain=-1.0)
     with pytest.raises(ConfigError, match="twist_above"):
         HandspringParams(twist_gain=3.0, twist_above=-1.0)
+    for cap in (-0.1, 2.5):
+        with pytest.raises(ConfigError, match="rise_cap"):
+            LeapParams(rise_cap=cap)
 
 
 def test_the_hands_carry_the_body_past_inverted_and_the_report_matches_the_log() -> None:
@@ -321,3 +325,20 @@ def test_the_knees_aim_is_centred_on_the_ramped_crouch() -> None:
     before = run_maneuver(old, perturbation=start, fps=10.0).report
     assert before["fell"] and not before["landed"]
     assert before["handspring_aim_knees"] > r["handspring_aim_knees"]
+
+
+def test_the_leap_holds_its_height_and_a_start_that_over_leapt_lands() -> None:
+    """Full-size start 43 (seed 0) leaps high: the COM rises 0.99 m (the landers 0.45-0.67),
+    the hands meet the floor past -220 deg with the knees' aim straight, and it does not
+    land. With the push's knees and ankles stopped once the COM's ballistic apex reaches 0.5
+    m (``rise_cap``) it rises under 0.6 m, meets the floor within the aim's range and lands."""
+    m = load_maneuver(EXAMPLE)
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    start = _starts(1.0, 44)[43]
+    high = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert high["achieved_height_m"] > 0.9 and high["rotation_at_hands_deg"] < -220.0
+    assert not (high["landed"] and not high["fell"])  # capture_region's failure
+    held = run_maneuver(_with(m, "leap", {**leap, "rise_cap": 0.5}), perturbation=start,
+                        fps=10.0).report  # fmt: skip
+    assert held["achieved_height_m"] < 0.6 and held["rotation_at_hands_deg"] > -195.0
+    assert held["landed"] and not held["fell"] and abs(held["rotation_deg"] + 360.0) <= 45.0
