@@ -265,6 +265,9 @@ class AnchoredReference:
         if self.step_ahead_swing:
             pl = self.path.planted
             self._firm[1:-1] &= pl[:-2] | pl[2:]
+        # and its own capture point's largest lead so predicted past its landings: a walk's
+        # own runs past its next landing in every single support (0.37-0.54 m on the walks)
+        self._swing_margin = self._clip_swing_margin() if self.step_ahead_swing else np.inf
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -642,6 +645,33 @@ class AnchoredReference:
         front = np.einsum("kfi,ki->kf", sole, u).max(axis=1)
         return float(max(0.0, (np.einsum("ki,ki->k", xi, u) - front).max()))
 
+    def _clip_swing_margin(self) -> float:
+        """``step_ahead_swing``'s base: over the clip's single supports where it walks (0.2
+        m/s or faster), its own capture point's largest lead (m) along its walk past its swing
+        foot's landing, predicted to that landing pivoting over the stance foot (as
+        :meth:`_swing_ahead` predicts the body's); 0 for a clip that never does."""
+        assert self.path.sole is not None
+        c, v = self._com, self._com_v
+        speed = np.hypot(v[:, 0], v[:, 1])
+        # per frame and foot, the first frame from it on where the foot is planted
+        n = len(self._firm)
+        idx = np.where(self._firm, np.arange(n)[:, None], n)
+        land = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
+        rows = np.arange(len(land))
+        swing = np.argmin(self._firm, axis=1)
+        k = land[rows, swing]
+        one = (self._firm.sum(axis=1) == 1) & (speed > 0.2) & (k < len(land))
+        if not one.any():
+            return 0.0
+        i, f, k = rows[one], swing[one], k[one]
+        u = v[i, :2] / speed[i, None]
+        omega = np.sqrt(-self._gravity[2] / np.maximum(c[i, 2] - self.floor_z, 0.3))
+        xi = c[i, :2] + v[i, :2] / omega[:, None]
+        stance = self.path.sole[i, 1 - f, :2]
+        pred = stance + (xi - stance) * np.exp(omega * (k - i) / self.path.fps)[:, None]
+        lead = np.einsum("ki,ki->k", pred - self.path.sole[k, f, :2], u)
+        return float(max(0.0, lead.max()))
+
     def _step_ahead(self, t: float) -> None:
         """After a walk's push (``step_ahead``): while the clip holds both feet planted and
         both are on the floor, a capture point more than the clip's own largest lead
@@ -684,8 +714,8 @@ class AnchoredReference:
         double supports counted as swing), with the swing foot in the air and the stance
         foot on the floor, the capture point predicted (pivoting over the stance foot) to
         the clip's landing of the swing foot and past that landing along the clip's walk by
-        more than ``step_ahead`` times the clip's own largest lead in its double supports
-        brings the landing forward: a balance step of the swing foot to
+        more than ``step_ahead`` times the clip's own largest such lead
+        (:meth:`_clip_swing_margin`) brings the landing forward: a balance step of the swing foot to
         :func:`step_target`, taking ``step_ahead_swing`` of the clip's time left to its
         landing. A step from double support only came after the body had run past its feet
         in the single support before it (``docs/tracking.md``)."""
@@ -699,7 +729,7 @@ class AnchoredReference:
         down = self._firm[i:, f]
         if not down.any():
             return  # the clip ends before the foot lands
-        k = i + int(np.argmax(down))
+        k = i + int(np.argmax(down))  # its landing
         left_s = (k - self.clock.frame(t)) / (self.path.fps * self.rate)
         if left_s <= 0.0:
             return
@@ -713,7 +743,7 @@ class AnchoredReference:
         stance = centre[1 - f, :2]
         pred = stance + (xi - stance) * np.exp(omega * left_s)
         land = _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
-        if float((pred - land) @ u) <= self._ahead_margin * self.step_ahead:
+        if float((pred - land) @ u) <= self._swing_margin * self.step_ahead:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),

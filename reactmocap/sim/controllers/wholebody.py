@@ -259,8 +259,9 @@ class WholeBodyTracker(AnchoredReference):
             so a lead growing fast starts it earlier (``docs/tracking.md``).
         step_ahead_swing: with ``step_ahead``, also in the clip's single supports (its
             one-frame double supports counted as swing, then also for the step from double
-            support): a capture point predicted past the clip's landing of its swing foot by
-            more than ``step_ahead`` times that lead brings the landing forward, a balance
+            support): a capture point predicted (pivoting over the stance foot) to the clip's
+            landing of its swing foot past that landing by more than ``step_ahead`` times the
+            clip's own largest such lead brings the landing forward, a balance
             step of the swing foot taking this fraction of the clip's time left to its
             landing (in (0, 1]; 0: off) (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
