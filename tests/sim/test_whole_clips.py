@@ -491,6 +491,29 @@ def test_a_walk_pushed_back_left_steps_earlier_on_its_capture_points_growth_and_
     assert np.array_equal(runs[0], runs[1])
 
 
+def test_a_walk_pushed_back_left_brings_its_swing_foots_landing_forward_and_walks_on(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared left-curving walk pushed 200 N back-left at the chest for 0.2 s at 1.5 s
+    is upright but not walking at the window's end with the defaults and with ``step_ahead``
+    1 alone (its step from double support never starts); with the step also taken in the
+    clip's single support, the swing foot's landing brought forward once the capture point
+    predicted to it passes it by more than the clip's own largest such lead
+    (``step_ahead_swing`` 1, opt-in; 2026-12-04) it walks as its clip does. Unpushed, the
+    option changes nothing, frame for frame."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, 135.0, 200.0)
+    assert _walk_pushed(walk, force, 1.5, {}) == "moving"
+    assert _walk_pushed(walk, force, 1.5, {"step_ahead": 1.0}) == "moving"
+    swing = {"step_ahead": 1.0, "step_ahead_swing": 1.0}
+    assert _walk_pushed(walk, force, 1.5, swing) == "ok"
+    runs = [
+        push_clip(walk, time=1.5, body="chest", force=[0.0, 0.0, 0.0], duration=0.2,
+                  start=1.0, seconds=1.2, params=params).rollout.frames()[1]
+        for params in ({}, swing)
+    ]  # fmt: skip
+    assert np.array_equal(runs[0], runs[1])
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}

@@ -281,6 +281,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("anchor_lag_speed", -0.45),
         ("step_ahead", -1.0),
         ("step_ahead_horizon", -0.1),
+        ("step_ahead_swing", -0.5),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -295,6 +296,15 @@ def test_step_ahead_growth_needs_its_step(guard: Motion) -> None:
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="step_ahead_horizon"):
         _tracker(world, guard, 0.0, step_ahead_horizon=0.1)
+
+
+@pytest.mark.parametrize("extra", [{}, {"step_ahead": 1.0, "step_ahead_swing": 1.5}])
+def test_step_ahead_swing_needs_its_step_and_a_fraction(guard: Motion, extra: dict) -> None:
+    """``step_ahead_swing`` only extends ``step_ahead``'s trigger and is a fraction of the
+    clip's swing left: alone, or past 1, it is refused."""
+    world = World(build_character(guard, frame=0))
+    with pytest.raises(ConfigError, match="step_ahead_swing"):
+        _tracker(world, guard, 0.0, **({"step_ahead_swing": 1.0} | extra))
 
 
 def test_a_look_ahead_restores_the_lead_growths_state(guard: Motion) -> None:

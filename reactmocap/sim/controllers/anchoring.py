@@ -79,6 +79,8 @@ _LAG_MOVING = 0.2
 # (s): a landing's impact moves it by metres per second for a tick (0.03 s lost 2 walking
 # pushes of 42 that 0.1 s keeps)
 _AHEAD_RATE_TAU = 0.1
+# ``step_ahead_swing``: a swing foot's landing brought forward takes at least this long (s)
+_SWING_AHEAD_MIN = 0.1
 
 
 def _left_of(heading: float) -> F64:
@@ -135,6 +137,7 @@ class AnchoredReference:
         anchor_lag_speed: float = 0.0,
         step_ahead: float = 0.0,
         step_ahead_horizon: float = 0.0,
+        step_ahead_swing: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -253,6 +256,18 @@ class AnchoredReference:
         )
         self._xi_rate = np.zeros(2)
         self._xi_last: tuple[float, F64] = (-np.inf, np.zeros(2))
+        # ``step_ahead_swing``: the clip's swing foot's landing brought forward in its single
+        # supports, the swing taking this fraction of the clip's time left to its landing;
+        # the clip's stance without its one-frame double supports (a swing foot touching
+        # between two frames of swing)
+        self.step_ahead_swing = float(step_ahead_swing)
+        self._firm = self.path.planted.copy()
+        if self.step_ahead_swing:
+            pl = self.path.planted
+            self._firm[1:-1] &= pl[:-2] | pl[2:]
+        # and its own capture point's largest lead so predicted past its landings: a walk's
+        # own runs past its next landing in every single support (0.37-0.54 m on the walks)
+        self._swing_margin = self._clip_swing_margin() if self.step_ahead_swing else np.inf
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -574,17 +589,19 @@ class AnchoredReference:
         self._start_step(t, foot, centre, xi, omega, left, shorten=True)
 
     def _start_step(
-        self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64, shorten: bool
-    ) -> None:
+        self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64,
+        shorten: bool, duration: float = 0.0,
+    ) -> None:  # fmt: skip
         """Start a balance step of ``foot`` (sole centres ``centre``, ``(2, 3)``) to
         :func:`step_target` for capture point ``xi``; ``left`` is the soles' unit left
         vector. ``shorten``: after a landed step, a short step (``step_short``) takes less
-        than the whole step time. The one step start of both step triggers."""
+        than the whole step time; ``duration`` (s, 0: ``step_time``) a swing foot's shortened
+        swing (``step_ahead_swing``). The one step start of the step triggers."""
+        duration = duration or self.step_time
         target = step_target(
-            xi, centre[1 - foot, :2], centre[foot, :2], omega, self.step_time, beyond=0.05,
+            xi, centre[1 - foot, :2], centre[foot, :2], omega, duration, beyond=0.05,
             max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
         )  # fmt: skip
-        duration = self.step_time
         if shorten and self.step_short and self._landed[0] >= 0:
             # after a step has landed, a short one (a foot put back down) need not take the
             # whole step time
@@ -628,6 +645,33 @@ class AnchoredReference:
         front = np.einsum("kfi,ki->kf", sole, u).max(axis=1)
         return float(max(0.0, (np.einsum("ki,ki->k", xi, u) - front).max()))
 
+    def _clip_swing_margin(self) -> float:
+        """``step_ahead_swing``'s base: over the clip's single supports where it walks (0.2
+        m/s or faster), its own capture point's largest lead (m) along its walk past its swing
+        foot's landing, predicted to that landing pivoting over the stance foot (as
+        :meth:`_swing_ahead` predicts the body's); 0 for a clip that never does."""
+        assert self.path.sole is not None
+        c, v = self._com, self._com_v
+        speed = np.hypot(v[:, 0], v[:, 1])
+        # per frame and foot, the first frame from it on where the foot is planted
+        n = len(self._firm)
+        idx = np.where(self._firm, np.arange(n)[:, None], n)
+        land = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
+        rows = np.arange(len(land))
+        swing = np.argmin(self._firm, axis=1)
+        k = land[rows, swing]
+        one = (self._firm.sum(axis=1) == 1) & (speed > 0.2) & (k < len(land))
+        if not one.any():
+            return 0.0
+        i, f, k = rows[one], swing[one], k[one]
+        u = v[i, :2] / speed[i, None]
+        omega = np.sqrt(-self._gravity[2] / np.maximum(c[i, 2] - self.floor_z, 0.3))
+        xi = c[i, :2] + v[i, :2] / omega[:, None]
+        stance = self.path.sole[i, 1 - f, :2]
+        pred = stance + (xi - stance) * np.exp(omega * (k - i) / self.path.fps)[:, None]
+        lead = np.einsum("ki,ki->k", pred - self.path.sole[k, f, :2], u)
+        return float(max(0.0, lead.max()))
+
     def _step_ahead(self, t: float) -> None:
         """After a walk's push (``step_ahead``): while the clip holds both feet planted and
         both are on the floor, a capture point more than the clip's own largest lead
@@ -639,7 +683,9 @@ class AnchoredReference:
         A body that ran past its feet in a double support of the clip's got its next step
         too late (``docs/tracking.md``)."""
         i = self.clock.nearest(t)
-        if not self.path.planted[i].all():
+        if not self._firm[i].all():
+            if self.step_ahead_swing and self._firm[i].any():
+                self._swing_ahead(t, i)
             return
         feet = self._footprint(t)
         if not all(len(f) for f in feet):
@@ -662,6 +708,46 @@ class AnchoredReference:
             return
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
                          shorten=False)  # fmt: skip
+
+    def _swing_ahead(self, t: float, i: int) -> None:
+        """``step_ahead_swing``: in the clip's single support at frame ``i`` (its one-frame
+        double supports counted as swing), with the swing foot in the air and the stance
+        foot on the floor, the capture point predicted (pivoting over the stance foot) to
+        the clip's landing of the swing foot and past that landing along the clip's walk by
+        more than ``step_ahead`` times the clip's own largest such lead
+        (:meth:`_clip_swing_margin`) brings the landing forward: a balance step of the swing foot to
+        :func:`step_target`, taking ``step_ahead_swing`` of the clip's time left to its
+        landing. A step from double support only came after the body had run past its feet
+        in the single support before it (``docs/tracking.md``)."""
+        assert self.path.sole is not None
+        f = int(np.argmin(self._firm[i]))  # the clip's swing foot
+        low = self.sole_corners()[:, :, 2].min(axis=1) - self.floor_z
+        if low[f] < self.anchor_touch or not len(self._footprint(t)[1 - f]):
+            return
+        if self._going_down():
+            return
+        down = self._firm[i:, f]
+        if not down.any():
+            return  # the clip ends before the foot lands
+        k = i + int(np.argmax(down))  # its landing
+        left_s = (k - self.clock.frame(t)) / (self.path.fps * self.rate)
+        if left_s <= 0.0:
+            return
+        _, v, _ = self.com_reference(t)
+        ref = float(np.hypot(v[0], v[1]))
+        if ref < 0.2:  # not walking
+            return
+        u = v[:2] / ref
+        xi, omega = self.capture_point()
+        centre = self._sole_centres()
+        stance = centre[1 - f, :2]
+        pred = stance + (xi - stance) * np.exp(omega * left_s)
+        land = _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
+        if float((pred - land) @ u) <= self._swing_margin * self.step_ahead:
+            return
+        duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
+        self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),
+                         shorten=False, duration=min(duration, self.step_time))  # fmt: skip
 
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its

@@ -257,6 +257,13 @@ class WholeBodyTracker(AnchoredReference):
             by the capture point's present velocity over this many s passes the clip's own
             largest lead in its double supports grown the same way (0: the lead now only),
             so a lead growing fast starts it earlier (``docs/tracking.md``).
+        step_ahead_swing: with ``step_ahead``, also in the clip's single supports (its
+            one-frame double supports counted as swing, then also for the step from double
+            support): a capture point predicted (pivoting over the stance foot) to the clip's
+            landing of its swing foot past that landing by more than ``step_ahead`` times the
+            clip's own largest such lead brings the landing forward, a balance
+            step of the swing foot taking this fraction of the clip's time left to its
+            landing (in (0, 1]; 0: off) (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -344,6 +351,7 @@ class WholeBodyTracker(AnchoredReference):
         anchor_lag_speed: float = 0.0,
         step_ahead: float = 0.0,
         step_ahead_horizon: float = 0.0,
+        step_ahead_swing: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -377,7 +385,7 @@ class WholeBodyTracker(AnchoredReference):
                 "warp_phase": warp_phase, "warp_for": warp_for, "place_pushed": place_pushed,
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
                 "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
-                "step_ahead_horizon": step_ahead_horizon,
+                "step_ahead_horizon": step_ahead_horizon, "step_ahead_swing": step_ahead_swing,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -396,6 +404,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_horizon ({step_ahead_horizon!r}) only extends step_ahead's "
                 f"trigger: it needs step_ahead > 0"
+            )
+        if step_ahead_swing and not (step_ahead and 0.0 < step_ahead_swing <= 1.0):
+            raise ConfigError(
+                f"step_ahead_swing ({step_ahead_swing!r}) is a fraction in (0, 1] of the "
+                f"clip's swing left, and extends step_ahead's trigger: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -498,7 +511,7 @@ class WholeBodyTracker(AnchoredReference):
             step_hold=step_hold, step_hold_for=step_hold_for, warp_for=warp_for,
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
             anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
-            step_ahead_horizon=step_ahead_horizon,
+            step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
