@@ -227,6 +227,12 @@ class LandingParams:
             recovery's last target (its lean eased from there), not from the pelvis's pitch;
             off: the target drops to the pelvis's pitch at the hand-over (0.44 rad on a male
             back layout with ``lean`` 0.8).
+        late_kv: the placement servo's ``kv`` for the rest of the reach once ``late_delta``
+            has found a late start (its decision needs ``late_delta``); ``None``: ``kv``.
+            Why: on the male back layout the late class's feet trail their target by ~10 cm
+            at touchdown with the servo at its clip, the ``kv`` term braking the legs' swing
+            (the landers' by ~1 cm); a lower ``kv`` on every start moves the landers' feet
+            past their ~1 cm windows too (docs/athletics.md, "late_kv").
     """
 
     knee: float = 0.6
@@ -264,6 +270,7 @@ class LandingParams:
     late_delta: tuple[float, ...] = ()
     recover_spin: float = 0.0
     carry_pitch: bool = False
+    late_kv: float | None = None
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -321,6 +328,12 @@ class LandingParams:
             raise ConfigError(
                 f"landing carry_pitch must be true or false, got {self.carry_pitch!r}"
             )
+        if self.late_kv is not None and not (
+            isinstance(self.late_kv, (int, float)) and 0.0 <= self.late_kv <= 1.0
+        ):
+            raise ConfigError(f"landing late_kv must be in [0, 1] rad s/m, got {self.late_kv!r}")
+        if self.late_kv is not None and not self.late_delta:
+            raise ConfigError("landing late_kv needs late_delta (it acts on its late class)")
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
@@ -435,7 +448,8 @@ class Landing(Basis):
                     want[0] += p.turn_gain * turn
             # eq. 6.1 as a correction on top of the geometric placement below
             xd = s.local(fvel - s.com_vel, h)
-            servo = np.clip(p.kp * (want - x) - p.kv * xd, -0.3, 0.3)
+            kv = p.late_kv if p.late_kv is not None and memo["late"] > 0 else p.kv  # late_kv
+            servo = np.clip(p.kp * (want - x) - kv * xd, -0.3, 0.3)
             # each leg aimed in the world at its foot's place, whatever the pelvis's pitch
             # (it turns freely in the air with the body's angular momentum)
             pelvis = bl.pelvis_pitch()

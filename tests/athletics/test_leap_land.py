@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -190,6 +192,17 @@ def test_landing_twist_arms_must_be_in_range() -> None:
 def test_landing_carry_pitch_must_be_a_bool() -> None:
     with pytest.raises(ConfigError, match="carry_pitch"):
         LandingParams(carry_pitch=1)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("bad", [-0.1, 1.5, math.nan, "0.1"])
+def test_landing_late_kv_must_be_in_range(bad: object) -> None:
+    with pytest.raises(ConfigError, match="late_kv"):
+        LandingParams(late_kv=bad, late_delta=(0.024, 0.15, -0.11))  # type: ignore[arg-type]
+
+
+def test_landing_late_kv_needs_late_delta() -> None:
+    with pytest.raises(ConfigError, match="late_kv"):
+        LandingParams(late_kv=0.0)
 
 
 def test_flight_conserves_angular_momentum() -> None:

@@ -920,6 +920,22 @@ def test_a_back_layout_falling_forward_off_its_absorption_leans_into_it() -> Non
     assert not (r["landed"] and not r["fell"])
 
 
+def test_a_late_back_layout_with_the_late_class_s_servo_undamped_lands() -> None:
+    """Start 15 of ``back_layout.toml``'s capture region at full size (seed 0) opens late
+    (``late_delta``'s class); the placement servo's ``kv`` brakes its legs' swing and its COM
+    touches down 10 cm ahead of the feet: it falls forward. With ``late_kv`` 0 its feet get
+    farther along and it lands."""
+    start = full_starts(16)[15]
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = next(ph for ph in m.phases if ph.controller == "land")
+    assert "late_kv" not in land.params
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert not (r["landed"] and not r["fell"])
+    r = run_maneuver(_with_land_params(m, {**land.params, "late_kv": 0.0}), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+
+
 def test_a_back_layout_carrying_its_pitch_target_leans_on_past_the_hand_over() -> None:
     """``back_layout.toml``'s landing leans the trunk 0.8 rad per radian of knee flexion, the
     balance after it 0.5: at the hand-over its pelvis pitch target dropped to the pelvis's
