@@ -437,6 +437,17 @@ def test_a_walk_pushed_back_left_with_its_path_held_ahead_only_while_slow_walks_
     assert _walk_pushed(walk, force, 1.5, {**held, "anchor_lag_speed": 0.45}) == "ok"
 
 
+def _unpushed_unchanged(walk: Motion, params: dict[str, float]) -> bool:
+    """Whether ``walk`` run unpushed with the opt-in ``params`` is frame for frame the
+    defaults' run."""
+    runs = [
+        push_clip(walk, time=1.5, body="chest", force=[0.0, 0.0, 0.0], duration=0.2,
+                  start=1.0, seconds=1.2, params=p).rollout.frames()[1]
+        for p in ({}, params)
+    ]  # fmt: skip
+    return bool(np.array_equal(runs[0], runs[1]))
+
+
 def test_a_walk_pushed_whose_body_runs_ahead_of_its_clip_only_falls_later(
     shared_mocap_dir: Path,
 ) -> None:
@@ -461,12 +472,7 @@ def test_a_walk_pushed_back_steps_from_double_support_and_walks_on(
     walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 180.0, 450.0)
     assert _walk_pushed(walk, force, 1.5, {}) == "moving"
     assert _walk_pushed(walk, force, 1.5, {"step_ahead": 1.0}) == "ok"
-    runs = [
-        push_clip(walk, time=1.5, body="chest", force=[0.0, 0.0, 0.0], duration=0.2,
-                  start=1.0, seconds=1.2, params=params).rollout.frames()[1]
-        for params in ({}, {"step_ahead": 1.0})
-    ]  # fmt: skip
-    assert np.array_equal(runs[0], runs[1])
+    assert _unpushed_unchanged(walk, {"step_ahead": 1.0})
 
 
 def test_a_walk_pushed_back_left_steps_earlier_on_its_capture_points_growth_and_walks_on(
@@ -483,12 +489,7 @@ def test_a_walk_pushed_back_left_steps_earlier_on_its_capture_points_growth_and_
     assert _walk_pushed(walk, force, 1.5, {"step_ahead": 1.0}) == "moving"
     grown = {"step_ahead": 1.0, "step_ahead_horizon": 0.1}
     assert _walk_pushed(walk, force, 1.5, grown) == "ok"
-    runs = [
-        push_clip(walk, time=1.5, body="chest", force=[0.0, 0.0, 0.0], duration=0.2,
-                  start=1.0, seconds=1.2, params=params).rollout.frames()[1]
-        for params in ({}, grown)
-    ]  # fmt: skip
-    assert np.array_equal(runs[0], runs[1])
+    assert _unpushed_unchanged(walk, grown)
 
 
 def test_a_walk_pushed_back_left_brings_its_swing_foots_landing_forward_and_walks_on(
@@ -506,12 +507,7 @@ def test_a_walk_pushed_back_left_brings_its_swing_foots_landing_forward_and_walk
     assert _walk_pushed(walk, force, 1.5, {"step_ahead": 1.0}) == "moving"
     swing = {"step_ahead": 1.0, "step_ahead_swing": 1.0}
     assert _walk_pushed(walk, force, 1.5, swing) == "ok"
-    runs = [
-        push_clip(walk, time=1.5, body="chest", force=[0.0, 0.0, 0.0], duration=0.2,
-                  start=1.0, seconds=1.2, params=params).rollout.frames()[1]
-        for params in ({}, swing)
-    ]  # fmt: skip
-    assert np.array_equal(runs[0], runs[1])
+    assert _unpushed_unchanged(walk, swing)
 
 
 def test_convex_hull_and_distances() -> None:

@@ -672,6 +672,16 @@ class AnchoredReference:
         lead = np.einsum("ki,ki->k", pred - self.path.sole[k, f, :2], u)
         return float(max(0.0, lead.max()))
 
+    def _walk_direction(self, t: float) -> F64 | None:
+        """The clip's walking direction at ``t``, a unit vector ``(2,)`` on the floor, from
+        its centre of mass's velocity; ``None`` where the clip is not walking (slower than
+        0.2 m/s). The walk-only steps' one gate."""
+        _, v, _ = self.com_reference(t)
+        ref = float(np.hypot(v[0], v[1]))
+        if ref < 0.2:  # not walking
+            return None
+        return v[:2] / ref
+
     def _step_ahead(self, t: float) -> None:
         """After a walk's push (``step_ahead``): while the clip holds both feet planted and
         both are on the floor, a capture point more than the clip's own largest lead
@@ -692,11 +702,9 @@ class AnchoredReference:
             return
         if self._going_down():
             return
-        _, v, _ = self.com_reference(t)
-        ref = float(np.hypot(v[0], v[1]))
-        if ref < 0.2:  # not walking
+        u = self._walk_direction(t)
+        if u is None:
             return
-        u = v[:2] / ref
         xi, omega = self.capture_point()
         centre = self._sole_centres()
         front = int(np.argmax(centre[:, :2] @ u))
@@ -733,11 +741,9 @@ class AnchoredReference:
         left_s = (k - self.clock.frame(t)) / (self.path.fps * self.rate)
         if left_s <= 0.0:
             return
-        _, v, _ = self.com_reference(t)
-        ref = float(np.hypot(v[0], v[1]))
-        if ref < 0.2:  # not walking
+        u = self._walk_direction(t)
+        if u is None:
             return
-        u = v[:2] / ref
         xi, omega = self.capture_point()
         centre = self._sole_centres()
         stance = centre[1 - f, :2]
