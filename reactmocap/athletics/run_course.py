@@ -82,31 +82,24 @@ def run_course(
     push: tuple[float, float, float] | None = None,
     fps: float = 60.0,
     on_tick: Callable[[float], None] | None = None,
-    run_up: float = 0.0,
 ) -> RunResult:
     """Run at ``speed`` m/s (2.5-5) for ``seconds`` along ``path`` (``"line"``,
     ``"circle:R"``, ``"eight:R"``, a CSV file, or a Course), starting in flight along +X from
     the origin. ``cloth="pants"`` dresses the runner in cloth driven by the body (with
     ``cloth_feedback`` its forces act back on the body). ``push`` is ``(time s, impulse N s,
     direction rad relative to the runner's heading)`` on the chest over 0.1 s. ``on_tick`` is
-    called now and then with the fraction simulated. ``run_up`` (m, 0-20; an opt-in, 0: off)
-    starts a path given by name that far ahead of the runner along +X, a straight run-up
-    before its first curve (with ``RunParams.curve_ease`` the curve eases in meanwhile)."""
+    called now and then with the fraction simulated."""
     speed = check_speed(speed)
     if not (isinstance(seconds, (int, float)) and math.isfinite(seconds) and seconds > 0):
         raise ConfigError(f"seconds must be > 0, got {seconds!r}")
     if not (math.isfinite(fps) and fps > 0):
         raise ConfigError(f"fps must be > 0, got {fps!r}")
-    if not (isinstance(run_up, (int, float)) and 0.0 <= run_up <= 20.0):
-        raise ConfigError(f"run_up must be in [0, 20] m, got {run_up!r}")
     ath = make_athlete(body)
     world = athletics_world(ath)
     # faster runs start at START_SPEED and the runner accelerates (Runner's ramp)
     qpos, qvel = running_start(ath, min(speed, START_SPEED))
     world.set_pose(0, qpos, qvel)
     start = world.com(0)[:2]
-    if run_up:
-        start = start + np.array([run_up, 0.0])
     course = parse_course(path, start, 0.0) if isinstance(path, str) else path
     if isinstance(course, (Polyline, Facing)):
         course.reset()
