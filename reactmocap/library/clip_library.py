@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import threading
 from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -149,8 +150,15 @@ def _to_npz(m: Motion) -> bytes:
     return npz_bytes(meta, arrays)
 
 
+# numpy reads each .npy header with ast.literal_eval, and CPython 3.11's AST construction is
+# not thread-safe: the library's thread pool raised "SystemError: AST constructor recursion
+# depth mismatch" on a cache read (CI, 2026-12-04; python/cpython#106905). Cache reads take
+# milliseconds, so they go one at a time; the BVH parsing stays parallel.
+_NPZ_READ = threading.Lock()
+
+
 def _from_npz(path: Path) -> Motion:
-    with np.load(path, allow_pickle=False) as z:
+    with _NPZ_READ, np.load(path, allow_pickle=False) as z:
         meta = npz_meta(z)
         layout = BVHLayout(
             channels=tuple(tuple(c) for c in meta["channels"]),

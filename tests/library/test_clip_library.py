@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import shutil
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -63,6 +65,37 @@ def test_cache_hit_equal_and_invalidated_on_change(small_lib: Path, tmp_path: Pa
     assert len(sorted(cache.glob("*.npz"))) == 4
     name = target.stem
     assert not np.allclose(third[name].root_positions[-1], first[name].root_positions[-1])
+
+
+def test_cache_reads_never_overlap_in_the_thread_pool(
+    small_lib: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """numpy parses .npy headers with ast.literal_eval, which CPython 3.11 does not make
+    thread-safe (a CI run raised "AST constructor recursion depth mismatch" on a cache read):
+    the pool's cache reads go one at a time, while their files are read by three workers."""
+    cache = tmp_path / "c"
+    first = load_library(small_lib, cache_dir=cache)
+    real_load = np.load
+    active, most = [0], [0]
+    guard = threading.Lock()
+
+    def slow_load(*args: object, **kwargs: object) -> object:
+        with guard:
+            active[0] += 1
+            most[0] = max(most[0], active[0])
+        time.sleep(0.05)  # a read long enough for the other workers to reach theirs
+        try:
+            return real_load(*args, **kwargs)  # type: ignore[arg-type]
+        finally:
+            with guard:
+                active[0] -= 1
+
+    monkeypatch.setattr(np, "load", slow_load)
+    again = load_library(small_lib, cache_dir=cache, workers=3)
+    assert most[0] == 1
+    assert sorted(again.clips) == sorted(first.clips)
+    for name, m in first.clips.items():
+        assert np.array_equal(again.clips[name].rotations, m.rotations)
 
 
 def test_corrupt_cache_entry_is_reparsed(small_lib: Path, tmp_path: Path) -> None:
