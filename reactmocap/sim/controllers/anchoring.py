@@ -265,6 +265,10 @@ class AnchoredReference:
         if self.step_ahead_swing:
             pl = self.path.planted
             self._firm[1:-1] &= pl[:-2] | pl[2:]
+        # per frame and foot, the first frame from it on where the foot is planted (len: never)
+        n = len(self._firm)
+        idx = np.where(self._firm, np.arange(n)[:, None], n)
+        self._next_planted = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
         # and its own capture point's largest lead so predicted past its landings: a walk's
         # own runs past its next landing in every single support (0.37-0.54 m on the walks)
         self._swing_margin = self._clip_swing_margin() if self.step_ahead_swing else np.inf
@@ -653,10 +657,7 @@ class AnchoredReference:
         assert self.path.sole is not None
         c, v = self._com, self._com_v
         speed = np.hypot(v[:, 0], v[:, 1])
-        # per frame and foot, the first frame from it on where the foot is planted
-        n = len(self._firm)
-        idx = np.where(self._firm, np.arange(n)[:, None], n)
-        land = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
+        land = self._next_planted
         rows = np.arange(len(land))
         swing = np.argmin(self._firm, axis=1)
         k = land[rows, swing]
@@ -734,10 +735,9 @@ class AnchoredReference:
             return
         if self._going_down():
             return
-        down = self._firm[i:, f]
-        if not down.any():
+        k = int(self._next_planted[i, f])  # its landing
+        if k >= len(self._next_planted):
             return  # the clip ends before the foot lands
-        k = i + int(np.argmax(down))  # its landing
         left_s = (k - self.clock.frame(t)) / (self.path.fps * self.rate)
         if left_s <= 0.0:
             return
