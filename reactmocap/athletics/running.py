@@ -649,11 +649,6 @@ class Runner:
         s.update(t)
         self._contacts()
         want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
-        ease = self.params.curve_ease
-        if t < ease:
-            # a settled start: the curve's lean, feed-forward and correction eased in
-            e = t / ease
-            self.curvature *= e * e * e * (10.0 + e * (6.0 * e - 15.0))
         if self.k["path_integral"] > 0 and math.isfinite(self.cross_track) and t >= PATH_AFTER:
             # the steady offset a curve leaves (pure pursuit's chord, the feed-forward's lead)
             # grows with the curvature and flips with it: integrated and applied in proportion

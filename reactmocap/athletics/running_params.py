@@ -144,10 +144,6 @@ class RunParams:
             integral of the cross-track error times the curvature (m/s; 0: none),
             which takes out the steady offset a curve leaves.
         lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
-        curve_ease: a settled start on a path: the curvature the lean, the turn's
-            feed-forward (``turn_lead``) and the path correction read is eased in (smoothstep)
-            over this long from the start (s; 0: off, at once). A path run otherwise starts
-            on the curve from its first step, straight from the set pose. Within 0-20 s.
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -195,7 +191,6 @@ class RunParams:
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
     lean: float | Speeds = 1.0
-    curve_ease: float = 0.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
@@ -219,8 +214,6 @@ class RunParams:
             v = getattr(self, name)
             if not all(0.0 <= b <= 1.0 for b in (v if isinstance(v, tuple) else (v,))):
                 raise ConfigError(f"{name} must be in [0, 1], got {v}")
-        if not 0.0 <= self.curve_ease <= 20.0:
-            raise ConfigError(f"curve_ease must be in [0, 20] s, got {self.curve_ease}")
         lo, hi = SPEED_RANGE
         for speed in (lo, hi):
             r = self.at(speed)
