@@ -153,15 +153,20 @@ class Step:
             foot clears the floor).
         seconds: the swing's planned duration; the step ends when the swing foot touches
             down after half of it (or at three times it).
+        across: on a step along the feet that would land under its own hip, the swing foot
+            lands at least this far (m) past the capture point across the feet, on its own
+            side (0: under its hip; opt-in, docs/athletics.md "The standing step's first
+            single support").
     """
 
     margin: float = 0.05
     reach: float = 0.1
     lift: float = 0.3
     seconds: float = 0.25
+    across: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("margin", "reach", "lift", "seconds"):
+        for name in ("margin", "reach", "lift", "seconds", "across"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise ConfigError(f"step {name} must be a finite number >= 0, got {v!r}")
@@ -771,6 +776,10 @@ class Stepper:
             want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
             if not self.sideways or (self.standing and self._out[1] == 0.0):
                 want[1] = at[1]
+                if st.across:  # the COM falls toward the swing side over the single support
+                    side = 1.0 if at[1] >= stand[1] else -1.0
+                    past = max(side * (at[1] - stand[1]), side * (cp[1] - stand[1]) + st.across)
+                    want[1] = stand[1] + side * past
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
         down = float(hip[2]) - float(d.xanchor[self._ankles[1 - k], 2])

@@ -247,3 +247,22 @@ def test_a_foot_left_hanging_is_put_down_by_the_standing_step(
     monkeypatch.setattr(balance, "STANDING_STILL", 0.0)  # the option before: never planted
     r = run("balance", "male", **push).report
     assert r["balanced"] and not r["on_both_feet"] and not r["steps"]
+
+
+def test_a_standing_step_put_past_the_capture_point_across_the_feet_lands(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's first single support"):
+    # at the male's 200 N forward push step="on" swings a foot under its own hip that never
+    # reaches the floor (the swing runs out at three times its 0.25 s) and he falls; with the
+    # foot put 0.15 m past the capture point across the feet (Step.across) it lands within
+    # 0.6 s and he is up at 3 s
+    push = {"check_range": False, "seconds": 3.0, "push": 200.0, "step": "on"}
+    r = run("balance", "male", **push).report
+    assert r["fell"] and r["steps"][0]["s"] >= 0.7
+    across = dataclasses.replace(balance.STANDING_STEP, across=0.15)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", across)
+    r = run("balance", "male", **push).report
+    assert not r["fell"] and r["steps"][0]["s"] < 0.6
+    with pytest.raises(ConfigError, match="across"):
+        Step(across=-0.1)
