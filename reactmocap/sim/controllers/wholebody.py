@@ -266,8 +266,8 @@ class WholeBodyTracker(AnchoredReference):
             landing (in (0, 1]; 0: off) (``docs/tracking.md``).
         step_ahead_phase: with ``step_ahead_swing``, the swing step's limit matched to the
             swing's phase: the clip's own predicted lead at the same frame plus this margin
-            (m, at most 0.5; 0: off, the clip's largest lead, which it reaches only late in
-            the swing) (``docs/tracking.md``).
+            (m, at most 0.5), in place of ``step_ahead`` times its largest such lead (0: off)
+            (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
