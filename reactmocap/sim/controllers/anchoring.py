@@ -276,7 +276,7 @@ class AnchoredReference:
         self._swing_margin = float(max(0.0, leads.max())) if self.step_ahead_swing else np.inf
         # ``step_ahead_phase``: the swing step's limit per frame, the clip's own lead at that
         # frame plus this margin (m): the largest is set where the clip's stance flags a
-        # foot still swinging as landed (0.49-0.57 m; past real landings -0.08-0.33 m);
+        # foot still swinging as landed (0.49-0.57 m; past real landings at most 0.33 m);
         # frames without a lead keep the largest
         self.step_ahead_phase = float(step_ahead_phase)
         self._swing_limit = (
