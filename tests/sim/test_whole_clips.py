@@ -510,6 +510,23 @@ def test_a_walk_pushed_back_left_brings_its_swing_foots_landing_forward_and_walk
     assert _unpushed_unchanged(walk, swing)
 
 
+def test_a_walk_pushed_back_right_brings_its_swing_step_on_a_phase_matched_limit(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared right-curving walk pushed 300 N back-right at the chest for 0.2 s at 1.5 s
+    is upright but not walking at the window's end with the defaults and with the swing
+    step against the clip's largest lead (``step_ahead_swing`` 1); with its limit the clip's
+    own lead at the same frame plus 0.05 m (``step_ahead_phase`` 0.05, opt-in; 2026-12-05)
+    it walks as its clip does. Unpushed, the option changes nothing, frame for frame."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-right_normal_001", 1.5, 225.0, 300.0)
+    assert _walk_pushed(walk, force, 1.5, {}) == "moving"
+    swing = {"step_ahead": 1.0, "step_ahead_swing": 1.0}
+    assert _walk_pushed(walk, force, 1.5, swing) == "moving"
+    phase = swing | {"step_ahead_phase": 0.05}
+    assert _walk_pushed(walk, force, 1.5, phase) == "ok"
+    assert _unpushed_unchanged(walk, phase)
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}

@@ -282,6 +282,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_ahead", -1.0),
         ("step_ahead_horizon", -0.1),
         ("step_ahead_swing", -0.5),
+        ("step_ahead_phase", -0.05),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -305,6 +306,18 @@ def test_step_ahead_swing_needs_its_step_and_a_fraction(guard: Motion, extra: di
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="step_ahead_swing"):
         _tracker(world, guard, 0.0, **({"step_ahead_swing": 1.0} | extra))
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [{"step_ahead": 1.0}, {"step_ahead": 1.0, "step_ahead_swing": 1.0, "step_ahead_phase": 0.8}],
+)
+def test_step_ahead_phase_needs_the_swing_step_and_a_margin(guard: Motion, extra: dict) -> None:
+    """``step_ahead_phase`` sets ``step_ahead_swing``'s limit and is a margin of at most
+    0.5 m: without the swing step, or past 0.5 m, it is refused."""
+    world = World(build_character(guard, frame=0))
+    with pytest.raises(ConfigError, match="step_ahead_phase"):
+        _tracker(world, guard, 0.0, **({"step_ahead_phase": 0.1} | extra))
 
 
 def test_a_look_ahead_restores_the_lead_growths_state(guard: Motion) -> None:

@@ -138,6 +138,7 @@ class AnchoredReference:
         step_ahead: float = 0.0,
         step_ahead_horizon: float = 0.0,
         step_ahead_swing: float = 0.0,
+        step_ahead_phase: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -271,7 +272,18 @@ class AnchoredReference:
         self._next_planted = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
         # and its own capture point's largest lead so predicted past its landings: a walk's
         # own runs past its next landing in every single support (0.37-0.54 m on the walks)
-        self._swing_margin = self._clip_swing_margin() if self.step_ahead_swing else np.inf
+        leads = self._clip_swing_leads() if self.step_ahead_swing else np.full(n, -np.inf)
+        self._swing_margin = float(max(0.0, leads.max())) if self.step_ahead_swing else np.inf
+        # ``step_ahead_phase``: the swing step's limit per frame, the clip's own lead at that
+        # frame plus this margin (m): the largest is set where the clip's stance flags a
+        # foot still swinging as landed (0.49-0.57 m; past real landings at most 0.33 m);
+        # frames without a lead keep the largest
+        self.step_ahead_phase = float(step_ahead_phase)
+        self._swing_limit = (
+            np.where(np.isfinite(leads), leads, self._swing_margin) + self.step_ahead_phase
+            if self.step_ahead_phase
+            else None
+        )
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -649,11 +661,11 @@ class AnchoredReference:
         front = np.einsum("kfi,ki->kf", sole, u).max(axis=1)
         return float(max(0.0, (np.einsum("ki,ki->k", xi, u) - front).max()))
 
-    def _clip_swing_margin(self) -> float:
-        """``step_ahead_swing``'s base: over the clip's single supports where it walks (0.2
-        m/s or faster), its own capture point's largest lead (m) along its walk past its swing
-        foot's landing, predicted to that landing pivoting over the stance foot (as
-        :meth:`_swing_ahead` predicts the body's); 0 for a clip that never does."""
+    def _clip_swing_leads(self) -> F64:
+        """``step_ahead_swing``'s base, per frame ``(n,)``: in the clip's single supports
+        where it walks (0.2 m/s or faster), its own capture point's lead (m) along its walk
+        past its swing foot's landing, predicted to that landing pivoting over the stance
+        foot (as :meth:`_swing_ahead` predicts the body's); -inf in the other frames."""
         assert self.path.sole is not None
         c, v = self._com, self._com_v
         speed = np.hypot(v[:, 0], v[:, 1])
@@ -662,16 +674,17 @@ class AnchoredReference:
         swing = np.argmin(self._firm, axis=1)
         k = land[rows, swing]
         one = (self._firm.sum(axis=1) == 1) & (speed > 0.2) & (k < len(land))
+        out = np.full(len(land), -np.inf)
         if not one.any():
-            return 0.0
+            return out
         i, f, k = rows[one], swing[one], k[one]
         u = v[i, :2] / speed[i, None]
         omega = np.sqrt(-self._gravity[2] / np.maximum(c[i, 2] - self.floor_z, 0.3))
         xi = c[i, :2] + v[i, :2] / omega[:, None]
         stance = self.path.sole[i, 1 - f, :2]
         pred = stance + (xi - stance) * np.exp(omega * (k - i) / self.path.fps)[:, None]
-        lead = np.einsum("ki,ki->k", pred - self.path.sole[k, f, :2], u)
-        return float(max(0.0, lead.max()))
+        out[one] = np.einsum("ki,ki->k", pred - self.path.sole[k, f, :2], u)
+        return out
 
     def _walk_direction(self, t: float) -> F64 | None:
         """The clip's walking direction at ``t``, a unit vector ``(2,)`` on the floor, from
@@ -749,7 +762,11 @@ class AnchoredReference:
         stance = centre[1 - f, :2]
         pred = stance + (xi - stance) * np.exp(omega * left_s)
         land = _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
-        if float((pred - land) @ u) <= self._swing_margin * self.step_ahead:
+        if self._swing_limit is not None:  # ``step_ahead_phase``: the clip's own lead here
+            limit = float(self._swing_limit[i])
+        else:
+            limit = self._swing_margin * self.step_ahead
+        if float((pred - land) @ u) <= limit:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),

@@ -264,6 +264,10 @@ class WholeBodyTracker(AnchoredReference):
             clip's own largest such lead brings the landing forward, a balance
             step of the swing foot taking this fraction of the clip's time left to its
             landing (in (0, 1]; 0: off) (``docs/tracking.md``).
+        step_ahead_phase: with ``step_ahead_swing``, the swing step's limit matched to the
+            swing's phase: the clip's own predicted lead at the same frame plus this margin
+            (m, at most 0.5), in place of ``step_ahead`` times its largest such lead (0: off)
+            (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -352,6 +356,7 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead: float = 0.0,
         step_ahead_horizon: float = 0.0,
         step_ahead_swing: float = 0.0,
+        step_ahead_phase: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -386,6 +391,7 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
                 "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
                 "step_ahead_horizon": step_ahead_horizon, "step_ahead_swing": step_ahead_swing,
+                "step_ahead_phase": step_ahead_phase,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -409,6 +415,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_swing ({step_ahead_swing!r}) is a fraction in (0, 1] of the "
                 f"clip's swing left, and extends step_ahead's trigger: it needs step_ahead > 0"
+            )
+        if step_ahead_phase and not (step_ahead_swing and 0.0 < step_ahead_phase <= 0.5):
+            raise ConfigError(
+                f"step_ahead_phase ({step_ahead_phase!r}) is a margin in (0, 0.5] m over the "
+                f"clip's own lead, and sets step_ahead_swing's limit: it needs step_ahead_swing"
             )
         servo = world.servo
         m = world.model
@@ -512,6 +523,7 @@ class WholeBodyTracker(AnchoredReference):
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
             anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
+            step_ahead_phase=step_ahead_phase,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
