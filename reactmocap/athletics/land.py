@@ -233,6 +233,12 @@ class LandingParams:
             at touchdown with the servo at its clip, the ``kv`` term braking the legs' swing
             (the landers' by ~1 cm); a lower ``kv`` on every start moves the landers' feet
             past their ~1 cm windows too (docs/athletics.md, "late_kv").
+        late_kv_margin: ``(from m, to m)``: ``late_kv`` scaled by how far past ``late_delta``'s
+            offset the feet are at its decision: ``kv`` up to ``from`` past it, ``late_kv``
+            from ``to`` on, blended linearly between (``from == to``: a step); empty:
+            ``late_kv`` on every late start. Why: on the male back layout a tenth's late
+            starts (0.09 m past) land with ``kv`` and fall with ``late_kv`` 0, full size's
+            (0.13-0.31 m past) the other way round (docs/athletics.md, "late_kv_margin").
     """
 
     knee: float = 0.6
@@ -271,6 +277,7 @@ class LandingParams:
     recover_spin: float = 0.0
     carry_pitch: bool = False
     late_kv: float | None = None
+    late_kv_margin: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -334,6 +341,17 @@ class LandingParams:
             raise ConfigError(f"landing late_kv must be in [0, 1] rad s/m, got {self.late_kv!r}")
         if self.late_kv is not None and not self.late_delta:
             raise ConfigError("landing late_kv needs late_delta (it acts on its late class)")
+        if self.late_kv_margin and not (
+            len(self.late_kv_margin) == 2
+            and all(isinstance(x, (int, float)) for x in self.late_kv_margin)
+            and 0.0 <= self.late_kv_margin[0] <= self.late_kv_margin[1] <= 1.0
+        ):
+            raise ConfigError(
+                "landing late_kv_margin must be (from, to) m with 0 <= from <= to <= 1, "
+                f"got {self.late_kv_margin!r}"
+            )
+        if self.late_kv_margin and self.late_kv is None:
+            raise ConfigError("landing late_kv_margin needs late_kv (it scales it)")
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
@@ -358,6 +376,17 @@ class LandingParams:
             return self.delta
         v, d = self._delta_table
         return float(np.interp(velocity, v, d))
+
+    def late_kv_at(self, past: float) -> float:
+        """The placement servo's ``kv`` for a late start whose feet are ``past`` m beyond
+        ``late_delta``'s offset (``late_kv``, scaled by ``late_kv_margin``)."""
+        if self.late_kv is None:
+            return self.kv
+        if not self.late_kv_margin or past >= self.late_kv_margin[1]:
+            return self.late_kv
+        lo, hi = self.late_kv_margin
+        w = max(past - lo, 0.0) / (hi - lo) if hi > lo else 0.0
+        return self.kv + w * (self.late_kv - self.kv)
 
 
 class Landing(Basis):
@@ -413,6 +442,7 @@ class Landing(Basis):
                 memo["fall"] = max(float(soles.min()), 0.0) + up * up / (2.0 * g)
             memo["rot_prev"], memo["t_prev"] = ctx.rotation, t  # turn_gain's rate
             memo["reach_t"], memo["late"] = t, -1.0  # late_delta: not yet decided (-1)
+            memo["kv"] = p.kv  # the placement servo's damping (late_kv once late)
 
         def reach(world: World, t: float) -> None:
             s = ctx.sense(t)
@@ -431,6 +461,8 @@ class Landing(Basis):
             x = s.local(feet - s.com, h)
             if p.late_delta and memo["late"] < 0 and t - memo["reach_t"] >= p.late_delta[0]:
                 memo["late"] = float(np.hypot(*x) > p.late_delta[1])  # decided once (late_delta)
+                if memo["late"] > 0:
+                    memo["kv"] = p.late_kv_at(float(np.hypot(*x)) - p.late_delta[1])
             delta = p.late_delta[2] if memo["late"] > 0 else p.delta_at(float(v[0]))
             want = np.array([lead * v[0] + delta * memo["scale"], side * v[1]])
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
@@ -448,8 +480,7 @@ class Landing(Basis):
                     want[0] += p.turn_gain * turn
             # eq. 6.1 as a correction on top of the geometric placement below
             xd = s.local(fvel - s.com_vel, h)
-            kv = p.late_kv if p.late_kv is not None and memo["late"] > 0 else p.kv  # late_kv
-            servo = np.clip(p.kp * (want - x) - kv * xd, -0.3, 0.3)
+            servo = np.clip(p.kp * (want - x) - memo["kv"] * xd, -0.3, 0.3)
             # each leg aimed in the world at its foot's place, whatever the pelvis's pitch
             # (it turns freely in the air with the body's angular momentum)
             pelvis = bl.pelvis_pitch()

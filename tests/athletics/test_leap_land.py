@@ -205,6 +205,27 @@ def test_landing_late_kv_needs_late_delta() -> None:
         LandingParams(late_kv=0.0)
 
 
+@pytest.mark.parametrize("bad", [(0.1,), (0.2, 0.1), (-0.1, 0.1), (0.1, 1.5), ("0.1", 0.2)])
+def test_landing_late_kv_margin_must_be_from_to(bad: tuple[float, ...]) -> None:
+    with pytest.raises(ConfigError, match="late_kv_margin"):
+        LandingParams(late_kv=0.0, late_kv_margin=bad, late_delta=(0.024, 0.15, -0.11))
+
+
+def test_landing_late_kv_margin_needs_late_kv() -> None:
+    with pytest.raises(ConfigError, match="late_kv_margin"):
+        LandingParams(late_kv_margin=(0.1, 0.1), late_delta=(0.024, 0.15, -0.11))
+
+
+def test_landing_late_kv_margin_blends_kv_to_late_kv() -> None:
+    late = (0.024, 0.15, -0.11)
+    p = LandingParams(kv=0.15, late_kv=0.0, late_kv_margin=(0.1, 0.2), late_delta=late)
+    assert [p.late_kv_at(x) for x in (0.05, 0.1, 0.2, 0.3)] == [0.15, 0.15, 0.0, 0.0]
+    assert p.late_kv_at(0.15) == pytest.approx(0.075)
+    step = LandingParams(kv=0.15, late_kv=0.0, late_kv_margin=(0.11, 0.11), late_delta=late)
+    assert (step.late_kv_at(0.1), step.late_kv_at(0.11)) == (0.15, 0.0)
+    assert LandingParams(late_kv=0.05, late_delta=late).late_kv_at(0.01) == 0.05
+
+
 def test_flight_conserves_angular_momentum() -> None:
     # a leap with pitch momentum; in the air only internal torques act
     r = run("leap", "male", effort=0.4, spin=15.0, push="timed")

@@ -936,6 +936,23 @@ def test_a_late_back_layout_with_the_late_class_s_servo_undamped_lands() -> None
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
 
 
+def test_a_late_back_layout_undamps_its_servo_only_past_the_late_kv_margin() -> None:
+    """``late_kv`` 0 lands full size's late start 15 (its feet 0.31 m past ``late_delta``'s
+    0.15 m offset at the decision) but loses a tenth's late start 5 (0.09 m past), which
+    lands with the file's ``kv``. With ``late_kv_margin`` (0.11, 0.11) the tenth's start
+    keeps ``kv`` and lands, and the full size's still gets ``late_kv`` 0 and lands."""
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = next(ph for ph in m.phases if ph.controller == "land")
+    undamped = _with_land_params(m, {**land.params, "late_kv": 0.0})
+    margin = _with_land_params(m, {**land.params, "late_kv": 0.0, "late_kv_margin": [0.11, 0.11]})
+    tenth = _tenth_start(0, 5)
+    r = run_maneuver(undamped, perturbation=tenth, fps=10.0).report
+    assert not (r["landed"] and not r["fell"])
+    for start in (tenth, full_starts(16)[15]):
+        r = run_maneuver(margin, perturbation=start, fps=10.0).report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+
+
 def test_a_back_layout_carrying_its_pitch_target_leans_on_past_the_hand_over() -> None:
     """``back_layout.toml``'s landing leans the trunk 0.8 rad per radian of knee flexion, the
     balance after it 0.5: at the hand-over its pelvis pitch target dropped to the pelvis's
