@@ -271,7 +271,8 @@ class AnchoredReference:
         idx = np.where(self._firm, np.arange(n)[:, None], n)
         self._next_planted = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
         # and its own capture point's largest lead so predicted past its landings: a walk's
-        # own runs past its next landing in every single support (0.37-0.54 m on the walks)
+        # own runs past its next flagged landing (0.49-0.57 m on the walks, set where the stance
+        # flags a foot still swinging as landed: docs/tracking.md, ``step_ahead_phase``)
         leads = self._clip_swing_leads() if self.step_ahead_swing else np.full(n, -np.inf)
         self._swing_margin = float(max(0.0, leads.max())) if self.step_ahead_swing else np.inf
         # ``step_ahead_phase``: the swing step's limit per frame, the clip's own lead at that
