@@ -234,6 +234,14 @@ class LeapParams:
     #: against the landers' 0.45-0.67 with the same take-off momentum and ran over the hands'
     #: contact (docs/athletics.md); 0: off (as before)
     rise_cap: float = 0.0
+    #: the cap looks ahead (s): it fires on the apex this far ahead at the apex's rate over
+    #: the last control tick. The push's last ticks raise the apex 0.1-0.2 m each, faster
+    #: in an over-leap than in an ordinary leap, so a cap on the tick's own apex cut both
+    #: (docs/athletics.md); 0: the apex as it stands (as before)
+    rise_lead: float = 0.0
+    #: the hips' spin allowance (rad) once the cap has fired (the cut push left 3-10 kg m^2/s
+    #: less spin); 0: ``spin_limit`` (as before)
+    rise_spin_limit: float = 0.0
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -242,7 +250,7 @@ class LeapParams:
                 self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
                 self.push_ramp, self.push_limit, self.push_hip, self.push_ankle,
                 self.tilt_gain, self.roll_gain, self.yaw_gain, self.com_ramp,
-                self.crouch_level, self.rise_cap]  # fmt: skip
+                self.crouch_level, self.rise_cap, self.rise_lead, self.rise_spin_limit]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.0 < self.crouch_side <= 5.0:
@@ -270,6 +278,15 @@ class LeapParams:
             raise ConfigError(f"leap com_ramp must be in [0, 5] s, got {self.com_ramp}")
         if not 0.0 <= self.rise_cap <= 2.0:
             raise ConfigError(f"leap rise_cap must be in [0, 2] m (0: off), got {self.rise_cap}")
+        if not 0.0 <= self.rise_lead <= 0.1:
+            raise ConfigError(
+                f"leap rise_lead must be in [0, 0.1] s (0: off), got {self.rise_lead}"
+            )
+        if not 0.0 <= self.rise_spin_limit <= 3.0:
+            raise ConfigError(
+                f"leap rise_spin_limit must be in [0, 3] rad (0: spin_limit), got "
+                f"{self.rise_spin_limit}"
+            )
         if not 0.0 <= self.tilt_gain <= 100.0:
             raise ConfigError(f"leap tilt_gain must be in [0, 100] rad, got {self.tilt_gain}")
         if not 0.0 <= self.roll_gain <= 100.0:
@@ -373,6 +390,7 @@ class Leap(Basis):
             memo["t_thrust"] = t
             memo.pop("ramp", None)
             memo.pop("capped", None)
+            memo.pop("apex_prev", None)
             rig = ctx.rig
             stiff = per_joint(LEAP_STIFFNESS) * p.stiffness
             stiff[[joint_index(f"{s}_ankle") for s in "lr"]] *= p.ankle_gain
@@ -412,7 +430,10 @@ class Leap(Basis):
                 # whole-body angular momentum about the COM (mj_subtreeVel has run), pitch
                 # axis of the heading frame: the hips tilt the push ahead of or behind the COM
                 err = (pitch_momentum(world, s) - p.spin) / unit
-                off = float(np.clip(spin_ramp * p.spin_gain * err, -p.spin_limit, p.spin_limit))
+                lim = p.spin_limit
+                if p.rise_spin_limit > 0 and "capped" in memo:  # give back the cut push's spin
+                    lim = p.rise_spin_limit
+                off = float(np.clip(spin_ramp * p.spin_gain * err, -lim, lim))
                 ctx.rig.offset[hips, 0] = off
             if p.tilt_gain > 0:
                 # roll and yaw momentum to zero, the hips tilting and turning the push about
@@ -425,7 +446,13 @@ class Leap(Basis):
             if p.rise_cap > 0 and "capped" not in memo:
                 z_stand = ctx.standing_com if ctx.standing_com is not None else memo["z_stand"]
                 vz = float(s.com_vel[2])
-                if vz > 0 and float(s.com[2]) - z_stand + vz * vz / (2.0 * g) >= p.rise_cap:
+                apex = float(s.com[2]) - z_stand + vz * vz / (2.0 * g)
+                if p.rise_lead > 0:
+                    t0, apex0 = memo.get("apex_prev", (t, apex))
+                    memo["apex_prev"] = (t, apex)
+                    if t > t0:
+                        apex += p.rise_lead * (apex - apex0) / (t - t0)
+                if vz > 0 and apex >= p.rise_cap:
                     # the apex is reached ballistically: the knees and ankles stop extending
                     memo["capped"] = t
                     goal = np.full((NJ, 3), np.nan)

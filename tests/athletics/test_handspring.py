@@ -57,6 +57,12 @@ def test_bad_handspring_parameters_are_config_errors() -> None:
     for cap in (-0.1, 2.5):
         with pytest.raises(ConfigError, match="rise_cap"):
             LeapParams(rise_cap=cap)
+    for lead in (-0.004, 0.2, float("nan")):
+        with pytest.raises(ConfigError, match="rise_lead"):
+            LeapParams(rise_lead=lead)
+    for lim in (-0.1, 3.5):
+        with pytest.raises(ConfigError, match="rise_spin_limit"):
+            LeapParams(rise_spin_limit=lim)
 
 
 def test_the_hands_carry_the_body_past_inverted_and_the_report_matches_the_log() -> None:
@@ -342,3 +348,25 @@ def test_the_leap_holds_its_height_and_a_start_that_over_leapt_lands() -> None:
                         fps=10.0).report  # fmt: skip
     assert held["achieved_height_m"] < 0.6 and held["rotation_at_hands_deg"] > -195.0
     assert held["landed"] and not held["fell"] and abs(held["rotation_deg"] + 360.0) <= 45.0
+
+
+def test_the_cap_looks_ahead_and_holds_only_the_over_leap() -> None:
+    """Full-size start 1 (seed 0) leaps 0.89 m with the file and does not land. A cap at 1.0 m
+    that looks 12 ms ahead at the apex's rate (``rise_lead``) fires in its push's last ticks,
+    where an over-leap's apex grows fastest: it rises under 0.65 m and lands. Start 0, an
+    ordinary leap (0.65 m) that lands with the file, runs as with the file (the cap never
+    fires; the 0.5 m cap without a lead cut it and it fell)."""
+    m = load_maneuver(EXAMPLE)
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    capped = _with(m, "leap", {**leap, "rise_cap": 1.0, "rise_lead": 0.012})
+    ordinary, high = _starts(1.0, 2)
+    before = run_maneuver(m, perturbation=high, fps=10.0).report
+    assert before["achieved_height_m"] > 0.85 and not (before["landed"] and not before["fell"])
+    held = run_maneuver(capped, perturbation=high, fps=10.0).report
+    assert held["achieved_height_m"] < 0.65
+    assert held["landed"] and not held["fell"] and abs(held["rotation_deg"] + 360.0) <= 45.0
+    file_run = run_maneuver(m, perturbation=ordinary, fps=10.0).report
+    same = run_maneuver(capped, perturbation=ordinary, fps=10.0).report
+    assert file_run["landed"] and not file_run["fell"]
+    for key in ("achieved_height_m", "rotation_deg", "landed", "fell"):
+        assert same[key] == file_run[key]
