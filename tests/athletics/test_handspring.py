@@ -139,9 +139,18 @@ def _with(m: Maneuver, controller: str, params: dict[str, float]) -> Maneuver:
     return replace(m, phases=phases)
 
 
+def _uncapped(m: Maneuver) -> Maneuver:
+    """``m`` as the file was before its leap's height cap (2026-12-05): no ``rise_cap`` /
+    ``rise_lead``."""
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    return _with(m, "leap", {k: v for k, v in leap.items() if not k.startswith("rise_")})
+
+
 def _aimed_at_196(m: Maneuver) -> Maneuver:
     """``m`` with the knees' aim as it was before it was centred on the ramped crouch
-    (2026-12-04): -196 deg at contact about 0.4 rad, clipped at the default 0.9."""
+    (2026-12-04): -196 deg at contact about 0.4 rad, clipped at the default 0.9 (and no
+    height cap)."""
+    m = _uncapped(m)
     hands = next(p for p in m.phases if p.controller == "handspring").params
     return _with(m, "handspring", {**{k: v for k, v in hands.items() if k != "aim_knees"},
                                    "aim": -3.42, "knees": 0.4})  # fmt: skip
@@ -150,7 +159,8 @@ def _aimed_at_196(m: Maneuver) -> Maneuver:
 def _hopping(m: Maneuver) -> Maneuver:
     """``m`` as the file was before its ramped crouch (2026-12-04): the crouch's COM target 10
     cm back at once (the step that hops the feet off the floor), the feet landing 55 cm back,
-    the knees' aim at -196 deg."""
+    the knees' aim at -196 deg (and no height cap)."""
+    m = _uncapped(m)
     leap = next(p for p in m.phases if p.controller == "leap").params
     land = next(p for p in m.phases if p.controller == "land").params
     m = _with(_aimed_at_196(m), "leap", {**{k: v for k, v in leap.items() if k != "com_ramp"},
@@ -338,7 +348,7 @@ def test_the_leap_holds_its_height_and_a_start_that_over_leapt_lands() -> None:
     the hands meet the floor past -220 deg with the knees' aim straight, and it does not
     land. With the push's knees and ankles stopped once the COM's ballistic apex reaches 0.5
     m (``rise_cap``) it rises under 0.6 m, meets the floor within the aim's range and lands."""
-    m = load_maneuver(EXAMPLE)
+    m = _uncapped(load_maneuver(EXAMPLE))  # the file before its look-ahead cap
     leap = next(p for p in m.phases if p.controller == "leap").params
     start = _starts(1.0, 44)[43]
     high = run_maneuver(m, perturbation=start, fps=10.0).report
@@ -351,22 +361,23 @@ def test_the_leap_holds_its_height_and_a_start_that_over_leapt_lands() -> None:
 
 
 def test_the_cap_looks_ahead_and_holds_only_the_over_leap() -> None:
-    """Full-size start 1 (seed 0) leaps 0.89 m with the file and does not land. A cap at 1.0 m
-    that looks 12 ms ahead at the apex's rate (``rise_lead``) fires in its push's last ticks,
-    where an over-leap's apex grows fastest: it rises under 0.65 m and lands. Start 0, an
-    ordinary leap (0.65 m) that lands with the file, runs as with the file (the cap never
-    fires; the 0.5 m cap without a lead cut it and it fell)."""
+    """Full-size start 1 (seed 0) leaps 0.89 m without the file's height cap and does not
+    land. The file's cap at 1.0 m looks 12 ms ahead at the apex's rate (``rise_lead``, since
+    2026-12-05) and fires in its push's last ticks, where an over-leap's apex grows fastest:
+    it rises under 0.65 m and lands. Start 0, an ordinary leap (0.65 m) that lands, runs as
+    without the cap (it never fires; the 0.5 m cap without a lead cut it and it fell)."""
     m = load_maneuver(EXAMPLE)
     leap = next(p for p in m.phases if p.controller == "leap").params
-    capped = _with(m, "leap", {**leap, "rise_cap": 1.0, "rise_lead": 0.012})
+    assert (leap["rise_cap"], leap["rise_lead"]) == (1.0, 0.012)
+    uncapped = _uncapped(m)
     ordinary, high = _starts(1.0, 2)
-    before = run_maneuver(m, perturbation=high, fps=10.0).report
+    before = run_maneuver(uncapped, perturbation=high, fps=10.0).report
     assert before["achieved_height_m"] > 0.85 and not (before["landed"] and not before["fell"])
-    held = run_maneuver(capped, perturbation=high, fps=10.0).report
+    held = run_maneuver(m, perturbation=high, fps=10.0).report
     assert held["achieved_height_m"] < 0.65
     assert held["landed"] and not held["fell"] and abs(held["rotation_deg"] + 360.0) <= 45.0
-    file_run = run_maneuver(m, perturbation=ordinary, fps=10.0).report
-    same = run_maneuver(capped, perturbation=ordinary, fps=10.0).report
-    assert file_run["landed"] and not file_run["fell"]
+    without = run_maneuver(uncapped, perturbation=ordinary, fps=10.0).report
+    same = run_maneuver(m, perturbation=ordinary, fps=10.0).report
+    assert without["landed"] and not without["fell"]
     for key in ("achieved_height_m", "rotation_deg", "landed", "fell"):
-        assert same[key] == file_run[key]
+        assert same[key] == without[key]
