@@ -270,21 +270,21 @@ class AnchoredReference:
         n = len(self._firm)
         idx = np.where(self._firm, np.arange(n)[:, None], n)
         self._next_planted = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
-        # and its own capture point's largest lead so predicted past its landings: a walk's
-        # own runs past its next flagged landing (0.49-0.57 m on the walks, set where the stance
-        # flags a foot still swinging as landed: docs/tracking.md, ``step_ahead_phase``)
-        leads = self._clip_swing_leads() if self.step_ahead_swing else np.full(n, -np.inf)
-        self._swing_margin = float(max(0.0, leads.max())) if self.step_ahead_swing else np.inf
-        # ``step_ahead_phase``: the swing step's limit per frame, the clip's own lead at that
-        # frame plus this margin (m): the largest is set where the clip's stance flags a
-        # foot still swinging as landed (0.49-0.57 m; past real landings at most 0.33 m);
-        # frames without a lead keep the largest
-        self.step_ahead_phase = float(step_ahead_phase)
-        self._swing_limit = (
-            np.where(np.isfinite(leads), leads, self._swing_margin) + self.step_ahead_phase
-            if self.step_ahead_phase
-            else None
-        )
+        # ``step_ahead_swing``'s limit per frame: ``step_ahead`` times the clip's own largest
+        # lead predicted past its landings (0.49-0.57 m on the walks, set where the stance
+        # flags a foot still swinging as landed: docs/tracking.md, ``step_ahead_phase``), or
+        # with ``step_ahead_phase`` the clip's own lead at that frame plus that margin (m;
+        # frames without a lead keep the largest)
+        self._swing_limit = np.full(n, np.inf)
+        if self.step_ahead_swing:
+            leads = self._clip_swing_leads()
+            largest = float(max(0.0, leads.max()))
+            if step_ahead_phase:
+                self._swing_limit = np.where(np.isfinite(leads), leads, largest) + float(
+                    step_ahead_phase
+                )
+            else:
+                self._swing_limit[:] = largest * self.step_ahead
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -737,8 +737,9 @@ class AnchoredReference:
         double supports counted as swing), with the swing foot in the air and the stance
         foot on the floor, the capture point predicted (pivoting over the stance foot) to
         the clip's landing of the swing foot and past that landing along the clip's walk by
-        more than ``step_ahead`` times the clip's own largest such lead
-        (:meth:`_clip_swing_margin`) brings the landing forward: a balance step of the swing foot to
+        more than the limit at that frame (``step_ahead`` times the clip's own largest such
+        lead, :meth:`_clip_swing_leads`, or with ``step_ahead_phase`` its own lead there plus
+        that margin) brings the landing forward: a balance step of the swing foot to
         :func:`step_target`, taking ``step_ahead_swing`` of the clip's time left to its
         landing. A step from double support only came after the body had run past its feet
         in the single support before it (``docs/tracking.md``)."""
@@ -763,11 +764,7 @@ class AnchoredReference:
         stance = centre[1 - f, :2]
         pred = stance + (xi - stance) * np.exp(omega * left_s)
         land = _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
-        if self._swing_limit is not None:  # ``step_ahead_phase``: the clip's own lead here
-            limit = float(self._swing_limit[i])
-        else:
-            limit = self._swing_margin * self.step_ahead
-        if float((pred - land) @ u) <= limit:
+        if float((pred - land) @ u) <= self._swing_limit[i]:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),
