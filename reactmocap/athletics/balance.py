@@ -157,6 +157,12 @@ class Step:
             lands at least this far (m) past the capture point across the feet, on its own
             side (0: under its hip; opt-in, docs/athletics.md "The standing step's first
             single support").
+        ground: from the swing's middle on, the swing leg is aimed from the hip's height as
+            it is (not from where the standing knee's bend for the reach will lower it) and
+            made at most this fraction of the straight leg, its place pulled in toward the hip
+            to where such a leg meets the floor (0: off, :data:`STEP_REACH` and the place past
+            the capture point, where the foot hung over the floor until the body sank;
+            opt-in, docs/athletics.md "The standing step's swing shortened").
     """
 
     margin: float = 0.05
@@ -164,14 +170,17 @@ class Step:
     lift: float = 0.3
     seconds: float = 0.25
     across: float = 0.0
+    ground: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("margin", "reach", "lift", "seconds", "across"):
+        for name in ("margin", "reach", "lift", "seconds", "across", "ground"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise ConfigError(f"step {name} must be a finite number >= 0, got {v!r}")
         if not 0.05 <= self.seconds <= 2.0:
             raise ConfigError(f"step seconds must be in [0.05, 2], got {self.seconds}")
+        if self.ground and not 0.5 <= self.ground <= 1.0:
+            raise ConfigError(f"step ground must be 0 or in [0.5, 1], got {self.ground}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -799,7 +808,14 @@ class Stepper:
                 bend = min(bend, self._bend + STANDING_BEND_RATE * max(t - self._t_last, 0.0))
                 self._bend = max(bend, 0.0)
             rig.offset[_KNEE[j], 0] = max(bend, float(rig.offset[_KNEE[j], 0]))
-            down -= low
+            if not st.ground or u < 0.5:  # aimed from the hip as low as that bend will put it
+                down -= low
+        if st.ground and u >= 0.5:  # then on the floor within this reach from the hip as it is
+            reach = st.ground * (ul + ll)
+            off = want - at
+            far = math.sqrt(max(reach * reach - down * down, 0.0))
+            want = at + off * min(far / max(float(np.hypot(*off)), 1e-9), 1.0)
+            ahead, aside = (float(x) for x in want - at)
         length = min(math.sqrt(ahead * ahead + aside * aside + max(down, 0.2) ** 2), reach)
         swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
         knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
