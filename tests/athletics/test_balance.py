@@ -266,3 +266,24 @@ def test_a_standing_step_put_past_the_capture_point_across_the_feet_lands(
     assert not r["fell"] and r["steps"][0]["s"] < 0.6
     with pytest.raises(ConfigError, match="across"):
         Step(across=-0.1)
+
+
+def test_a_standing_step_aimed_on_the_floor_from_the_hip_ends_sooner(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's swing shortened"): at the
+    # male's 200 N forward push step="on"'s first swing hangs over the floor at STEP_REACH
+    # until it runs out (0.75 s); aimed from its middle on at the floor from the hip as it is,
+    # with the leg up to 0.99 of straight (Step.ground), the foot lands after about 0.40 s
+    # and about as far ahead
+    push = {"check_range": False, "seconds": 3.0, "push": 200.0, "step": "on"}
+    first = run("balance", "male", **push).report["steps"][0]
+    assert first["s"] >= 0.7
+    ground = dataclasses.replace(balance.STANDING_STEP, ground=0.99)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", ground)
+    steps = run("balance", "male", **push).report["steps"]
+    assert steps[0]["t"] == pytest.approx(first["t"])
+    assert steps[0]["s"] < 0.45 and steps[0]["to_m"] > 0.4
+    for bad in (0.3, 1.2, -1.0):
+        with pytest.raises(ConfigError, match="ground"):
+            Step(ground=bad)
