@@ -404,6 +404,20 @@ class Runner:
             # it drove the heel into the ground (11-13 body weights) and it bounced off
             ease = clamp((self.world.data.time - self.t_touchdown) / k["attitude_ramp"], 0, 1)
             torque *= ease * ease * (3.0 - 2.0 * ease)
+        # the stance thigh's long axis: a torque about it only twists the leg against the foot
+        leg = self.active
+        axis = d.xanchor[self._knees[leg]] - d.xanchor[self._hips[leg]]
+        axis /= max(float(np.linalg.norm(axis)), 1e-9)
+        grf = max(float(self.senses.grf[2]), 0.0)
+        load = k["twist_load"]
+        twist = 0.0
+        if load > 0:
+            # opt-in: the twist taken out before the norm limit (scaled with it, it cut roll
+            # and pitch), eased in with the ground force and held to the grip
+            along = float(torque @ axis)
+            torque = torque - along * axis
+            grip = k["yaw_grip"] * self.foot_length * grf
+            twist = clamp(along * min(grf / (load * self.mass * self.g), 1.0), -grip, grip)
         limit = k["attitude_limit"]
         if k["touchdown_limit"] > 0 and self.machine.current.name in ("loading", "heel"):
             # until the ball is down: at once a large torque drove the heel into the ground
@@ -414,13 +428,12 @@ class Runner:
             size = float(np.linalg.norm(torque))
             if size > top:
                 torque *= top / size
+        if load > 0:
+            return torque + twist * axis
         # the part about the stance thigh's long axis only twists the leg against the foot's
         # grip on the ground: it stays within what the foot can hold, or the leg spins
-        leg = self.active
-        axis = d.xanchor[self._knees[leg]] - d.xanchor[self._hips[leg]]
-        axis /= max(float(np.linalg.norm(axis)), 1e-9)
         along = float(torque @ axis)
-        limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
+        limit = k["yaw_grip"] * self.foot_length * grf
         return torque - (along - clamp(along, -limit, limit)) * axis
 
     def _support_point(self, t: float) -> F64:

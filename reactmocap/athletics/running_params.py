@@ -100,6 +100,12 @@ class RunParams:
             fell. In a traced eight the touchdowns that did not bounce met 1.1-3.4.
         yaw_grip: the twisting moment a stance foot can hold, in units of its length times
             the vertical ground force (a friction coefficient times the lever).
+        twist_load: opt-in (body weights; 0: off, at most 5): the attitude torque's part
+            about the stance thigh's long axis is taken out before the norm limit
+            (``attitude_limit``, ``touchdown_limit``, which then act on the rest alone), its
+            gain ramped in by the stance's vertical ground force over this many body weights,
+            and held to ``yaw_grip`` (by default the limit scales the whole torque, the twist
+            too, and the grip clamps the twist after).
         knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
             keep only their roll and yaw (the leg spring drives their pitch).
         push_hold: in the push (the toe and unloading states), the share (0-1) of those
@@ -171,6 +177,7 @@ class RunParams:
     attitude_ramp: float | Speeds = (0, 0, 0.02)
     touchdown_limit: float | Speeds = (4.0, 4.0, 8.0)
     yaw_grip: float | Speeds = 0.181
+    twist_load: float | Speeds = 0.0
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
     push_hold: float | Speeds = 1.0
@@ -225,6 +232,10 @@ class RunParams:
                 raise ConfigError(f"stance_blend must be in (0, 1], got {self.stance_blend}")
             if r["thrust_drop"] <= 0:
                 raise ConfigError(f"thrust_drop must be > 0, got {self.thrust_drop}")
+            if not 0 <= r["twist_load"] <= 5:
+                raise ConfigError(
+                    f"twist_load must be in [0, 5] body weights, got {self.twist_load}"
+                )
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
             if not (r["step_stance"] == 0 or 0.1 <= r["step_stance"] <= 0.5):
