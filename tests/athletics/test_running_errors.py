@@ -54,6 +54,10 @@ def test_run_params_are_checked() -> None:
         RunParams(stance_blend=(0.0, 1.0, 1.0))
     with pytest.raises(ConfigError, match="path_integral"):
         RunParams(path_integral=-1.0)
+    with pytest.raises(ConfigError, match="twist_load"):
+        RunParams(twist_load=-0.5)
+    with pytest.raises(ConfigError, match="twist_load"):
+        RunParams(twist_load=(0.0, 6.0, 0.0))
     with pytest.raises(ConfigError, match="thrust_drop"):
         RunParams(thrust_drop=0.0)
     p = RunParams(thrust=(1.0, 2.0, 4.0))
