@@ -198,6 +198,7 @@ class Runner:
         self.t_heel_toe = 0.0
         self.stance_estimate = k["stance_time"]
         self.vz_touchdown = 0.0
+        self.yaw_td = math.nan
         #: the stance the commanded step lasts (s; 0: the leg spring's stance)
         self.step_stance = 0.0
         self.targets = np.zeros((NJ, 3))
@@ -391,6 +392,14 @@ class Runner:
         c, s = math.cos(heading), math.sin(heading)
         axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
         local = axes @ err
+        slew = k["twist_slew"]
+        if slew > 0:
+            # opt-in: the yaw error starts from the heel strike's and is slewed to the facing
+            # at this rate (at once it asked 6-8 times the foot's grip at heel strike)
+            if math.isnan(self.yaw_td):
+                self.yaw_td = float(local[2])
+            since = self.world.data.time - self.t_touchdown
+            local[2] -= math.copysign(max(abs(self.yaw_td) - slew * since, 0.0), self.yaw_td)
         gain = self.inertia_unit * (
             self._attitude_kp * local - self._attitude_kv * (axes @ d.cvel[self._chest, :3])
         )
@@ -589,6 +598,7 @@ class Runner:
         self.released = False
         self.vz_peak = -math.inf
         self.vz_touchdown = float(self.senses.com_vel[2])
+        self.yaw_td = math.nan  # read at the stance's first attitude tick
         # the start runs on the leg spring: from the set pose the commanded step fell
         switch = not self.step_stance and t >= STEP_AFTER and self.k["step_stance"] > 0
         self.step_stance = self.k["step_stance"] if t >= STEP_AFTER else 0.0

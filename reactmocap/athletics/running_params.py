@@ -106,6 +106,9 @@ class RunParams:
             gain ramped in by the stance's vertical ground force over this many body weights,
             and held to ``yaw_grip`` (by default the limit scales the whole torque, the twist
             too, and the grip clamps the twist after).
+        twist_slew: opt-in (rad/s; 0: off): the stance hip's yaw error starts at each
+            stance from the one at its first tick and is slewed to the desired facing's at
+            this rate.
         knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
             keep only their roll and yaw (the leg spring drives their pitch).
         push_hold: in the push (the toe and unloading states), the share (0-1) of those
@@ -178,6 +181,7 @@ class RunParams:
     touchdown_limit: float | Speeds = (4.0, 4.0, 8.0)
     yaw_grip: float | Speeds = 0.181
     twist_load: float | Speeds = 0.0
+    twist_slew: float | Speeds = 0.0
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
     push_hold: float | Speeds = 1.0
@@ -236,6 +240,8 @@ class RunParams:
                 raise ConfigError(
                     f"twist_load must be in [0, 5] body weights, got {self.twist_load}"
                 )
+            if r["twist_slew"] < 0:
+                raise ConfigError(f"twist_slew must be >= 0 rad/s, got {self.twist_slew}")
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
             if not (r["step_stance"] == 0 or 0.1 <= r["step_stance"] <= 0.5):
