@@ -671,7 +671,12 @@ class Runner:
         s = self.senses
         s.update(t)
         self._contacts()
-        want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
+        ahead = self.k["steer_ahead"]
+        # opt-in: the facing aimed from where the body's velocity takes it (the pursuit from
+        # inside a curve slowed the facing while the body still turned into the curve); not
+        # over the start (set at once at the first tick, its larger facing threw the runner)
+        lead = s.com_vel[:2] * ahead if ahead > 0 and t >= PATH_AFTER else None
+        want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t, lead)
         if self.k["path_integral"] > 0 and math.isfinite(self.cross_track) and t >= PATH_AFTER:
             # the steady offset a curve leaves (pure pursuit's chord, the feed-forward's lead)
             # grows with the curvature and flips with it: integrated and applied in proportion

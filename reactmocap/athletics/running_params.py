@@ -152,6 +152,9 @@ class RunParams:
         path_integral: the facing is turned by this gain times the curvature times the
             integral of the cross-track error times the curvature (m/s; 0: none),
             which takes out the steady offset a curve leaves.
+        steer_ahead: opt-in (s, 0: off, at most 1): the pursuit's facing is aimed from the
+            position predicted this far ahead along the body's velocity (the cross-track
+            error stays the body's own), so the facing keeps turning while the body does.
         lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
@@ -201,6 +204,7 @@ class RunParams:
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
+    steer_ahead: float | Speeds = 0.0
     lean: float | Speeds = 1.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
@@ -244,6 +248,8 @@ class RunParams:
                 raise ConfigError(f"twist_slew must be >= 0 rad/s, got {self.twist_slew}")
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
+            if not 0 <= r["steer_ahead"] <= 1:
+                raise ConfigError(f"steer_ahead must be in [0, 1] s, got {self.steer_ahead}")
             if not (r["step_stance"] == 0 or 0.1 <= r["step_stance"] <= 0.5):
                 raise ConfigError(
                     f"step_stance must be 0 (off) or 0.1-0.5 s, got {self.step_stance}"
