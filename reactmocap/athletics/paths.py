@@ -39,9 +39,8 @@ TURN_RATE = 0.2
 
 
 class Course(Protocol):
-    def steer(self, pos: F64, t: float, lead: F64 | None = None) -> tuple[float, float, float]:
-        """Desired facing, curvature and cross-track error at ground position ``pos (2,)``;
-        a path's facing is aimed from ``pos + lead`` when ``lead (2,)`` is given."""
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
+        """Desired facing, curvature and cross-track error at ground position ``pos (2,)``."""
         ...
 
 
@@ -67,8 +66,8 @@ class Facing:
         self.heading = self.schedule[0][1]
         self.time = self.schedule[0][0]
 
-    def steer(self, pos: F64, t: float, lead: F64 | None = None) -> tuple[float, float, float]:
-        del pos, lead
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
+        del pos
         goal = self.schedule[0][1]
         for when, heading in self.schedule:
             if t >= when:
@@ -94,14 +93,13 @@ class Circle:
         self.sign = 1.0 if ccw else -1.0
         self.lookahead = float(lookahead)
 
-    def steer(self, pos: F64, t: float, lead: F64 | None = None) -> tuple[float, float, float]:
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
         del t
         r = np.asarray(pos[:2], dtype=np.float64) - self.centre
         dist = max(float(np.hypot(*r)), 1e-6)
-        q = r if lead is None else r + lead[:2]  # where the facing is aimed from
-        ang = math.atan2(q[1], q[0]) + self.sign * self.lookahead / self.radius
+        ang = math.atan2(r[1], r[0]) + self.sign * self.lookahead / self.radius
         target = self.centre + self.radius * np.array([math.cos(ang), math.sin(ang)])
-        d = target - (pos[:2] if lead is None else pos[:2] + lead[:2])
+        d = target - pos[:2]
         # left of the path: inside an anticlockwise circle, outside a clockwise one
         cross = self.sign * (self.radius - dist)
         return math.atan2(d[1], d[0]), self.sign / self.radius, cross
@@ -172,7 +170,7 @@ class Polyline:
         u = (s - self.cum[i]) / self.len[i]
         return self.points[i] + u * self.seg[i]
 
-    def steer(self, pos: F64, t: float, lead: F64 | None = None) -> tuple[float, float, float]:
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
         del t
         p = np.asarray(pos[:2], dtype=np.float64)
         i, s, cross = self._closest(p)
@@ -180,17 +178,11 @@ class Polyline:
             self._laps += 1  # past the closing point into the next lap
         self.index = i
         self.progress = s + self._laps * self.total
-        # aimed from the predicted position, its arc length moved on by the lead's
-        # along-track share (the closest-point search, and the progress, stay the body's)
-        q, aim = p, s
-        if lead is not None:
-            q = p + lead[:2]
-            aim = s + max(float(lead[:2] @ self.seg[i]) / float(self.len[i]), 0.0)
-        target = self.point_at(aim + self.lookahead)
-        if not self.closed and aim + self.lookahead > self.total:  # past the end: straight on
+        target = self.point_at(s + self.lookahead)
+        if not self.closed and s + self.lookahead > self.total:  # past the end: straight on
             d = self.points[-1] - self.points[-2]
-            target = q + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead
-        d = target - q
+            target = p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead
+        d = target - p
         # the curvature over the look-ahead: the turn between its two halves' chords (the
         # segments' own directions turn in steps, and the lean read from them jumped)
         half = 0.5 * self.lookahead

@@ -198,7 +198,6 @@ class Runner:
         self.t_heel_toe = 0.0
         self.stance_estimate = k["stance_time"]
         self.vz_touchdown = 0.0
-        self.yaw_td = math.nan
         #: the stance the commanded step lasts (s; 0: the leg spring's stance)
         self.step_stance = 0.0
         self.targets = np.zeros((NJ, 3))
@@ -392,14 +391,6 @@ class Runner:
         c, s = math.cos(heading), math.sin(heading)
         axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
         local = axes @ err
-        slew = k["twist_slew"]
-        if slew > 0:
-            # opt-in: the yaw error starts from the heel strike's and is slewed to the facing
-            # at this rate (at once it asked 6-8 times the foot's grip at heel strike)
-            if math.isnan(self.yaw_td):
-                self.yaw_td = float(local[2])
-            since = self.world.data.time - self.t_touchdown
-            local[2] -= math.copysign(max(abs(self.yaw_td) - slew * since, 0.0), self.yaw_td)
         gain = self.inertia_unit * (
             self._attitude_kp * local - self._attitude_kv * (axes @ d.cvel[self._chest, :3])
         )
@@ -413,20 +404,6 @@ class Runner:
             # it drove the heel into the ground (11-13 body weights) and it bounced off
             ease = clamp((self.world.data.time - self.t_touchdown) / k["attitude_ramp"], 0, 1)
             torque *= ease * ease * (3.0 - 2.0 * ease)
-        # the stance thigh's long axis: a torque about it only twists the leg against the foot
-        leg = self.active
-        axis = d.xanchor[self._knees[leg]] - d.xanchor[self._hips[leg]]
-        axis /= max(float(np.linalg.norm(axis)), 1e-9)
-        grf = max(float(self.senses.grf[2]), 0.0)
-        load = k["twist_load"]
-        twist = 0.0
-        if load > 0:
-            # opt-in: the twist taken out before the norm limit (scaled with it, it cut roll
-            # and pitch), eased in with the ground force and held to the grip
-            along = float(torque @ axis)
-            torque = torque - along * axis
-            grip = k["yaw_grip"] * self.foot_length * grf
-            twist = clamp(along * min(grf / (load * self.mass * self.g), 1.0), -grip, grip)
         limit = k["attitude_limit"]
         if k["touchdown_limit"] > 0 and self.machine.current.name in ("loading", "heel"):
             # until the ball is down: at once a large torque drove the heel into the ground
@@ -437,12 +414,13 @@ class Runner:
             size = float(np.linalg.norm(torque))
             if size > top:
                 torque *= top / size
-        if load > 0:
-            return torque + twist * axis
         # the part about the stance thigh's long axis only twists the leg against the foot's
         # grip on the ground: it stays within what the foot can hold, or the leg spins
+        leg = self.active
+        axis = d.xanchor[self._knees[leg]] - d.xanchor[self._hips[leg]]
+        axis /= max(float(np.linalg.norm(axis)), 1e-9)
         along = float(torque @ axis)
-        limit = k["yaw_grip"] * self.foot_length * grf
+        limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
         return torque - (along - clamp(along, -limit, limit)) * axis
 
     def _support_point(self, t: float) -> F64:
@@ -598,7 +576,6 @@ class Runner:
         self.released = False
         self.vz_peak = -math.inf
         self.vz_touchdown = float(self.senses.com_vel[2])
-        self.yaw_td = math.nan  # read at the stance's first attitude tick
         # the start runs on the leg spring: from the set pose the commanded step fell
         switch = not self.step_stance and t >= STEP_AFTER and self.k["step_stance"] > 0
         self.step_stance = self.k["step_stance"] if t >= STEP_AFTER else 0.0
@@ -671,12 +648,7 @@ class Runner:
         s = self.senses
         s.update(t)
         self._contacts()
-        ahead = self.k["steer_ahead"]
-        # opt-in: the facing aimed from where the body's velocity takes it (the pursuit from
-        # inside a curve slowed the facing while the body still turned into the curve); not
-        # over the start (set at once at the first tick, its larger facing threw the runner)
-        lead = s.com_vel[:2] * ahead if ahead > 0 and t >= PATH_AFTER else None
-        want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t, lead)
+        want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
         if self.k["path_integral"] > 0 and math.isfinite(self.cross_track) and t >= PATH_AFTER:
             # the steady offset a curve leaves (pure pursuit's chord, the feed-forward's lead)
             # grows with the curvature and flips with it: integrated and applied in proportion

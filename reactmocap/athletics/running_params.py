@@ -100,15 +100,6 @@ class RunParams:
             fell. In a traced eight the touchdowns that did not bounce met 1.1-3.4.
         yaw_grip: the twisting moment a stance foot can hold, in units of its length times
             the vertical ground force (a friction coefficient times the lever).
-        twist_load: opt-in (body weights; 0: off, at most 5): the attitude torque's part
-            about the stance thigh's long axis is taken out before the norm limit
-            (``attitude_limit``, ``touchdown_limit``, which then act on the rest alone), its
-            gain ramped in by the stance's vertical ground force over this many body weights,
-            and held to ``yaw_grip`` (by default the limit scales the whole torque, the twist
-            too, and the grip clamps the twist after).
-        twist_slew: opt-in (rad/s; 0: off): the stance hip's yaw error starts at each
-            stance from the one at its first tick and is slewed to the desired facing's at
-            this rate.
         knee_hold, ankle_hold: stiffness of the stance knee's and ankle's own servos, which
             keep only their roll and yaw (the leg spring drives their pitch).
         push_hold: in the push (the toe and unloading states), the share (0-1) of those
@@ -152,9 +143,6 @@ class RunParams:
         path_integral: the facing is turned by this gain times the curvature times the
             integral of the cross-track error times the curvature (m/s; 0: none),
             which takes out the steady offset a curve leaves.
-        steer_ahead: opt-in (s, 0: off, at most 1): the pursuit's facing is aimed from the
-            position predicted this far ahead along the body's velocity (the cross-track
-            error stays the body's own), so the facing keeps turning while the body does.
         lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
@@ -183,8 +171,6 @@ class RunParams:
     attitude_ramp: float | Speeds = (0, 0, 0.02)
     touchdown_limit: float | Speeds = (4.0, 4.0, 8.0)
     yaw_grip: float | Speeds = 0.181
-    twist_load: float | Speeds = 0.0
-    twist_slew: float | Speeds = 0.0
     knee_hold: float | Speeds = 3.0
     ankle_hold: float | Speeds = 1.0
     push_hold: float | Speeds = 1.0
@@ -204,7 +190,6 @@ class RunParams:
     turn_rate: float | Speeds = 0.35
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
-    steer_ahead: float | Speeds = 0.0
     lean: float | Speeds = 1.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
@@ -240,16 +225,8 @@ class RunParams:
                 raise ConfigError(f"stance_blend must be in (0, 1], got {self.stance_blend}")
             if r["thrust_drop"] <= 0:
                 raise ConfigError(f"thrust_drop must be > 0, got {self.thrust_drop}")
-            if not 0 <= r["twist_load"] <= 5:
-                raise ConfigError(
-                    f"twist_load must be in [0, 5] body weights, got {self.twist_load}"
-                )
-            if r["twist_slew"] < 0:
-                raise ConfigError(f"twist_slew must be >= 0 rad/s, got {self.twist_slew}")
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
-            if not 0 <= r["steer_ahead"] <= 1:
-                raise ConfigError(f"steer_ahead must be in [0, 1] s, got {self.steer_ahead}")
             if not (r["step_stance"] == 0 or 0.1 <= r["step_stance"] <= 0.5):
                 raise ConfigError(
                     f"step_stance must be 0 (off) or 0.1-0.5 s, got {self.step_stance}"

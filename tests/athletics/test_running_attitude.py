@@ -4,7 +4,6 @@ MuJoCo, the thesis male)."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from reactmocap.athletics.run_course import run_course
 from reactmocap.athletics.running import RunParams
@@ -114,45 +113,3 @@ def test_the_thrust_stops_at_the_take_off_speed_or_once_the_rise_slows() -> None
     assert not push(0.0, 0.5 * top, 0.5 * top - 0.5 * drop)  # a small dip: still on
     assert push(0.0, 0.5 * top, 0.5 * top - 2.0 * drop)
     assert RunParams().at(4.0)["thrust_drop"] > 2.0  # off where the fast gaits were tuned
-
-
-def test_twist_load_keeps_roll_and_pitch_when_the_norm_limit_cuts() -> None:
-    """``twist_load`` (opt-in) takes the twist about the stance thigh out before the norm
-    limit: with a large yaw error and the limit cutting, the roll and pitch part (off the
-    thigh's axis) keeps the limit's whole size, where by default it is cut with the twist;
-    the twist is held to the grip either way, and eased in with the ground force."""
-    res = run_course(2.5, seconds=0.2, path="circle:10", fps=10.0)
-    runner = res.runner
-    k = runner.k
-    assert runner.machine.current.name != "flight"
-    d = runner.world.data
-    leg = runner.active
-    axis = d.xanchor[runner._knees[leg]] - d.xanchor[runner._hips[leg]]
-    axis /= np.linalg.norm(axis)
-    fz = float(runner.senses.grf[2])
-    grip = k["yaw_grip"] * runner.foot_length * fz
-    assert fz > 0.5 * runner.mass * runner.g
-    runner.heading_d += 1.0  # a radian of yaw to turn: a twist well over the grip
-    k["pitch"] += 0.05  # and some pitch to hold
-    k["attitude_limit"] = 0.5  # a norm limit that cuts (m g L units)
-    top = 0.5 * runner.mass * runner.g * runner.athlete.leg_length
-
-    def parts(load: float) -> tuple[float, float]:
-        k["twist_load"] = load
-        torque = runner._attitude_torque(runner.heading_d)
-        along = float(torque @ axis)
-        return along, float(np.linalg.norm(torque - along * axis))
-
-    twist0, rest0 = parts(0.0)
-    twist1, rest1 = parts(0.5)
-    assert abs(twist0) <= grip * (1 + 1e-9) and abs(twist1) <= grip * (1 + 1e-9)
-    assert rest1 == pytest.approx(top, rel=1e-9)  # the norm limit on roll and pitch alone
-    assert rest0 < 0.9 * rest1  # by default the twist took its share of the limit
-    # eased in: the twist's gain is the ground force over ``twist_load`` body weights (a
-    # grip that does not bind here, to see the ramp alone)
-    k["yaw_grip"] = 1e3
-    full, _ = parts(0.5)
-    eased, _ = parts(5.0)
-    ratio = fz / (5.0 * runner.mass * runner.g)
-    assert 0.1 < ratio < 1 and abs(full) > 2 * grip
-    assert eased == pytest.approx(ratio * full, rel=1e-9)

@@ -54,12 +54,6 @@ def test_run_params_are_checked() -> None:
         RunParams(stance_blend=(0.0, 1.0, 1.0))
     with pytest.raises(ConfigError, match="path_integral"):
         RunParams(path_integral=-1.0)
-    with pytest.raises(ConfigError, match="twist_load"):
-        RunParams(twist_load=-0.5)
-    with pytest.raises(ConfigError, match="twist_load"):
-        RunParams(twist_load=(0.0, 6.0, 0.0))
-    with pytest.raises(ConfigError, match="steer_ahead"):
-        RunParams(steer_ahead=1.5)
     with pytest.raises(ConfigError, match="thrust_drop"):
         RunParams(thrust_drop=0.0)
     p = RunParams(thrust=(1.0, 2.0, 4.0))
@@ -112,22 +106,6 @@ def test_circle_steering() -> None:
     assert 0 < heading < 0.5 and curvature == pytest.approx(0.1) and cross == pytest.approx(0.0)
     _, _, inside = c.steer(np.array([0.0, 1.0]), 0.0)
     assert inside == pytest.approx(1.0)  # left of an anticlockwise path: inside
-
-
-def test_steering_from_a_lead() -> None:
-    """A lead aims the pursuit from the predicted position: on a curve, once on the path, the
-    facing turns further into it, while the cross-track error stays the body's own."""
-    c = Circle((0.0, 10.0), 10.0)
-    at = np.array([0.0, 0.0])
-    plain = c.steer(at, 0.0)
-    assert c.steer(at, 0.0, None) == plain
-    ahead = c.steer(at, 0.0, np.array([0.75, 0.0]))
-    assert ahead[0] > plain[0] + 0.05 and ahead[1:] == plain[1:]
-    eight = figure_eight(10.0)
-    plain = eight.steer(at, 0.0)
-    ahead = eight.steer(at, 0.0, np.array([0.75, 0.0]))
-    assert ahead[0] > plain[0] + 0.05 and ahead[1:] == plain[1:]
-    assert eight.progress == pytest.approx(0.0)  # the progress is the body's
 
 
 def test_polyline_follows_in_order() -> None:
