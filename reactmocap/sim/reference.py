@@ -135,16 +135,20 @@ def reference_path(
     reach: float = 0.05,
     pivot_rate: float | None = 2.0,
     slide_speed: float | None = None,
+    centre_speed: float | None = None,
 ) -> ReferencePath:
     """``source`` on ``world``'s ``character`` as a :class:`ReferencePath`: a Motion on the
     character's skeleton, or a ``(T, 67)`` qpos path sampled at ``fps``. Foot stance is
     measured on the character's own sole boxes (``pivot_rate`` rad/s; ``None``: no pivots); a
     foot whose lowest corner moves faster than ``slide_speed`` (m/s) is not planted (``None``:
-    any foot within ``reach``, the short-window and response trackers' stance)."""
+    any foot within ``reach``, the short-window and response trackers' stance); one whose sole
+    centre moves horizontally faster than ``centre_speed`` (m/s) is not planted either
+    (``None``: off; the lowest corner is slow while a swinging foot rolls over it)."""
     for name, value in (
         ("reach", reach),
         ("pivot_rate", 0.0 if pivot_rate is None else pivot_rate),
         ("slide_speed", 0.0 if slide_speed is None else slide_speed),
+        ("centre_speed", 0.0 if centre_speed is None else centre_speed),
     ):
         if not (np.isfinite(value) and value >= 0):
             raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -176,6 +180,10 @@ def reference_path(
     if slide_speed is not None:
         # a foot skimming the floor (a low step, a slide in the capture) is not a support
         planted &= (slide < slide_speed) | turning
+    if centre_speed is not None and n > 1:
+        # a foot rolling over its lowest corner mid-swing: that corner is slow, the sole not
+        centre_v = np.gradient(centre[..., :2], 1.0 / rate, axis=0)
+        planted &= np.linalg.norm(centre_v, axis=-1) < centre_speed
     pivoting = planted & turning
     arrays = (q, v, a, planted, pivoting, centre, yaw, corner_z, com, up)
     for arr in arrays:
