@@ -180,15 +180,22 @@ def reference_path(
     if slide_speed is not None:
         # a foot skimming the floor (a low step, a slide in the capture) is not a support
         planted &= (slide < slide_speed) | turning
-    if centre_speed is not None and n > 1:
+    if centre_speed is not None:
         # a foot rolling over its lowest corner mid-swing: that corner is slow, the sole not
-        centre_v = np.gradient(centre[..., :2], 1.0 / rate, axis=0)
-        planted &= np.linalg.norm(centre_v, axis=-1) < centre_speed
+        planted &= sole_speed(centre, rate) < centre_speed
     pivoting = planted & turning
     arrays = (q, v, a, planted, pivoting, centre, yaw, corner_z, com, up)
     for arr in arrays:
         arr.flags.writeable = False
     return ReferencePath(q, v, a, planted, pivoting, rate, centre, yaw, corner_z, com, up)
+
+
+def sole_speed(sole: F64, fps: float) -> F64:
+    """Each sole centre's horizontal speed ``(T, 2)`` (m/s, central differences) from its
+    track ``sole`` ``(T, 2, 3)`` at ``fps``; zero for a single frame."""
+    if sole.shape[0] < 2:
+        return np.zeros(sole.shape[:2])
+    return np.linalg.norm(np.gradient(sole[..., :2], 1.0 / fps, axis=0), axis=-1)
 
 
 def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F64, F64]:
