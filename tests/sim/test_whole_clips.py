@@ -612,7 +612,8 @@ def test_a_swinging_foot_rolling_over_its_corner_is_not_planted(shared_mocap_dir
     foot planted for a few frames while its sole centre moves faster than 1 m/s (its lowest
     corner slow as the foot rolls over it), and those false landings set the clip's largest
     predicted lead; with ``centre_speed`` 1.0 (opt-in, 2026-12-05) none is left and the lead
-    falls to what the real landings give. Without it the flags are ``slide_speed``'s alone."""
+    falls to what the real landings give; ``step_ahead_centre`` 1.0 does the same for the
+    stance the pushed walk's steps read only. Without them the flags are ``slide_speed``'s."""
     from reactmocap.library.bvh import read_bvh
 
     clip = shared_mocap_dir / "dataset-1_walk-left_normal_001.bvh"
@@ -631,14 +632,18 @@ def test_a_swinging_foot_rolling_over_its_corner_is_not_planted(shared_mocap_dir
         slide.planted.tolist()
     )
 
-    def largest_lead(**extra: float) -> float:
-        wb = WholeBodyTracker(World(build_character(walk, frame=0)), 0, walk, 0.0,
-                              kp_joint=100.0, servo_kv=1.0, control_every=8, step_ahead=1.0,
-                              step_ahead_swing=1.0, slide_speed=0.5, **extra)  # fmt: skip
-        return float(wb._clip_swing_leads().max())
+    def tracker(**extra: float) -> WholeBodyTracker:
+        return WholeBodyTracker(World(build_character(walk, frame=0)), 0, walk, 0.0,
+                                kp_joint=100.0, servo_kv=1.0, control_every=8, step_ahead=1.0,
+                                step_ahead_swing=1.0, slide_speed=0.5, **extra)  # fmt: skip
 
-    assert largest_lead() > 0.5  # 0.535 m, past a mid-swing "landing"
-    assert largest_lead(centre_speed=1.0) < 0.35  # 0.294 m
+    assert tracker()._clip_swing_leads().max() > 0.5  # 0.535 m, past a mid-swing "landing"
+    assert tracker(centre_speed=1.0)._clip_swing_leads().max() < 0.35  # 0.294 m
+    # ``step_ahead_centre``: the same for the stance step_ahead reads, the tracker's unchanged
+    scoped = tracker(step_ahead_centre=1.0)
+    assert scoped._clip_swing_leads().max() < 0.35
+    assert np.array_equal(scoped.path.planted, slide.planted)
+    assert not (scoped._firm & (centre > 1.0)).any()
 
 
 def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:
