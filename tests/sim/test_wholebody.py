@@ -284,7 +284,6 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_ahead_swing", -0.5),
         ("step_ahead_phase", -0.05),
         ("centre_speed", -1.0),
-        ("step_ahead_centre", -1.0),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -308,14 +307,6 @@ def test_step_ahead_swing_needs_its_step_and_a_fraction(guard: Motion, extra: di
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="step_ahead_swing"):
         _tracker(world, guard, 0.0, **({"step_ahead_swing": 1.0} | extra))
-
-
-def test_step_ahead_centre_needs_its_step(guard: Motion) -> None:
-    """``step_ahead_centre`` only changes the stance ``step_ahead`` reads: alone it is
-    refused."""
-    world = World(build_character(guard, frame=0))
-    with pytest.raises(ConfigError, match="step_ahead_centre"):
-        _tracker(world, guard, 0.0, step_ahead_centre=1.0)
 
 
 @pytest.mark.parametrize(

@@ -23,7 +23,7 @@ from reactmocap.sim.controllers.stepping import (
     step_target,
 )
 from reactmocap.sim.feet import foot_soles, sole_corners_world
-from reactmocap.sim.reference import ReferencePath, sole_speed
+from reactmocap.sim.reference import ReferencePath
 from reactmocap.sim.world import World
 
 __all__ = ["AnchoredReference"]
@@ -139,7 +139,6 @@ class AnchoredReference:
         step_ahead_horizon: float = 0.0,
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
-        step_ahead_centre: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -264,13 +263,8 @@ class AnchoredReference:
         # between two frames of swing)
         self.step_ahead_swing = float(step_ahead_swing)
         self._firm = self.path.planted.copy()
-        if step_ahead_centre:
-            # ``step_ahead_centre``: a swinging foot rolling over its lowest corner is flagged
-            # planted mid-swing (that corner slow, the sole centre at 3-4 m/s)
-            assert self.path.sole is not None
-            self._firm &= sole_speed(self.path.sole, self.path.fps) < step_ahead_centre
         if self.step_ahead_swing:
-            pl = self._firm.copy()
+            pl = self.path.planted
             self._firm[1:-1] &= pl[:-2] | pl[2:]
         # per frame and foot, the first frame from it on where the foot is planted (len: never)
         n = len(self._firm)

@@ -270,11 +270,6 @@ class WholeBodyTracker(AnchoredReference):
             swing's phase: the clip's own predicted lead at the same frame plus this margin
             (m, at most 0.5), in place of ``step_ahead`` times its largest such lead (0: off)
             (``docs/tracking.md``).
-        step_ahead_centre: with ``step_ahead``, the clip's stance as ``step_ahead`` and its
-            swing step read it (landings, single and double supports, the clip's own leads)
-            counts a foot planted only while its sole centre also moves slower than this
-            (m/s; 0: off); the tracker's own stance is unchanged (``centre_speed`` changes
-            that) (``docs/tracking.md``).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -365,7 +360,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_horizon: float = 0.0,
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
-        step_ahead_centre: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -400,7 +394,7 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
                 "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
                 "step_ahead_horizon": step_ahead_horizon, "step_ahead_swing": step_ahead_swing,
-                "step_ahead_phase": step_ahead_phase, "step_ahead_centre": step_ahead_centre,
+                "step_ahead_phase": step_ahead_phase,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -429,11 +423,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_phase ({step_ahead_phase!r}) is a margin in (0, 0.5] m over the "
                 f"clip's own lead, and sets step_ahead_swing's limit: it needs step_ahead_swing"
-            )
-        if step_ahead_centre and not step_ahead:
-            raise ConfigError(
-                f"step_ahead_centre ({step_ahead_centre!r}) only changes the stance "
-                f"step_ahead reads: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -539,7 +528,6 @@ class WholeBodyTracker(AnchoredReference):
             anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase,
-            step_ahead_centre=step_ahead_centre,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
