@@ -13,16 +13,19 @@
 5. Whole clips: every shared clip tracked from start to end by ``--whole-controllers``: upright
    to the end (a fall just after a ``support_feasibility``-flagged span is excused and counted
    apart), PHC's criterion (Luo et al. 2023: a clip fails when the mean body position error
-   exceeds 0.5 m at any frame), no ``unstable`` status, real-time factors (wall and CPU).
+   exceeds 0.5 m at any frame), no ``unstable`` status, real-time factors (wall and CPU);
+   ``--whole-params`` (JSON) sets options over ``WHOLE_CLIP`` (e.g. ``'{"centre_speed": 1.0}'``).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -256,12 +259,12 @@ EXCUSE_AFTER_S = 0.5
 PHC_THRESHOLD_M = 0.5
 
 
-def _track_whole(job: tuple[Path, str]) -> dict[str, object]:
+def _track_whole(job: tuple[Path, str, dict[str, Any]]) -> dict[str, object]:
     """One whole clip: status, fall time, errors, PHC's criterion, feasibility excuse, rates."""
-    path, controller = job
+    path, controller, params = job
     motion = _read_bvh(path)
     cpu = time.process_time()
-    res = track_clip(motion, controller=controller)
+    res = track_clip(motion, controller=controller, params=params or None)
     cpu = time.process_time() - cpu
     rep = res.report
     roll = res.rollout
@@ -282,18 +285,19 @@ def _track_whole(job: tuple[Path, str]) -> dict[str, object]:
     }  # fmt: skip
 
 
-def bench_whole(controllers: list[str], jobs: int) -> None:
+def bench_whole(controllers: list[str], jobs: int, params: dict[str, Any] | None = None) -> None:
     clips = sorted(SHARED.glob("*/*.bvh"))
     if not clips:
         print(f"\n(no shared clips under {SHARED.resolve()}: whole clips skipped)")
         return
     with ProcessPoolExecutor(max_workers=jobs) as pool:
         for controller in controllers:
-            print(f"\n## whole clips, {controller} (default gains; {jobs} processes)")
+            how = f"params {json.dumps(params)} over the defaults" if params else "default gains"
+            print(f"\n## whole clips, {controller} ({how}; {jobs} processes)")
             print(f"{'clip':<30} {'s':>5} {'status':<8} {'fell at':>7} {'excused':>7} "
                   f"{'max root m':>10} {'PHC ok':>6} {'RT wall':>7} {'RT cpu':>6}")  # fmt: skip
             t0 = time.perf_counter()
-            rows = list(pool.map(_track_whole, [(p, controller) for p in clips]))
+            rows = list(pool.map(_track_whole, [(p, controller, params or {}) for p in clips]))
             for r in rows:
                 fell = "-" if r["fell_at_s"] is None else f"{r['fell_at_s']:.2f}"
                 print(
@@ -352,6 +356,10 @@ def main(argv: list[str] | None = None) -> int:
         "--whole-controllers", nargs="*", default=["wholebody"],
         help="controllers tracking the whole shared clips (predictive: ~40x slower)",
     )  # fmt: skip
+    ap.add_argument(
+        "--whole-params", type=json.loads, default={},
+        help="JSON options over the whole clips' (WHOLE_CLIP and the controller's defaults)",
+    )  # fmt: skip
     ap.add_argument("--jobs", type=int, default=2, help="processes for the tracking runs")
     args = ap.parse_args(argv)
     print(f"mujoco {mujoco.__version__}, python {sys.version.split()[0]}")
@@ -364,7 +372,7 @@ def main(argv: list[str] | None = None) -> int:
     if "tracking" not in args.skip:
         bench_tracking(args.assist, args.controllers, args.jobs)
     if "whole" not in args.skip:
-        bench_whole(args.whole_controllers, args.jobs)
+        bench_whole(args.whole_controllers, args.jobs, args.whole_params)
     return 0
 
 

@@ -135,16 +135,20 @@ def reference_path(
     reach: float = 0.05,
     pivot_rate: float | None = 2.0,
     slide_speed: float | None = None,
+    centre_speed: float | None = None,
 ) -> ReferencePath:
     """``source`` on ``world``'s ``character`` as a :class:`ReferencePath`: a Motion on the
     character's skeleton, or a ``(T, 67)`` qpos path sampled at ``fps``. Foot stance is
     measured on the character's own sole boxes (``pivot_rate`` rad/s; ``None``: no pivots); a
     foot whose lowest corner moves faster than ``slide_speed`` (m/s) is not planted (``None``:
-    any foot within ``reach``, the short-window and response trackers' stance)."""
+    any foot within ``reach``, the short-window and response trackers' stance); one whose sole
+    centre moves horizontally faster than ``centre_speed`` (m/s) is not planted either
+    (``None``: off; the lowest corner is slow while a swinging foot rolls over it)."""
     for name, value in (
         ("reach", reach),
         ("pivot_rate", 0.0 if pivot_rate is None else pivot_rate),
         ("slide_speed", 0.0 if slide_speed is None else slide_speed),
+        ("centre_speed", 0.0 if centre_speed is None else centre_speed),
     ):
         if not (np.isfinite(value) and value >= 0):
             raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -176,11 +180,22 @@ def reference_path(
     if slide_speed is not None:
         # a foot skimming the floor (a low step, a slide in the capture) is not a support
         planted &= (slide < slide_speed) | turning
+    if centre_speed is not None:
+        # a foot rolling over its lowest corner mid-swing: that corner is slow, the sole not
+        planted &= sole_speed(centre, rate) < centre_speed
     pivoting = planted & turning
     arrays = (q, v, a, planted, pivoting, centre, yaw, corner_z, com, up)
     for arr in arrays:
         arr.flags.writeable = False
     return ReferencePath(q, v, a, planted, pivoting, rate, centre, yaw, corner_z, com, up)
+
+
+def sole_speed(sole: F64, fps: float) -> F64:
+    """Each sole centre's horizontal speed ``(T, 2)`` (m/s, central differences) from its
+    track ``sole`` ``(T, 2, 3)`` at ``fps``; zero for a single frame."""
+    if sole.shape[0] < 2:
+        return np.zeros(sole.shape[:2])
+    return np.linalg.norm(np.gradient(sole[..., :2], 1.0 / fps, axis=0), axis=-1)
 
 
 def _sole_tracks(world: World, character: int, q: F64) -> tuple[F64, F64, F64, F64, F64]:

@@ -28,7 +28,7 @@ from reactmocap.sim.controllers.stepping import (
     step_target,
 )
 from reactmocap.sim.controllers.wholebody import WholeBodyTracker
-from reactmocap.sim.reference import reference_path
+from reactmocap.sim.reference import reference_path, sole_speed
 from reactmocap.sim.tracking import TrackResult
 
 SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]])
@@ -605,6 +605,39 @@ def test_a_sliding_foot_is_not_planted(guard: Motion) -> None:
     assert path.planted[0].all() and still.planted.all()
     assert not glide.planted[2:-2].any()
     assert glide.sole is not None and glide.sole.shape == (20, 2, 3)
+
+
+def test_a_swinging_foot_rolling_over_its_corner_is_not_planted(shared_mocap_dir: Path) -> None:
+    """On the shared left-curving walk ``slide_speed`` 0.5 (``WHOLE_CLIP``'s) flags a swinging
+    foot planted for a few frames while its sole centre moves faster than 1 m/s (its lowest
+    corner slow as the foot rolls over it), and those false landings set the clip's largest
+    predicted lead; with ``centre_speed`` 1.0 (opt-in, 2026-12-05) none is left and the lead
+    falls to what the real landings give. Without it the flags are ``slide_speed``'s alone."""
+    from reactmocap.library.bvh import read_bvh
+
+    clip = shared_mocap_dir / "dataset-1_walk-left_normal_001.bvh"
+    if not clip.is_file():
+        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
+    walk = read_bvh(clip)
+    world = World(build_character(walk, frame=0))
+    slide = reference_path(world, 0, walk, slide_speed=0.5)
+    strict = reference_path(world, 0, walk, slide_speed=0.5, centre_speed=1.0)
+    assert slide.sole is not None
+    centre = sole_speed(slide.sole, slide.fps)
+    assert (slide.planted & (centre > 1.0)).sum() > 20  # 27 frames
+    assert not (strict.planted & (centre > 1.0)).any()
+    assert not (strict.planted & ~slide.planted).any()  # stricter only
+    assert reference_path(world, 0, walk, slide_speed=0.5, centre_speed=None).planted.tolist() == (
+        slide.planted.tolist()
+    )
+
+    def tracker(**extra: float) -> WholeBodyTracker:
+        return WholeBodyTracker(World(build_character(walk, frame=0)), 0, walk, 0.0,
+                                kp_joint=100.0, servo_kv=1.0, control_every=8, step_ahead=1.0,
+                                step_ahead_swing=1.0, slide_speed=0.5, **extra)  # fmt: skip
+
+    assert tracker()._clip_swing_leads().max() > 0.5  # 0.535 m, past a mid-swing "landing"
+    assert tracker(centre_speed=1.0)._clip_swing_leads().max() < 0.35  # 0.294 m
 
 
 def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:

@@ -149,6 +149,8 @@ class WholeBodyTracker(AnchoredReference):
             :class:`ReferencePath` given, its own ``planted`` and ``pivoting`` are used.
         slide_speed: a foot near the floor is planted only while its lowest corner moves
             slower than this (m/s) or it pivots (0: any speed).
+        centre_speed: and only while its sole's centre moves slower than this (m/s; 0: any
+            speed): a swinging foot rolling over its lowest corner keeps that corner slow.
         roll_band: a sole corner carries force only while the mocap holds it within this of
             its foot's lowest corner (m): a heel the actor raises is let go (0: every
             touching corner).
@@ -319,6 +321,7 @@ class WholeBodyTracker(AnchoredReference):
         force_reg: float = 1e-6,
         pivot_rate: float | None = 2.0,
         slide_speed: float = 0.0,
+        centre_speed: float = 0.0,
         roll_band: float = 0.0,
         anchor_tau: float = 0.0,
         anchor_touch: float = 0.01,
@@ -375,7 +378,7 @@ class WholeBodyTracker(AnchoredReference):
                 "hip_tilt": hip_tilt, "hip_tilt_step": hip_tilt_step,
                 "contact_kv": contact_kv, "friction": friction, "reach": reach, "touch": touch,
                 "force_reg": force_reg, "pivot_rate": pivot_rate, "servo_kv": servo_kv,
-                "slide_speed": slide_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
+                "slide_speed": slide_speed, "centre_speed": centre_speed, "roll_band": roll_band, "anchor_tau": anchor_tau,
                 "anchor_touch": anchor_touch,
                 "anchor_return": anchor_return, "anchor_deadband": anchor_deadband, "balance_margin": balance_margin,
                 "balance_tau": balance_tau, "stepping": stepping, "step_margin": step_margin, "step_time": step_time,
@@ -507,6 +510,7 @@ class WholeBodyTracker(AnchoredReference):
                 reach=reach,
                 pivot_rate=pivot_rate,
                 slide_speed=slide_speed or None,
+                centre_speed=centre_speed or None,
             ),
         )
         super().__init__(
