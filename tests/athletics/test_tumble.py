@@ -953,6 +953,24 @@ def test_a_late_back_layout_undamps_its_servo_only_past_the_late_kv_margin() -> 
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
 
 
+def test_a_late_back_layout_undamps_its_servo_only_once_turned_past_late_kv_rotation() -> None:
+    """Full size's late starts 33 and 43 (seed 0) are alike at ``late_delta``'s decision
+    (feet 0.303 / 0.293 m from the COM, so ``late_kv_margin`` cannot part them), but 33 lands
+    only with the file's ``kv`` and 43 only with ``late_kv`` 0. 43 has turned further by then
+    (-3.094 rad against -3.076): with ``late_kv_rotation`` -3.085 rad 33 keeps ``kv`` and
+    lands, and 43 gets ``late_kv`` 0 and lands."""
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = next(ph for ph in m.phases if ph.controller == "land")
+    undamped = _with_land_params(m, {**land.params, "late_kv": 0.0})
+    gated = _with_land_params(m, {**land.params, "late_kv": 0.0, "late_kv_rotation": -3.085})
+    starts = full_starts(44)
+    r = run_maneuver(undamped, perturbation=starts[33], fps=10.0).report
+    assert not (r["landed"] and not r["fell"])
+    for k in (33, 43):
+        r = run_maneuver(gated, perturbation=starts[k], fps=10.0).report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, k
+
+
 def test_a_back_layout_carrying_its_pitch_target_leans_on_past_the_hand_over() -> None:
     """``back_layout.toml``'s landing leans the trunk 0.8 rad per radian of knee flexion, the
     balance after it 0.5: at the hand-over its pelvis pitch target dropped to the pelvis's
