@@ -928,10 +928,11 @@ def test_a_late_back_layout_with_the_late_class_s_servo_undamped_lands() -> None
     start = full_starts(16)[15]
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = next(ph for ph in m.phases if ph.controller == "land")
-    assert "late_kv" not in land.params
-    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert land.params["late_kv"] == 0.0  # the file's, gated by late_kv_rotation since 2026-12-05
+    damped = {k: v for k, v in land.params.items() if k not in ("late_kv", "late_kv_rotation")}
+    r = run_maneuver(_with_land_params(m, damped), perturbation=start, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
-    r = run_maneuver(_with_land_params(m, {**land.params, "late_kv": 0.0}), perturbation=start,
+    r = run_maneuver(_with_land_params(m, {**damped, "late_kv": 0.0}), perturbation=start,
                      fps=10.0).report  # fmt: skip
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
 
@@ -943,8 +944,9 @@ def test_a_late_back_layout_undamps_its_servo_only_past_the_late_kv_margin() -> 
     keeps ``kv`` and lands, and the full size's still gets ``late_kv`` 0 and lands."""
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = next(ph for ph in m.phases if ph.controller == "land")
-    undamped = _with_land_params(m, {**land.params, "late_kv": 0.0})
-    margin = _with_land_params(m, {**land.params, "late_kv": 0.0, "late_kv_margin": [0.11, 0.11]})
+    params = {k: v for k, v in land.params.items() if k != "late_kv_rotation"}  # the file's gate
+    undamped = _with_land_params(m, {**params, "late_kv": 0.0})
+    margin = _with_land_params(m, {**params, "late_kv": 0.0, "late_kv_margin": [0.11, 0.11]})
     tenth = _tenth_start(0, 5)
     r = run_maneuver(undamped, perturbation=tenth, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
@@ -961,8 +963,10 @@ def test_a_late_back_layout_undamps_its_servo_only_once_turned_past_late_kv_rota
     lands, and 43 gets ``late_kv`` 0 and lands."""
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = next(ph for ph in m.phases if ph.controller == "land")
-    undamped = _with_land_params(m, {**land.params, "late_kv": 0.0})
-    gated = _with_land_params(m, {**land.params, "late_kv": 0.0, "late_kv_rotation": -3.085})
+    assert land.params["late_kv_rotation"] == -3.085  # the file's since 2026-12-05
+    params = {k: v for k, v in land.params.items() if k != "late_kv_rotation"}
+    undamped = _with_land_params(m, {**params, "late_kv": 0.0})
+    gated = _with_land_params(m, {**params, "late_kv": 0.0, "late_kv_rotation": -3.085})
     starts = full_starts(44)
     r = run_maneuver(undamped, perturbation=starts[33], fps=10.0).report
     assert not (r["landed"] and not r["fell"])
