@@ -851,7 +851,9 @@ def test_a_late_back_layout_touchdown_lands_with_the_feet_ahead_from_the_reach_s
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = m.phases[3]
     assert land.controller == "land" and land.params["late_delta"] == [0.024, 0.15, -0.11]
-    r = run_maneuver(_without_land_param(m, "late_delta"), perturbation=start, fps=10.0).report
+    late = ("late_delta", "late_kv", "late_kv_rotation")  # late_kv acts on late_delta's class
+    before = _with_land_params(m, {k: v for k, v in land.params.items() if k not in late})
+    r = run_maneuver(before, perturbation=start, fps=10.0).report
     assert -301.5 < r["rotation_at_touchdown_deg"] < -296.0, r["rotation_at_touchdown_deg"]
     assert not (r["landed"] and not r["fell"])
     r = run_maneuver(m, perturbation=start, fps=10.0).report
