@@ -239,6 +239,13 @@ class LandingParams:
             ``late_kv`` on every late start. Why: on the male back layout a tenth's late
             starts (0.09 m past) land with ``kv`` and fall with ``late_kv`` 0, full size's
             (0.13-0.31 m past) the other way round (docs/athletics.md, "late_kv_margin").
+        late_kv_rotation: ``late_kv`` only for a late start whose somersault rotation at
+            ``late_delta``'s decision is at least this far along (rad, signed like the
+            rotation: a backward somersault's is negative); the others keep ``kv``. ``None``:
+            every late start. Why: on the male back layout the late starts that land only
+            with ``kv`` have turned -3.03..-3.08 rad by then, those that land only with
+            ``late_kv`` 0 -3.09..-3.29, where the feet's distance does not sort them
+            (docs/athletics.md, "late_kv_rotation").
     """
 
     knee: float = 0.6
@@ -278,6 +285,7 @@ class LandingParams:
     carry_pitch: bool = False
     late_kv: float | None = None
     late_kv_margin: tuple[float, ...] = ()
+    late_kv_rotation: float | None = None
 
     def __post_init__(self) -> None:
         Step.of(self.step)  # checked here (ConfigError) though built per run
@@ -352,6 +360,17 @@ class LandingParams:
             )
         if self.late_kv_margin and self.late_kv is None:
             raise ConfigError("landing late_kv_margin needs late_kv (it scales it)")
+        if self.late_kv_rotation is not None and not (
+            isinstance(self.late_kv_rotation, (int, float))
+            and math.isfinite(self.late_kv_rotation)
+            and self.late_kv_rotation != 0.0
+        ):
+            raise ConfigError(
+                f"landing late_kv_rotation must be a nonzero rotation (rad), "
+                f"got {self.late_kv_rotation!r}"
+            )
+        if self.late_kv_rotation is not None and self.late_kv is None:
+            raise ConfigError("landing late_kv_rotation needs late_kv (it gates it)")
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
@@ -377,10 +396,14 @@ class LandingParams:
         v, d = self._delta_table
         return float(np.interp(velocity, v, d))
 
-    def late_kv_at(self, past: float) -> float:
+    def late_kv_at(self, past: float, rotation: float = 0.0) -> float:
         """The placement servo's ``kv`` for a late start whose feet are ``past`` m beyond
-        ``late_delta``'s offset (``late_kv``, scaled by ``late_kv_margin``)."""
+        ``late_delta``'s offset and whose somersault has turned ``rotation`` rad at its
+        decision (``late_kv``, gated by ``late_kv_rotation``, scaled by ``late_kv_margin``)."""
         if self.late_kv is None:
+            return self.kv
+        r = self.late_kv_rotation
+        if r is not None and math.copysign(1.0, r) * (rotation - r) < 0.0:
             return self.kv
         if not self.late_kv_margin or past >= self.late_kv_margin[1]:
             return self.late_kv
@@ -462,7 +485,8 @@ class Landing(Basis):
             if p.late_delta and memo["late"] < 0 and t - memo["reach_t"] >= p.late_delta[0]:
                 memo["late"] = float(np.hypot(*x) > p.late_delta[1])  # decided once (late_delta)
                 if memo["late"] > 0:
-                    memo["kv"] = p.late_kv_at(float(np.hypot(*x)) - p.late_delta[1])
+                    past = float(np.hypot(*x)) - p.late_delta[1]
+                    memo["kv"] = p.late_kv_at(past, ctx.rotation)
             delta = p.late_delta[2] if memo["late"] > 0 else p.delta_at(float(v[0]))
             want = np.array([lead * v[0] + delta * memo["scale"], side * v[1]])
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)

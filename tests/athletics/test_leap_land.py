@@ -226,6 +226,28 @@ def test_landing_late_kv_margin_blends_kv_to_late_kv() -> None:
     assert LandingParams(late_kv=0.05, late_delta=late).late_kv_at(0.01) == 0.05
 
 
+@pytest.mark.parametrize("bad", [0.0, math.nan, math.inf, "-3.1"])
+def test_landing_late_kv_rotation_must_be_a_nonzero_rotation(bad: object) -> None:
+    with pytest.raises(ConfigError, match="late_kv_rotation"):
+        LandingParams(late_kv=0.0, late_kv_rotation=bad, late_delta=(0.024, 0.15, -0.11))  # type: ignore[arg-type]
+
+
+def test_landing_late_kv_rotation_needs_late_kv() -> None:
+    with pytest.raises(ConfigError, match="late_kv_rotation"):
+        LandingParams(late_kv_rotation=-3.0, late_delta=(0.024, 0.15, -0.11))
+
+
+def test_landing_late_kv_rotation_gates_late_kv_by_the_rotation_so_far() -> None:
+    late = (0.024, 0.15, -0.11)
+    back = LandingParams(kv=0.15, late_kv=0.0, late_kv_rotation=-3.085, late_delta=late)
+    assert [back.late_kv_at(0.1, r) for r in (-3.0, -3.08, -3.085, -3.3)] == [0.15, 0.15, 0.0, 0.0]
+    forward = LandingParams(kv=0.15, late_kv=0.05, late_kv_rotation=2.0, late_delta=late)
+    assert (forward.late_kv_at(0.1, 1.9), forward.late_kv_at(0.1, 2.1)) == (0.15, 0.05)
+    both = LandingParams(kv=0.15, late_kv=0.0, late_kv_rotation=-3.0, late_kv_margin=(0.1, 0.2),
+                         late_delta=late)  # fmt: skip
+    assert (both.late_kv_at(0.3, -2.9), both.late_kv_at(0.15, -3.1)) == (0.15, pytest.approx(0.075))
+
+
 def test_flight_conserves_angular_momentum() -> None:
     # a leap with pitch momentum; in the air only internal torques act
     r = run("leap", "male", effort=0.4, spin=15.0, push="timed")

@@ -851,7 +851,9 @@ def test_a_late_back_layout_touchdown_lands_with_the_feet_ahead_from_the_reach_s
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = m.phases[3]
     assert land.controller == "land" and land.params["late_delta"] == [0.024, 0.15, -0.11]
-    r = run_maneuver(_without_land_param(m, "late_delta"), perturbation=start, fps=10.0).report
+    late = ("late_delta", "late_kv", "late_kv_rotation")  # late_kv acts on late_delta's class
+    before = _with_land_params(m, {k: v for k, v in land.params.items() if k not in late})
+    r = run_maneuver(before, perturbation=start, fps=10.0).report
     assert -301.5 < r["rotation_at_touchdown_deg"] < -296.0, r["rotation_at_touchdown_deg"]
     assert not (r["landed"] and not r["fell"])
     r = run_maneuver(m, perturbation=start, fps=10.0).report
@@ -928,10 +930,11 @@ def test_a_late_back_layout_with_the_late_class_s_servo_undamped_lands() -> None
     start = full_starts(16)[15]
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = next(ph for ph in m.phases if ph.controller == "land")
-    assert "late_kv" not in land.params
-    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert land.params["late_kv"] == 0.0  # the file's, gated by late_kv_rotation since 2026-12-05
+    damped = {k: v for k, v in land.params.items() if k not in ("late_kv", "late_kv_rotation")}
+    r = run_maneuver(_with_land_params(m, damped), perturbation=start, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
-    r = run_maneuver(_with_land_params(m, {**land.params, "late_kv": 0.0}), perturbation=start,
+    r = run_maneuver(_with_land_params(m, {**damped, "late_kv": 0.0}), perturbation=start,
                      fps=10.0).report  # fmt: skip
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
 
@@ -943,14 +946,35 @@ def test_a_late_back_layout_undamps_its_servo_only_past_the_late_kv_margin() -> 
     keeps ``kv`` and lands, and the full size's still gets ``late_kv`` 0 and lands."""
     m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
     land = next(ph for ph in m.phases if ph.controller == "land")
-    undamped = _with_land_params(m, {**land.params, "late_kv": 0.0})
-    margin = _with_land_params(m, {**land.params, "late_kv": 0.0, "late_kv_margin": [0.11, 0.11]})
+    params = {k: v for k, v in land.params.items() if k != "late_kv_rotation"}  # the file's gate
+    undamped = _with_land_params(m, {**params, "late_kv": 0.0})
+    margin = _with_land_params(m, {**params, "late_kv": 0.0, "late_kv_margin": [0.11, 0.11]})
     tenth = _tenth_start(0, 5)
     r = run_maneuver(undamped, perturbation=tenth, fps=10.0).report
     assert not (r["landed"] and not r["fell"])
     for start in (tenth, full_starts(16)[15]):
         r = run_maneuver(margin, perturbation=start, fps=10.0).report
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+
+
+def test_a_late_back_layout_undamps_its_servo_only_once_turned_past_late_kv_rotation() -> None:
+    """Full size's late starts 33 and 43 (seed 0) are alike at ``late_delta``'s decision
+    (feet 0.303 / 0.293 m from the COM, so ``late_kv_margin`` cannot part them), but 33 lands
+    only with the file's ``kv`` and 43 only with ``late_kv`` 0. 43 has turned further by then
+    (-3.094 rad against -3.076): with ``late_kv_rotation`` -3.085 rad 33 keeps ``kv`` and
+    lands, and 43 gets ``late_kv`` 0 and lands."""
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = next(ph for ph in m.phases if ph.controller == "land")
+    assert land.params["late_kv_rotation"] == -3.085  # the file's since 2026-12-05
+    params = {k: v for k, v in land.params.items() if k != "late_kv_rotation"}
+    undamped = _with_land_params(m, {**params, "late_kv": 0.0})
+    gated = _with_land_params(m, {**params, "late_kv": 0.0, "late_kv_rotation": -3.085})
+    starts = full_starts(44)
+    r = run_maneuver(undamped, perturbation=starts[33], fps=10.0).report
+    assert not (r["landed"] and not r["fell"])
+    for k in (33, 43):
+        r = run_maneuver(gated, perturbation=starts[k], fps=10.0).report
+        assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, k
 
 
 def test_a_back_layout_carrying_its_pitch_target_leans_on_past_the_hand_over() -> None:
