@@ -63,6 +63,11 @@ def test_bad_handspring_parameters_are_config_errors() -> None:
     for lim in (-0.1, 3.5):
         with pytest.raises(ConfigError, match="rise_spin_limit"):
             LeapParams(rise_spin_limit=lim)
+    for bad in ({"rise_spin_rate": -1.0}, {"rise_spin_rate": 120.0},
+                {"rise_spin_rate": 33.5, "rise_spin_limit": 1.6},
+                {"rise_spin_rate": 33.5, "rise_cap": 1.0}):  # fmt: skip
+        with pytest.raises(ConfigError, match="rise_spin_rate"):
+            LeapParams(**bad)
 
 
 def test_the_hands_carry_the_body_past_inverted_and_the_report_matches_the_log() -> None:
@@ -381,3 +386,26 @@ def test_the_cap_looks_ahead_and_holds_only_the_over_leap() -> None:
     assert without["landed"] and not without["fell"]
     for key in ("achieved_height_m", "rotation_deg", "landed", "fell"):
         assert same[key] == without[key]
+
+
+def test_the_hips_give_the_spin_back_a_tick_before_the_cap() -> None:
+    """Full-size start 25 (seed 0) over-leaps; the file's cap (1.0 m, 12 ms ahead) stops its
+    knees and ankles in the push's last ticks, where the spin is made: it leaves with -68.7
+    kg m^2/s, meets the hands at -177 deg with the knees at their clip and falls back. With the
+    hips' spin allowance opened to 1.6 rad a tick before the cap, once the apex climbs faster
+    than 33.5 m/s (``rise_spin_rate``, ``rise_spin_limit``), it leaves with over 5 kg m^2/s
+    more spin and lands. Start 0 (an ordinary lander, its apex never that fast) runs as the
+    file."""
+    m = load_maneuver(EXAMPLE)
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    spun = _with(m, "leap", {**leap, "rise_spin_limit": 1.6, "rise_spin_rate": 33.5})
+    starts = _starts(1.0, 26)
+    cut = run_maneuver(m, perturbation=starts[25], fps=10.0).report
+    given = run_maneuver(spun, perturbation=starts[25], fps=10.0).report
+    assert not (cut["landed"] and not cut["fell"])
+    assert given["liftoff_pitch_momentum"] < cut["liftoff_pitch_momentum"] - 5.0
+    assert given["landed"] and not given["fell"] and abs(given["rotation_deg"] + 360.0) <= 45.0
+    file = run_maneuver(m, perturbation=starts[0], fps=10.0).report
+    same = run_maneuver(spun, perturbation=starts[0], fps=10.0).report
+    for key in ("achieved_height_m", "liftoff_pitch_momentum", "rotation_deg", "landed"):
+        assert same[key] == file[key]
