@@ -242,6 +242,11 @@ class LeapParams:
     #: the hips' spin allowance (rad) once the cap has fired (the cut push left 3-10 kg m^2/s
     #: less spin); 0: ``spin_limit`` (as before)
     rise_spin_limit: float = 0.0
+    #: ``rise_spin_limit`` applies already once the apex climbs faster than this (m/s, over
+    #: the last control tick), a tick or two before the cap: an over-leap's apex climbs at
+    #: 34-43 m/s the tick before the cap, an ordinary leap's at most 32, and the spin the cut
+    #: push loses is made in those last ticks (docs/athletics.md); 0: off (as before)
+    rise_spin_rate: float = 0.0
 
     def __post_init__(self) -> None:
         vals = [self.leg, self.pitch, self.com_offset, self.arms, self.arms_back, self.crouch,
@@ -250,7 +255,8 @@ class LeapParams:
                 self.spin, self.spin_gain, self.spin_limit, self.rise, self.push_end,
                 self.push_ramp, self.push_limit, self.push_hip, self.push_ankle,
                 self.tilt_gain, self.roll_gain, self.yaw_gain, self.com_ramp,
-                self.crouch_level, self.rise_cap, self.rise_lead, self.rise_spin_limit]  # fmt: skip
+                self.crouch_level, self.rise_cap, self.rise_lead, self.rise_spin_limit,
+                self.rise_spin_rate]  # fmt: skip
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in vals):
             raise ConfigError(f"leap parameters must be finite numbers, got {self}")
         if not 0.0 < self.crouch_side <= 5.0:
@@ -286,6 +292,13 @@ class LeapParams:
             raise ConfigError(
                 f"leap rise_spin_limit must be in [0, 3] rad (0: spin_limit), got "
                 f"{self.rise_spin_limit}"
+            )
+        if not 0.0 <= self.rise_spin_rate <= 100.0 or (
+            self.rise_spin_rate > 0 and (self.rise_cap == 0 or self.rise_spin_limit == 0)
+        ):
+            raise ConfigError(
+                f"leap rise_spin_rate must be in [0, 100] m/s (0: off) and needs rise_cap and "
+                f"rise_spin_limit, got {self.rise_spin_rate}"
             )
         if not 0.0 <= self.tilt_gain <= 100.0:
             raise ConfigError(f"leap tilt_gain must be in [0, 100] rad, got {self.tilt_gain}")
@@ -390,6 +403,7 @@ class Leap(Basis):
             memo["t_thrust"] = t
             memo.pop("ramp", None)
             memo.pop("capped", None)
+            memo.pop("spun", None)
             memo.pop("apex_prev", None)
             rig = ctx.rig
             stiff = per_joint(LEAP_STIFFNESS) * p.stiffness
@@ -431,7 +445,8 @@ class Leap(Basis):
                 # axis of the heading frame: the hips tilt the push ahead of or behind the COM
                 err = (pitch_momentum(world, s) - p.spin) / unit
                 lim = p.spin_limit
-                if p.rise_spin_limit > 0 and "capped" in memo:  # give back the cut push's spin
+                if p.rise_spin_limit > 0 and ("capped" in memo or "spun" in memo):
+                    # give back the spin the cut push loses
                     lim = p.rise_spin_limit
                 off = float(np.clip(spin_ramp * p.spin_gain * err, -lim, lim))
                 ctx.rig.offset[hips, 0] = off
@@ -447,10 +462,12 @@ class Leap(Basis):
                 z_stand = ctx.standing_com if ctx.standing_com is not None else memo["z_stand"]
                 vz = float(s.com_vel[2])
                 apex = float(s.com[2]) - z_stand + vz * vz / (2.0 * g)
-                if p.rise_lead > 0:
+                if p.rise_lead > 0 or p.rise_spin_rate > 0:
                     t0, apex0 = memo.get("apex_prev", (t, apex))
                     memo["apex_prev"] = (t, apex)
                     if t > t0:
+                        if 0 < p.rise_spin_rate <= (apex - apex0) / (t - t0) and vz > 0:
+                            memo["spun"] = t  # an over-leap's last ticks: open the hips
                         apex += p.rise_lead * (apex - apex0) / (t - t0)
                 if vz > 0 and apex >= p.rise_cap:
                     # the apex is reached ballistically: the knees and ankles stop extending

@@ -439,11 +439,13 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # from 17 and 20); since 2026-12-04 (later) the knees' aim is centred on that crouch's
     # nominal (-186 deg, 0.9 rad, up to 1.3: about 0.4 rad the knees sat at their clip); since
     # 2026-12-05 the push stops at a 1.0 m apex looked 12 ms ahead (LeapParams.rise_lead: only
-    # the over-leaps are cut; 27/50 and 27/50 from 24 and 24). A
-    # list: a maneuver file's numbers load as one
+    # the over-leaps are cut; 27/50 and 27/50 from 24 and 24), and (later) the hips' spin
+    # allowance opens to 1.6 rad a tick before that cut (LeapParams.rise_spin_rate: 29/50 and
+    # 26/50 from 27 and 27). A list: a maneuver file's numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3, "hold": 0.22, "com_offset": -0.13,
-                                  "com_ramp": 0.2, "rise_cap": 1.0, "rise_lead": 0.012}),
+                                  "com_ramp": 0.2, "rise_cap": 1.0, "rise_lead": 0.012,
+                                  "rise_spin_limit": 1.6, "rise_spin_rate": 33.5}),
         "handspring": MappingProxyType({"aim": -3.25, "knees": 0.9, "aim_knees": 1.3}),
         "land": MappingProxyType({"delta": -0.6, "spin_ref": -96.8,
                                   "step": [0.05, 0.1, 0.3, 0.25]}),

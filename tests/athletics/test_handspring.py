@@ -63,6 +63,11 @@ def test_bad_handspring_parameters_are_config_errors() -> None:
     for lim in (-0.1, 3.5):
         with pytest.raises(ConfigError, match="rise_spin_limit"):
             LeapParams(rise_spin_limit=lim)
+    for bad in ({"rise_spin_rate": -1.0}, {"rise_spin_rate": 120.0},
+                {"rise_spin_rate": 33.5, "rise_spin_limit": 1.6},
+                {"rise_spin_rate": 33.5, "rise_cap": 1.0}):  # fmt: skip
+        with pytest.raises(ConfigError, match="rise_spin_rate"):
+            LeapParams(**bad)
 
 
 def test_the_hands_carry_the_body_past_inverted_and_the_report_matches_the_log() -> None:
@@ -144,6 +149,13 @@ def _uncapped(m: Maneuver) -> Maneuver:
     ``rise_lead``."""
     leap = next(p for p in m.phases if p.controller == "leap").params
     return _with(m, "leap", {k: v for k, v in leap.items() if not k.startswith("rise_")})
+
+
+def _unspun(m: Maneuver) -> Maneuver:
+    """``m`` as the file was before the hips gave the cut push's spin back (2026-12-05,
+    later): no ``rise_spin_limit`` / ``rise_spin_rate``."""
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    return _with(m, "leap", {k: v for k, v in leap.items() if not k.startswith("rise_spin")})
 
 
 def _aimed_at_196(m: Maneuver) -> Maneuver:
@@ -370,6 +382,7 @@ def test_the_cap_looks_ahead_and_holds_only_the_over_leap() -> None:
     leap = next(p for p in m.phases if p.controller == "leap").params
     assert (leap["rise_cap"], leap["rise_lead"]) == (1.0, 0.012)
     uncapped = _uncapped(m)
+    m = _unspun(m)  # as measured then
     ordinary, high = _starts(1.0, 2)
     before = run_maneuver(uncapped, perturbation=high, fps=10.0).report
     assert before["achieved_height_m"] > 0.85 and not (before["landed"] and not before["fell"])
@@ -380,4 +393,28 @@ def test_the_cap_looks_ahead_and_holds_only_the_over_leap() -> None:
     same = run_maneuver(m, perturbation=ordinary, fps=10.0).report
     assert without["landed"] and not without["fell"]
     for key in ("achieved_height_m", "rotation_deg", "landed", "fell"):
+        assert same[key] == without[key]
+
+
+def test_the_hips_give_the_spin_back_a_tick_before_the_cap() -> None:
+    """Full-size start 25 (seed 0) over-leaps; the cap (1.0 m, 12 ms ahead) stops its knees
+    and ankles in the push's last ticks, where the spin is made: without the file's spin
+    given back it leaves with -68.7 kg m^2/s, meets the hands at -177 deg with the knees at
+    their clip and falls back. The file opens the hips' spin allowance to 1.6 rad a tick
+    before the cap, once the apex climbs faster than 33.5 m/s (``rise_spin_rate``,
+    ``rise_spin_limit``, since 2026-12-05): it leaves with over 5 kg m^2/s more spin and
+    lands. Start 0 (an ordinary lander, its apex never that fast) runs as without it."""
+    m = load_maneuver(EXAMPLE)
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    assert (leap["rise_spin_limit"], leap["rise_spin_rate"]) == (1.6, 33.5)
+    cut_file = _unspun(m)
+    starts = _starts(1.0, 26)
+    cut = run_maneuver(cut_file, perturbation=starts[25], fps=10.0).report
+    given = run_maneuver(m, perturbation=starts[25], fps=10.0).report
+    assert not (cut["landed"] and not cut["fell"])
+    assert given["liftoff_pitch_momentum"] < cut["liftoff_pitch_momentum"] - 5.0
+    assert given["landed"] and not given["fell"] and abs(given["rotation_deg"] + 360.0) <= 45.0
+    without = run_maneuver(cut_file, perturbation=starts[0], fps=10.0).report
+    same = run_maneuver(m, perturbation=starts[0], fps=10.0).report
+    for key in ("achieved_height_m", "liftoff_pitch_momentum", "rotation_deg", "landed"):
         assert same[key] == without[key]
