@@ -812,10 +812,9 @@ class Stepper:
                 down -= low
         if st.ground and u >= 0.5:  # then on the floor within this reach from the hip as it is
             reach = st.ground * (ul + ll)
-            off = want - at
             far = math.sqrt(max(reach * reach - down * down, 0.0))
-            want = at + off * min(far / max(float(np.hypot(*off)), 1e-9), 1.0)
-            ahead, aside = (float(x) for x in want - at)
+            pull = min(far / max(math.hypot(ahead, aside), 1e-9), 1.0)
+            ahead, aside = ahead * pull, aside * pull
         length = min(math.sqrt(ahead * ahead + aside * aside + max(down, 0.2) ** 2), reach)
         swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
         knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
