@@ -163,19 +163,15 @@ class Step:
             to where such a leg meets the floor (0: off, :data:`STEP_REACH` and the place past
             the capture point, where the foot hung over the floor until the body sank;
             opt-in, docs/athletics.md "The standing step's swing shortened").
-        give: at a step's touchdown the landed knee's target bends this much more (rad) than
-            its angle there, as a critically damped spring over ``give_time``, and the other
-            ankle's target is held at its angle there (the rear foot kept on its toes, not
-            turned flat: that lifted them off within 8 ms), both eased back to the law's over
-            :data:`STEP_GIVE_BACK` ``give_time``s more (0: off, the knees from their angles
-            to the posture's; the hips already follow: the law holds the pelvis's pitch
-            whatever the thighs do; opt-in, docs/athletics.md "The standing step's landed
-            knee yields").
-        give_time: the seconds of ``give``'s bend (in [0.02, 0.5]).
-        foresee: with ``across``, the capture point across the feet taken where the COM's
-            sideways speed will have carried it (LIPM about the standing foot) this many
-            seconds after the swing began, not where it is (0: where it is; opt-in,
+        give: at the touchdown of a step along the feet (a sideways one as without: her
+            110 N left push was lost) the landed knee's target bends this much more (rad)
+            than its angle there, as a critically damped spring over ``give_time``, and the
+            other ankle's target is held at its angle there (the rear foot kept on its toes,
+            not turned flat: that lifted them off within 8 ms), both eased back to the law's
+            over :data:`STEP_GIVE_BACK` ``give_time``s more (0: off; the hips follow as
+            without: the law holds the pelvis's pitch whatever the thighs do; opt-in,
             docs/athletics.md "The standing step's landed knee yields").
+        give_time: the seconds of ``give``'s bend (in [0.02, 0.5]).
     """
 
     margin: float = 0.05
@@ -186,11 +182,9 @@ class Step:
     ground: float = 0.0
     give: float = 0.0
     give_time: float = 0.1
-    foresee: float = 0.0
 
     def __post_init__(self) -> None:
-        names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
-        for name in names:
+        for name in ("margin", "reach", "lift", "seconds", "across", "ground", "give"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise ConfigError(f"step {name} must be a finite number >= 0, got {v!r}")
@@ -203,8 +197,6 @@ class Step:
         g = self.give_time
         if not (isinstance(g, (int, float)) and math.isfinite(g) and 0.02 <= g <= 0.5):
             raise ConfigError(f"step give_time must be in [0.02, 0.5] s, got {g!r}")
-        if self.foresee and not (self.across and self.foresee <= 1.0):
-            raise ConfigError(f"step foresee must be 0 or in (0, 1] s, with across: {self.foresee}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -733,6 +725,7 @@ class Stepper:
         self._stood = 0
         self._goal = np.full((NJ, 3), np.nan)
         self._held = np.zeros(2)  # Step.give: the landed knee's, the rear ankle's angle
+        self._t_give = -math.inf  # Step.give: the touchdown it is for
         self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
@@ -759,7 +752,7 @@ class Stepper:
                                     "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
         if self.foot < 0 and self.standing and not bl.posture.plant:
             self._plant_if_hanging(bl, float(np.hypot(*vel)), t)
-        if self.foot < 0 and st.give and t - self._t_end < (1.0 + STEP_GIVE_BACK) * st.give_time:
+        if self.foot < 0 and t - self._t_give < (1.0 + STEP_GIVE_BACK) * st.give_time:
             self._give(t)
         if self.foot < 0:
             if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
@@ -792,7 +785,8 @@ class Stepper:
             self.record[-1]["s"] = t - self._t0
             self._close, self._stood = self._out is not None and not self.standing, 1 - k
             self.foot, self._t_end = -1, t
-            if st.give:  # Step.give: the landed knee yields, the rear ankle is held
+            if st.give and self._out is not None and self._out[1] == 0.0:  # Step.give
+                self._t_give = t
                 now = rig.current_angles()
                 self._held[:] = now[_KNEE[k], 0] + st.give, now[_ANKLE[1 - k], 0]
             # both knees on from where they are to the posture's, over what is left of its
@@ -819,10 +813,7 @@ class Stepper:
                 want[1] = at[1]
                 if st.across:  # the COM falls toward the swing side over the single support
                     side = 1.0 if at[1] >= stand[1] else -1.0
-                    lat = cp[1] - stand[1]
-                    if st.foresee:  # the capture point diverges from the standing foot
-                        lat *= math.exp(omega * max(st.foresee - (t - self._t0), 0.0))
-                    past = max(side * (at[1] - stand[1]), side * lat + st.across)
+                    past = max(side * (at[1] - stand[1]), side * (cp[1] - stand[1]) + st.across)
                     want[1] = stand[1] + side * past
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
@@ -877,7 +868,7 @@ class Stepper:
         """:attr:`Step.give`: the landed knee's and the rear ankle's targets after a
         touchdown, in place of the law's."""
         rig = self.ctx.rig
-        x = (t - self._t_end) / self.step.give_time
+        x = (t - self._t_give) / self.step.give_time
         spring = 1.0 - (1.0 + 4.0 * x) * math.exp(-4.0 * x)  # critically damped, 0.91 at x = 1
         joints = [_KNEE[1 - self._stood], _ANKLE[self._stood]]
         held = self._held - (self.step.give * (1.0 - spring), 0.0)

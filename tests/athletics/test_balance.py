@@ -287,3 +287,35 @@ def test_a_standing_step_aimed_on_the_floor_from_the_hip_ends_sooner(
     for bad in (0.3, 1.2, -1.0):
         with pytest.raises(ConfigError, match="ground"):
             Step(ground=bad)
+
+
+def test_a_standing_step_whose_landed_knee_gives_stays_on_both_feet_longer(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's landed knee yields"): at
+    # the male's 175 N forward push with Step.ground 0.99 the first step lands at about 2.63 s
+    # on a near-straight leg and the rear foot, on its toes, is turned flat off the floor: both
+    # feet down about a sixth of the next 0.3 s, and the body hops (COM up at 0.86 m/s); with
+    # the landed knee giving 0.3 rad and the rear ankle held (Step.give), about a third,
+    # without the hop
+    push = {"check_range": False, "seconds": 2.95, "push": 175.0, "step": "on"}
+    ground = dataclasses.replace(balance.STANDING_STEP, ground=0.99)
+
+    def after_touchdown(step: Step) -> tuple[float, float, float]:
+        monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+        r = run("balance", "male", **push)
+        first = r.report["steps"][0]
+        td = first["t"] + first["s"]
+        t = r.log["t"]
+        w = (t >= td) & (t < td + 0.3)
+        up = float(r.log["com_vel"][(t >= td) & (t < td + 0.12), 2].max())
+        return td, float(np.mean(r.log["feet"][w] == 2)), up
+
+    td, both, up = after_touchdown(ground)
+    assert both < 0.25 and up > 0.5
+    td_give, both_give, up_give = after_touchdown(dataclasses.replace(ground, give=0.3))
+    assert td_give == pytest.approx(td)
+    assert both_give > both + 0.1 and up_give < 0.3
+    for field, bad in (("give", -0.1), ("give", 1.5), ("give_time", 0.01), ("give_time", 0.6)):
+        with pytest.raises(ConfigError, match=field):
+            Step(**{field: bad})  # type: ignore[arg-type]
