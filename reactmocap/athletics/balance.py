@@ -172,6 +172,11 @@ class Step:
             without: the law holds the pelvis's pitch whatever the thighs do; opt-in,
             docs/athletics.md "The standing step's landed knee yields").
         give_time: the seconds of ``give``'s bend (in [0.02, 0.5]).
+        foresee: with ``across``, the capture point across the feet taken where the COM's
+            sideways speed will have carried it (LIPM about the standing foot) this many
+            seconds after the swing began, not where it is (0: where it is, and the COM still
+            fell on past the landed foot; opt-in, docs/athletics.md "The standing step's
+            landed knee yields").
     """
 
     margin: float = 0.05
@@ -182,9 +187,11 @@ class Step:
     ground: float = 0.0
     give: float = 0.0
     give_time: float = 0.1
+    foresee: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("margin", "reach", "lift", "seconds", "across", "ground", "give"):
+        names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
+        for name in names:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise ConfigError(f"step {name} must be a finite number >= 0, got {v!r}")
@@ -197,6 +204,8 @@ class Step:
         g = self.give_time
         if not (isinstance(g, (int, float)) and math.isfinite(g) and 0.02 <= g <= 0.5):
             raise ConfigError(f"step give_time must be in [0.02, 0.5] s, got {g!r}")
+        if self.foresee and not (self.across and self.foresee <= 1.0):
+            raise ConfigError(f"step foresee must be 0 or in (0, 1] s, with across: {self.foresee}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -813,7 +822,10 @@ class Stepper:
                 want[1] = at[1]
                 if st.across:  # the COM falls toward the swing side over the single support
                     side = 1.0 if at[1] >= stand[1] else -1.0
-                    past = max(side * (at[1] - stand[1]), side * (cp[1] - stand[1]) + st.across)
+                    lat = cp[1] - stand[1]
+                    if st.foresee:  # the capture point diverges from the standing foot
+                        lat *= math.exp(omega * max(st.foresee - (t - self._t0), 0.0))
+                    past = max(side * (at[1] - stand[1]), side * lat + st.across)
                     want[1] = stand[1] + side * past
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing

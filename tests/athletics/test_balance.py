@@ -319,3 +319,27 @@ def test_a_standing_step_whose_landed_knee_gives_stays_on_both_feet_longer(
     for field, bad in (("give", -0.1), ("give", 1.5), ("give_time", 0.01), ("give_time", 0.6)):
         with pytest.raises(ConfigError, match=field):
             Step(**{field: bad})  # type: ignore[arg-type]
+
+
+def test_a_standing_step_placed_at_the_foreseen_capture_point_keeps_the_body_up(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's landed knee yields"): at
+    # the male's 200 N forward push, with Step.ground 0.99, give 0.3 and across 0.15, the
+    # first step lands past the capture point across the feet as it is at each tick, the COM
+    # falls on sideways past the landed foot and he falls by 3 s; with the capture point taken
+    # where the COM's sideways speed will have carried it 0.3 s after the swing began
+    # (Step.foresee) the same step lands farther out and he does not fall
+    push = {"check_range": False, "seconds": 3.0, "push": 200.0, "step": "on"}
+    step = dataclasses.replace(balance.STANDING_STEP, ground=0.99, give=0.3, across=0.15)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    r = run("balance", "male", **push).report
+    assert r["fell"]
+    monkeypatch.setattr(behaviours, "STANDING_STEP", dataclasses.replace(step, foresee=0.3))
+    r_foresee = run("balance", "male", **push).report
+    assert r_foresee["steps"][0]["t"] == pytest.approx(r["steps"][0]["t"])
+    assert not r_foresee["fell"]
+    with pytest.raises(ConfigError, match="foresee"):
+        Step(foresee=0.3)
+    with pytest.raises(ConfigError, match="foresee"):
+        Step(across=0.15, foresee=1.5)
