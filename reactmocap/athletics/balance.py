@@ -163,6 +163,16 @@ class Step:
             to where such a leg meets the floor (0: off, :data:`STEP_REACH` and the place past
             the capture point, where the foot hung over the floor until the body sank;
             opt-in, docs/athletics.md "The standing step's swing shortened").
+        down_after: from this many seconds into the swing on, the place is the floor under
+            where the swing foot was then (the leg aimed straight down there, lengthened to
+            reach it) instead of past the capture point (0: off; opt-in: the male back
+            handspring's landing steps hung 3-5 cm over the floor, the foot 0.2-0.3 m beside
+            its place, until the swing's limit, docs/athletics.md "the step put down").
+        catch: a closing swing (the foot left hanging brought down beside the other) becomes
+            a step past the capture point once that lies more than this (m) past the foot
+            stood on, moving away (0: off; opt-in: on the male back handspring the closing
+            swing after the landing's first step ran 0.75 s while the body fell back past
+            the standing foot, no new step possible, docs/athletics.md "the step put down").
     """
 
     margin: float = 0.05
@@ -171,6 +181,8 @@ class Step:
     seconds: float = 0.25
     across: float = 0.0
     ground: float = 0.0
+    down_after: float = 0.0
+    catch: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("margin", "reach", "lift", "seconds", "across", "ground"):
@@ -181,6 +193,10 @@ class Step:
             raise ConfigError(f"step seconds must be in [0.05, 2], got {self.seconds}")
         if self.ground and not 0.5 <= self.ground <= 1.0:
             raise ConfigError(f"step ground must be 0 or in [0.5, 1], got {self.ground}")
+        if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
+            raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
+        if not (isinstance(self.catch, (int, float)) and 0.0 <= self.catch <= 1.0):
+            raise ConfigError(f"step catch must be in [0, 1] m, got {self.catch!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -707,6 +723,7 @@ class Stepper:
         self._stood = 0
         self._goal = np.full((NJ, 3), np.nan)
         self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
+        self._down: F64 | None = None  # Step.down_after: where the foot goes down (world)
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
 
@@ -735,13 +752,7 @@ class Stepper:
         if self.foot < 0:
             if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
                 return
-            lo, hi = s.support_extent(h)
-            # how far the capture point lies outside the soles' box (along the feet only
-            # unless sideways), and the way out
-            out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
-            if not self.sideways:
-                out[1] = 0.0
-            beyond = float(np.hypot(*out))
+            out, beyond = self._outside(cp, h)
             if beyond <= st.margin or float(vel @ out) <= 0.0:
                 return
             # the farther foot swings (on a sideways fall toward the standing foot it crosses
@@ -752,11 +763,19 @@ class Stepper:
             self.foot, self._out, self._t0 = k, out / beyond, t
             self.record.append({"t": t, "foot": float(k), "beyond_m": beyond,
                                 "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
+        if self._out is None and st.catch and t > self._t0:
+            # a closing swing while the capture point leaves the foot stood on: a step past it
+            out, beyond = self._outside(cp, h)
+            if beyond > st.catch and float(vel @ out) > 0.0:
+                self._out, self._t0 = out / beyond, t
+                self.record.append({"t": t, "foot": float(self.foot), "beyond_m": beyond,
+                                    "from_m": float(feet[self.foot, 0] - feet[1 - self.foot, 0])})  # fmt: skip
         k = self.foot
         if t == self._t0:  # the hip's eased target starts where the hip is
             self._t_last = t
             self._bend = 0.0
             self._hip[:] = rig.current_angles()[_HIP[k]]
+            self._down = None
         u = (t - self._t0) / st.seconds
         if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
@@ -789,6 +808,10 @@ class Stepper:
                     side = 1.0 if at[1] >= stand[1] else -1.0
                     past = max(side * (at[1] - stand[1]), side * (cp[1] - stand[1]) + st.across)
                     want[1] = stand[1] + side * past
+        if st.down_after and t - self._t0 >= st.down_after:  # put down under where it is
+            if self._down is None:
+                self._down = s.corners[k].mean(axis=0)
+            want = s.local(self._down, h)[:2]
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
         down = float(hip[2]) - float(d.xanchor[self._ankles[1 - k], 2])
@@ -837,6 +860,15 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
+
+    def _outside(self, cp: F64, h: float) -> tuple[F64, float]:
+        """How far the capture point ``cp`` lies outside the supporting soles' box (along
+        the feet only unless sideways; heading frame), and that distance."""
+        lo, hi = self.ctx.senses.support_extent(h)
+        out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
+        if not self.sideways:
+            out[1] = 0.0
+        return out, float(np.hypot(*out))
 
     def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
         """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough
