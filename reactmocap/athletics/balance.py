@@ -767,9 +767,10 @@ class Stepper:
             # a closing swing while the capture point leaves the foot stood on: a step past it
             out, beyond = self._outside(cp, h)
             if beyond > st.catch and float(vel @ out) > 0.0:
+                j = self.foot
                 self._out, self._t0 = out / beyond, t
-                self.record.append({"t": t, "foot": float(self.foot), "beyond_m": beyond,
-                                    "from_m": float(feet[self.foot, 0] - feet[1 - self.foot, 0])})  # fmt: skip
+                self.record.append({"t": t, "foot": float(j), "beyond_m": beyond,
+                                    "from_m": float(feet[j, 0] - feet[1 - j, 0])})  # fmt: skip
         k = self.foot
         if t == self._t0:  # the hip's eased target starts where the hip is
             self._t_last = t

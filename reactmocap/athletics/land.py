@@ -248,10 +248,10 @@ class LandingParams:
             (docs/athletics.md, "late_kv_rotation").
         step_across, step_ground, step_down_after, step_catch: the ``step``'s
             :class:`~reactmocap.athletics.balance.Step` ``across``, ``ground``,
-            ``down_after`` and ``catch`` (0: off, their defaults; only with ``step``). Why: on the male back
-            handspring 13 of 19 full-size failures that reach the feet had a step's swing
-            run its whole 0.75 s without the foot down (docs/athletics.md, "the step put
-            down").
+            ``down_after`` and ``catch`` (0: off, their defaults; only with ``step``). Why:
+            on the male back handspring 13 of 19 full-size failures that reach the feet had
+            a step's swing run its whole 0.75 s without the foot down (docs/athletics.md,
+            "the step put down").
     """
 
     knee: float = 0.6
