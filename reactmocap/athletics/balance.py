@@ -153,10 +153,10 @@ class Step:
             foot clears the floor).
         seconds: the swing's planned duration; the step ends when the swing foot touches
             down after half of it (or at three times it).
-        across: on a step along the feet that would land under its own hip, the swing foot
-            lands at least this far (m) past the capture point across the feet, on its own
-            side (0: under its hip; opt-in, docs/athletics.md "The standing step's first
-            single support").
+        across: on a step along the feet that would land under its own hip (a closing step
+            too), the swing foot lands at least this far (m) past the capture point across
+            the feet, on its own side (0: under its hip; opt-in, docs/athletics.md "The
+            standing step's first single support").
         ground: from the swing's middle on, the swing leg is aimed from the hip's height as
             it is (not from where the standing knee's bend for the reach will lower it) and
             made at most this fraction of the straight leg, its place pulled in toward the hip
@@ -795,6 +795,7 @@ class Stepper:
         hip = d.xanchor[self._hips[k]]
         at = s.local(hip, h)[:2]
         stand = feet[1 - k]
+        under = self._out is None  # the place across the feet under its own hip
         if self._out is None:  # closing: beside the other, under its own hip
             want = np.array([stand[0], at[1]])
         else:  # past the capture point
@@ -805,10 +806,11 @@ class Stepper:
             want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
             if not self.sideways or (self.standing and self._out[1] == 0.0):
                 want[1] = at[1]
-                if st.across:  # the COM falls toward the swing side over the single support
-                    side = 1.0 if at[1] >= stand[1] else -1.0
-                    past = max(side * (at[1] - stand[1]), side * (cp[1] - stand[1]) + st.across)
-                    want[1] = stand[1] + side * past
+                under = True
+        if st.across and under:  # the COM falls toward the swing side over the single support
+            side = 1.0 if at[1] >= stand[1] else -1.0
+            past = max(side * (at[1] - stand[1]), side * (cp[1] - stand[1]) + st.across)
+            want[1] = stand[1] + side * past
         if st.down_after and t - self._t0 >= st.down_after:  # put down under where it is
             if self._down is None:
                 self._down = s.corners[k].mean(axis=0)
