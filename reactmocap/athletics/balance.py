@@ -168,11 +168,6 @@ class Step:
             reach it) instead of past the capture point (0: off; opt-in: the male back
             handspring's landing steps hung 3-5 cm over the floor, the foot 0.2-0.3 m beside
             its place, until the swing's limit, docs/athletics.md "the step put down").
-        catch: a closing swing (the foot left hanging brought down beside the other) becomes
-            a step past the capture point once that lies more than this (m) past the foot
-            stood on, moving away (0: off; opt-in: on the male back handspring the closing
-            swing after the landing's first step ran 0.75 s while the body fell back past
-            the standing foot, no new step possible, docs/athletics.md "the step put down").
     """
 
     margin: float = 0.05
@@ -182,7 +177,6 @@ class Step:
     across: float = 0.0
     ground: float = 0.0
     down_after: float = 0.0
-    catch: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("margin", "reach", "lift", "seconds", "across", "ground"):
@@ -195,8 +189,6 @@ class Step:
             raise ConfigError(f"step ground must be 0 or in [0.5, 1], got {self.ground}")
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
-        if not (isinstance(self.catch, (int, float)) and 0.0 <= self.catch <= 1.0):
-            raise ConfigError(f"step catch must be in [0, 1] m, got {self.catch!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -752,7 +744,13 @@ class Stepper:
         if self.foot < 0:
             if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
                 return
-            out, beyond = self._outside(cp, h)
+            lo, hi = s.support_extent(h)
+            # how far the capture point lies outside the soles' box (along the feet only
+            # unless sideways), and the way out
+            out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
+            if not self.sideways:
+                out[1] = 0.0
+            beyond = float(np.hypot(*out))
             if beyond <= st.margin or float(vel @ out) <= 0.0:
                 return
             # the farther foot swings (on a sideways fall toward the standing foot it crosses
@@ -763,14 +761,6 @@ class Stepper:
             self.foot, self._out, self._t0 = k, out / beyond, t
             self.record.append({"t": t, "foot": float(k), "beyond_m": beyond,
                                 "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
-        if self._out is None and st.catch and t > self._t0:
-            # a closing swing while the capture point leaves the foot stood on: a step past it
-            out, beyond = self._outside(cp, h)
-            if beyond > st.catch and float(vel @ out) > 0.0:
-                j = self.foot
-                self._out, self._t0 = out / beyond, t
-                self.record.append({"t": t, "foot": float(j), "beyond_m": beyond,
-                                    "from_m": float(feet[j, 0] - feet[1 - j, 0])})  # fmt: skip
         k = self.foot
         if t == self._t0:  # the hip's eased target starts where the hip is
             self._t_last = t
@@ -863,15 +853,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-
-    def _outside(self, cp: F64, h: float) -> tuple[F64, float]:
-        """How far the capture point ``cp`` lies outside the supporting soles' box (along
-        the feet only unless sideways; heading frame), and that distance."""
-        lo, hi = self.ctx.senses.support_extent(h)
-        out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
-        if not self.sideways:
-            out[1] = 0.0
-        return out, float(np.hypot(*out))
 
     def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
         """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough

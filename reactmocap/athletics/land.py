@@ -246,9 +246,9 @@ class LandingParams:
             with ``kv`` have turned -3.03..-3.08 rad by then, those that land only with
             ``late_kv`` 0 -3.09..-3.29, where the feet's distance does not sort them
             (docs/athletics.md, "late_kv_rotation").
-        step_across, step_ground, step_down_after, step_catch: the ``step``'s
-            :class:`~reactmocap.athletics.balance.Step` ``across``, ``ground``,
-            ``down_after`` and ``catch`` (0: off, their defaults; only with ``step``). Why:
+        step_across, step_ground, step_down_after: the ``step``'s
+            :class:`~reactmocap.athletics.balance.Step` ``across``, ``ground`` and
+            ``down_after`` (0: off, their defaults; only with ``step``). Why:
             on the male back handspring 13 of 19 full-size failures that reach the feet had
             a step's swing run its whole 0.75 s without the foot down (docs/athletics.md,
             "the step put down").
@@ -295,7 +295,6 @@ class LandingParams:
     step_across: float = 0.0
     step_ground: float = 0.0
     step_down_after: float = 0.0
-    step_catch: float = 0.0
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -426,11 +425,11 @@ class LandingParams:
         ``step_*`` fields), or None (off)."""
         step = Step.of(self.step)
         more = {"across": self.step_across, "ground": self.step_ground,
-                "down_after": self.step_down_after, "catch": self.step_catch}  # fmt: skip
+                "down_after": self.step_down_after}  # fmt: skip
         if step is None:
             if any(v != getattr(Step, k) for k, v in more.items()):
-                raise ConfigError("landing step_across, step_ground, step_down_after and "
-                                  "step_catch need a step")  # fmt: skip
+                raise ConfigError("landing step_across, step_ground and step_down_after "
+                                  "need a step")  # fmt: skip
             return None
         try:
             return replace(step, **more)
