@@ -153,10 +153,10 @@ class Step:
             foot clears the floor).
         seconds: the swing's planned duration; the step ends when the swing foot touches
             down after half of it (or at three times it).
-        across: on a step along the feet that would land under its own hip, the swing foot
-            lands at least this far (m) past the capture point across the feet, on its own
-            side (0: under its hip; opt-in, docs/athletics.md "The standing step's first
-            single support").
+        across: on a step along the feet that would land under its own hip (a closing step
+            too), the swing foot lands at least this far (m) past the capture point across
+            the feet, on its own side (0: under its hip; opt-in, docs/athletics.md "The
+            standing step's first single support").
         ground: from the swing's middle on, the swing leg is aimed from the hip's height as
             it is (not from where the standing knee's bend for the reach will lower it) and
             made at most this fraction of the straight leg, its place pulled in toward the hip
@@ -177,6 +177,11 @@ class Step:
             seconds after the swing began, not where it is (0: where it is, and the COM still
             fell on past the landed foot; opt-in, docs/athletics.md "The standing step's
             landed knee yields").
+        down_after: from this many seconds into the swing on, the place is the floor under
+            where the swing foot was then (the leg aimed straight down there, lengthened to
+            reach it) instead of past the capture point (0: off; opt-in: the male back
+            handspring's landing steps hung 3-5 cm over the floor, the foot 0.2-0.3 m beside
+            its place, until the swing's limit, docs/athletics.md "the step put down").
     """
 
     margin: float = 0.05
@@ -188,6 +193,7 @@ class Step:
     give: float = 0.0
     give_time: float = 0.1
     foresee: float = 0.0
+    down_after: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -206,6 +212,8 @@ class Step:
             raise ConfigError(f"step give_time must be in [0.02, 0.5] s, got {g!r}")
         if self.foresee and not (self.across and self.foresee <= 1.0):
             raise ConfigError(f"step foresee must be 0 or in (0, 1] s, with across: {self.foresee}")
+        if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
+            raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -736,6 +744,7 @@ class Stepper:
         self._held = np.zeros(2)  # Step.give: the landed knee's, the rear ankle's angle
         self._t_give = -math.inf  # Step.give: the touchdown it is for
         self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
+        self._down: F64 | None = None  # Step.down_after: where the foot goes down (world)
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
 
@@ -788,6 +797,7 @@ class Stepper:
             self._t_last = t
             self._bend = 0.0
             self._hip[:] = rig.current_angles()[_HIP[k]]
+            self._down = None
         u = (t - self._t0) / st.seconds
         if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
@@ -810,6 +820,7 @@ class Stepper:
         hip = d.xanchor[self._hips[k]]
         at = s.local(hip, h)[:2]
         stand = feet[1 - k]
+        under = self._out is None  # the place across the feet under its own hip
         if self._out is None:  # closing: beside the other, under its own hip
             want = np.array([stand[0], at[1]])
         else:  # past the capture point
@@ -820,13 +831,18 @@ class Stepper:
             want[1] = stand[1] + math.copysign(max(abs(apart), STEP_WIDTH), apart)
             if not self.sideways or (self.standing and self._out[1] == 0.0):
                 want[1] = at[1]
-                if st.across:  # the COM falls toward the swing side over the single support
-                    side = 1.0 if at[1] >= stand[1] else -1.0
-                    lat = cp[1] - stand[1]
-                    if st.foresee:  # the capture point diverges from the standing foot
-                        lat *= math.exp(omega * max(st.foresee - (t - self._t0), 0.0))
-                    past = max(side * (at[1] - stand[1]), side * lat + st.across)
-                    want[1] = stand[1] + side * past
+                under = True
+        if st.across and under:  # the COM falls toward the swing side over the single support
+            side = 1.0 if at[1] >= stand[1] else -1.0
+            lat = cp[1] - stand[1]
+            if st.foresee:  # the capture point diverges from the standing foot
+                lat *= math.exp(omega * max(st.foresee - (t - self._t0), 0.0))
+            past = max(side * (at[1] - stand[1]), side * lat + st.across)
+            want[1] = stand[1] + side * past
+        if st.down_after and t - self._t0 >= st.down_after:  # put down under where it is
+            if self._down is None:
+                self._down = s.corners[k].mean(axis=0)
+            want = s.local(self._down, h)[:2]
         # the leg as long as it takes to put the sole on the floor at the place (the stance
         # ankle's height over the floor below the hip), its knee lifted over the swing
         down = float(hip[2]) - float(d.xanchor[self._ankles[1 - k], 2])

@@ -418,3 +418,31 @@ def test_the_hips_give_the_spin_back_a_tick_before_the_cap() -> None:
     same = run_maneuver(m, perturbation=starts[0], fps=10.0).report
     for key in ("achieved_height_m", "liftoff_pitch_momentum", "rotation_deg", "landed"):
         assert same[key] == without[key]
+
+
+def test_the_landing_steps_closing_swing_ends_sooner_put_down_or_placed_across() -> None:
+    """Full-size start 28 (seed 0) steps back on landing; the file's closing swing (the front
+    foot brought back beside the rear one) hangs over the floor, the foot 0.2 m beside its
+    place, while the body falls sideways toward it, until the swing's 0.75 s limit. Opt-ins:
+    with ``step_down_after`` 0.3 the place is the floor under the foot from 0.3 s on and the
+    swing ends by 0.35 s; with ``step_across`` 0.15 the closing foot goes past the capture
+    point across the feet and lands within 0.3 s. With ``step_down_after`` the first step is
+    the file's, record for record."""
+    m = replace(load_maneuver(EXAMPLE), seconds=4.6)
+    land = next(p for p in m.phases if p.controller == "land").params
+    assert "step_down_after" not in land and "step_across" not in land
+    start = _starts(1.0, 29)[28]
+    steps = run_maneuver(m, perturbation=start, fps=10.0).report["steps"]
+    assert steps[1]["beyond_m"] == 0.0 and steps[1]["s"] >= 0.7  # the closing swing hangs
+    down = _with(m, "land", {**land, "step_down_after": 0.3})
+    put = run_maneuver(down, perturbation=start, fps=10.0).report["steps"]
+    assert put[0] == steps[0]
+    assert put[1]["t"] == steps[1]["t"] and put[1]["s"] <= 0.35
+    wide = _with(m, "land", {**land, "step_across": 0.15})
+    placed = run_maneuver(wide, perturbation=start, fps=10.0).report["steps"]
+    assert placed[1]["beyond_m"] == 0.0 and placed[1]["s"] <= 0.3
+    for bad in ({"step_down_after": -0.1}, {"step_across": -0.1}):
+        with pytest.raises(ConfigError, match=next(iter(bad))):
+            LandingParams(step=(0.05,), **bad)
+    with pytest.raises(ConfigError, match="need a step"):
+        LandingParams(step_down_after=0.3)
