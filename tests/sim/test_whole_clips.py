@@ -640,33 +640,6 @@ def test_a_swinging_foot_rolling_over_its_corner_is_not_planted(shared_mocap_dir
     assert tracker(centre_speed=1.0)._clip_swing_leads().max() < 0.35  # 0.294 m
 
 
-def test_step_ahead_reads_the_stance_without_mid_swing_landings(shared_mocap_dir: Path) -> None:
-    """On the shared left-curving walk with ``WHOLE_CLIP``'s stance the false mid-swing
-    landings set ``step_ahead``'s limits: the clip's largest lead past its front foot in its
-    double supports (0.347 m) and past its swing foot's landing (0.535 m); with
-    ``step_ahead_centre_speed`` 2.5 (opt-in, 2026-12-05) those limits read the stance
-    without them (0.229 and 0.259 m) while the flags the foot lock, anchoring and balance
-    shift read stay the corner's."""
-    from reactmocap.library.bvh import read_bvh
-
-    clip = shared_mocap_dir / "dataset-1_walk-left_normal_001.bvh"
-    if not clip.is_file():
-        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
-    walk = read_bvh(clip)
-
-    def tracker(**extra: float) -> WholeBodyTracker:
-        return WholeBodyTracker(World(build_character(walk, frame=0)), 0, walk, 0.0,
-                                kp_joint=100.0, servo_kv=1.0, control_every=8, step_ahead=1.0,
-                                step_ahead_swing=1.0, slide_speed=0.5, **extra)  # fmt: skip
-
-    plain, strict = tracker(), tracker(step_ahead_centre_speed=2.5)
-    assert np.array_equal(plain.path.planted, strict.path.planted)
-    assert np.array_equal(plain.path.pivoting, strict.path.pivoting)
-    assert plain._ahead_margin > 0.3 and strict._ahead_margin < 0.25
-    assert plain._clip_swing_leads().max() > 0.5 and strict._clip_swing_leads().max() < 0.3
-    assert not (strict._firm & ~plain._firm).any()  # stricter only
-
-
 def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:
     """The whole-clip trunk rows keep their weight while nothing pushes (even with the capture
     point off), are off while a push acts and until the capture point is back near the

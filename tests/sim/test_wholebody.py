@@ -284,7 +284,6 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_ahead_swing", -0.5),
         ("step_ahead_phase", -0.05),
         ("centre_speed", -1.0),
-        ("step_ahead_centre_speed", -2.5),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -320,14 +319,6 @@ def test_step_ahead_phase_needs_the_swing_step_and_a_margin(guard: Motion, extra
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="step_ahead_phase"):
         _tracker(world, guard, 0.0, **({"step_ahead_phase": 0.1} | extra))
-
-
-def test_step_ahead_centre_speed_needs_its_step(guard: Motion) -> None:
-    """``step_ahead_centre_speed`` sets the stance ``step_ahead``'s limits read: without
-    ``step_ahead`` it is refused."""
-    world = World(build_character(guard, frame=0))
-    with pytest.raises(ConfigError, match="step_ahead_centre_speed"):
-        _tracker(world, guard, 0.0, step_ahead_centre_speed=2.5)
 
 
 def test_a_look_ahead_restores_the_lead_growths_state(guard: Motion) -> None:

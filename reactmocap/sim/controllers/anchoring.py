@@ -23,7 +23,7 @@ from reactmocap.sim.controllers.stepping import (
     step_target,
 )
 from reactmocap.sim.feet import foot_soles, sole_corners_world
-from reactmocap.sim.reference import ReferencePath, sole_speed
+from reactmocap.sim.reference import ReferencePath
 from reactmocap.sim.world import World
 
 __all__ = ["AnchoredReference"]
@@ -139,7 +139,6 @@ class AnchoredReference:
         step_ahead_horizon: float = 0.0,
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
-        step_ahead_centre_speed: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -246,13 +245,6 @@ class AnchoredReference:
         # ``step_ahead``: the capture point's largest lead past the front foot in the clip's
         # own double supports (m), and whether a walk's push has armed the step
         self.step_ahead = float(step_ahead)
-        # the clip's stance as ``step_ahead``'s limits and triggers read it
-        # (``step_ahead_centre_speed``: without the mid-swing "landings" of a foot rolling over
-        # its slow lowest corner, which set its largest leads; the foot lock keeps them)
-        self._stance = self.path.planted
-        if step_ahead_centre_speed:
-            fast = sole_speed(self.path.sole, self.path.fps) >= step_ahead_centre_speed
-            self._stance = self.path.planted & ~fast
         self._ahead_margin = self._clip_ahead_margin() if self.step_ahead else np.inf
         self._ahead_armed = False
         # ``step_ahead_horizon``: the lead predicted this far ahead (s) by the capture point's
@@ -270,9 +262,9 @@ class AnchoredReference:
         # the clip's stance without its one-frame double supports (a swing foot touching
         # between two frames of swing)
         self.step_ahead_swing = float(step_ahead_swing)
-        self._firm = self._stance.copy()
+        self._firm = self.path.planted.copy()
         if self.step_ahead_swing:
-            pl = self._stance
+            pl = self.path.planted
             self._firm[1:-1] &= pl[:-2] | pl[2:]
         # per frame and foot, the first frame from it on where the foot is planted (len: never)
         n = len(self._firm)
@@ -658,7 +650,7 @@ class AnchoredReference:
         assert self.path.sole is not None
         c, v, a = self._com, self._com_v, self._com_a
         speed = np.hypot(v[:, 0], v[:, 1])
-        both = self._stance.all(axis=1) & (speed > 0.2)
+        both = self.path.planted.all(axis=1) & (speed > 0.2)
         if not both.any():
             return 0.0
         u = v[both, :2] / speed[both, None]

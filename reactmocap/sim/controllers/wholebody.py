@@ -270,11 +270,6 @@ class WholeBodyTracker(AnchoredReference):
             swing's phase: the clip's own predicted lead at the same frame plus this margin
             (m, at most 0.5), in place of ``step_ahead`` times its largest such lead (0: off)
             (``docs/tracking.md``).
-        step_ahead_centre_speed: with ``step_ahead``, its limits and triggers (the clip's
-            double supports, single supports and landings) read a foot as planted only while
-            its sole centre is also slower than this (m/s; 0: off, the clip's stance as the
-            foot lock reads it); the contact rows, anchoring and balance shift keep the
-            corner flags (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -365,7 +360,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_horizon: float = 0.0,
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
-        step_ahead_centre_speed: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -401,7 +395,6 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
                 "step_ahead_horizon": step_ahead_horizon, "step_ahead_swing": step_ahead_swing,
                 "step_ahead_phase": step_ahead_phase,
-                "step_ahead_centre_speed": step_ahead_centre_speed,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -430,11 +423,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_phase ({step_ahead_phase!r}) is a margin in (0, 0.5] m over the "
                 f"clip's own lead, and sets step_ahead_swing's limit: it needs step_ahead_swing"
-            )
-        if step_ahead_centre_speed and not step_ahead:
-            raise ConfigError(
-                f"step_ahead_centre_speed ({step_ahead_centre_speed!r}) sets the stance "
-                f"step_ahead's limits read: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -539,7 +527,7 @@ class WholeBodyTracker(AnchoredReference):
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
             anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
-            step_ahead_phase=step_ahead_phase, step_ahead_centre_speed=step_ahead_centre_speed,
+            step_ahead_phase=step_ahead_phase,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
