@@ -305,7 +305,7 @@ class AnchoredReference:
 
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
-        the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
+        the planted feet (2,) as the foot lock reads them (:meth:`planted_now`)."""
         q, v, a, _ = self.path.sample(self.clock.frame(t), self.clock.coast(t))
         planted = self.planted_now(t, lock=True)
         if self.anchor_yaw or self.anchor_shift.any():
