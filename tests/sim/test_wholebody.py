@@ -284,6 +284,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_ahead_swing", -0.5),
         ("step_ahead_phase", -0.05),
         ("centre_speed", -1.0),
+        ("centre_speed_lock", -2.5),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:

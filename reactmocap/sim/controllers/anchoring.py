@@ -23,7 +23,7 @@ from reactmocap.sim.controllers.stepping import (
     step_target,
 )
 from reactmocap.sim.feet import foot_soles, sole_corners_world
-from reactmocap.sim.reference import ReferencePath
+from reactmocap.sim.reference import ReferencePath, sole_speed
 from reactmocap.sim.world import World
 
 __all__ = ["AnchoredReference"]
@@ -139,6 +139,7 @@ class AnchoredReference:
         step_ahead_horizon: float = 0.0,
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
+        centre_speed_lock: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -167,6 +168,14 @@ class AnchoredReference:
         self._com_v = np.gradient(self._com, dt_f, axis=0) if n > 1 else 0 * self._com
         self._com_a = np.gradient(self._com_v, dt_f, axis=0) if n > 2 else 0 * self._com
         self._sole_v = np.gradient(self.path.sole, dt_f, axis=0) if n > 1 else 0 * self.path.sole
+        # the stance the foot lock reads (contact rows, anchoring, pivot patch):
+        # ``centre_speed_lock`` drops a foot rolling over its slow lowest corner mid-swing; the
+        # balance shift, the balance steps and ``step_ahead`` keep the path's flags
+        self._lock_planted, self._lock_pivoting = self.path.planted, self.path.pivoting
+        if centre_speed_lock:
+            slow = sole_speed(self.path.sole, self.path.fps) < centre_speed_lock
+            self._lock_planted = self.path.planted & slow
+            self._lock_pivoting = self.path.pivoting & slow
         self.balance_margin = float(balance_margin)
         self._balance_rate = min(1.0, dt_slow / balance_tau) if balance_tau > 0 else 0.0
         #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
@@ -296,9 +305,9 @@ class AnchoredReference:
 
     def reference(self, t: float) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
         """The mocap at rollout time ``t``: ``qpos`` (67,), ``qvel`` (51,), ``qacc`` (51,) and
-        the planted feet (2,) (see :meth:`ReferencePath.sample`)."""
+        the planted feet (2,) as the foot lock reads them (:meth:`planted_now`)."""
         q, v, a, _ = self.path.sample(self.clock.frame(t), self.clock.coast(t))
-        planted = self.planted_now(t)
+        planted = self.planted_now(t, lock=True)
         if self.anchor_yaw or self.anchor_shift.any():
             if self._turn[0] != self.anchor_yaw:  # it moves every few ticks only
                 self._turn = (
@@ -367,10 +376,12 @@ class AnchoredReference:
             self._corners_at = key
         return self._corners_now
 
-    def planted_now(self, t: float) -> NDArray[np.bool_]:
-        """``(2,)`` the feet the tracker stands on at ``t``: those planted in the mocap, but
-        for the foot of a balance step under way."""
-        planted = self.path.planted[self.clock.nearest(t)].copy()
+    def planted_now(self, t: float, lock: bool = False) -> NDArray[np.bool_]:
+        """``(2,)`` the feet the tracker stands on at ``t``: those planted in the mocap (as the
+        foot lock reads them with ``lock``, ``centre_speed_lock``), but for the foot of a
+        balance step under way."""
+        flags = self._lock_planted if lock else self.path.planted
+        planted = flags[self.clock.nearest(t)].copy()
         if self.step is not None:
             planted[self.step.foot] = False
         return planted
@@ -813,7 +824,8 @@ class AnchoredReference:
         d = self.world.data
         i = self.clock.nearest(t)
         corners = self.sole_corners()
-        on = self.planted_now(t) & (corners[:, :, 2].min(axis=1) - self.floor_z < self.anchor_touch)
+        low = corners[:, :, 2].min(axis=1) - self.floor_z
+        on = self.planted_now(t, lock=True) & (low < self.anchor_touch)
         if not on.any():
             return
         rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
@@ -824,7 +836,7 @@ class AnchoredReference:
         err = centre - ref.mean(axis=0)
         if t <= self.lag_until:
             err = self._lag(t, err)
-        turn = on & ~self.path.pivoting[i]  # a pivoting foot's heading is the clip's own turn
+        turn = on & ~self._lock_pivoting[i]  # a pivoting foot's heading is the clip's own turn
         dyaw = 0.0
         if turn.any():
             yaw = np.arctan2(rot[turn, 1, 0], rot[turn, 0, 0]) - ref_yaw[turn] - self.anchor_yaw

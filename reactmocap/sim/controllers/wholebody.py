@@ -270,6 +270,11 @@ class WholeBodyTracker(AnchoredReference):
             swing's phase: the clip's own predicted lead at the same frame plus this margin
             (m, at most 0.5), in place of ``step_ahead`` times its largest such lead (0: off)
             (``docs/tracking.md``).
+        centre_speed_lock: the foot lock (contact rows, the ground path's anchoring, the
+            pivot patch) reads a foot as planted only while its sole centre also moves slower
+            than this (m/s; 0: off), while the balance shift, the balance steps and
+            ``step_ahead`` keep the clip's flags (``centre_speed`` filters them all)
+            (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -360,6 +365,7 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_horizon: float = 0.0,
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
+        centre_speed_lock: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -394,7 +400,7 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_lag": anchor_lag, "anchor_lag_heading": anchor_lag_heading,
                 "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
                 "step_ahead_horizon": step_ahead_horizon, "step_ahead_swing": step_ahead_swing,
-                "step_ahead_phase": step_ahead_phase,
+                "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -527,7 +533,7 @@ class WholeBodyTracker(AnchoredReference):
             anchor_lag=anchor_lag, anchor_lag_heading=anchor_lag_heading,
             anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
-            step_ahead_phase=step_ahead_phase,
+            step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
@@ -1006,7 +1012,7 @@ class WholeBodyTracker(AnchoredReference):
             self._ff[:] = 0.0
             return
         i = self.clock.nearest(t)
-        patch = self.path.pivoting[i]
+        patch = self._lock_pivoting[i]
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(patch[f]))
         self.update_ground(t)
