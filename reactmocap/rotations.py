@@ -43,6 +43,20 @@ F64 = NDArray[np.float64]
 Floats = NDArray[np.floating[Any]]
 #: the dtypes kept as they are (overloads: float32 or float64 in, the same out)
 _F = TypeVar("_F", np.float32, np.float64)
+# quaternion component of each axis, and the right product with its unit quaternion,
+# q (0, e_axis), as a signed permutation of q's (w, x, y, z)
+_AXIS = {"X": 1, "Y": 2, "Z": 3}
+_RIGHT_UNIT = {
+    "X": (np.array([1, 0, 3, 2]), np.array([-1.0, 1.0, 1.0, -1.0])),
+    "Y": (np.array([2, 3, 0, 1]), np.array([-1.0, -1.0, 1.0, 1.0])),
+    "Z": (np.array([3, 2, 1, 0]), np.array([-1.0, 1.0, -1.0, 1.0])),
+}
+# e_k b for the units e_k = 1, i, j, k: signed permutations of b's (w, x, y, z)
+_MUL_PERM = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
+_SIGNS = [[1, 1, 1, 1], [-1, 1, -1, 1], [-1, 1, 1, -1], [-1, -1, 1, 1]]
+_MUL_SIGN = {c: np.array(_SIGNS, dtype=c) for c in "fd"}
+#: quat_mul's small form up to this many entries of a and b together
+_MUL_SMALL = 512
 # cross_rows' component order
 _C1 = np.array([1, 2, 0])
 _C2 = np.array([2, 0, 1])
@@ -111,6 +125,12 @@ def quat_mul(a: ArrayLike, b: ArrayLike) -> F64: ...
 def quat_mul(a: ArrayLike, b: ArrayLike) -> Floats:
     """Hamilton product ``a * b`` (apply ``b`` first, then ``a``)."""
     qa, qb = _common(a, b)
+    if qa.size + qb.size <= _MUL_SMALL:
+        # a * b = sum_k a_k (e_k b): the same products summed in the same order as below (to
+        # the bit, test) in 4 numpy calls, not 30: 3x faster on the control ticks' 15
+        # joints, 9x slower on 1e5 quaternions
+        terms = qa[..., :, None] * (qb[..., _MUL_PERM] * _MUL_SIGN[qa.dtype.char])
+        return np.add.reduce(terms, axis=-2)
     aw, ax, ay, az = qa[..., 0], qa[..., 1], qa[..., 2], qa[..., 3]
     bw, bx, by, bz = qb[..., 0], qb[..., 1], qb[..., 2], qb[..., 3]
     return np.stack(
@@ -222,10 +242,24 @@ def quat_slerp_path(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F64:
 
 def quat_from_euler(angles_rad: ArrayLike, order: str) -> F64:
     """Quaternions from intrinsic Euler angles ``(..., 3)``; ``order`` like ``"ZXY"`` means
-    ``R = Rz @ Rx @ Ry`` (the BVH channel order). Always float64 (scipy)."""
+    ``R = Rz @ Rx @ Ry`` (the BVH channel order). Always float64. The elementary rotations'
+    product as scipy's ``Rotation.from_euler`` forms it: each component is one rounding of the
+    same one or two products, so the values equal scipy's to the bit (test), at a fraction of
+    its cost on the control ticks' 15 joints (no Rotation object)."""
     a = np.asarray(angles_rad, dtype=np.float64)
-    r = Rotation.from_euler(order.upper(), a.reshape(-1, 3))
-    return wxyz_from_rotation(r).reshape(*a.shape[:-1], 4)
+    seq = order.upper()
+    if len(seq) != 3 or not set(seq) <= set("XYZ") or seq[0] == seq[1] or seq[1] == seq[2]:
+        raise ValueError(f"Euler order must be 3 axes of XYZ, none twice in a row; got {order!r}")
+    half = a / 2
+    c, s = np.cos(half), np.sin(half)
+    q = np.zeros((*a.shape[:-1], 4))
+    q[..., 0] = c[..., 0]
+    q[..., _AXIS[seq[0]]] = s[..., 0]
+    for k in (1, 2):
+        # q (cos + sin u) = cos q + sin (q u), q u a signed permutation of q's components
+        perm, sign = _RIGHT_UNIT[seq[k]]
+        q = c[..., k, None] * q + s[..., k, None] * (q[..., perm] * sign)
+    return q
 
 
 def quat_to_euler(q: ArrayLike, order: str) -> F64:

@@ -224,7 +224,7 @@ class Athlete:
 
     def joint_quats(self, angles: F64) -> F64:
         """``(15, 4)`` MuJoCo ball-joint quaternions of anatomical angles ``(15, 3)``."""
-        r = quat_from_euler(np.asarray(angles)[:, [0, 1, 2]], EULER_ORDER)
+        r = quat_from_euler(angles, EULER_ORDER)
         return quat_mul(self.joint_left, quat_mul(r, self.joint_right))
 
     def joint_angles(self, quats: F64) -> F64:

@@ -7,6 +7,7 @@ runner is left of the path; NaN without a path)."""
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -127,6 +128,9 @@ class Polyline:
         self.seg = np.diff(self.points, axis=0)
         self.len = np.hypot(self.seg[:, 0], self.seg[:, 1])
         self.cum = np.concatenate([[0.0], np.cumsum(self.len)])
+        self._cum = self.cum.tolist()  # bisect on a list: np.searchsorted cost 5 us a point
+        #: the search window of _closest for the segment it was made at
+        self._window: tuple[int, NDArray[np.intp], F64, F64, F64] | None = None
         self.closed = closed
         self.lookahead = float(lookahead)
         self.total = float(self.cum[-1])
@@ -141,19 +145,15 @@ class Polyline:
     def _closest(self, p: F64) -> tuple[int, float, float]:
         """Segment, arc length and signed distance of the closest point, searched a window
         ahead of the current segment."""
-        n = len(self.len)
-        span = max(
-            4,
-            int(np.searchsorted(self.cum, self.cum[self.index] + 2 * self.lookahead)) - self.index,
-        )
-        idx = np.arange(self.index, self.index + span + 1)
-        if self.closed:
-            idx = idx % n
-        else:
-            idx = idx[idx < n]
-        a = self.points[idx]
-        sv = self.seg[idx]
-        u = np.clip(np.einsum("ij,ij->i", p - a, sv) / self.len[idx] ** 2, 0.0, 1.0)
+        if self._window is None or self._window[0] != self.index:
+            # the window's segments change only when the runner passes on to the next one
+            n = len(self.len)
+            end = bisect.bisect_left(self._cum, self._cum[self.index] + 2 * self.lookahead)
+            idx = np.arange(self.index, self.index + max(4, end - self.index) + 1)
+            idx = idx % n if self.closed else idx[idx < n]
+            self._window = (self.index, idx, self.points[idx], self.seg[idx], self.len[idx] ** 2)
+        _, idx, a, sv, len2 = self._window
+        u = np.clip(np.einsum("ij,ij->i", p - a, sv) / len2, 0.0, 1.0)
         q = a + u[:, None] * sv
         dist = np.hypot(*(p - q).T)
         j = int(np.argmin(dist))
@@ -166,7 +166,7 @@ class Polyline:
             s = s % self.total
         # builtin min/max: np.clip on one number cost 20 us, four times a tick
         s = float(min(max(s, 0.0), self.total))
-        i = min(max(int(np.searchsorted(self.cum, s, side="right")) - 1, 0), len(self.len) - 1)
+        i = min(max(bisect.bisect_right(self._cum, s) - 1, 0), len(self.len) - 1)
         u = (s - self.cum[i]) / self.len[i]
         return self.points[i] + u * self.seg[i]
 

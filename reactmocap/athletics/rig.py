@@ -111,6 +111,9 @@ class Rig:
         up = -np.asarray(m.opt.gravity, dtype=np.float64)
         self._up = up / max(float(np.linalg.norm(up)), 1e-12)
         self._weight = m.body_subtreemass[self._child] * g  # (15,) N
+        # each subtree's weight up (15, 3) and its columns as the cross product takes them
+        w = self._weight[:, None] * self._up
+        self._w_201, self._w_120 = w[:, [2, 0, 1]], w[:, [1, 2, 0]]
         self._weight_n = self.mass * g
         self._tau = np.zeros((NJ, 3))
         self._jacp = np.zeros((3, m.nv))
@@ -200,11 +203,8 @@ class Rig:
         on = values > 0
         self.servo.enable(self.character, [BALL_JOINTS[i] for i in np.flatnonzero(~on)], False)
         self.servo.enable(self.character, [BALL_JOINTS[i] for i in np.flatnonzero(on)], True)
-        for i in np.flatnonzero(on):
-            k = values[i] * self.stiffness_unit
-            self.servo.set_gain_scale(
-                self.character, [BALL_JOINTS[i]], k / (SERVO_KP * scale_inertia[i])
-            )
+        scale = values * self.stiffness_unit / (SERVO_KP * scale_inertia)
+        self.servo.set_gain_scales(self.character, np.where(on, scale, np.nan))
         self._kp[:] = np.where(on, values * self.stiffness_unit / scale_inertia, 0.0)
         self.stiffness[:] = values
 
@@ -247,14 +247,23 @@ class Rig:
         both ends), or with ``accelerate`` a constant acceleration from rest that arrives at
         full speed (a push)."""
         goal = np.asarray(goal, dtype=np.float64)
+        if joints is None and np.ndim(duration) == 0 and duration <= 0.0:
+            # every joint jumps (the runner's tick): as below, without the masks
+            new = np.where(np.isnan(goal), self._goal, goal)
+            self._start[:] = new
+            self._goal[:] = new
+            self._t0[:] = t
+            self._dur[:] = 1e-9
+            self._accel[:] = accelerate
+            return
         sel = np.ones(NJ, dtype=bool) if joints is None else np.zeros(NJ, dtype=bool)
         if joints is not None:
             sel[np.asarray(joints)] = True
-        now = self.desired(t)
         dur = np.broadcast_to(np.asarray(duration, dtype=np.float64), (NJ,))
         new = np.where(np.isnan(goal), self._goal, goal)
         jump = sel & (dur <= 0.0)
-        self._start[sel] = now[sel]
+        if not np.array_equal(jump, sel):  # where the targets are now: only for a path
+            self._start[sel] = self.desired(t)[sel]
         self._start[jump] = new[jump]
         self._goal[sel] = new[sel]
         self._t0[sel] = t
@@ -285,8 +294,7 @@ class Rig:
         m, d = self.world.model, self.world.data
         # each joint holds its subtree up: (subtree com - anchor) x (weight up), child frame
         r = d.subtree_com[self._child] - d.xanchor[self._balls]
-        w = self._weight[:, None] * self._up
-        tau = r[:, [1, 2, 0]] * w[:, [2, 0, 1]] - r[:, [2, 0, 1]] * w[:, [1, 2, 0]]  # r x w
+        tau = r[:, [1, 2, 0]] * self._w_201 - r[:, [2, 0, 1]] * self._w_120  # r x w
         rot = d.xmat[self._child].reshape(NJ, 3, 3)
         self.feedforward[:] = np.einsum("nji,nj->ni", rot, tau)
         flat = self.feedforward.reshape(-1)

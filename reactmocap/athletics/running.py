@@ -145,7 +145,8 @@ class Runner:
         m = world.model
         self.mass = self.rig.mass
         self.g = float(np.linalg.norm(m.opt.gravity))
-        self.inertia_unit = self.mass * athlete.leg_length**2
+        self._leg_length = athlete.leg_length  # a property: a mean at every read
+        self.inertia_unit = self.mass * self._leg_length**2
         self._hips = [m.joint(wc.prefix + f"{s}_hip").id for s in "lr"]
         self._knees = [m.joint(wc.prefix + f"{s}_knee").id for s in "lr"]
         self._ankles = [m.joint(wc.prefix + f"{s}_ankle").id for s in "lr"]
@@ -272,10 +273,12 @@ class Runner:
             angles[j, 0] = pitch_yxz(rel)
         return angles
 
-    def trunk_euler(self) -> tuple[float, float, float]:
-        """Chest pitch, roll and yaw (anatomical, heading frame, rad)."""
+    def trunk_euler(self, heading: float | None = None) -> tuple[float, float, float]:
+        """Chest pitch, roll and yaw (anatomical, in the frame of ``heading``, default the
+        pelvis's, rad)."""
         chest = SIM_BODY_INDEX["chest"]
-        return euler_yxz(qmul1(qyaw(-self.heading()), self._anat(self._chest, chest)))
+        h = self.heading() if heading is None else heading
+        return euler_yxz(qmul1(qyaw(-h), self._anat(self._chest, chest)))
 
     def _contacts(self) -> None:
         """Which feet touch with their heel (rear corners) and toe (front corners)."""
@@ -410,7 +413,7 @@ class Runner:
             # and the foot bounced off (the turning runner's falls at 2.5 m/s)
             limit = min(limit, k["touchdown_limit"]) if limit > 0 else k["touchdown_limit"]
         if limit > 0:
-            top = limit * self.mass * self.g * self.athlete.leg_length
+            top = limit * self.mass * self.g * self._leg_length
             size = float(np.linalg.norm(torque))
             if size > top:
                 torque *= top / size
@@ -479,7 +482,7 @@ class Runner:
         u = line / max(float(np.linalg.norm(line)), 1e-6)
         rate = (length - self.leg_prev) / dt if self.leg_prev > 0 else 0.0
         self.leg_prev = length
-        stiff = k["leg_stiffness"] * self.mass * self.g / self.athlete.leg_length
+        stiff = k["leg_stiffness"] * self.mass * self.g / self._leg_length
         damp = 2.0 * k["leg_damping"] * math.sqrt(stiff * self.mass)
         state = self.machine.current.name
         if self.step_stance:
@@ -700,10 +703,11 @@ class Runner:
     def _log(self, t: float, angles: F64) -> None:
         s = self.senses
         feet = int(s.foot_contact[0]) | (int(s.foot_contact[1]) << 1)
+        h = s.heading()
         self.log.rows.append((
-            t, s.com.copy(), s.com_vel.copy(), s.heading(),
+            t, s.com.copy(), s.com_vel.copy(), h,
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
             angles[self._hip_rows, 0], angles[self._knee_rows, 0], self.heading_d, self.cross_track,
-            self.trunk_euler()[0],
+            self.trunk_euler(h)[0],
         ))  # fmt: skip
