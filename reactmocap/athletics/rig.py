@@ -229,7 +229,7 @@ class Rig:
     # ------------------------------------------------------------------ targets
     def desired(self, t: float) -> F64:
         """``(15, 3)`` smoothed target angles at time ``t`` (without :attr:`offset`)."""
-        x = np.clip((t - self._t0) / self._dur, 0.0, 1.0)
+        x = np.minimum(np.maximum((t - self._t0) / self._dur, 0.0), 1.0)  # np.clip: 3x the cost
         s = np.where(self._accel, x * x, smoothstep(x))[:, None]
         return self._start + (self._goal - self._start) * s
 

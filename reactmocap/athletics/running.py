@@ -165,10 +165,14 @@ class Runner:
         child = [j + 1 for j in LEG_JOINTS]
         parent = [int(SIM_PARENTS[c]) for c in child]
         parts = sorted(set(child) | set(parent))
-        self._anat_bodies = [(int(wc.body_ids[b]), b) for b in parts]
-        self._leg_pairs = [(j, parts.index(p), parts.index(c))
+        # rows of MjData's and the buffer's arrays as views made once (indexing per tick
+        # cost as much as the products); the World keeps one MjData for its life
+        self._anat_buf = anat = np.empty((len(parts), 4))
+        xquat = world.data.xquat
+        self._anat_rows = [(anat[k], xquat[int(wc.body_ids[b])], self._neutral_conj[b])
+                           for k, b in enumerate(parts)]  # fmt: skip
+        self._leg_pairs = [(j, anat[parts.index(p)], anat[parts.index(c)])
                            for j, p, c in zip(LEG_JOINTS, parent, child)]  # fmt: skip
-        self._anat_buf = np.empty((len(parts), 4))
         self._q_inv = np.empty(4)
         self._q_rel = np.empty(4)
         self._angles = np.zeros((NJ, 3))
@@ -263,13 +267,12 @@ class Runner:
         of the ``(NJ, 3)`` angles (a buffer reused every tick), as :meth:`_joint_pitch`:
         MuJoCo's quaternion product on one quaternion at a time, since numpy's
         vectorised products and arctan2 differ from it in the last bits."""
-        xquat, anat, conj = self.world.data.xquat, self._anat_buf, self._neutral_conj
-        for k, (body, part) in enumerate(self._anat_bodies):
-            mujoco.mju_mulQuat(anat[k], xquat[body], conj[part])
+        for out, q, conj in self._anat_rows:
+            mujoco.mju_mulQuat(out, q, conj)
         inv, rel, angles = self._q_inv, self._q_rel, self._angles
         for j, p, c in self._leg_pairs:
-            mujoco.mju_negQuat(inv, anat[p])
-            mujoco.mju_mulQuat(rel, inv, anat[c])
+            mujoco.mju_negQuat(inv, p)
+            mujoco.mju_mulQuat(rel, inv, c)
             angles[j, 0] = pitch_yxz(rel)
         return angles
 
