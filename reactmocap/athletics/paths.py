@@ -156,7 +156,7 @@ class Polyline:
             idx = idx % n if self.closed else idx[idx < n]
             self._window = (self.index, idx, self.points[idx], self.seg[idx], self.len[idx] ** 2)
         _, idx, a, sv, len2 = self._window
-        u = np.clip(np.einsum("ij,ij->i", p - a, sv) / len2, 0.0, 1.0)
+        u = np.minimum(np.maximum(np.einsum("ij,ij->i", p - a, sv) / len2, 0.0), 1.0)  # clip
         q = a + u[:, None] * sv
         dist = np.hypot(*(p - q).T)
         j = int(np.argmin(dist))
