@@ -97,6 +97,7 @@ class Rig:
         self._start = np.zeros((NJ, 3))
         self._t0 = np.zeros(NJ)
         self._dur = np.ones(NJ)
+        self._jumped: float | None = None  # the time every joint last jumped to its goal
         self._accel = np.zeros(NJ, dtype=bool)  # joints on an accelerating (s^2) path
         self.offset = np.zeros((NJ, 3))
         self.stiffness = np.zeros(NJ)
@@ -163,6 +164,7 @@ class Rig:
         self._goal[:] = now
         self._t0[:] = 0.0
         self._dur[:] = 1e-9
+        self._jumped = None
         self.offset[:] = 0.0
         self.axis_gain[:] = 1.0
         self._sent_gain[:] = 1.0
@@ -229,6 +231,8 @@ class Rig:
     # ------------------------------------------------------------------ targets
     def desired(self, t: float) -> F64:
         """``(15, 3)`` smoothed target angles at time ``t`` (without :attr:`offset`)."""
+        if t == self._jumped:  # every path starts at t: s = 0 below, exactly
+            return self._start + (self._goal - self._start) * 0.0
         x = np.minimum(np.maximum((t - self._t0) / self._dur, 0.0), 1.0)  # np.clip: 3x the cost
         s = np.where(self._accel, x * x, smoothstep(x))[:, None]
         return self._start + (self._goal - self._start) * s
@@ -255,7 +259,9 @@ class Rig:
             self._t0[:] = t
             self._dur[:] = 1e-9
             self._accel[:] = accelerate
+            self._jumped = t
             return
+        self._jumped = None
         sel = np.ones(NJ, dtype=bool) if joints is None else np.zeros(NJ, dtype=bool)
         if joints is not None:
             sel[np.asarray(joints)] = True

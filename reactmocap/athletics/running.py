@@ -286,12 +286,15 @@ class Runner:
     def _contacts(self) -> None:
         """Which feet touch with their heel (rear corners) and toe (front corners)."""
         s = self.senses
-        z = s.sole_corners()[..., 2] - self.world.data.geom_xpos[s.floor][2]
-        near = z < CORNER_TOUCH
-        touch = s.foot_contact
-        self.toe[:] = touch & near[:, :2].any(axis=1)
-        self.heel[:] = touch & near[:, 2:].any(axis=1)
-        self.heel[touch & ~(self.toe | self.heel)] = True  # touching by an edge only
+        floor = float(self.world.data.geom_xpos[s.floor][2])
+        # floats: eight corners' numpy calls cost more than the comparisons
+        for k, (corners, touch) in enumerate(zip(s.sole_corners()[..., 2].tolist(),
+                                                 s.foot_contact.tolist())):  # fmt: skip
+            near = [z - floor < CORNER_TOUCH for z in corners]
+            toe = touch and (near[0] or near[1])
+            heel = touch and (near[2] or near[3])
+            self.toe[k] = toe
+            self.heel[k] = heel or (touch and not toe)  # touching by an edge only
 
     # ------------------------------------------------------------------ control laws
     def _placement(self, leg: int, heading: float) -> None:
