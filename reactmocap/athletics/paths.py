@@ -165,6 +165,10 @@ class Polyline:
         return i, float(self.cum[i] + u[j] * self.len[i]), side * float(dist[j])
 
     def point_at(self, s: float) -> F64:
+        return np.array(self._point(s))
+
+    def _point(self, s: float) -> tuple[float, float]:
+        """:meth:`point_at` as floats."""
         if self.closed:
             s = s % self.total
         # builtin min/max: np.clip on one number cost 20 us, four times a tick
@@ -172,7 +176,7 @@ class Polyline:
         i = min(max(bisect.bisect_right(self._cum, s) - 1, 0), len(self._len) - 1)
         u = (s - self._cum[i]) / self._len[i]
         (px, py), (sx, sy) = self._points[i], self._seg[i]
-        return np.array([px + u * sx, py + u * sy])
+        return px + u * sx, py + u * sy
 
     def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
         del t
@@ -182,19 +186,20 @@ class Polyline:
             self._laps += 1  # past the closing point into the next lap
         self.index = i
         self.progress = s + self._laps * self.total
-        target = self.point_at(s + self.lookahead)
+        # in floats from here (the same roundings as the arrays' without their calls)
+        tx, ty = self._point(s + self.lookahead)
         if not self.closed and s + self.lookahead > self.total:  # past the end: straight on
             d = self.points[-1] - self.points[-2]
-            target = p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead
-        d = target - p
+            tx, ty = (p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead).tolist()
+        px, py = p.tolist()
         # the curvature over the look-ahead: the turn between its two halves' chords (the
         # segments' own directions turn in steps, and the lean read from them jumped)
         half = 0.5 * self.lookahead
-        p0, p1, p2 = (self.point_at(s + f * half) for f in (0.0, 1.0, 2.0))
-        c0, c1 = p1 - p0, p2 - p1
-        turn = math.atan2(c0[0] * c1[1] - c0[1] * c1[0], float(c0 @ c1))
+        (x0, y0), (x1, y1), (x2, y2) = (self._point(s + f * half) for f in (0.0, 1.0, 2.0))
+        ax, ay, bx, by = x1 - x0, y1 - y0, x2 - x1, y2 - y1
+        turn = math.atan2(ax * by - ay * bx, ax * bx + ay * by)
         turn = 0.0 if abs(turn) < 1e-12 else turn  # a straight stretch: no rounding's lean
-        return math.atan2(d[1], d[0]), turn / half, cross
+        return math.atan2(ty - py, tx - px), turn / half, cross
 
 
 def Straight(heading: float = 0.0, start: ArrayLike = (0.0, 0.0)) -> Polyline:

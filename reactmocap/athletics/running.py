@@ -276,12 +276,10 @@ class Runner:
             angles[j, 0] = pitch_yxz(rel)
         return angles
 
-    def trunk_euler(self, heading: float | None = None) -> tuple[float, float, float]:
-        """Chest pitch, roll and yaw (anatomical, in the frame of ``heading``, default the
-        pelvis's, rad)."""
+    def trunk_euler(self) -> tuple[float, float, float]:
+        """Chest pitch, roll and yaw (anatomical, heading frame, rad)."""
         chest = SIM_BODY_INDEX["chest"]
-        h = self.heading() if heading is None else heading
-        return euler_yxz(qmul1(qyaw(-h), self._anat(self._chest, chest)))
+        return euler_yxz(qmul1(qyaw(-self.heading()), self._anat(self._chest, chest)))
 
     def _contacts(self) -> None:
         """Which feet touch with their heel (rear corners) and toe (front corners)."""
@@ -715,5 +713,5 @@ class Runner:
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
             angles[self._hip_rows, 0], angles[self._knee_rows, 0], self.heading_d, self.cross_track,
-            self.trunk_euler(h)[0],
+            self._pitch(self._chest, SIM_BODY_INDEX["chest"], h),  # trunk_euler's pitch
         ))  # fmt: skip
