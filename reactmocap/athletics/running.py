@@ -75,6 +75,8 @@ __all__ = [
     "running_start",
 ]
 
+#: the upper body's rows of the goals, in :meth:`Runner._upper`'s order
+_UPPER = (*SHOULDER, *ELBOW, *SPINE, NECK)
 #: the states of the active leg (Fig. 3)
 RUN_STATES = ("flight", "loading", "heel", "heel_toe", "toe", "unloading")
 #: a sole corner closer than this to the floor (m) counts as touching
@@ -302,13 +304,13 @@ class Runner:
         k = self.k
         d = self.world.data
         s = self.senses
-        v = s.com_vel[:2]
+        v = s.com_vel[:2].tolist()  # floats: the same roundings as numpy's scalars, faster
         hd = self.heading_d
         # on a curve the desired velocity is the one a moment ahead, turned into the curve
         # (the centripetal acceleration's feed-forward): without it the velocity lagged the
         # facing by up to 0.1 rad and the stances were irregular
         lead = hd + k["turn_lead"] * self.speed * self.curvature
-        vd = self.speed * np.array([math.cos(lead), math.sin(lead)])
+        vd = (self.speed * math.cos(lead), self.speed * math.sin(lead))
         ts, lf = self.stance_estimate, self.foot_length
         x_hh = 0.5 * (ts * v[0] - math.cos(heading) * lf) + k["speed_gain"] * (v[0] - vd[0])
         y_hh = 0.5 * (ts * v[1] - math.sin(heading) * lf) + k["speed_gain"] * (v[1] - vd[1])
@@ -320,8 +322,9 @@ class Runner:
         # apart, rather than under the hip joint 8 cm to the side (runners land near the
         # midline); the hip-to-heel vector follows from where the hip is now
         c, sn = math.cos(heading), math.sin(heading)
-        hip = d.xanchor[self._hips[leg]]
-        off = np.array([x_hh, y_hh]) + s.com[:2] - hip[:2]
+        hip = d.xanchor[self._hips[leg]].tolist()
+        com = s.com.tolist()
+        off = (x_hh + com[0] - hip[0], y_hh + com[1] - hip[1])
         fwd = c * off[0] + sn * off[1]
         lat = -sn * off[0] + c * off[1] + (0.5 if leg == 0 else -0.5) * k["step_width"]
         # ground-speed matching: the foot reaches further forward while it is high and comes
@@ -368,20 +371,19 @@ class Runner:
             late = clamp(2.0 * prog - 1.0, 0.0, 1.0)
             knee += (k["reach_knee"] - k["idle_knee"]) * late * late * (3.0 - 2.0 * late)
         hip = clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
-        self.goal[HIP[i]] = (hip, 0.03 * (1 - 2 * i), 0.0)
-        self.goal[KNEE[i]] = (knee, 0.0, 0.0)
-        self.goal[ANKLE[i]] = (-0.15, 0.0, 0.0)
+        # one write for the leg's three rows (each row's write cost as much as its law)
+        self.goal[(HIP[i], KNEE[i], ANKLE[i]),] = ((hip, 0.03 * (1 - 2 * i), 0.0),
+                                                   (knee, 0.0, 0.0), (-0.15, 0.0, 0.0))  # fmt: skip
 
     def _upper(self, hips: F64) -> None:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
         k = self.k
-        for leg in range(2):
-            self.goal[SHOULDER[leg]] = (k["arm_gain"] * hips[1 - leg] + k["arm_offset"],
-                                         0.15 * (1 - 2 * leg), 0.0)  # fmt: skip
-            self.goal[ELBOW[leg]] = (-k["elbow"], 0.0, 0.0)
-        for j in SPINE:
-            self.goal[j] = 0.0
-        self.goal[NECK] = (-0.1, 0.0, 0.0)
+        arm = (k["arm_gain"] * hips[::-1] + k["arm_offset"]).tolist()  # each opposite hip's
+        elbow = -k["elbow"]
+        # one write for the seven rows (each row's write cost as much as its law)
+        self.goal[_UPPER,] = ((arm[0], 0.15, 0.0), (arm[1], -0.15, 0.0), (elbow, 0.0, 0.0),
+                              (elbow, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
+                              (-0.1, 0.0, 0.0))  # fmt: skip
 
     def _attitude_torque(self, heading: float) -> F64:
         """World torque on the trunk that servos its attitude toward the desired roll (a

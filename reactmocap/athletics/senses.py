@@ -112,15 +112,16 @@ class Senses:
                     point[k] = [q[0] + fn * px, q[1] + fn * py, q[2] + fn * pz]
                 else:
                     others.add(SIM_BODIES[int(self._body[g])])
+        self.corners = sole_corners_world(d, self.soles, self._corners)
+        for k in range(2):
+            if force[k] > 0:
+                point[k] = [x / force[k] for x in point[k]]
         self.grf[:] = grf
         self.foot_contact[:] = touch
         self.foot_force[:] = force
         self.foot_point[:] = point
-        self.corners = sole_corners_world(d, self.soles, self._corners)
         for k in range(2):
-            if self.foot_force[k] > 0:
-                self.foot_point[k] /= self.foot_force[k]
-            elif self.foot_contact[k]:
+            if touch[k] and not force[k] > 0:
                 self.foot_point[k] = self.corners[k].mean(0)
         self.other_contact = tuple(sorted(others))
         rel = self.corners - d.geom_xpos[self.floor]
