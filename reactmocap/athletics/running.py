@@ -41,6 +41,7 @@ from reactmocap.athletics.running_body import (
     THIGH,
     clamp,
     euler_yxz,
+    norm,
     pitch_yxz,
     qconj1,
     qmul1,
@@ -420,14 +421,14 @@ class Runner:
             limit = min(limit, k["touchdown_limit"]) if limit > 0 else k["touchdown_limit"]
         if limit > 0:
             top = limit * self.mass * self.g * self._leg_length
-            size = float(np.linalg.norm(torque))
+            size = norm(torque)
             if size > top:
                 torque *= top / size
         # the part about the stance thigh's long axis only twists the leg against the foot's
         # grip on the ground: it stays within what the foot can hold, or the leg spins
         leg = self.active
         axis = d.xanchor[self._knees[leg]] - d.xanchor[self._hips[leg]]
-        axis /= max(float(np.linalg.norm(axis)), 1e-9)
+        axis /= max(norm(axis), 1e-9)
         along = float(torque @ axis)
         limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
         return torque - (along - clamp(along, -limit, limit)) * axis
@@ -482,10 +483,10 @@ class Runner:
         k = self.k
         d = self.world.data
         hip = d.xanchor[self._hips[leg]]
-        length = float(np.linalg.norm(hip - d.xanchor[self._ankles[leg]]))
+        length = norm(hip - d.xanchor[self._ankles[leg]])
         point = self._support_point(t)
         line = hip - point
-        u = line / max(float(np.linalg.norm(line)), 1e-6)
+        u = line / max(norm(line), 1e-6)
         rate = (length - self.leg_prev) / dt if self.leg_prev > 0 else 0.0
         self.leg_prev = length
         stiff = k["leg_stiffness"] * self.mass * self.g / self._leg_length

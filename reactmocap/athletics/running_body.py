@@ -29,6 +29,7 @@ __all__ = [
     "SPINE",
     "THIGH",
     "clamp",
+    "norm",
     "euler_yxz",
     "pitch_yxz",
     "qconj1",
@@ -64,6 +65,12 @@ def qmul1(a: F64, b: F64) -> F64:
     out = np.empty(4)
     mujoco.mju_mulQuat(out, a, b)
     return out
+
+
+def norm(v: F64) -> float:
+    """Length of a vector: ``np.linalg.norm``'s own sum (``v.dot(v)``) and square root, to the
+    bit, without its checks (a third of a tick's vector lengths' cost)."""
+    return math.sqrt(v.dot(v))
 
 
 def clamp(x: float, lo: float, hi: float) -> float:
