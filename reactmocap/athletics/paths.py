@@ -161,8 +161,10 @@ class Polyline:
         dist = np.hypot(*(p - q).T)
         j = int(np.argmin(dist))
         i = int(idx[j])
-        side = float(np.sign(sv[j, 0] * (p[1] - q[j, 1]) - sv[j, 1] * (p[0] - q[j, 0])))
-        return i, float(self.cum[i] + u[j] * self.len[i]), side * float(dist[j])
+        # the closest point's side and distance in floats (numpy's scalars: the same values)
+        (sx, sy), (qx, qy), (px, py) = sv[j].tolist(), q[j].tolist(), p.tolist()
+        side = float(np.sign(sx * (py - qy) - sy * (px - qx)))
+        return i, self._cum[i] + float(u[j]) * self._len[i], side * float(dist[j])
 
     def point_at(self, s: float) -> F64:
         return np.array(self._point(s))

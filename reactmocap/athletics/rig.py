@@ -251,7 +251,7 @@ class Rig:
         both ends), or with ``accelerate`` a constant acceleration from rest that arrives at
         full speed (a push)."""
         goal = np.asarray(goal, dtype=np.float64)
-        if joints is None and np.ndim(duration) == 0 and duration <= 0.0:
+        if joints is None and isinstance(duration, (int, float)) and duration <= 0.0:
             # every joint jumps (the runner's tick): as below, without the masks
             new = np.where(np.isnan(goal), self._goal, goal)
             self._start[:] = new

@@ -5,6 +5,8 @@ touches the ground."""
 
 from __future__ import annotations
 
+import math
+
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
@@ -44,6 +46,7 @@ class Senses:
         self.leg_bodies = np.array([self._ids[f"{s}_{p}"] for p in ("thigh", "shin", "foot")
                                     for s in "lr"])  # fmt: skip
         self._own = world.geom_character == character
+        self._own_list = self._own.tolist()
         self._body = world.geom_body
         self._f6 = np.zeros(6)
         self._forward = _axis_in_body(athlete, np.array([1.0, 0.0, 0.0]))
@@ -89,9 +92,10 @@ class Senses:
             # the contact arrays' views made once (each attribute read makes a new one)
             con = d.contact
             geoms, frames, points = con.geom[:n], con.frame, con.pos
-            hit = np.flatnonzero((geoms == self.floor).any(axis=1) & self._own[geoms].any(axis=1))
-            f6 = self._f6
-            for i, (g1, g2) in zip(hit.tolist(), geoms[hit].tolist()):
+            floor, own, f6 = self.floor, self._own_list, self._f6
+            for i, (g1, g2) in enumerate(geoms.tolist()):
+                if not ((g1 == floor or g2 == floor) and (own[g1] or own[g2])):
+                    continue  # not this character on the floor
                 g = g2 if g1 == self.floor else g1
                 mujoco.mj_contactForce(m, d, i, f6)
                 # world force on geom2 from geom1: the contact frame's rows^T f
@@ -142,8 +146,8 @@ class Senses:
     def heading(self) -> float:
         """Heading (rad about +Z) of the pelvis's anatomical forward axis."""
         d = self.world.data
-        fwd = d.xmat[self.root].reshape(3, 3) @ self._forward
-        return float(np.arctan2(fwd[1], fwd[0]))
+        x, y, _ = (d.xmat[self.root].reshape(3, 3) @ self._forward).tolist()
+        return math.atan2(y, x)  # np.arctan2's value, without a ufunc call on two scalars
 
     def side_axis(self) -> F64:
         """The pelvis's anatomical left-right axis (world, unit; left > 0): the axis a
