@@ -113,8 +113,10 @@ class Rig:
         self._up = up / max(float(np.linalg.norm(up)), 1e-12)
         self._weight = m.body_subtreemass[self._child] * g  # (15,) N
         # each subtree's weight up (15, 3) and its columns as the cross product takes them
+        # (index arrays made once: a list index is converted at every use)
         w = self._weight[:, None] * self._up
-        self._w_201, self._w_120 = w[:, [2, 0, 1]], w[:, [1, 2, 0]]
+        self._c120, self._c201 = np.array([1, 2, 0]), np.array([2, 0, 1])
+        self._w_201, self._w_120 = w[:, self._c201], w[:, self._c120]
         self._weight_n = self.mass * g
         self._tau = np.zeros((NJ, 3))
         self._jacp = np.zeros((3, m.nv))
@@ -300,7 +302,7 @@ class Rig:
         m, d = self.world.model, self.world.data
         # each joint holds its subtree up: (subtree com - anchor) x (weight up), child frame
         r = d.subtree_com[self._child] - d.xanchor[self._balls]
-        tau = r[:, [1, 2, 0]] * self._w_201 - r[:, [2, 0, 1]] * self._w_120  # r x w
+        tau = r.take(self._c120, 1) * self._w_201 - r.take(self._c201, 1) * self._w_120  # r x w
         rot = d.xmat[self._child].reshape(NJ, 3, 3)
         self.feedforward[:] = np.einsum("nji,nj->ni", rot, tau)
         flat = self.feedforward.reshape(-1)

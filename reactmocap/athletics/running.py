@@ -76,8 +76,10 @@ __all__ = [
     "running_start",
 ]
 
-#: the upper body's rows of the goals, in :meth:`Runner._upper`'s order
-_UPPER = (*SHOULDER, *ELBOW, *SPINE, NECK)
+#: the upper body's rows of the goals, in :meth:`Runner._upper`'s order, and each idle leg's
+#: (hip, knee, ankle) rows (index arrays: a tuple index is converted at every use)
+_UPPER = np.array((*SHOULDER, *ELBOW, *SPINE, NECK))
+_LEG_ROWS = tuple(np.array((HIP[i], KNEE[i], ANKLE[i])) for i in range(2))
 #: the states of the active leg (Fig. 3)
 RUN_STATES = ("flight", "loading", "heel", "heel_toe", "toe", "unloading")
 #: a sole corner closer than this to the floor (m) counts as touching
@@ -373,8 +375,8 @@ class Runner:
             knee += (k["reach_knee"] - k["idle_knee"]) * late * late * (3.0 - 2.0 * late)
         hip = clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
         # one write for the leg's three rows (each row's write cost as much as its law)
-        self.goal[(HIP[i], KNEE[i], ANKLE[i]),] = ((hip, 0.03 * (1 - 2 * i), 0.0),
-                                                   (knee, 0.0, 0.0), (-0.15, 0.0, 0.0))  # fmt: skip
+        self.goal[_LEG_ROWS[i]] = ((hip, 0.03 * (1 - 2 * i), 0.0), (knee, 0.0, 0.0),
+                                   (-0.15, 0.0, 0.0))  # fmt: skip
 
     def _upper(self, hips: F64) -> None:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
@@ -382,9 +384,9 @@ class Runner:
         arm = (k["arm_gain"] * hips[::-1] + k["arm_offset"]).tolist()  # each opposite hip's
         elbow = -k["elbow"]
         # one write for the seven rows (each row's write cost as much as its law)
-        self.goal[_UPPER,] = ((arm[0], 0.15, 0.0), (arm[1], -0.15, 0.0), (elbow, 0.0, 0.0),
-                              (elbow, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
-                              (-0.1, 0.0, 0.0))  # fmt: skip
+        self.goal[_UPPER] = ((arm[0], 0.15, 0.0), (arm[1], -0.15, 0.0), (elbow, 0.0, 0.0),
+                             (elbow, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
+                             (-0.1, 0.0, 0.0))  # fmt: skip
 
     def _attitude_torque(self, heading: float) -> F64:
         """World torque on the trunk that servos its attitude toward the desired roll (a
