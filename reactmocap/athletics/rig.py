@@ -290,7 +290,7 @@ class Rig:
         angles = self.desired(t) + self.offset
         self.servo.set_targets(self.character, self.athlete.joint_quats(angles))
         np.not_equal(self.axis_gain, self._sent_gain, out=self._gain_changed)
-        if self._gain_changed.any():
+        if np.logical_or.reduce(self._gain_changed, axis=None):  # .any(): a Python call more
             self.servo.set_axis_gains(self.character, self._axes, self.axis_gain)
             self._sent_gain[:] = self.axis_gain
         if self.gravity_compensation:

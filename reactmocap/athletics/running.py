@@ -691,7 +691,8 @@ class Runner:
         heading = self.heading_d if self.p_frame else self.heading()
         angles = self._leg_pitches()
         self._idle(t, heading)
-        self._upper(angles[self._hip_rows, 0])
+        hips = angles[self._hip_rows, 0]
+        self._upper(hips)
         # eq. 6: the targets move smoothly toward the goals (first order, time constant)
         dt = self.control_every * self._timestep
         smoothing = self.k["smoothing"]
@@ -707,9 +708,9 @@ class Runner:
             rot = world.data.xmat[self._thighs[self.active]].reshape(3, 3)
             rig.feedforward[HIP[self.active]] = -rot.T @ self._attitude_torque(heading)
             self._leg_spring(t, dt, angles)
-        self._log(t, angles)
+        self._log(t, angles, hips)
 
-    def _log(self, t: float, angles: F64) -> None:
+    def _log(self, t: float, angles: F64, hips: F64) -> None:
         s = self.senses
         feet = int(s.foot_contact[0]) | (int(s.foot_contact[1]) << 1)
         h = s.heading()
@@ -717,6 +718,6 @@ class Runner:
             t, s.com.copy(), s.com_vel.copy(), h,
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
-            angles[self._hip_rows, 0], angles[self._knee_rows, 0], self.heading_d, self.cross_track,
+            hips, angles[self._knee_rows, 0], self.heading_d, self.cross_track,
             self._pitch(self._chest, SIM_BODY_INDEX["chest"], h),  # trunk_euler's pitch
         ))  # fmt: skip

@@ -343,11 +343,12 @@ class PDServo:
         base = self._base(character)
         sl = slice(base, base + NJ)  # every control tick: no fancy indexing
         q = np.asarray(quats, dtype=np.float64).reshape(NJ, 4)
-        if not np.isfinite(q).all():
+        # the reductions themselves: ndarray.all/any add a Python call each, every tick
+        if not np.logical_and.reduce(np.isfinite(q), axis=None):
             raise SimulationError("PD targets contain NaN or inf")
         q = q / np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
         keep = self._frozen[sl]
-        if keep.any():
+        if np.logical_or.reduce(keep):
             q = np.where(keep[:, None], self.targets[sl], q)
         self.targets[sl] = q
         np.multiply(q[:, _RIDX], _RSIGN, out=self._rd[sl])
