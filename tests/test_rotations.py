@@ -168,7 +168,48 @@ def test_other_input_is_computed_in_float64() -> None:
     mixed = quat_mul(np.float32([1, 0, 0, 0]), np.array([0.0, 1.0, 0.0, 0.0]))
     assert mixed.dtype == np.float64
     assert quat_to_matrix(np.float16([1, 0, 0, 0])).dtype == np.float64
-    assert quat_from_euler(np.float32([0.1, 0.2, 0.3]), "ZXY").dtype == np.float64  # scipy
+    assert quat_from_euler(np.float32([0.1, 0.2, 0.3]), "ZXY").dtype == np.float64  # always
+
+
+_EULER_ORDERS = [a + b + c for a in "XYZ" for b in "XYZ" for c in "XYZ" if a != b and b != c]
+
+
+@pytest.mark.parametrize("order", _EULER_ORDERS)
+def test_euler_equals_scipy_to_the_bit(order: str) -> None:
+    # numpy's own product of the elementary rotations (the control ticks' converter) gives
+    # scipy's Rotation.from_euler values exactly: the simulated motions stay bit-identical
+    rng = np.random.default_rng(len(order) + sum(map(ord, order)))
+    angles = rng.uniform(-4.0, 4.0, (3000, 3)) * rng.choice([1e-3, 1.0, 10.0], (3000, 1))
+    angles[:100] = 0.0
+    angles[100:200, 1] = 0.0
+    angles[200:300, 0] = np.pi
+    expected = Rotation.from_euler(order, angles).as_quat(scalar_first=True)
+    np.testing.assert_array_equal(quat_from_euler(angles, order), expected)
+    np.testing.assert_array_equal(quat_from_euler(angles, order.lower()), expected)
+    assert quat_from_euler(angles[0], order).shape == (4,)
+    assert quat_from_euler(angles[:10].reshape(2, 5, 3), order).shape == (2, 5, 4)
+
+
+@pytest.mark.parametrize("order", ["XY", "XXY", "XYZX", "XYW"])
+def test_euler_order_must_be_three_axes(order: str) -> None:
+    with pytest.raises(ValueError, match="Euler order"):
+        quat_from_euler([0.1, 0.2, 0.3], order)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_small_mul_equals_the_large_form_to_the_bit(dtype: type) -> None:
+    # quat_mul's small-array form (4 numpy calls) sums the same products in the same order as
+    # its component form (zeros' signs included): the control ticks stay bit-identical
+    a, b = _random_quats(2000, 3).astype(dtype), _random_quats(2000, 4).astype(dtype)
+    a[:300, 1] = 0.0
+    b[200:500, 2] = -0.0
+    large = quat_mul(a, b)  # 16000 entries: the component form
+    small = np.concatenate([quat_mul(a[i : i + 16], b[i : i + 16]) for i in range(0, 2000, 16)])
+    assert small.dtype == large.dtype == dtype
+    np.testing.assert_array_equal(small, large)
+    np.testing.assert_array_equal(np.signbit(small), np.signbit(large))
+    one = quat_mul(a[5], b[:7])  # broadcasting one against several, against the large form
+    np.testing.assert_array_equal(one, quat_mul(np.tile(a[5], (2000, 1)), b)[:7])
 
 
 def test_slerp_path_follows_a_spin_past_half_a_turn_where_framewise_slerp_jumps() -> None:

@@ -7,6 +7,7 @@ runner is left of the path; NaN without a path)."""
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -127,6 +128,12 @@ class Polyline:
         self.seg = np.diff(self.points, axis=0)
         self.len = np.hypot(self.seg[:, 0], self.seg[:, 1])
         self.cum = np.concatenate([[0.0], np.cumsum(self.len)])
+        # as lists for point_at's one point (bisect for np.searchsorted, floats for numpy's
+        # scalars: the same comparisons and roundings at a tenth of the cost)
+        self._cum, self._len = self.cum.tolist(), self.len.tolist()
+        self._points, self._seg = self.points.tolist(), self.seg.tolist()
+        #: the search window of _closest for the segment it was made at
+        self._window: tuple[int, NDArray[np.intp], F64, F64, F64] | None = None
         self.closed = closed
         self.lookahead = float(lookahead)
         self.total = float(self.cum[-1])
@@ -141,34 +148,37 @@ class Polyline:
     def _closest(self, p: F64) -> tuple[int, float, float]:
         """Segment, arc length and signed distance of the closest point, searched a window
         ahead of the current segment."""
-        n = len(self.len)
-        span = max(
-            4,
-            int(np.searchsorted(self.cum, self.cum[self.index] + 2 * self.lookahead)) - self.index,
-        )
-        idx = np.arange(self.index, self.index + span + 1)
-        if self.closed:
-            idx = idx % n
-        else:
-            idx = idx[idx < n]
-        a = self.points[idx]
-        sv = self.seg[idx]
-        u = np.clip(np.einsum("ij,ij->i", p - a, sv) / self.len[idx] ** 2, 0.0, 1.0)
+        if self._window is None or self._window[0] != self.index:
+            # the window's segments change only when the runner passes on to the next one
+            n = len(self.len)
+            end = bisect.bisect_left(self._cum, self._cum[self.index] + 2 * self.lookahead)
+            idx = np.arange(self.index, self.index + max(4, end - self.index) + 1)
+            idx = idx % n if self.closed else idx[idx < n]
+            self._window = (self.index, idx, self.points[idx], self.seg[idx], self.len[idx] ** 2)
+        _, idx, a, sv, len2 = self._window
+        u = np.minimum(np.maximum(np.einsum("ij,ij->i", p - a, sv) / len2, 0.0), 1.0)  # clip
         q = a + u[:, None] * sv
         dist = np.hypot(*(p - q).T)
         j = int(np.argmin(dist))
         i = int(idx[j])
-        side = float(np.sign(sv[j, 0] * (p[1] - q[j, 1]) - sv[j, 1] * (p[0] - q[j, 0])))
-        return i, float(self.cum[i] + u[j] * self.len[i]), side * float(dist[j])
+        # the closest point's side and distance in floats (numpy's scalars: the same values)
+        (sx, sy), (qx, qy), (px, py) = sv[j].tolist(), q[j].tolist(), p.tolist()
+        side = float(np.sign(sx * (py - qy) - sy * (px - qx)))
+        return i, self._cum[i] + float(u[j]) * self._len[i], side * float(dist[j])
 
     def point_at(self, s: float) -> F64:
+        return np.array(self._point(s))
+
+    def _point(self, s: float) -> tuple[float, float]:
+        """:meth:`point_at` as floats."""
         if self.closed:
             s = s % self.total
         # builtin min/max: np.clip on one number cost 20 us, four times a tick
         s = float(min(max(s, 0.0), self.total))
-        i = min(max(int(np.searchsorted(self.cum, s, side="right")) - 1, 0), len(self.len) - 1)
-        u = (s - self.cum[i]) / self.len[i]
-        return self.points[i] + u * self.seg[i]
+        i = min(max(bisect.bisect_right(self._cum, s) - 1, 0), len(self._len) - 1)
+        u = (s - self._cum[i]) / self._len[i]
+        (px, py), (sx, sy) = self._points[i], self._seg[i]
+        return px + u * sx, py + u * sy
 
     def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
         del t
@@ -178,19 +188,20 @@ class Polyline:
             self._laps += 1  # past the closing point into the next lap
         self.index = i
         self.progress = s + self._laps * self.total
-        target = self.point_at(s + self.lookahead)
+        # in floats from here (the same roundings as the arrays' without their calls)
+        tx, ty = self._point(s + self.lookahead)
         if not self.closed and s + self.lookahead > self.total:  # past the end: straight on
             d = self.points[-1] - self.points[-2]
-            target = p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead
-        d = target - p
+            tx, ty = (p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead).tolist()
+        px, py = p.tolist()
         # the curvature over the look-ahead: the turn between its two halves' chords (the
         # segments' own directions turn in steps, and the lean read from them jumped)
         half = 0.5 * self.lookahead
-        p0, p1, p2 = (self.point_at(s + f * half) for f in (0.0, 1.0, 2.0))
-        c0, c1 = p1 - p0, p2 - p1
-        turn = math.atan2(c0[0] * c1[1] - c0[1] * c1[0], float(c0 @ c1))
+        (x0, y0), (x1, y1), (x2, y2) = (self._point(s + f * half) for f in (0.0, 1.0, 2.0))
+        ax, ay, bx, by = x1 - x0, y1 - y0, x2 - x1, y2 - y1
+        turn = math.atan2(ax * by - ay * bx, ax * bx + ay * by)
         turn = 0.0 if abs(turn) < 1e-12 else turn  # a straight stretch: no rounding's lean
-        return math.atan2(d[1], d[0]), turn / half, cross
+        return math.atan2(ty - py, tx - px), turn / half, cross
 
 
 def Straight(heading: float = 0.0, start: ArrayLike = (0.0, 0.0)) -> Polyline:

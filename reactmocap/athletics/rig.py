@@ -97,6 +97,7 @@ class Rig:
         self._start = np.zeros((NJ, 3))
         self._t0 = np.zeros(NJ)
         self._dur = np.ones(NJ)
+        self._jumped: float | None = None  # the time every joint last jumped to its goal
         self._accel = np.zeros(NJ, dtype=bool)  # joints on an accelerating (s^2) path
         self.offset = np.zeros((NJ, 3))
         self.stiffness = np.zeros(NJ)
@@ -111,6 +112,11 @@ class Rig:
         up = -np.asarray(m.opt.gravity, dtype=np.float64)
         self._up = up / max(float(np.linalg.norm(up)), 1e-12)
         self._weight = m.body_subtreemass[self._child] * g  # (15,) N
+        # each subtree's weight up (15, 3) and its columns as the cross product takes them
+        # (index arrays made once: a list index is converted at every use)
+        w = self._weight[:, None] * self._up
+        self._c120, self._c201 = np.array([1, 2, 0]), np.array([2, 0, 1])
+        self._w_201, self._w_120 = w[:, self._c201], w[:, self._c120]
         self._weight_n = self.mass * g
         self._tau = np.zeros((NJ, 3))
         self._jacp = np.zeros((3, m.nv))
@@ -160,6 +166,7 @@ class Rig:
         self._goal[:] = now
         self._t0[:] = 0.0
         self._dur[:] = 1e-9
+        self._jumped = None
         self.offset[:] = 0.0
         self.axis_gain[:] = 1.0
         self._sent_gain[:] = 1.0
@@ -200,11 +207,8 @@ class Rig:
         on = values > 0
         self.servo.enable(self.character, [BALL_JOINTS[i] for i in np.flatnonzero(~on)], False)
         self.servo.enable(self.character, [BALL_JOINTS[i] for i in np.flatnonzero(on)], True)
-        for i in np.flatnonzero(on):
-            k = values[i] * self.stiffness_unit
-            self.servo.set_gain_scale(
-                self.character, [BALL_JOINTS[i]], k / (SERVO_KP * scale_inertia[i])
-            )
+        scale = values * self.stiffness_unit / (SERVO_KP * scale_inertia)
+        self.servo.set_gain_scales(self.character, np.where(on, scale, np.nan))
         self._kp[:] = np.where(on, values * self.stiffness_unit / scale_inertia, 0.0)
         self.stiffness[:] = values
 
@@ -229,7 +233,9 @@ class Rig:
     # ------------------------------------------------------------------ targets
     def desired(self, t: float) -> F64:
         """``(15, 3)`` smoothed target angles at time ``t`` (without :attr:`offset`)."""
-        x = np.clip((t - self._t0) / self._dur, 0.0, 1.0)
+        if t == self._jumped:  # every path starts at t: s = 0 below, exactly
+            return self._start + (self._goal - self._start) * 0.0
+        x = np.minimum(np.maximum((t - self._t0) / self._dur, 0.0), 1.0)  # np.clip: 3x the cost
         s = np.where(self._accel, x * x, smoothstep(x))[:, None]
         return self._start + (self._goal - self._start) * s
 
@@ -247,14 +253,25 @@ class Rig:
         both ends), or with ``accelerate`` a constant acceleration from rest that arrives at
         full speed (a push)."""
         goal = np.asarray(goal, dtype=np.float64)
+        if joints is None and isinstance(duration, (int, float)) and duration <= 0.0:
+            # every joint jumps (the runner's tick): as below, without the masks
+            new = np.where(np.isnan(goal), self._goal, goal)
+            self._start[:] = new
+            self._goal[:] = new
+            self._t0[:] = t
+            self._dur[:] = 1e-9
+            self._accel[:] = accelerate
+            self._jumped = t
+            return
+        self._jumped = None
         sel = np.ones(NJ, dtype=bool) if joints is None else np.zeros(NJ, dtype=bool)
         if joints is not None:
             sel[np.asarray(joints)] = True
-        now = self.desired(t)
         dur = np.broadcast_to(np.asarray(duration, dtype=np.float64), (NJ,))
         new = np.where(np.isnan(goal), self._goal, goal)
         jump = sel & (dur <= 0.0)
-        self._start[sel] = now[sel]
+        if not np.array_equal(jump, sel):  # where the targets are now: only for a path
+            self._start[sel] = self.desired(t)[sel]
         self._start[jump] = new[jump]
         self._goal[sel] = new[sel]
         self._t0[sel] = t
@@ -273,7 +290,7 @@ class Rig:
         angles = self.desired(t) + self.offset
         self.servo.set_targets(self.character, self.athlete.joint_quats(angles))
         np.not_equal(self.axis_gain, self._sent_gain, out=self._gain_changed)
-        if self._gain_changed.any():
+        if np.logical_or.reduce(self._gain_changed, axis=None):  # .any(): a Python call more
             self.servo.set_axis_gains(self.character, self._axes, self.axis_gain)
             self._sent_gain[:] = self.axis_gain
         if self.gravity_compensation:
@@ -285,8 +302,7 @@ class Rig:
         m, d = self.world.model, self.world.data
         # each joint holds its subtree up: (subtree com - anchor) x (weight up), child frame
         r = d.subtree_com[self._child] - d.xanchor[self._balls]
-        w = self._weight[:, None] * self._up
-        tau = r[:, [1, 2, 0]] * w[:, [2, 0, 1]] - r[:, [2, 0, 1]] * w[:, [1, 2, 0]]  # r x w
+        tau = r.take(self._c120, 1) * self._w_201 - r.take(self._c201, 1) * self._w_120  # r x w
         rot = d.xmat[self._child].reshape(NJ, 3, 3)
         self.feedforward[:] = np.einsum("nji,nj->ni", rot, tau)
         flat = self.feedforward.reshape(-1)

@@ -41,6 +41,7 @@ from reactmocap.athletics.running_body import (
     THIGH,
     clamp,
     euler_yxz,
+    norm,
     pitch_yxz,
     qconj1,
     qmul1,
@@ -75,6 +76,10 @@ __all__ = [
     "running_start",
 ]
 
+#: the upper body's rows of the goals, in :meth:`Runner._upper`'s order, and each idle leg's
+#: (hip, knee, ankle) rows (index arrays: a tuple index is converted at every use)
+_UPPER = np.array((*SHOULDER, *ELBOW, *SPINE, NECK))
+_LEG_ROWS = tuple(np.array((HIP[i], KNEE[i], ANKLE[i])) for i in range(2))
 #: the states of the active leg (Fig. 3)
 RUN_STATES = ("flight", "loading", "heel", "heel_toe", "toe", "unloading")
 #: a sole corner closer than this to the floor (m) counts as touching
@@ -145,7 +150,8 @@ class Runner:
         m = world.model
         self.mass = self.rig.mass
         self.g = float(np.linalg.norm(m.opt.gravity))
-        self.inertia_unit = self.mass * athlete.leg_length**2
+        self._leg_length = athlete.leg_length  # a property: a mean at every read
+        self.inertia_unit = self.mass * self._leg_length**2
         self._hips = [m.joint(wc.prefix + f"{s}_hip").id for s in "lr"]
         self._knees = [m.joint(wc.prefix + f"{s}_knee").id for s in "lr"]
         self._ankles = [m.joint(wc.prefix + f"{s}_ankle").id for s in "lr"]
@@ -164,10 +170,14 @@ class Runner:
         child = [j + 1 for j in LEG_JOINTS]
         parent = [int(SIM_PARENTS[c]) for c in child]
         parts = sorted(set(child) | set(parent))
-        self._anat_bodies = [(int(wc.body_ids[b]), b) for b in parts]
-        self._leg_pairs = [(j, parts.index(p), parts.index(c))
+        # rows of MjData's and the buffer's arrays as views made once (indexing per tick
+        # cost as much as the products); the World keeps one MjData for its life
+        self._anat_buf = anat = np.empty((len(parts), 4))
+        xquat = world.data.xquat
+        self._anat_rows = [(anat[k], xquat[int(wc.body_ids[b])], self._neutral_conj[b])
+                           for k, b in enumerate(parts)]  # fmt: skip
+        self._leg_pairs = [(j, anat[parts.index(p)], anat[parts.index(c)])
                            for j, p, c in zip(LEG_JOINTS, parent, child)]  # fmt: skip
-        self._anat_buf = np.empty((len(parts), 4))
         self._q_inv = np.empty(4)
         self._q_rel = np.empty(4)
         self._angles = np.zeros((NJ, 3))
@@ -262,13 +272,12 @@ class Runner:
         of the ``(NJ, 3)`` angles (a buffer reused every tick), as :meth:`_joint_pitch`:
         MuJoCo's quaternion product on one quaternion at a time, since numpy's
         vectorised products and arctan2 differ from it in the last bits."""
-        xquat, anat, conj = self.world.data.xquat, self._anat_buf, self._neutral_conj
-        for k, (body, part) in enumerate(self._anat_bodies):
-            mujoco.mju_mulQuat(anat[k], xquat[body], conj[part])
+        for out, q, conj in self._anat_rows:
+            mujoco.mju_mulQuat(out, q, conj)
         inv, rel, angles = self._q_inv, self._q_rel, self._angles
         for j, p, c in self._leg_pairs:
-            mujoco.mju_negQuat(inv, anat[p])
-            mujoco.mju_mulQuat(rel, inv, anat[c])
+            mujoco.mju_negQuat(inv, p)
+            mujoco.mju_mulQuat(rel, inv, c)
             angles[j, 0] = pitch_yxz(rel)
         return angles
 
@@ -280,12 +289,15 @@ class Runner:
     def _contacts(self) -> None:
         """Which feet touch with their heel (rear corners) and toe (front corners)."""
         s = self.senses
-        z = s.sole_corners()[..., 2] - self.world.data.geom_xpos[s.floor][2]
-        near = z < CORNER_TOUCH
-        touch = s.foot_contact
-        self.toe[:] = touch & near[:, :2].any(axis=1)
-        self.heel[:] = touch & near[:, 2:].any(axis=1)
-        self.heel[touch & ~(self.toe | self.heel)] = True  # touching by an edge only
+        floor = float(self.world.data.geom_xpos[s.floor][2])
+        # floats: eight corners' numpy calls cost more than the comparisons
+        for k, (corners, touch) in enumerate(zip(s.sole_corners()[..., 2].tolist(),
+                                                 s.foot_contact.tolist())):  # fmt: skip
+            near = [z - floor < CORNER_TOUCH for z in corners]
+            toe = touch and (near[0] or near[1])
+            heel = touch and (near[2] or near[3])
+            self.toe[k] = toe
+            self.heel[k] = heel or (touch and not toe)  # touching by an edge only
 
     # ------------------------------------------------------------------ control laws
     def _placement(self, leg: int, heading: float) -> None:
@@ -295,13 +307,13 @@ class Runner:
         k = self.k
         d = self.world.data
         s = self.senses
-        v = s.com_vel[:2]
+        v = s.com_vel[:2].tolist()  # floats: the same roundings as numpy's scalars, faster
         hd = self.heading_d
         # on a curve the desired velocity is the one a moment ahead, turned into the curve
         # (the centripetal acceleration's feed-forward): without it the velocity lagged the
         # facing by up to 0.1 rad and the stances were irregular
         lead = hd + k["turn_lead"] * self.speed * self.curvature
-        vd = self.speed * np.array([math.cos(lead), math.sin(lead)])
+        vd = (self.speed * math.cos(lead), self.speed * math.sin(lead))
         ts, lf = self.stance_estimate, self.foot_length
         x_hh = 0.5 * (ts * v[0] - math.cos(heading) * lf) + k["speed_gain"] * (v[0] - vd[0])
         y_hh = 0.5 * (ts * v[1] - math.sin(heading) * lf) + k["speed_gain"] * (v[1] - vd[1])
@@ -313,8 +325,9 @@ class Runner:
         # apart, rather than under the hip joint 8 cm to the side (runners land near the
         # midline); the hip-to-heel vector follows from where the hip is now
         c, sn = math.cos(heading), math.sin(heading)
-        hip = d.xanchor[self._hips[leg]]
-        off = np.array([x_hh, y_hh]) + s.com[:2] - hip[:2]
+        hip = d.xanchor[self._hips[leg]].tolist()
+        com = s.com.tolist()
+        off = (x_hh + com[0] - hip[0], y_hh + com[1] - hip[1])
         fwd = c * off[0] + sn * off[1]
         lat = -sn * off[0] + c * off[1] + (0.5 if leg == 0 else -0.5) * k["step_width"]
         # ground-speed matching: the foot reaches further forward while it is high and comes
@@ -361,20 +374,19 @@ class Runner:
             late = clamp(2.0 * prog - 1.0, 0.0, 1.0)
             knee += (k["reach_knee"] - k["idle_knee"]) * late * late * (3.0 - 2.0 * late)
         hip = clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
-        self.goal[HIP[i]] = (hip, 0.03 * (1 - 2 * i), 0.0)
-        self.goal[KNEE[i]] = (knee, 0.0, 0.0)
-        self.goal[ANKLE[i]] = (-0.15, 0.0, 0.0)
+        # one write for the leg's three rows (each row's write cost as much as its law)
+        self.goal[_LEG_ROWS[i]] = ((hip, 0.03 * (1 - 2 * i), 0.0), (knee, 0.0, 0.0),
+                                   (-0.15, 0.0, 0.0))  # fmt: skip
 
     def _upper(self, hips: F64) -> None:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
         k = self.k
-        for leg in range(2):
-            self.goal[SHOULDER[leg]] = (k["arm_gain"] * hips[1 - leg] + k["arm_offset"],
-                                         0.15 * (1 - 2 * leg), 0.0)  # fmt: skip
-            self.goal[ELBOW[leg]] = (-k["elbow"], 0.0, 0.0)
-        for j in SPINE:
-            self.goal[j] = 0.0
-        self.goal[NECK] = (-0.1, 0.0, 0.0)
+        arm = (k["arm_gain"] * hips[::-1] + k["arm_offset"]).tolist()  # each opposite hip's
+        elbow = -k["elbow"]
+        # one write for the seven rows (each row's write cost as much as its law)
+        self.goal[_UPPER] = ((arm[0], 0.15, 0.0), (arm[1], -0.15, 0.0), (elbow, 0.0, 0.0),
+                             (elbow, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
+                             (-0.1, 0.0, 0.0))  # fmt: skip
 
     def _attitude_torque(self, heading: float) -> F64:
         """World torque on the trunk that servos its attitude toward the desired roll (a
@@ -410,15 +422,15 @@ class Runner:
             # and the foot bounced off (the turning runner's falls at 2.5 m/s)
             limit = min(limit, k["touchdown_limit"]) if limit > 0 else k["touchdown_limit"]
         if limit > 0:
-            top = limit * self.mass * self.g * self.athlete.leg_length
-            size = float(np.linalg.norm(torque))
+            top = limit * self.mass * self.g * self._leg_length
+            size = norm(torque)
             if size > top:
                 torque *= top / size
         # the part about the stance thigh's long axis only twists the leg against the foot's
         # grip on the ground: it stays within what the foot can hold, or the leg spins
         leg = self.active
         axis = d.xanchor[self._knees[leg]] - d.xanchor[self._hips[leg]]
-        axis /= max(float(np.linalg.norm(axis)), 1e-9)
+        axis /= max(norm(axis), 1e-9)
         along = float(torque @ axis)
         limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
         return torque - (along - clamp(along, -limit, limit)) * axis
@@ -473,13 +485,13 @@ class Runner:
         k = self.k
         d = self.world.data
         hip = d.xanchor[self._hips[leg]]
-        length = float(np.linalg.norm(hip - d.xanchor[self._ankles[leg]]))
+        length = norm(hip - d.xanchor[self._ankles[leg]])
         point = self._support_point(t)
         line = hip - point
-        u = line / max(float(np.linalg.norm(line)), 1e-6)
+        u = line / max(norm(line), 1e-6)
         rate = (length - self.leg_prev) / dt if self.leg_prev > 0 else 0.0
         self.leg_prev = length
-        stiff = k["leg_stiffness"] * self.mass * self.g / self.athlete.leg_length
+        stiff = k["leg_stiffness"] * self.mass * self.g / self._leg_length
         damp = 2.0 * k["leg_damping"] * math.sqrt(stiff * self.mass)
         state = self.machine.current.name
         if self.step_stance:
@@ -679,7 +691,8 @@ class Runner:
         heading = self.heading_d if self.p_frame else self.heading()
         angles = self._leg_pitches()
         self._idle(t, heading)
-        self._upper(angles[self._hip_rows, 0])
+        hips = angles[self._hip_rows, 0]
+        self._upper(hips)
         # eq. 6: the targets move smoothly toward the goals (first order, time constant)
         dt = self.control_every * self._timestep
         smoothing = self.k["smoothing"]
@@ -695,15 +708,16 @@ class Runner:
             rot = world.data.xmat[self._thighs[self.active]].reshape(3, 3)
             rig.feedforward[HIP[self.active]] = -rot.T @ self._attitude_torque(heading)
             self._leg_spring(t, dt, angles)
-        self._log(t, angles)
+        self._log(t, angles, hips)
 
-    def _log(self, t: float, angles: F64) -> None:
+    def _log(self, t: float, angles: F64, hips: F64) -> None:
         s = self.senses
         feet = int(s.foot_contact[0]) | (int(s.foot_contact[1]) << 1)
+        h = s.heading()
         self.log.rows.append((
-            t, s.com.copy(), s.com_vel.copy(), s.heading(),
+            t, s.com.copy(), s.com_vel.copy(), h,
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
-            angles[self._hip_rows, 0], angles[self._knee_rows, 0], self.heading_d, self.cross_track,
-            self.trunk_euler()[0],
+            hips, angles[self._knee_rows, 0], self.heading_d, self.cross_track,
+            self._pitch(self._chest, SIM_BODY_INDEX["chest"], h),  # trunk_euler's pitch
         ))  # fmt: skip

@@ -29,6 +29,7 @@ __all__ = [
     "SPINE",
     "THIGH",
     "clamp",
+    "norm",
     "euler_yxz",
     "pitch_yxz",
     "qconj1",
@@ -66,6 +67,12 @@ def qmul1(a: F64, b: F64) -> F64:
     return out
 
 
+def norm(v: F64) -> float:
+    """Length of a vector: ``np.linalg.norm``'s own sum (``v.dot(v)``) and square root, to the
+    bit, without its checks (a third of a tick's vector lengths' cost)."""
+    return math.sqrt(v.dot(v))
+
+
 def clamp(x: float, lo: float, hi: float) -> float:
     """``x`` within ``[lo, hi]``."""
     return float(min(max(x, lo), hi))
@@ -91,14 +98,14 @@ def quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
 
 def pitch_yxz(q: F64) -> float:
     """The pitch of :func:`euler_yxz` alone (what the leg joints' laws read)."""
-    w, x, y, z = q
+    w, x, y, z = q.tolist()  # floats: numpy scalars' arithmetic is 3x slower, same rounding
     return math.atan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y))
 
 
 def euler_yxz(q: F64) -> tuple[float, float, float]:
     """Intrinsic Y-X-Z Euler angles (pitch, roll, yaw) of a quaternion: with
     ``R = Ry Rx Rz``, pitch = atan2(R02, R22), roll = asin(-R12), yaw = atan2(R10, R11)."""
-    w, x, y, z = q
+    w, x, y, z = q.tolist()
     r12 = 2.0 * (y * z - w * x)
     r10 = 2.0 * (x * y + w * z)
     r11 = 1.0 - 2.0 * (x * x + z * z)

@@ -206,6 +206,21 @@ class PDServo:
         self._gain_scale[rows] = scale
         self._refresh_gains()
 
+    def set_gain_scales(self, character: int, scales: F64) -> None:
+        """:meth:`set_gain_scale` for each of one character's joints at once, ``scales``
+        ``(15,)``; NaN keeps a joint's scale. One gain refresh rather than one per joint."""
+        scales = np.asarray(scales, dtype=np.float64)
+        keep = np.isnan(scales)
+        if scales.shape != (NJ,) or not np.all(keep | (np.isfinite(scales) & (scales > 0))):
+            raise ConfigError(f"gain scales must be ({NJ},) positive numbers or NaN")
+        rows = self._rows(character, None)
+        old = self._gain_scale[rows]
+        new = np.where(keep, old, scales)
+        if np.array_equal(new, old):
+            return
+        self._gain_scale[rows] = new
+        self._refresh_gains()
+
     def _refresh_gains(self) -> None:
         scale = np.where(self._frozen, self.freeze_scale, 1.0) * self._gain_scale
         on = self._enabled | self._frozen
@@ -252,12 +267,16 @@ class PDServo:
         self._any_shaped = bool(self._shaped.any())
         self._dirty = True
 
-    def _rows(self, character: int, joints: Sequence[str] | None) -> NDArray[np.intp]:
+    def _base(self, character: int) -> int:
+        """The first of one character's rows."""
         if character not in self.character_indices:
             raise ConfigError(
                 f"character {character} is not driven by this servo {self.character_indices}"
             )
-        base = self.character_indices.index(character) * NJ
+        return self.character_indices.index(character) * NJ
+
+    def _rows(self, character: int, joints: Sequence[str] | None) -> NDArray[np.intp]:
+        base = self._base(character)
         if joints is None:
             return np.arange(base, base + NJ)
         rows = []
@@ -321,14 +340,15 @@ class PDServo:
     def set_targets(self, character: int, quats: F64) -> None:
         """Desired local rotations ``(15, 4)`` (wxyz, MuJoCo ball order) of one character.
         Frozen joints keep their clamp targets."""
-        rows = self._rows(character, None)
-        sl = slice(int(rows[0]), int(rows[0]) + NJ)  # every control tick: no fancy indexing
+        base = self._base(character)
+        sl = slice(base, base + NJ)  # every control tick: no fancy indexing
         q = np.asarray(quats, dtype=np.float64).reshape(NJ, 4)
-        if not np.isfinite(q).all():
+        # the reductions themselves: ndarray.all/any add a Python call each, every tick
+        if not np.logical_and.reduce(np.isfinite(q), axis=None):
             raise SimulationError("PD targets contain NaN or inf")
         q = q / np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
         keep = self._frozen[sl]
-        if keep.any():
+        if np.logical_or.reduce(keep):
             q = np.where(keep[:, None], self.targets[sl], q)
         self.targets[sl] = q
         np.multiply(q[:, _RIDX], _RSIGN, out=self._rd[sl])

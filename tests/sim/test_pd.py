@@ -383,3 +383,36 @@ def test_axis_gains_free_one_axis_and_keep_the_others(guard: Motion) -> None:
     assert np.array_equal(d.qfrc_actuator[servo.dof_indices].reshape(-1, 3), full)
     with pytest.raises(ConfigError, match=r"in \[0, 1\]"):
         servo.set_axis_gains(0, axes, np.full((NJ, 3), 1.5))
+
+
+def test_gain_scales_at_once_equal_one_joint_at_a_time(guard: Motion) -> None:
+    """set_gain_scales (one gain refresh, the athletic rigs' set_stiffness) leaves the
+    actuators and their torques as set_gain_scale joint by joint; NaN keeps a joint's scale."""
+    from reactmocap.errors import ConfigError
+    from reactmocap.sim.bodies import BALL_JOINTS
+
+    scales = np.linspace(0.5, 2.0, NJ)
+    kept = BALL_JOINTS.index("l_knee")
+    scales[kept] = np.nan
+    worlds = []
+    for at_once in (False, True):
+        world, servo = _random_world(guard, 1.0, 0)
+        servo.set_gain_scale(1, ["l_knee"], 3.0)
+        if at_once:
+            servo.set_gain_scales(1, scales)
+        else:
+            for j, scale in zip(BALL_JOINTS, scales):
+                if not np.isnan(scale):
+                    servo.set_gain_scale(1, [j], float(scale))
+        servo.refresh()
+        mujoco.mj_forward(world.model, world.data)
+        worlds.append(world)
+    one, both = worlds
+    for name in ("actuator_gainprm", "actuator_biasprm", "actuator_gear"):
+        np.testing.assert_array_equal(getattr(both.model, name), getattr(one.model, name))
+    np.testing.assert_array_equal(both.data.qfrc_actuator, one.data.qfrc_actuator)
+    assert both.servo._gain_scale[NJ + kept] == 3.0  # the NaN kept the knee's scale
+    with pytest.raises(ConfigError, match="gain scales"):
+        both.servo.set_gain_scales(1, np.zeros(NJ))
+    with pytest.raises(ConfigError, match="gain scales"):
+        both.servo.set_gain_scales(1, np.ones(3))
