@@ -69,13 +69,14 @@ SETTLE_SECONDS = 2.7
 #: :data:`SETTLE_SECONDS` more (8.2, as ``back_somersault.toml``)
 SOMERSAULT_SECONDS = MappingProxyType({"after": 5.5, "settled": 5.5 + SETTLE_SECONDS})
 #: the :data:`SOMERSAULT_PRESETS` entries (``body/key``) that do not start from
-#: :data:`SETTLED_START`, and their start. The male forward tuck still leaps 0.3 s into the
-#: start: settled first, it sinks its landing's crouch 3 mm further, below the fall line, and
-#: falls (the twisting presets keep the timed start too: settled, the full twist's perturbed
-#: starts landed 0 of 29 at full size, against 2/50: docs/athletics.md, 2026-12-02). The female
-#: backward presets settle with the standing gains (:data:`SETTLED_START_STANDING`).
+#: :data:`SETTLED_START`, and their start (the twisting presets keep the timed start: settled,
+#: the full twist's perturbed starts landed 0 of 29 at full size, against 2/50:
+#: docs/athletics.md, 2026-12-02). The female backward presets and, since 2026-12-05, the male
+#: forward tuck settle with the standing gains (:data:`SETTLED_START_STANDING`): leaping 0.3 s
+#: into the start, 7 of the tuck's 16 full-size failures (seed 0) crouched on one foot, and
+#: starts with the COM 7-10 cm behind the feet fell backward settling under the ankles alone.
 PRESET_STARTS: Mapping[str, Phase] = MappingProxyType({
-    "male/forward": TIMED_START, "female/backward": SETTLED_START_STANDING,
+    "male/forward": SETTLED_START_STANDING, "female/backward": SETTLED_START_STANDING,
 })  # fmt: skip
 #: the built-in somersaults, tuned by hand (as the thesis's, section 8.4) per body:
 #: body -> ``direction`` or ``direction/position`` -> (leap, tumble, landing parameters); a

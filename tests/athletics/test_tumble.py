@@ -32,6 +32,7 @@ from reactmocap.athletics.routines import (
     DIVE_PIKE_HIP,
     SETTLED_START,
     SETTLED_START_STANDING,
+    SOMERSAULT_SECONDS,
     TIMED_START,
     dive_maneuver,
     somersault,
@@ -249,13 +250,39 @@ def _with_land_params(m: Maneuver, params: Mapping[str, Any]) -> Maneuver:
     )
 
 
+def _forward_timed() -> Maneuver:
+    """The forward preset leaping 0.3 s into the start (:data:`TIMED_START`, 5.5 s), as
+    before 2026-12-05 (since then it settles first, :data:`SETTLED_START_STANDING`): the
+    tests of the leap's and the landing's options below were written on starts whose outcome
+    the settled start changes."""
+    m = somersault_maneuver(direction="forward")
+    return replace(m, phases=(TIMED_START, *m.phases[1:]), seconds=SOMERSAULT_SECONDS["after"])
+
+
 def _forward_hold_015() -> Maneuver:
     """The forward preset with its crouch's hold at 0.15 s, as before 2026-12-03 22:45 UTC
-    (since then 0.25): the tests of the push's and the landing's options below were
-    written on starts whose outcome the longer hold changes."""
-    m = somersault_maneuver(direction="forward")
+    (since then 0.25), from the timed start (:func:`_forward_timed`): the tests of the push's
+    and the landing's options below were written on starts whose outcome the longer hold
+    changes."""
+    m = _forward_timed()
     leap = replace(m.phases[1], params={**m.phases[1].params, "hold": 0.15})
     return replace(m, phases=(m.phases[0], leap, *m.phases[2:]))
+
+
+def test_a_perturbed_forward_tuck_settles_onto_both_feet_before_the_crouch() -> None:
+    """Start 12 of the capture region at full size (seed 0): leaping 0.3 s into the start
+    (:func:`_forward_timed`), it crouched on one foot (fewer than two down 98% of the crouch
+    and hold), took off with -12.6 kg m^2/s of roll and fell forward 0.78 s after touchdown.
+    The preset's start since 2026-12-05 (:data:`SETTLED_START_STANDING`) settles it onto both
+    feet first: it leaps later and lands (docs/athletics.md, "Forward tuck: a census of the
+    full-size failures")."""
+    start = full_starts(13)[12]
+    m = somersault_maneuver(direction="forward")
+    assert m.phases[0] == SETTLED_START_STANDING
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+    before = run_maneuver(_forward_timed(), perturbation=start, fps=10.0).report
+    assert not before["landed"] and before["time_to_liftoff_s"] < r["time_to_liftoff_s"]
 
 
 def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> None:
@@ -558,7 +585,8 @@ def test_the_female_back_somersault_file_is_the_preset() -> None:
 def test_the_somersault_command_leaps_from_a_settled_start_as_the_files_do() -> None:
     """The command's presets start as ``back_somersault.toml`` does (since 2026-12-02): the
     start settled onto both feet (:data:`SETTLED_START`) before the leap, not 0.3 s into it.
-    The male forward tuck and the full twist keep the timed start (:data:`PRESET_STARTS`).
+    The full twist keeps the timed start (:data:`PRESET_STARTS`); the male forward tuck settles
+    with the standing gains since 2026-12-05.
     Start 4 of the full-size starts (seed 0) left the timed start moving back at 1.1 m/s and
     fell after touchdown; settled first it lands."""
     maneuvers = Path(__file__).parents[2] / "examples" / "athletics" / "maneuvers"
@@ -571,12 +599,11 @@ def test_the_somersault_command_leaps_from_a_settled_start_as_the_files_do() -> 
     assert m.seconds == load_maneuver(maneuvers / "back_somersault.toml").seconds
     for built in (m, somersault_maneuver("pike"), somersault_maneuver("layout")):
         assert built.phases[0] == SETTLED_START, built.name
-    female = somersault_maneuver(body="female")  # the same, with the standing gains
-    assert female.phases[0] == SETTLED_START_STANDING
-    assert replace(female.phases[0], params={"plant": True}) == SETTLED_START
-    for built in (somersault_maneuver(direction="forward"),
-                  somersault_maneuver("layout", twist=1.0)):  # fmt: skip
-        assert built.phases[0] == TIMED_START, built.name
+    for built in (somersault_maneuver(body="female"), somersault_maneuver(direction="forward")):
+        assert built.phases[0] == SETTLED_START_STANDING, built.name  # with the standing gains
+        assert built.seconds == m.seconds, built.name
+    assert replace(SETTLED_START_STANDING, params={"plant": True}) == SETTLED_START
+    assert somersault_maneuver("layout", twist=1.0).phases[0] == TIMED_START
     start = full_starts(5)[4]
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
@@ -747,7 +774,7 @@ def test_a_perturbed_forward_tuck_crouches_onto_both_feet_with_crouch_plant() ->
     docs/athletics.md) aims the crouch's COM at both soles' middle and brings the hanging
     foot down: both feet carry weight at the thrust and it lands."""
     start = full_starts(13)[12]
-    m = somersault_maneuver(direction="forward")
+    m = _forward_timed()
     assert not run_maneuver(m, perturbation=start, fps=10.0).report["landed"]
     leap = replace(m.phases[1], params={**m.phases[1].params, "crouch_plant": True})
     r = run_maneuver(replace(m, phases=(m.phases[0], leap, *m.phases[2:])), perturbation=start,
@@ -791,7 +818,7 @@ def test_a_perturbed_forward_tuck_waits_in_the_crouch_with_crouch_until() -> Non
     both feet are down and the COM is within 2 cm of the soles' middle sideways, moving
     sideways under 0.05 m/s (at most 0.3 s more): it thrusts later and lands."""
     start = full_starts(46)[45]
-    m = somersault_maneuver(direction="forward")
+    m = _forward_timed()
     before = run_maneuver(m, perturbation=start, fps=10.0).report
     assert not before["landed"] or before["fell"]
     leap = replace(m.phases[1], params={**m.phases[1].params, "crouch_until": [0.02, 0.05, 0.3]})
@@ -814,7 +841,7 @@ def test_a_perturbed_forward_tuck_lets_its_crouch_settle_before_the_thrust() -> 
     62 -> 79 on seeds 0 and 1, docs/athletics.md) lets the start's motion settle first: it
     lands."""
     start = full_starts(23)[22]
-    m = somersault_maneuver(direction="forward")
+    m = _forward_timed()
     assert m.phases[1].params["hold"] == 0.25
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
@@ -829,7 +856,7 @@ def test_a_perturbed_forward_tuck_holds_its_crouch_without_the_creep_with_hold_c
     docs/athletics.md) holds the COM target where the COM stands at the crouch's end: it
     takes off with less pitch and lands."""
     start = _tenth_start(0, 2)
-    m = somersault_maneuver(direction="forward")
+    m = _forward_timed()
     assert not m.phases[1].params.get("hold_com", False)
     before = run_maneuver(m, perturbation=start, fps=10.0).report
     assert before["liftoff_pitch_momentum"] > 53.0 and (not before["landed"] or before["fell"])
