@@ -332,10 +332,15 @@ class Runner:
         swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
         roll = math.atan2(lat, math.hypot(fwd, down))
         knee, geom = knee_for_length(self.athlete.thigh[leg], self.athlete.shin[leg], length)
-        thigh = qmul1(qyaw(heading), quat_yxz(-swing + float(geom), roll, 0.0))
+        # the foot placed turned into the curve (``place_yaw``): the hip twists the thigh
+        # about its own axis by the turn the path makes that long ahead; from PATH_AFTER on
+        # (any change to the start from the set pose threw the runner)
+        turned = k["place_yaw"] > 0 and d.time >= PATH_AFTER
+        turn = k["place_yaw"] * self.speed * self.curvature if turned else 0.0
+        thigh = qmul1(qyaw(heading), quat_yxz(-swing + float(geom), roll, turn))
         pelvis = self._anat(self._root, 0)
         hip_pitch, hip_roll, _ = euler_yxz(qmul1(qconj1(pelvis), thigh))
-        self.goal[HIP[leg]] = (hip_pitch, hip_roll, 0.0)
+        self.goal[HIP[leg]] = (hip_pitch, hip_roll, turn)
         self.goal[KNEE[leg]] = (float(knee), 0.0, 0.0)
         self.knee_td = float(knee)
         shin = self._pitch(self._shins[leg], SHIN[leg], heading)
@@ -368,9 +373,17 @@ class Runner:
     def _upper(self, hips: F64) -> None:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
         k = self.k
+        spin = 0.0
+        if k["arm_yaw"] > 0 and self.world.data.time >= PATH_AFTER:
+            # the arms counter-rotate against the trunk's yaw past the facing (``arm_yaw``):
+            # their reaction turns the trunk without the stance foot's grip
+            chest = self._anat(self._chest, SIM_BODY_INDEX["chest"])
+            spin = k["arm_yaw"] * euler_yxz(qmul1(qyaw(-self.heading_d), chest))[2]
         for leg in range(2):
-            self.goal[SHOULDER[leg]] = (k["arm_gain"] * hips[1 - leg] + k["arm_offset"],
-                                         0.15 * (1 - 2 * leg), 0.0)  # fmt: skip
+            pitch = k["arm_gain"] * hips[1 - leg] + k["arm_offset"]
+            if spin:
+                pitch += (1 - 2 * leg) * spin  # left back, right forward for a trunk ahead
+            self.goal[SHOULDER[leg]] = (pitch, 0.15 * (1 - 2 * leg), 0.0)
             self.goal[ELBOW[leg]] = (-k["elbow"], 0.0, 0.0)
         for j in SPINE:
             self.goal[j] = 0.0
