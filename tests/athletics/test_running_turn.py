@@ -66,8 +66,8 @@ def test_arm_yaw_counter_rotates_the_arms_against_the_trunks_yaw() -> None:
     assert extra0 == [0.0, 0.0]
     # the trunk's yaw moved on by at most a few hundredths in the last tick's physics steps
     assert extra1[0] == pytest.approx(-extra1[1], abs=1e-12)
-    assert abs(yaw) > 0.01
-    assert extra1[0] == pytest.approx(gain * yaw, abs=0.05 + 0.2 * abs(gain * yaw))
+    assert extra1[0] != 0.0
+    assert extra1[0] == pytest.approx(gain * yaw, abs=0.05)
     before = off["t"] < PATH_AFTER
     assert np.array_equal(off["com"][before], on["com"][before])
     assert not np.array_equal(off["com"][~before], on["com"][~before])
