@@ -332,15 +332,10 @@ class Runner:
         swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
         roll = math.atan2(lat, math.hypot(fwd, down))
         knee, geom = knee_for_length(self.athlete.thigh[leg], self.athlete.shin[leg], length)
-        # the foot placed turned into the curve (``place_yaw``): the hip twists the thigh
-        # about its own axis by the turn the path makes that long ahead; from PATH_AFTER on
-        # (any change to the start from the set pose threw the runner)
-        turned = k["place_yaw"] > 0 and d.time >= PATH_AFTER
-        turn = k["place_yaw"] * self.speed * self.curvature if turned else 0.0
-        thigh = qmul1(qyaw(heading), quat_yxz(-swing + float(geom), roll, turn))
+        thigh = qmul1(qyaw(heading), quat_yxz(-swing + float(geom), roll, 0.0))
         pelvis = self._anat(self._root, 0)
         hip_pitch, hip_roll, _ = euler_yxz(qmul1(qconj1(pelvis), thigh))
-        self.goal[HIP[leg]] = (hip_pitch, hip_roll, turn)
+        self.goal[HIP[leg]] = (hip_pitch, hip_roll, 0.0)
         self.goal[KNEE[leg]] = (float(knee), 0.0, 0.0)
         self.knee_td = float(knee)
         shin = self._pitch(self._shins[leg], SHIN[leg], heading)

@@ -144,11 +144,6 @@ class RunParams:
             integral of the cross-track error times the curvature (m/s; 0: none),
             which takes out the steady offset a curve leaves.
         lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
-        place_yaw: the foot placed turned into the curve (s; 0: off, the swing hip's yaw
-            left at the pelvis's): in flight the placing hip twists the thigh (and foot) to
-            the desired facing turned on by ``place_yaw * v * kappa``, the facing the path
-            will have that long ahead, so the new stance starts turned (the stance hip's
-            twist is at the foot's grip on ~95% of the stance ticks). Within [0, 1].
         arm_yaw: the arms' counter-rotation (rad per rad; 0: off): each shoulder's pitch
             moved by this times the trunk's yaw past the desired facing, the left arm back
             and the right forward for a trunk turned left of it, so the arms' reaction turns
@@ -200,7 +195,6 @@ class RunParams:
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
     lean: float | Speeds = 1.0
-    place_yaw: float | Speeds = 0.0
     arm_yaw: float | Speeds = 0.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
@@ -221,8 +215,7 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
-        for name, top in (("push_hold", 1.0), ("push_ramp", 1.0), ("place_yaw", 1.0),
-                          ("arm_yaw", 5.0)):  # fmt: skip
+        for name, top in (("push_hold", 1.0), ("push_ramp", 1.0), ("arm_yaw", 5.0)):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
                 raise ConfigError(f"{name} must be in [0, {top:g}], got {v}")
