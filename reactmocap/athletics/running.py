@@ -368,17 +368,9 @@ class Runner:
     def _upper(self, hips: F64) -> None:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
         k = self.k
-        spin = 0.0
-        if k["arm_yaw"] > 0 and self.world.data.time >= PATH_AFTER:
-            # the arms counter-rotate against the trunk's yaw past the facing (``arm_yaw``):
-            # their reaction turns the trunk without the stance foot's grip
-            chest = self._anat(self._chest, SIM_BODY_INDEX["chest"])
-            spin = k["arm_yaw"] * euler_yxz(qmul1(qyaw(-self.heading_d), chest))[2]
         for leg in range(2):
-            pitch = k["arm_gain"] * hips[1 - leg] + k["arm_offset"]
-            if spin:
-                pitch += (1 - 2 * leg) * spin  # left back, right forward for a trunk ahead
-            self.goal[SHOULDER[leg]] = (pitch, 0.15 * (1 - 2 * leg), 0.0)
+            self.goal[SHOULDER[leg]] = (k["arm_gain"] * hips[1 - leg] + k["arm_offset"],
+                                         0.15 * (1 - 2 * leg), 0.0)  # fmt: skip
             self.goal[ELBOW[leg]] = (-k["elbow"], 0.0, 0.0)
         for j in SPINE:
             self.goal[j] = 0.0
