@@ -71,13 +71,6 @@ def knee_for_length(thigh: F64 | float, shin: F64 | float, length: F64 | float) 
     """Knee flexion (rad) that makes the hip-to-ankle distance ``length`` (eq. 7.5), and the
     hip flexion that keeps the pelvis over the ankle with the hip-ankle line vertical (eq. 7.6,
     returned negative: thigh forward)."""
-    if np.ndim(thigh) == np.ndim(shin) == np.ndim(length) == 0:
-        # one leg (the runner's tick): floats and math, the same roundings as numpy's
-        u, s, h = float(thigh), float(shin), float(length)
-        h = min(max(h, abs(u - s) + 1e-3), u + s - 1e-6)
-        k = math.pi - math.acos(min(max((u * u + s * s - h * h) / (2 * u * s), -1.0), 1.0))
-        hp = -math.acos(min(max((u * u - s * s + h * h) / (2 * u * h), -1.0), 1.0))
-        return np.array([k, hp])
     ul, ll = np.asarray(thigh, dtype=np.float64), np.asarray(shin, dtype=np.float64)
     lh = np.clip(np.asarray(length, dtype=np.float64), abs(ul - ll) + 1e-3, ul + ll - 1e-6)
     knee = np.pi - np.arccos(np.clip((ul**2 + ll**2 - lh**2) / (2 * ul * ll), -1.0, 1.0))

@@ -382,6 +382,12 @@ class Runner:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
         k = self.k
         arm = (k["arm_gain"] * hips[::-1] + k["arm_offset"]).tolist()  # each opposite hip's
+        if k["arm_yaw"] > 0 and self.world.data.time >= PATH_AFTER:
+            # the arms counter-rotate against the trunk's yaw past the facing (``arm_yaw``):
+            # their reaction turns the trunk without the stance foot's grip
+            chest = self._anat(self._chest, SIM_BODY_INDEX["chest"])
+            spin = k["arm_yaw"] * euler_yxz(qmul1(qyaw(-self.heading_d), chest))[2]
+            arm = [arm[0] + spin, arm[1] - spin]  # left back, right forward for a trunk ahead
         elbow = -k["elbow"]
         # one write for the seven rows (each row's write cost as much as its law)
         self.goal[_UPPER] = ((arm[0], 0.15, 0.0), (arm[1], -0.15, 0.0), (elbow, 0.0, 0.0),

@@ -144,6 +144,10 @@ class RunParams:
             integral of the cross-track error times the curvature (m/s; 0: none),
             which takes out the steady offset a curve leaves.
         lean: how much of the curve's lean ``atan(v^2 kappa / g)`` the trunk takes.
+        arm_yaw: the arms' counter-rotation (rad per rad; 0: off): each shoulder's pitch
+            moved by this times the trunk's yaw past the desired facing, the left arm back
+            and the right forward for a trunk turned left of it, so the arms' reaction turns
+            the trunk back without the stance foot's grip. Within [0, 5].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -191,6 +195,7 @@ class RunParams:
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
     lean: float | Speeds = 1.0
+    arm_yaw: float | Speeds = 0.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
@@ -210,10 +215,10 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
-        for name in ("push_hold", "push_ramp"):
+        for name, top in (("push_hold", 1.0), ("push_ramp", 1.0), ("arm_yaw", 5.0)):
             v = getattr(self, name)
-            if not all(0.0 <= b <= 1.0 for b in (v if isinstance(v, tuple) else (v,))):
-                raise ConfigError(f"{name} must be in [0, 1], got {v}")
+            if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
+                raise ConfigError(f"{name} must be in [0, {top:g}], got {v}")
         lo, hi = SPEED_RANGE
         for speed in (lo, hi):
             r = self.at(speed)

@@ -5,10 +5,16 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from reactmocap.athletics.paths import Facing
 from reactmocap.athletics.run_course import run_course
+from reactmocap.athletics.running import PATH_AFTER, SHOULDER
+from reactmocap.athletics.running_body import euler_yxz, qmul1, qyaw
+from reactmocap.athletics.running_params import RunParams
+from reactmocap.errors import ConfigError
+from reactmocap.sim.bodies import SIM_BODY_INDEX
 
 
 @pytest.mark.parametrize("angle", [45.0])
@@ -36,3 +42,39 @@ def test_stance_estimate_is_smoothed_at_the_path_speed() -> None:
     assert runner.stance_estimate == pytest.approx(est, rel=1e-12)
     # and it is not the last stance's duration alone (eqs. 1-2 unsmoothed)
     assert abs(runner.stance_estimate - last) > 1e-4
+
+
+def test_arm_yaw_counter_rotates_the_arms_against_the_trunks_yaw() -> None:
+    """``arm_yaw``: from ``PATH_AFTER`` on the shoulders' pitch goals leave eq. 5 by the gain
+    times the trunk's yaw past the desired facing, the left arm back and the right forward
+    for a trunk turned left of it; before it the run is the default's to the bit, and off
+    (the default) eq. 5 is left as it is."""
+    gain = 2.0
+    runs = {}
+    for g in (0.0, gain):
+        res = run_course(2.5, seconds=PATH_AFTER + 0.5, path="circle:10", fps=10.0,
+                         params=RunParams(arm_yaw=g))  # fmt: skip
+        r = res.runner
+        hips = r._angles[r._hip_rows, 0].copy()
+        r._upper(hips)  # the arms' law on the run's last state
+        k = r.k
+        extra = [r.goal[SHOULDER[leg], 0] - (k["arm_gain"] * hips[1 - leg] + k["arm_offset"])
+                 for leg in range(2)]  # fmt: skip
+        chest = r._anat(r._chest, SIM_BODY_INDEX["chest"])
+        yaw = euler_yxz(qmul1(qyaw(-r.heading_d), chest))[2]
+        runs[g] = (r.log.arrays(), extra, yaw)
+    (off, extra0, _), (on, extra1, yaw) = runs[0.0], runs[gain]
+    assert extra0 == [0.0, 0.0]
+    assert abs(yaw) > 1e-4
+    assert extra1 == pytest.approx([gain * yaw, -gain * yaw], rel=1e-9)
+    before = off["t"] < PATH_AFTER
+    assert np.array_equal(off["com"][before], on["com"][before])
+    assert not np.array_equal(off["com"][~before], on["com"][~before])
+
+
+def test_arm_yaw_is_checked() -> None:
+    with pytest.raises(ConfigError, match=r"arm_yaw must be in \[0, 5\]"):
+        RunParams(arm_yaw=(0.0, 0.0, 6.0))
+    with pytest.raises(ConfigError, match=r"arm_yaw must be in \[0, 5\]"):
+        RunParams(arm_yaw=-0.1)
+    assert RunParams().at(2.5)["arm_yaw"] == 0.0
