@@ -17,6 +17,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from reactmocap.errors import ConfigError
+
 __all__ = [
     "cross_rows",
     "quat_canonical",
@@ -267,7 +269,7 @@ def quat_from_euler(angles_rad: ArrayLike, order: str) -> F64:
     a = np.asarray(angles_rad, dtype=np.float64)
     seq = order.upper()
     if len(seq) != 3 or not set(seq) <= set("XYZ") or seq[0] == seq[1] or seq[1] == seq[2]:
-        raise ValueError(f"Euler order must be 3 axes of XYZ, none twice in a row; got {order!r}")
+        raise ConfigError(f"Euler order must be 3 axes of XYZ, none twice in a row; got {order!r}")
     idx, sign = _euler_terms(seq)
     half = a / 2
     cs = np.empty((*a.shape, 2))  # (..., 3, 2): cosines and sines (np.stack cost as much again)

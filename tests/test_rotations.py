@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy.spatial.transform import Rotation
 
+from reactmocap.errors import ConfigError
 from reactmocap.rotations import (
     quat_canonical,
     quat_conj,
@@ -192,7 +193,7 @@ def test_euler_equals_scipy_to_the_bit(order: str) -> None:
 
 @pytest.mark.parametrize("order", ["XY", "XXY", "XYZX", "XYW"])
 def test_euler_order_must_be_three_axes(order: str) -> None:
-    with pytest.raises(ValueError, match="Euler order"):
+    with pytest.raises(ConfigError, match="Euler order"):
         quat_from_euler([0.1, 0.2, 0.3], order)
 
 
