@@ -120,13 +120,12 @@ class Senses:
         for k in range(2):
             if force[k] > 0:
                 point[k] = [x / force[k] for x in point[k]]
+            elif touch[k]:  # touching without a normal force: the sole's centre
+                point[k] = self.corners[k].mean(0).tolist()
         self.grf[:] = grf
         self.foot_contact[:] = touch
         self.foot_force[:] = force
         self.foot_point[:] = point
-        for k in range(2):
-            if touch[k] and not force[k] > 0:
-                self.foot_point[k] = self.corners[k].mean(0)
         self.other_contact = tuple(sorted(others))
         rel = self.corners - d.geom_xpos[self.floor]
         self.clearance = float((rel @ self.floor_normal).min())
