@@ -72,9 +72,14 @@ def knee_for_length(thigh: F64 | float, shin: F64 | float, length: F64 | float) 
     hip flexion that keeps the pelvis over the ankle with the hip-ankle line vertical (eq. 7.6,
     returned negative: thigh forward)."""
     ul, ll = np.asarray(thigh, dtype=np.float64), np.asarray(shin, dtype=np.float64)
-    lh = np.clip(np.asarray(length, dtype=np.float64), abs(ul - ll) + 1e-3, ul + ll - 1e-6)
-    knee = np.pi - np.arccos(np.clip((ul**2 + ll**2 - lh**2) / (2 * ul * ll), -1.0, 1.0))
-    hip = -np.arccos(np.clip((ul**2 - ll**2 + lh**2) / (2 * ul * lh), -1.0, 1.0))
+    # np.clip as the two ufuncs it is for finite bounds (its wrappers cost more than the sums;
+    # the runner calls this at every flight tick)
+    lh = np.minimum(np.maximum(np.asarray(length, dtype=np.float64), abs(ul - ll) + 1e-3),
+                    ul + ll - 1e-6)  # fmt: skip
+    knee = np.pi - np.arccos(
+        np.minimum(np.maximum((ul**2 + ll**2 - lh**2) / (2 * ul * ll), -1.0), 1.0)
+    )
+    hip = -np.arccos(np.minimum(np.maximum((ul**2 - ll**2 + lh**2) / (2 * ul * lh), -1.0), 1.0))
     return np.stack([knee, hip])
 
 

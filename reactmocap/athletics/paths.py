@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from reactmocap.errors import ConfigError
+from reactmocap.rotations import einsum
 
 __all__ = [
     "LOOKAHEAD",
@@ -156,10 +157,10 @@ class Polyline:
             idx = idx % n if self.closed else idx[idx < n]
             self._window = (self.index, idx, self.points[idx], self.seg[idx], self.len[idx] ** 2)
         _, idx, a, sv, len2 = self._window
-        u = np.minimum(np.maximum(np.einsum("ij,ij->i", p - a, sv) / len2, 0.0), 1.0)  # clip
+        u = np.minimum(np.maximum(einsum("ij,ij->i", p - a, sv) / len2, 0.0), 1.0)  # clip
         q = a + u[:, None] * sv
         dist = np.hypot(*(p - q).T)
-        j = int(np.argmin(dist))
+        j = int(dist.argmin())  # the method: np.argmin wraps it
         i = int(idx[j])
         # the closest point's side and distance in floats (numpy's scalars: the same values)
         (sx, sy), (qx, qy), (px, py) = sv[j].tolist(), q[j].tolist(), p.tolist()

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.response.blend import smoothstep  # the one Hermite ease; re-exported here
-from reactmocap.rotations import quat_conj, quat_log, quat_mul, quat_rotate
+from reactmocap.rotations import einsum, quat_conj, quat_log, quat_mul, quat_rotate
 from reactmocap.sim.bodies import BALL_JOINT_INDEX, BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.world import World
 
@@ -119,6 +119,15 @@ class Rig:
         self._w_201, self._w_120 = w[:, self._c201], w[:, self._c120]
         self._weight_n = self.mass * g
         self._tau = np.zeros((NJ, 3))
+        # gravity compensation's buffers, and MjData's arrays it reads (the World keeps one
+        # MjData; each attribute read makes a new array)
+        d = world.data
+        self._com_anchor = (d.subtree_com, d.xanchor, d.xmat)
+        self._r = np.empty((NJ, 3))
+        self._r_anchor = np.empty((NJ, 3))
+        self._r_other = np.empty((NJ, 3))
+        self._rot = np.empty((NJ, 9))
+        self._rot3 = self._rot.reshape(NJ, 3, 3)
         self._jacp = np.zeros((3, m.nv))
         self._feet = [int(wc.body_ids[SIM_BODIES.index(f)]) for f in ("l_foot", "r_foot")]
         self._leg_cols = [
@@ -300,17 +309,28 @@ class Rig:
 
     def _feedforward(self) -> None:
         m, d = self.world.model, self.world.data
-        # each joint holds its subtree up: (subtree com - anchor) x (weight up), child frame
-        r = d.subtree_com[self._child] - d.xanchor[self._balls]
-        tau = r.take(self._c120, 1) * self._w_201 - r.take(self._c201, 1) * self._w_120  # r x w
-        rot = d.xmat[self._child].reshape(NJ, 3, 3)
-        self.feedforward[:] = np.einsum("nji,nj->ni", rot, tau)
+        # each joint holds its subtree up: (subtree com - anchor) x (weight up), child frame;
+        # the same products as the arrays' operators, into buffers made once
+        com, anchor, xmat = self._com_anchor
+        r, tau, other = self._r, self._tau, self._r_other
+        com.take(self._child, 0, out=r)
+        anchor.take(self._balls, 0, out=self._r_anchor)
+        np.subtract(r, self._r_anchor, out=r)
+        r.take(self._c120, 1, out=tau)
+        np.multiply(tau, self._w_201, out=tau)
+        r.take(self._c201, 1, out=other)
+        np.multiply(other, self._w_120, out=other)
+        np.subtract(tau, other, out=tau)  # r x w
+        xmat.take(self._child, 0, out=self._rot)
+        einsum("nji,nj->ni", self._rot3, tau, out=self.feedforward)
         flat = self.feedforward.reshape(-1)
-        for k in np.flatnonzero(self.support > 0):
+        for k, share in enumerate(self.support.tolist()):  # two feet: floats, no flatnonzero
+            if not share > 0:
+                continue
             up = self._up if self.support_dir is None else self.support_dir
             if up.ndim == 2:  # one direction per foot
                 up = up[k]
-            force = self.support[k] * self.support_scale * self._weight_n * up
+            force = share * self.support_scale * self._weight_n * up
             at = d.xanchor[self._ankles[k]] if self.support_point is None else self.support_point[k]
             mujoco.mj_jac(m, d, self._jacp, None, at, self._feet[k])
             cols = self._leg_cols[k]

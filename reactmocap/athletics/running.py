@@ -334,7 +334,7 @@ class Runner:
         # back over the last moments before touchdown (predicted from the lowest sole corner
         # and the body's vertical speed), so it meets the ground moving back under the body
         vz = float(s.com_vel[2])
-        low = float(s.sole_corners()[leg, :, 2].min())
+        low = float(np.minimum.reduce(s.sole_corners()[leg, :, 2]))  # .min(): a Python call more
         to_go = low / -vz if vz < -1e-3 else np.inf
         fwd += k["speed_matching"] * clamp(to_go / k["retract_time"], 0.0, 1.0)
         fwd += 0.3 * lf  # the heel sits behind the ankle

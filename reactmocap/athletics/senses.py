@@ -66,6 +66,11 @@ class Senses:
         self.clearance = 0.0
         #: ``(2, 4, 3)`` world sole corners at the last update
         self.corners = np.zeros((2, 4, 3))
+        # MjData's rows read at every update, as views made once (the World keeps one MjData)
+        d = world.data
+        self._rows = (d.subtree_com[self.root], d.subtree_linvel[self.root],
+                      d.geom_xmat[self.floor].reshape(3, 3)[:, 2], d.geom_xpos[self.floor])  # fmt: skip
+        self._root_xmat = d.xmat[self.root].reshape(3, 3)
 
     def body(self, name: str) -> int:
         return self._ids[name]
@@ -77,9 +82,10 @@ class Senses:
         self.time = t
         m, d = self.world.model, self.world.data
         mujoco.mj_subtreeVel(m, d)
-        self.com[:] = d.subtree_com[self.root]
-        self.com_vel[:] = d.subtree_linvel[self.root]
-        self.floor_normal[:] = d.geom_xmat[self.floor].reshape(3, 3)[:, 2]
+        com, com_vel, normal, floor_pos = self._rows
+        self.com[:] = com
+        self.com_vel[:] = com_vel
+        self.floor_normal[:] = normal
         # summed in floats, contact by contact: the same roundings as numpy's in-place sums,
         # without a numpy call per term (a quarter of the runner's senses)
         grf = [0.0, 0.0, 0.0]
@@ -127,8 +133,8 @@ class Senses:
         self.foot_force[:] = force
         self.foot_point[:] = point
         self.other_contact = tuple(sorted(others))
-        rel = self.corners - d.geom_xpos[self.floor]
-        self.clearance = float((rel @ self.floor_normal).min())
+        rel = self.corners - floor_pos
+        self.clearance = float(np.minimum.reduce(rel @ self.floor_normal, axis=None))  # .min()
 
     # ------------------------------------------------------------------ derived
     @property
@@ -144,8 +150,7 @@ class Senses:
 
     def heading(self) -> float:
         """Heading (rad about +Z) of the pelvis's anatomical forward axis."""
-        d = self.world.data
-        x, y, _ = (d.xmat[self.root].reshape(3, 3) @ self._forward).tolist()
+        x, y, _ = (self._root_xmat @ self._forward).tolist()
         return math.atan2(y, x)  # np.arctan2's value, without a ufunc call on two scalars
 
     def side_axis(self) -> F64:

@@ -7,6 +7,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError
+from reactmocap.rotations import einsum
 from reactmocap.sim.character import SIM_BODIES
 from reactmocap.sim.world import World
 
@@ -38,4 +39,4 @@ def foot_soles(
 def sole_corners_world(d: mujoco.MjData, sole: NDArray[np.int64], corners: F64) -> F64:
     """``(2, 4, 3)`` world positions of the sole corners from :func:`foot_soles`."""
     rot = d.geom_xmat[sole].reshape(2, 3, 3)
-    return np.einsum("fij,fkj->fki", rot, corners) + d.geom_xpos[sole][:, None]
+    return einsum("fij,fkj->fki", rot, corners) + d.geom_xpos[sole][:, None]

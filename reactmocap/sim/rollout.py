@@ -155,7 +155,9 @@ class _Guard:
 
     def problem(self, t: float) -> str | None:
         w, d = self.world, self.world.data
-        if not (np.isfinite(d.qvel).all() and np.isfinite(d.qpos).all()):
+        # the reductions themselves: ndarray.all adds a Python call each, every check
+        finite = np.logical_and.reduce
+        if not (finite(np.isfinite(d.qvel)) and finite(np.isfinite(d.qpos))):
             bad = "unknown"
             for wc in w.characters:
                 if not (np.isfinite(d.xpos[wc.body_ids]).all() and

@@ -12,10 +12,11 @@ from collections.abc import Sequence
 
 import mujoco
 import numpy as np
+from numpy.linalg import _umath_linalg  # type: ignore[attr-defined]
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, SimulationError, UnknownKeyError
-from reactmocap.rotations import quat_log, quat_normalize
+from reactmocap.rotations import einsum, quat_log, quat_normalize
 from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.world import World
 
@@ -133,8 +134,24 @@ class PDServo:
         self._sum = np.empty((n, 3, 1))
         self._sum_flat = self._sum[:, :, 0]
         self._inertia = np.empty((n, 3, 3))
+        # the Cholesky factors L, and views made once: L^T (row k: column l_k of L), and the
+        # last entry of each, NaN where LAPACK found a block not positive definite
+        self._chol = np.empty((n, 3, 3))
+        self._chol_t = self._chol.transpose(0, 2, 1)
+        self._chol_last = self._chol[:, 2, 2]
+        # qfrc_applied's rows of the servo's DOFs as a view (the World keeps one MjData)
+        d0 = int(self._didx[0])
+        self._qfrc = (
+            d.qfrc_applied[d0 : d0 + 3 * n]
+            if np.array_equal(self._didx, np.arange(d0, d0 + 3 * n))
+            else None
+        )
         self._any_hot = False
         self.targets = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+        # set_targets' buffers: one character's target lengths and right-matrix entries
+        self._len = np.empty(NJ)
+        self._len_col = self._len[:, None]
+        self._rd_entries = np.empty((NJ, 4, 4))
         self._rd = _right_matrix(self.targets)
         #: extra joint torques (N m, child frame) added to the servo's output, e.g. gravity
         #: compensation or a balance controller's; ``(n, 3)``, written in place by controllers
@@ -346,12 +363,17 @@ class PDServo:
         # the reductions themselves: ndarray.all/any add a Python call each, every tick
         if not np.logical_and.reduce(np.isfinite(q), axis=None):
             raise SimulationError("PD targets contain NaN or inf")
-        q = q / np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
+        # the same operations as q / sqrt(sum q^2) and q[:, _RIDX] * _RSIGN, into buffers
+        einsum("ij,ij->i", q, q, out=self._len)
+        np.sqrt(self._len, out=self._len)
         keep = self._frozen[sl]
+        targets = self.targets[sl]
         if np.logical_or.reduce(keep):
-            q = np.where(keep[:, None], self.targets[sl], q)
-        self.targets[sl] = q
-        np.multiply(q[:, _RIDX], _RSIGN, out=self._rd[sl])
+            targets[:] = np.where(keep[:, None], targets, q / self._len_col)
+        else:
+            np.divide(q, self._len_col, out=targets)
+        targets.take(_RIDX, axis=1, out=self._rd_entries)
+        np.multiply(self._rd_entries, _RSIGN, out=self._rd[sl])
         self._dirty = True
 
     def set_targets_to_current(self) -> None:
@@ -367,14 +389,17 @@ class PDServo:
         factor into the gears, rotation vectors into ``ctrl``), copy :attr:`feedforward`
         into ``qfrc_applied``. After it the actuators' torque equals :meth:`torques`."""
         d = self.world.data
-        np.take(d.M, self._midx, out=self._inertia)
-        try:
-            lt = np.linalg.cholesky(self._inertia).transpose(0, 2, 1)  # row k: column l_k of L
-        except np.linalg.LinAlgError:  # only a state that diverged since the engine's check
+        d.M.take(self._midx, out=self._inertia)
+        # np.linalg.cholesky's own LAPACK gufunc, without its wrapper (a third of the cost);
+        # a block that is not positive definite comes back as NaN
+        _umath_linalg.cholesky_lo(self._inertia, signature="d->d", out=self._chol)
+        lt = self._chol_t
+        total = np.add.reduce(self._chol_last)
+        if total != total:  # only a state that diverged since the engine's check
             raise SimulationError(
                 f"simulation went unstable at t = {float(d.time):.4f} s: a joint inertia of "
                 "the servo is not positive definite"
-            ) from None
+            )
         np.take(d.qpos, self._qidx, out=self._q0_flat)
         np.matmul(self._rd, self._q0_col, out=self._p_col)  # conj(q0) * q_d
         # both logs at once, as mju_quat2Vel: 2 atan2(|v|, |w|) sign(w) v / |v| (shortest arc)
@@ -409,8 +434,11 @@ class PDServo:
             self.world.model.dof_damping[self._didx] = self._base_damping + (
                 self._kv[:, None] * diag
             ).reshape(-1)
-        d.qfrc_applied[self._didx] = self.feedforward.reshape(-1)
-        if self._any_hot or self._half0.max() > 0.5 * (np.pi - HALF_TURN_MARGIN):
+        if self._qfrc is not None:
+            self._qfrc[:] = self.feedforward.reshape(-1)
+        else:
+            d.qfrc_applied[self._didx] = self.feedforward.reshape(-1)
+        if self._any_hot or np.maximum.reduce(self._half0) > 0.5 * (np.pi - HALF_TURN_MARGIN):
             self._half_turns(self._half0 > 0.5 * (np.pi - HALF_TURN_MARGIN), self._x1)
         self._since = 0
         self._dirty = False

@@ -229,6 +229,7 @@ class World:
         self.spec = spec
         m = self.model
         self.data = mujoco.MjData(m)
+        self._mv = np.empty(m.nv)
         #: bumped whenever the state is set from outside the integrator (set_pose, set_state):
         #: a PDServo then re-linearises its actuators before the next step
         self.state_epoch = 0
@@ -468,7 +469,7 @@ class World:
     def kinetic_energy(self, index: int | None = None) -> float:
         """Kinetic energy (J) of one character (or of everything), 0.5 v^T M v."""
         m, d = self.model, self.data
-        mv = np.empty(m.nv)
+        mv = self._mv  # made once: the rollout's guard asks every few steps
         mujoco.mj_mulM(m, d, mv, d.qvel)
         if index is None:
             return 0.5 * float(d.qvel @ mv)
