@@ -21,6 +21,7 @@ from reactmocap.errors import ConfigError
 
 __all__ = [
     "cross_rows",
+    "EulerQuats",
     "einsum",
     "quat_canonical",
     "quat_conj",
@@ -160,17 +161,25 @@ def quat_mul(a: ArrayLike, b: ArrayLike) -> Floats:
     )
 
 
-def quat_mul_table(b: NDArray[_F]) -> NDArray[_F]:
+def quat_mul_table(b: NDArray[_F], out: NDArray[_F] | None = None) -> NDArray[_F]:
     """``(..., 4, 4)``: the products ``e_k b`` of the units ``e_k`` = 1, i, j, k with float
     quaternions ``b``, for :func:`quat_mul_rows`; made once for a ``b`` that does not change
-    (a body's joint frames)."""
-    return b[..., _MUL_PERM] * _MUL_SIGN[b.dtype.char]
+    (a body's joint frames), or into ``out`` (the same values)."""
+    if out is None:
+        return b[..., _MUL_PERM] * _MUL_SIGN[b.dtype.char]
+    b.take(_MUL_PERM, axis=-1, out=out)
+    return np.multiply(out, _MUL_SIGN[b.dtype.char], out=out)
 
 
-def quat_mul_rows(a: NDArray[_F], table: NDArray[_F]) -> NDArray[_F]:
+def quat_mul_rows(
+    a: NDArray[_F], table: NDArray[_F], work: NDArray[_F] | None = None
+) -> NDArray[_F]:
     """``a * b`` from ``b``'s :func:`quat_mul_table` (same dtype): :func:`quat_mul`'s values
-    to the bit."""
-    return np.add.reduce(a[..., :, None] * table, axis=-2)
+    to the bit. ``work``: a buffer of the products' shape ``(..., 4, 4)`` (the same values)."""
+    if work is None:
+        return np.add.reduce(a[..., :, None] * table, axis=-2)
+    np.multiply(a[..., :, None], table, out=work)
+    return np.add.reduce(work, axis=-2)
 
 
 @overload
@@ -289,6 +298,39 @@ def quat_from_euler(angles_rad: ArrayLike, order: str) -> F64:
     t = cs[..., 0, :, None, None] * cs[..., 1, None, :, None] * cs[..., 2, None, None, :]
     terms = t.reshape(*a.shape[:-1], 8)[..., idx] * sign
     return terms[..., 0] + terms[..., 1]
+
+
+class EulerQuats:
+    """:func:`quat_from_euler` of ``(n, 3)`` float64 angles in one ``order``, into buffers
+    made once: the same operations in the same order, so the same values to the bit (test),
+    without the checks, the allocations and their Python calls (the athletic controllers
+    convert their 15 joints at every tick). The result is a buffer the next call overwrites."""
+
+    def __init__(self, order: str, n: int) -> None:
+        quat_from_euler(np.zeros(3), order)  # the order's check
+        self._idx, self._sign = _euler_terms(order.upper())
+        self._half = np.empty((n, 3))
+        cs = np.empty((n, 3, 2))
+        self._cos, self._sin = cs[..., 0], cs[..., 1]
+        # the three angles' (cos, sin) pairs as the products broadcast them
+        self._x1, self._x2, self._x3 = cs[:, 0, :, None], cs[:, 1, None, :], cs[:, 2, None, None, :]
+        self._x12 = np.empty((n, 2, 2))
+        self._x12_col = self._x12[..., None]
+        t = np.empty((n, 2, 2, 2))
+        self._t, self._t8 = t, t.reshape(n, 8)
+        terms = np.empty((n, 4, 2))
+        self._terms, self._first, self._second = terms, terms[..., 0], terms[..., 1]
+        self.out = np.empty((n, 4))
+
+    def __call__(self, angles: F64) -> F64:
+        np.divide(angles, 2, out=self._half)
+        np.cos(self._half, out=self._cos)
+        np.sin(self._half, out=self._sin)
+        np.multiply(self._x1, self._x2, out=self._x12)
+        np.multiply(self._x12_col, self._x3, out=self._t)
+        self._t8.take(self._idx, axis=1, out=self._terms)
+        np.multiply(self._terms, self._sign, out=self._terms)
+        return np.add(self._first, self._second, out=self.out)
 
 
 @functools.cache

@@ -19,6 +19,7 @@ from reactmocap.library.bodyparts import BodyPartMap, map_body_parts
 from reactmocap.library.motion import Motion
 from reactmocap.library.skeleton import BVHLayout, Skeleton
 from reactmocap.rotations import (
+    EulerQuats,
     quat_conj,
     quat_from_euler,
     quat_from_yaw,
@@ -215,6 +216,12 @@ class Athlete:
         self.joint_left = quat_mul(quat_conj(bq), quat_conj(parent))
         self.joint_right = n[1:]
         self._right_table = quat_mul_table(np.array(self.joint_right))  # for joint_quats
+        # joint_quats' buffers for the (15, 3) angles of the control ticks
+        nj = len(self.joint_right)
+        self._euler = EulerQuats(EULER_ORDER, nj)
+        self._euler_shape = (nj, 3)
+        self._products = np.empty((nj, 4, 4))
+        self._table = np.empty((nj, 4, 4))
 
     @property
     def mass(self) -> float:
@@ -227,6 +234,12 @@ class Athlete:
 
     def joint_quats(self, angles: F64) -> F64:
         """``(15, 4)`` MuJoCo ball-joint quaternions of anatomical angles ``(15, 3)``."""
+        if (isinstance(angles, np.ndarray) and angles.dtype == np.float64
+                and angles.shape == self._euler_shape):  # fmt: skip
+            # the same products into buffers (the control ticks: a fifth of the cost)
+            work = self._products
+            r = quat_mul_rows(self._euler(angles), self._right_table, work)
+            return quat_mul_rows(self.joint_left, quat_mul_table(r, self._table), work)
         r = quat_mul_rows(quat_from_euler(angles, EULER_ORDER), self._right_table)
         return quat_mul_rows(self.joint_left, quat_mul_table(r))  # quat_mul's values, faster
 

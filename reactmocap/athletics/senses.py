@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.sim.bodies import SIM_BODIES
-from reactmocap.sim.feet import foot_soles, sole_corners_world
+from reactmocap.sim.feet import SoleCorners, foot_soles
 from reactmocap.sim.world import World
 
 __all__ = ["LIFTOFF_CLEARANCE", "Senses"]
@@ -71,6 +71,7 @@ class Senses:
         self._rows = (d.subtree_com[self.root], d.subtree_linvel[self.root],
                       d.geom_xmat[self.floor].reshape(3, 3)[:, 2], d.geom_xpos[self.floor])  # fmt: skip
         self._root_xmat = d.xmat[self.root].reshape(3, 3)
+        self._sole_corners = SoleCorners(d, self.soles, self._corners)
 
     def body(self, name: str) -> int:
         return self._ids[name]
@@ -122,7 +123,7 @@ class Senses:
                     point[k] = [q[0] + fn * px, q[1] + fn * py, q[2] + fn * pz]
                 else:
                     others.add(SIM_BODIES[int(self._body[g])])
-        self.corners = sole_corners_world(d, self.soles, self._corners)
+        self.corners = self._sole_corners()
         for k in range(2):
             if force[k] > 0:
                 point[k] = [x / force[k] for x in point[k]]

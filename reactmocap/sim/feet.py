@@ -11,7 +11,7 @@ from reactmocap.rotations import einsum
 from reactmocap.sim.character import SIM_BODIES
 from reactmocap.sim.world import World
 
-__all__ = ["FEET", "foot_soles", "sole_corners_world"]
+__all__ = ["FEET", "SoleCorners", "foot_soles", "sole_corners_world"]
 
 F64 = NDArray[np.float64]
 #: the two foot bodies, left then right (index 0 and 1 everywhere a foot is numbered)
@@ -40,3 +40,24 @@ def sole_corners_world(d: mujoco.MjData, sole: NDArray[np.int64], corners: F64) 
     """``(2, 4, 3)`` world positions of the sole corners from :func:`foot_soles`."""
     rot = d.geom_xmat[sole].reshape(2, 3, 3)
     return einsum("fij,fkj->fki", rot, corners) + d.geom_xpos[sole][:, None]
+
+
+class SoleCorners:
+    """:func:`sole_corners_world` for one MjData, with its arrays read once and buffers made
+    once (the same products: the same values); each call returns a new ``(2, 4, 3)`` array.
+    For a per-tick caller whose MjData lives as long as it does."""
+
+    def __init__(self, d: mujoco.MjData, sole: NDArray[np.int64], corners: F64) -> None:
+        self._xmat, self._xpos = d.geom_xmat, d.geom_xpos
+        self._sole, self._corners = sole, corners
+        self._rot = np.empty((len(sole), 9))
+        self._rot3 = self._rot.reshape(len(sole), 3, 3)
+        self._pos = np.empty((len(sole), 3))
+        self._pos_col = self._pos[:, None]
+        self._local = np.empty(corners.shape)
+
+    def __call__(self) -> F64:
+        self._xmat.take(self._sole, 0, out=self._rot)
+        einsum("fij,fkj->fki", self._rot3, self._corners, out=self._local)
+        self._xpos.take(self._sole, 0, out=self._pos)
+        return self._local + self._pos_col
