@@ -76,10 +76,15 @@ __all__ = [
     "running_start",
 ]
 
-#: the upper body's rows of the goals, in :meth:`Runner._upper`'s order, and each idle leg's
-#: (hip, knee, ankle) rows (index arrays: a tuple index is converted at every use)
-_UPPER = np.array((*SHOULDER, *ELBOW, *SPINE, NECK))
-_LEG_ROWS = tuple(np.array((HIP[i], KNEE[i], ANKLE[i])) for i in range(2))
+#: the flat positions in the ``(NJ, 3)`` goals of the upper body's rows, in
+#: :meth:`Runner._upper`'s order, and of each idle leg's (hip, knee, ankle) rows (index
+#: arrays: a tuple index is converted at every use; a flat tuple of floats converts at a
+#: fraction of the cost of a nested one)
+_UPPER = (3 * np.array((*SHOULDER, *ELBOW, *SPINE, NECK))[:, None] + np.arange(3)).reshape(-1)
+_LEG_ROWS = tuple(
+    (3 * np.array((HIP[i], KNEE[i], ANKLE[i]))[:, None] + np.arange(3)).reshape(-1)
+    for i in range(2)
+)
 #: the states of the active leg (Fig. 3)
 RUN_STATES = ("flight", "loading", "heel", "heel_toe", "toe", "unloading")
 #: a sole corner closer than this to the floor (m) counts as touching
@@ -173,7 +178,7 @@ class Runner:
         # rows of MjData's and the buffer's arrays as views made once (indexing per tick
         # cost as much as the products); the World keeps one MjData for its life
         self._anat_buf = anat = np.empty((len(parts), 4))
-        xquat = world.data.xquat
+        self._xquat = xquat = world.data.xquat
         self._anat_rows = [(anat[k], xquat[int(wc.body_ids[b])], self._neutral_conj[b])
                            for k, b in enumerate(parts)]  # fmt: skip
         self._leg_pairs = [(j, anat[parts.index(p)], anat[parts.index(c)])
@@ -252,7 +257,7 @@ class Runner:
 
     def _anat(self, body: int, neutral: int) -> F64:
         """A body's anatomical world rotation."""
-        return qmul1(self.world.data.xquat[body], self._neutral_conj[neutral])
+        return qmul1(self._xquat[body], self._neutral_conj[neutral])
 
     def _pitch(self, body: int, neutral: int, heading: float) -> float:
         """Anatomical pitch (rad) of a body in the heading frame (thigh forward < 0)."""
@@ -348,11 +353,12 @@ class Runner:
         thigh = qmul1(qyaw(heading), quat_yxz(-swing + float(geom), roll, 0.0))
         pelvis = self._anat(self._root, 0)
         hip_pitch, hip_roll, _ = euler_yxz(qmul1(qconj1(pelvis), thigh))
-        self.goal[HIP[leg]] = (hip_pitch, hip_roll, 0.0)
-        self.goal[KNEE[leg]] = (float(knee), 0.0, 0.0)
         self.knee_td = float(knee)
         shin = self._pitch(self._shins[leg], SHIN[leg], heading)
-        self.goal[ANKLE[leg]] = (clamp(-k["heel_up"] - shin, -0.5, 0.9), 0.0, 0.0)
+        ankle = clamp(-k["heel_up"] - shin, -0.5, 0.9)
+        # the leg's hip, knee and ankle rows in one write
+        self.goal.reshape(-1)[_LEG_ROWS[leg]] = (hip_pitch, hip_roll, 0.0, self.knee_td, 0.0,
+                                                 0.0, ankle, 0.0, 0.0)  # fmt: skip
 
     def _idle(self, t: float, heading: float) -> None:
         """The idle leg. In flight, eqs. 3-4: the idle thigh mirrors the active one's travel
@@ -375,8 +381,8 @@ class Runner:
             knee += (k["reach_knee"] - k["idle_knee"]) * late * late * (3.0 - 2.0 * late)
         hip = clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
         # one write for the leg's three rows (each row's write cost as much as its law)
-        self.goal[_LEG_ROWS[i]] = ((hip, 0.03 * (1 - 2 * i), 0.0), (knee, 0.0, 0.0),
-                                   (-0.15, 0.0, 0.0))  # fmt: skip
+        self.goal.reshape(-1)[_LEG_ROWS[i]] = (hip, 0.03 * (1 - 2 * i), 0.0, knee, 0.0, 0.0,
+                                               -0.15, 0.0, 0.0)  # fmt: skip
 
     def _upper(self, hips: F64) -> None:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
@@ -390,9 +396,9 @@ class Runner:
             arm = [arm[0] + spin, arm[1] - spin]  # left back, right forward for a trunk ahead
         elbow = -k["elbow"]
         # one write for the seven rows (each row's write cost as much as its law)
-        self.goal[_UPPER] = ((arm[0], 0.15, 0.0), (arm[1], -0.15, 0.0), (elbow, 0.0, 0.0),
-                             (elbow, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
-                             (-0.1, 0.0, 0.0))  # fmt: skip
+        self.goal.reshape(-1)[_UPPER] = (arm[0], 0.15, 0.0, arm[1], -0.15, 0.0, elbow, 0.0, 0.0,
+                                         elbow, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                                         -0.1, 0.0, 0.0)  # fmt: skip
 
     def _attitude_torque(self, heading: float) -> F64:
         """World torque on the trunk that servos its attitude toward the desired roll (a

@@ -132,10 +132,16 @@ class Senses:
         self.grf[:] = grf
         self.foot_contact[:] = touch
         self.foot_force[:] = force
-        self.foot_point[:] = point
+        self.foot_point.reshape(-1)[:] = point[0] + point[1]  # a flat list converts faster
         self.other_contact = tuple(sorted(others))
-        rel = self.corners - floor_pos
-        self.clearance = float(np.minimum.reduce(rel @ self.floor_normal, axis=None))  # .min()
+        if self.floor_normal.tolist() == [0.0, 0.0, 1.0]:
+            # a level floor: each corner's height over it, exactly the product below (x 0 +
+            # y 0 + z 1 in any order), and min(z - f) = min(z) - f (rounding is monotonic)
+            low = np.minimum.reduce(self.corners[..., 2], axis=None)
+            self.clearance = float(low) - float(floor_pos[2])
+        else:
+            rel = self.corners - floor_pos
+            self.clearance = float(np.minimum.reduce(rel @ self.floor_normal, axis=None))
 
     # ------------------------------------------------------------------ derived
     @property

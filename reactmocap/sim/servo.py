@@ -139,7 +139,9 @@ class PDServo:
         self._chol = np.empty((n, 3, 3))
         self._chol_t = self._chol.transpose(0, 2, 1)
         self._chol_last = self._chol[:, 2, 2]
-        # qfrc_applied's rows of the servo's DOFs as a view (the World keeps one MjData)
+        # MjData's arrays read at every refresh (the World keeps one MjData), and
+        # qfrc_applied's rows of the servo's DOFs as a view
+        self._mjM, self._mjqpos = d.M, d.qpos
         d0 = int(self._didx[0])
         self._qfrc = (
             d.qfrc_applied[d0 : d0 + 3 * n]
@@ -389,7 +391,7 @@ class PDServo:
         factor into the gears, rotation vectors into ``ctrl``), copy :attr:`feedforward`
         into ``qfrc_applied``. After it the actuators' torque equals :meth:`torques`."""
         d = self.world.data
-        d.M.take(self._midx, out=self._inertia)
+        self._mjM.take(self._midx, out=self._inertia)
         # np.linalg.cholesky's own LAPACK gufunc, without its wrapper (a third of the cost);
         # a block that is not positive definite comes back as NaN
         _umath_linalg.cholesky_lo(self._inertia, signature="d->d", out=self._chol)
@@ -400,7 +402,7 @@ class PDServo:
                 f"simulation went unstable at t = {float(d.time):.4f} s: a joint inertia of "
                 "the servo is not positive definite"
             )
-        np.take(d.qpos, self._qidx, out=self._q0_flat)
+        self._mjqpos.take(self._qidx, out=self._q0_flat)
         np.matmul(self._rd, self._q0_col, out=self._p_col)  # conj(q0) * q_d
         # both logs at once, as mju_quat2Vel: 2 atan2(|v|, |w|) sign(w) v / |v| (shortest arc)
         s, half, f, w = self._s, self._half, self._f, self._w
