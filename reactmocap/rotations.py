@@ -50,7 +50,7 @@ __all__ = [
 try:  # np.einsum's C routine: what np.einsum calls (optimize off), less its Python wrapper
     from numpy._core.multiarray import c_einsum as _c_einsum
 except ImportError:  # numpy 1.x
-    from numpy.core.multiarray import c_einsum as _c_einsum
+    from numpy.core.multiarray import c_einsum as _c_einsum  # type: ignore[no-redef]
 
 F64 = NDArray[np.float64]
 Floats = NDArray[np.floating[Any]]

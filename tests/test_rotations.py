@@ -11,6 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from reactmocap.errors import ConfigError
 from reactmocap.rotations import (
+    EulerQuats,
     quat_canonical,
     quat_conj,
     quat_continuous,
@@ -20,6 +21,8 @@ from reactmocap.rotations import (
     quat_from_yaw,
     quat_log,
     quat_mul,
+    quat_mul_rows,
+    quat_mul_table,
     quat_normalize,
     quat_rotate,
     quat_slerp,
@@ -189,6 +192,36 @@ def test_euler_equals_scipy_to_the_bit(order: str) -> None:
     np.testing.assert_array_equal(quat_from_euler(angles, order.lower()), expected)
     assert quat_from_euler(angles[0], order).shape == (4,)
     assert quat_from_euler(angles[:10].reshape(2, 5, 3), order).shape == (2, 5, 4)
+
+
+@pytest.mark.parametrize("order", ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX",
+                                   "XYX", "XZX", "YXY", "YZY", "ZXZ", "ZYZ"])  # fmt: skip
+def test_euler_quats_into_buffers_equal_quat_from_euler_to_the_bit(order: str) -> None:
+    # the control ticks' buffered converter makes the same products in the same order: the
+    # same values and zero signs, call after call on the same buffers
+    rng = np.random.default_rng(sum(map(ord, order)))
+    convert = EulerQuats(order, 15)
+    for _ in range(200):
+        angles = rng.uniform(-4.0, 4.0, (15, 3)) * rng.choice([1e-3, 1.0, 10.0], (15, 1))
+        angles[rng.random((15, 3)) < 0.1] = 0.0
+        angles[rng.random((15, 3)) < 0.1] = -0.0
+        got, want = convert(angles), quat_from_euler(angles, order)
+        np.testing.assert_array_equal(got, want)
+        np.testing.assert_array_equal(np.signbit(got), np.signbit(want))
+    with pytest.raises(ConfigError, match="Euler order"):
+        EulerQuats("XXY", 15)
+
+
+def test_quat_mul_rows_into_buffers_equal_the_plain_form_to_the_bit() -> None:
+    a, b = _random_quats(15, 5), _random_quats(15, 6)
+    a[:4, 2] = -0.0
+    table = np.empty((15, 4, 4))
+    assert quat_mul_table(b, table) is table
+    np.testing.assert_array_equal(table, quat_mul_table(b))
+    got, want = quat_mul_rows(a, table, np.empty((15, 4, 4))), quat_mul_rows(a, quat_mul_table(b))
+    np.testing.assert_array_equal(got, want)
+    np.testing.assert_array_equal(np.signbit(got), np.signbit(want))
+    np.testing.assert_array_equal(want, quat_mul(a, b))
 
 
 @pytest.mark.parametrize("order", ["XY", "XXY", "XYZX", "XYW"])

@@ -392,9 +392,10 @@ class PDServo:
         into ``qfrc_applied``. After it the actuators' torque equals :meth:`torques`."""
         d = self.world.data
         self._mjM.take(self._midx, out=self._inertia)
-        # np.linalg.cholesky's own LAPACK gufunc, without its wrapper (a third of the cost);
-        # a block that is not positive definite comes back as NaN
-        _umath_linalg.cholesky_lo(self._inertia, signature="d->d", out=self._chol)
+        # np.linalg.cholesky's own LAPACK gufunc, without its wrapper (half the cost); a block
+        # that is not positive definite comes back as NaN (quietly: the error below says it)
+        with np.errstate(invalid="ignore"):
+            _umath_linalg.cholesky_lo(self._inertia, signature="d->d", out=self._chol)
         lt = self._chol_t
         total = np.add.reduce(self._chol_last)
         if total != total:  # only a state that diverged since the engine's check

@@ -102,3 +102,42 @@ def test_unknown_bodies_list_the_valid_ones(tmp_path) -> None:  # type: ignore[n
         athlete("robot")
     with pytest.raises(ConfigError, match="does not exist"):
         athlete(tmp_path / "missing.bvh")
+
+
+def test_joint_quats_buffered_path_equals_the_plain_one_to_the_bit() -> None:
+    # the control ticks' (15, 3) float64 angles go through buffers; anything else through
+    # quat_from_euler and the plain products: the same values and zero signs
+    ath = athlete("male")
+    rng = np.random.default_rng(7)
+    for _ in range(100):
+        angles = rng.uniform(-2.0, 2.0, (15, 3))
+        angles[rng.random((15, 3)) < 0.15] = -0.0
+        fast = ath.joint_quats(angles)
+        plain = ath.joint_quats(angles.tolist())  # type: ignore[arg-type]
+        np.testing.assert_array_equal(fast, plain)
+        np.testing.assert_array_equal(np.signbit(fast), np.signbit(plain))
+    assert ath.joint_quats(angles) is not ath.joint_quats(angles)  # a new array each call
+
+
+def test_senses_sole_corners_equal_sole_corners_world() -> None:
+    from reactmocap.athletics.running import running_start
+    from reactmocap.athletics.scene import athletics_world
+    from reactmocap.athletics.senses import Senses
+    from reactmocap.sim.feet import SoleCorners, foot_soles, sole_corners_world
+
+    ath = athlete("male")
+    world = athletics_world(ath)
+    qpos, qvel = running_start(ath, 3.0)
+    world.set_pose(0, qpos, qvel)
+    senses = Senses(world, ath)
+    _, soles, local = foot_soles(world, 0, "test")
+    corners = SoleCorners(world.data, soles, local)
+    for k in range(5):
+        world.step(40)
+        senses.update(float(k))
+        want = sole_corners_world(world.data, soles, local)
+        np.testing.assert_array_equal(corners(), want)
+        np.testing.assert_array_equal(senses.sole_corners(), want)
+        low = float((want - world.data.geom_xpos[senses.floor]).reshape(-1, 3)[:, 2].min())
+        assert senses.clearance == low  # the level floor's shortcut: the product's value
+    assert corners() is not corners()  # a new array each call

@@ -8,6 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from reactmocap.errors import SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.rotations import quat_normalize
 from reactmocap.sim import Impact, PDServo, PDTracker, World, WorldConfig, build_character
@@ -416,3 +417,29 @@ def test_gain_scales_at_once_equal_one_joint_at_a_time(guard: Motion) -> None:
         both.servo.set_gain_scales(1, np.zeros(NJ))
     with pytest.raises(ConfigError, match="gain scales"):
         both.servo.set_gain_scales(1, np.ones(3))
+
+
+def test_set_targets_normalises_into_the_servo_and_keeps_frozen_clamps(guard: Motion) -> None:
+    # set_targets writes into its buffers: the same q / |q| and right matrices as the plain
+    # expressions, frozen joints keep their clamp targets
+    _, servo = _random_world(guard, 2.0, 3)
+    rng = np.random.default_rng(3)
+    q = rng.normal(size=(NJ, 4)) * 3.0
+    clamp = servo.targets[:NJ].copy()
+    servo.set_targets(0, q)
+    want = q / np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
+    frozen = servo.frozen[:NJ]
+    assert frozen.any()
+    want[frozen] = clamp[frozen]
+    np.testing.assert_array_equal(servo.targets[:NJ], want)
+    np.testing.assert_array_equal(servo._rd[:NJ], _right_matrix(want))
+    with pytest.raises(SimulationError, match="NaN"):
+        servo.set_targets(0, np.full((NJ, 4), np.nan))
+
+
+def test_refresh_raises_on_an_inertia_that_is_not_positive_definite(guard: Motion) -> None:
+    world, servo = _random_world(guard, 1.0, 4)
+    servo.refresh()
+    world.data.M[servo._midx[3, 0, 0]] = -1.0  # one joint's block no longer positive definite
+    with pytest.raises(SimulationError, match="not positive definite"):
+        servo.refresh()
