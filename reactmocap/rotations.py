@@ -47,10 +47,15 @@ __all__ = [
     "wxyz_from_rotation",
 ]
 
-try:  # np.einsum's C routine: what np.einsum calls (optimize off), less its Python wrapper
+# np.einsum's C routine: what np.einsum calls (optimize off), less its Python wrapper; a
+# private name, so a numpy that moves it falls back to np.einsum (the same values, slower)
+try:
     from numpy._core.multiarray import c_einsum as _c_einsum
-except ImportError:  # numpy 1.x
-    from numpy.core.multiarray import c_einsum as _c_einsum  # type: ignore[no-redef]
+except ImportError:
+    try:  # numpy 1.x
+        from numpy.core.multiarray import c_einsum as _c_einsum  # type: ignore[no-redef]
+    except ImportError:
+        _c_einsum = np.einsum
 
 F64 = NDArray[np.float64]
 Floats = NDArray[np.floating[Any]]

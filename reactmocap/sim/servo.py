@@ -8,11 +8,10 @@ way (actuator gears from a Cholesky factor, implicit damping, half turns): ``doc
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import mujoco
 import numpy as np
-from numpy.linalg import _umath_linalg  # type: ignore[attr-defined]
 from numpy.typing import NDArray
 
 from reactmocap.errors import ConfigError, SimulationError, UnknownKeyError
@@ -21,6 +20,26 @@ from reactmocap.sim.character import BALL_JOINTS
 from reactmocap.sim.world import World
 
 __all__ = ["PDServo", "critical_kv"]
+
+
+def _cholesky_public(a: NDArray[np.float64], signature: str, out: NDArray[np.float64]) -> None:
+    """np.linalg.cholesky into ``out``, NaN where a block is not positive definite: the
+    fallback for a numpy without the private gufunc below (the same values)."""
+    try:
+        out[...] = np.linalg.cholesky(a)
+    except np.linalg.LinAlgError:
+        out.fill(np.nan)
+
+
+# np.linalg.cholesky's own LAPACK gufunc without its wrapper (half the cost); a private name,
+# so a numpy that moves it gets the public call
+_cholesky_lo: Callable[..., object]
+try:
+    from numpy.linalg import _umath_linalg  # type: ignore[attr-defined]
+
+    _cholesky_lo = _umath_linalg.cholesky_lo
+except (ImportError, AttributeError):
+    _cholesky_lo = _cholesky_public
 
 F64 = NDArray[np.float64]
 NJ = len(BALL_JOINTS)
@@ -392,10 +411,10 @@ class PDServo:
         into ``qfrc_applied``. After it the actuators' torque equals :meth:`torques`."""
         d = self.world.data
         self._mjM.take(self._midx, out=self._inertia)
-        # np.linalg.cholesky's own LAPACK gufunc, without its wrapper (half the cost); a block
-        # that is not positive definite comes back as NaN (quietly: the error below says it)
+        # a block that is not positive definite comes back as NaN (quietly: the error below
+        # says it)
         with np.errstate(invalid="ignore"):
-            _umath_linalg.cholesky_lo(self._inertia, signature="d->d", out=self._chol)
+            _cholesky_lo(self._inertia, signature="d->d", out=self._chol)
         lt = self._chol_t
         total = np.add.reduce(self._chol_last)
         if total != total:  # only a state that diverged since the engine's check
