@@ -184,9 +184,10 @@ class Step:
             its place, until the swing's limit, docs/athletics.md "the step put down").
         hang_still: before the run's first step, a foot left hanging by the standing balance
             is planted (:data:`STANDING_HANG`) once the COM is slower than this (m/s) instead
-            of :data:`STANDING_STILL` (0: off; her 85 N right push hung a foot for 0.8 s at
-            0.10 m/s until a step fired; opt-in, docs/athletics.md "What follows the standing
-            step's first touchdown").
+            of :data:`STANDING_STILL` (0: off; :data:`STANDING_STEP` 0.25: her 85 N right push
+            hung a foot for 0.8 s at 0.10 m/s until a step fired; the 16 pushes' limits 2255
+            -> 2425 N, none lower; docs/athletics.md "What follows the standing step's first
+            touchdown").
     """
 
     margin: float = 0.05
@@ -404,8 +405,9 @@ STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
                               windmill=(8.0, 0.05))  # fmt: skip
 #: the ``balance`` behaviour's opt-in step (``step="on"``; :class:`Stepper`'s ``standing``),
 #: with :attr:`BalanceGains.bow_ease` this many seconds, the standing knee bending at most
-#: :data:`STANDING_BEND_RATE` (rad/s) for the swing leg's reach
-STANDING_STEP = Step()
+#: :data:`STANDING_BEND_RATE` (rad/s) for the swing leg's reach; a foot hung before the first
+#: step planted under a COM slower than 0.25 m/s (:attr:`Step.hang_still`)
+STANDING_STEP = Step(hang_still=0.25)
 STANDING_BOW_EASE = 0.15
 STANDING_BEND_RATE = 1.5
 #: the standing step's end: once one foot alone has been down for :data:`STANDING_HANG` s

@@ -245,6 +245,8 @@ def test_a_foot_left_hanging_is_put_down_by_the_standing_step(
     r = run("balance", "male", **push).report
     assert r["balanced"] and r["on_both_feet"] and not r["steps"]
     monkeypatch.setattr(balance, "STANDING_STILL", 0.0)  # the option before: never planted
+    never = dataclasses.replace(balance.STANDING_STEP, hang_still=0.0)  # nor before a step
+    monkeypatch.setattr(behaviours, "STANDING_STEP", never)
     r = run("balance", "male", **push).report
     assert r["balanced"] and not r["on_both_feet"] and not r["steps"]
 
@@ -354,11 +356,14 @@ def test_a_foot_hung_before_the_first_step_is_planted_under_a_faster_com(
     # the capture point drifts out and the steps that follow leave her moving at 3 s; planted
     # once the COM is slower than 0.25 m/s (Step.hang_still) she stands still on both feet
     # without a step
+    # without it (step="on" has it 0.25)
     push = {"check_range": False, "seconds": 3.0, "push": 85.0, "push_dir": -math.pi / 2}
+    assert balance.STANDING_STEP.hang_still == 0.25
+    step = dataclasses.replace(balance.STANDING_STEP, hang_still=0.0)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
     r = run("balance", "female", step="on", **push).report
     assert r["steps"] and not (r["balanced"] and r["on_both_feet"])
-    step = dataclasses.replace(balance.STANDING_STEP, hang_still=0.25)
-    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", balance.STANDING_STEP)
     r_still = run("balance", "female", step="on", **push).report
     assert not r_still["steps"]
     assert r_still["balanced"] and r_still["on_both_feet"]
