@@ -187,6 +187,12 @@ class Step:
             reach it) instead of past the capture point (0: off; opt-in: the male back
             handspring's landing steps hung 3-5 cm over the floor, the foot 0.2-0.3 m beside
             its place, until the swing's limit, docs/athletics.md "the step put down").
+        hang_still: before the run's first step, a foot left hanging by the standing balance
+            is planted (:data:`STANDING_HANG`) once the COM is slower than this (m/s) instead
+            of :data:`STANDING_STILL` (0: off; :data:`STANDING_STEP` 0.25: her 85 N right push
+            hung a foot for 0.8 s at 0.10 m/s until a step fired; the 16 pushes' limits 2255
+            -> 2425 N, none lower; docs/athletics.md "What follows the standing step's first
+            touchdown").
     """
 
     margin: float = 0.05
@@ -199,6 +205,7 @@ class Step:
     give_time: float = 0.1
     foresee: float = 0.0
     down_after: float = 0.0
+    hang_still: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -219,6 +226,9 @@ class Step:
             raise ConfigError(f"step foresee must be 0 or in (0, 1] s, with across: {self.foresee}")
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
+        v = self.hang_still
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 1.0):
+            raise ConfigError(f"step hang_still must be in [0, 1] m/s, got {v!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -400,8 +410,9 @@ STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
                               windmill=(8.0, 0.05))  # fmt: skip
 #: the ``balance`` behaviour's opt-in step (``step="on"``; :class:`Stepper`'s ``standing``),
 #: with :attr:`BalanceGains.bow_ease` this many seconds, the standing knee bending at most
-#: :data:`STANDING_BEND_RATE` (rad/s) for the swing leg's reach
-STANDING_STEP = Step()
+#: :data:`STANDING_BEND_RATE` (rad/s) for the swing leg's reach; a foot hung before the first
+#: step planted under a COM slower than 0.25 m/s (:attr:`Step.hang_still`)
+STANDING_STEP = Step(hang_still=0.25)
 STANDING_BOW_EASE = 0.15
 STANDING_BEND_RATE = 1.5
 #: the standing step's end: once one foot alone has been down for :data:`STANDING_HANG` s
@@ -916,10 +927,8 @@ class Stepper:
             self._t_hang = math.inf
             return
         self._t_hang = min(self._t_hang, t)
-        if (
-            t >= max(self._t_hang + STANDING_HANG, self._t_end + STEP_PAUSE)
-            and speed < STANDING_STILL
-        ):
+        still = self.step.hang_still if self.step.hang_still and not self.record else STANDING_STILL
+        if t >= max(self._t_hang + STANDING_HANG, self._t_end + STEP_PAUSE) and speed < still:
             bl.posture = replace(bl.posture, plant=True)
 
 

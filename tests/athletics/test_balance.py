@@ -245,6 +245,8 @@ def test_a_foot_left_hanging_is_put_down_by_the_standing_step(
     r = run("balance", "male", **push).report
     assert r["balanced"] and r["on_both_feet"] and not r["steps"]
     monkeypatch.setattr(balance, "STANDING_STILL", 0.0)  # the option before: never planted
+    never = dataclasses.replace(balance.STANDING_STEP, hang_still=0.0)  # nor before a step
+    monkeypatch.setattr(behaviours, "STANDING_STEP", never)
     r = run("balance", "male", **push).report
     assert r["balanced"] and not r["on_both_feet"] and not r["steps"]
 
@@ -343,3 +345,29 @@ def test_a_standing_step_placed_at_the_foreseen_capture_point_keeps_the_body_up(
         Step(foresee=0.3)
     with pytest.raises(ConfigError, match="foresee"):
         Step(across=0.15, foresee=1.5)
+
+
+def test_a_foot_hung_before_the_first_step_is_planted_under_a_faster_com(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "What follows the standing step's first
+    # touchdown"): at the female's 85 N push to her right the standing balance hangs a foot
+    # from 1.25 s, the COM slowing to 0.10 m/s, never under STANDING_STILL (0.08), so no plant;
+    # the capture point drifts out and the steps that follow leave her moving at 3 s; planted
+    # once the COM is slower than 0.25 m/s (Step.hang_still) she stands still on both feet
+    # without a step
+    # without it (step="on" has it 0.25)
+    push = {"check_range": False, "seconds": 3.0, "push": 85.0, "push_dir": -math.pi / 2}
+    assert balance.STANDING_STEP.hang_still == 0.25
+    step = dataclasses.replace(balance.STANDING_STEP, hang_still=0.0)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    r = run("balance", "female", step="on", **push).report
+    assert r["steps"] and not (r["balanced"] and r["on_both_feet"])
+    monkeypatch.setattr(behaviours, "STANDING_STEP", balance.STANDING_STEP)
+    r_still = run("balance", "female", step="on", **push).report
+    assert not r_still["steps"]
+    assert r_still["balanced"] and r_still["on_both_feet"]
+    with pytest.raises(ConfigError, match="hang_still"):
+        Step(hang_still=-0.1)
+    with pytest.raises(ConfigError, match="hang_still"):
+        Step(hang_still=float("nan"))
