@@ -597,8 +597,9 @@ def test_the_ground_path_follows_displaced_feet(guard: Motion) -> None:
 def test_the_ground_path_turns_no_faster_than_its_bound(guard: Motion) -> None:
     """A character standing turned 0.5 rad from its mocap: the re-anchored path turns after
     its feet, at most ``anchor_turn_rate`` over the clip's own soles' turn (opt-in,
-    2026-12-05: a foot down early took a walk's path 13 deg round in 0.1 s), to the same
-    heading as unbounded in the end; unbounded it turns several times faster."""
+    2026-12-05: with ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round
+    in 0.1 s), to the same heading as unbounded in the end; unbounded it turns several times
+    faster."""
     import mujoco
 
     from reactmocap.rotations import quat_from_yaw, quat_mul

@@ -276,9 +276,9 @@ class WholeBodyTracker(AnchoredReference):
             ``step_ahead`` keep the clip's flags (``centre_speed`` filters them all)
             (``docs/tracking.md``, issue 16).
         anchor_turn_rate: the ground path's heading (``anchor_tau``) turns at most this much
-            faster (rad/s) than the clip's own soles that set it (their mean yaw rate): a foot
-            down early took the path 13 deg round in 0.1 s (0: unbounded; needs
-            ``anchor_tau``) (``docs/tracking.md``, issue 16).
+            faster (rad/s) than the clip's own soles that set it (their mean yaw rate): with
+            ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round in 0.1 s
+            (0: unbounded; needs ``anchor_tau``) (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
