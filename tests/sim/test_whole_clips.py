@@ -594,6 +594,42 @@ def test_the_ground_path_follows_displaced_feet(guard: Motion) -> None:
     assert not off.anchor_shift.any()
 
 
+def test_the_ground_path_turns_no_faster_than_its_bound(guard: Motion) -> None:
+    """A character standing turned 0.5 rad from its mocap: the re-anchored path turns after
+    its feet, at most ``anchor_turn_rate`` over the clip's own soles' turn (opt-in,
+    2026-12-05: with ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round
+    in 0.1 s), to the same heading as unbounded in the end; unbounded it turns several times
+    faster."""
+    import mujoco
+
+    from reactmocap.rotations import quat_from_yaw, quat_mul
+
+    world = World(build_character(guard, frame=0))
+    world.set_from_motion(0, guard, 0)
+    root = world.characters[0].qpos_slice.start + 3
+    world.data.qpos[root : root + 4] = quat_mul(
+        quat_from_yaw(0.5), world.data.qpos[root : root + 4]
+    )
+    mujoco.mj_forward(world.model, world.data)
+    spec = controller_spec("wholebody")
+
+    def turned(calls: int, **kw: float) -> WholeBodyTracker:
+        wb = WholeBodyTracker(world, 0, guard, 0.0, kp_joint=1000.0, anchor_tau=0.1,
+                              servo_kv=float(spec.defaults["servo_kv"]), control_every=4,
+                              **kw)  # fmt: skip
+        for _ in range(calls):
+            wb.reanchor(0.0)
+        return wb
+
+    bounded, free = turned(20, anchor_turn_rate=0.25), turned(20)
+    most = 20 * (bounded._turn_step + float(bounded._sole_turn[0].mean()))
+    assert 0.0 < bounded.anchor_yaw <= most + 1e-12  # 0.25 rad/s for 0.16 s, the clip still
+    assert free.anchor_yaw > 3 * most
+    assert turned(600, anchor_turn_rate=0.25).anchor_yaw == pytest.approx(
+        turned(600).anchor_yaw, abs=0.01
+    )
+
+
 def test_a_sliding_foot_is_not_planted(guard: Motion) -> None:
     """A foot skimming the floor faster than ``slide_speed`` is not a support."""
     world = World(build_character(guard, frame=0))

@@ -285,12 +285,20 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_ahead_phase", -0.05),
         ("centre_speed", -1.0),
         ("centre_speed_lock", -2.5),
+        ("anchor_turn_rate", -0.5),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match=key):
         _tracker(world, guard, 0.0, **{key: value})
+
+
+def test_anchor_turn_rate_needs_the_anchoring(guard: Motion) -> None:
+    """The anchoring's turn bound (``anchor_turn_rate``) without the anchoring is refused."""
+    world = World(build_character(guard, frame=0))
+    with pytest.raises(ConfigError, match="anchor_turn_rate"):
+        _tracker(world, guard, 0.0, anchor_turn_rate=0.5)
 
 
 def test_step_ahead_growth_needs_its_step(guard: Motion) -> None:

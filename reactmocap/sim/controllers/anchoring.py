@@ -140,6 +140,7 @@ class AnchoredReference:
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
         centre_speed_lock: float = 0.0,
+        anchor_turn_rate: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -162,6 +163,7 @@ class AnchoredReference:
         self.roll_band = float(roll_band) if roll_band > 0 else np.inf
         self._sole_half = m.geom_size[self.sole, 2][:, None].copy()
         assert self.path.com is not None and self.path.sole is not None
+        assert self.path.sole_yaw is not None
         self._com: F64 = self.path.com
         dt_f = 1.0 / self.path.fps
         n = self.path.num_frames
@@ -176,6 +178,14 @@ class AnchoredReference:
             slow = sole_speed(self.path.sole, self.path.fps) < centre_speed_lock
             self._lock_planted = self.path.planted & slow
             self._lock_pivoting = self.path.pivoting & slow
+        # ``anchor_turn_rate``: the anchoring's largest yaw step per slow tick over the clip's
+        # own soles' yaw step there (rad; inf: off)
+        self._turn_step = anchor_turn_rate * dt_slow if anchor_turn_rate else np.inf
+        self._sole_turn = (
+            np.abs(np.gradient(self.path.sole_yaw, dt_f, axis=0)) * dt_slow
+            if anchor_turn_rate and n > 1
+            else np.zeros((n, 2))
+        )
         self.balance_margin = float(balance_margin)
         self._balance_rate = min(1.0, dt_slow / balance_tau) if balance_tau > 0 else 0.0
         #: horizontal shift of the pelvis and centre-of-mass targets (m) keeping the mocap's
@@ -847,8 +857,13 @@ class AnchoredReference:
         err = err * max(0.0, 1.0 - db / n) if n > 0 else err
         dyaw = float(np.sign(dyaw) * max(0.0, abs(dyaw) - db / _DEADBAND_ARM))
         k = self._anchor_rate
-        self.anchor_yaw += k * dyaw
-        self.anchor_shift = _rot2(k * dyaw) @ (self.anchor_shift + k * err - centre) + centre
+        # a foot down early turns the path at most as its clip's soles turn, plus the bound
+        dyaw = k * dyaw
+        if self._turn_step < np.inf and turn.any():
+            most = self._turn_step + float(self._sole_turn[i, turn].mean())
+            dyaw = min(max(dyaw, -most), most)
+        self.anchor_yaw += dyaw
+        self.anchor_shift = _rot2(dyaw) @ (self.anchor_shift + k * err - centre) + centre
         # and slowly back toward the captured path, which the gait then follows step by step
         self.anchor_yaw -= self._return_rate * self.anchor_yaw
         self.anchor_shift -= self._return_rate * self.anchor_shift

@@ -275,6 +275,10 @@ class WholeBodyTracker(AnchoredReference):
             than this (m/s; 0: off), while the balance shift, the balance steps and
             ``step_ahead`` keep the clip's flags (``centre_speed`` filters them all)
             (``docs/tracking.md``, issue 16).
+        anchor_turn_rate: the ground path's heading (``anchor_tau``) turns at most this much
+            faster (rad/s) than the clip's own soles that set it (their mean yaw rate): with
+            ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round in 0.1 s
+            (0: unbounded; needs ``anchor_tau``) (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -366,6 +370,7 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
         centre_speed_lock: float = 0.0,
+        anchor_turn_rate: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -401,7 +406,7 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
                 "step_ahead_horizon": step_ahead_horizon, "step_ahead_swing": step_ahead_swing,
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
-                "torque_limit": torque_limit,
+                "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -414,6 +419,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_leg must be 0 (off) or in [0.5, 1.5] (a leg over the pelvis's height), "
                 f"got {step_leg!r}"
+            )
+        if anchor_turn_rate and not anchor_tau:
+            raise ConfigError(
+                f"anchor_turn_rate ({anchor_turn_rate!r}) bounds the anchoring's turn: it needs "
+                f"anchor_tau > 0"
             )
         if step_ahead_horizon and not step_ahead:
             raise ConfigError(
@@ -534,6 +544,7 @@ class WholeBodyTracker(AnchoredReference):
             anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
+            anchor_turn_rate=anchor_turn_rate,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
