@@ -220,6 +220,7 @@ class Runner:
         self.heel = np.zeros(2, dtype=bool)
         self.toe = np.zeros(2, dtype=bool)
         self.heading_d = 0.0
+        self.facing_rate = 0.0  # the desired facing's turn per second, this tick
         self._steered = False
         self.curvature = 0.0
         self.cross_track = math.nan
@@ -388,11 +389,16 @@ class Runner:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
         k = self.k
         arm = (k["arm_gain"] * hips[::-1] + k["arm_offset"]).tolist()  # each opposite hip's
-        if k["arm_yaw"] > 0 and self.world.data.time >= PATH_AFTER:
+        if (k["arm_yaw"] > 0 or k["arm_yaw_rate"] > 0) and self.world.data.time >= PATH_AFTER:
             # the arms counter-rotate against the trunk's yaw past the facing (``arm_yaw``):
             # their reaction turns the trunk without the stance foot's grip
             chest = self._anat(self._chest, SIM_BODY_INDEX["chest"])
             spin = k["arm_yaw"] * euler_yxz(qmul1(qyaw(-self.heading_d), chest))[2]
+            if k["arm_yaw_rate"] > 0:
+                # and against its yaw rate past the facing's (``arm_yaw_rate``): the rate
+                # leads the angle, within the stance that makes the yaw momentum
+                wz = float(self.world.data.cvel[self._chest, 2])
+                spin += k["arm_yaw_rate"] * (wz - self.facing_rate)
             arm = [arm[0] + spin, arm[1] - spin]  # left back, right forward for a trunk ahead
         elbow = -k["elbow"]
         # one write for the seven rows (each row's write cost as much as its law)
@@ -687,7 +693,9 @@ class Runner:
         if self._steered:
             step = wrap_angle(want - self.heading_d)
             limit = self.k["turn_rate"] * self.control_every * self._timestep
-            self.heading_d += clamp(step, -limit, limit)
+            turn = clamp(step, -limit, limit)
+            self.heading_d += turn
+            self.facing_rate = turn / (self.control_every * self._timestep)
         else:
             self.heading_d, self._steered = want, True
         if self.speed < self.target:

@@ -148,6 +148,9 @@ class RunParams:
             moved by this times the trunk's yaw past the desired facing, the left arm back
             and the right forward for a trunk turned left of it, so the arms' reaction turns
             the trunk back without the stance foot's grip. Within [0, 5].
+        arm_yaw_rate: the same for the trunk's yaw rate past the desired facing's rate (s;
+            0: off): each shoulder's pitch also moved by this times it, the same signs as
+            ``arm_yaw``'s, from ``PATH_AFTER`` on. Within [0, 1].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -196,6 +199,7 @@ class RunParams:
     path_integral: float | Speeds = (5.0, 0, 0)
     lean: float | Speeds = 1.0
     arm_yaw: float | Speeds = 0.0
+    arm_yaw_rate: float | Speeds = 0.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
@@ -215,7 +219,12 @@ class RunParams:
                     f"running parameter {f.name} takes a number or three (at {TUNED_SPEEDS} m/s)"
                 )
         per_joint(self.stiffness)  # unknown joint kinds are named there
-        for name, top in (("push_hold", 1.0), ("push_ramp", 1.0), ("arm_yaw", 5.0)):
+        for name, top in (
+            ("push_hold", 1.0),
+            ("push_ramp", 1.0),
+            ("arm_yaw", 5.0),
+            ("arm_yaw_rate", 1.0),
+        ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
                 raise ConfigError(f"{name} must be in [0, {top:g}], got {v}")

@@ -72,9 +72,44 @@ def test_arm_yaw_counter_rotates_the_arms_against_the_trunks_yaw() -> None:
     assert not np.array_equal(off["com"][~before], on["com"][~before])
 
 
+def test_arm_yaw_rate_moves_the_arms_by_the_trunks_yaw_rate_past_the_facings() -> None:
+    """``arm_yaw_rate``: beside ``arm_yaw``'s angle term the shoulders' pitch goals move by
+    the gain times the chest's yaw rate past the desired facing's rate (same signs), from
+    ``PATH_AFTER`` on; before it the run is ``arm_yaw``'s alone to the bit."""
+    rate = 0.1
+    runs = {}
+    for g in (0.0, rate):
+        res = run_course(2.5, seconds=PATH_AFTER + 0.5, path="circle:10", fps=10.0,
+                         params=RunParams(arm_yaw=2.0, arm_yaw_rate=g))  # fmt: skip
+        r = res.runner
+        hips = r._angles[r._hip_rows, 0].copy()
+        r._upper(hips)  # the arms' law on the run's last state
+        k = r.k
+        extra = [r.goal[SHOULDER[leg], 0] - (k["arm_gain"] * hips[1 - leg] + k["arm_offset"])
+                 for leg in range(2)]  # fmt: skip
+        chest = r._anat(r._chest, SIM_BODY_INDEX["chest"])
+        spin = 2.0 * euler_yxz(qmul1(qyaw(-r.heading_d), chest))[2]
+        past = float(r.world.data.cvel[r._chest, 2]) - r.facing_rate
+        runs[g] = (r.log.arrays(), extra, spin, past, r.facing_rate)
+    (off, extra0, spin0, _, _), (on, extra1, spin1, past, facing) = runs[0.0], runs[rate]
+    assert extra0 == pytest.approx([spin0, -spin0], rel=1e-9)
+    # on the circle the facing turns (about 0.25 rad/s) and the chest's rate differs from it
+    assert 0.1 < facing <= 0.35 + 1e-9
+    assert abs(rate * past) > 1e-3
+    assert extra1 == pytest.approx([spin1 + rate * past, -spin1 - rate * past], rel=1e-9)
+    before = off["t"] < PATH_AFTER
+    assert np.array_equal(off["com"][before], on["com"][before])
+    assert not np.array_equal(off["com"][~before], on["com"][~before])
+
+
 def test_arm_yaw_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"arm_yaw must be in \[0, 5\]"):
         RunParams(arm_yaw=(0.0, 0.0, 6.0))
     with pytest.raises(ConfigError, match=r"arm_yaw must be in \[0, 5\]"):
         RunParams(arm_yaw=-0.1)
     assert RunParams().at(2.5)["arm_yaw"] == 0.0
+    with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
+        RunParams(arm_yaw_rate=1.5)
+    with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
+        RunParams(arm_yaw_rate=(0.0, -0.05, 0.0))
+    assert RunParams().at(2.5)["arm_yaw_rate"] == 0.0
