@@ -252,6 +252,10 @@ class LandingParams:
             on the male back handspring 13 of 19 full-size failures that reach the feet had
             a step's swing run its whole 0.75 s without the foot down (docs/athletics.md,
             "the step put down").
+        recover_leg: the recovery stands up to at least this fraction of the straight leg
+            (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
+            back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
+            0.71-0.78 m, sinking (docs/athletics.md, "the one-leg stand-up").
     """
 
     knee: float = 0.6
@@ -295,6 +299,7 @@ class LandingParams:
     step_across: float = 0.0
     step_ground: float = 0.0
     step_down_after: float = 0.0
+    recover_leg: float = 0.0
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -336,6 +341,9 @@ class LandingParams:
             raise ConfigError(f"landing pitch_ease must be >= 0 s, got {self.pitch_ease}")
         if not 0.0 <= self.roll_ease <= 0.9:  # the recovery hands over within 1 s anyway
             raise ConfigError(f"landing roll_ease must be in [0, 0.9] s, got {self.roll_ease}")
+        r = self.recover_leg
+        if not (isinstance(r, (int, float)) and (r == 0.0 or 0.5 <= r <= 1.0)):
+            raise ConfigError(f"landing recover_leg must be 0 or in [0.5, 1], got {r!r}")
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
         if self.late_delta and not (
@@ -669,7 +677,8 @@ class Landing(Basis):
             rig.move(rig.current_angles(), 0.0, t, _KNEE)  # the knees stiffen where they are
             leg = _leg_fraction(ctx)
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
-            bl.set_posture(Posture(leg=max(leg, 0.5), lean=p.lean, settle=0.3), t)
+            stand_up = max(leg, 0.5, p.recover_leg)  # recover_leg: at least so tall
+            bl.set_posture(Posture(leg=stand_up, lean=p.lean, settle=0.3), t)
 
         def settled(world: World, t: float, t_in: float) -> bool:
             s = ctx.sense(t)

@@ -446,3 +446,26 @@ def test_the_landing_steps_closing_swing_ends_sooner_put_down_or_placed_across()
             LandingParams(step=(0.05,), **bad)
     with pytest.raises(ConfigError, match="need a step"):
         LandingParams(step_down_after=0.3)
+
+
+def test_the_landings_recover_leg_stands_the_recovery_up_taller() -> None:
+    """``LandingParams.recover_leg`` (opt-in, off in the file): the recovery's stand-up goes
+    to at least that fraction of the straight leg, not to where the landing's crouch left the
+    legs. Full-size start 28 (seed 0): the run is the file's up to the recovery, and 0.5 s
+    after the feet touch its COM stands higher; a bad value is named."""
+    m = replace(load_maneuver(EXAMPLE), seconds=4.2)
+    land = next(p for p in m.phases if p.controller == "land").params
+    assert "recover_leg" not in land
+    start = _starts(1.0, 29)[28]
+    base = run_maneuver(m, perturbation=start, fps=10.0)
+    tall = run_maneuver(_with(m, "land", {**land, "recover_leg": 0.8}), perturbation=start,
+                        fps=10.0)  # fmt: skip
+    td = base.report["touchdown_s"]
+    assert tall.report["touchdown_s"] == td
+    t = base.log["t"]
+    before, after = t < td, int(np.searchsorted(t, td + 0.5))
+    assert np.array_equal(base.log["com"][before], tall.log["com"][before])
+    assert tall.log["com"][after, 2] > base.log["com"][after, 2] + 0.03
+    for bad in (0.3, 1.2):
+        with pytest.raises(ConfigError, match="recover_leg"):
+            LandingParams(recover_leg=bad)
