@@ -10,7 +10,7 @@ import pytest
 
 from reactmocap.athletics.paths import Facing
 from reactmocap.athletics.run_course import run_course
-from reactmocap.athletics.running import PATH_AFTER, SHOULDER
+from reactmocap.athletics.running import PATH_AFTER, SHOULDER, Runner
 from reactmocap.athletics.running_body import euler_yxz, qmul1, qyaw
 from reactmocap.athletics.running_params import RunParams
 from reactmocap.errors import ConfigError
@@ -44,6 +44,18 @@ def test_stance_estimate_is_smoothed_at_the_path_speed() -> None:
     assert abs(runner.stance_estimate - last) > 1e-4
 
 
+def _arms_past_eq5(params: RunParams) -> tuple[Runner, list[float]]:
+    """A circle run 0.5 s past ``PATH_AFTER`` and how far each shoulder's pitch goal lies
+    from eq. 5's on its last state (the arms' law run once more there)."""
+    r = run_course(2.5, seconds=PATH_AFTER + 0.5, path="circle:10", fps=10.0, params=params).runner
+    hips = r._angles[r._hip_rows, 0].copy()
+    r._upper(hips)
+    k = r.k
+    extra = [r.goal[SHOULDER[leg], 0] - (k["arm_gain"] * hips[1 - leg] + k["arm_offset"])
+             for leg in range(2)]  # fmt: skip
+    return r, extra
+
+
 def test_arm_yaw_counter_rotates_the_arms_against_the_trunks_yaw() -> None:
     """``arm_yaw``: from ``PATH_AFTER`` on the shoulders' pitch goals leave eq. 5 by the gain
     times the trunk's yaw past the desired facing, the left arm back and the right forward
@@ -52,14 +64,7 @@ def test_arm_yaw_counter_rotates_the_arms_against_the_trunks_yaw() -> None:
     gain = 2.0
     runs = {}
     for g in (0.0, gain):
-        res = run_course(2.5, seconds=PATH_AFTER + 0.5, path="circle:10", fps=10.0,
-                         params=RunParams(arm_yaw=g))  # fmt: skip
-        r = res.runner
-        hips = r._angles[r._hip_rows, 0].copy()
-        r._upper(hips)  # the arms' law on the run's last state
-        k = r.k
-        extra = [r.goal[SHOULDER[leg], 0] - (k["arm_gain"] * hips[1 - leg] + k["arm_offset"])
-                 for leg in range(2)]  # fmt: skip
+        r, extra = _arms_past_eq5(RunParams(arm_yaw=g))
         chest = r._anat(r._chest, SIM_BODY_INDEX["chest"])
         yaw = euler_yxz(qmul1(qyaw(-r.heading_d), chest))[2]
         runs[g] = (r.log.arrays(), extra, yaw)
@@ -79,14 +84,7 @@ def test_arm_yaw_rate_moves_the_arms_by_the_trunks_yaw_rate_past_the_facings() -
     rate = 0.1
     runs = {}
     for g in (0.0, rate):
-        res = run_course(2.5, seconds=PATH_AFTER + 0.5, path="circle:10", fps=10.0,
-                         params=RunParams(arm_yaw=2.0, arm_yaw_rate=g))  # fmt: skip
-        r = res.runner
-        hips = r._angles[r._hip_rows, 0].copy()
-        r._upper(hips)  # the arms' law on the run's last state
-        k = r.k
-        extra = [r.goal[SHOULDER[leg], 0] - (k["arm_gain"] * hips[1 - leg] + k["arm_offset"])
-                 for leg in range(2)]  # fmt: skip
+        r, extra = _arms_past_eq5(RunParams(arm_yaw=2.0, arm_yaw_rate=g))
         chest = r._anat(r._chest, SIM_BODY_INDEX["chest"])
         spin = 2.0 * euler_yxz(qmul1(qyaw(-r.heading_d), chest))[2]
         past = float(r.world.data.cvel[r._chest, 2]) - r.facing_rate
