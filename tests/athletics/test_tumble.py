@@ -285,6 +285,22 @@ def test_a_perturbed_forward_tuck_settles_onto_both_feet_before_the_crouch() -> 
     assert not before["landed"] and before["time_to_liftoff_s"] < r["time_to_liftoff_s"]
 
 
+def test_the_forward_tuck_files_feet_move_by_the_predicted_touchdown_rotation() -> None:
+    """Start 23 of the capture region at full size (seed 0): without the landing's
+    ``turn_gain`` it lands 448 deg round, over-rotated, and falls; the file since 2026-12-05
+    (``turn_gain`` 0.25 past ``turn_ref`` 5.49 rad) puts the feet ahead by the rotation
+    predicted at touchdown and it lands (full size 44 / 44 / 40 of 50 on seeds 0 / 1 / 2,
+    from 44 / 41 / 37; docs/athletics.md, "Forward tuck: the short touchdown's class C")."""
+    m = load_maneuver(
+        Path(__file__).parents[2] / "examples/athletics/maneuvers/forward_somersault.toml"
+    )
+    start = full_starts(24)[23]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+    before = run_maneuver(_without_land_param(m, "turn_gain"), perturbation=start, fps=10.0).report
+    assert not before["landed"] and before["rotation_deg"] > 400.0
+
+
 def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> None:
     """Start 2 of the capture region at full size (seed 0). Its "com" push let the start's
     small roll grow to -5.8 kg m^2/s of cartwheel momentum: the feet touched down 12 cm to
