@@ -122,7 +122,7 @@ class Rig:
         # gravity compensation's buffers, and MjData's arrays it reads (the World keeps one
         # MjData; each attribute read makes a new array)
         d = world.data
-        self._com_anchor = (d.subtree_com, d.xanchor, d.xmat)
+        self._mj_arrays = (d.subtree_com, d.xanchor, d.xmat)
         self._r = np.empty((NJ, 3))
         self._r_anchor = np.empty((NJ, 3))
         self._r_other = np.empty((NJ, 3))
@@ -311,7 +311,7 @@ class Rig:
         m, d = self.world.model, self.world.data
         # each joint holds its subtree up: (subtree com - anchor) x (weight up), child frame;
         # the same products as the arrays' operators, into buffers made once
-        com, anchor, xmat = self._com_anchor
+        com, anchor, xmat = self._mj_arrays
         r, tau, other = self._r, self._tau, self._r_other
         com.take(self._child, 0, out=r)
         anchor.take(self._balls, 0, out=self._r_anchor)
