@@ -38,14 +38,13 @@ def foot_soles(
 
 def sole_corners_world(d: mujoco.MjData, sole: NDArray[np.int64], corners: F64) -> F64:
     """``(2, 4, 3)`` world positions of the sole corners from :func:`foot_soles`."""
-    rot = d.geom_xmat[sole].reshape(2, 3, 3)
-    return einsum("fij,fkj->fki", rot, corners) + d.geom_xpos[sole][:, None]
+    return SoleCorners(d, sole, corners)()
 
 
 class SoleCorners:
     """:func:`sole_corners_world` for one MjData, with its arrays read once and buffers made
-    once (the same products: the same values); each call returns a new ``(2, 4, 3)`` array.
-    For a per-tick caller whose MjData lives as long as it does."""
+    once; each call returns a new ``(2, 4, 3)`` array (the one place the corners' formula
+    lives). For a per-tick caller whose MjData lives as long as it does."""
 
     def __init__(self, d: mujoco.MjData, sole: NDArray[np.int64], corners: F64) -> None:
         self._xmat, self._xpos = d.geom_xmat, d.geom_xpos

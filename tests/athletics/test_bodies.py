@@ -135,7 +135,10 @@ def test_senses_sole_corners_equal_sole_corners_world() -> None:
     for k in range(5):
         world.step(40)
         senses.update(float(k))
-        want = sole_corners_world(world.data, soles, local)
+        d = world.data  # the oracle: each corner rotated and moved by its sole geom's frame
+        rot = d.geom_xmat[soles].reshape(2, 3, 3)
+        want = np.einsum("fij,fkj->fki", rot, local) + d.geom_xpos[soles][:, None]
+        np.testing.assert_array_equal(sole_corners_world(d, soles, local), want)
         np.testing.assert_array_equal(corners(), want)
         np.testing.assert_array_equal(senses.sole_corners(), want)
         low = float((want - world.data.geom_xpos[senses.floor]).reshape(-1, 3)[:, 2].min())
