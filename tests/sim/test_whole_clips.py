@@ -705,6 +705,37 @@ def test_a_walk_whose_foot_lock_skips_the_mid_swing_landings_tracks_closer(
     assert rep.max_root_error_m < 0.6  # 0.506 m; the defaults 0.767 m
 
 
+def test_the_foot_lock_gated_to_walking_clips_leaves_a_fighting_clip_as_the_defaults(
+    shared_mocap_dir: Path,
+) -> None:
+    """``centre_speed_lock_walking`` (opt-in, 2026-12-05): the foot lock acts only on a clip
+    whose centre of mass's median horizontal speed reaches the gate. On a punch (median 0.10
+    m/s) whose lock at 0.7 m/s drops planted frames from 0.77 s on, the gated lock moves the
+    body exactly as the defaults and the ungated lock does not; on a walk (1.54 m/s) the
+    gated lock is the lock."""
+    from reactmocap.library.bvh import read_bvh
+
+    clips = {
+        n: shared_mocap_dir / f"dataset-1_{n}.bvh" for n in ("punch_normal_001", "walk_normal_002")
+    }
+    for clip in clips.values():
+        if not clip.is_file():
+            pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
+    lock = {"centre_speed_lock": 0.7}
+    gated = {**lock, "centre_speed_lock_walking": 0.7}
+
+    def root(name: str, seconds: float, params: dict[str, float]) -> np.ndarray:
+        res = track_clip(read_bvh(clips[name]), seconds=seconds, params=params)
+        return res.rollout.qpos[:, :3]
+
+    punch = root("punch_normal_001", 1.1, {})
+    assert np.array_equal(root("punch_normal_001", 1.1, gated), punch)
+    assert not np.array_equal(root("punch_normal_001", 1.1, lock), punch)
+    walk = root("walk_normal_002", 0.5, lock)
+    assert np.array_equal(root("walk_normal_002", 0.5, gated), walk)
+    assert not np.array_equal(root("walk_normal_002", 0.5, {}), walk)
+
+
 def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:
     """The whole-clip trunk rows keep their weight while nothing pushes (even with the capture
     point off), are off while a push acts and until the capture point is back near the

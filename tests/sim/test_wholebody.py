@@ -285,6 +285,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("step_ahead_phase", -0.05),
         ("centre_speed", -1.0),
         ("centre_speed_lock", -2.5),
+        ("centre_speed_lock_walking", -0.7),
         ("anchor_turn_rate", -0.5),
     ],
 )
@@ -292,6 +293,13 @@ def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match=key):
         _tracker(world, guard, 0.0, **{key: value})
+
+
+def test_centre_speed_lock_walking_needs_the_lock(guard: Motion) -> None:
+    """The foot lock's walking gate (``centre_speed_lock_walking``) without the lock is refused."""
+    world = World(build_character(guard, frame=0))
+    with pytest.raises(ConfigError, match="centre_speed_lock_walking"):
+        _tracker(world, guard, 0.0, centre_speed_lock_walking=0.7)
 
 
 def test_anchor_turn_rate_needs_the_anchoring(guard: Motion) -> None:

@@ -275,6 +275,10 @@ class WholeBodyTracker(AnchoredReference):
             than this (m/s; 0: off), while the balance shift, the balance steps and
             ``step_ahead`` keep the clip's flags (``centre_speed`` filters them all)
             (``docs/tracking.md``, issue 16).
+        centre_speed_lock_walking: ``centre_speed_lock`` only on a walking clip, one whose
+            centre of mass's median horizontal speed is at least this (m/s; 0: every clip;
+            needs ``centre_speed_lock``): the walks 1.0-1.6 m/s, the fighting clips 0.05-0.42
+            (``docs/tracking.md``, issue 16).
         anchor_turn_rate: the ground path's heading (``anchor_tau``) turns at most this much
             faster (rad/s) than the clip's own soles that set it (their mean yaw rate): with
             ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round in 0.1 s
@@ -370,6 +374,7 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_swing: float = 0.0,
         step_ahead_phase: float = 0.0,
         centre_speed_lock: float = 0.0,
+        centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
@@ -406,6 +411,7 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_lag_speed": anchor_lag_speed, "step_ahead": step_ahead,
                 "step_ahead_horizon": step_ahead_horizon, "step_ahead_swing": step_ahead_swing,
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
+                "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -419,6 +425,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_leg must be 0 (off) or in [0.5, 1.5] (a leg over the pelvis's height), "
                 f"got {step_leg!r}"
+            )
+        if centre_speed_lock_walking and not centre_speed_lock:
+            raise ConfigError(
+                f"centre_speed_lock_walking ({centre_speed_lock_walking!r}) gates the foot lock: "
+                f"it needs centre_speed_lock > 0"
             )
         if anchor_turn_rate and not anchor_tau:
             raise ConfigError(
@@ -544,7 +555,7 @@ class WholeBodyTracker(AnchoredReference):
             anchor_lag_speed=anchor_lag_speed, step_ahead=step_ahead,
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
-            anchor_turn_rate=anchor_turn_rate,
+            anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
