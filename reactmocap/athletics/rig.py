@@ -214,10 +214,9 @@ class Rig:
         inertia = self.servo.joint_inertia(self.character)
         scale_inertia = np.einsum("nii->n", inertia) / 3.0
         on = values > 0
-        self.servo.enable(self.character, [BALL_JOINTS[i] for i in np.flatnonzero(~on)], False)
-        self.servo.enable(self.character, [BALL_JOINTS[i] for i in np.flatnonzero(on)], True)
         scale = values * self.stiffness_unit / (SERVO_KP * scale_inertia)
-        self.servo.set_gain_scales(self.character, np.where(on, scale, np.nan))
+        # the switches and the scales in one gain refresh (the gains are a function of both)
+        self.servo.set_gain_scales(self.character, np.where(on, scale, np.nan), enabled=on)
         self._kp[:] = np.where(on, values * self.stiffness_unit / scale_inertia, 0.0)
         self.stiffness[:] = values
 
