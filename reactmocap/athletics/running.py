@@ -21,7 +21,7 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
-from reactmocap.athletics.balance import knee_for_length
+from reactmocap.athletics.balance import knee_for_length1
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.paths import Course, Straight
 from reactmocap.athletics.rig import Rig, per_joint
@@ -350,11 +350,11 @@ class Runner:
         down = math.sqrt(max(length * length - fwd * fwd - lat * lat, 0.04))
         swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
         roll = math.atan2(lat, math.hypot(fwd, down))
-        knee, geom = knee_for_length(self.athlete.thigh[leg], self.athlete.shin[leg], length)
-        thigh = qmul1(qyaw(heading), quat_yxz(-swing + float(geom), roll, 0.0))
+        knee, geom = knee_for_length1(self.athlete.thigh[leg], self.athlete.shin[leg], length)
+        thigh = qmul1(qyaw(heading), quat_yxz(-swing + geom, roll, 0.0))
         pelvis = self._anat(self._root, 0)
         hip_pitch, hip_roll, _ = euler_yxz(qmul1(qconj1(pelvis), thigh))
-        self.knee_td = float(knee)
+        self.knee_td = knee
         shin = self._pitch(self._shins[leg], SHIN[leg], heading)
         ankle = clamp(-k["heel_up"] - shin, -0.5, 0.9)
         # the leg's hip, knee and ankle rows in one write
