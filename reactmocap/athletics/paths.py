@@ -190,15 +190,17 @@ class Polyline:
         self.index = i
         self.progress = s + self._laps * self.total
         # in floats from here (the same roundings as the arrays' without their calls)
-        tx, ty = self._point(s + self.lookahead)
+        ahead = self._point(s + self.lookahead)
+        tx, ty = ahead
         if not self.closed and s + self.lookahead > self.total:  # past the end: straight on
             d = self.points[-1] - self.points[-2]
             tx, ty = (p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead).tolist()
         px, py = p.tolist()
         # the curvature over the look-ahead: the turn between its two halves' chords (the
-        # segments' own directions turn in steps, and the lean read from them jumped)
+        # segments' own directions turn in steps, and the lean read from them jumped); the
+        # far end is the look-ahead point (2 (L / 2) = L and s + 0 = s exactly)
         half = 0.5 * self.lookahead
-        (x0, y0), (x1, y1), (x2, y2) = (self._point(s + f * half) for f in (0.0, 1.0, 2.0))
+        (x0, y0), (x1, y1), (x2, y2) = self._point(s), self._point(s + half), ahead
         ax, ay, bx, by = x1 - x0, y1 - y0, x2 - x1, y2 - y1
         turn = math.atan2(ax * by - ay * bx, ax * bx + ay * by)
         turn = 0.0 if abs(turn) < 1e-12 else turn  # a straight stretch: no rounding's lean

@@ -194,6 +194,10 @@ class Runner:
                            for j, p, c in zip(LEG_JOINTS, parent, child)]  # fmt: skip
         self._q_rel = np.empty(4)
         self._yaw_key = math.nan  # the heading of the last _yaw_inv
+        # the attitude servo's last desired rotation and its inputs (_attitude_torque)
+        self._want = np.array([1.0, 0.0, 0.0, 0.0])
+        self._want_key: tuple[float, ...] = (math.nan,)
+        self._want_signs: tuple[float, ...] = ()
         self._yaw_q = qyaw(0.0)
         self._angles = np.zeros((NJ, 3))
         self._hip_rows = np.array(HIP)
@@ -438,7 +442,14 @@ class Runner:
         lean into the curve), pitch (slightly forward) and yaw (the desired facing)."""
         k = self.k
         lean = k["lean"] * math.atan(self.speed**2 * self.curvature / self.g)
-        want = qmul1(qyaw(self.heading_d), quat_yxz(k["pitch"], -lean, 0.0))
+        # the same inputs (zeros' signs too: they sign the quaternion's zeros) as the last
+        # tick's, on a straight stretch most ticks: the same quaternion
+        key = (self.heading_d, k["pitch"], lean)
+        signs = tuple(math.copysign(1.0, x) for x in key)
+        if key != self._want_key or signs != self._want_signs:
+            self._want = qmul1(qyaw(self.heading_d), quat_yxz(k["pitch"], -lean, 0.0))
+            self._want_key, self._want_signs = key, signs
+        want = self._want
         # the chest's attitude and rate: the pelvis alone is light and sits between two
         # servoed joints, and damping its rate explicitly at the control rate rings
         d = self.world.data
