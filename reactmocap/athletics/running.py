@@ -27,6 +27,7 @@ from reactmocap.athletics.paths import Course, Straight
 from reactmocap.athletics.rig import Rig, per_joint
 from reactmocap.athletics.running_body import (
     ANKLE,
+    CONJ,
     ELBOW,
     F64,
     FOOT,
@@ -85,8 +86,6 @@ _LEG_ROWS = tuple(
     (3 * np.array((HIP[i], KNEE[i], ANKLE[i]))[:, None] + np.arange(3)).reshape(-1)
     for i in range(2)
 )
-#: a quaternion's conjugate as a product (mju_negQuat's sign flips)
-_CONJ = np.array([1.0, -1.0, -1.0, -1.0])
 #: the states of the active leg (Fig. 3)
 RUN_STATES = ("flight", "loading", "heel", "heel_toe", "toe", "unloading")
 #: a sole corner closer than this to the floor (m) counts as touching
@@ -296,7 +295,7 @@ class Runner:
         for out, q, conj in self._anat_rows:
             mujoco.mju_mulQuat(out, q, conj)
         # the parents' conjugates (mju_negQuat's sign flips) in one product
-        np.multiply(self._parents_anat, _CONJ, out=self._parents_inv)
+        np.multiply(self._parents_anat, CONJ, out=self._parents_inv)
         rel, angles = self._q_rel, self._angles
         for j, inv, c in self._leg_pairs:
             mujoco.mju_mulQuat(rel, inv, c)
