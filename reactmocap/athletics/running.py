@@ -197,6 +197,9 @@ class Runner:
         self._want = np.array([1.0, 0.0, 0.0, 0.0])
         self._want_key: tuple[float, ...] = (math.nan,)
         self._want_signs: tuple[float, ...] = ()
+        self._att_err = np.empty(3)
+        self._att_axes = np.eye(3)
+        self._att_axes_flat = self._att_axes.reshape(-1)
         self._yaw_q = qyaw(0.0)
         self._angles = np.zeros((NJ, 3))
         self._hip_rows = np.array(HIP)
@@ -444,7 +447,8 @@ class Runner:
         # the same inputs (zeros' signs too: they sign the quaternion's zeros) as the last
         # tick's, on a straight stretch most ticks: the same quaternion
         key = (self.heading_d, k["pitch"], lean)
-        signs = tuple(math.copysign(1.0, x) for x in key)
+        sign = math.copysign
+        signs = (sign(1.0, key[0]), sign(1.0, key[1]), sign(1.0, key[2]))
         if key != self._want_key or signs != self._want_signs:
             self._want = qmul1(qyaw(self.heading_d), quat_yxz(k["pitch"], -lean, 0.0))
             self._want_key, self._want_signs = key, signs
@@ -453,10 +457,13 @@ class Runner:
         # servoed joints, and damping its rate explicitly at the control rate rings
         d = self.world.data
         now = self._anat_now[self._chest]
-        err = np.empty(3)
+        err = self._att_err
         mujoco.mju_quat2Vel(err, qmul1(want, qconj1(now)), 1.0)  # world rotation vector
         c, s = math.cos(heading), math.sin(heading)
-        axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
+        # rows roll, pitch, yaw: [[c, s, 0], [-s, c, 0], [0, 0, 1]] (its entries written
+        # into a buffer, as a nested list converted at four times the cost)
+        axes, flat = self._att_axes, self._att_axes_flat
+        flat[0], flat[1], flat[3], flat[4] = c, s, -s, c
         local = axes @ err
         gain = self.inertia_unit * (
             self._attitude_kp * local - self._attitude_kv * (axes @ d.cvel[self._chest, :3])
