@@ -38,3 +38,25 @@ def test_the_tick_rotations_equal_the_plain_forms_to_the_bit() -> None:
         for body, neutral in bodies:
             plain, tick = r._pitch(body, neutral, heading), r._tick_pitch(body, heading)
             assert np.float64(plain).tobytes() == np.float64(tick).tobytes()
+
+
+def test_closest_on_one_segment_equals_the_array_search_to_the_bit() -> None:
+    # the straight line's window is one segment: the float search against the arrays' (the
+    # window search's own expressions), points on, off and behind the segment
+    from reactmocap.athletics.paths import Straight
+    from reactmocap.rotations import einsum
+
+    rng = np.random.default_rng(11)
+    for heading in (0.0, 0.7, -2.9):
+        line = Straight(heading, rng.normal(size=2) * 10.0)
+        a, sv, len2 = line.points[:1], line.seg[:1], line.len[:1] ** 2
+        pts = rng.normal(size=(500, 2)) * np.array([[1e4], [1.0]]).repeat(250, 0)
+        pts[::50] = line.points[0]
+        for p in pts:
+            u = np.minimum(np.maximum(einsum("ij,ij->i", p - a, sv) / len2, 0.0), 1.0)
+            q = a + u[:, None] * sv
+            dist = np.hypot(*(p - q).T)
+            side = float(np.sign(sv[0, 0] * (p[1] - q[0, 1]) - sv[0, 1] * (p[0] - q[0, 0])))
+            want = (0, line._cum[0] + float(u[0]) * line._len[0], side * float(dist[0]))
+            got = line._closest(p)
+            assert np.array(got).tobytes() == np.array(want).tobytes(), (heading, p)
