@@ -502,12 +502,13 @@ class Runner:
         down, then rolling toward the ball by the expected end of the heel-and-toe phase,
         then the ball (the paper's heel-to-metatarsus travel)."""
         corners = self.senses.sole_corners()[self.active]
-        ball = 0.5 * (corners[0] + corners[1])
-        heel = 0.5 * (corners[2] + corners[3])
         state = self.machine.current.name
+        # each of the heel and the ball only where the phase reads it
         if state in ("loading", "heel"):
-            return heel
+            return 0.5 * (corners[2] + corners[3])  # the heel
+        ball = 0.5 * (corners[0] + corners[1])
         if state == "heel_toe":
+            heel = 0.5 * (corners[2] + corners[3])
             end = self.t_touchdown + self.k["toe_fraction"] * self.stance_estimate
             span = max(end - self.t_heel_toe, 1e-3)
             frac = clamp((t - self.t_heel_toe) / span, 0.0, 1.0)
