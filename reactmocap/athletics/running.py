@@ -785,5 +785,6 @@ class Runner:
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
             hips, angles[self._knee_rows, 0], self.heading_d, self.cross_track,
-            self._tick_pitch(self._chest, h),  # trunk_euler's pitch
+            # trunk_euler's pitch (the pelvis's heading: not the tick's made-once yaw)
+            pitch_yxz(qmul1(qyaw(-h), self._anat_now[self._chest])),
         ))  # fmt: skip
