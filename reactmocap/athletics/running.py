@@ -40,6 +40,7 @@ from reactmocap.athletics.running_body import (
     SHOULDER,
     SPINE,
     THIGH,
+    YawMemo,
     clamp,
     euler_yxz,
     norm,
@@ -192,7 +193,10 @@ class Runner:
         self._leg_pairs = [(j, inv[parents.index(p)], anat[parts.index(c)])
                            for j, p, c in zip(LEG_JOINTS, parent, child)]  # fmt: skip
         self._q_rel = np.empty(4)
-        self._yaw_key = math.nan  # the heading of the last _yaw_inv
+        # the tick's yaws of the facing (the heading frame's and its inverse), made once
+        self._yaw_inv, self._yaw_fwd = YawMemo(), YawMemo()
+        self._root_inv = inv[parents.index(0)]  # the pelvis's conjugate, this tick
+        self._thigh_len, self._shin_len = athlete.thigh.tolist(), athlete.shin.tolist()
         # the attitude servo's last desired rotation and its inputs (_attitude_torque)
         self._want = np.array([1.0, 0.0, 0.0, 0.0])
         self._want_key: tuple[float, ...] = (math.nan,)
@@ -200,7 +204,6 @@ class Runner:
         self._att_err = np.empty(3)
         self._att_axes = np.eye(3)
         self._att_axes_flat = self._att_axes.reshape(-1)
-        self._yaw_q = qyaw(0.0)
         self._angles = np.zeros((NJ, 3))
         self._hip_rows = np.array(HIP)
         self._knee_rows = np.array(KNEE)
@@ -305,20 +308,10 @@ class Runner:
             angles[j, 0] = pitch_yxz(rel)
         return angles
 
-    def _yaw_inv(self, heading: float) -> F64:
-        """``qyaw(-heading)``, made once for the tick's heading (a heading of the other
-        zero's sign is another quaternion)."""
-        if heading != self._yaw_key or math.copysign(1.0, heading) != math.copysign(
-            1.0, self._yaw_key
-        ):
-            self._yaw_q = qyaw(-heading)
-            self._yaw_key = heading
-        return self._yaw_q
-
     def _tick_pitch(self, body: int, heading: float) -> float:
         """:meth:`_pitch` of a body of :attr:`_anat_now` within the tick (its rotation made
         once by :meth:`_leg_pitches` at the tick's start)."""
-        return pitch_yxz(qmul1(self._yaw_inv(heading), self._anat_now[body]))
+        return pitch_yxz(qmul1(self._yaw_inv(-heading), self._anat_now[body]))
 
     def trunk_euler(self) -> tuple[float, float, float]:
         """Chest pitch, roll and yaw (anatomical, heading frame, rad)."""
@@ -377,16 +370,17 @@ class Runner:
         to_go = low / -vz if vz < -1e-3 else np.inf
         fwd += k["speed_matching"] * clamp(to_go / k["retract_time"], 0.0, 1.0)
         fwd += 0.3 * lf  # the heel sits behind the ankle
-        length = k["touchdown_leg"] * (self.athlete.thigh[leg] + self.athlete.shin[leg])
+        ul, ll = self._thigh_len[leg], self._shin_len[leg]  # floats: numpy's values
+        length = k["touchdown_leg"] * (ul + ll)
         fwd = clamp(fwd, -0.5 * length, 0.75 * length)
         lat = clamp(lat, -0.3 * length, 0.3 * length)
         down = math.sqrt(max(length * length - fwd * fwd - lat * lat, 0.04))
         swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
         roll = math.atan2(lat, math.hypot(fwd, down))
-        knee, geom = knee_for_length1(self.athlete.thigh[leg], self.athlete.shin[leg], length)
-        thigh = qmul1(qyaw(heading), quat_yxz(-swing + geom, roll, 0.0))
-        pelvis = self._anat_now[self._root]
-        hip_pitch, hip_roll, _ = euler_yxz(qmul1(qconj1(pelvis), thigh))
+        knee, geom = knee_for_length1(ul, ll, length)
+        thigh = qmul1(self._yaw_fwd(heading), quat_yxz(-swing + geom, roll, 0.0))
+        # the pelvis's conjugate: made by _leg_pitches this tick, as qconj1 makes it
+        hip_pitch, hip_roll, _ = euler_yxz(qmul1(self._root_inv, thigh))
         self.knee_td = knee
         shin = self._tick_pitch(self._shins[leg], heading)
         ankle = clamp(-k["heel_up"] - shin, -0.5, 0.9)
