@@ -51,6 +51,7 @@ __all__ = [
     "Step",
     "Stepper",
     "knee_for_length",
+    "knee_for_length1",
 ]
 
 F64 = NDArray[np.float64]
@@ -81,6 +82,19 @@ def knee_for_length(thigh: F64 | float, shin: F64 | float, length: F64 | float) 
     )
     hip = -np.arccos(np.minimum(np.maximum((ul**2 - ll**2 + lh**2) / (2 * ul * lh), -1.0), 1.0))
     return np.stack([knee, hip])
+
+
+def knee_for_length1(thigh: float, shin: float, length: float) -> tuple[float, float]:
+    """:func:`knee_for_length` of one leg as two floats (the runner's flight ticks): the same
+    operations in the same order on floats, and numpy's own ``arccos`` (``math.acos`` may
+    round differently), so the same values to the bit (test) for a twentieth of the numpy
+    calls. There ``thigh**2`` (a 0-d array) is numpy's square ``x * x``, but ``lh**2`` (the
+    numpy scalar its clip returns) is C's ``pow``, as Python's float power is."""
+    ul, ll = float(thigh), float(shin)
+    lh = min(max(float(length), abs(ul - ll) + 1e-3), ul + ll - 1e-6)
+    cos_knee = min(max((ul * ul + ll * ll - lh**2) / (2 * ul * ll), -1.0), 1.0)
+    cos_hip = min(max((ul * ul - ll * ll + lh**2) / (2 * ul * lh), -1.0), 1.0)
+    return float(np.pi - np.arccos(cos_knee)), float(-np.arccos(cos_hip))
 
 
 @dataclass(frozen=True)

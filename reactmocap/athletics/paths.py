@@ -157,6 +157,8 @@ class Polyline:
             idx = idx % n if self.closed else idx[idx < n]
             self._window = (self.index, idx, self.points[idx], self.seg[idx], self.len[idx] ** 2)
         _, idx, a, sv, len2 = self._window
+        if len(idx) == 1:  # one segment (a straight line): the same search in floats
+            return self._closest1(int(idx[0]), p.tolist(), float(len2[0]))
         u = np.minimum(np.maximum(einsum("ij,ij->i", p - a, sv) / len2, 0.0), 1.0)  # clip
         q = a + u[:, None] * sv
         dist = np.hypot(*(p - q).T)
@@ -166,6 +168,19 @@ class Polyline:
         (sx, sy), (qx, qy), (px, py) = sv[j].tolist(), q[j].tolist(), p.tolist()
         side = float(np.sign(sx * (py - qy) - sy * (px - qx)))
         return i, self._cum[i] + float(u[j]) * self._len[i], side * float(dist[j])
+
+    def _closest1(self, i: int, p: list[float], len2: float) -> tuple[int, float, float]:
+        """:meth:`_closest` over a window of the one segment ``i`` (``len2`` its squared
+        length), in floats: the einsum's two products summed as numpy's sum makes them (its
+        sum starts from +0.0: ``+ 0.0`` turns a -0.0 into +0.0 as it does; equal on 300000
+        random cases, zeros' signs included), numpy's own ``hypot`` and ``sign``."""
+        (ax, ay), (sx, sy), (px, py) = self._points[i], self._seg[i], p
+        dot = ((px - ax) * sx + (py - ay) * sy) + 0.0
+        u = min(max(dot / len2, 0.0), 1.0)  # np.clip's value: NaN stays NaN
+        qx, qy = ax + u * sx, ay + u * sy
+        dist = float(np.hypot(px - qx, py - qy))
+        side = float(np.sign(sx * (py - qy) - sy * (px - qx)))
+        return i, self._cum[i] + u * self._len[i], side * dist
 
     def point_at(self, s: float) -> F64:
         return np.array(self._point(s))
@@ -190,15 +205,17 @@ class Polyline:
         self.index = i
         self.progress = s + self._laps * self.total
         # in floats from here (the same roundings as the arrays' without their calls)
-        tx, ty = self._point(s + self.lookahead)
+        ahead = self._point(s + self.lookahead)
+        tx, ty = ahead
         if not self.closed and s + self.lookahead > self.total:  # past the end: straight on
             d = self.points[-1] - self.points[-2]
             tx, ty = (p + d / max(float(np.hypot(*d)), 1e-9) * self.lookahead).tolist()
         px, py = p.tolist()
         # the curvature over the look-ahead: the turn between its two halves' chords (the
-        # segments' own directions turn in steps, and the lean read from them jumped)
+        # segments' own directions turn in steps, and the lean read from them jumped); the
+        # far end is the look-ahead point (2 (L / 2) = L and s + 0 = s exactly)
         half = 0.5 * self.lookahead
-        (x0, y0), (x1, y1), (x2, y2) = (self._point(s + f * half) for f in (0.0, 1.0, 2.0))
+        (x0, y0), (x1, y1), (x2, y2) = self._point(s), self._point(s + half), ahead
         ax, ay, bx, by = x1 - x0, y1 - y0, x2 - x1, y2 - y1
         turn = math.atan2(ax * by - ay * bx, ax * bx + ay * by)
         turn = 0.0 if abs(turn) < 1e-12 else turn  # a straight stretch: no rounding's lean

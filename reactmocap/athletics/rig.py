@@ -98,6 +98,7 @@ class Rig:
         self._t0 = np.zeros(NJ)
         self._dur = np.ones(NJ)
         self._jumped: float | None = None  # the time every joint last jumped to its goal
+        self._jump_accel = False  # that jump's accelerate
         self._accel = np.zeros(NJ, dtype=bool)  # joints on an accelerating (s^2) path
         self.offset = np.zeros((NJ, 3))
         self.stiffness = np.zeros(NJ)
@@ -214,10 +215,9 @@ class Rig:
         inertia = self.servo.joint_inertia(self.character)
         scale_inertia = np.einsum("nii->n", inertia) / 3.0
         on = values > 0
-        self.servo.enable(self.character, [BALL_JOINTS[i] for i in np.flatnonzero(~on)], False)
-        self.servo.enable(self.character, [BALL_JOINTS[i] for i in np.flatnonzero(on)], True)
         scale = values * self.stiffness_unit / (SERVO_KP * scale_inertia)
-        self.servo.set_gain_scales(self.character, np.where(on, scale, np.nan))
+        # the switches and the scales in one gain refresh (the gains are a function of both)
+        self.servo.set_gain_scales(self.character, np.where(on, scale, np.nan), enabled=on)
         self._kp[:] = np.where(on, values * self.stiffness_unit / scale_inertia, 0.0)
         self.stiffness[:] = values
 
@@ -243,7 +243,9 @@ class Rig:
     def desired(self, t: float) -> F64:
         """``(15, 3)`` smoothed target angles at time ``t`` (without :attr:`offset`)."""
         if t == self._jumped:  # every path starts at t: s = 0 below, exactly
-            return self._start + (self._goal - self._start) * 0.0
+            # and the goal is the start: (goal - start) * 0.0 is start - start (+0.0, or
+            # NaN where the start is not finite)
+            return self._start + (self._start - self._start)
         x = np.minimum(np.maximum((t - self._t0) / self._dur, 0.0), 1.0)  # np.clip: 3x the cost
         s = np.where(self._accel, x * x, smoothstep(x))[:, None]
         return self._start + (self._goal - self._start) * s
@@ -268,9 +270,10 @@ class Rig:
             self._start[:] = new
             self._goal[:] = new
             self._t0[:] = t
-            self._dur[:] = 1e-9
-            self._accel[:] = accelerate
-            self._jumped = t
+            if self._jumped is None or self._jump_accel != accelerate:  # else as they are
+                self._dur[:] = 1e-9
+                self._accel[:] = accelerate
+            self._jumped, self._jump_accel = t, accelerate
             return
         self._jumped = None
         sel = np.ones(NJ, dtype=bool) if joints is None else np.zeros(NJ, dtype=bool)

@@ -21,12 +21,13 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
-from reactmocap.athletics.balance import knee_for_length
+from reactmocap.athletics.balance import knee_for_length1
 from reactmocap.athletics.bodies import Athlete
 from reactmocap.athletics.paths import Course, Straight
 from reactmocap.athletics.rig import Rig, per_joint
 from reactmocap.athletics.running_body import (
     ANKLE,
+    CONJ,
     ELBOW,
     F64,
     FOOT,
@@ -39,6 +40,7 @@ from reactmocap.athletics.running_body import (
     SHOULDER,
     SPINE,
     THIGH,
+    YawMemo,
     clamp,
     euler_yxz,
     norm,
@@ -170,21 +172,38 @@ class Runner:
         self._bodies = np.asarray(wc.body_ids)
         self._jacp = np.zeros((3, m.nv))
         # the legs' joint pitches at every tick (_leg_pitches): each body a leg joint joins
-        # (pelvis, thighs, shins, feet) turned into its anatomical frame once, into buffers
-        # made here; the pitch-only column of the angles the laws read stays 0 elsewhere
+        # (pelvis, thighs, shins, feet) and the chest turned into its anatomical frame once a
+        # tick, into buffers made here, for the laws' pitches too (_tick_pitch); the
+        # pitch-only column of the angles the laws read stays 0 elsewhere
         child = [j + 1 for j in LEG_JOINTS]
         parent = [int(SIM_PARENTS[c]) for c in child]
-        parts = sorted(set(child) | set(parent))
+        # the parents first: their conjugates in one product
+        parents = sorted(set(parent))
+        parts = parents + sorted((set(child) - set(parents)) | {SIM_BODY_INDEX["chest"]})
         # rows of MjData's and the buffer's arrays as views made once (indexing per tick
         # cost as much as the products); the World keeps one MjData for its life
         self._anat_buf = anat = np.empty((len(parts), 4))
         self._xquat = xquat = world.data.xquat
         self._anat_rows = [(anat[k], xquat[int(wc.body_ids[b])], self._neutral_conj[b])
                            for k, b in enumerate(parts)]  # fmt: skip
-        self._leg_pairs = [(j, anat[parts.index(p)], anat[parts.index(c)])
+        #: the tick's anatomical rotations by MuJoCo body id (rows of the buffer)
+        self._anat_now = {int(wc.body_ids[b]): anat[k] for k, b in enumerate(parts)}
+        self._parents_anat = anat[: len(parents)]
+        self._parents_inv = inv = np.empty((len(parents), 4))
+        self._leg_pairs = [(j, inv[parents.index(p)], anat[parts.index(c)])
                            for j, p, c in zip(LEG_JOINTS, parent, child)]  # fmt: skip
-        self._q_inv = np.empty(4)
         self._q_rel = np.empty(4)
+        # the tick's yaws of the facing (the heading frame's and its inverse), made once
+        self._yaw_inv, self._yaw_fwd = YawMemo(), YawMemo()
+        self._root_inv = inv[parents.index(0)]  # the pelvis's conjugate, this tick
+        self._thigh_len, self._shin_len = athlete.thigh.tolist(), athlete.shin.tolist()
+        # the attitude servo's last desired rotation and its inputs (_attitude_torque)
+        self._want = np.array([1.0, 0.0, 0.0, 0.0])
+        self._want_key: tuple[float, ...] = (math.nan,)
+        self._want_signs: tuple[float, ...] = ()
+        self._att_err = np.empty(3)
+        self._att_axes = np.eye(3)
+        self._att_axes_flat = self._att_axes.reshape(-1)
         self._angles = np.zeros((NJ, 3))
         self._hip_rows = np.array(HIP)
         self._knee_rows = np.array(KNEE)
@@ -277,15 +296,22 @@ class Runner:
         """The pitch of the legs' joints (the only joint angles the laws read) in column 0
         of the ``(NJ, 3)`` angles (a buffer reused every tick), as :meth:`_joint_pitch`:
         MuJoCo's quaternion product on one quaternion at a time, since numpy's
-        vectorised products and arctan2 differ from it in the last bits."""
+        vectorised products and arctan2 differ from it in the last bits. Also the tick's
+        anatomical rotations of the legs' bodies and the chest (:attr:`_anat_now`)."""
         for out, q, conj in self._anat_rows:
             mujoco.mju_mulQuat(out, q, conj)
-        inv, rel, angles = self._q_inv, self._q_rel, self._angles
-        for j, p, c in self._leg_pairs:
-            mujoco.mju_negQuat(inv, p)
+        # the parents' conjugates (mju_negQuat's sign flips) in one product
+        np.multiply(self._parents_anat, CONJ, out=self._parents_inv)
+        rel, angles = self._q_rel, self._angles
+        for j, inv, c in self._leg_pairs:
             mujoco.mju_mulQuat(rel, inv, c)
             angles[j, 0] = pitch_yxz(rel)
         return angles
+
+    def _tick_pitch(self, body: int, heading: float) -> float:
+        """:meth:`_pitch` of a body of :attr:`_anat_now` within the tick (its rotation made
+        once by :meth:`_leg_pitches` at the tick's start)."""
+        return pitch_yxz(qmul1(self._yaw_inv(-heading), self._anat_now[body]))
 
     def trunk_euler(self) -> tuple[float, float, float]:
         """Chest pitch, roll and yaw (anatomical, heading frame, rad)."""
@@ -344,18 +370,19 @@ class Runner:
         to_go = low / -vz if vz < -1e-3 else np.inf
         fwd += k["speed_matching"] * clamp(to_go / k["retract_time"], 0.0, 1.0)
         fwd += 0.3 * lf  # the heel sits behind the ankle
-        length = k["touchdown_leg"] * (self.athlete.thigh[leg] + self.athlete.shin[leg])
+        ul, ll = self._thigh_len[leg], self._shin_len[leg]  # floats: numpy's values
+        length = k["touchdown_leg"] * (ul + ll)
         fwd = clamp(fwd, -0.5 * length, 0.75 * length)
         lat = clamp(lat, -0.3 * length, 0.3 * length)
         down = math.sqrt(max(length * length - fwd * fwd - lat * lat, 0.04))
         swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
         roll = math.atan2(lat, math.hypot(fwd, down))
-        knee, geom = knee_for_length(self.athlete.thigh[leg], self.athlete.shin[leg], length)
-        thigh = qmul1(qyaw(heading), quat_yxz(-swing + float(geom), roll, 0.0))
-        pelvis = self._anat(self._root, 0)
-        hip_pitch, hip_roll, _ = euler_yxz(qmul1(qconj1(pelvis), thigh))
-        self.knee_td = float(knee)
-        shin = self._pitch(self._shins[leg], SHIN[leg], heading)
+        knee, geom = knee_for_length1(ul, ll, length)
+        thigh = qmul1(self._yaw_fwd(heading), quat_yxz(-swing + geom, roll, 0.0))
+        # the pelvis's conjugate: made by _leg_pitches this tick, as qconj1 makes it
+        hip_pitch, hip_roll, _ = euler_yxz(qmul1(self._root_inv, thigh))
+        self.knee_td = knee
+        shin = self._tick_pitch(self._shins[leg], heading)
         ankle = clamp(-k["heel_up"] - shin, -0.5, 0.9)
         # the leg's hip, knee and ankle rows in one write
         self.goal.reshape(-1)[_LEG_ROWS[leg]] = (hip_pitch, hip_roll, 0.0, self.knee_td, 0.0,
@@ -372,7 +399,7 @@ class Runner:
         a, i = self.active, 1 - self.active
         knee = k["idle_knee"]
         if self.machine.current.name == "flight":
-            act = self._pitch(self._thighs[a], THIGH[a], heading)
+            act = self._tick_pitch(self._thighs[a], heading)
             want = self.lo_pitch[i] - (act - self.lo_pitch[a])
         else:
             prog = (t - self.t_touchdown) / max(self.stance_estimate, 0.05)
@@ -380,7 +407,7 @@ class Runner:
             want = self.td_pitch + (k["swing_ready"] - self.td_pitch) * sm * sm * (3.0 - 2.0 * sm)
             late = clamp(2.0 * prog - 1.0, 0.0, 1.0)
             knee += (k["reach_knee"] - k["idle_knee"]) * late * late * (3.0 - 2.0 * late)
-        hip = clamp(want, -1.1, 0.7) - self._pitch(self._root, 0, heading)
+        hip = clamp(want, -1.1, 0.7) - self._tick_pitch(self._root, heading)
         # one write for the leg's three rows (each row's write cost as much as its law)
         self.goal.reshape(-1)[_LEG_ROWS[i]] = (hip, 0.03 * (1 - 2 * i), 0.0, knee, 0.0, 0.0,
                                                -0.15, 0.0, 0.0)  # fmt: skip
@@ -411,15 +438,26 @@ class Runner:
         lean into the curve), pitch (slightly forward) and yaw (the desired facing)."""
         k = self.k
         lean = k["lean"] * math.atan(self.speed**2 * self.curvature / self.g)
-        want = qmul1(qyaw(self.heading_d), quat_yxz(k["pitch"], -lean, 0.0))
+        # the same inputs (zeros' signs too: they sign the quaternion's zeros) as the last
+        # tick's, on a straight stretch most ticks: the same quaternion
+        key = (self.heading_d, k["pitch"], lean)
+        sign = math.copysign
+        signs = (sign(1.0, key[0]), sign(1.0, key[1]), sign(1.0, key[2]))
+        if key != self._want_key or signs != self._want_signs:
+            self._want = qmul1(qyaw(self.heading_d), quat_yxz(k["pitch"], -lean, 0.0))
+            self._want_key, self._want_signs = key, signs
+        want = self._want
         # the chest's attitude and rate: the pelvis alone is light and sits between two
         # servoed joints, and damping its rate explicitly at the control rate rings
         d = self.world.data
-        now = self._anat(self._chest, SIM_BODY_INDEX["chest"])
-        err = np.empty(3)
+        now = self._anat_now[self._chest]
+        err = self._att_err
         mujoco.mju_quat2Vel(err, qmul1(want, qconj1(now)), 1.0)  # world rotation vector
         c, s = math.cos(heading), math.sin(heading)
-        axes = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # roll, pitch, yaw
+        # rows roll, pitch, yaw: [[c, s, 0], [-s, c, 0], [0, 0, 1]] (its entries written
+        # into a buffer, as a nested list converted at four times the cost)
+        axes, flat = self._att_axes, self._att_axes_flat
+        flat[0], flat[1], flat[3], flat[4] = c, s, -s, c
         local = axes @ err
         gain = self.inertia_unit * (
             self._attitude_kp * local - self._attitude_kv * (axes @ d.cvel[self._chest, :3])
@@ -458,12 +496,13 @@ class Runner:
         down, then rolling toward the ball by the expected end of the heel-and-toe phase,
         then the ball (the paper's heel-to-metatarsus travel)."""
         corners = self.senses.sole_corners()[self.active]
-        ball = 0.5 * (corners[0] + corners[1])
-        heel = 0.5 * (corners[2] + corners[3])
         state = self.machine.current.name
+        # each of the heel and the ball only where the phase reads it
         if state in ("loading", "heel"):
-            return heel
+            return 0.5 * (corners[2] + corners[3])  # the heel
+        ball = 0.5 * (corners[0] + corners[1])
         if state == "heel_toe":
+            heel = 0.5 * (corners[2] + corners[3])
             end = self.t_touchdown + self.k["toe_fraction"] * self.stance_estimate
             span = max(end - self.t_heel_toe, 1e-3)
             frac = clamp((t - self.t_heel_toe) / span, 0.0, 1.0)
@@ -552,7 +591,7 @@ class Runner:
         def knee_extended(_w: World, t: float, t_in: float) -> bool:
             if self.step_stance:  # the commanded step lets go at its stance time
                 return t - self.t_touchdown >= self.step_stance
-            knee = self._joint_pitch(KNEE[self.active])
+            knee = self._angles[KNEE[self.active], 0]  # _joint_pitch's, made this tick
             return t_in > 0.02 and knee <= self.knee_td + 0.05
 
         def left_ground(_w: World, _t: float, _ti: float) -> bool:
@@ -597,7 +636,7 @@ class Runner:
             self.log.liftoffs.append((t, self.active))
             self.active = 1 - self.active
         h = self.heading()
-        self.lo_pitch = [self._pitch(self._thighs[j], THIGH[j], h) for j in range(2)]
+        self.lo_pitch = [self._tick_pitch(self._thighs[j], h) for j in range(2)]
         self._set_stiffness(False)
 
     def _enter_loading(self, world: World, t: float) -> None:
@@ -611,7 +650,7 @@ class Runner:
         self.step_stance = self.k["step_stance"] if t >= STEP_AFTER else 0.0
         leg = self.active
         d = self.world.data
-        self.td_pitch = self._pitch(self._thighs[1 - leg], THIGH[1 - leg], self.heading())
+        self.td_pitch = self._tick_pitch(self._thighs[1 - leg], self.heading())
         foot = d.xpos[self._feet[leg]]
         self.log.touchdowns.append((t, leg, float(foot[0]), float(foot[1])))
         self.steps += 1
@@ -677,6 +716,8 @@ class Runner:
     def control(self, world: World, t: float) -> None:
         s = self.senses
         s.update(t)
+        # the joints' pitches and the bodies' anatomical rotations, before the laws read them
+        angles = self._leg_pitches()
         self._contacts()
         want, self.curvature, self.cross_track = self.course.steer(s.com[:2], t)
         if self.k["path_integral"] > 0 and math.isfinite(self.cross_track) and t >= PATH_AFTER:
@@ -709,7 +750,6 @@ class Runner:
         # the frame the legs are placed and swung in: the desired facing, not the pelvis's
         # (which yaws back and forth with every stride)
         heading = self.heading_d if self.p_frame else self.heading()
-        angles = self._leg_pitches()
         self._idle(t, heading)
         hips = angles[self._hip_rows, 0]
         self._upper(hips)
@@ -739,5 +779,6 @@ class Runner:
             RUN_STATES.index(self.machine.current.name), self.active, feet,
             float(self.world.data.xpos[self._root][2]), bool(s.other_contact),
             hips, angles[self._knee_rows, 0], self.heading_d, self.cross_track,
-            self._pitch(self._chest, SIM_BODY_INDEX["chest"], h),  # trunk_euler's pitch
+            # trunk_euler's pitch (the pelvis's heading: not the tick's made-once yaw)
+            pitch_yxz(qmul1(qyaw(-h), self._anat_now[self._chest])),
         ))  # fmt: skip

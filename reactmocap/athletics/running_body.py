@@ -28,6 +28,7 @@ __all__ = [
     "SHOULDER",
     "SPINE",
     "THIGH",
+    "CONJ",
     "clamp",
     "norm",
     "euler_yxz",
@@ -35,6 +36,7 @@ __all__ = [
     "qconj1",
     "qmul1",
     "quat_yxz",
+    "YawMemo",
     "qyaw",
     "running_start",
 ]
@@ -78,9 +80,14 @@ def clamp(x: float, lo: float, hi: float) -> float:
     return float(min(max(x, lo), hi))
 
 
+#: a quaternion's conjugate as a product (the same sign flips as negation)
+CONJ = np.array([1.0, -1.0, -1.0, -1.0])
+
+
 def qconj1(q: F64) -> F64:
-    """Conjugate of a ``(4,)`` quaternion."""
-    return np.array([q[0], -q[1], -q[2], -q[3]])
+    """Conjugate of a ``(4,)`` quaternion (one product: each entry's own four reads and
+    negations cost eight numpy calls)."""
+    return np.multiply(q, CONJ)
 
 
 def qyaw(yaw: float) -> F64:
@@ -88,12 +95,33 @@ def qyaw(yaw: float) -> F64:
     return np.array([math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw)])
 
 
+class YawMemo:
+    """:func:`qyaw`, made again only when the angle changes (a zero of the other sign is
+    another quaternion): the laws' yaws stay the same over a straight stretch's ticks. The
+    array returned is kept: not to be written."""
+
+    def __init__(self) -> None:
+        self._key = math.nan
+        self._q = qyaw(0.0)
+
+    def __call__(self, yaw: float) -> F64:
+        if yaw != self._key or math.copysign(1.0, yaw) != math.copysign(1.0, self._key):
+            self._q = qyaw(yaw)
+            self._key = yaw
+        return self._q
+
+
+#: qyaw(0.0), the laws' yaw in quat_yxz
+_QYAW_ZERO = qyaw(0.0)
+
+
 def quat_yxz(pitch: float, roll: float, yaw: float) -> F64:
     """Quaternion of intrinsic Y-X-Z Euler angles (:data:`~reactmocap.athletics.bodies.
     EULER_ORDER`)."""
     qy = np.array([math.cos(0.5 * pitch), 0.0, math.sin(0.5 * pitch), 0.0])
     qx = np.array([math.cos(0.5 * roll), math.sin(0.5 * roll), 0.0, 0.0])
-    return qmul1(qmul1(qy, qx), qyaw(yaw))
+    plus_zero = yaw == 0.0 and math.copysign(1.0, yaw) > 0.0
+    return qmul1(qmul1(qy, qx), _QYAW_ZERO if plus_zero else qyaw(yaw))
 
 
 def pitch_yxz(q: F64) -> float:

@@ -98,16 +98,17 @@ class Senses:
         if n:
             # the contact arrays' views made once (each attribute read makes a new one)
             con = d.contact
-            geoms, frames, points = con.geom[:n], con.frame, con.pos
+            # the contacts' rows as lists at once (a row's index and list cost per contact)
+            frames, points = con.frame[:n].tolist(), con.pos[:n].tolist()
             floor, own, f6 = self.floor, self._own_list, self._f6
-            for i, (g1, g2) in enumerate(geoms.tolist()):
+            for i, (g1, g2) in enumerate(con.geom[:n].tolist()):
                 if not ((g1 == floor or g2 == floor) and (own[g1] or own[g2])):
                     continue  # not this character on the floor
                 g = g2 if g1 == self.floor else g1
                 mujoco.mj_contactForce(m, d, i, f6)
                 # world force on geom2 from geom1: the contact frame's rows^T f
-                r = frames[i].tolist()
-                fx, fy, fz = f6[:3].tolist()
+                r = frames[i]
+                fx, fy, fz = f6.tolist()[:3]
                 f = [r[0] * fx + r[3] * fy + r[6] * fz, r[1] * fx + r[4] * fy + r[7] * fz,
                      r[2] * fx + r[5] * fy + r[8] * fz]  # fmt: skip
                 if g == g1:
@@ -118,7 +119,7 @@ class Senses:
                     fn = abs(fx)
                     touch[k] = True
                     force[k] += fn
-                    px, py, pz = points[i].tolist()
+                    px, py, pz = points[i]
                     q = point[k]
                     point[k] = [q[0] + fn * px, q[1] + fn * py, q[2] + fn * pz]
                 else:

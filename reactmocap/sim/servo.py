@@ -244,18 +244,26 @@ class PDServo:
         self._gain_scale[rows] = scale
         self._refresh_gains()
 
-    def set_gain_scales(self, character: int, scales: F64) -> None:
+    def set_gain_scales(
+        self, character: int, scales: F64, enabled: NDArray[np.bool_] | None = None
+    ) -> None:
         """:meth:`set_gain_scale` for each of one character's joints at once, ``scales``
-        ``(15,)``; NaN keeps a joint's scale. One gain refresh rather than one per joint."""
+        ``(15,)``; NaN keeps a joint's scale. One gain refresh rather than one per joint.
+        ``enabled`` ``(15,)``: also switch each joint on or off, as :meth:`enable` does (it
+        refreshes then, changed or not, as :meth:`enable`), in the same refresh."""
         scales = np.asarray(scales, dtype=np.float64)
         keep = np.isnan(scales)
         if scales.shape != (NJ,) or not np.all(keep | (np.isfinite(scales) & (scales > 0))):
             raise ConfigError(f"gain scales must be ({NJ},) positive numbers or NaN")
+        if enabled is not None and np.shape(enabled) != (NJ,):
+            raise ConfigError(f"enabled must be ({NJ},) bools, got shape {np.shape(enabled)}")
         rows = self._rows(character, None)
         old = self._gain_scale[rows]
         new = np.where(keep, old, scales)
-        if np.array_equal(new, old):
+        if enabled is None and np.array_equal(new, old):
             return
+        if enabled is not None:
+            self._enabled[rows] = enabled
         self._gain_scale[rows] = new
         self._refresh_gains()
 

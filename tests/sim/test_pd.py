@@ -419,6 +419,36 @@ def test_gain_scales_at_once_equal_one_joint_at_a_time(guard: Motion) -> None:
         both.servo.set_gain_scales(1, np.ones(3))
 
 
+def test_gain_scales_with_switches_equal_enable_then_scales(guard: Motion) -> None:
+    """set_gain_scales' ``enabled`` (the rigs' set_stiffness: one gain refresh) leaves the
+    actuators and their torques as enable() for the joints off, then on, then the scales."""
+    from reactmocap.errors import ConfigError
+    from reactmocap.sim.bodies import BALL_JOINTS
+
+    scales = np.linspace(0.5, 2.0, NJ)
+    on = np.arange(NJ) % 3 != 0
+    scales[~on] = np.nan
+    worlds = []
+    for at_once in (False, True):
+        world, servo = _random_world(guard, 1.0, 0)
+        if at_once:
+            servo.set_gain_scales(1, scales, enabled=on)
+        else:
+            servo.enable(1, [BALL_JOINTS[i] for i in np.flatnonzero(~on)], False)
+            servo.enable(1, [BALL_JOINTS[i] for i in np.flatnonzero(on)], True)
+            servo.set_gain_scales(1, scales)
+        servo.refresh()
+        mujoco.mj_forward(world.model, world.data)
+        worlds.append(world)
+    one, both = worlds
+    for name in ("actuator_gainprm", "actuator_biasprm", "actuator_gear"):
+        np.testing.assert_array_equal(getattr(both.model, name), getattr(one.model, name))
+    np.testing.assert_array_equal(both.data.qfrc_actuator, one.data.qfrc_actuator)
+    assert not both.servo.enabled[NJ:][~on].any()  # the switched-off joints are passive
+    with pytest.raises(ConfigError, match="enabled"):
+        both.servo.set_gain_scales(1, scales, enabled=np.ones(3, dtype=bool))
+
+
 def test_set_targets_normalises_into_the_servo_and_keeps_frozen_clamps(guard: Motion) -> None:
     # set_targets writes into its buffers: the same q / |q| and right matrices as the plain
     # expressions, frozen joints keep their clamp targets
