@@ -193,6 +193,13 @@ class Step:
             hung a foot for 0.8 s at 0.10 m/s until a step fired; the 16 pushes' limits 2255
             -> 2425 N, none lower; docs/athletics.md "What follows the standing step's first
             touchdown").
+        pair: after the run's first step, the next starts only once the capture point lies
+            more than this (m) past the box of both soles, a lifted one counted, in either
+            axis (the COM's sideways speed in it); while it lies within, a foot that hangs is
+            planted at once (:attr:`Posture.plant`; 0: off, the box of the soles in contact
+            and ``margin``, and the rear foot that rolled off the floor after the first
+            touchdown was swung while the COM went on sideways; opt-in, docs/athletics.md
+            "The standing step's second trigger on both soles").
     """
 
     margin: float = 0.05
@@ -206,6 +213,7 @@ class Step:
     foresee: float = 0.0
     down_after: float = 0.0
     hang_still: float = 0.0
+    pair: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -229,6 +237,9 @@ class Step:
         v = self.hang_still
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 1.0):
             raise ConfigError(f"step hang_still must be in [0, 1] m/s, got {v!r}")
+        v = self.pair
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.3):
+            raise ConfigError(f"step pair must be in [0, 0.3] m, got {v!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -791,14 +802,20 @@ class Stepper:
         if self.foot < 0:
             if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
                 return
-            lo, hi = s.support_extent(h)
+            # Step.pair: both soles' box after a step along the feet (after a sideways one as
+            # without: her 110 N left push was lost)
+            along = self._out is not None and self._out[1] == 0.0
+            pair = bool(st.pair and self.record and along)
+            lo, hi = s.support_extent(h, both=pair)
             # how far the capture point lies outside the soles' box (along the feet only
             # unless sideways), and the way out
             out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
             if not self.sideways:
                 out[1] = 0.0
             beyond = float(np.hypot(*out))
-            if beyond <= st.margin or float(vel @ out) <= 0.0:
+            if beyond <= (st.pair if pair else st.margin) or float(vel @ out) <= 0.0:
+                if pair and beyond <= st.pair and not s.foot_contact.all():
+                    bl.posture = replace(bl.posture, plant=True)  # the hanging foot put down
                 return
             # the farther foot swings (on a sideways fall toward the standing foot it crosses
             # over, see below)
