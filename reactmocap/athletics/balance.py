@@ -200,6 +200,11 @@ class Step:
             and ``margin``, and the rear foot that rolled off the floor after the first
             touchdown was swung while the COM went on sideways; opt-in, docs/athletics.md
             "The standing step's second trigger on both soles").
+        bow_hold: during a swing the hip strategy's bow (:attr:`BalanceGains.bow_ease`)
+            eases out over this many seconds instead (0: off, the gains' 0.15 s; the pelvis
+            pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
+            foot 0.2-0.3 m over the floor; opt-in, docs/athletics.md "The standing step's
+            bow held through the swing").
     """
 
     margin: float = 0.05
@@ -214,6 +219,7 @@ class Step:
     down_after: float = 0.0
     hang_still: float = 0.0
     pair: float = 0.0
+    bow_hold: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -237,6 +243,9 @@ class Step:
         v = self.hang_still
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 1.0):
             raise ConfigError(f"step hang_still must be in [0, 1] m/s, got {v!r}")
+        v = self.bow_hold
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 5.0):
+            raise ConfigError(f"step bow_hold must be in [0, 5] s, got {v!r}")
         v = self.pair
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.3):
             raise ConfigError(f"step pair must be in [0, 0.3] m, got {v!r}")
@@ -672,7 +681,11 @@ class BalanceLaw:
         if both:
             self._bow_now = self._bow(cp, vel)
         else:
-            self._bow_now *= math.exp(-dt / max(self.gains.bow_ease or 0.0, 1e-9))
+            tau = self.gains.bow_ease or 0.0
+            st = self.stepper
+            if st is not None and st.step.bow_hold and st.along():  # Step.bow_hold
+                tau = st.step.bow_hold
+            self._bow_now *= math.exp(-dt / max(tau, 1e-9))
         return self._bow_now
 
     def _bow(self, cp: float, vel: float) -> float:
@@ -924,6 +937,10 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
+
+    def along(self) -> bool:
+        """A swing under way along the feet (not a sideways one, nor a closing one)."""
+        return self.foot >= 0 and self._out is not None and self._out[1] == 0.0
 
     def _give(self, t: float) -> None:
         """:attr:`Step.give`: the landed knee's and the rear ankle's targets after a
