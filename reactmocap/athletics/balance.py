@@ -199,7 +199,7 @@ class Step:
             planted at once (:attr:`Posture.plant`; 0: off, the box of the soles in contact
             and ``margin``, and the rear foot that rolled off the floor after the first
             touchdown was swung while the COM went on sideways; opt-in, docs/athletics.md
-            "The standing step's second trigger on both soles").
+            "The standing step's bow held through the swing").
         bow_hold: during a swing the hip strategy's bow (:attr:`BalanceGains.bow_ease`)
             eases out over this many seconds instead (0: off, the gains' 0.15 s; the pelvis
             pitching back at up to 6 rad/s took the lagging swing thigh up with it and the

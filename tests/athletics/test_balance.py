@@ -371,3 +371,47 @@ def test_a_foot_hung_before_the_first_step_is_planted_under_a_faster_com(
         Step(hang_still=-0.1)
     with pytest.raises(ConfigError, match="hang_still"):
         Step(hang_still=float("nan"))
+
+
+def test_a_standing_step_whose_bow_is_held_through_the_swing_lands_sooner(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's bow held through the
+    # swing"): at the female's 105 N push backward the step fires from a bow; eased out over
+    # the gains' 0.15 s as the foot lifts, the pelvis pitching back takes the lagging swing thigh
+    # with it, the foot hangs over the floor and the first swing takes >= 0.55 s (planned 0.25)
+    # and she falls; with the bow eased out over 1 s during the swing (Step.bow_hold) the same
+    # step lands within 0.45 s and she does not fall
+    push = {"check_range": False, "seconds": 3.0, "push": 105.0, "push_dir": math.pi}
+    r = run("balance", "female", step="on", **push).report
+    assert r["steps"][0]["s"] >= 0.55 and r["fell"]
+    step = dataclasses.replace(balance.STANDING_STEP, bow_hold=1.0)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    r_held = run("balance", "female", step="on", **push).report
+    assert r_held["steps"][0]["t"] == r["steps"][0]["t"]
+    assert r_held["steps"][0]["s"] < 0.45 and not r_held["fell"]
+    for bad in (-0.1, 5.5, float("nan")):
+        with pytest.raises(ConfigError, match="bow_hold"):
+            Step(bow_hold=bad)
+
+
+def test_a_standing_steps_next_trigger_on_both_soles_waits_for_the_capture_point(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's bow held through the
+    # swing"): at the female's 85 N push backward the rear foot rolls off after the first step
+    # and the second fires on the front sole's box alone, the capture point still within 5 cm
+    # of both soles' box; judged against both soles' box (Step.pair 0.05) it fires later,
+    # with the capture point more than 5 cm past that box
+    push = {"check_range": False, "seconds": 3.0, "push": 85.0, "push_dir": math.pi}
+    r = run("balance", "female", step="on", **push).report
+    step = dataclasses.replace(balance.STANDING_STEP, pair=0.05)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    r_pair = run("balance", "female", step="on", **push).report
+    assert len(r["steps"]) >= 2 and len(r_pair["steps"]) >= 2
+    assert r_pair["steps"][0] == r["steps"][0]
+    assert r_pair["steps"][1]["t"] > r["steps"][1]["t"]
+    assert r_pair["steps"][1]["beyond_m"] > 0.05
+    for bad in (-0.01, 0.31, float("inf")):
+        with pytest.raises(ConfigError, match="pair"):
+            Step(pair=bad)
