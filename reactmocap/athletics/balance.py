@@ -867,6 +867,9 @@ class Stepper:
         at = s.local(hip, h)[:2]
         stand = feet[1 - k]
         under = self._out is None  # the place across the feet under its own hip
+        # Step.ground on the standing balance's steps along the feet only (her 110 N left
+        # push's shorter sideways swings took 4-6 steps and lost it)
+        ground = 0.0 if self.standing and not self.along() else st.ground
         if self._out is None:  # closing: beside the other, under its own hip
             want = np.array([stand[0], at[1]])
         else:  # past the capture point
@@ -908,10 +911,10 @@ class Stepper:
                 bend = min(bend, self._bend + STANDING_BEND_RATE * max(t - self._t_last, 0.0))
                 self._bend = max(bend, 0.0)
             rig.offset[_KNEE[j], 0] = max(bend, float(rig.offset[_KNEE[j], 0]))
-            if not st.ground or u < 0.5:  # aimed from the hip as low as that bend will put it
+            if not ground or u < 0.5:  # aimed from the hip as low as that bend will put it
                 down -= low
-        if st.ground and u >= 0.5:  # then on the floor within this reach from the hip as it is
-            reach = st.ground * (ul + ll)
+        if ground and u >= 0.5:  # then on the floor within this reach from the hip as it is
+            reach = ground * (ul + ll)
             far = math.sqrt(max(reach * reach - down * down, 0.0))
             pull = min(far / max(math.hypot(ahead, aside), 1e-9), 1.0)
             ahead, aside = ahead * pull, aside * pull
