@@ -167,7 +167,8 @@ class Step:
             made at most this fraction of the straight leg, its place pulled in toward the hip
             to where such a leg meets the floor (0: off, :data:`STEP_REACH` and the place past
             the capture point, where the foot hung over the floor until the body sank;
-            opt-in, docs/athletics.md "The standing step's swing shortened").
+            opt-in, docs/athletics.md "The standing step's swing shortened"; on the standing
+            balance's sideways steps not at all: her 110 N left push was lost).
         give: at the touchdown of a step along the feet (a sideways one as without: her
             110 N left push was lost) the landed knee's target bends this much more (rad)
             than its angle there, as a critically damped spring over ``give_time``, and the
