@@ -167,8 +167,9 @@ class Step:
             made at most this fraction of the straight leg, its place pulled in toward the hip
             to where such a leg meets the floor (0: off, :data:`STEP_REACH` and the place past
             the capture point, where the foot hung over the floor until the body sank;
-            opt-in, docs/athletics.md "The standing step's swing shortened"; on the standing
-            balance's sideways steps not at all: her 110 N left push was lost).
+            docs/athletics.md "The standing step's swing shortened"; on the standing
+            balance's sideways steps not at all: her 110 N left push was lost;
+            :data:`STANDING_STEP` 0.99 with ``bow_hold``).
         give: at the touchdown of a step along the feet (a sideways one as without: her
             110 N left push was lost) the landed knee's target bends this much more (rad)
             than its angle there, as a critically damped spring over ``give_time``, and the
@@ -204,8 +205,8 @@ class Step:
         bow_hold: during a swing the hip strategy's bow (:attr:`BalanceGains.bow_ease`)
             eases out over this many seconds instead (0: off, the gains' 0.15 s; the pelvis
             pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
-            foot 0.2-0.3 m over the floor; opt-in, docs/athletics.md "The standing step's
-            bow held through the swing").
+            foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
+            "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
     """
 
     margin: float = 0.05
@@ -432,8 +433,12 @@ STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
 #: the ``balance`` behaviour's opt-in step (``step="on"``; :class:`Stepper`'s ``standing``),
 #: with :attr:`BalanceGains.bow_ease` this many seconds, the standing knee bending at most
 #: :data:`STANDING_BEND_RATE` (rad/s) for the swing leg's reach; a foot hung before the first
-#: step planted under a COM slower than 0.25 m/s (:attr:`Step.hang_still`)
-STANDING_STEP = Step(hang_still=0.25)
+#: step planted under a COM slower than 0.25 m/s (:attr:`Step.hang_still`); on a step along
+#: the feet the bow eased out over 1 s during the swing (:attr:`Step.bow_hold`) and the foot
+#: aimed at the floor from the hip as it is (:attr:`Step.ground` 0.99): the 16 pushes' limits
+#: 2425 -> 2430 N (his forward 170 -> 175), none lower (docs/athletics.md "The standing
+#: step's bow held through the swing")
+STANDING_STEP = Step(hang_still=0.25, ground=0.99, bow_hold=1.0)
 STANDING_BOW_EASE = 0.15
 STANDING_BEND_RATE = 1.5
 #: the standing step's end: once one foot alone has been down for :data:`STANDING_HANG` s
