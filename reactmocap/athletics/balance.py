@@ -181,7 +181,9 @@ class Step:
             made at most this fraction of the straight leg, its place pulled in toward the hip
             to where such a leg meets the floor (0: off, :data:`STEP_REACH` and the place past
             the capture point, where the foot hung over the floor until the body sank;
-            opt-in, docs/athletics.md "The standing step's swing shortened").
+            docs/athletics.md "The standing step's swing shortened"; on the standing
+            balance's sideways steps not at all: her 110 N left push was lost;
+            :data:`STANDING_STEP` 0.99 with ``bow_hold``).
         give: at the touchdown of a step along the feet (a sideways one as without: her
             110 N left push was lost) the landed knee's target bends this much more (rad)
             than its angle there, as a critically damped spring over ``give_time``, and the
@@ -207,6 +209,18 @@ class Step:
             hung a foot for 0.8 s at 0.10 m/s until a step fired; the 16 pushes' limits 2255
             -> 2425 N, none lower; docs/athletics.md "What follows the standing step's first
             touchdown").
+        pair: after the run's first step, the next starts only once the capture point lies
+            more than this (m) past the box of both soles, a lifted one counted, in either
+            axis (the COM's sideways speed in it); while it lies within, a foot that hangs is
+            planted at once (:attr:`Posture.plant`; 0: off, the box of the soles in contact
+            and ``margin``, and the rear foot that rolled off the floor after the first
+            touchdown was swung while the COM went on sideways; opt-in, docs/athletics.md
+            "The standing step's bow held through the swing").
+        bow_hold: during a swing the hip strategy's bow (:attr:`BalanceGains.bow_ease`)
+            eases out over this many seconds instead (0: off, the gains' 0.15 s; the pelvis
+            pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
+            foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
+            "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
     """
 
     margin: float = 0.05
@@ -220,6 +234,8 @@ class Step:
     foresee: float = 0.0
     down_after: float = 0.0
     hang_still: float = 0.0
+    pair: float = 0.0
+    bow_hold: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -243,6 +259,12 @@ class Step:
         v = self.hang_still
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 1.0):
             raise ConfigError(f"step hang_still must be in [0, 1] m/s, got {v!r}")
+        v = self.bow_hold
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 5.0):
+            raise ConfigError(f"step bow_hold must be in [0, 5] s, got {v!r}")
+        v = self.pair
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.3):
+            raise ConfigError(f"step pair must be in [0, 0.3] m, got {v!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -425,8 +447,12 @@ STANDING_GAINS = BalanceGains(uphill=(-0.03, 0.07), side_roll=(0.0, -1.0),
 #: the ``balance`` behaviour's opt-in step (``step="on"``; :class:`Stepper`'s ``standing``),
 #: with :attr:`BalanceGains.bow_ease` this many seconds, the standing knee bending at most
 #: :data:`STANDING_BEND_RATE` (rad/s) for the swing leg's reach; a foot hung before the first
-#: step planted under a COM slower than 0.25 m/s (:attr:`Step.hang_still`)
-STANDING_STEP = Step(hang_still=0.25)
+#: step planted under a COM slower than 0.25 m/s (:attr:`Step.hang_still`); on a step along
+#: the feet the bow eased out over 1 s during the swing (:attr:`Step.bow_hold`) and the foot
+#: aimed at the floor from the hip as it is (:attr:`Step.ground` 0.99): the 16 pushes' limits
+#: 2425 -> 2430 N (his forward 170 -> 175), none lower (docs/athletics.md "The standing
+#: step's bow held through the swing")
+STANDING_STEP = Step(hang_still=0.25, ground=0.99, bow_hold=1.0)
 STANDING_BOW_EASE = 0.15
 STANDING_BEND_RATE = 1.5
 #: the standing step's end: once one foot alone has been down for :data:`STANDING_HANG` s
@@ -675,7 +701,11 @@ class BalanceLaw:
         if both:
             self._bow_now = self._bow(cp, vel)
         else:
-            self._bow_now *= math.exp(-dt / max(self.gains.bow_ease or 0.0, 1e-9))
+            tau = self.gains.bow_ease or 0.0
+            st = self.stepper
+            if st is not None and st.step.bow_hold and st.along():  # Step.bow_hold
+                tau = st.step.bow_hold
+            self._bow_now *= math.exp(-dt / max(tau, 1e-9))
         return self._bow_now
 
     def _bow(self, cp: float, vel: float) -> float:
@@ -805,14 +835,20 @@ class Stepper:
         if self.foot < 0:
             if t < self._t_end + STEP_PAUSE or not s.foot_contact.any():
                 return
-            lo, hi = s.support_extent(h)
+            # Step.pair: both soles' box after a step along the feet (after a sideways one as
+            # without: her 110 N left push was lost)
+            along = self._out is not None and self._out[1] == 0.0
+            pair = bool(st.pair and self.record and along)
+            lo, hi = s.support_extent(h, both=pair)
             # how far the capture point lies outside the soles' box (along the feet only
             # unless sideways), and the way out
             out = np.maximum(cp - hi[:2], 0.0) - np.maximum(lo[:2] - cp, 0.0)
             if not self.sideways:
                 out[1] = 0.0
             beyond = float(np.hypot(*out))
-            if beyond <= st.margin or float(vel @ out) <= 0.0:
+            if beyond <= (st.pair if pair else st.margin) or float(vel @ out) <= 0.0:
+                if pair and beyond <= st.pair and not s.foot_contact.all():
+                    bl.posture = replace(bl.posture, plant=True)  # the hanging foot put down
                 return
             # the farther foot swings (on a sideways fall toward the standing foot it crosses
             # over, see below)
@@ -851,6 +887,9 @@ class Stepper:
         at = s.local(hip, h)[:2]
         stand = feet[1 - k]
         under = self._out is None  # the place across the feet under its own hip
+        # Step.ground on the standing balance's steps along the feet only (her 110 N left
+        # push's shorter sideways swings took 4-6 steps and lost it)
+        ground = 0.0 if self.standing and not self.along() else st.ground
         if self._out is None:  # closing: beside the other, under its own hip
             want = np.array([stand[0], at[1]])
         else:  # past the capture point
@@ -892,10 +931,10 @@ class Stepper:
                 bend = min(bend, self._bend + STANDING_BEND_RATE * max(t - self._t_last, 0.0))
                 self._bend = max(bend, 0.0)
             rig.offset[_KNEE[j], 0] = max(bend, float(rig.offset[_KNEE[j], 0]))
-            if not st.ground or u < 0.5:  # aimed from the hip as low as that bend will put it
+            if not ground or u < 0.5:  # aimed from the hip as low as that bend will put it
                 down -= low
-        if st.ground and u >= 0.5:  # then on the floor within this reach from the hip as it is
-            reach = st.ground * (ul + ll)
+        if ground and u >= 0.5:  # then on the floor within this reach from the hip as it is
+            reach = ground * (ul + ll)
             far = math.sqrt(max(reach * reach - down * down, 0.0))
             pull = min(far / max(math.hypot(ahead, aside), 1e-9), 1.0)
             ahead, aside = ahead * pull, aside * pull
@@ -921,6 +960,10 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
+
+    def along(self) -> bool:
+        """A swing under way along the feet (not a sideways one, nor a closing one)."""
+        return self.foot >= 0 and self._out is not None and self._out[1] == 0.0
 
     def _give(self, t: float) -> None:
         """:attr:`Step.give`: the landed knee's and the rear ankle's targets after a

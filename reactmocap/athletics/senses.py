@@ -198,10 +198,13 @@ class Senses:
         z = float(pts[:, 2].mean())
         return np.array([c * mid[0] - s * mid[1], s * mid[0] + c * mid[1], z])
 
-    def support_extent(self, heading: float | None = None) -> tuple[F64, F64]:
-        """Min and max ``(2,)`` of the supporting soles' corners in the heading frame."""
+    def support_extent(
+        self, heading: float | None = None, both: bool = False
+    ) -> tuple[F64, F64]:
+        """Min and max ``(2,)`` of the supporting soles' corners in the heading frame (both
+        soles' when none is down, or ``both``)."""
         corners = self.sole_corners()
-        use = self.foot_contact if self.foot_contact.any() else np.ones(2, dtype=bool)
+        use = self.foot_contact if self.foot_contact.any() and not both else np.ones(2, dtype=bool)
         loc = self.local(corners[use].reshape(-1, 3), heading)
         return loc.min(axis=0), loc.max(axis=0)
 

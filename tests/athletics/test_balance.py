@@ -202,6 +202,12 @@ def test_a_step_moves_a_foot_toward_the_capture_point_and_off_changes_nothing() 
         Step.of([0.1, 0.1, 0.3, 0.25, 1.0])
 
 
+#: step="on" before Step.bow_hold and Step.ground were joined to it (2026-12-05,
+#: docs/athletics.md "The standing step's bow held through the swing"): the step the tests
+#: below measured their options against
+_STEP_BEFORE = dataclasses.replace(balance.STANDING_STEP, ground=0.0, bow_hold=0.0)
+
+
 def test_a_sideways_push_past_the_feet_is_taken_by_a_balance_step() -> None:
     # the balance behaviour's opt-in step (step="on", balance.STANDING_STEP): 110 N to the
     # female's left for 0.25 s falls with the feet in place (her limit 75 N, 2026-12-03); with
@@ -260,9 +266,10 @@ def test_a_standing_step_put_past_the_capture_point_across_the_feet_lands(
     # foot put 0.15 m past the capture point across the feet (Step.across) it lands within
     # 0.6 s and he is up at 3 s
     push = {"check_range": False, "seconds": 3.0, "push": 200.0, "step": "on"}
+    monkeypatch.setattr(behaviours, "STANDING_STEP", _STEP_BEFORE)
     r = run("balance", "male", **push).report
     assert r["fell"] and r["steps"][0]["s"] >= 0.7
-    across = dataclasses.replace(balance.STANDING_STEP, across=0.15)
+    across = dataclasses.replace(_STEP_BEFORE, across=0.15)
     monkeypatch.setattr(behaviours, "STANDING_STEP", across)
     r = run("balance", "male", **push).report
     assert not r["fell"] and r["steps"][0]["s"] < 0.6
@@ -279,9 +286,10 @@ def test_a_standing_step_aimed_on_the_floor_from_the_hip_ends_sooner(
     # with the leg up to 0.99 of straight (Step.ground), the foot lands after about 0.40 s
     # and about as far ahead
     push = {"check_range": False, "seconds": 3.0, "push": 200.0, "step": "on"}
+    monkeypatch.setattr(behaviours, "STANDING_STEP", _STEP_BEFORE)
     first = run("balance", "male", **push).report["steps"][0]
     assert first["s"] >= 0.7
-    ground = dataclasses.replace(balance.STANDING_STEP, ground=0.99)
+    ground = dataclasses.replace(_STEP_BEFORE, ground=0.99)
     monkeypatch.setattr(behaviours, "STANDING_STEP", ground)
     steps = run("balance", "male", **push).report["steps"]
     assert steps[0]["t"] == pytest.approx(first["t"])
@@ -301,7 +309,7 @@ def test_a_standing_step_whose_landed_knee_gives_stays_on_both_feet_longer(
     # the landed knee giving 0.3 rad and the rear ankle held (Step.give), about a third,
     # without the hop
     push = {"check_range": False, "seconds": 2.95, "push": 175.0, "step": "on"}
-    ground = dataclasses.replace(balance.STANDING_STEP, ground=0.99)
+    ground = dataclasses.replace(_STEP_BEFORE, ground=0.99)
 
     def after_touchdown(step: Step) -> tuple[float, float, float]:
         monkeypatch.setattr(behaviours, "STANDING_STEP", step)
@@ -333,7 +341,7 @@ def test_a_standing_step_placed_at_the_foreseen_capture_point_keeps_the_body_up(
     # where the COM's sideways speed will have carried it 0.3 s after the swing began
     # (Step.foresee) the same step lands farther out and he does not fall
     push = {"check_range": False, "seconds": 3.0, "push": 200.0, "step": "on"}
-    step = dataclasses.replace(balance.STANDING_STEP, ground=0.99, give=0.3, across=0.15)
+    step = dataclasses.replace(_STEP_BEFORE, ground=0.99, give=0.3, across=0.15)
     monkeypatch.setattr(behaviours, "STANDING_STEP", step)
     r = run("balance", "male", **push).report
     assert r["fell"]
@@ -359,11 +367,11 @@ def test_a_foot_hung_before_the_first_step_is_planted_under_a_faster_com(
     # without it (step="on" has it 0.25)
     push = {"check_range": False, "seconds": 3.0, "push": 85.0, "push_dir": -math.pi / 2}
     assert balance.STANDING_STEP.hang_still == 0.25
-    step = dataclasses.replace(balance.STANDING_STEP, hang_still=0.0)
+    step = dataclasses.replace(_STEP_BEFORE, hang_still=0.0)
     monkeypatch.setattr(behaviours, "STANDING_STEP", step)
     r = run("balance", "female", step="on", **push).report
     assert r["steps"] and not (r["balanced"] and r["on_both_feet"])
-    monkeypatch.setattr(behaviours, "STANDING_STEP", balance.STANDING_STEP)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", _STEP_BEFORE)
     r_still = run("balance", "female", step="on", **push).report
     assert not r_still["steps"]
     assert r_still["balanced"] and r_still["on_both_feet"]
@@ -371,3 +379,66 @@ def test_a_foot_hung_before_the_first_step_is_planted_under_a_faster_com(
         Step(hang_still=-0.1)
     with pytest.raises(ConfigError, match="hang_still"):
         Step(hang_still=float("nan"))
+
+
+def test_a_standing_step_whose_bow_is_held_through_the_swing_lands_sooner(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's bow held through the
+    # swing"): at the female's 105 N push backward the step fires from a bow; eased out over
+    # the gains' 0.15 s as the foot lifts, the pelvis pitching back takes the lagging swing thigh
+    # with it, the foot hangs over the floor and the first swing takes >= 0.55 s (planned 0.25)
+    # and she falls; with the bow eased out over 1 s during the swing (Step.bow_hold) the same
+    # step lands within 0.45 s and she does not fall
+    push = {"check_range": False, "seconds": 3.0, "push": 105.0, "push_dir": math.pi}
+    monkeypatch.setattr(behaviours, "STANDING_STEP", _STEP_BEFORE)
+    r = run("balance", "female", step="on", **push).report
+    assert r["steps"][0]["s"] >= 0.55 and r["fell"]
+    step = dataclasses.replace(_STEP_BEFORE, bow_hold=1.0)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    r_held = run("balance", "female", step="on", **push).report
+    assert r_held["steps"][0]["t"] == r["steps"][0]["t"]
+    assert r_held["steps"][0]["s"] < 0.45 and not r_held["fell"]
+    for bad in (-0.1, 5.5, float("nan")):
+        with pytest.raises(ConfigError, match="bow_hold"):
+            Step(bow_hold=bad)
+
+
+def test_a_standing_steps_next_trigger_on_both_soles_waits_for_the_capture_point(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's bow held through the
+    # swing"): at the female's 85 N push backward the rear foot rolls off after the first step
+    # and the second fires on the front sole's box alone, the capture point still within 5 cm
+    # of both soles' box; judged against both soles' box (Step.pair 0.05) it fires later,
+    # with the capture point more than 5 cm past that box
+    push = {"check_range": False, "seconds": 3.0, "push": 85.0, "push_dir": math.pi}
+    monkeypatch.setattr(behaviours, "STANDING_STEP", _STEP_BEFORE)
+    r = run("balance", "female", step="on", **push).report
+    step = dataclasses.replace(_STEP_BEFORE, pair=0.05)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    r_pair = run("balance", "female", step="on", **push).report
+    assert len(r["steps"]) >= 2 and len(r_pair["steps"]) >= 2
+    assert r_pair["steps"][0] == r["steps"][0]
+    assert r_pair["steps"][1]["t"] > r["steps"][1]["t"]
+    assert r_pair["steps"][1]["beyond_m"] > 0.05
+    for bad in (-0.01, 0.31, float("inf")):
+        with pytest.raises(ConfigError, match="pair"):
+            Step(pair=bad)
+
+
+def test_the_standing_step_holds_his_175_n_forward_push_with_the_bow_held(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step's bow held through the
+    # swing"): step="on" with Step.bow_hold 1.0 and Step.ground 0.99 joined: the male's 175 N
+    # forward push (his limit before, 170 N) steps once and ends still on both feet; before
+    # (neither) the step's swing takes over 0.5 s and he is still moving at 3 s
+    push = {"check_range": False, "seconds": 3.0, "push": 175.0, "step": "on"}
+    assert balance.STANDING_STEP.bow_hold == 1.0 and balance.STANDING_STEP.ground == 0.99
+    r = run("balance", "male", **push).report
+    assert len(r["steps"]) == 1 and r["balanced"] and r["on_both_feet"]
+    monkeypatch.setattr(behaviours, "STANDING_STEP", _STEP_BEFORE)
+    r_before = run("balance", "male", **push).report
+    assert r_before["steps"][0]["t"] == r["steps"][0]["t"]
+    assert r_before["steps"][0]["s"] > 0.5 and not r_before["balanced"]
