@@ -736,32 +736,6 @@ def test_the_foot_lock_gated_to_walking_clips_leaves_a_fighting_clip_as_the_defa
     assert not np.array_equal(root("walk_normal_002", 0.5, {}), walk)
 
 
-def test_a_foot_down_early_in_a_frame_the_lock_drops_gets_ramped_rows(
-    shared_mocap_dir: Path,
-) -> None:
-    """``centre_speed_lock_ramp`` (opt-in, 2026-12-05): on the shared right-turning walk from
-    1.0 s the foot lock drops the left foot's mid-swing "landing" (frames 38-39) and the
-    simulated left foot reaches the floor inside it at 0.316 s. With the ramp that foot gets
-    contact rows (its no-slip rows ramped in): the body moves exactly as with the lock alone
-    until the touchdown, and differently after it."""
-    from reactmocap.library.bvh import read_bvh
-
-    clip = shared_mocap_dir / "dataset-1_walk-right_normal_001.bvh"
-    if not clip.is_file():
-        pytest.skip(f"{clip.name} not in {shared_mocap_dir}")
-    walk = read_bvh(clip)
-    lock = {"centre_speed_lock": 2.5}
-
-    def rollout(params: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
-        return track_clip(walk, start=1.0, seconds=0.45, params=params).rollout.frames()
-
-    t, locked = rollout(lock)
-    _, ramped = rollout({**lock, "centre_speed_lock_ramp": 0.02})
-    before = t <= 0.31
-    assert np.array_equal(ramped[before], locked[before])
-    assert np.abs(ramped[~before] - locked[~before]).max() > 1e-3  # 0.03-0.05 m / rad
-
-
 def test_the_trunk_rows_give_after_a_push_only(guard: Motion) -> None:
     """The whole-clip trunk rows keep their weight while nothing pushes (even with the capture
     point off), are off while a push acts and until the capture point is back near the

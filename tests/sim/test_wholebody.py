@@ -286,7 +286,6 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("centre_speed", -1.0),
         ("centre_speed_lock", -2.5),
         ("centre_speed_lock_walking", -0.7),
-        ("centre_speed_lock_ramp", -0.1),
         ("anchor_turn_rate", -0.5),
     ],
 )
@@ -301,20 +300,6 @@ def test_centre_speed_lock_walking_needs_the_lock(guard: Motion) -> None:
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="centre_speed_lock_walking"):
         _tracker(world, guard, 0.0, centre_speed_lock_walking=0.7)
-
-
-@pytest.mark.parametrize(
-    "params",
-    [{"centre_speed_lock_ramp": 0.1}, {"centre_speed_lock": 2.5, "centre_speed_lock_ramp": 1.5}],
-)
-def test_centre_speed_lock_ramp_needs_the_lock_and_a_short_ramp(
-    guard: Motion, params: dict[str, float]
-) -> None:
-    """The ramped rows at the lock's dropped frames (``centre_speed_lock_ramp``) without the
-    lock, or longer than 1 s, are refused."""
-    world = World(build_character(guard, frame=0))
-    with pytest.raises(ConfigError, match="centre_speed_lock_ramp"):
-        _tracker(world, guard, 0.0, **params)
 
 
 def test_anchor_turn_rate_needs_the_anchoring(guard: Motion) -> None:

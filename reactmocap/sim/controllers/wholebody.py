@@ -279,11 +279,6 @@ class WholeBodyTracker(AnchoredReference):
             centre of mass's median horizontal speed is at least this (m/s; 0: every clip;
             needs ``centre_speed_lock``): the walks 1.0-1.6 m/s, the fighting clips 0.05-0.42
             (``docs/tracking.md``, issue 16).
-        centre_speed_lock_ramp: a foot that reaches the floor inside a frame the foot lock
-            drops (planted in the clip, not in the lock) gets contact rows after all, its
-            no-slip rows rising linearly over this many seconds from its touchdown (0: off, at
-            most 1; needs ``centre_speed_lock``): unheld, such a foot lost a pushed walk, held
-            fully it lost the lock's closer unpushed tracking (``docs/tracking.md``, issue 16).
         anchor_turn_rate: the ground path's heading (``anchor_tau``) turns at most this much
             faster (rad/s) than the clip's own soles that set it (their mean yaw rate): with
             ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round in 0.1 s
@@ -380,7 +375,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_phase: float = 0.0,
         centre_speed_lock: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        centre_speed_lock_ramp: float = 0.0,
         anchor_turn_rate: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
@@ -418,7 +412,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_horizon": step_ahead_horizon, "step_ahead_swing": step_ahead_swing,
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "centre_speed_lock_walking": centre_speed_lock_walking,
-                "centre_speed_lock_ramp": centre_speed_lock_ramp,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -437,12 +430,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"centre_speed_lock_walking ({centre_speed_lock_walking!r}) gates the foot lock: "
                 f"it needs centre_speed_lock > 0"
-            )
-        if centre_speed_lock_ramp and not (centre_speed_lock and centre_speed_lock_ramp <= 1.0):
-            raise ConfigError(
-                f"centre_speed_lock_ramp must be 0 (off) or in (0, 1] s and needs "
-                f"centre_speed_lock > 0, got {centre_speed_lock_ramp!r} "
-                f"(centre_speed_lock {centre_speed_lock!r})"
             )
         if anchor_turn_rate and not anchor_tau:
             raise ConfigError(
@@ -572,9 +559,6 @@ class WholeBodyTracker(AnchoredReference):
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
-        self._lock_ramp = float(centre_speed_lock_ramp)
-        # each foot's touchdown inside a frame the lock drops (nan: none under way)
-        self._ramp_t0 = np.full(2, np.nan)
         self._soft_reg = float(np.sqrt(step_soft_reg))
         self._dt_tick = self.control_every * world.timestep
         self.sqrt_ws = float(np.sqrt(swing_weight))
@@ -700,10 +684,6 @@ class WholeBodyTracker(AnchoredReference):
         quantities of the last step). Does not touch the simulation."""
         m, d = self.world.model, self.world.data
         qr, vr, ar, planted = self.reference(t)
-        early = None
-        if self._lock_ramp:  # a foot on the floor in a frame the lock drops: ramped rows
-            early = self.planted_now(t) & ~planted
-            planted |= early
         held = self._held(t)
         sl = self._dofs
         v = d.qvel[sl]
@@ -724,9 +704,6 @@ class WholeBodyTracker(AnchoredReference):
         h = d.qfrc_bias[sl]
         sup = self._support(d, planted, held)
         nc = len(sup.points)
-        wc = self._landing_weights(t, sup) if self._soft else None
-        if early is not None:
-            wc = self._ramp_weights(t, sup, early, wc)
         qb = sup.gen
         nb = qb.shape[1]
         nj = 3 * NJ
@@ -773,6 +750,7 @@ class WholeBodyTracker(AnchoredReference):
             # the tangential rows and a soft weight, joint accelerations missed the plan by
             # 100-350 rad/s^2 in double support
             jt = sup.rows
+            wc = self._landing_weights(t, sup) if self._soft else None
             if wc is None:
                 tasks.append(
                     (self.sqrt_wc * jt, -self.sqrt_wc * (sup.bias + self.contact_kv * (jt @ v)))
@@ -860,29 +838,6 @@ class WholeBodyTracker(AnchoredReference):
         r0 = sum(sup.nrows[:k])
         w[r0 : r0 + sup.nrows[k]] *= (t - landed + self._dt_tick) / (self._soft + self._dt_tick)
         return w
-
-    def _ramp_weights(
-        self, t: float, sup: _Support, early: NDArray[np.bool_], wc: F64 | None
-    ) -> F64 | None:
-        """``wc`` (the no-slip rows' square-root weights, ``None``: all ``sqrt_wc``) with the
-        rows of a foot ``early`` (planted in the clip, dropped by the foot lock) and in
-        contact rising linearly from a tick's share over ``centre_speed_lock_ramp`` s from its
-        touchdown (``_ramp_t0``, restarted whenever the foot leaves such a contact)."""
-        for f in range(2):
-            on = bool(early[f]) and f in sup.feet
-            if not on:
-                self._ramp_t0[f] = np.nan
-                continue
-            if np.isnan(self._ramp_t0[f]):
-                self._ramp_t0[f] = t
-            k = sup.feet.index(f)
-            r0 = sum(sup.nrows[:k])
-            share = (t - self._ramp_t0[f] + self._dt_tick) / (self._lock_ramp + self._dt_tick)
-            if share < 1.0:
-                if wc is None:
-                    wc = np.full(len(sup.rows), self.sqrt_wc)
-                wc[r0 : r0 + sup.nrows[k]] *= share
-        return wc
 
     def _push_response(self, t: float) -> float:
         """Follows pushes and returns the trunk rows' weight at ``t``: while the mocap stands,
@@ -1048,12 +1003,9 @@ class WholeBodyTracker(AnchoredReference):
 
     def memory(self) -> tuple[object, ...]:
         return (*super().memory(), self._hip_from, self._pushed, self._back_from,
-                self.kp[:3].copy(), self.kv[:3].copy(), self._holding, self._scale,
-                self._ramp_t0.copy())  # fmt: skip
+                self.kp[:3].copy(), self.kv[:3].copy(), self._holding, self._scale)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
-        self._ramp_t0[:] = memory[-1]  # type: ignore[call-overload]
-        memory = memory[:-1]
         super().restore(memory[:-7])
         self._hip_from = float(memory[-7])  # type: ignore[arg-type]
         self._pushed = bool(memory[-6])
@@ -1065,7 +1017,6 @@ class WholeBodyTracker(AnchoredReference):
         self.reset_ground(world)
         self._pushed, self._back_from, self._hip_from = False, -np.inf, -np.inf
         self._holding = False
-        self._ramp_t0[:] = np.nan
         if self._stiffness != 1.0:
             self.stiffen_joints(1.0)
         if self._kp_root_pushed:  # the pelvis servo as built
