@@ -442,14 +442,17 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # 2026-12-05 the push stops at a 1.0 m apex looked 12 ms ahead (LeapParams.rise_lead: only
     # the over-leaps are cut; 27/50 and 27/50 from 24 and 24), and (later) the hips' spin
     # allowance opens to 1.6 rad a tick before that cut (LeapParams.rise_spin_rate: 29/50 and
-    # 26/50 from 27 and 27). A list: a maneuver file's numbers load as one
+    # 26/50 from 27 and 27); since 2026-12-05 (later) the landing's step swings to the
+    # capture point itself (reach 0) and the recovery stands up to 0.8 of the straight leg
+    # (LandingParams.recover_leg: 32/50 and 26/50 from 29 and 26, held-out seed 2 30 from
+    # 27). A list: a maneuver file's numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3, "hold": 0.22, "com_offset": -0.13,
                                   "com_ramp": 0.2, "rise_cap": 1.0, "rise_lead": 0.012,
                                   "rise_spin_limit": 1.6, "rise_spin_rate": 33.5}),
         "handspring": MappingProxyType({"aim": -3.25, "knees": 0.9, "aim_knees": 1.3}),
         "land": MappingProxyType({"delta": -0.6, "spin_ref": -96.8,
-                                  "step": [0.05, 0.1, 0.3, 0.25]}),
+                                  "step": [0.05, 0.0, 0.3, 0.25], "recover_leg": 0.8}),
     }),
     "female": MappingProxyType({
         "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 2.0}),

@@ -158,6 +158,14 @@ def _unspun(m: Maneuver) -> Maneuver:
     return _with(m, "leap", {k: v for k, v in leap.items() if not k.startswith("rise_spin")})
 
 
+def _unpaired(m: Maneuver) -> Maneuver:
+    """``m`` with the landing as the file had it before the pair (2026-12-05, later): the
+    step to 10 cm past the capture point (reach 0.1), no ``recover_leg``."""
+    land = next(p for p in m.phases if p.controller == "land").params
+    old = {k: v for k, v in land.items() if k != "recover_leg"}
+    return _with(m, "land", {**old, "step": [0.05, 0.1, 0.3, 0.25]})
+
+
 def _aimed_at_196(m: Maneuver) -> Maneuver:
     """``m`` with the knees' aim as it was before it was centred on the ramped crouch
     (2026-12-04): -196 deg at contact about 0.4 rad, clipped at the default 0.9 (and no
@@ -341,9 +349,10 @@ def test_the_knees_aim_is_centred_on_the_ramped_crouch() -> None:
     knees aimed at -196 deg about 0.4 rad sat at their 0.9 rad clip. Centred there (aim -3.25
     rad about 0.9, up to 1.3: the file) the nominal lands as before, with its knees inside
     the range; full-size start 5 (seed 0) leaps high (0.67 m), and with the knees straightened
-    further it meets the floor earlier and lands, where it fell with the old aim."""
+    further it meets the floor earlier and lands, where it fell with the old aim (both on the
+    landing as it was then: the file's since 2026-12-05 lands start 5 with the old aim too)."""
     m = load_maneuver(EXAMPLE)
-    old = _aimed_at_196(m)
+    old = _aimed_at_196(_unpaired(m))
     nominal = run_maneuver(m, fps=10.0).report
     assert nominal["landed"] and 0.5 < nominal["handspring_aim_knees"] < 1.3
     assert run_maneuver(old, fps=10.0).report["handspring_aim_knees"] == 0.9
@@ -427,8 +436,9 @@ def test_the_landing_steps_closing_swing_ends_sooner_put_down_or_placed_across()
     with ``step_down_after`` 0.3 the place is the floor under the foot from 0.3 s on and the
     swing ends by 0.35 s; with ``step_across`` 0.15 the closing foot goes past the capture
     point across the feet and lands within 0.3 s. With ``step_down_after`` the first step is
-    the file's, record for record."""
-    m = replace(load_maneuver(EXAMPLE), seconds=4.6)
+    the file's, record for record. On the landing as it was then (the file's since 2026-12-05,
+    the step to the capture point and ``recover_leg``, stands start 28 up)."""
+    m = replace(_unpaired(load_maneuver(EXAMPLE)), seconds=4.6)
     land = next(p for p in m.phases if p.controller == "land").params
     assert "step_down_after" not in land and "step_across" not in land
     start = _starts(1.0, 29)[28]
@@ -449,11 +459,14 @@ def test_the_landing_steps_closing_swing_ends_sooner_put_down_or_placed_across()
 
 
 def test_the_landings_recover_leg_stands_the_recovery_up_taller() -> None:
-    """``LandingParams.recover_leg`` (opt-in, off in the file): the recovery's stand-up goes
-    to at least that fraction of the straight leg, not to where the landing's crouch left the
-    legs. Full-size start 28 (seed 0): the run is the file's up to the recovery, and 0.5 s
+    """``LandingParams.recover_leg`` (0.8 in the file since 2026-12-05, with the step's reach
+    0): the recovery's stand-up goes to at least that fraction of the straight leg, not to
+    where the landing's crouch left the legs. Full-size start 28 (seed 0), on the landing as
+    it was before (no ``recover_leg``): the run is that one's up to the recovery, and 0.5 s
     after the feet touch its COM stands higher; a bad value is named."""
-    m = replace(load_maneuver(EXAMPLE), seconds=4.2)
+    assert next(p for p in load_maneuver(EXAMPLE).phases
+                if p.controller == "land").params["recover_leg"] == 0.8  # fmt: skip
+    m = replace(_unpaired(load_maneuver(EXAMPLE)), seconds=4.2)
     land = next(p for p in m.phases if p.controller == "land").params
     assert "recover_leg" not in land
     start = _starts(1.0, 29)[28]
