@@ -482,3 +482,19 @@ def test_the_landings_recover_leg_stands_the_recovery_up_taller() -> None:
     for bad in (0.3, 1.2):
         with pytest.raises(ConfigError, match="recover_leg"):
             LandingParams(recover_leg=bad)
+
+
+def test_the_last_balance_keeps_the_com_between_both_feet_after_the_landings_steps() -> None:
+    """Full-size start 16 (seed 0) lands, steps back and closes its feet as the landers do, then
+    drifts sideways over one foot and falls during a third step 2.0 s after touchdown. With
+    the last balance's COM target kept between both soles while one is unloaded
+    (``Posture.side_both``, the file since 2026-12-05) it stands; without it it falls."""
+    m = replace(load_maneuver(EXAMPLE), seconds=5.0)  # touchdown at 2.55 s
+    last = m.phases[-1]
+    assert last.controller == "balance" and last.params["side_both"] is True
+    start = _starts(1.0, 17)[16]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    plain = replace(last, params={k: v for k, v in last.params.items() if k != "side_both"})
+    old = run_maneuver(replace(m, phases=(*m.phases[:-1], plain)), perturbation=start, fps=10.0)
+    assert old.report["fell"] and not old.report["landed"]
