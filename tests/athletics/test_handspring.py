@@ -159,11 +159,15 @@ def _unspun(m: Maneuver) -> Maneuver:
 
 
 def _unpaired(m: Maneuver) -> Maneuver:
-    """``m`` with the landing as the file had it before the pair (2026-12-05, later): the
-    step to 10 cm past the capture point (reach 0.1), no ``recover_leg``."""
+    """``m`` with the landing and the last balance as the file had them before 2026-12-05
+    (later): the step to 10 cm past the capture point (reach 0.1), no ``recover_leg``, no
+    ``side_both``."""
     land = next(p for p in m.phases if p.controller == "land").params
     old = {k: v for k, v in land.items() if k != "recover_leg"}
-    return _with(m, "land", {**old, "step": [0.05, 0.1, 0.3, 0.25]})
+    m = _with(m, "land", {**old, "step": [0.05, 0.1, 0.3, 0.25]})
+    last = m.phases[-1]
+    plain = {k: v for k, v in last.params.items() if k != "side_both"}
+    return replace(m, phases=(*m.phases[:-1], replace(last, params=plain)))
 
 
 def _aimed_at_196(m: Maneuver) -> Maneuver:
@@ -350,7 +354,8 @@ def test_the_knees_aim_is_centred_on_the_ramped_crouch() -> None:
     rad about 0.9, up to 1.3: the file) the nominal lands as before, with its knees inside
     the range; full-size start 5 (seed 0) leaps high (0.67 m), and with the knees straightened
     further it meets the floor earlier and lands, where it fell with the old aim (both on the
-    landing as it was then: the file's since 2026-12-05 lands start 5 with the old aim too)."""
+    landing and last balance as they were then: the file's since 2026-12-05 lands start 5
+    with the old aim too)."""
     m = load_maneuver(EXAMPLE)
     old = _aimed_at_196(_unpaired(m))
     nominal = run_maneuver(m, fps=10.0).report
@@ -390,6 +395,7 @@ def test_the_cap_looks_ahead_and_holds_only_the_over_leap() -> None:
     m = load_maneuver(EXAMPLE)
     leap = next(p for p in m.phases if p.controller == "leap").params
     assert (leap["rise_cap"], leap["rise_lead"]) == (1.0, 0.012)
+    m = _unpaired(m)  # the landing and last balance as then (start 1 falls with the file's)
     uncapped = _uncapped(m)
     m = _unspun(m)  # as measured then
     ordinary, high = _starts(1.0, 2)
@@ -436,8 +442,9 @@ def test_the_landing_steps_closing_swing_ends_sooner_put_down_or_placed_across()
     with ``step_down_after`` 0.3 the place is the floor under the foot from 0.3 s on and the
     swing ends by 0.35 s; with ``step_across`` 0.15 the closing foot goes past the capture
     point across the feet and lands within 0.3 s. With ``step_down_after`` the first step is
-    the file's, record for record. On the landing as it was then (the file's since 2026-12-05,
-    the step to the capture point and ``recover_leg``, stands start 28 up)."""
+    the file's, record for record. On the landing and last balance as they were then (the
+    file's since 2026-12-05, the step to the capture point, ``recover_leg`` and
+    ``side_both``, stands start 28 up)."""
     m = replace(_unpaired(load_maneuver(EXAMPLE)), seconds=4.6)
     land = next(p for p in m.phases if p.controller == "land").params
     assert "step_down_after" not in land and "step_across" not in land
