@@ -423,10 +423,11 @@ HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
                                     "snap": 0.1}),
     "land": MappingProxyType({"delta": -0.45}),
 })  # fmt: skip
-#: a body's own replacements for the male preset's leap and landing parameters. The female
-#: (hand-tuned 2026-12-02, narrow: docs/athletics.md) leaps harder with more hip feedback,
-#: and lands on feet placed farther behind her (the hip swing allowed past asin 0.9) with
-#: stiffer, more damped knees, which stop the legs bouncing her back into the air
+#: a body's own replacements for the male preset's leap, landing and last balance
+#: parameters. The female (hand-tuned 2026-12-02, narrow: docs/athletics.md) leaps harder
+#: with more hip feedback, and lands on feet placed farther behind her (the hip swing
+#: allowed past asin 0.9) with stiffer, more damped knees, which stop the legs bouncing her
+#: back into the air
 HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingProxyType({
     # the male's landing scales its delta by the spin the push left (LandingParams.spin_ref:
     # the spin at the nominal's release, 2026-12-03). Since 2026-12-03 his knees aim the
@@ -442,14 +443,20 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # 2026-12-05 the push stops at a 1.0 m apex looked 12 ms ahead (LeapParams.rise_lead: only
     # the over-leaps are cut; 27/50 and 27/50 from 24 and 24), and (later) the hips' spin
     # allowance opens to 1.6 rad a tick before that cut (LeapParams.rise_spin_rate: 29/50 and
-    # 26/50 from 27 and 27). A list: a maneuver file's numbers load as one
+    # 26/50 from 27 and 27); since 2026-12-05 (later) the landing's step swings to the
+    # capture point itself (reach 0) and the recovery stands up to 0.8 of the straight leg
+    # (LandingParams.recover_leg: 32/50 and 26/50 from 29 and 26, held-out seed 2 30 from
+    # 27); and (later) his last balance keeps the COM target's sideways part between both
+    # soles while one is unloaded (Posture.side_both: 35/50 and 29/50 from 32 and 26, held-out
+    # seed 2 30 from 30). A list: a maneuver file's numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3, "hold": 0.22, "com_offset": -0.13,
                                   "com_ramp": 0.2, "rise_cap": 1.0, "rise_lead": 0.012,
                                   "rise_spin_limit": 1.6, "rise_spin_rate": 33.5}),
         "handspring": MappingProxyType({"aim": -3.25, "knees": 0.9, "aim_knees": 1.3}),
         "land": MappingProxyType({"delta": -0.6, "spin_ref": -96.8,
-                                  "step": [0.05, 0.1, 0.3, 0.25]}),
+                                  "step": [0.05, 0.0, 0.3, 0.25], "recover_leg": 0.8}),
+        "balance": MappingProxyType({"side_both": True}),
     }),
     "female": MappingProxyType({
         "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 2.0}),
@@ -474,17 +481,19 @@ HANDSPRING_STARTS: Mapping[str, Phase] = MappingProxyType({"male": SETTLED_START
 def handspring_maneuver(body: str = "male") -> Maneuver:
     """The back handspring as a maneuver: balance, leap with backward rotation, hand support
     (:class:`~reactmocap.athletics.handspring.Handspring`), land, balance. A body with a
-    :data:`HANDSPRING_BODY_PRESET` entry gets its own leap and landing; any other body than
-    the male one aims its leap at the male's angular momentum scaled by its layout inertia
-    (the same spin rate); that is untuned and its report says what happened."""
+    :data:`HANDSPRING_BODY_PRESET` entry gets its own leap, landing and last balance; any
+    other body than the male one aims its leap at the male's angular momentum scaled by its
+    layout inertia (the same spin rate); that is untuned and its report says what happened."""
     leap = dict(HANDSPRING_PRESET["leap"])
     hands = dict(HANDSPRING_PRESET["handspring"])
     land: dict[str, Any] = dict(HANDSPRING_PRESET["land"])
+    last: dict[str, Any] = {"settle": 2.0}
     own = HANDSPRING_BODY_PRESET.get(body)
     if own is not None:
         leap.update(own.get("leap", {}))
         hands.update(own.get("handspring", {}))
         land.update(own.get("land", {}))
+        last.update(own.get("balance", {}))
     elif body != "male":
         ratio = somersault_inertia(athlete(body), "layout") / somersault_inertia(
             athlete("male"), "layout"
@@ -499,7 +508,7 @@ def handspring_maneuver(body: str = "male") -> Maneuver:
         Phase("leap", "liftoff", leap),
         Phase("handspring", "released", hands),
         Phase("land", "settled", land),
-        Phase("balance", "never", {"settle": 2.0}),
+        Phase("balance", "never", last),
     )
     return Maneuver("back_handspring", phases, body, seconds)
 

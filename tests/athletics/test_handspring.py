@@ -158,6 +158,18 @@ def _unspun(m: Maneuver) -> Maneuver:
     return _with(m, "leap", {k: v for k, v in leap.items() if not k.startswith("rise_spin")})
 
 
+def _unpaired(m: Maneuver) -> Maneuver:
+    """``m`` with the landing and the last balance as the file had them before 2026-12-05
+    (later): the step to 10 cm past the capture point (reach 0.1), no ``recover_leg``, no
+    ``side_both``."""
+    land = next(p for p in m.phases if p.controller == "land").params
+    old = {k: v for k, v in land.items() if k != "recover_leg"}
+    m = _with(m, "land", {**old, "step": [0.05, 0.1, 0.3, 0.25]})
+    last = m.phases[-1]
+    plain = {k: v for k, v in last.params.items() if k != "side_both"}
+    return replace(m, phases=(*m.phases[:-1], replace(last, params=plain)))
+
+
 def _aimed_at_196(m: Maneuver) -> Maneuver:
     """``m`` with the knees' aim as it was before it was centred on the ramped crouch
     (2026-12-04): -196 deg at contact about 0.4 rad, clipped at the default 0.9 (and no
@@ -341,9 +353,11 @@ def test_the_knees_aim_is_centred_on_the_ramped_crouch() -> None:
     knees aimed at -196 deg about 0.4 rad sat at their 0.9 rad clip. Centred there (aim -3.25
     rad about 0.9, up to 1.3: the file) the nominal lands as before, with its knees inside
     the range; full-size start 5 (seed 0) leaps high (0.67 m), and with the knees straightened
-    further it meets the floor earlier and lands, where it fell with the old aim."""
+    further it meets the floor earlier and lands, where it fell with the old aim (both on the
+    landing and last balance as they were then: the file's since 2026-12-05 lands start 5
+    with the old aim too)."""
     m = load_maneuver(EXAMPLE)
-    old = _aimed_at_196(m)
+    old = _aimed_at_196(_unpaired(m))
     nominal = run_maneuver(m, fps=10.0).report
     assert nominal["landed"] and 0.5 < nominal["handspring_aim_knees"] < 1.3
     assert run_maneuver(old, fps=10.0).report["handspring_aim_knees"] == 0.9
@@ -381,6 +395,7 @@ def test_the_cap_looks_ahead_and_holds_only_the_over_leap() -> None:
     m = load_maneuver(EXAMPLE)
     leap = next(p for p in m.phases if p.controller == "leap").params
     assert (leap["rise_cap"], leap["rise_lead"]) == (1.0, 0.012)
+    m = _unpaired(m)  # the landing and last balance as then (start 1 falls with the file's)
     uncapped = _uncapped(m)
     m = _unspun(m)  # as measured then
     ordinary, high = _starts(1.0, 2)
@@ -427,8 +442,10 @@ def test_the_landing_steps_closing_swing_ends_sooner_put_down_or_placed_across()
     with ``step_down_after`` 0.3 the place is the floor under the foot from 0.3 s on and the
     swing ends by 0.35 s; with ``step_across`` 0.15 the closing foot goes past the capture
     point across the feet and lands within 0.3 s. With ``step_down_after`` the first step is
-    the file's, record for record."""
-    m = replace(load_maneuver(EXAMPLE), seconds=4.6)
+    the file's, record for record. On the landing and last balance as they were then (the
+    file's since 2026-12-05, the step to the capture point, ``recover_leg`` and
+    ``side_both``, stands start 28 up)."""
+    m = replace(_unpaired(load_maneuver(EXAMPLE)), seconds=4.6)
     land = next(p for p in m.phases if p.controller == "land").params
     assert "step_down_after" not in land and "step_across" not in land
     start = _starts(1.0, 29)[28]
@@ -449,11 +466,14 @@ def test_the_landing_steps_closing_swing_ends_sooner_put_down_or_placed_across()
 
 
 def test_the_landings_recover_leg_stands_the_recovery_up_taller() -> None:
-    """``LandingParams.recover_leg`` (opt-in, off in the file): the recovery's stand-up goes
-    to at least that fraction of the straight leg, not to where the landing's crouch left the
-    legs. Full-size start 28 (seed 0): the run is the file's up to the recovery, and 0.5 s
+    """``LandingParams.recover_leg`` (0.8 in the file since 2026-12-05, with the step's reach
+    0): the recovery's stand-up goes to at least that fraction of the straight leg, not to
+    where the landing's crouch left the legs. Full-size start 28 (seed 0), on the landing as
+    it was before (no ``recover_leg``): the run is that one's up to the recovery, and 0.5 s
     after the feet touch its COM stands higher; a bad value is named."""
-    m = replace(load_maneuver(EXAMPLE), seconds=4.2)
+    assert next(p for p in load_maneuver(EXAMPLE).phases
+                if p.controller == "land").params["recover_leg"] == 0.8  # fmt: skip
+    m = replace(_unpaired(load_maneuver(EXAMPLE)), seconds=4.2)
     land = next(p for p in m.phases if p.controller == "land").params
     assert "recover_leg" not in land
     start = _starts(1.0, 29)[28]
@@ -469,3 +489,19 @@ def test_the_landings_recover_leg_stands_the_recovery_up_taller() -> None:
     for bad in (0.3, 1.2):
         with pytest.raises(ConfigError, match="recover_leg"):
             LandingParams(recover_leg=bad)
+
+
+def test_the_last_balance_keeps_the_com_between_both_feet_after_the_landings_steps() -> None:
+    """Full-size start 16 (seed 0) lands, steps back and closes its feet as the landers do, then
+    drifts sideways over one foot and falls during a third step 2.0 s after touchdown. With
+    the last balance's COM target kept between both soles while one is unloaded
+    (``Posture.side_both``, the file since 2026-12-05) it stands; without it it falls."""
+    m = replace(load_maneuver(EXAMPLE), seconds=5.0)  # touchdown at 2.55 s
+    last = m.phases[-1]
+    assert last.controller == "balance" and last.params["side_both"] is True
+    start = _starts(1.0, 17)[16]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    plain = replace(last, params={k: v for k, v in last.params.items() if k != "side_both"})
+    old = run_maneuver(replace(m, phases=(*m.phases[:-1], plain)), perturbation=start, fps=10.0)
+    assert old.report["fell"] and not old.report["landed"]
