@@ -200,7 +200,7 @@ class RunParams:
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
     lean: float | Speeds = 1.0
-    arm_yaw: float | Speeds = 2.0
+    arm_yaw: float | Speeds = 1.0
     arm_yaw_rate: float | Speeds = 0.05
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(

@@ -125,7 +125,7 @@ def test_arm_yaw_is_checked() -> None:
         RunParams(arm_yaw=(0.0, 0.0, 6.0))
     with pytest.raises(ConfigError, match=r"arm_yaw must be in \[0, 5\]"):
         RunParams(arm_yaw=-0.1)
-    assert RunParams().at(2.5)["arm_yaw"] == 2.0
+    assert RunParams().at(2.5)["arm_yaw"] == 1.0
     with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
         RunParams(arm_yaw_rate=1.5)
     with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
