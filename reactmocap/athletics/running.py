@@ -110,6 +110,9 @@ STEP_AFTER = 2.0
 PATH_AFTER = 3.0
 #: the most the path correction's integral (cross-track times curvature) holds (s)
 PATH_SUM = 5.0
+#: the arms' yaw terms act only where the course curves more than this (1/m): a straight
+#: line (curvature 0) runs without them, as they slowed its strides
+ARM_CURVE = 1e-6
 
 
 class Runner:
@@ -416,7 +419,8 @@ class Runner:
         """Eq. 5 (arms with the opposite hip), elbows bent, spine and neck held."""
         k = self.k
         arm = (k["arm_gain"] * hips[::-1] + k["arm_offset"]).tolist()  # each opposite hip's
-        if (k["arm_yaw"] > 0 or k["arm_yaw_rate"] > 0) and self.world.data.time >= PATH_AFTER:
+        if ((k["arm_yaw"] > 0 or k["arm_yaw_rate"] > 0) and abs(self.curvature) > ARM_CURVE
+                and self.world.data.time >= PATH_AFTER):  # fmt: skip
             # the arms counter-rotate against the trunk's yaw past the facing (``arm_yaw``):
             # their reaction turns the trunk without the stance foot's grip
             chest = self._anat(self._chest, SIM_BODY_INDEX["chest"])

@@ -147,10 +147,12 @@ class RunParams:
         arm_yaw: the arms' counter-rotation (rad per rad; 0: off): each shoulder's pitch
             moved by this times the trunk's yaw past the desired facing, the left arm back
             and the right forward for a trunk turned left of it, so the arms' reaction turns
-            the trunk back without the stance foot's grip. Within [0, 5].
+            the trunk back without the stance foot's grip. Only where the course curves
+            (``ARM_CURVE``; a straight line runs without it) and from ``PATH_AFTER`` on.
+            Within [0, 5].
         arm_yaw_rate: the same for the trunk's yaw rate past the desired facing's rate (s;
             0: off): each shoulder's pitch also moved by this times it, the same signs as
-            ``arm_yaw``'s, from ``PATH_AFTER`` on. Within [0, 1].
+            ``arm_yaw``'s, where ``arm_yaw`` acts. Within [0, 1].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -198,8 +200,8 @@ class RunParams:
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
     lean: float | Speeds = 1.0
-    arm_yaw: float | Speeds = 0.0
-    arm_yaw_rate: float | Speeds = 0.0
+    arm_yaw: float | Speeds = 1.0
+    arm_yaw_rate: float | Speeds = 0.05
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {

@@ -59,12 +59,12 @@ def _arms_past_eq5(params: RunParams) -> tuple[Runner, list[float]]:
 def test_arm_yaw_counter_rotates_the_arms_against_the_trunks_yaw() -> None:
     """``arm_yaw``: from ``PATH_AFTER`` on the shoulders' pitch goals leave eq. 5 by the gain
     times the trunk's yaw past the desired facing, the left arm back and the right forward
-    for a trunk turned left of it; before it the run is the default's to the bit, and off
-    (the default) eq. 5 is left as it is."""
+    for a trunk turned left of it; before it the run is the one without it to the bit, and
+    off eq. 5 is left as it is."""
     gain = 2.0
     runs = {}
     for g in (0.0, gain):
-        r, extra = _arms_past_eq5(RunParams(arm_yaw=g))
+        r, extra = _arms_past_eq5(RunParams(arm_yaw=g, arm_yaw_rate=0.0))
         chest = r._anat(r._chest, SIM_BODY_INDEX["chest"])
         yaw = euler_yxz(qmul1(qyaw(-r.heading_d), chest))[2]
         runs[g] = (r.log.arrays(), extra, yaw)
@@ -100,14 +100,34 @@ def test_arm_yaw_rate_moves_the_arms_by_the_trunks_yaw_rate_past_the_facings() -
     assert not np.array_equal(off["com"][~before], on["com"][~before])
 
 
+def test_arm_yaw_terms_are_off_on_a_straight_line() -> None:
+    """The arms' yaw terms act only where the course curves (``ARM_CURVE``): on a straight
+    line a run with them is the run without them to the bit, past ``PATH_AFTER`` too, while
+    on the circle the same terms change the run from ``PATH_AFTER`` on."""
+    on = RunParams(arm_yaw=2.0, arm_yaw_rate=0.05)
+    off = RunParams(arm_yaw=0.0, arm_yaw_rate=0.0)
+    secs = PATH_AFTER + 0.5
+    line = [run_course(2.5, seconds=secs, fps=10.0, params=p) for p in (on, off)]
+    assert line[0].report["simulated_s"] == pytest.approx(secs)
+    assert max(line[0].log["t"]) > PATH_AFTER + 0.4
+    for key in ("t", "com", "cross_track", "heading"):
+        assert np.array_equal(line[0].log[key], line[1].log[key]), key
+    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
+    curve = [run_course(2.5, seconds=secs, path="circle:10", fps=10.0, params=p).log
+             for p in (on, off)]  # fmt: skip
+    before = curve[0]["t"] < PATH_AFTER
+    assert np.array_equal(curve[0]["com"][before], curve[1]["com"][before])
+    assert not np.array_equal(curve[0]["com"][~before], curve[1]["com"][~before])
+
+
 def test_arm_yaw_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"arm_yaw must be in \[0, 5\]"):
         RunParams(arm_yaw=(0.0, 0.0, 6.0))
     with pytest.raises(ConfigError, match=r"arm_yaw must be in \[0, 5\]"):
         RunParams(arm_yaw=-0.1)
-    assert RunParams().at(2.5)["arm_yaw"] == 0.0
+    assert RunParams().at(2.5)["arm_yaw"] == 1.0
     with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
         RunParams(arm_yaw_rate=1.5)
     with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
         RunParams(arm_yaw_rate=(0.0, -0.05, 0.0))
-    assert RunParams().at(2.5)["arm_yaw_rate"] == 0.0
+    assert RunParams().at(2.5)["arm_yaw_rate"] == 0.05
