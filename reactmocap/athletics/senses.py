@@ -198,9 +198,7 @@ class Senses:
         z = float(pts[:, 2].mean())
         return np.array([c * mid[0] - s * mid[1], s * mid[0] + c * mid[1], z])
 
-    def support_extent(
-        self, heading: float | None = None, both: bool = False
-    ) -> tuple[F64, F64]:
+    def support_extent(self, heading: float | None = None, both: bool = False) -> tuple[F64, F64]:
         """Min and max ``(2,)`` of the supporting soles' corners in the heading frame (both
         soles' when none is down, or ``both``)."""
         corners = self.sole_corners()
