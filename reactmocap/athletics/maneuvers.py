@@ -158,8 +158,8 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
     standing = bool(p.pop("standing_step", False))
     if standing:
         # the balance behaviour's step="on": a hung foot planted, steps across the feet too,
-        # the bow (standing gains) eased
-        step = step or STANDING_STEP
+        # the bow (standing gains) eased; `step` numbers override its own, not the plant
+        step = replace(step, hang_still=STANDING_STEP.hang_still) if step else STANDING_STEP
         g = replace(g, bow_ease=STANDING_BOW_EASE) if g.bow is not None else g
     seconds = phase.seconds if phase.exit == "after" else None
     within = None
@@ -240,7 +240,8 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
         "`step`: [margin, reach, lift, seconds], a step when the capture point leaves the feet; "
         "`standing_step` (default false): the standing balance's step (the `balance` "
         "behaviour's step \"on\": a foot left hanging put down once the COM is slower than "
-        "0.25 m/s, steps across the feet too; `step` overrides its numbers)",
+        "0.25 m/s, steps across the feet too; `step` overrides its step's numbers, not the "
+        "plant)",
         {**_kinds(Posture), "settle_share": "number", "gains": "string", "step": "numbers",
          "standing_step": "bool"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
