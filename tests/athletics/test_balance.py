@@ -225,6 +225,10 @@ def test_a_maneuver_balance_with_the_standing_step_puts_a_hanging_foot_down(
     last = [np.asarray(r.log["feet"])[np.asarray(r.log["t"]) > 2.0] for r in (off, on)]
     assert not off.report["fell"] and np.mean(last[0] == 1) > 0.9
     assert not on.report["fell"] and np.all(last[1] == 2)
+    # a step's numbers override the standing step's, not its plant (a 10 m margin: no step)
+    planted = _drifting({"standing_step": True, "step": [10.0]})
+    feet = np.asarray(planted.log["feet"])[np.asarray(planted.log["t"]) > 2.0]
+    assert not planted.report["fell"] and np.all(feet == 2) and "steps" not in planted.report
     bad = tmp_path / "m.toml"
     bad.write_text('[[phase]]\ncontroller = "balance"\nparams = { standing_step = "on" }\n'
                    'exit = { event = "never" }\n')  # fmt: skip
