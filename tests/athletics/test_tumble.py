@@ -294,8 +294,8 @@ def test_the_forward_tuck_files_feet_move_by_the_predicted_touchdown_rotation() 
     (``turn_gain`` 0.25 past ``turn_ref`` 5.49 rad) puts the feet ahead by the rotation
     predicted at touchdown and it lands (full size 44 / 44 / 40 of 50 on seeds 0 / 1 / 2,
     from 44 / 41 / 37; docs/athletics.md, "Forward tuck: the short touchdown's class C");
-    the over-rotation read with the last balance as it was then (since 2026-12-05 13:40 UTC
-    the standing step and gains: without ``turn_gain`` it falls all the same)."""
+    the over-rotation read with the last balance as it was then (since 2026-12-05 13:50 UTC
+    the standing plant and gains)."""
     m = load_maneuver(FORWARD_FILE)
     start = full_starts(24)[23]
     r = run_maneuver(m, perturbation=start, fps=10.0).report
@@ -314,10 +314,10 @@ def _with_last_balance_params(m: Maneuver, params: Mapping[str, Any]) -> Maneuve
 def test_the_forward_tucks_last_balance_puts_down_a_foot_left_hanging() -> None:
     """Start 42 of the capture region at full size (seed 0) lands, then stands up on one
     foot in the last balance (97% of it, the lifted foot cm up) and falls sideways 1.7 s after
-    touchdown; the file since 2026-12-05 13:40 UTC (the standing balance's own step and
-    gains, ``standing_step``) puts the foot down and it stands (full size 44 / 45 / 40 of 50
-    on seeds 0 / 1 / 2 from 44 / 44 / 40; docs/athletics.md, "Forward tuck: the standing
-    balance's own step in the last balance")."""
+    touchdown; the file since 2026-12-05 13:50 UTC (the standing balance's plant of a hung
+    foot and its gains, ``standing_step``, its step off) puts the foot down and it stands
+    (full size 45 / 46 / 41 of 50 on seeds 0 / 1 / 2 from 44 / 44 / 40; docs/athletics.md,
+    "Forward tuck: the standing balance's own step in the last balance")."""
     m = load_maneuver(FORWARD_FILE)
     assert m.phases[-1].params["standing_step"] is True
     start = full_starts(43)[42]
