@@ -181,33 +181,6 @@ def test_a_sideways_push_is_taken_by_arms_circling_in_the_frontal_plane(
         BalanceGains(windmill_side=(8.0, 0.05, 2.0))
 
 
-def _pushed_back(step: list[float] | None) -> AthleticsResult:
-    """A standing male balance started with the body moving back at 0.5 m/s (its capture
-    point past the heels), with the balance's step if given."""
-    params = {"step": step} if step is not None else {}
-    m = Maneuver("pushed", (Phase("balance", "never", params),), "male", 1.0)
-    still = tuple((0.0, 0.0, 0.0) for _ in range(15))
-    return run_maneuver(m, perturbation=Perturbation(still, velocity=(-0.5, 0.0, 0.0)), fps=10.0)
-
-
-def test_a_step_moves_a_foot_toward_the_capture_point_and_off_changes_nothing() -> None:
-    stepped = _pushed_back([0.05, 0.1, 0.3, 0.25])
-    first = stepped.report["steps"][0]
-    # the capture point lies behind: a foot swings from beside the other to well behind it
-    assert abs(first["from_m"]) < 0.05 and first["beyond_m"] > 0.05
-    assert first["to_m"] < -0.15
-    # off (the default), or on with a margin it never passes: the same run to the bit
-    off = _pushed_back(None)
-    never = _pushed_back([10.0])
-    assert "steps" not in off.report and "steps" not in never.report
-    np.testing.assert_array_equal(off.log["com"], never.log["com"])
-    assert not np.array_equal(off.log["com"], stepped.log["com"])
-    with pytest.raises(ConfigError, match="step"):
-        Step(margin=-0.1)
-    with pytest.raises(ConfigError, match="step"):
-        Step.of([0.1, 0.1, 0.3, 0.25, 1.0])
-
-
 def _drifting(params: dict[str, object]) -> AthleticsResult:
     """A standing male balance started moving back and to the left at 0.3 m/s each: the
     balance phase alone lifts a foot and stands on the other."""
@@ -237,6 +210,33 @@ def test_a_maneuver_balance_with_the_standing_step_puts_a_hanging_foot_down(
     ) as err:
         load_maneuver(bad)
     assert str(bad) in str(err.value)
+
+
+def _pushed_back(step: list[float] | None) -> AthleticsResult:
+    """A standing male balance started with the body moving back at 0.5 m/s (its capture
+    point past the heels), with the balance's step if given."""
+    params = {"step": step} if step is not None else {}
+    m = Maneuver("pushed", (Phase("balance", "never", params),), "male", 1.0)
+    still = tuple((0.0, 0.0, 0.0) for _ in range(15))
+    return run_maneuver(m, perturbation=Perturbation(still, velocity=(-0.5, 0.0, 0.0)), fps=10.0)
+
+
+def test_a_step_moves_a_foot_toward_the_capture_point_and_off_changes_nothing() -> None:
+    stepped = _pushed_back([0.05, 0.1, 0.3, 0.25])
+    first = stepped.report["steps"][0]
+    # the capture point lies behind: a foot swings from beside the other to well behind it
+    assert abs(first["from_m"]) < 0.05 and first["beyond_m"] > 0.05
+    assert first["to_m"] < -0.15
+    # off (the default), or on with a margin it never passes: the same run to the bit
+    off = _pushed_back(None)
+    never = _pushed_back([10.0])
+    assert "steps" not in off.report and "steps" not in never.report
+    np.testing.assert_array_equal(off.log["com"], never.log["com"])
+    assert not np.array_equal(off.log["com"], stepped.log["com"])
+    with pytest.raises(ConfigError, match="step"):
+        Step(margin=-0.1)
+    with pytest.raises(ConfigError, match="step"):
+        Step.of([0.1, 0.1, 0.3, 0.25, 1.0])
 
 
 def test_a_sideways_push_past_the_feet_is_taken_by_a_balance_step() -> None:
