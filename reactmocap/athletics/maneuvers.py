@@ -40,7 +40,15 @@ import numpy as np
 
 from reactmocap.athletics import tables
 from reactmocap.athletics.backdrop import Backdrop, backdrop_keyframes
-from reactmocap.athletics.balance import BALANCE_GAINS, STANDING_GAINS, Balance, Posture, Step
+from reactmocap.athletics.balance import (
+    BALANCE_GAINS,
+    STANDING_BOW_EASE,
+    STANDING_GAINS,
+    STANDING_STEP,
+    Balance,
+    Posture,
+    Step,
+)
 from reactmocap.athletics.behaviours import (
     AthleticsResult,
     athletics_result,
@@ -146,12 +154,19 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
         raise ConfigError(
             f"balance gains must be one of {sorted(BALANCE_GAIN_SETS)}, got {gains!r}"
         )
+    g = BALANCE_GAIN_SETS[gains]
+    standing = bool(p.pop("standing_step", False))
+    if standing:
+        # the balance behaviour's step="on": a hung foot planted, steps across the feet too,
+        # the bow (standing gains) eased; `step` numbers override its own, not the plant
+        step = replace(step, hang_still=STANDING_STEP.hang_still) if step else STANDING_STEP
+        g = replace(g, bow_ease=STANDING_BOW_EASE) if g.bow is not None else g
     seconds = phase.seconds if phase.exit == "after" else None
     within = None
     if phase.exit == "settled":
         within = phase.seconds if phase.seconds is not None else SETTLE_WITHIN
-    return Balance(Posture(**p), seconds=seconds, gains=BALANCE_GAIN_SETS[gains],
-                   settle_within=within, settle_share=share, step=step)  # fmt: skip
+    return Balance(Posture(**p), seconds=seconds, gains=g, settle_within=within,
+                   settle_share=share, step=step, standing_step=standing)  # fmt: skip
 
 
 def _build_leap(phase: Phase, ath: Athlete) -> Basis:
@@ -222,8 +237,13 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
         "balance", "stand balanced in a posture (thesis ch. 7); `settle_share`: the weight "
         "each foot must bear for the exit `settled` (default 0.2); `gains`: \"balance\" "
         "(default) or \"standing\" (the hip and arm strategies against a fall as well); "
-        "`step`: [margin, reach, lift, seconds], a step when the capture point leaves the feet",
-        {**_kinds(Posture), "settle_share": "number", "gains": "string", "step": "numbers"},
+        "`step`: [margin, reach, lift, seconds], a step when the capture point leaves the feet; "
+        "`standing_step` (default false): the standing balance's step (the `balance` "
+        "behaviour's step \"on\": a foot left hanging put down once the COM is slower than "
+        "0.25 m/s, steps across the feet too; `step` overrides its step's numbers, not the "
+        "plant)",
+        {**_kinds(Posture), "settle_share": "number", "gains": "string", "step": "numbers",
+         "standing_step": "bool"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
          "settled": "once standing still on both feet with the COM over them (a perturbed "
                     "start); not settled within `seconds` (default 2): the run fails there"},

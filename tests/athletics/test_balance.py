@@ -12,7 +12,13 @@ import pytest
 from reactmocap.athletics import balance, behaviours, run
 from reactmocap.athletics.balance import STANDING_GAINS, BalanceGains, BalanceLaw, Step
 from reactmocap.athletics.behaviours import AthleticsResult
-from reactmocap.athletics.maneuvers import Maneuver, Perturbation, Phase, run_maneuver
+from reactmocap.athletics.maneuvers import (
+    Maneuver,
+    Perturbation,
+    Phase,
+    load_maneuver,
+    run_maneuver,
+)
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError
 
@@ -173,6 +179,37 @@ def test_a_sideways_push_is_taken_by_arms_circling_in_the_frontal_plane(
     assert not run("balance", "female", **push).report["balanced"]
     with pytest.raises(ConfigError, match="windmill_side"):
         BalanceGains(windmill_side=(8.0, 0.05, 2.0))
+
+
+def _drifting(params: dict[str, object]) -> AthleticsResult:
+    """A standing male balance started moving back and to the left at 0.3 m/s each: the
+    balance phase alone lifts a foot and stands on the other."""
+    m = Maneuver("drifting", (Phase("balance", "never", params),), "male", 3.0)
+    still = tuple((0.0, 0.0, 0.0) for _ in range(15))
+    return run_maneuver(m, perturbation=Perturbation(still, velocity=(-0.3, 0.3, 0.0)), fps=10.0)
+
+
+def test_a_maneuver_balance_with_the_standing_step_puts_a_hanging_foot_down(
+    tmp_path: Path,
+) -> None:
+    # the file key standing_step (issue 19, 2026-12-05): the balance behaviour's step="on"
+    # in a maneuver's balance phase; without it the body ends the run on one foot
+    off, on = _drifting({}), _drifting({"standing_step": True})
+    last = [np.asarray(r.log["feet"])[np.asarray(r.log["t"]) > 2.0] for r in (off, on)]
+    assert not off.report["fell"] and np.mean(last[0] == 1) > 0.9
+    assert not on.report["fell"] and np.all(last[1] == 2)
+    # a step's numbers override the standing step's, not its plant (a 10 m margin: no step)
+    planted = _drifting({"standing_step": True, "step": [10.0]})
+    feet = np.asarray(planted.log["feet"])[np.asarray(planted.log["t"]) > 2.0]
+    assert not planted.report["fell"] and np.all(feet == 2) and "steps" not in planted.report
+    bad = tmp_path / "m.toml"
+    bad.write_text('[[phase]]\ncontroller = "balance"\nparams = { standing_step = "on" }\n'
+                   'exit = { event = "never" }\n')  # fmt: skip
+    with pytest.raises(
+        ConfigError, match=r"phase\[1\]\.params\.standing_step must be true or false"
+    ) as err:
+        load_maneuver(bad)
+    assert str(bad) in str(err.value)
 
 
 def _pushed_back(step: list[float] | None) -> AthleticsResult:

@@ -236,6 +236,9 @@ def _tenth_start(seed: int, i: int) -> Perturbation:
     return [Perturbation.sample(rng, **_TENTH) for _ in range(i + 1)][i]
 
 
+FORWARD_FILE = Path(__file__).parents[2] / "examples/athletics/maneuvers/forward_somersault.toml"
+
+
 def _without_land_param(m: Maneuver, key: str) -> Maneuver:
     """``m`` with ``key`` taken out of its landing phase's parameters."""
     i = next(k for k, ph in enumerate(m.phases) if ph.controller == "land")
@@ -290,15 +293,40 @@ def test_the_forward_tuck_files_feet_move_by_the_predicted_touchdown_rotation() 
     ``turn_gain`` it lands 448 deg round, over-rotated, and falls; the file since 2026-12-05
     (``turn_gain`` 0.25 past ``turn_ref`` 5.49 rad) puts the feet ahead by the rotation
     predicted at touchdown and it lands (full size 44 / 44 / 40 of 50 on seeds 0 / 1 / 2,
-    from 44 / 41 / 37; docs/athletics.md, "Forward tuck: the short touchdown's class C")."""
-    m = load_maneuver(
-        Path(__file__).parents[2] / "examples/athletics/maneuvers/forward_somersault.toml"
-    )
+    from 44 / 41 / 37; docs/athletics.md, "Forward tuck: the short touchdown's class C");
+    the over-rotation read with the last balance as it was then (since 2026-12-05 13:50 UTC
+    the standing plant and gains)."""
+    m = load_maneuver(FORWARD_FILE)
     start = full_starts(24)[23]
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
-    before = run_maneuver(_without_land_param(m, "turn_gain"), perturbation=start, fps=10.0).report
-    assert not before["landed"] and before["rotation_deg"] > 400.0
+    plain = _with_last_balance_params(m, {"settle": 2.0})
+    before = run_maneuver(_without_land_param(plain, "turn_gain"), perturbation=start, fps=10.0)
+    assert not before.report["landed"] and before.report["rotation_deg"] > 400.0
+
+
+def _with_last_balance_params(m: Maneuver, params: Mapping[str, Any]) -> Maneuver:
+    """``m`` with its last phase (a balance) given ``params``."""
+    assert m.phases[-1].controller == "balance"
+    return replace(m, phases=(*m.phases[:-1], replace(m.phases[-1], params=params)))
+
+
+def test_the_forward_tucks_last_balance_puts_down_a_foot_left_hanging() -> None:
+    """Start 42 of the capture region at full size (seed 0) lands, then stands up on one
+    foot in the last balance (97% of it, the lifted foot cm up) and falls sideways 1.7 s after
+    touchdown; the file since 2026-12-05 13:50 UTC (the standing balance's plant of a hung
+    foot and its gains, ``standing_step``, its step off) puts the foot down and it stands
+    (full size 45 / 46 / 41 of 50 on seeds 0 / 1 / 2 from 44 / 44 / 40; docs/athletics.md,
+    "Forward tuck: the standing balance's own step in the last balance")."""
+    m = load_maneuver(FORWARD_FILE)
+    assert m.phases[-1].params["standing_step"] is True
+    start = full_starts(43)[42]
+    r = run_maneuver(m, perturbation=start, fps=10.0)
+    assert r.report["landed"] and not r.report["fell"]
+    assert abs(r.report["rotation_deg"] - 360.0) <= 30.0 and int(r.log["feet"][-1]) == 2
+    before = run_maneuver(_with_last_balance_params(m, {"settle": 2.0}), perturbation=start,
+                          fps=10.0)  # fmt: skip
+    assert before.report["fell"] and not before.report["landed"]
 
 
 def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> None:
