@@ -409,14 +409,19 @@ def test_gain_scales_at_once_equal_one_joint_at_a_time(guard: Motion) -> None:
         mujoco.mj_forward(world.model, world.data)
         worlds.append(world)
     one, both = worlds
-    for name in ("actuator_gainprm", "actuator_biasprm", "actuator_gear"):
-        np.testing.assert_array_equal(getattr(both.model, name), getattr(one.model, name))
-    np.testing.assert_array_equal(both.data.qfrc_actuator, one.data.qfrc_actuator)
+    _assert_same_actuation(one, both)
     assert both.servo._gain_scale[NJ + kept] == 3.0  # the NaN kept the knee's scale
     with pytest.raises(ConfigError, match="gain scales"):
         both.servo.set_gain_scales(1, np.zeros(NJ))
     with pytest.raises(ConfigError, match="gain scales"):
         both.servo.set_gain_scales(1, np.ones(3))
+
+
+def _assert_same_actuation(one: World, both: World) -> None:
+    """The two worlds' actuators and the torques they apply are the same to the bit."""
+    for name in ("actuator_gainprm", "actuator_biasprm", "actuator_gear"):
+        np.testing.assert_array_equal(getattr(both.model, name), getattr(one.model, name))
+    np.testing.assert_array_equal(both.data.qfrc_actuator, one.data.qfrc_actuator)
 
 
 def test_gain_scales_with_switches_equal_enable_then_scales(guard: Motion) -> None:
@@ -441,9 +446,7 @@ def test_gain_scales_with_switches_equal_enable_then_scales(guard: Motion) -> No
         mujoco.mj_forward(world.model, world.data)
         worlds.append(world)
     one, both = worlds
-    for name in ("actuator_gainprm", "actuator_biasprm", "actuator_gear"):
-        np.testing.assert_array_equal(getattr(both.model, name), getattr(one.model, name))
-    np.testing.assert_array_equal(both.data.qfrc_actuator, one.data.qfrc_actuator)
+    _assert_same_actuation(one, both)
     assert not both.servo.enabled[NJ:][~on].any()  # the switched-off joints are passive
     with pytest.raises(ConfigError, match="enabled"):
         both.servo.set_gain_scales(1, scales, enabled=np.ones(3, dtype=bool))
