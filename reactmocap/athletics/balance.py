@@ -225,7 +225,7 @@ class Step:
             at touchdown, its position carried on by its velocity (over the last control tick)
             for this fraction of the swing's remaining planned time, and the place is pulled
             in toward that point (0: off, from the hip as it is, and her back steps fell
-            0.1-0.2 m short of the place; in [0, 2]; docs/athletics.md "The standing step
+            0.09-0.18 m short of the place; in [0, 2]; docs/athletics.md "The standing step
             placed for the hip at touchdown").
         drift: with ``across``, the capture point across the feet carried on by the COM's
             sideways speed alone over this many seconds after the swing began (linear: not
