@@ -479,3 +479,51 @@ def test_the_standing_step_holds_his_175_n_forward_push_with_the_bow_held(
     r_before = run("balance", "male", **push).report
     assert r_before["steps"][0]["t"] == r["steps"][0]["t"]
     assert r_before["steps"][0]["s"] > 0.5 and not r_before["balanced"]
+
+
+def test_a_standing_step_placed_for_the_hip_at_touchdown_lands_farther_back(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step placed for the hip at
+    # touchdown"): at the female's 95 N push backward step="on" aims the leg at the floor
+    # from the hip as it is (Step.ground), the place pulled in to 0.20-0.30 m from it, and the
+    # first step lands 0.45 m behind the other foot, short of the capture point; reached from
+    # where the hip will be at touchdown (Step.carry 1.0) the same step lands over 5 cm farther
+    push = {"check_range": False, "seconds": 2.0, "push": 95.0, "push_dir": math.pi}
+    r = run("balance", "female", step="on", **push).report
+    step = dataclasses.replace(balance.STANDING_STEP, carry=1.0)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    r_carry = run("balance", "female", step="on", **push).report
+    assert r_carry["steps"][0]["t"] == r["steps"][0]["t"]
+    assert r_carry["steps"][0]["to_m"] < r["steps"][0]["to_m"] - 0.05
+    for bad in (-0.1, 2.5, float("nan")):
+        with pytest.raises(ConfigError, match="carry"):
+            Step(ground=0.99, carry=bad)
+    with pytest.raises(ConfigError, match="carry"):
+        Step(carry=1.0)  # without ground
+
+
+def test_a_standing_step_put_across_by_the_sideways_speed_lands_sooner(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # issue 18 (2026-12-05, docs/athletics.md "The standing step placed for the hip at
+    # touchdown"): at the male's 195 N push forward the COM falls toward the swing side over
+    # the single support; with the step put 0.05 m past the capture point across the feet
+    # (Step.across) the first swing takes about 0.39 s; with the capture point carried on by
+    # the COM's sideways speed over 1 s from the swing's start (Step.drift) the foot goes
+    # farther out and the same step lands over 0.03 s sooner
+    push = {"check_range": False, "seconds": 2.3, "push": 195.0, "step": "on"}
+    step = dataclasses.replace(balance.STANDING_STEP, across=0.05)
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    r = run("balance", "male", **push).report
+    monkeypatch.setattr(behaviours, "STANDING_STEP", dataclasses.replace(step, drift=1.0))
+    r_drift = run("balance", "male", **push).report
+    assert r_drift["steps"][0]["t"] == r["steps"][0]["t"]
+    assert r_drift["steps"][0]["s"] < r["steps"][0]["s"] - 0.03
+    for bad in (-0.1, 1.5, float("nan")):
+        with pytest.raises(ConfigError, match="drift"):
+            Step(across=0.05, drift=bad)
+    with pytest.raises(ConfigError, match="drift"):
+        Step(drift=0.3)  # without across
+    with pytest.raises(ConfigError, match="drift"):
+        Step(across=0.05, foresee=0.3, drift=0.3)
