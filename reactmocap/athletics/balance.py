@@ -221,17 +221,6 @@ class Step:
             pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
             foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
             "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
-        carry: with ``ground``, the floor's reach is measured from where the swing hip will be
-            at touchdown, its position carried on by its velocity (over the last control tick)
-            for this fraction of the swing's remaining planned time, and the place is pulled
-            in toward that point (0: off, from the hip as it is, and her back steps fell
-            0.09-0.18 m short of the place; in [0, 2]; docs/athletics.md "The standing step
-            placed for the hip at touchdown").
-        drift: with ``across``, the capture point across the feet carried on by the COM's
-            sideways speed alone over this many seconds after the swing began (linear: not
-            ``foresee``'s divergence of its offset from the standing foot, which put his 175
-            N step 0.3 m aside; 0: off; in [0, 1] s, not with ``foresee``; docs/athletics.md
-            "The standing step placed for the hip at touchdown").
     """
 
     margin: float = 0.05
@@ -247,8 +236,6 @@ class Step:
     hang_still: float = 0.0
     pair: float = 0.0
     bow_hold: float = 0.0
-    carry: float = 0.0
-    drift: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -278,14 +265,6 @@ class Step:
         v = self.pair
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.3):
             raise ConfigError(f"step pair must be in [0, 0.3] m, got {v!r}")
-        v = self.carry
-        if not (isinstance(v, (int, float)) and 0.0 <= v <= 2.0 and (self.ground or not v)):
-            raise ConfigError(f"step carry must be in [0, 2] (with ground), got {v!r}")
-        v = self.drift
-        if not (isinstance(v, (int, float)) and 0.0 <= v <= 1.0) or (
-            v and not (self.across and not self.foresee)
-        ):
-            raise ConfigError(f"step drift must be in [0, 1] s (with across, not foresee): {v!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -826,8 +805,6 @@ class Stepper:
         self._t_give = -math.inf  # Step.give: the touchdown it is for
         self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
         self._down: F64 | None = None  # Step.down_after: where the foot goes down (world)
-        self._hip_was = np.zeros(3)  # Step.carry: the swing hip at the last tick (world)
-        self._hip_vel = np.zeros(3)  # Step.carry: its velocity over that tick
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
 
@@ -882,9 +859,7 @@ class Stepper:
             self.record.append({"t": t, "foot": float(k), "beyond_m": beyond,
                                 "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
         k = self.foot
-        hip = d.xanchor[self._hips[k]]
         if t == self._t0:  # the hip's eased target starts where the hip is
-            self._hip_was[:] = hip
             self._t_last = t
             self._bend = 0.0
             self._hip[:] = rig.current_angles()[_HIP[k]]
@@ -908,6 +883,7 @@ class Stepper:
             self._goal[_KNEE, 0] = goal
             rig.move(self._goal, left, t, _KNEE)
             return
+        hip = d.xanchor[self._hips[k]]
         at = s.local(hip, h)[:2]
         stand = feet[1 - k]
         under = self._out is None  # the place across the feet under its own hip
@@ -930,8 +906,6 @@ class Stepper:
             lat = cp[1] - stand[1]
             if st.foresee:  # the capture point diverges from the standing foot
                 lat *= math.exp(omega * max(st.foresee - (t - self._t0), 0.0))
-            elif st.drift:  # the COM's sideways speed alone carries it on
-                lat += float(vel[1]) * max(st.drift - (t - self._t0), 0.0)
             past = max(side * (at[1] - stand[1]), side * lat + st.across)
             want[1] = stand[1] + side * past
         if st.down_after and t - self._t0 >= st.down_after:  # put down under where it is
@@ -961,23 +935,9 @@ class Stepper:
                 down -= low
         if ground and u >= 0.5:  # then on the floor within this reach from the hip as it is
             reach = ground * (ul + ll)
-            if st.carry:  # or as it will be at touchdown: the place pulled in toward there
-                dt = t - self._t_last
-                if dt > 0.0:
-                    np.subtract(hip, self._hip_was, out=self._hip_vel)
-                    self._hip_vel /= dt
-                lead = st.carry * max(st.seconds - (t - self._t0), 0.0)
-                fut = s.local(self._hip_vel, h) * lead  # heading frame (a direction)
-                low_td = down + float(self._hip_vel[2]) * lead  # the hip sinks over the swing
-                far = math.sqrt(max(reach * reach - low_td * low_td, 0.0))
-                rel_x, rel_y = ahead - float(fut[0]), aside - float(fut[1])
-                pull = min(far / max(math.hypot(rel_x, rel_y), 1e-9), 1.0)
-                ahead, aside = float(fut[0]) + rel_x * pull, float(fut[1]) + rel_y * pull
-            else:
-                far = math.sqrt(max(reach * reach - down * down, 0.0))
-                pull = min(far / max(math.hypot(ahead, aside), 1e-9), 1.0)
-                ahead, aside = ahead * pull, aside * pull
-        self._hip_was[:] = hip
+            far = math.sqrt(max(reach * reach - down * down, 0.0))
+            pull = min(far / max(math.hypot(ahead, aside), 1e-9), 1.0)
+            ahead, aside = ahead * pull, aside * pull
         length = min(math.sqrt(ahead * ahead + aside * aside + max(down, 0.2) ** 2), reach)
         swing = math.asin(float(np.clip(ahead / length, -STEP_SWING_CAP, STEP_SWING_CAP)))
         knee, geom = (float(x) for x in knee_for_length(ul, ll, length))
