@@ -376,6 +376,8 @@ class WholeBodyTracker(AnchoredReference):
         centre_speed_lock: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
+        step_ahead_grounded: bool = False,
+        step_ahead_time: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -413,6 +415,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
+                "step_ahead_grounded": step_ahead_grounded, "step_ahead_time": step_ahead_time,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -450,6 +453,16 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_phase ({step_ahead_phase!r}) is a margin in (0, 0.5] m over the "
                 f"clip's own lead, and sets step_ahead_swing's limit: it needs step_ahead_swing"
+            )
+        if step_ahead_grounded and not step_ahead_swing:
+            raise ConfigError(
+                f"step_ahead_grounded ({step_ahead_grounded!r}) extends step_ahead_swing's "
+                f"step to a swing foot still on the floor: it needs step_ahead_swing > 0"
+            )
+        if step_ahead_time and not (step_ahead and 0.1 <= step_ahead_time <= step_time):
+            raise ConfigError(
+                f"step_ahead_time ({step_ahead_time!r}) is step_ahead's step time, in "
+                f"[0.1, step_time ({step_time!r})] s: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -556,6 +569,7 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
+            step_ahead_grounded=step_ahead_grounded, step_ahead_time=step_ahead_time,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
