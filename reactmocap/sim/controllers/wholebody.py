@@ -283,6 +283,12 @@ class WholeBodyTracker(AnchoredReference):
             faster (rad/s) than the clip's own soles that set it (their mean yaw rate): with
             ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round in 0.1 s
             (0: unbounded; needs ``anchor_tau``) (``docs/tracking.md``, issue 16).
+        step_ahead_grounded: with ``step_ahead_swing``, its step also for a clip's swing foot
+            the body still has on the floor (after a back push it dragged through the clip's
+            single supports; off: only a foot in the air) (``docs/tracking.md``, issue 16).
+        step_ahead_time: ``step_ahead``'s step from the clip's double support takes this long
+            (s, in [0.1, ``step_time``]; 0: ``step_time``), its target predicted over it
+            (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
