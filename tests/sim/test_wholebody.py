@@ -287,7 +287,6 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("centre_speed_lock", -2.5),
         ("centre_speed_lock_walking", -0.7),
         ("anchor_turn_rate", -0.5),
-        ("step_ahead_time", -0.2),
         ("step_ahead_servo", -20.0),
     ],
 )
@@ -338,25 +337,6 @@ def test_step_ahead_phase_needs_the_swing_step_and_a_margin(guard: Motion, extra
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="step_ahead_phase"):
         _tracker(world, guard, 0.0, **({"step_ahead_phase": 0.1} | extra))
-
-
-def test_step_ahead_grounded_needs_the_swing_step(guard: Motion) -> None:
-    """``step_ahead_grounded`` extends ``step_ahead_swing``'s step: without it, refused."""
-    world = World(build_character(guard, frame=0))
-    with pytest.raises(ConfigError, match="step_ahead_grounded"):
-        _tracker(world, guard, 0.0, step_ahead=1.0, step_ahead_grounded=True)
-
-
-@pytest.mark.parametrize(
-    "extra",
-    [{}, {"step_ahead": 1.0, "step_ahead_time": 0.05}, {"step_ahead": 1.0, "step_ahead_time": 0.5}],
-)
-def test_step_ahead_time_needs_its_step_and_a_step_time(guard: Motion, extra: dict) -> None:
-    """``step_ahead_time`` is ``step_ahead``'s step time, 0.1 s to ``step_time`` (0.35):
-    without ``step_ahead``, shorter or longer, it is refused."""
-    world = World(build_character(guard, frame=0))
-    with pytest.raises(ConfigError, match="step_ahead_time"):
-        _tracker(world, guard, 0.0, **({"step_ahead_time": 0.2} | extra))
 
 
 @pytest.mark.parametrize("extra", [{}, {"step_ahead": 1.0, "step_ahead_servo": 150.0}])

@@ -142,8 +142,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_ahead_grounded: bool = False,
-        step_ahead_time: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -310,12 +308,6 @@ class AnchoredReference:
                 )
             else:
                 self._swing_limit[:] = largest * self.step_ahead
-        # ``step_ahead_grounded``: the swing step also for a clip's swing foot the body still
-        # has on the floor (after a back push it dragged through the clip's single supports)
-        self.step_ahead_grounded = bool(step_ahead_grounded)
-        # ``step_ahead_time``: ``step_ahead``'s step from double support takes this long (s;
-        # 0: ``step_time``): over 0.35 s its capture point ran 3 times as far out
-        self.step_ahead_time = float(step_ahead_time)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -763,7 +755,7 @@ class AnchoredReference:
         if lead <= limit and grown <= self._grown_margin * self.step_ahead:
             return
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False, duration=self.step_ahead_time)  # fmt: skip
+                         shorten=False)  # fmt: skip
 
     def _swing_ahead(self, t: float, i: int) -> None:
         """``step_ahead_swing``: in the clip's single support at frame ``i`` (its one-frame
@@ -779,9 +771,7 @@ class AnchoredReference:
         assert self.path.sole is not None
         f = int(np.argmin(self._firm[i]))  # the clip's swing foot
         low = self.sole_corners()[:, :, 2].min(axis=1) - self.floor_z
-        if (low[f] < self.anchor_touch and not self.step_ahead_grounded) or not len(
-            self._footprint(t)[1 - f]
-        ):
+        if low[f] < self.anchor_touch or not len(self._footprint(t)[1 - f]):
             return
         if self._going_down():
             return

@@ -283,12 +283,6 @@ class WholeBodyTracker(AnchoredReference):
             faster (rad/s) than the clip's own soles that set it (their mean yaw rate): with
             ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round in 0.1 s
             (0: unbounded; needs ``anchor_tau``) (``docs/tracking.md``, issue 16).
-        step_ahead_grounded: with ``step_ahead_swing``, its step also for a clip's swing foot
-            the body still has on the floor (after a back push it dragged through the clip's
-            single supports; off: only a foot in the air) (``docs/tracking.md``, issue 16).
-        step_ahead_time: ``step_ahead``'s step from the clip's double support takes this long
-            (s, in [0.1, ``step_time``]; 0: ``step_time``), its target predicted over it
-            (``docs/tracking.md``, issue 16).
         step_ahead_servo: with ``step_ahead``, the pelvis position servo's gain while one of
             its steps is under way (1/s^2, at most 100; 0: off): the clip's pelvis, at the
             clip's speed, pulled the body on past its feet (``docs/tracking.md``, issue 16).
@@ -385,8 +379,6 @@ class WholeBodyTracker(AnchoredReference):
         centre_speed_lock: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
-        step_ahead_grounded: bool = False,
-        step_ahead_time: float = 0.0,
         step_ahead_servo: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
@@ -425,7 +417,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
-                "step_ahead_grounded": step_ahead_grounded, "step_ahead_time": step_ahead_time,
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
@@ -464,16 +455,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_phase ({step_ahead_phase!r}) is a margin in (0, 0.5] m over the "
                 f"clip's own lead, and sets step_ahead_swing's limit: it needs step_ahead_swing"
-            )
-        if step_ahead_grounded and not step_ahead_swing:
-            raise ConfigError(
-                f"step_ahead_grounded ({step_ahead_grounded!r}) extends step_ahead_swing's "
-                f"step to a swing foot still on the floor: it needs step_ahead_swing > 0"
-            )
-        if step_ahead_time and not (step_ahead and 0.1 <= step_ahead_time <= step_time):
-            raise ConfigError(
-                f"step_ahead_time ({step_ahead_time!r}) is step_ahead's step time, in "
-                f"[0.1, step_time ({step_time!r})] s: it needs step_ahead > 0"
             )
         if step_ahead_servo and not (step_ahead and step_ahead_servo <= 100.0):
             raise ConfigError(
@@ -589,7 +570,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_grounded=step_ahead_grounded, step_ahead_time=step_ahead_time,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
