@@ -527,7 +527,6 @@ def test_a_walk_pushed_back_right_brings_its_swing_step_on_a_phase_matched_limit
     assert _unpushed_unchanged(walk, phase)
 
 
-
 def test_a_walk_pushed_back_steps_with_its_pelvis_servo_eased_and_walks_on(
     shared_mocap_dir: Path,
 ) -> None:
@@ -542,6 +541,7 @@ def test_a_walk_pushed_back_steps_with_its_pelvis_servo_eased_and_walks_on(
     eased = phase | {"step_ahead_servo": 20.0}
     assert _walk_pushed(walk, force, 1.5, eased) == "ok"
     assert _unpushed_unchanged(walk, eased)
+
 
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
