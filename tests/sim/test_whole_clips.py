@@ -527,6 +527,22 @@ def test_a_walk_pushed_back_right_brings_its_swing_step_on_a_phase_matched_limit
     assert _unpushed_unchanged(walk, phase)
 
 
+def test_a_walk_pushed_back_steps_with_its_pelvis_servo_eased_and_walks_on(
+    shared_mocap_dir: Path,
+) -> None:
+    """The shared left-curving walk pushed 400 N straight back at the chest for 0.2 s at
+    1.5 s is upright but not walking at the window's end with the swing step on its
+    phase-matched limit (``step_ahead`` 1, ``step_ahead_swing`` 1, ``step_ahead_phase`` 0.05);
+    with the pelvis servo eased to 20 while those steps swing (``step_ahead_servo``, opt-in;
+    2026-12-05) it walks as its clip does. Unpushed, the option changes nothing."""
+    walk, force = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.5, 180.0, 400.0)
+    phase = {"step_ahead": 1.0, "step_ahead_swing": 1.0, "step_ahead_phase": 0.05}
+    assert _walk_pushed(walk, force, 1.5, phase) == "moving"
+    eased = phase | {"step_ahead_servo": 20.0}
+    assert _walk_pushed(walk, force, 1.5, eased) == "ok"
+    assert _unpushed_unchanged(walk, eased)
+
+
 def test_convex_hull_and_distances() -> None:
     hull = convex_hull(SQUARE)
     assert len(hull) == 4 and {tuple(p) for p in hull} == {(0, 0), (1, 0), (1, 1), (0, 1)}

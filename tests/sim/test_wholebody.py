@@ -287,6 +287,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("centre_speed_lock", -2.5),
         ("centre_speed_lock_walking", -0.7),
         ("anchor_turn_rate", -0.5),
+        ("step_ahead_servo", -20.0),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -336,6 +337,15 @@ def test_step_ahead_phase_needs_the_swing_step_and_a_margin(guard: Motion, extra
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="step_ahead_phase"):
         _tracker(world, guard, 0.0, **({"step_ahead_phase": 0.1} | extra))
+
+
+@pytest.mark.parametrize("extra", [{}, {"step_ahead": 1.0, "step_ahead_servo": 150.0}])
+def test_step_ahead_servo_needs_its_step_and_a_gain(guard: Motion, extra: dict) -> None:
+    """``step_ahead_servo`` is the pelvis gain during ``step_ahead``'s steps, at most 100:
+    without ``step_ahead``, or past 100, it is refused."""
+    world = World(build_character(guard, frame=0))
+    with pytest.raises(ConfigError, match="step_ahead_servo"):
+        _tracker(world, guard, 0.0, **({"step_ahead_servo": 20.0} | extra))
 
 
 def test_a_look_ahead_restores_the_lead_growths_state(guard: Motion) -> None:

@@ -283,6 +283,9 @@ class WholeBodyTracker(AnchoredReference):
             faster (rad/s) than the clip's own soles that set it (their mean yaw rate): with
             ``centre_speed`` 2.5 a foot down early took a walk's path 13 deg round in 0.1 s
             (0: unbounded; needs ``anchor_tau``) (``docs/tracking.md``, issue 16).
+        step_ahead_servo: with ``step_ahead``, the pelvis position servo's gain while one of
+            its steps is under way (1/s^2, at most 100; 0: off): the clip's pelvis, at the
+            clip's speed, pulled the body on past its feet (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -376,6 +379,7 @@ class WholeBodyTracker(AnchoredReference):
         centre_speed_lock: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
+        step_ahead_servo: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -413,6 +417,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
+                "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -451,6 +456,11 @@ class WholeBodyTracker(AnchoredReference):
                 f"step_ahead_phase ({step_ahead_phase!r}) is a margin in (0, 0.5] m over the "
                 f"clip's own lead, and sets step_ahead_swing's limit: it needs step_ahead_swing"
             )
+        if step_ahead_servo and not (step_ahead and step_ahead_servo <= 100.0):
+            raise ConfigError(
+                f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
+                f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
+            )
         servo = world.servo
         m = world.model
         if np.any(m.opt.gravity[:2]):
@@ -478,6 +488,10 @@ class WholeBodyTracker(AnchoredReference):
         self._give_band = float(trunk_band)
         self._kp_root_pushed = float(kp_root_pushed)
         self._kp_root_against = float(kp_root_against)
+        # ``step_ahead_servo``: the pelvis gain while a step after a back push is under way,
+        # and the one the push set (back to it on landing)
+        self._ahead_servo = float(step_ahead_servo)
+        self._kp_pushed = float(self.kp[0])
         self._step_pushed = bool(step_pushed)
         self._pushed = False  # an external force has acted on the body
         self._pushing = False  # one acts now
@@ -882,6 +896,14 @@ class WholeBodyTracker(AnchoredReference):
                 kp = self._kp_root_pushed
                 if self._kp_root_against and ahead < -_AGAINST_COS * np.hypot(f[0], f[1]):
                     kp = self._kp_root_against
+                self.kp[:3] = kp
+                self.kv[:3] = critical_kv(kp)
+            self._kp_pushed = float(self.kp[0])
+        if self._ahead_servo and self._ahead_armed:
+            # the clip's pelvis, at the clip's speed, pulled the body on past its feet while
+            # the step after the push swung
+            kp = self._ahead_servo if self.step is not None else self._kp_pushed
+            if self.kp[0] != kp:
                 self.kp[:3] = kp
                 self.kv[:3] = critical_kv(kp)
         if pushing and not self._pushed and standing and self._step_pushed:
