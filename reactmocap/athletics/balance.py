@@ -411,6 +411,8 @@ SIDE_SLOPE = 0.2
 STEP_LONGEST = 0.7
 STEP_SWING_CAP = 0.8
 STEP_PAUSE = 0.1
+#: the largest :attr:`Balance.step_margin` (m) a balance may give a landing's step
+STEP_MARGIN_MAX = 0.5
 #: seconds after a step within which a foot left hanging is brought down beside the other
 STEP_CLOSE = 1.0
 #: the least sideways distance (m) between the soles' middles a step leaves
@@ -1087,7 +1089,10 @@ class Balance(Basis):
     ``settle_share``: the weight each foot must bear to count as settled (default
     :data:`SETTLED`'s). ``step``: a step when the capture point leaves the feet
     (:class:`Step`; None: off, unless a landing before it handed over its own);
-    ``standing_step``: the standing balance's kind of step (:class:`Stepper`)."""
+    ``standing_step``: the standing balance's kind of step (:class:`Stepper`).
+    ``step_margin`` (m, in (0, :data:`STEP_MARGIN_MAX`]): the margin of the step a landing
+    hands over, from this phase's entry on (its swing and state carried on); None: as
+    handed over."""
 
     name = "balance"
     initial = "hold"
@@ -1102,10 +1107,18 @@ class Balance(Basis):
         settle_share: float | None = None,
         step: Step | None = None,
         standing_step: bool = False,
+        step_margin: float | None = None,
     ) -> None:
         self.posture = posture or Posture()
         self.step = step
         self.standing_step = standing_step
+        if step_margin is not None and not (
+            math.isfinite(step_margin) and 0.0 < step_margin <= STEP_MARGIN_MAX
+        ):
+            raise ConfigError(
+                f"balance step_margin must be in (0, {STEP_MARGIN_MAX:g}] m, got {step_margin!r}"
+            )
+        self.step_margin = step_margin
         if seconds is not None and not (math.isfinite(seconds) and seconds >= 0):
             raise ConfigError(f"balance seconds must be >= 0, got {seconds!r}")
         if settle_within is not None and not (math.isfinite(settle_within) and settle_within > 0):
@@ -1137,6 +1150,8 @@ class Balance(Basis):
             stepper = ctx.handover.get("stepper")
             if bl.stepper is None and isinstance(stepper, Stepper):  # the landing's step goes on
                 bl.stepper = stepper
+                if self.step_margin is not None:  # its margin only: a swing under way goes on
+                    stepper.step = replace(stepper.step, margin=self.step_margin)
             # a landing's last pitch target, carried on (LandingParams.carry_pitch)
             pitch = ctx.handover.pop("pitch", None)
             bl.set_posture(self.posture, t, pitch_from=pitch if isinstance(pitch, float) else None)

@@ -45,6 +45,7 @@ from reactmocap.athletics.balance import (
     STANDING_BOW_EASE,
     STANDING_GAINS,
     STANDING_STEP,
+    STEP_MARGIN_MAX,
     Balance,
     Posture,
     Step,
@@ -156,6 +157,7 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
         )
     g = BALANCE_GAIN_SETS[gains]
     standing = bool(p.pop("standing_step", False))
+    margin = p.pop("step_margin", None)
     if standing:
         # the balance behaviour's step="on": a hung foot planted, steps across the feet too,
         # the bow (standing gains) eased; `step` numbers override its own, not the plant
@@ -166,7 +168,8 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
     if phase.exit == "settled":
         within = phase.seconds if phase.seconds is not None else SETTLE_WITHIN
     return Balance(Posture(**p), seconds=seconds, gains=g, settle_within=within,
-                   settle_share=share, step=step, standing_step=standing)  # fmt: skip
+                   settle_share=share, step=step, standing_step=standing,
+                   step_margin=margin)  # fmt: skip
 
 
 def _build_leap(phase: Phase, ath: Athlete) -> Basis:
@@ -241,9 +244,10 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
         "`standing_step` (default false): the standing balance's step (the `balance` "
         "behaviour's step \"on\": a foot left hanging put down once the COM is slower than "
         "0.25 m/s, steps across the feet too; `step` overrides its step's numbers, not the "
-        "plant)",
+        "plant); `step_margin` (m, (0, 0.5]): the margin of the step a landing hands over, "
+        "from this phase on (its swing under way carried on; default: the landing's)",
         {**_kinds(Posture), "settle_share": "number", "gains": "string", "step": "numbers",
-         "standing_step": "bool"},
+         "standing_step": "bool", "step_margin": "number"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
          "settled": "once standing still on both feet with the COM over them (a perturbed "
                     "start); not settled within `seconds` (default 2): the run fails there"},
@@ -350,6 +354,16 @@ def check_phase(phase: Phase, where: str) -> Phase:
     effort = params.get("effort") if phase.controller == "leap" else None
     if effort is not None and not 0.0 <= effort <= 1.0:  # the measured tables' range
         raise ConfigError(f"{where}.params.effort: must be 0-1, got {effort:g}")
+    margin = params.get("step_margin") if phase.controller == "balance" else None
+    if margin is not None and not 0.0 < margin <= STEP_MARGIN_MAX:
+        raise ConfigError(
+            f"{where}.params.step_margin: must be in (0, {STEP_MARGIN_MAX:g}] m, got {margin:g}"
+        )
+    if margin is not None and "step" in params:
+        raise ConfigError(
+            f"{where}.params.step_margin: sets the landing's step's margin; with the phase's "
+            f"own `step`, give the margin there"
+        )
     if phase.controller == "tumble" and params.get("position", "tuck") not in POSITIONS:
         raise ConfigError(
             f"{where}.params.position: unknown position {params['position']!r}; valid "
