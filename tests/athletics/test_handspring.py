@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from reactmocap.athletics.balance import Balance
 from reactmocap.athletics.handspring import HandspringParams
 from reactmocap.athletics.land import LandingParams
 from reactmocap.athletics.leap import LeapParams
@@ -505,3 +506,34 @@ def test_the_last_balance_keeps_the_com_between_both_feet_after_the_landings_ste
     plain = replace(last, params={k: v for k, v in last.params.items() if k != "side_both"})
     old = run_maneuver(replace(m, phases=(*m.phases[:-1], plain)), perturbation=start, fps=10.0)
     assert old.report["fell"] and not old.report["landed"]
+
+
+def test_the_last_balance_sets_the_margin_of_the_landings_step_it_carries_on(
+    tmp_path: Path,
+) -> None:
+    """A balance's ``step_margin`` (2026-12-05, opt-in) replaces the margin of the step the
+    landing hands over, from the balance's entry on; the stepper itself (its swing, its
+    record) goes on. Full-size start 29 (seed 0, class S): the landing's step and its closing
+    step are the file's, and the third step, which the file takes with the capture point
+    5.2 cm past the feet, waits until it is 10 cm past them. Bad values are named."""
+    m = replace(load_maneuver(EXAMPLE), seconds=4.7)  # the third step at 4.45 s
+    last = m.phases[-1]
+    assert "step_margin" not in last.params
+    start = _starts(1.0, 30)[29]
+    base = run_maneuver(m, perturbation=start, fps=10.0).report["steps"]
+    wide = replace(last, params={**last.params, "step_margin": 0.1})
+    steps = run_maneuver(replace(m, phases=(*m.phases[:-1], wide)), perturbation=start,
+                         fps=10.0).report["steps"]  # fmt: skip
+    assert len(base) == len(steps) == 3
+    assert steps[:2] == base[:2]  # the landing's step and its closing step carried on
+    assert 0.05 <= base[2]["beyond_m"] < 0.06
+    assert steps[2]["beyond_m"] >= 0.1 and steps[2]["t"] > base[2]["t"]
+    for bad, why in (("0.0", "must be in"), ("0.6", "must be in"), ("0.1, step = [0.05]", "own")):
+        f = tmp_path / "m.toml"
+        f.write_text('[[phase]]\ncontroller = "balance"\nparams = { step_margin = ' + bad
+                     + ' }\nexit = { event = "never" }\n')  # fmt: skip
+        with pytest.raises(ConfigError, match=r"phase\[1\]\.params\.step_margin: .*" + why) as e:
+            load_maneuver(f)
+        assert str(f) in str(e.value)
+    with pytest.raises(ConfigError, match="step_margin"):
+        Balance(step_margin=float("nan"))
