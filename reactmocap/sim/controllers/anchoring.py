@@ -151,6 +151,7 @@ class AnchoredReference:
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
         step_ahead_phase_centre: float = 0.0,
+        step_ahead_phase_land: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -306,6 +307,7 @@ class AnchoredReference:
         # with ``step_ahead_phase`` the clip's own lead at that frame plus that margin (m;
         # frames without a lead keep the largest)
         self._swing_limit = np.full(n, np.inf)
+        self._swing_land = self._next_planted  # the landings the swing step predicts to
         if self.step_ahead_swing:
             leads = self._clip_swing_leads(self._firm, self._next_planted)
             if step_ahead_phase_centre:
@@ -315,7 +317,10 @@ class AnchoredReference:
                 slow = sole_speed(self.path.sole, self.path.fps) < step_ahead_phase_centre
                 firm = self.path.planted & slow
                 firm[1:-1] &= firm[:-2] | firm[2:]
-                leads = self._clip_swing_leads(firm, _next_planted(firm))
+                nxt = _next_planted(firm)
+                leads = self._clip_swing_leads(firm, nxt)
+                if step_ahead_phase_land:  # PROBE: the trigger predicts to those landings too
+                    self._swing_land = nxt
             largest = float(max(0.0, leads.max()))
             if step_ahead_phase:
                 self._swing_limit = np.where(np.isfinite(leads), leads, largest) + float(
@@ -791,7 +796,7 @@ class AnchoredReference:
             return
         if self._going_down():
             return
-        k = int(self._next_planted[i, f])  # its landing
+        k = int(self._swing_land[i, f])  # its landing
         if k >= len(self._next_planted):
             return  # the clip ends before the foot lands
         left_s = (k - self.clock.frame(t)) / (self.path.fps * self.rate)

@@ -385,6 +385,7 @@ class WholeBodyTracker(AnchoredReference):
         anchor_turn_rate: float = 0.0,
         step_ahead_servo: float = 0.0,
         step_ahead_phase_centre: float = 0.0,
+        step_ahead_phase_land: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -580,7 +581,7 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_phase_centre=step_ahead_phase_centre,
+            step_ahead_phase_centre=step_ahead_phase_centre, step_ahead_phase_land=step_ahead_phase_land,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
