@@ -321,6 +321,8 @@ class AnchoredReference:
                 leads = self._clip_swing_leads(firm, nxt)
                 if step_ahead_phase_land:  # PROBE: the trigger predicts to those landings too
                     self._swing_land = nxt
+                if step_ahead_phase_land == 2.0:  # PROBE: and its single supports (S4)
+                    self._firm, self._next_planted = firm, nxt
             largest = float(max(0.0, leads.max()))
             if step_ahead_phase:
                 self._swing_limit = np.where(np.isfinite(leads), leads, largest) + float(
