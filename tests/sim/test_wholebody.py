@@ -288,7 +288,6 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("centre_speed_lock_walking", -0.7),
         ("anchor_turn_rate", -0.5),
         ("step_ahead_servo", -20.0),
-        ("step_ahead_phase_centre", -2.5),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -347,23 +346,6 @@ def test_step_ahead_servo_needs_its_step_and_a_gain(guard: Motion, extra: dict) 
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match="step_ahead_servo"):
         _tracker(world, guard, 0.0, **({"step_ahead_servo": 20.0} | extra))
-
-
-_PHASE = {"step_ahead": 1.0, "step_ahead_swing": 1.0, "step_ahead_phase": 0.05}
-
-
-@pytest.mark.parametrize(
-    "extra",
-    [{"step_ahead": 1.0, "step_ahead_swing": 1.0}, _PHASE | {"step_ahead_phase_centre": 20.0}],
-)
-def test_step_ahead_phase_centre_needs_the_phase_limit_and_a_speed(
-    guard: Motion, extra: dict
-) -> None:
-    """``step_ahead_phase_centre`` recomputes ``step_ahead_phase``'s limit and is a sole speed
-    of at most 10 m/s: without the phase limit, or past 10 m/s, it is refused."""
-    world = World(build_character(guard, frame=0))
-    with pytest.raises(ConfigError, match="step_ahead_phase_centre"):
-        _tracker(world, guard, 0.0, **({"step_ahead_phase_centre": 2.5} | extra))
 
 
 def test_a_look_ahead_restores_the_lead_growths_state(guard: Motion) -> None:

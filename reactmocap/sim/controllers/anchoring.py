@@ -93,14 +93,6 @@ def _rot2(yaw: float) -> F64:
     return np.array([[c, -s], [s, c]])
 
 
-def _next_planted(firm: NDArray[np.bool_]) -> NDArray[np.int_]:
-    """Per frame and foot of the stance ``firm`` ``(n, 2)``, the first frame from it on
-    where the foot is planted (``n``: never)."""
-    n = len(firm)
-    idx = np.where(firm, np.arange(n)[:, None], n)
-    return np.minimum.accumulate(idx[::-1], axis=0)[::-1]
-
-
 class AnchoredReference:
     """The reference ``path`` of one ``character`` of ``world`` from clip time ``start``, as
     the whole-body tracker follows it; ``dt_tick`` its control period (s). The options are
@@ -150,8 +142,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_ahead_phase_centre: float = 0.0,
-        step_ahead_phase_land: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -300,29 +290,17 @@ class AnchoredReference:
             pl = self.path.planted
             self._firm[1:-1] &= pl[:-2] | pl[2:]
         # per frame and foot, the first frame from it on where the foot is planted (len: never)
-        self._next_planted = _next_planted(self._firm)
+        n = len(self._firm)
+        idx = np.where(self._firm, np.arange(n)[:, None], n)
+        self._next_planted = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
         # ``step_ahead_swing``'s limit per frame: ``step_ahead`` times the clip's own largest
         # lead predicted past its landings (0.49-0.57 m on the walks, set where the stance
         # flags a foot still swinging as landed: docs/tracking.md, ``step_ahead_phase``), or
         # with ``step_ahead_phase`` the clip's own lead at that frame plus that margin (m;
         # frames without a lead keep the largest)
         self._swing_limit = np.full(n, np.inf)
-        self._swing_land = self._next_planted  # the landings the swing step predicts to
         if self.step_ahead_swing:
-            leads = self._clip_swing_leads(self._firm, self._next_planted)
-            if step_ahead_phase_centre:
-                # ``step_ahead_phase_centre``: the clip's own leads on the stance without its
-                # feet whose sole centre moves this fast (its false mid-swing landings, which
-                # set the limit high); the trigger keeps the clip's flags
-                slow = sole_speed(self.path.sole, self.path.fps) < step_ahead_phase_centre
-                firm = self.path.planted & slow
-                firm[1:-1] &= firm[:-2] | firm[2:]
-                nxt = _next_planted(firm)
-                leads = self._clip_swing_leads(firm, nxt)
-                if step_ahead_phase_land:  # PROBE: the trigger predicts to those landings too
-                    self._swing_land = nxt
-                if step_ahead_phase_land == 2.0:  # PROBE: and its single supports (S4)
-                    self._firm, self._next_planted = firm, nxt
+            leads = self._clip_swing_leads()
             largest = float(max(0.0, leads.max()))
             if step_ahead_phase:
                 self._swing_limit = np.where(np.isfinite(leads), leads, largest) + float(
@@ -709,20 +687,19 @@ class AnchoredReference:
         front = np.einsum("kfi,ki->kf", sole, u).max(axis=1)
         return float(max(0.0, (np.einsum("ki,ki->k", xi, u) - front).max()))
 
-    def _clip_swing_leads(self, firm: NDArray[np.bool_], next_planted: NDArray[np.int_]) -> F64:
+    def _clip_swing_leads(self) -> F64:
         """``step_ahead_swing``'s base, per frame ``(n,)``: in the clip's single supports
         where it walks (0.2 m/s or faster), its own capture point's lead (m) along its walk
         past its swing foot's landing, predicted to that landing pivoting over the stance
-        foot (as :meth:`_swing_ahead` predicts the body's); -inf in the other frames. On the
-        stance ``firm`` ``(n, 2)`` and its next planted frames (:func:`_next_planted`)."""
+        foot (as :meth:`_swing_ahead` predicts the body's); -inf in the other frames."""
         assert self.path.sole is not None
         c, v = self._com, self._com_v
         speed = np.hypot(v[:, 0], v[:, 1])
-        land = next_planted
+        land = self._next_planted
         rows = np.arange(len(land))
-        swing = np.argmin(firm, axis=1)
+        swing = np.argmin(self._firm, axis=1)
         k = land[rows, swing]
-        one = (firm.sum(axis=1) == 1) & (speed > 0.2) & (k < len(land))
+        one = (self._firm.sum(axis=1) == 1) & (speed > 0.2) & (k < len(land))
         out = np.full(len(land), -np.inf)
         if not one.any():
             return out
@@ -798,7 +775,7 @@ class AnchoredReference:
             return
         if self._going_down():
             return
-        k = int(self._swing_land[i, f])  # its landing
+        k = int(self._next_planted[i, f])  # its landing
         if k >= len(self._next_planted):
             return  # the clip ends before the foot lands
         left_s = (k - self.clock.frame(t)) / (self.path.fps * self.rate)

@@ -286,10 +286,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_servo: with ``step_ahead``, the pelvis position servo's gain while one of
             its steps is under way (1/s^2, at most 100; 0: off): the clip's pelvis, at the
             clip's speed, pulled the body on past its feet (``docs/tracking.md``, issue 16).
-        step_ahead_phase_centre: with ``step_ahead_phase``, the clip's own leads that set the
-            swing step's limit computed on its stance without the feet whose sole centre moves
-            this fast or faster (m/s; 0: off): its false mid-swing landings set that limit
-            high; the trigger keeps the clip's flags (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -384,8 +380,6 @@ class WholeBodyTracker(AnchoredReference):
         centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
         step_ahead_servo: float = 0.0,
-        step_ahead_phase_centre: float = 0.0,
-        step_ahead_phase_land: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -423,7 +417,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
-                "step_ahead_servo": step_ahead_servo, "step_ahead_phase_centre": step_ahead_phase_centre,
+                "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -466,11 +460,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
-            )
-        if step_ahead_phase_centre and not (step_ahead_phase and step_ahead_phase_centre <= 10.0):
-            raise ConfigError(
-                f"step_ahead_phase_centre ({step_ahead_phase_centre!r}) is a sole speed in "
-                f"(0, 10] m/s for step_ahead_phase's limit: it needs step_ahead_phase > 0"
             )
         servo = world.servo
         m = world.model
@@ -581,7 +570,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_phase_centre=step_ahead_phase_centre, step_ahead_phase_land=step_ahead_phase_land,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
