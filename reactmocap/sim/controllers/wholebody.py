@@ -293,6 +293,12 @@ class WholeBodyTracker(AnchoredReference):
             the rollout, whatever :meth:`scale_gains` asks: the body gives way above the hips
             and keeps its balance (the response's physical mode; a lighter hit yields whole;
             ``docs/benchmarks.md``).
+        roll_damp, roll_damp_kv, roll_damp_flat: rows of weight ``roll_damp`` (0: off) asking
+            each supporting foot on its corners, while the clip's sole tilts less than
+            ``roll_damp_flat`` rad and the simulated sole's tilt grows, for a tilt acceleration
+            of ``-roll_damp_kv`` (1/s) times its rate: damping about the edge it rolls over, no
+            tilt target (``slash_002``'s loaded foot rolled onto an edge, ``docs/tracking.md``,
+            issue 16).
 
     The constructor's defaults are the short-window tracker (the captured world path, every
     touching corner, any foot near the floor; chosen on the benchmark's 1 s windows);
@@ -378,6 +384,10 @@ class WholeBodyTracker(AnchoredReference):
         anchor_turn_rate: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
+        roll_damp: float = 0.0,
+        roll_damp_kv: float = 20.0,
+        roll_damp_flat: float = 0.1,
+        roll_damp_stand: bool = True,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -414,6 +424,7 @@ class WholeBodyTracker(AnchoredReference):
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
+                "roll_damp": roll_damp, "roll_damp_kv": roll_damp_kv, "roll_damp_stand": roll_damp_stand,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -451,6 +462,15 @@ class WholeBodyTracker(AnchoredReference):
                 f"step_ahead_phase ({step_ahead_phase!r}) is a margin in (0, 0.5] m over the "
                 f"clip's own lead, and sets step_ahead_swing's limit: it needs step_ahead_swing"
             )
+        if not 0.0 < roll_damp_flat < 0.5 * np.pi:
+            raise ConfigError(
+                f"roll_damp_flat must be in (0, pi/2) rad (the clip's sole tilt below which "
+                f"roll_damp acts), got {roll_damp_flat!r}"
+            )
+        self._roll_damp = float(roll_damp)
+        self._roll_kv = float(roll_damp_kv)
+        self._roll_cos = float(np.cos(roll_damp_flat))
+        self._roll_stand = bool(roll_damp_stand)
         servo = world.servo
         m = world.model
         if np.any(m.opt.gravity[:2]):
@@ -738,6 +758,8 @@ class WholeBodyTracker(AnchoredReference):
                 wj = wj.copy()
                 wj[self._hip_joints] = free
             tasks.append((root_rows, root_target))
+            if self._roll_damp:
+                tasks.extend(self._roll_tasks(t, sup, v))
             if w_trunk:
                 # the chest's world turn as the plan's own targets turn it (pelvis, waist and
                 # back together): without it the least squares spent the waist to hold the
@@ -825,6 +847,44 @@ class WholeBodyTracker(AnchoredReference):
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
+
+    def _roll_tasks(self, t: float, sup: _Support, v: F64) -> list[tuple[F64, F64]]:
+        """``roll_damp``'s rows: each supporting foot on its corners, while the clip holds its
+        sole flat, has its tilt rate damped at ``roll_damp_kv`` while the tilt grows (one row
+        about the horizontal axis it tilts about; no tilt target, none while it comes back
+        flat: damping both ways held a foot landed on an edge there, ``slash_002`` fell at
+        2.97 s). The no-slip rows hold the touching corners still, not the lifted ones: a
+        loaded foot rolled about the edge it held (``docs/tracking.md``, issue 16)."""
+        m, d = self.world.model, self.world.data
+        up = self.path.sole_up
+        if up is None:
+            return []
+        i = self.clock.nearest(t)
+        if self._roll_stand and not self.path.planted[i : i + self._stand_frames].all():
+            return []
+        flat = up[i, :, 2] > self._roll_cos
+        patch_on = self.world.foot_patch_on(self.character)
+        sl = self._dofs
+        out: list[tuple[F64, F64]] = []
+        for f in sup.feet:
+            if not flat[f] or patch_on[f]:
+                continue
+            u = d.geom_xmat[self.sole[f]].reshape(3, 3)[:, 2]
+            s_tilt = float(np.hypot(u[0], u[1]))
+            if s_tilt < 1e-3:
+                continue
+            axis = np.array([-u[1], u[0], 0.0]) / s_tilt  # z x (the sole normal's lean)
+            body = int(self.feet[f])
+            mujoco.mj_jac(m, d, None, self._jacr, d.xpos[body], body)
+            row = axis @ self._jacr[:, sl]
+            rate = float(row @ v)
+            if rate <= 0.0:
+                continue
+            mujoco.mj_jacDot(m, d, None, self._jacrd, d.xpos[body], body)
+            w = self._roll_damp
+            target = -self._roll_kv * rate - float(axis @ (self._jacrd[:, sl] @ v))
+            out.append((w * row[None], np.array([w * target])))
+        return out
 
     def _landing_weights(self, t: float, sup: _Support) -> F64 | None:
         """The no-slip rows' square-root weights in the ``step_soft`` s after a balance
