@@ -485,3 +485,55 @@ def test_stiffen_joints_stiffens_the_joint_rows_only_and_reset_undoes_it(guard: 
     np.testing.assert_allclose(wb.kv, kv)
     with pytest.raises(ConfigError, match="factor must be > 0"):
         wb.stiffen_joints(0.0)
+
+
+def _left_foot_tilt_acc(guard: Motion, rate: float, **kw: float) -> tuple[float, float]:
+    """The standing guard's left foot tilted 3.4 deg by its ankle and turning at ``rate``
+    rad/s about it: its sole's tilt rate and the tilt acceleration the plan asks."""
+    world = World(build_character(guard, frame=0))
+    world.set_from_motion(0, guard, 0)
+    m, d = world.model, world.data
+    wb = _tracker(world, guard, 0.0, touch=0.003, **kw)
+    sl = wb._dofs
+    ankle = sl.start + 6 + 3 * BALL_JOINTS.index("l_ankle")
+    d.qvel[:] = 0.0
+    d.qvel[ankle] = 2.0
+    mujoco.mj_integratePos(m, d.qpos, d.qvel, 0.03)
+    d.qvel[ankle] = rate
+    mujoco.mj_forward(m, d)
+    plan = wb.plan(0.0)
+    assert 0 in plan.support  # the foot stands on its corners
+    u = d.geom_xmat[wb.sole[0]].reshape(3, 3)[:, 2]
+    axis = np.array([-u[1], u[0], 0.0]) / np.hypot(u[0], u[1])  # the tilt grows about it
+    jr, jd = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+    foot = int(wb.feet[0])
+    mujoco.mj_jac(m, d, None, jr, d.xpos[foot], foot)
+    mujoco.mj_jacDot(m, d, None, jd, d.xpos[foot], foot)
+    tilt_rate = float(axis @ jr[:, sl] @ d.qvel[sl])
+    return tilt_rate, float(axis @ (jr[:, sl] @ plan.qacc + jd[:, sl] @ d.qvel[sl]))
+
+
+def test_roll_damp_damps_a_flat_held_foots_growing_tilt_only(guard: Motion) -> None:
+    """``roll_damp`` (opt-in, issue 16): a supporting foot the clip holds flat whose tilt grows
+    is asked a tilt acceleration of ``-roll_damp_kv`` times its rate; while it comes back flat
+    the plan is the defaults'."""
+    rate, free = _left_foot_tilt_acc(guard, 2.0)
+    assert rate > 1.0  # the tilt grows
+    for kv in (5.0, 60.0):
+        _, damped = _left_foot_tilt_acc(guard, 2.0, roll_damp=1e3, roll_damp_kv=kv)
+        assert damped == pytest.approx(-kv * rate, rel=0.01)
+        assert abs(free - damped) > 0.5 * abs(damped)  # the defaults ask something else
+    back, free_back = _left_foot_tilt_acc(guard, -2.0)
+    assert back < -1.0
+    assert _left_foot_tilt_acc(guard, -2.0, roll_damp=1e3)[1] == free_back
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("roll_damp", -1.0), ("roll_damp_kv", float("nan")), ("roll_damp_flat", 0.0),
+     ("roll_damp_flat", 2.0)],
+)  # fmt: skip
+def test_roll_damp_bad_values_rejected(guard: Motion, key: str, value: float) -> None:
+    world = World(build_character(guard, frame=0))
+    with pytest.raises(ConfigError, match=key):
+        _tracker(world, guard, 0.0, **{key: value})
