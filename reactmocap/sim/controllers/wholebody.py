@@ -293,12 +293,14 @@ class WholeBodyTracker(AnchoredReference):
             the rollout, whatever :meth:`scale_gains` asks: the body gives way above the hips
             and keeps its balance (the response's physical mode; a lighter hit yields whole;
             ``docs/benchmarks.md``).
-        roll_damp, roll_damp_kv, roll_damp_flat: rows of weight ``roll_damp`` (0: off) asking
-            each supporting foot on its corners, while the clip's sole tilts less than
-            ``roll_damp_flat`` rad and the simulated sole's tilt grows, for a tilt acceleration
-            of ``-roll_damp_kv`` (1/s) times its rate: damping about the edge it rolls over, no
-            tilt target (``slash_002``'s loaded foot rolled onto an edge, ``docs/tracking.md``,
-            issue 16).
+        roll_damp, roll_damp_kv, roll_damp_flat, roll_damp_stand: rows of weight ``roll_damp``
+            (0: off) asking each supporting foot on its corners, while the clip's sole tilts
+            less than ``roll_damp_flat`` rad and the simulated sole's tilt grows, for a tilt
+            acceleration of ``-roll_damp_kv`` (1/s) times its rate: damping about the edge it
+            rolls over, no tilt target; with ``roll_damp_stand`` only while the clip stands
+            (both feet planted for ``step_time``). ``slash_002``'s loaded foot rolled onto an
+            edge; the row did not hold it and cost clips at every weight tried (0.1-100), so it
+            stays off (``docs/tracking.md``, issue 16).
 
     The constructor's defaults are the short-window tracker (the captured world path, every
     touching corner, any foot near the floor; chosen on the benchmark's 1 s windows);
