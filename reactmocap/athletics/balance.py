@@ -224,9 +224,10 @@ class Step:
         bow_after: outside a swing, a foot counts as up for the bow's easing only once it
             has been off the floor this many seconds; a shorter loss of contact is read as
             both feet down (the bow as on both feet), in [0, 0.2] (0: off, any lost contact
-            eased the bow: his 165 N forward push's 6-19 N contact flicker in a vertical
-            bounce did, and two hops followed; docs/athletics.md "The standing step's bow
-            eased only after a foot has been up a while").
+            eased the bow; opt-in: 0.02 holds his 165 N forward push, whose one-tick loss of
+            contact in a vertical bounce eased it and two hops followed, but the 16 limits
+            fell 2430 -> 2270 N; docs/athletics.md "The standing step's bow eased only after
+            a foot has been up a while").
     """
 
     margin: float = 0.05
