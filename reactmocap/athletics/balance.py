@@ -221,13 +221,6 @@ class Step:
             pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
             foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
             "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
-        bow_after: outside a swing, a foot counts as up for the bow's easing only once it
-            has been off the floor this many seconds; a shorter loss of contact is read as
-            both feet down (the bow as on both feet), in [0, 0.2] (0: off, any lost contact
-            eased the bow; opt-in: 0.02 holds his 165 N forward push, whose one-tick loss of
-            contact in a vertical bounce eased it and two hops followed, but the 16 limits
-            fell 2430 -> 2270 N; docs/athletics.md "The standing step's bow eased only after
-            a foot has been up a while").
     """
 
     margin: float = 0.05
@@ -243,7 +236,6 @@ class Step:
     hang_still: float = 0.0
     pair: float = 0.0
     bow_hold: float = 0.0
-    bow_after: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -270,9 +262,6 @@ class Step:
         v = self.bow_hold
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 5.0):
             raise ConfigError(f"step bow_hold must be in [0, 5] s, got {v!r}")
-        v = self.bow_after
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.2):
-            raise ConfigError(f"step bow_after must be in [0, 0.2] s, got {v!r}")
         v = self.pair
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.3):
             raise ConfigError(f"step pair must be in [0, 0.3] m, got {v!r}")
@@ -500,8 +489,6 @@ class BalanceLaw:
         #: :attr:`BalanceGains.bow_ease`: the bow applied last, its tick
         self._bow_now = 0.0
         self._t_bow = math.nan
-        #: :attr:`Step.bow_after`: since when a foot has been off the floor (nan: both down)
-        self._t_up = math.nan
         #: a step when the capture point leaves the feet (:class:`Step`), or None
         self.stepper: Stepper | None = None
         #: the pelvis's roll target (rad, heading frame; 0 upright): the landing's roll_ease
@@ -711,18 +698,11 @@ class BalanceLaw:
         :attr:`BalanceGains.bow_ease` s (first order) instead of at once."""
         dt = 0.0 if math.isnan(self._t_bow) else max(t - self._t_bow, 0.0)
         self._t_bow = t
-        st = self.stepper
-        if both:
-            self._t_up = math.nan
-        elif st is not None and st.step.bow_after:  # Step.bow_after
-            if math.isnan(self._t_up):
-                self._t_up = t
-            # a contact flicker, not a lift (a swing's lift is one at once)
-            both = st.foot < 0 and t - self._t_up < st.step.bow_after
         if both:
             self._bow_now = self._bow(cp, vel)
         else:
             tau = self.gains.bow_ease or 0.0
+            st = self.stepper
             if st is not None and st.step.bow_hold and st.along():  # Step.bow_hold
                 tau = st.step.bow_hold
             self._bow_now *= math.exp(-dt / max(tau, 1e-9))

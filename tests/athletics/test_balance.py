@@ -479,23 +479,3 @@ def test_the_standing_step_holds_his_175_n_forward_push_with_the_bow_held(
     r_before = run("balance", "male", **push).report
     assert r_before["steps"][0]["t"] == r["steps"][0]["t"]
     assert r_before["steps"][0]["s"] > 0.5 and not r_before["balanced"]
-
-
-def test_the_standing_step_eases_the_bow_only_after_a_foot_has_been_up_a_while(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # issue 18 (2026-12-05, docs/athletics.md "The standing step's bow eased only after a foot
-    # has been up a while"): at the male's 165 N forward push no step fires, and step="on"'s
-    # bow easing reads a one-tick loss of contact in a vertical bounce as a lifted foot; he is
-    # still moving at 3 s. With that read as both feet down unless it lasts 20 ms
-    # (Step.bow_after 0.02) the same run ends still on both feet, no step taken
-    push = {"check_range": False, "seconds": 3.0, "push": 165.0, "step": "on"}
-    r = run("balance", "male", **push).report
-    assert not r["steps"] and not r["balanced"]
-    step = dataclasses.replace(balance.STANDING_STEP, bow_after=0.02)
-    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
-    r_after = run("balance", "male", **push).report
-    assert not r_after["steps"] and r_after["balanced"] and r_after["on_both_feet"]
-    for bad in (-0.01, 0.21, float("nan")):
-        with pytest.raises(ConfigError, match="bow_after"):
-            Step(bow_after=bad)
