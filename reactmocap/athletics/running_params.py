@@ -140,7 +140,9 @@ class RunParams:
         turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
         turn_accel: the most the desired facing's turn rate changes (rad/s^2; 0: off), so
             that at a figure eight's reversal the rate eases from the old curve's to the new
-            one's instead of flipping within a tick or two. Within [0, 50].
+            one's instead of flipping within a tick or two; braked so that the facing stops
+            at the course's. Only where the course curves (``ARM_CURVE``; a straight line
+            runs without it). Within [0, 50].
         turn_lead: on a curve, eqs. 1-2's desired velocity is turned into it by ``turn_lead
             * v * kappa`` (s; the velocity a moment ahead): the turn's feed-forward.
         path_integral: the facing is turned by this gain times the curvature times the
