@@ -739,17 +739,6 @@ class Runner:
             step = wrap_angle(want - self.heading_d)
             limit = self.k["turn_rate"] * self.control_every * self._timestep
             turn = clamp(step, -limit, limit)
-            accel = self.k["turn_accel"]
-            if accel > 0 and abs(self.curvature) > ARM_CURVE:
-                # and its rate changes at a limited rate (``turn_accel``; where the course
-                # curves, as the arms' yaw terms): at an eight's reversal it flipped from the
-                # limit within a tick or two and the yaw swung; braked in time to stop at the
-                # course's facing (without, it overshot and swung)
-                dt = self.control_every * self._timestep
-                brake = math.sqrt(2.0 * accel * abs(step)) * dt
-                turn = clamp(turn, -brake, brake)
-                ease = accel * dt * dt
-                turn = clamp(turn, self.facing_rate * dt - ease, self.facing_rate * dt + ease)
             self.heading_d += turn
             self.facing_rate = turn / (self.control_every * self._timestep)
         else:

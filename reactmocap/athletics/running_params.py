@@ -138,11 +138,6 @@ class RunParams:
         arm_gain, arm_offset: eq. 5, shoulder pitch = gain * opposite hip pitch + offset.
         elbow: elbow flexion (rad).
         turn_rate: the most the desired facing turns (rad/s), whatever the course asks.
-        turn_accel: the most the desired facing's turn rate changes (rad/s^2; 0: off), so
-            that at a figure eight's reversal the rate eases from the old curve's to the new
-            one's instead of flipping within a tick or two; braked so that the facing stops
-            at the course's. Only where the course curves (``ARM_CURVE``; a straight line
-            runs without it). Within [0, 50].
         turn_lead: on a curve, eqs. 1-2's desired velocity is turned into it by ``turn_lead
             * v * kappa`` (s; the velocity a moment ahead): the turn's feed-forward.
         path_integral: the facing is turned by this gain times the curvature times the
@@ -202,7 +197,6 @@ class RunParams:
     step_bias: float | Speeds = 0.0
     step_until: float = 0.0
     turn_rate: float | Speeds = 0.35
-    turn_accel: float | Speeds = 0.0
     turn_lead: float | Speeds = (0.1, 0, 0)
     path_integral: float | Speeds = (5.0, 0, 0)
     lean: float | Speeds = 1.0
@@ -232,7 +226,6 @@ class RunParams:
             ("push_ramp", 1.0),
             ("arm_yaw", 5.0),
             ("arm_yaw_rate", 1.0),
-            ("turn_accel", 50.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):

@@ -131,34 +131,3 @@ def test_arm_yaw_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
         RunParams(arm_yaw_rate=(0.0, -0.05, 0.0))
     assert RunParams().at(2.5)["arm_yaw_rate"] == 0.05
-
-
-def test_turn_accel_bounds_the_facings_rate_change_on_a_curve_and_not_a_line() -> None:
-    """``turn_accel``: on the circle the desired facing's turn rate changes by at most the
-    limit per second (off it jumps by several rad/s^2 tick to tick, pure pursuit following
-    the body's sway); on a straight line (a fixed facing) the run is the one without it."""
-    accel = 1.0
-    secs = 2.0
-    jumps = {}
-    for a in (0.0, accel):
-        log = run_course(2.5, seconds=secs, path="circle:10", fps=10.0,
-                         params=RunParams(turn_accel=a)).log  # fmt: skip
-        t, facing = log["t"], np.unwrap(log["desired_heading"])
-        rate = np.diff(facing) / np.diff(t)
-        jumps[a] = float(np.max(np.abs(np.diff(rate)) / np.diff(t)[1:]))
-        assert np.max(np.abs(rate)) <= 0.35 + 1e-9
-    assert jumps[accel] <= accel * (1 + 1e-6)
-    assert jumps[0.0] > 4 * accel
-    line = [run_course(2.5, seconds=1.0, fps=10.0, params=RunParams(turn_accel=a))
-            for a in (0.0, accel)]  # fmt: skip
-    for key in ("t", "com", "heading", "desired_heading"):
-        assert np.array_equal(line[0].log[key], line[1].log[key]), key
-    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
-
-
-def test_turn_accel_is_checked() -> None:
-    assert RunParams().at(2.5)["turn_accel"] == 0.0
-    with pytest.raises(ConfigError, match=r"turn_accel must be in \[0, 50\]"):
-        RunParams(turn_accel=-1.0)
-    with pytest.raises(ConfigError, match=r"turn_accel must be in \[0, 50\]"):
-        RunParams(turn_accel=(0.0, 0.0, 60.0))
