@@ -156,10 +156,14 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
         )
     g = BALANCE_GAIN_SETS[gains]
     standing = bool(p.pop("standing_step", False))
+    hang = p.pop("hang_still", None)
+    if hang is not None and not (standing and 0.0 < hang <= 1.0):
+        raise ConfigError(f"balance hang_still needs standing_step and (0, 1] m/s, got {hang!r}")
     if standing:
         # the balance behaviour's step="on": a hung foot planted, steps across the feet too,
         # the bow (standing gains) eased; `step` numbers override its own, not the plant
-        step = replace(step, hang_still=STANDING_STEP.hang_still) if step else STANDING_STEP
+        still = STANDING_STEP.hang_still if hang is None else hang
+        step = replace(step or STANDING_STEP, hang_still=still)
         g = replace(g, bow_ease=STANDING_BOW_EASE) if g.bow is not None else g
     seconds = phase.seconds if phase.exit == "after" else None
     within = None
@@ -241,9 +245,10 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
         "`standing_step` (default false): the standing balance's step (the `balance` "
         "behaviour's step \"on\": a foot left hanging put down once the COM is slower than "
         "0.25 m/s, steps across the feet too; `step` overrides its step's numbers, not the "
-        "plant)",
+        "plant); `hang_still` (m/s, (0, 1], with `standing_step`; default 0.25): the COM "
+        "speed under which that foot is put down",
         {**_kinds(Posture), "settle_share": "number", "gains": "string", "step": "numbers",
-         "standing_step": "bool"},
+         "standing_step": "bool", "hang_still": "number"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
          "settled": "once standing still on both feet with the COM over them (a perturbed "
                     "start); not settled within `seconds` (default 2): the run fails there"},
@@ -350,6 +355,10 @@ def check_phase(phase: Phase, where: str) -> Phase:
     effort = params.get("effort") if phase.controller == "leap" else None
     if effort is not None and not 0.0 <= effort <= 1.0:  # the measured tables' range
         raise ConfigError(f"{where}.params.effort: must be 0-1, got {effort:g}")
+    hang = params.get("hang_still") if phase.controller == "balance" else None
+    if hang is not None and not (params.get("standing_step") is True and 0.0 < hang <= 1.0):
+        raise ConfigError(f"{where}.params.hang_still: needs standing_step = true and must "
+                          f"be in (0, 1] m/s, got {hang:g}")  # fmt: skip
     if phase.controller == "tumble" and params.get("position", "tuck") not in POSITIONS:
         raise ConfigError(
             f"{where}.params.position: unknown position {params['position']!r}; valid "

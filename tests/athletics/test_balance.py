@@ -212,6 +212,30 @@ def test_a_maneuver_balance_with_the_standing_step_puts_a_hanging_foot_down(
     assert str(bad) in str(err.value)
 
 
+def test_a_maneuver_balances_hang_still_waits_for_a_slower_com_to_put_the_foot_down(
+    tmp_path: Path,
+) -> None:
+    # the file key hang_still (issue 19, 2026-12-05): the standing step's plant of a hung foot
+    # once the COM is slower than this (default 0.25 m/s); the forward tuck's early plant kept
+    # seed 2's landers on one foot (docs/athletics.md, "Forward tuck: seed 2's class F")
+    def one_foot(hang: float | None) -> np.ndarray:
+        p: dict[str, object] = {"standing_step": True, "step": [10.0]}
+        r = _drifting(p if hang is None else {**p, "hang_still": hang})
+        assert not r.report["fell"]
+        t, feet = np.asarray(r.log["t"]), np.asarray(r.log["feet"])
+        return t[feet == 1]
+
+    default, slower, still = one_foot(None), one_foot(0.06), one_foot(0.02)
+    assert default.max() + 0.2 < slower.max() < 2.0  # put down, later
+    assert still.max() > 2.9  # never slow enough: on one foot to the end
+    for params in ("standing_step = true, hang_still = 1.5", "hang_still = 0.1"):
+        bad = tmp_path / "m.toml"
+        bad.write_text(f'[[phase]]\ncontroller = "balance"\nparams = {{ {params} }}\n'
+                       'exit = { event = "never" }\n')  # fmt: skip
+        with pytest.raises(ConfigError, match=r"phase\[1\]\.params\.hang_still: needs"):
+            load_maneuver(bad)
+
+
 def _pushed_back(step: list[float] | None) -> AthleticsResult:
     """A standing male balance started with the body moving back at 0.5 m/s (its capture
     point past the heels), with the balance's step if given."""

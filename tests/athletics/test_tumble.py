@@ -49,7 +49,7 @@ from reactmocap.athletics.tumble import (
 )
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.sim.bodies import SIM_BODIES
-from tests.athletics.test_capture import full_starts
+from tests.athletics.test_capture import FULL, full_starts
 
 #: Fig. 5.2: moment of inertia about the somersault axis (kg m^2)
 THESIS_FIG_5_2 = {
@@ -327,6 +327,26 @@ def test_the_forward_tucks_last_balance_puts_down_a_foot_left_hanging() -> None:
     before = run_maneuver(_with_last_balance_params(m, {"settle": 2.0}), perturbation=start,
                           fps=10.0)  # fmt: skip
     assert before.report["fell"] and not before.report["landed"]
+
+
+def test_the_forward_tucks_hanging_foot_put_down_under_a_slower_com_lands_seed_2s_start_26(
+) -> None:
+    """Start 26 of the capture region at full size, seed 2: the file's last balance puts its
+    hung foot down 0.32 s after touchdown, the COM still 0.09 m/s and 11 cm off the support,
+    and it stands on one foot for 84% of the balance and falls; with ``hang_still`` 0.06 (the
+    plant waits for a COM slower than 0.06 m/s, not 0.25) it never fires there, both feet
+    take turns down and it lands (an opt-in; the file unchanged: docs/athletics.md, "Forward
+    tuck: seed 2's class F")."""
+    rng = np.random.default_rng(2)
+    start = [Perturbation.sample(rng, **FULL) for _ in range(27)][26]
+    m = replace(load_maneuver(FORWARD_FILE), seconds=5.5)
+    last = m.phases[-1].params
+    assert "hang_still" not in last
+    before = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert before["fell"] and not before["landed"]
+    slower = _with_last_balance_params(m, {**last, "hang_still": 0.06})
+    r = run_maneuver(slower, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
 
 
 def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> None:
