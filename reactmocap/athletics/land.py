@@ -111,7 +111,7 @@ class LandingParams:
             pelvis rolled up to 16 degrees, the feet up to 7 cm to the side of the COM and
             6-8 cm apart fore-aft, and stood on one foot after the landing.
         aim_sideways_above: ``aim_sideways`` only for a reach that begins with the COM moving
-            sideways (in the heading's frame) faster than this (m/s); 0 (the default) is
+            across the take-off's heading (``Context.heading0``) faster than this (m/s); 0 (the default) is
             off. Why: on the male back layout ``aim_sideways`` for every start gained the
             starts that drift across on one foot after touchdown but lost the landers.
         spin_aim: the reach for a body still turning (a somersault's landing): the legs are
@@ -512,7 +512,10 @@ class Landing(Basis):
             memo["side"] = float(p.aim_sideways)  # aim_sideways, or gated (aim_sideways_above)
             if p.aim_sideways_above:
                 sn = ctx.sense(t)
-                across = abs(float(sn.local(sn.com_vel, sn.heading())[1]))
+                # the take-off's frame: the pelvis's heading at the reach's start (a body near
+                # horizontal) did not separate the drifting starts from the landers
+                h0 = sn.heading() if ctx.heading0 is None else ctx.heading0
+                across = abs(float(sn.local(sn.com_vel, h0)[1]))
                 memo["side"] = float(across > p.aim_sideways_above)
 
         def reach(world: World, t: float) -> None:
