@@ -110,10 +110,6 @@ class LandingParams:
             own roll not taken out: a back tuck from a perturbed start touched down with the
             pelvis rolled up to 16 degrees, the feet up to 7 cm to the side of the COM and
             6-8 cm apart fore-aft, and stood on one foot after the landing.
-        aim_sideways_above: ``aim_sideways`` only for a reach that begins with the COM moving
-            across the take-off's heading (``Context.heading0``) faster than this (m/s); 0 (the default) is
-            off. Why: on the male back layout ``aim_sideways`` for every start gained the
-            starts that drift across on one foot after touchdown but lost the landers.
         spin_aim: the reach for a body still turning (a somersault's landing): the legs are
             aimed in the heading of the pelvis's left-right axis (``Senses.side_heading``;
             the pelvis's forward axis, the default's heading, flips by half a turn as the
@@ -277,7 +273,6 @@ class LandingParams:
     pitch_ease: float = 0.0
     swing_cap: float = 0.9
     aim_sideways: bool = False
-    aim_sideways_above: float = 0.0
     spin_aim: bool = False
     twist_aim: bool = False
     fall_gain: float = 0.0
@@ -336,11 +331,6 @@ class LandingParams:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise ConfigError(f"landing {name} must be a finite number, got {v!r}")
-        a = self.aim_sideways_above
-        if not (isinstance(a, (int, float)) and math.isfinite(a) and 0.0 <= a <= 2.0):
-            raise ConfigError(f"landing aim_sideways_above must be in [0, 2] m/s, got {a!r}")
-        if a and self.aim_sideways:
-            raise ConfigError("landing aim_sideways_above needs aim_sideways off (it gates it)")
         if not 0.0 <= self.twist_arms <= 100.0:
             raise ConfigError(f"landing twist_arms must be in [0, 100] rad, got {self.twist_arms}")
         if self.side_lead is not None and not (
@@ -509,14 +499,6 @@ class Landing(Basis):
             memo["rot_prev"], memo["t_prev"] = ctx.rotation, t  # turn_gain's rate
             memo["reach_t"], memo["late"] = t, -1.0  # late_delta: not yet decided (-1)
             memo["kv"] = p.kv  # the placement servo's damping (late_kv once late)
-            memo["side"] = float(p.aim_sideways)  # aim_sideways, or gated (aim_sideways_above)
-            if p.aim_sideways_above:
-                sn = ctx.sense(t)
-                # the take-off's frame: the pelvis's heading at the reach's start (a body near
-                # horizontal) did not separate the drifting starts from the landers
-                h0 = sn.heading() if ctx.heading0 is None else ctx.heading0
-                across = abs(float(sn.local(sn.com_vel, h0)[1]))
-                memo["side"] = float(across > p.aim_sideways_above)
 
         def reach(world: World, t: float) -> None:
             s = ctx.sense(t)
@@ -564,7 +546,7 @@ class Landing(Basis):
             goal = np.full((NJ, 3), np.nan)
             thighs = np.zeros((2, 3))  # aim_sideways: each thigh's pitch and roll in the world
             hips = d.xanchor[hip_joints]
-            if memo["side"]:
+            if p.aim_sideways:
                 middle = s.local(s.com - hips.mean(axis=0), h)
             for k in range(2):
                 hip = hips[k]
@@ -576,10 +558,10 @@ class Landing(Basis):
                 geom = float(knee_for_length(ctx.athlete.thigh[k], ctx.athlete.shin[k],
                                              length)[1])  # fmt: skip
                 goal[_HIP[k]] = (-swing + geom - servo[0] - pelvis, servo[1], 0.0)
-                if memo["side"]:
+                if p.aim_sideways:
                     side = float(np.clip((middle[1] + want[1]) / max(length, 0.2), -0.5, 0.5))
                     thighs[k] = (-swing + geom - servo[0], math.asin(side) + servo[1], 0.0)
-            if memo["side"]:  # the roll from the pelvis's whole orientation; pitch as above
+            if p.aim_sideways:  # the roll from the pelvis's whole orientation; pitch as above
                 ahead = memo["lag"] * d.cvel[s.root, :3] if p.twist_aim else None
                 goal[_HIP, 1] = hips_for_thighs(ctx, d, thighs, h, ahead)[:, 1]
             rig.move(goal, 0.0, t, _HIP)

@@ -416,33 +416,6 @@ def test_the_back_layout_opens_by_the_reach_s_turn_over_its_time() -> None:
         assert r["fell"] and not r["landed"], i
 
 
-def test_the_back_layouts_sideways_aim_gated_by_the_drift_lands_37_and_keeps_28() -> None:
-    """Starts 37 and 28 of ``back_layout.toml``'s capture region at full size (seed 0). 37
-    drifts across at 0.17 m/s (the take-off's frame) as the reach begins and, with the file's
-    landing, stands on one foot and falls; ``aim_sideways_above`` 0.12 aims its legs from the
-    pelvis's whole orientation and it lands. 28 (0.08 m/s, under the gate) keeps the file's
-    landing, the same run (``aim_sideways`` for every start lost it; docs/athletics.md, "Back
-    layout: ``aim_sideways`` gated")."""
-    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
-    gated = _with_land_params(m, {**m.phases[3].params, "aim_sideways_above": 0.12})
-    starts = full_starts(38)
-    r = run_maneuver(gated, perturbation=starts[37], fps=10.0).report
-    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
-    r = run_maneuver(m, perturbation=starts[37], fps=10.0).report
-    assert r["fell"] and not r["landed"]
-    a = run_maneuver(gated, perturbation=starts[28], fps=10.0).report
-    b = run_maneuver(m, perturbation=starts[28], fps=10.0).report
-    assert a["landed"] and not a["fell"] and a["rotation_deg"] == b["rotation_deg"]
-
-
-def test_the_landing_refuses_an_aim_sideways_above_out_of_range() -> None:
-    for bad in (-0.1, 2.5, math.nan):
-        with pytest.raises(ConfigError, match="aim_sideways_above"):
-            LandingParams(aim_sideways_above=bad)
-    with pytest.raises(ConfigError, match="aim_sideways_above"):
-        LandingParams(aim_sideways_above=0.1, aim_sideways=True)
-
-
 def test_perturbed_back_tucks_land_with_the_legs_aimed_sideways() -> None:
     """Starts 0 and 5 of the capture region at full size (seed 0). Both fell with the legs'
     roll from the foot servo alone: start 0 touched down with the pelvis rolled 16 degrees and
