@@ -143,7 +143,6 @@ class AnchoredReference:
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
         step_tilt: float = 0.0,
-        step_tilt_vertical: bool = False,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -216,10 +215,6 @@ class AnchoredReference:
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
         # ``step_tilt``: that limit (deg; 0: the fixed 35)
         self._tilt_cos = float(np.cos(np.radians(step_tilt))) if step_tilt else _STEP_TILT_COS
-        # ``step_tilt_vertical``: the tilt of the pelvis axis that was vertical at the start
-        # (a row of its rotation), not of its own z axis, which on the humanoid's pelvis lies
-        # along the floor, so the walk's turn read as tilt
-        self._tilt_vertical = bool(step_tilt_vertical)
         self.step_hold = float(step_hold)
         self.step_hold_for = float(step_hold_for)
         self.place_gain = float(place_gain)
@@ -249,7 +244,7 @@ class AnchoredReference:
         self._slow_next = 0.0
         self._z_adr = wc.qpos_slice.start + 2
         self._z0 = float(world.data.qpos[self._z_adr])
-        self._root_up0 = self._root_up().copy()
+        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
         self._corners_at: tuple[float, bytes] = (float("nan"), b"")
         self._corners_now = np.zeros((2, 4, 3))
         #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
@@ -667,17 +662,12 @@ class AnchoredReference:
         rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
         return d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half
 
-    def _root_up(self) -> F64:
-        """The pelvis axis the tilt latch reads: its z axis, or with ``step_tilt_vertical``
-        its rotation's last row (the world's vertical in its frame)."""
-        r = self.world.data.xmat[self._root].reshape(3, 3)
-        return r[2] if self._tilt_vertical else r[:, 2]
-
     def _going_down(self) -> bool:
         """The pelvis has tilted past the balance steps' limit (now or before) or sunk below
         0.75 of its starting height: the body is already going down."""
         d = self.world.data
-        self._gone_down |= bool(self._root_up() @ self._root_up0 < self._tilt_cos)
+        up = d.xmat[self._root].reshape(3, 3)[:, 2]
+        self._gone_down |= bool(up @ self._root_up0 < self._tilt_cos)
         return self._gone_down or bool(d.qpos[self._z_adr] < 0.75 * self._z0)
 
     def _clip_ahead_margin(self, horizon: float = 0.0) -> float:
@@ -1015,7 +1005,7 @@ class AnchoredReference:
         self._xi_rate = np.zeros(2)
         self._xi_last = (-np.inf, np.zeros(2))
         self._z0 = float(world.data.qpos[self._z_adr])
-        self._root_up0 = self._root_up().copy()
+        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
 
     def hold(self, t: float) -> None:
         """From rollout time ``t`` on, follow the reference's pose at ``t``."""

@@ -289,9 +289,6 @@ class WholeBodyTracker(AnchoredReference):
         step_tilt: the pelvis tilt (deg, from its start) past which no balance step is taken
             for the rest of the run (0: 35): a pushed walk's pelvis tilted past 35 deg still
             0.86 m up and every step stopped (``docs/tracking.md``, issue 16).
-        step_tilt_vertical: that tilt is of the pelvis axis vertical at the start; off, of
-            the pelvis's z axis, which on the humanoid lies along the floor, so the latch
-            reads the walk's turn from its start (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -387,7 +384,6 @@ class WholeBodyTracker(AnchoredReference):
         anchor_turn_rate: float = 0.0,
         step_ahead_servo: float = 0.0,
         step_tilt: float = 0.0,
-        step_tilt_vertical: bool = False,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -426,7 +422,6 @@ class WholeBodyTracker(AnchoredReference):
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "step_ahead_servo": step_ahead_servo, "step_tilt": step_tilt,
-                "step_tilt_vertical": step_tilt_vertical,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -584,7 +579,7 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_tilt=step_tilt, step_tilt_vertical=step_tilt_vertical,
+            step_tilt=step_tilt,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
