@@ -142,7 +142,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_tilt: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -213,8 +212,6 @@ class AnchoredReference:
         self._drop_step: tuple[float, bool] = (-np.inf, False)
         self._landed = (-1, -np.inf)  # the last balance step's foot and landing time
         self._gone_down = False  # the pelvis has tilted past the balance steps' limit
-        # ``step_tilt``: that limit (deg; 0: the fixed 35)
-        self._tilt_cos = float(np.cos(np.radians(step_tilt))) if step_tilt else _STEP_TILT_COS
         self.step_hold = float(step_hold)
         self.step_hold_for = float(step_hold_for)
         self.place_gain = float(place_gain)
@@ -667,7 +664,7 @@ class AnchoredReference:
         0.75 of its starting height: the body is already going down."""
         d = self.world.data
         up = d.xmat[self._root].reshape(3, 3)[:, 2]
-        self._gone_down |= bool(up @ self._root_up0 < self._tilt_cos)
+        self._gone_down |= bool(up @ self._root_up0 < _STEP_TILT_COS)
         return self._gone_down or bool(d.qpos[self._z_adr] < 0.75 * self._z0)
 
     def _clip_ahead_margin(self, horizon: float = 0.0) -> float:
