@@ -209,6 +209,10 @@ class Step:
             hung a foot for 0.8 s at 0.10 m/s until a step fired; the 16 pushes' limits 2255
             -> 2425 N, none lower; docs/athletics.md "What follows the standing step's first
             touchdown").
+        hang_near: with ``hang_still``, that plant also waits until the COM lies within this
+            (m, horizontal) of the supporting sole's middle (0: off; opt-in: the forward tuck's
+            hung foot put down 9-11 cm off the support kept it on one foot, docs/athletics.md
+            "Forward tuck: the hung foot put down near the support").
         pair: after the run's first step, the next starts only once the capture point lies
             more than this (m) past the box of both soles, a lifted one counted, in either
             axis (the COM's sideways speed in it); while it lies within, a foot that hangs is
@@ -234,6 +238,7 @@ class Step:
     foresee: float = 0.0
     down_after: float = 0.0
     hang_still: float = 0.0
+    hang_near: float = 0.0
     pair: float = 0.0
     bow_hold: float = 0.0
 
@@ -259,6 +264,9 @@ class Step:
         v = self.hang_still
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 1.0):
             raise ConfigError(f"step hang_still must be in [0, 1] m/s, got {v!r}")
+        v = self.hang_near
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.3):
+            raise ConfigError(f"step hang_near must be in [0, 0.3] m, got {v!r}")
         v = self.bow_hold
         if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 5.0):
             raise ConfigError(f"step bow_hold must be in [0, 5] s, got {v!r}")
@@ -984,8 +992,13 @@ class Stepper:
             self._t_hang = math.inf
             return
         self._t_hang = min(self._t_hang, t)
-        still = self.step.hang_still if self.step.hang_still and not self.record else STANDING_STILL
+        first = bool(self.step.hang_still and not self.record)
+        still = self.step.hang_still if first else STANDING_STILL
         if t >= max(self._t_hang + STANDING_HANG, self._t_end + STEP_PAUSE) and speed < still:
+            if first and self.step.hang_near:
+                s = self.ctx.senses
+                if float(np.hypot(*(s.com[:2] - s.support_center()[:2]))) >= self.step.hang_near:
+                    return  # Step.hang_near: the COM still far off the standing sole
             bl.posture = replace(bl.posture, plant=True)
 
 

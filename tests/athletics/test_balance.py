@@ -212,6 +212,34 @@ def test_a_maneuver_balance_with_the_standing_step_puts_a_hanging_foot_down(
     assert str(bad) in str(err.value)
 
 
+def test_a_maneuver_balances_hang_near_waits_for_the_com_near_the_sole_to_put_the_foot_down(
+    tmp_path: Path,
+) -> None:
+    # the file key hang_near (issue 19, 2026-12-05): the standing step's plant of a hung foot
+    # waits, besides a slow COM, for the COM within this of the standing sole's middle; the
+    # forward tuck's plant 9-11 cm off the support kept it on one foot (docs/athletics.md,
+    # "Forward tuck: the hung foot put down near the support")
+    def one_foot(near: float | None) -> np.ndarray:
+        p: dict[str, object] = {"standing_step": True, "step": [10.0]}
+        r = _drifting(p if near is None else {**p, "hang_near": near})
+        assert not r.report["fell"]
+        t, feet = np.asarray(r.log["t"]), np.asarray(r.log["feet"])
+        return t[feet == 1]
+
+    default, wide, close = one_foot(None), one_foot(0.05), one_foot(0.005)
+    assert default.max() < 1.5 and np.array_equal(wide, default)  # near enough: as before
+    assert close.max() > 2.9  # never that near: on one foot to the end
+    for params in ("standing_step = true, hang_near = 0.5", "hang_near = 0.05"):
+        bad = tmp_path / "m.toml"
+        bad.write_text(f'[[phase]]\ncontroller = "balance"\nparams = {{ {params} }}\n'
+                       'exit = { event = "never" }\n')  # fmt: skip
+        with pytest.raises(ConfigError, match=r"phase\[1\]\.params\.hang_near: needs") as err:
+            load_maneuver(bad)
+        assert str(bad) in str(err.value)
+    with pytest.raises(ConfigError, match="hang_near"):
+        Step(hang_near=-0.1)
+
+
 def _pushed_back(step: list[float] | None) -> AthleticsResult:
     """A standing male balance started with the body moving back at 0.5 m/s (its capture
     point past the heels), with the balance's step if given."""

@@ -49,7 +49,7 @@ from reactmocap.athletics.tumble import (
 )
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.sim.bodies import SIM_BODIES
-from tests.athletics.test_capture import full_starts
+from tests.athletics.test_capture import FULL, full_starts
 
 #: Fig. 5.2: moment of inertia about the somersault axis (kg m^2)
 THESIS_FIG_5_2 = {
@@ -326,6 +326,26 @@ def test_the_forward_tucks_last_balance_puts_down_a_foot_left_hanging() -> None:
     assert abs(r.report["rotation_deg"] - 360.0) <= 30.0 and int(r.log["feet"][-1]) == 2
     before = run_maneuver(_with_last_balance_params(m, {"settle": 2.0}), perturbation=start,
                           fps=10.0)  # fmt: skip
+    assert before.report["fell"] and not before.report["landed"]
+
+
+def test_the_forward_tucks_hanging_foot_put_down_near_the_support_lands_seed_2s_start_26(
+) -> None:
+    """Start 26 of the capture region at full size, seed 2: without ``hang_near`` the last
+    balance puts its hung foot down 0.32 s after touchdown with the COM still 11 cm off the
+    standing sole, and it stands on one foot for 84% of the balance and falls; the file since
+    2026-12-05 16:50 UTC (``hang_near`` 0.085: the plant waits for the COM within 8.5 cm of
+    the sole too) never plants it there, both feet take turns down and it lands (full size
+    45 / 47 / 43 of 50 on seeds 0 / 1 / 2 from 45 / 46 / 41; docs/athletics.md, "Forward
+    tuck: the hung foot put down near the support")."""
+    rng = np.random.default_rng(2)
+    start = [Perturbation.sample(rng, **FULL) for _ in range(27)][26]
+    m = replace(load_maneuver(FORWARD_FILE), seconds=5.5)
+    last = dict(m.phases[-1].params)
+    assert last.pop("hang_near") == 0.085
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+    before = run_maneuver(_with_last_balance_params(m, last), perturbation=start, fps=10.0)
     assert before.report["fell"] and not before.report["landed"]
 
 
