@@ -329,8 +329,7 @@ def test_the_forward_tucks_last_balance_puts_down_a_foot_left_hanging() -> None:
     assert before.report["fell"] and not before.report["landed"]
 
 
-def test_the_forward_tucks_hanging_foot_put_down_near_the_support_lands_seed_2s_start_26(
-) -> None:
+def test_the_forward_tucks_hanging_foot_put_down_near_the_support_lands_seed_2s_start_26() -> None:
     """Start 26 of the capture region at full size, seed 2: without ``hang_near`` the last
     balance puts its hung foot down 0.32 s after touchdown with the COM still 11 cm off the
     standing sole, and it stands on one foot for 84% of the balance and falls; the file since
