@@ -252,6 +252,11 @@ class LandingParams:
             on the male back handspring 13 of 19 full-size failures that reach the feet had
             a step's swing run its whole 0.75 s without the foot down (docs/athletics.md,
             "the step put down").
+        step_foresee: the ``step``'s :class:`~reactmocap.athletics.balance.Step` ``foresee``
+            (s, 0: off; only with ``step_across``). Why: on the male back handspring the
+            class-S fallers tipped out sideways over one foot after the closing step; with
+            ``step_across`` 0.05 and ``step_foresee`` 0.25 the three seeds land 106 of 150
+            from 94, none lost (docs/athletics.md, "class S ... across/foresee").
         recover_leg: the recovery stands up to at least this fraction of the straight leg
             (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
@@ -299,6 +304,7 @@ class LandingParams:
     step_across: float = 0.0
     step_ground: float = 0.0
     step_down_after: float = 0.0
+    step_foresee: float = 0.0
     recover_leg: float = 0.0
 
     def __post_init__(self) -> None:
@@ -433,11 +439,11 @@ class LandingParams:
         ``step_*`` fields), or None (off)."""
         step = Step.of(self.step)
         more = {"across": self.step_across, "ground": self.step_ground,
-                "down_after": self.step_down_after}  # fmt: skip
+                "down_after": self.step_down_after, "foresee": self.step_foresee}  # fmt: skip
         if step is None:
             if any(v != getattr(Step, k) for k, v in more.items()):
-                raise ConfigError("landing step_across, step_ground and step_down_after "
-                                  "need a step")  # fmt: skip
+                raise ConfigError("landing step_across, step_ground, step_down_after and "
+                                  "step_foresee need a step")  # fmt: skip
             return None
         try:
             return replace(step, **more)

@@ -158,10 +158,19 @@ def _unspun(m: Maneuver) -> Maneuver:
     return _with(m, "leap", {k: v for k, v in leap.items() if not k.startswith("rise_spin")})
 
 
+def _unforeseen(m: Maneuver) -> Maneuver:
+    """``m`` with the landing's step as the file had it before 2026-12-05 (latest): no
+    ``step_across`` / ``step_foresee``."""
+    land = next(p for p in m.phases if p.controller == "land").params
+    old = {k: v for k, v in land.items() if k not in ("step_across", "step_foresee")}
+    return _with(m, "land", old)
+
+
 def _unpaired(m: Maneuver) -> Maneuver:
     """``m`` with the landing and the last balance as the file had them before 2026-12-05
     (later): the step to 10 cm past the capture point (reach 0.1), no ``recover_leg``, no
-    ``side_both``."""
+    ``side_both`` (nor the later ``step_across`` / ``step_foresee``)."""
+    m = _unforeseen(m)
     land = next(p for p in m.phases if p.controller == "land").params
     old = {k: v for k, v in land.items() if k != "recover_leg"}
     m = _with(m, "land", {**old, "step": [0.05, 0.1, 0.3, 0.25]})
@@ -495,8 +504,9 @@ def test_the_last_balance_keeps_the_com_between_both_feet_after_the_landings_ste
     """Full-size start 16 (seed 0) lands, steps back and closes its feet as the landers do, then
     drifts sideways over one foot and falls during a third step 2.0 s after touchdown. With
     the last balance's COM target kept between both soles while one is unloaded
-    (``Posture.side_both``, the file since 2026-12-05) it stands; without it it falls."""
-    m = replace(load_maneuver(EXAMPLE), seconds=5.0)  # touchdown at 2.55 s
+    (``Posture.side_both``, the file since 2026-12-05) it stands; without it it falls. On
+    the landing's step as it was then (no ``step_across`` / ``step_foresee``)."""
+    m = replace(_unforeseen(load_maneuver(EXAMPLE)), seconds=5.0)  # touchdown at 2.55 s
     last = m.phases[-1]
     assert last.controller == "balance" and last.params["side_both"] is True
     start = _starts(1.0, 17)[16]
@@ -505,3 +515,23 @@ def test_the_last_balance_keeps_the_com_between_both_feet_after_the_landings_ste
     plain = replace(last, params={k: v for k, v in last.params.items() if k != "side_both"})
     old = run_maneuver(replace(m, phases=(*m.phases[:-1], plain)), perturbation=start, fps=10.0)
     assert old.report["fell"] and not old.report["landed"]
+
+
+def test_the_landings_step_fires_on_the_capture_point_across_the_feet_foreseen() -> None:
+    """Full-size start 40 (seed 0) lands and steps, then tips out sideways over one foot and
+    falls (class S). With the landing's step also fired by the capture point across the feet
+    carried 0.25 s on (``step_across`` 0.05, ``step_foresee`` 0.25: the file since 2026-12-05,
+    latest) it stands. ``step_foresee`` needs ``step_across``; a bad value is named."""
+    m = load_maneuver(EXAMPLE)
+    land = next(p for p in m.phases if p.controller == "land").params
+    assert land["step_across"] == 0.05 and land["step_foresee"] == 0.25
+    start = _starts(1.0, 41)[40]
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"]
+    old = run_maneuver(_unforeseen(m), perturbation=start, fps=10.0).report
+    assert old["fell"] and not old["landed"]
+    for bad in ({"step_foresee": 0.25}, {"step_across": 0.05, "step_foresee": 1.5}):
+        with pytest.raises(ConfigError, match="step_foresee"):
+            LandingParams(step=(0.05,), **bad).balance_step()
+    with pytest.raises(ConfigError, match="need a step"):
+        LandingParams(step_foresee=0.25)
