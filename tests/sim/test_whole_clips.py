@@ -226,11 +226,12 @@ def test_a_second_step_eased_down_only_delays_the_fall(shared_mocap_dir: Path) -
     second balance step starts while the eased pelvis target is still coming back up and drops
     it in one tick (0.15 m as traced at 175 N); the body falls. Lowered over 0.05 s instead
     (``step_ease_in``, opt-in: it lost pushes on the fixed-force sweep, ``docs/tracking.md``)
-    the body is upright when the window ends but still falling (centre of mass 0.82 m/s, its
-    capture point 0.57 m ahead of both feet, the pelvis sinking): not a recovery."""
+    it is not a recovery either. (Before the tilt latch read the pelvis's true tilt,
+    2026-12-05, the eased run ended upright but still falling, because the latch, fooled by
+    the body's turn, stopped the third step that now starts from a sunk pelvis.)"""
     respond, force = _shared_push(shared_mocap_dir, "respond_normal_001", 1.0, 0.0, 200.0)
     assert _stand_pushed(respond, force, {}) in ("fell", "unstable")
-    assert _stand_pushed(respond, force, {"step_ease_in": 0.05}) == "moving"
+    assert _stand_pushed(respond, force, {"step_ease_in": 0.05}) != "ok"
 
 
 def test_a_balance_step_landing_softly_stays_up(shared_mocap_dir: Path) -> None:
@@ -804,3 +805,32 @@ def test_a_pushed_step_softens_the_pelvis_servo(step_forward: Motion) -> None:
     np.testing.assert_allclose(wb.kp[:3], 30.0)
     wb.reset(world)
     np.testing.assert_allclose(wb.kp[:3], 100.0)
+
+
+def test_the_balance_steps_tilt_latch_reads_tilt_not_a_turn(shared_mocap_dir: Path) -> None:
+    """``_going_down`` latches once the pelvis tilts past 35 deg from upright. A real
+    skeleton's pelvis z axis lies along the floor, so reading that axis made a 60 deg turn
+    look like a fall and stopped every balance step after it (until 2026-12-05): a turn
+    leaves the latch open, a 45 deg lean closes it."""
+    import mujoco
+
+    walk, _ = _shared_push(shared_mocap_dir, "walk-left_normal_001", 1.0, 0.0, 0.0)
+    world = World(build_character(walk, frame=0))
+    world.set_from_motion(0, walk, 0)
+    mujoco.mj_forward(world.model, world.data)
+    spec = controller_spec("wholebody")
+    wb = WholeBodyTracker(
+        world, 0, walk, start=0.0, kp_joint=spec.defaults["kp"],
+        servo_kv=spec.defaults["servo_kv"], control_every=4,
+    )  # fmt: skip
+    wb.reset(world)
+    d = world.data
+    adr = world.characters[0].qpos_slice.start + 3
+    q0 = d.qpos[adr : adr + 4].copy()
+    for axis, degrees, closed in (((0.0, 0.0, 1.0), 60.0, False), ((1.0, 0.0, 0.0), 45.0, True)):
+        wb._gone_down = False
+        half = np.radians(degrees) / 2
+        turn = [np.cos(half), *(np.sin(half) * np.array(axis))]
+        mujoco.mju_mulQuat(d.qpos[adr : adr + 4], turn, q0)
+        mujoco.mj_kinematics(world.model, d)
+        assert wb._going_down() is closed, (axis, degrees)

@@ -241,7 +241,9 @@ class AnchoredReference:
         self._slow_next = 0.0
         self._z_adr = wc.qpos_slice.start + 2
         self._z0 = float(world.data.qpos[self._z_adr])
-        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
+        # the pelvis's own axis that points up at the start (its rotation's last row): a real
+        # skeleton's pelvis z axis lies along the floor, and reading it took a turn for a tilt
+        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[2].copy()
         self._corners_at: tuple[float, bytes] = (float("nan"), b"")
         self._corners_now = np.zeros((2, 4, 3))
         #: the re-anchoring of the mocap's ground path: heading (rad) and horizontal shift (m),
@@ -663,8 +665,8 @@ class AnchoredReference:
         """The pelvis has tilted past the balance steps' limit (now or before) or sunk below
         0.75 of its starting height: the body is already going down."""
         d = self.world.data
-        up = d.xmat[self._root].reshape(3, 3)[:, 2]
-        self._gone_down |= bool(up @ self._root_up0 < _STEP_TILT_COS)
+        up_z = d.xmat[self._root].reshape(3, 3)[2] @ self._root_up0  # that axis's height
+        self._gone_down |= bool(up_z < _STEP_TILT_COS)
         return self._gone_down or bool(d.qpos[self._z_adr] < 0.75 * self._z0)
 
     def _clip_ahead_margin(self, horizon: float = 0.0) -> float:
@@ -1002,7 +1004,7 @@ class AnchoredReference:
         self._xi_rate = np.zeros(2)
         self._xi_last = (-np.inf, np.zeros(2))
         self._z0 = float(world.data.qpos[self._z_adr])
-        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[:, 2].copy()
+        self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[2].copy()
 
     def hold(self, t: float) -> None:
         """From rollout time ``t`` on, follow the reference's pose at ``t``."""
