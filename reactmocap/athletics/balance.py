@@ -261,18 +261,12 @@ class Step:
             raise ConfigError(f"step foresee must be 0 or in (0, 1] s, with across: {self.foresee}")
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
-        v = self.hang_still
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 1.0):
-            raise ConfigError(f"step hang_still must be in [0, 1] m/s, got {v!r}")
-        v = self.hang_near
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.3):
-            raise ConfigError(f"step hang_near must be in [0, 0.3] m, got {v!r}")
-        v = self.bow_hold
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 5.0):
-            raise ConfigError(f"step bow_hold must be in [0, 5] s, got {v!r}")
-        v = self.pair
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= 0.3):
-            raise ConfigError(f"step pair must be in [0, 0.3] m, got {v!r}")
+        ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
+                  ("pair", 0.3, "m"))  # fmt: skip
+        for name, hi, unit in ranges:
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
+                raise ConfigError(f"step {name} must be in [0, {hi:g}] {unit}, got {v!r}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:

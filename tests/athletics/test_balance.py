@@ -446,6 +446,14 @@ def test_a_foot_hung_before_the_first_step_is_planted_under_a_faster_com(
         Step(hang_still=float("nan"))
 
 
+def _her_pushed_back(monkeypatch: pytest.MonkeyPatch, step: Step, newtons: float) -> dict:
+    """The female's 3 s standing balance pushed straight back, ``step="on"`` meaning
+    ``step``: the run's report."""
+    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
+    push = {"check_range": False, "seconds": 3.0, "push": newtons, "push_dir": math.pi}
+    return run("balance", "female", step="on", **push).report
+
+
 def test_a_standing_step_whose_bow_is_held_through_the_swing_lands_sooner(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -455,13 +463,9 @@ def test_a_standing_step_whose_bow_is_held_through_the_swing_lands_sooner(
     # with it, the foot hangs over the floor and the first swing takes >= 0.55 s (planned 0.25)
     # and she falls; with the bow eased out over 1 s during the swing (Step.bow_hold) the same
     # step lands within 0.45 s and she does not fall
-    push = {"check_range": False, "seconds": 3.0, "push": 105.0, "push_dir": math.pi}
-    monkeypatch.setattr(behaviours, "STANDING_STEP", _STEP_BEFORE)
-    r = run("balance", "female", step="on", **push).report
+    r = _her_pushed_back(monkeypatch, _STEP_BEFORE, 105.0)
     assert r["steps"][0]["s"] >= 0.55 and r["fell"]
-    step = dataclasses.replace(_STEP_BEFORE, bow_hold=1.0)
-    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
-    r_held = run("balance", "female", step="on", **push).report
+    r_held = _her_pushed_back(monkeypatch, dataclasses.replace(_STEP_BEFORE, bow_hold=1.0), 105.0)
     assert r_held["steps"][0]["t"] == r["steps"][0]["t"]
     assert r_held["steps"][0]["s"] < 0.45 and not r_held["fell"]
     for bad in (-0.1, 5.5, float("nan")):
@@ -477,12 +481,8 @@ def test_a_standing_steps_next_trigger_on_both_soles_waits_for_the_capture_point
     # and the second fires on the front sole's box alone, the capture point still within 5 cm
     # of both soles' box; judged against both soles' box (Step.pair 0.05) it fires later,
     # with the capture point more than 5 cm past that box
-    push = {"check_range": False, "seconds": 3.0, "push": 85.0, "push_dir": math.pi}
-    monkeypatch.setattr(behaviours, "STANDING_STEP", _STEP_BEFORE)
-    r = run("balance", "female", step="on", **push).report
-    step = dataclasses.replace(_STEP_BEFORE, pair=0.05)
-    monkeypatch.setattr(behaviours, "STANDING_STEP", step)
-    r_pair = run("balance", "female", step="on", **push).report
+    r = _her_pushed_back(monkeypatch, _STEP_BEFORE, 85.0)
+    r_pair = _her_pushed_back(monkeypatch, dataclasses.replace(_STEP_BEFORE, pair=0.05), 85.0)
     assert len(r["steps"]) >= 2 and len(r_pair["steps"]) >= 2
     assert r_pair["steps"][0] == r["steps"][0]
     assert r_pair["steps"][1]["t"] > r["steps"][1]["t"]
