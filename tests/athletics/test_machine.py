@@ -4,16 +4,19 @@ from __future__ import annotations
 
 import math
 
+import mujoco
 import numpy as np
 import pytest
 
 from reactmocap.athletics import Balance, Landing, Posture, Sequencer, athlete
+from reactmocap.athletics.leap import pitch_momentum
 from reactmocap.athletics.machine import NEXT, Basis, Context, angle, apex, touchdown
 from reactmocap.athletics.rig import Rig, per_joint
 from reactmocap.athletics.scene import athletics_world, stand_angles
 from reactmocap.errors import ConfigError, UnknownKeyError
 from reactmocap.sim.controllers.machine import State, after
 from reactmocap.sim.rollout import rollout
+from reactmocap.sim.world import World
 
 
 def test_a_drop_runs_the_landing_states_in_order_and_hands_over_to_balance() -> None:
@@ -31,6 +34,58 @@ def test_a_drop_runs_the_landing_states_in_order_and_hands_over_to_balance() -> 
     # the hand-over moves no target: the knees' targets are continuous across it
     log = ctx.log.arrays()
     assert not log["others"].any()
+
+
+class _Reader:
+    """Each tick, reads again what the controllers read: the senses re-measured (their
+    per-time cache emptied), their derived values, the world's state and kinetic energy.
+    ``forward_at``: also one ``mj_forward`` then (not a pure read: it recomputes the mass
+    matrix the servo linearises on)."""
+
+    control_every = 8
+
+    def __init__(self, ctx: Context, forward_at: float | None = None) -> None:
+        self.ctx, self.forward_at = ctx, forward_at
+
+    def reset(self, world: World) -> None:
+        pass
+
+    def control(self, world: World, t: float) -> None:
+        s = self.ctx.senses
+        s.time = -1.0
+        s.update(t)
+        s.heading(), s.side_heading(), s.local(s.com_vel), s.support_center(), s.airborne
+        pitch_momentum(world, s), world.kinetic_energy(), world.get_state()
+        if self.forward_at is not None and t >= self.forward_at:
+            mujoco.mj_forward(world.model, world.data)
+            self.forward_at = None
+
+
+def _drop(reader: float | bool, first: bool = False) -> tuple[np.ndarray, list[str]]:
+    """The drop above for 0.8 s: its recorded qpos and transitions, with a :class:`_Reader`
+    (a float: its ``forward_at``; ``first``: ticked before the sequencer) or without."""
+    ath = athlete("male")
+    world = athletics_world(ath)
+    world.set_pose(0, ath.standing_qpos(stand_angles(ath, 0.92), clearance=0.3))
+    ctx = Context.make(world, ath, control_every=8)
+    seq = Sequencer(ctx, [Landing(), Balance(Posture(settle=1.0))])
+    extra = [] if reader is False else [_Reader(ctx, None if reader is True else reader)]
+    res = rollout(world, 0.8, controllers=[*extra, seq] if first else [seq, *extra])
+    return res.qpos, [tr.target for tr in seq.transitions]
+
+
+def test_reading_the_senses_again_leaves_a_run_bit_identical() -> None:
+    # a second read in a tick must not change the simulation (docs/athletics.md, 2026-12-05,
+    # "reading the sensors"): the senses' mj_subtreeVel and mj_contactForce write no state
+    plain, states = _drop(False)
+    assert "land.absorb" in states
+    for first in (True, False):  # the sequencer then reads the reader's measurement, or not
+        read, read_states = _drop(True, first)
+        assert read_states == states
+        assert np.array_equal(read, plain)
+    # the comparison catches a read that is not pure: one mj_forward mid-landing
+    forward, _ = _drop(0.3)
+    assert not np.array_equal(forward, plain)
 
 
 def test_events_fire_on_what_they_measure() -> None:
