@@ -142,6 +142,7 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
+        step_max_length: float = 0.6,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -202,6 +203,8 @@ class AnchoredReference:
         self.step_leg = float(step_leg)
         self.step_alternate = bool(step_alternate)
         self.step_short = float(step_short)
+        # a balance step lands at most this far from the stance foot (m)
+        self.step_max_length = float(step_max_length)
         self.step_ease = float(step_ease)
         # how far (m) the pelvis target is down for a balance step (``step_ease``) and the
         # rollout time it was last moved
@@ -644,7 +647,7 @@ class AnchoredReference:
         duration = duration or self.step_time
         target = step_target(
             xi, centre[1 - foot, :2], centre[foot, :2], omega, duration, beyond=0.05,
-            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
+            max_length=self.step_max_length, min_width=0.12, lateral=left if foot == 0 else -left,
         )  # fmt: skip
         if shorten and self.step_short and self._landed[0] >= 0:
             # after a step has landed, a short one (a foot put back down) need not take the
