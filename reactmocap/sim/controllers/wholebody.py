@@ -384,6 +384,7 @@ class WholeBodyTracker(AnchoredReference):
         anchor_turn_rate: float = 0.0,
         step_ahead_servo: float = 0.0,
         step_max_length: float = 0.6,
+        step_ahead_short_of: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -422,6 +423,7 @@ class WholeBodyTracker(AnchoredReference):
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "step_ahead_servo": step_ahead_servo, "step_max_length": step_max_length,
+                "step_ahead_short_of": step_ahead_short_of,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -469,6 +471,11 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_max_length ({step_max_length!r}) is a balance step's longest reach from "
                 f"the stance foot, in [0.3, 1.2] m"
+            )
+        if step_ahead_short_of and not (step_ahead and step_ahead_short_of <= 0.6):
+            raise ConfigError(
+                f"step_ahead_short_of ({step_ahead_short_of!r}) is in (0, 0.6] m and needs "
+                f"step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -579,7 +586,7 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_max_length=step_max_length,
+            step_max_length=step_max_length, step_ahead_short_of=step_ahead_short_of,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
