@@ -142,8 +142,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_max_length: float = 0.6,
-        step_ahead_short_of: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -204,10 +202,6 @@ class AnchoredReference:
         self.step_leg = float(step_leg)
         self.step_alternate = bool(step_alternate)
         self.step_short = float(step_short)
-        # a balance step lands at most this far from the stance foot (m)
-        self.step_max_length = float(step_max_length)
-        # ``step_ahead``'s steps land this far short of the capture point (m): probe
-        self.step_ahead_short_of = float(step_ahead_short_of)
         self.step_ease = float(step_ease)
         # how far (m) the pelvis target is down for a balance step (``step_ease``) and the
         # rollout time it was last moved
@@ -640,7 +634,7 @@ class AnchoredReference:
 
     def _start_step(
         self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64,
-        shorten: bool, duration: float = 0.0, short_of: float = 0.0,
+        shorten: bool, duration: float = 0.0,
     ) -> None:  # fmt: skip
         """Start a balance step of ``foot`` (sole centres ``centre``, ``(2, 3)``) to
         :func:`step_target` for capture point ``xi``; ``left`` is the soles' unit left
@@ -649,8 +643,8 @@ class AnchoredReference:
         swing (``step_ahead_swing``). The one step start of the step triggers."""
         duration = duration or self.step_time
         target = step_target(
-            xi, centre[1 - foot, :2], centre[foot, :2], omega, duration, beyond=0.05 - short_of,
-            max_length=self.step_max_length, min_width=0.12, lateral=left if foot == 0 else -left,
+            xi, centre[1 - foot, :2], centre[foot, :2], omega, duration, beyond=0.05,
+            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
         )  # fmt: skip
         if shorten and self.step_short and self._landed[0] >= 0:
             # after a step has landed, a short one (a foot put back down) need not take the
@@ -763,7 +757,7 @@ class AnchoredReference:
         if lead <= limit and grown <= self._grown_margin * self.step_ahead:
             return
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False, short_of=self.step_ahead_short_of)  # fmt: skip
+                         shorten=False)  # fmt: skip
 
     def _swing_ahead(self, t: float, i: int) -> None:
         """``step_ahead_swing``: in the clip's single support at frame ``i`` (its one-frame
@@ -801,8 +795,7 @@ class AnchoredReference:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False, duration=min(duration, self.step_time),
-                         short_of=self.step_ahead_short_of)  # fmt: skip
+                         shorten=False, duration=min(duration, self.step_time))  # fmt: skip
 
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its

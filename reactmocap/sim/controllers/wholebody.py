@@ -286,9 +286,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_servo: with ``step_ahead``, the pelvis position servo's gain while one of
             its steps is under way (1/s^2, at most 100; 0: off): the clip's pelvis, at the
             clip's speed, pulled the body on past its feet (``docs/tracking.md``, issue 16).
-        step_max_length: a balance step lands at most this far from the stance foot (m, in
-            [0.3, 1.2]; the default 0.6 is the cap every step had before it was an option)
-            (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -383,8 +380,6 @@ class WholeBodyTracker(AnchoredReference):
         centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
         step_ahead_servo: float = 0.0,
-        step_max_length: float = 0.6,
-        step_ahead_short_of: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -422,8 +417,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
-                "step_ahead_servo": step_ahead_servo, "step_max_length": step_max_length,
-                "step_ahead_short_of": step_ahead_short_of,
+                "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -466,16 +460,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
-            )
-        if not 0.3 <= step_max_length <= 1.2:
-            raise ConfigError(
-                f"step_max_length ({step_max_length!r}) is a balance step's longest reach from "
-                f"the stance foot, in [0.3, 1.2] m"
-            )
-        if step_ahead_short_of and not (step_ahead and step_ahead_short_of <= 0.6):
-            raise ConfigError(
-                f"step_ahead_short_of ({step_ahead_short_of!r}) is in (0, 0.6] m and needs "
-                f"step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -586,7 +570,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_max_length=step_max_length, step_ahead_short_of=step_ahead_short_of,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
