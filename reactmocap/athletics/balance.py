@@ -225,11 +225,6 @@ class Step:
             pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
             foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
             "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
-        tilt_damp: each loaded foot's ankle pitch target less this (s) times the ankle's own
-            pitch rate, every tick (a damper through the servo's target: on the toe edges in
-            the deep bow the feet-flat PD is a vertical spring that bounced at 7.8 Hz, and the
-            model's joint damper barely touched it; 0: off; opt-in, docs/athletics.md "The
-            ankles' tilt-rate damping").
     """
 
     margin: float = 0.05
@@ -246,7 +241,6 @@ class Step:
     hang_near: float = 0.0
     pair: float = 0.0
     bow_hold: float = 0.0
-    tilt_damp: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -268,7 +262,7 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"), ("tilt_damp", 0.1, "s"))  # fmt: skip
+                  ("pair", 0.3, "m"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -676,8 +670,6 @@ class BalanceLaw:
         self.support(s)
         if self.stepper is not None:
             self.stepper.control(self, d, h, t)
-            if self.stepper.step.tilt_damp:
-                self.stepper.damp_ankles(d, s)
 
     def _windmill(
         self, k: int, cp: float, ahead: float, dt: float, level: bool, rate: float, margin: float
@@ -817,12 +809,6 @@ class Stepper:
         self._down: F64 | None = None  # Step.down_after: where the foot goes down (world)
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
-        # Step.tilt_damp: the ankles' ball velocity columns and pitch axes, their buffers
-        ball = ctx.rig.wc.ball_dof_start + 3 * np.asarray(_ANKLE)
-        self._ankle_dofs = ball[:, None] + np.arange(3)
-        self._ankle_pitch = ctx.rig.axes[_ANKLE, 0].copy()
-        self._ankle_w = np.zeros((2, 3))
-        self._ankle_rate = np.zeros(2)
 
     def control(self, bl: BalanceLaw, d, h: float, t: float) -> None:  # type: ignore[no-untyped-def]
         s = self.ctx.senses
@@ -976,12 +962,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-
-    def damp_ankles(self, d, s: Senses) -> None:  # type: ignore[no-untyped-def]
-        """:attr:`Step.tilt_damp` on the law's and the step's ankle targets (after both)."""
-        d.qvel.take(self._ankle_dofs, out=self._ankle_w)
-        np.einsum("ij,ij->i", self._ankle_w, self._ankle_pitch, out=self._ankle_rate)
-        self.ctx.rig.offset[_ANKLE, 0] -= self.step.tilt_damp * self._ankle_rate * s.foot_contact
 
     def along(self) -> bool:
         """A swing under way along the feet (not a sideways one, nor a closing one)."""

@@ -164,12 +164,6 @@ class Rig:
         self._sent_gain = np.ones((NJ, 3))  # what the servo has (sent only when changed)
         self._gain_changed = np.zeros((NJ, 3), dtype=bool)
 
-    @property
-    def axes(self) -> F64:
-        """``(15, 3, 3)`` each joint's anatomical axes (pitch, roll, yaw) in its child frame,
-        where MuJoCo's ball velocities live (read only)."""
-        return self._axes
-
     # ------------------------------------------------------------------ setup
     def reset(self, angles: F64 | None = None) -> None:
         """Servo on at :data:`SERVO_KP`, targets at ``angles`` (default: the current pose)."""
