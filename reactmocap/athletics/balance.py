@@ -346,12 +346,6 @@ class BalanceGains:
     damping: tuple[tuple[str, float], ...] = (
         ("waist", 0.1), ("back", 0.1), ("hip", 0.15), ("knee", 0.15), ("ankle", 0.2),
     )  # fmt: skip
-    #: :attr:`windmill`'s arms also turn about their own long axis (yaw), one turn per turn
-    #: of the circle (left +, right -): the arm's path is the same, but each shoulder's
-    #: rotation from the model's reference pose stays 1.5-1.65 rad, off its 2.9 rad cone
-    #: limit (the plain circle reaches pi: the arms rode the cone and slipped off it, lifting
-    #: both feet, docs/athletics.md); ``False``: the plain circle
-    windmill_twist: bool = False
 
     def __post_init__(self) -> None:
         for name in ("uphill", "side_roll"):
@@ -384,10 +378,6 @@ class BalanceGains:
             raise ConfigError(
                 f"balance windmill_side must be (rate rad/s >= 0, margin m >= 0, lean rad in "
                 f"[-pi/2, pi/2]), got {ws!r}"
-            )
-        if not isinstance(self.windmill_twist, bool):
-            raise ConfigError(
-                f"balance windmill_twist must be True or False, got {self.windmill_twist!r}"
             )
         a = self.arms
         if a is not None and (len(a) != 3 or not all(math.isfinite(x) and x >= 0 for x in a)):
@@ -660,11 +650,7 @@ class BalanceLaw:
             dt = 0.0 if math.isnan(self._t_wind) else max(t - self._t_wind, 0.0)
             self._t_wind = t
             if g.windmill is not None:
-                spin = self._windmill(0, cp, ahead, dt, level, *g.windmill)
-                rig.offset[_SHOULDER, 0] += spin
-                if g.windmill_twist:  # about the arms' long axes: off the shoulders' cones
-                    rig.offset[_SHOULDER[0], 2] += spin
-                    rig.offset[_SHOULDER[1], 2] -= spin
+                rig.offset[_SHOULDER, 0] += self._windmill(0, cp, ahead, dt, level, *g.windmill)
             if g.windmill_side is not None:
                 rate, margin, lean = g.windmill_side
                 # a fall to the left (+y) is a roll about -x: the arms roll that way too; only

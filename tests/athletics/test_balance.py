@@ -507,35 +507,3 @@ def test_the_standing_step_holds_his_175_n_forward_push_with_the_bow_held(
     r_before = run("balance", "male", **push).report
     assert r_before["steps"][0]["t"] == r["steps"][0]["t"]
     assert r_before["steps"][0]["s"] > 0.5 and not r_before["balanced"]
-
-
-def _shoulder_angles(r: AthleticsResult) -> np.ndarray:
-    """Each recorded frame's largest shoulder rotation (rad) from the model's reference pose,
-    what the ball joints' cone limits bound."""
-    m = r.rollout.world.model
-    adr = [int(m.jnt_qposadr[m.joint(f"a/{s}_shoulder").id]) for s in "lr"]
-    w = np.abs(r.rollout.qpos[:, adr])  # the quaternions' w
-    return np.asarray(2.0 * np.arccos(np.minimum(w, 1.0)).max(axis=1))
-
-
-def test_the_windmill_twisted_about_the_arms_keeps_the_shoulders_off_their_cones(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # issue 18 (2026-12-05, docs/athletics.md "The windmill kept off the shoulders' cones"):
-    # his 175 N forward push, step="on", cut to 2 s: the plain circle reaches the shoulders'
-    # 2.9 rad cones (riding them 1.50-1.89 s, then slipping off with both feet in the air);
-    # with BalanceGains.windmill_twist the arms turn about their long axes too and the
-    # shoulders stay near their 1.5 rad, with no tick on no foot before 2 s
-    push = {"check_range": False, "seconds": 2.0, "push": 175.0, "step": "on"}
-    plain = run("balance", "male", **push)
-    twist = dataclasses.replace(STANDING_GAINS, windmill_twist=True)
-    monkeypatch.setattr(behaviours, "STANDING_GAINS", twist)
-    twisted = run("balance", "male", **push)
-    assert _shoulder_angles(plain).max() > 2.8
-    assert _shoulder_angles(twisted).max() < 2.0
-    window = (plain.log["t"] >= 1.2) & (plain.log["t"] < 2.0)
-    assert np.count_nonzero(plain.log["feet"][window] == 0) > 0
-    assert np.count_nonzero(twisted.log["feet"][window] == 0) == 0
-    for bad in (1, 0.5, None):
-        with pytest.raises(ConfigError, match="windmill_twist"):
-            BalanceGains(windmill_twist=bad)  # type: ignore[arg-type]
