@@ -483,8 +483,6 @@ class BalanceLaw:
         #: seconds (None: the posture's settle)
         self._com0: tuple[float, float] | None = None
         self._com_over: float | None = None
-        #: :meth:`ramp_servo`: the COM servo's offsets ramped in from 0, (start s, span s)
-        self.ramp: tuple[float, float] | None = None
         #: :attr:`BalanceGains.windmill` (index 0, pitch) and ``windmill_side`` (1, roll): the
         #: arms' circle (rad), its sense; the last tick
         self._wind = [0.0, 0.0]
@@ -538,13 +536,6 @@ class BalanceLaw:
         once (any ease of :meth:`set_posture`'s ``ease_com`` ends)."""
         self.posture = replace(self.posture, com_offset=offset)
         self._com0 = None
-
-    def ramp_servo(self, t: float, over: float) -> None:
-        """Ramp the COM servo's offsets (``delta``) in linearly from 0 at ``t`` over ``over``
-        s. Why: a landing's absorb holds the ankles at 0; its recovery's servo at once put
-        them at their clip and hopped the female back handspring off the floor
-        (docs/athletics.md, "the recovery's COM servo ramped in")."""
-        self.ramp = (t, over)
 
     def pelvis_roll(self, heading: float) -> float:
         """Current anatomical roll of the pelvis (rad) in the frame of ``heading``, as
@@ -631,12 +622,6 @@ class BalanceLaw:
         delta = g.kp * err - g.kv * vel
         delta[1] *= g.side
         np.clip(delta, -g.max_offset, g.max_offset, out=delta)
-        if self.ramp is not None:  # ramp_servo
-            w = (t - self.ramp[0]) / self.ramp[1]
-            if w >= 1.0:
-                self.ramp = None
-            else:
-                delta *= max(w, 0.0)
         pitch = self.pitch_target(t)
         cp = cp_side = 0.0
         if any(x is not None for x in (g.bow, g.arms, g.windmill, g.windmill_side)):
@@ -1156,9 +1141,6 @@ class Balance(Basis):
             prev = ctx.handover.get("posture")
             if isinstance(prev, Posture):
                 bl.posture = prev
-            ramp = ctx.handover.pop("ramp", None)  # a landing's servo_ramp, carried on
-            if isinstance(ramp, tuple):
-                bl.ramp = ramp
             stepper = ctx.handover.get("stepper")
             if bl.stepper is None and isinstance(stepper, Stepper):  # the landing's step goes on
                 bl.stepper = stepper

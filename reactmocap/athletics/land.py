@@ -261,11 +261,6 @@ class LandingParams:
             (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
             0.71-0.78 m, sinking (docs/athletics.md, "the one-leg stand-up").
-        servo_ramp: the recovery's COM servo offsets ramped in from 0 over this many s (0:
-            off, at once; else in (0, 0.5]; a ramp not done at the hand-over goes on in the
-            balance that follows). Why: on the female back handspring the servo put the ankles
-            at their 0.35 rad clip on the recovery's first tick, 560-640 N m, adding +0.7 to
-            +1.2 m/s to the hop (docs/athletics.md, "the recovery's COM servo ramped in").
     """
 
     knee: float = 0.6
@@ -311,7 +306,6 @@ class LandingParams:
     step_down_after: float = 0.0
     step_foresee: float = 0.0
     recover_leg: float = 0.0
-    servo_ramp: float = 0.0
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -356,9 +350,6 @@ class LandingParams:
         r = self.recover_leg
         if not (isinstance(r, (int, float)) and (r == 0.0 or 0.5 <= r <= 1.0)):
             raise ConfigError(f"landing recover_leg must be 0 or in [0.5, 1], got {r!r}")
-        r = self.servo_ramp
-        if not (isinstance(r, (int, float)) and 0.0 <= r <= 0.5):
-            raise ConfigError(f"landing servo_ramp must be in [0, 0.5] s, got {r!r}")
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
         if self.late_delta and not (
@@ -694,8 +685,6 @@ class Landing(Basis):
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
             stand_up = max(leg, 0.5, p.recover_leg)  # recover_leg: at least so tall
             bl.set_posture(Posture(leg=stand_up, lean=p.lean, settle=0.3), t)
-            if p.servo_ramp:
-                bl.ramp_servo(t, p.servo_ramp)
 
         def settled(world: World, t: float, t_in: float) -> bool:
             s = ctx.sense(t)
@@ -714,8 +703,6 @@ class Landing(Basis):
             ctx.handover["posture"] = bl.posture
             if bl.stepper is not None:
                 ctx.handover["stepper"] = bl.stepper
-            if bl.ramp is not None:  # servo_ramp: the balance that follows ends the ramp
-                ctx.handover["ramp"] = bl.ramp
             if p.carry_pitch:  # the balance's pitch target starts from ours (carry_pitch)
                 ctx.handover["pitch"] = bl.pitch_target(t)
 
