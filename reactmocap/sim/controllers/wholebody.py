@@ -291,12 +291,12 @@ class WholeBodyTracker(AnchoredReference):
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
             at a hip blew up (the bow kicked, ``docs/benchmarks.md``).
-        flat_weight, flat_band: a foot planted in the mocap with its sole within ``flat_band``
-            rad of level that supports on at most two sole corners, its sole more than
-            ``flat_band`` off the mocap's, gets two rows of weight ``flat_weight`` (as
-            ``swing_weight``; 0: off) turning its sole toward the mocap's (``kp_swing``,
-            critically damped): a foot loaded on its edge while the mocap's was flat stayed on
-            it and the capture point left the line of the edges (``docs/tracking.md``, issue 16).
+        flat_weight, flat_band: a foot planted in the mocap that supports on at most two
+            sole corners, its sole more than ``flat_band`` rad off the mocap's, gets two rows
+            of weight ``flat_weight`` (as ``swing_weight``; 0: off) turning its sole toward the
+            mocap's (``kp_swing``, critically damped): a foot loaded on its edge while the
+            mocap's was flat stayed on it and the capture point left the line of the edges
+            (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -861,8 +861,7 @@ class WholeBodyTracker(AnchoredReference):
         )  # fmt: skip
 
     def _flat_feet(self, planted: NDArray[np.bool_], t: float) -> dict[int, F64]:
-        """``flat_weight``: the feet planted with a level sole in the mocap (within
-        ``flat_band``) that support on at most two sole corners, their sole more than
+        """``flat_weight``: the planted feet on at most two sole corners whose sole is more than
         ``flat_band`` off the mocap's, with the mocap's sole normal (world, as re-anchored)."""
         assert self.path.sole_up is not None
         d = self.world.data
@@ -876,8 +875,6 @@ class WholeBodyTracker(AnchoredReference):
             if (corners[f, :, 2] - self.floor_z < self.touch).sum() > 2:
                 continue
             up = self.path.sole_up[i, f].copy()
-            if up[2] < self._flat_cos:  # a raised heel or toe: the clip's own tilt
-                continue
             up[:2] = _rot2(self.anchor_yaw) @ up[:2]
             if float(d.geom_xmat[self.sole[f], 2::3] @ up) > self._flat_cos:  # its z axis
                 continue
