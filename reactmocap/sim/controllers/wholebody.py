@@ -471,8 +471,13 @@ class WholeBodyTracker(AnchoredReference):
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
             )
-        if not 0.0 < flat_band < np.pi / 2:
-            raise ConfigError(f"flat_band must be in (0, pi/2) rad, got {flat_band!r}")
+        if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
+            # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
+            raise ConfigError(
+                f"flat_band must be in (0, pi/2) rad and flat_weight needs swing_weight > 0, "
+                f"got flat_band {flat_band!r}, flat_weight {flat_weight!r}, "
+                f"swing_weight {swing_weight!r}"
+            )
         servo = world.servo
         m = world.model
         if np.any(m.opt.gravity[:2]):
