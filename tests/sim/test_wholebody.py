@@ -25,6 +25,7 @@ from reactmocap.sim import (
     track_clip,
 )
 from reactmocap.sim.character import BALL_JOINTS, PATCH_GEOM_GROUP
+from reactmocap.sim.controllers.registry import WHOLE_CLIP, build
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "mocap"
 
@@ -288,12 +289,54 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("centre_speed_lock_walking", -0.7),
         ("anchor_turn_rate", -0.5),
         ("step_ahead_servo", -20.0),
+        ("flat_weight", -1.0),
+        ("flat_band", 0.0),
+        ("flat_band", 2.0),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
     world = World(build_character(guard, frame=0))
     with pytest.raises(ConfigError, match=key):
         _tracker(world, guard, 0.0, **{key: value})
+
+
+def _edge_tilt(clip: Motion, start: float, seconds: float, flat_weight: float) -> float:
+    """Mean over the control ticks and the feet planted in the clip of how far (deg) the
+    simulated sole tilts past the clip's, tracking with ``WHOLE_CLIP`` and ``flat_weight``."""
+    frame = round(start * clip.fps)
+    world = World(build_character(clip, frame=frame))
+    world.set_from_motion(0, clip, frame)
+    params = {**WHOLE_CLIP, "flat_weight": flat_weight}
+    wb = build("wholebody", world, clip, params, start=start)
+    assert isinstance(wb, WholeBodyTracker) and wb.path.sole_up is not None
+    excess: list[float] = []
+
+    def spy(w: World, t: float) -> None:
+        wb.control(w, t)
+        i = wb.clock.nearest(t)
+        up = w.data.geom_xmat[wb.sole].reshape(2, 3, 3)[:, 2, 2]  # the soles' z axes' height
+        tilt = np.degrees(np.arccos(np.clip(up, -1.0, 1.0)))
+        clip_tilt = np.degrees(np.arccos(np.clip(wb.path.sole_up[i, :, 2], -1.0, 1.0)))  # type: ignore[index]
+        excess.extend((tilt - clip_tilt)[wb.path.planted[i]])
+
+    rollout(world, seconds, controllers=[FunctionController(spy, 4)], on_unstable="stop")
+    return float(np.mean(excess))
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason=f"shared mocap not found at {SHARED}")
+def test_flat_weight_turns_feet_standing_on_an_edge_back_toward_the_clips_soles() -> None:
+    """``punch_normal_001``'s fighting stance from 2.0 s: the simulated feet stand on one or two
+    corners tilted past the clip's soles (mean 7.8 deg over 1.5 s); the flat rows turn them
+    back (5.3 deg)."""
+    from reactmocap.library.bvh import read_bvh
+
+    clips = sorted(SHARED.glob("*/*punch_normal_001.bvh"))
+    if not clips:
+        pytest.skip(f"no punch_normal_001 clip under {SHARED}")
+    punch = read_bvh(clips[0])
+    off, on = (_edge_tilt(punch, 2.0, 1.5, w) for w in (0.0, 1.0))
+    assert off > 5.0, off  # the defaults' feet do stand tilted past the clip's
+    assert on < 0.8 * off, (on, off)
 
 
 def test_centre_speed_lock_walking_needs_the_lock(guard: Motion) -> None:

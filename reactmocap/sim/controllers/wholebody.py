@@ -21,7 +21,7 @@ from scipy.optimize import nnls
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.controllers.anchoring import AnchoredReference
+from reactmocap.sim.controllers.anchoring import AnchoredReference, _rot2
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import outside_distance
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
@@ -38,6 +38,7 @@ _PYRAMID = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=np.float64)
 _UP = np.array([[0.0], [0.0], [1.0]])
 # largest acceleration a swinging foot's rows ask for (m/s^2, and rad/s^2 for its tilt)
 _SWING_ACC = 100.0
+_ZERO3 = np.zeros(3)
 # a walk's push within this angle of sideways (tan 30 deg) places its swing feet
 _PLACE_SIDE_TAN = float(np.tan(np.radians(30.0)))
 # a walk's push within this angle of straight against the walk is one ``kp_root_against``
@@ -290,6 +291,12 @@ class WholeBodyTracker(AnchoredReference):
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
             at a hip blew up (the bow kicked, ``docs/benchmarks.md``).
+        flat_weight, flat_band: a foot planted in the mocap that supports on at most two
+            sole corners, its sole more than ``flat_band`` rad off the mocap's, gets two rows
+            of weight ``flat_weight`` (as ``swing_weight``; 0: off) turning its sole toward the
+            mocap's (``kp_swing``, critically damped): a foot loaded on its edge while the
+            mocap's was flat stayed on it and the capture point left the line of the edges
+            (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -382,6 +389,8 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_servo: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
+        flat_weight: float = 0.0,
+        flat_band: float = 0.07,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -419,6 +428,7 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
+                "flat_weight": flat_weight, "flat_band": flat_band,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -460,6 +470,13 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
+            )
+        if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
+            # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
+            raise ConfigError(
+                f"flat_band must be in (0, pi/2) rad and flat_weight needs swing_weight > 0, "
+                f"got flat_band {flat_band!r}, flat_weight {flat_weight!r}, "
+                f"swing_weight {swing_weight!r}"
             )
         servo = world.servo
         m = world.model
@@ -572,6 +589,8 @@ class WholeBodyTracker(AnchoredReference):
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
+        self._flat_w = float(flat_weight)
+        self._flat_cos = float(np.cos(flat_band))
         self._soft = float(step_soft)
         self._soft_reg = float(np.sqrt(step_soft_reg))
         self._dt_tick = self.control_every * world.timestep
@@ -699,6 +718,7 @@ class WholeBodyTracker(AnchoredReference):
         m, d = self.world.model, self.world.data
         qr, vr, ar, planted = self.reference(t)
         held = self._held(t)
+        flat = self._flat_feet(planted, t) if self._flat_w else {}
         sl = self._dofs
         v = d.qvel[sl]
         if not (np.isfinite(d.qpos[self.wc.qpos_slice]).all() and np.isfinite(v).all()):
@@ -784,6 +804,11 @@ class WholeBodyTracker(AnchoredReference):
                 wj[self._leg_rows[1 - self.step.foot]] = 0.3
         for f, (p_d, v_d, a_d, up_d) in swing.items():
             tasks.append(self._swing_task(f, v, p_d, v_d, a_d, up_d))
+        for f, up_d in flat.items():
+            if f not in swing:  # the tilt rows only, at ``flat_weight``
+                rows, target = self._swing_task(f, v, _ZERO3, _ZERO3, _ZERO3, up_d)
+                k = np.sqrt(self._flat_w) / self.sqrt_ws
+                tasks.append((k * rows[3:], k * target[3:]))
         a = acc_des[6:]
         beta = np.zeros(0)
         if not tasks:
@@ -839,6 +864,27 @@ class WholeBodyTracker(AnchoredReference):
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
+
+    def _flat_feet(self, planted: NDArray[np.bool_], t: float) -> dict[int, F64]:
+        """``flat_weight``: the planted feet on at most two sole corners whose sole is more than
+        ``flat_band`` off the mocap's, with the mocap's sole normal (world, as re-anchored)."""
+        assert self.path.sole_up is not None
+        d = self.world.data
+        i = self.clock.nearest(t)
+        patch_on = self.world.foot_patch_on(self.character)
+        corners = self.sole_corners()
+        out: dict[int, F64] = {}
+        for f in range(2):  # two feet
+            if not planted[f] or patch_on[f]:
+                continue
+            if (corners[f, :, 2] - self.floor_z < self.touch).sum() > 2:
+                continue
+            up = self.path.sole_up[i, f].copy()
+            up[:2] = _rot2(self.anchor_yaw) @ up[:2]
+            if float(d.geom_xmat[self.sole[f], 2::3] @ up) > self._flat_cos:  # its z axis
+                continue
+            out[f] = up
+        return out
 
     def _landing_weights(self, t: float, sup: _Support) -> F64 | None:
         """The no-slip rows' square-root weights in the ``step_soft`` s after a balance
