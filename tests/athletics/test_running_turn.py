@@ -131,3 +131,40 @@ def test_arm_yaw_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
         RunParams(arm_yaw_rate=(0.0, -0.05, 0.0))
     assert RunParams().at(2.5)["arm_yaw_rate"] == 0.05
+
+
+
+def test_spin_grip_holds_the_vertical_twist_on_a_curve_and_not_a_line() -> None:
+    """``spin_grip`` acts only where the course curves: a line runs as without it to the bit;
+    on the circle the run is the same before ``PATH_AFTER`` and not after. From the run's own
+    last state the hip's torque about the vertical is within the grip, roll and pitch as
+    without the option."""
+    on, off = RunParams(spin_grip=1e-6), RunParams()
+    secs = PATH_AFTER + 0.5
+    line = [run_course(2.5, seconds=secs, fps=10.0, params=p) for p in (on, off)]
+    assert max(line[0].log["t"]) > PATH_AFTER + 0.4
+    assert np.array_equal(line[0].log["com"], line[1].log["com"])
+    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
+    curve = [run_course(2.5, seconds=secs, path="circle:10", fps=10.0, params=p)
+             for p in (on, off)]  # fmt: skip
+    logs = [c.log for c in curve]
+    before = logs[0]["t"] < PATH_AFTER
+    assert np.array_equal(logs[0]["com"][before], logs[1]["com"][before])
+    assert not np.array_equal(logs[0]["com"][~before], logs[1]["com"][~before])
+    r = curve[0].runner
+    assert abs(float(r.world.data.cvel[r._feet[r.active], 2])) > 1e-6  # the foot turns
+    held = r._attitude_torque(r.heading_d)
+    grip = r.k["yaw_grip"] * r.foot_length * max(float(r.senses.grf[2]), 0.0)
+    assert abs(held[2]) <= grip + 1e-9
+    r.k = dict(r.k, spin_grip=0.0)
+    free = r._attitude_torque(r.heading_d)
+    assert np.array_equal(free[:2], held[:2])
+    assert abs(free[2]) >= abs(held[2])
+
+
+def test_spin_grip_is_checked() -> None:
+    with pytest.raises(ConfigError, match=r"spin_grip must be in \[0, 100\]"):
+        RunParams(spin_grip=-1.0)
+    with pytest.raises(ConfigError, match=r"spin_grip must be in \[0, 100\]"):
+        RunParams(spin_grip=(0.0, 0.0, 150.0))
+    assert RunParams().at(2.5)["spin_grip"] == 0.0
