@@ -493,15 +493,7 @@ class Runner:
         axis /= max(norm(axis), 1e-9)
         along = float(torque @ axis)
         limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
-        torque = torque - (along - clamp(along, -limit, limit)) * axis
-        spin = k["spin_grip"]
-        if (spin > 0 and abs(float(d.cvel[self._feet[leg], 2])) > spin
-                and abs(self.curvature) > ARM_CURVE and d.time >= PATH_AFTER):  # fmt: skip
-            # the clamp along the leaning thigh leaves roll and pitch torque about the
-            # vertical (after an eight's reversal hundreds of grips) and the stance foot spun
-            # (the eights' falls): while it spins, that part is held to the grip
-            torque[2] = clamp(float(torque[2]), -limit, limit)
-        return torque
+        return torque - (along - clamp(along, -limit, limit)) * axis
 
     def _support_point(self, t: float) -> F64:
         """Where the stance foot bears on the ground (world): the heel until the ball is

@@ -153,10 +153,6 @@ class RunParams:
         arm_yaw_rate: the same for the trunk's yaw rate past the desired facing's rate (s;
             0: off): each shoulder's pitch also moved by this times it, the same signs as
             ``arm_yaw``'s, where ``arm_yaw`` acts. Within [0, 1].
-        spin_grip: where the course curves (as ``arm_yaw``), while the stance foot yaws
-            faster than this (rad/s; 0: off), the stance hip's attitude torque about the
-            vertical (left after ``yaw_grip``'s clamp along the thigh) is held to that grip.
-            Within [0, 100].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -206,7 +202,6 @@ class RunParams:
     lean: float | Speeds = 1.0
     arm_yaw: float | Speeds = 1.0
     arm_yaw_rate: float | Speeds = 0.05
-    spin_grip: float | Speeds = 0.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
@@ -231,7 +226,6 @@ class RunParams:
             ("push_ramp", 1.0),
             ("arm_yaw", 5.0),
             ("arm_yaw_rate", 1.0),
-            ("spin_grip", 100.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
