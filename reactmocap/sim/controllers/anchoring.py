@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from reactmocap.rotations import quat_from_yaw, wrap_angle
 from reactmocap.sim.controllers.stepping import (
     Step,
+    clamp_step,
     clamp_to_support,
     convex_hull,
     outside_distance,
@@ -142,6 +143,7 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
+        step_ahead_footfall: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -310,6 +312,15 @@ class AnchoredReference:
                 )
             else:
                 self._swing_limit[:] = largest * self.step_ahead
+        # ``step_ahead_footfall``: per frame and foot, the clip's next landing of that foot
+        # after its next swing (len: none); a swing foot's own landing in its swing
+        self.step_ahead_footfall = float(step_ahead_footfall)
+        self._next_footfall = self._next_planted
+        if self.step_ahead_footfall:
+            idx = np.where(self._firm, n, np.arange(n)[:, None])
+            lift = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
+            ext = np.vstack([self._next_planted, np.full((1, 2), n)])
+            self._next_footfall = np.take_along_axis(ext, lift, axis=0)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -503,6 +514,20 @@ class AnchoredReference:
         v[:2] = rot @ v[:2]
         return p, v
 
+    def _clip_sole(self, k: int, f: int) -> F64:
+        """The clip's sole centre of foot ``f`` at frame ``k`` on the floor (2,), as
+        re-anchored."""
+        assert self.path.sole is not None
+        return _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
+
+    def _capture_miss(self, t: float) -> tuple[F64, float, F64, F64]:
+        """The simulated capture point (2,), ``omega``, the clip's centre-of-mass velocity at
+        ``t`` (3,) and the push's part of the capture point (2,): the body's against the
+        clip's (a walk's own capture point runs ahead of its stance foot)."""
+        xi, omega = self.capture_point()
+        c_ref, v_ref, _ = self.com_reference(t)
+        return xi, omega, v_ref, xi - c_ref[:2] - v_ref[:2] / omega
+
     def sole_heading(self) -> float:
         """The simulated soles' mean yaw (rad)."""
         rot = self.world.data.geom_xmat[self.sole].reshape(2, 3, 3)
@@ -534,10 +559,7 @@ class AnchoredReference:
         if t > self._place_until:
             return
         assert self.path.sole is not None
-        xi, omega = self.capture_point()
-        c_ref, v_ref, _ = self.com_reference(t)
-        # the push's part only: a walk's own capture point runs ahead of its stance foot
-        miss = xi - c_ref[:2] - v_ref[:2] / omega
+        xi, omega, v_ref, miss = self._capture_miss(t)
         left = _left_of(self.sole_heading())
         i = self.clock.nearest(t)
         ahead = self.path.sole[i : i + round(0.5 * self.path.fps), :, 2] - self.floor_z
@@ -546,7 +568,7 @@ class AnchoredReference:
             if low[f] < self.anchor_touch or self._mocap_swing(t, f) is None:
                 continue
             k = int(np.argmax(ahead[:, f] < self.place_height))  # the mocap's landing
-            land = _rot2(self.anchor_yaw) @ self.path.sole[i + k, f, :2] + self.anchor_shift
+            land = self._clip_sole(i + k, f)
             out = left if f == 0 else -left
             side = float(miss @ out)
             along = abs(float(miss @ np.array([left[1], -left[0]])))
@@ -570,9 +592,7 @@ class AnchoredReference:
         if self.placing:
             self._place_walk(t)
         if self.place_gain and not self.path.planted[self.clock.nearest(t)].all():
-            xi, omega = self.capture_point()
-            c_ref, cv_ref, _ = self.com_reference(t)
-            miss = xi - c_ref[:2] - cv_ref[:2] / omega
+            _, _, _, miss = self._capture_miss(t)
             n = float(np.linalg.norm(miss))
             if n > self.place_deadband:
                 # beyond the dead band a walk's own capture-point error never reaches
@@ -634,18 +654,26 @@ class AnchoredReference:
 
     def _start_step(
         self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64,
-        shorten: bool, duration: float = 0.0,
+        shorten: bool, duration: float = 0.0, ahead: bool = False,
     ) -> None:  # fmt: skip
         """Start a balance step of ``foot`` (sole centres ``centre``, ``(2, 3)``) to
         :func:`step_target` for capture point ``xi``; ``left`` is the soles' unit left
         vector. ``shorten``: after a landed step, a short step (``step_short``) takes less
         than the whole step time; ``duration`` (s, 0: ``step_time``) a swing foot's shortened
-        swing (``step_ahead_swing``). The one step start of the step triggers."""
+        swing (``step_ahead_swing``); ``ahead``: one of ``step_ahead``'s steps (aimed at
+        :meth:`_footfall_aim` with ``step_ahead_footfall``). The one step start of the step
+        triggers."""
         duration = duration or self.step_time
-        target = step_target(
-            xi, centre[1 - foot, :2], centre[foot, :2], omega, duration, beyond=0.05,
-            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
-        )  # fmt: skip
+        lateral = left if foot == 0 else -left
+        aim = self._footfall_aim(t, foot, duration) if ahead and self.step_ahead_footfall else None
+        if aim is None:
+            target = step_target(
+                xi, centre[1 - foot, :2], centre[foot, :2], omega, duration, beyond=0.05,
+                max_length=0.6, min_width=0.12, lateral=lateral,
+            )  # fmt: skip
+        else:
+            target = clamp_step(aim, centre[1 - foot, :2], max_length=0.6, min_width=0.12,
+                                lateral=lateral)  # fmt: skip
         if shorten and self.step_short and self._landed[0] >= 0:
             # after a step has landed, a short one (a foot put back down) need not take the
             # whole step time
@@ -654,6 +682,19 @@ class AnchoredReference:
         self.step = Step(foot, t, duration, centre[foot].copy(),
                          np.r_[target, self.floor_z], self.step_height)  # fmt: skip
         self.steps_taken.append(t)
+
+    def _footfall_aim(self, t: float, foot: int, duration: float) -> F64 | None:
+        """``step_ahead_footfall``: where one of ``step_ahead``'s steps of ``foot`` taking
+        ``duration`` s aims (2,): the clip's next landing of that foot moved by that times the
+        push's part of the capture point (:meth:`_capture_miss`) grown over the step, as
+        ``place_pushed`` moves the clip's own landings; ``None`` where the clip ends first.
+        :func:`step_target` stops the body over the new foot, which on a walk stopped the
+        walk (``docs/tracking.md``)."""
+        k = int(self._next_footfall[self.clock.nearest(t), foot])
+        if k >= len(self._next_footfall):
+            return None
+        _, omega, _, miss = self._capture_miss(t)
+        return self._clip_sole(k, foot) + self.step_ahead_footfall * np.exp(omega * duration) * miss
 
     def _sole_centres(self) -> F64:
         """The simulated soles' centres, ``(2, 3)`` (m)."""
@@ -757,7 +798,7 @@ class AnchoredReference:
         if lead <= limit and grown <= self._grown_margin * self.step_ahead:
             return
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False)  # fmt: skip
+                         shorten=False, ahead=True)  # fmt: skip
 
     def _swing_ahead(self, t: float, i: int) -> None:
         """``step_ahead_swing``: in the clip's single support at frame ``i`` (its one-frame
@@ -790,12 +831,13 @@ class AnchoredReference:
         centre = self._sole_centres()
         stance = centre[1 - f, :2]
         pred = stance + (xi - stance) * np.exp(omega * left_s)
-        land = _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
+        land = self._clip_sole(k, f)
         if float((pred - land) @ u) <= self._swing_limit[i]:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False, duration=min(duration, self.step_time))  # fmt: skip
+                         shorten=False, duration=min(duration, self.step_time),
+                         ahead=True)  # fmt: skip
 
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
