@@ -82,6 +82,9 @@ _LAG_MOVING = 0.2
 _AHEAD_RATE_TAU = 0.1
 # ``step_ahead_swing``: a swing foot's landing brought forward takes at least this long (s)
 _SWING_AHEAD_MIN = 0.1
+# ``step_ahead_footfall``: its aimed steps reach at most this far (m) from the stance foot
+# (probe: the clip's footfall from double support lay 1.1 m ahead, past the 0.6 m cap)
+_FOOTFALL_REACH = 1.0
 
 
 def _left_of(heading: float) -> F64:
@@ -672,8 +675,8 @@ class AnchoredReference:
                 max_length=0.6, min_width=0.12, lateral=lateral,
             )  # fmt: skip
         else:
-            target = clamp_step(aim, centre[1 - foot, :2], max_length=0.6, min_width=0.12,
-                                lateral=lateral)  # fmt: skip
+            target = clamp_step(aim, centre[1 - foot, :2], max_length=_FOOTFALL_REACH,
+                                min_width=0.12, lateral=lateral)  # fmt: skip
         if shorten and self.step_short and self._landed[0] >= 0:
             # after a step has landed, a short one (a foot put back down) need not take the
             # whole step time
