@@ -839,8 +839,7 @@ class AnchoredReference:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False, duration=min(duration, self.step_time),
-                         ahead=True)  # fmt: skip
+                         shorten=False, duration=min(duration, self.step_time))  # fmt: skip
 
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
