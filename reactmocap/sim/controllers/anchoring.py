@@ -84,7 +84,7 @@ _AHEAD_RATE_TAU = 0.1
 _SWING_AHEAD_MIN = 0.1
 # ``step_ahead_footfall``: its aimed steps reach at most this far (m) from the stance foot
 # (probe: the clip's footfall from double support lay 1.1 m ahead, past the 0.6 m cap)
-_FOOTFALL_REACH = 1.0
+_FOOTFALL_REACH = 0.6
 
 
 def _left_of(heading: float) -> F64:
