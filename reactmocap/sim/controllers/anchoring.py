@@ -17,7 +17,6 @@ from numpy.typing import NDArray
 from reactmocap.rotations import quat_from_yaw, wrap_angle
 from reactmocap.sim.controllers.stepping import (
     Step,
-    clamp_step,
     clamp_to_support,
     convex_hull,
     outside_distance,
@@ -82,9 +81,6 @@ _LAG_MOVING = 0.2
 _AHEAD_RATE_TAU = 0.1
 # ``step_ahead_swing``: a swing foot's landing brought forward takes at least this long (s)
 _SWING_AHEAD_MIN = 0.1
-# ``step_ahead_footfall``: its aimed steps reach at most this far (m) from the stance foot
-# (probe: the clip's footfall from double support lay 1.1 m ahead, past the 0.6 m cap)
-_FOOTFALL_REACH = 0.6
 
 
 def _left_of(heading: float) -> F64:
@@ -146,7 +142,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_ahead_footfall: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -315,15 +310,6 @@ class AnchoredReference:
                 )
             else:
                 self._swing_limit[:] = largest * self.step_ahead
-        # ``step_ahead_footfall``: per frame and foot, the clip's next landing of that foot
-        # after its next swing (len: none); a swing foot's own landing in its swing
-        self.step_ahead_footfall = float(step_ahead_footfall)
-        self._next_footfall = self._next_planted
-        if self.step_ahead_footfall:
-            idx = np.where(self._firm, n, np.arange(n)[:, None])
-            lift = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
-            ext = np.vstack([self._next_planted, np.full((1, 2), n)])
-            self._next_footfall = np.take_along_axis(ext, lift, axis=0)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -517,20 +503,6 @@ class AnchoredReference:
         v[:2] = rot @ v[:2]
         return p, v
 
-    def _clip_sole(self, k: int, f: int) -> F64:
-        """The clip's sole centre of foot ``f`` at frame ``k`` on the floor (2,), as
-        re-anchored."""
-        assert self.path.sole is not None
-        return _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
-
-    def _capture_miss(self, t: float) -> tuple[F64, float, F64, F64]:
-        """The simulated capture point (2,), ``omega``, the clip's centre-of-mass velocity at
-        ``t`` (3,) and the push's part of the capture point (2,): the body's against the
-        clip's (a walk's own capture point runs ahead of its stance foot)."""
-        xi, omega = self.capture_point()
-        c_ref, v_ref, _ = self.com_reference(t)
-        return xi, omega, v_ref, xi - c_ref[:2] - v_ref[:2] / omega
-
     def sole_heading(self) -> float:
         """The simulated soles' mean yaw (rad)."""
         rot = self.world.data.geom_xmat[self.sole].reshape(2, 3, 3)
@@ -562,7 +534,10 @@ class AnchoredReference:
         if t > self._place_until:
             return
         assert self.path.sole is not None
-        xi, omega, v_ref, miss = self._capture_miss(t)
+        xi, omega = self.capture_point()
+        c_ref, v_ref, _ = self.com_reference(t)
+        # the push's part only: a walk's own capture point runs ahead of its stance foot
+        miss = xi - c_ref[:2] - v_ref[:2] / omega
         left = _left_of(self.sole_heading())
         i = self.clock.nearest(t)
         ahead = self.path.sole[i : i + round(0.5 * self.path.fps), :, 2] - self.floor_z
@@ -571,7 +546,7 @@ class AnchoredReference:
             if low[f] < self.anchor_touch or self._mocap_swing(t, f) is None:
                 continue
             k = int(np.argmax(ahead[:, f] < self.place_height))  # the mocap's landing
-            land = self._clip_sole(i + k, f)
+            land = _rot2(self.anchor_yaw) @ self.path.sole[i + k, f, :2] + self.anchor_shift
             out = left if f == 0 else -left
             side = float(miss @ out)
             along = abs(float(miss @ np.array([left[1], -left[0]])))
@@ -595,7 +570,9 @@ class AnchoredReference:
         if self.placing:
             self._place_walk(t)
         if self.place_gain and not self.path.planted[self.clock.nearest(t)].all():
-            _, _, _, miss = self._capture_miss(t)
+            xi, omega = self.capture_point()
+            c_ref, cv_ref, _ = self.com_reference(t)
+            miss = xi - c_ref[:2] - cv_ref[:2] / omega
             n = float(np.linalg.norm(miss))
             if n > self.place_deadband:
                 # beyond the dead band a walk's own capture-point error never reaches
@@ -657,26 +634,18 @@ class AnchoredReference:
 
     def _start_step(
         self, t: float, foot: int, centre: F64, xi: F64, omega: float, left: F64,
-        shorten: bool, duration: float = 0.0, ahead: bool = False,
+        shorten: bool, duration: float = 0.0,
     ) -> None:  # fmt: skip
         """Start a balance step of ``foot`` (sole centres ``centre``, ``(2, 3)``) to
         :func:`step_target` for capture point ``xi``; ``left`` is the soles' unit left
         vector. ``shorten``: after a landed step, a short step (``step_short``) takes less
         than the whole step time; ``duration`` (s, 0: ``step_time``) a swing foot's shortened
-        swing (``step_ahead_swing``); ``ahead``: one of ``step_ahead``'s steps (aimed at
-        :meth:`_footfall_aim` with ``step_ahead_footfall``). The one step start of the step
-        triggers."""
+        swing (``step_ahead_swing``). The one step start of the step triggers."""
         duration = duration or self.step_time
-        lateral = left if foot == 0 else -left
-        aim = self._footfall_aim(t, foot, duration) if ahead and self.step_ahead_footfall else None
-        if aim is None:
-            target = step_target(
-                xi, centre[1 - foot, :2], centre[foot, :2], omega, duration, beyond=0.05,
-                max_length=0.6, min_width=0.12, lateral=lateral,
-            )  # fmt: skip
-        else:
-            target = clamp_step(aim, centre[1 - foot, :2], max_length=_FOOTFALL_REACH,
-                                min_width=0.12, lateral=lateral)  # fmt: skip
+        target = step_target(
+            xi, centre[1 - foot, :2], centre[foot, :2], omega, duration, beyond=0.05,
+            max_length=0.6, min_width=0.12, lateral=left if foot == 0 else -left,
+        )  # fmt: skip
         if shorten and self.step_short and self._landed[0] >= 0:
             # after a step has landed, a short one (a foot put back down) need not take the
             # whole step time
@@ -685,19 +654,6 @@ class AnchoredReference:
         self.step = Step(foot, t, duration, centre[foot].copy(),
                          np.r_[target, self.floor_z], self.step_height)  # fmt: skip
         self.steps_taken.append(t)
-
-    def _footfall_aim(self, t: float, foot: int, duration: float) -> F64 | None:
-        """``step_ahead_footfall``: where one of ``step_ahead``'s steps of ``foot`` taking
-        ``duration`` s aims (2,): the clip's next landing of that foot moved by that times the
-        push's part of the capture point (:meth:`_capture_miss`) grown over the step, as
-        ``place_pushed`` moves the clip's own landings; ``None`` where the clip ends first.
-        :func:`step_target` stops the body over the new foot, which on a walk stopped the
-        walk (``docs/tracking.md``)."""
-        k = int(self._next_footfall[self.clock.nearest(t), foot])
-        if k >= len(self._next_footfall):
-            return None
-        _, omega, _, miss = self._capture_miss(t)
-        return self._clip_sole(k, foot) + self.step_ahead_footfall * np.exp(omega * duration) * miss
 
     def _sole_centres(self) -> F64:
         """The simulated soles' centres, ``(2, 3)`` (m)."""
@@ -801,7 +757,7 @@ class AnchoredReference:
         if lead <= limit and grown <= self._grown_margin * self.step_ahead:
             return
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False, ahead=True)  # fmt: skip
+                         shorten=False)  # fmt: skip
 
     def _swing_ahead(self, t: float, i: int) -> None:
         """``step_ahead_swing``: in the clip's single support at frame ``i`` (its one-frame
@@ -834,7 +790,7 @@ class AnchoredReference:
         centre = self._sole_centres()
         stance = centre[1 - f, :2]
         pred = stance + (xi - stance) * np.exp(omega * left_s)
-        land = self._clip_sole(k, f)
+        land = _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
         if float((pred - land) @ u) <= self._swing_limit[i]:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)

@@ -9,9 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = [
-    "Step", "clamp_step", "clamp_to_support", "convex_hull", "outside_distance", "step_target",
-]  # fmt: skip
+__all__ = ["Step", "clamp_to_support", "convex_hull", "outside_distance", "step_target"]
 
 F64 = NDArray[np.float64]
 
@@ -144,16 +142,6 @@ def step_target(
     fall = pred - stance
     n = float(np.linalg.norm(fall))
     target = pred + (fall / n) * beyond if n > 1e-9 else pred.copy()
-    del swing
-    return clamp_step(target, stance, max_length=max_length, min_width=min_width, lateral=lateral)
-
-
-def clamp_step(
-    target: F64, stance: F64, *, max_length: float, min_width: float, lateral: F64
-) -> F64:
-    """A step's ``target`` (2,) moved at least ``min_width`` m to the swing foot's side of the
-    ``stance`` foot (``lateral``: unit vector toward that side), so the legs do not cross, and
-    then brought within ``max_length`` m of it."""
     rel = target - stance
     side = float(rel @ lateral)
     if side < min_width:
@@ -162,4 +150,5 @@ def clamp_step(
     n = float(np.linalg.norm(rel))
     if n > max_length:
         target = stance + rel * (max_length / n)
+    del swing
     return target

@@ -286,12 +286,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_servo: with ``step_ahead``, the pelvis position servo's gain while one of
             its steps is under way (1/s^2, at most 100; 0: off): the clip's pelvis, at the
             clip's speed, pulled the body on past its feet (``docs/tracking.md``, issue 16).
-        step_ahead_footfall: with ``step_ahead``, its steps aim not at the capture point
-            (:func:`~reactmocap.sim.controllers.stepping.step_target`, which stops the body
-            over the new foot) but at the clip's next landing of the stepping foot, moved by
-            this times the capture point's error against the clip's grown over the step, as
-            ``place_pushed`` moves the clip's own landings (in (0, 3]; 0: off; the same 0.6 m
-            reach) (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -386,7 +380,6 @@ class WholeBodyTracker(AnchoredReference):
         centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
         step_ahead_servo: float = 0.0,
-        step_ahead_footfall: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         servo_kv: float,
@@ -424,7 +417,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
-                "step_ahead_servo": step_ahead_servo, "step_ahead_footfall": step_ahead_footfall,
+                "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
             },
         )  # fmt: skip
@@ -467,12 +460,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
-            )
-        if step_ahead_footfall and not (step_ahead and step_ahead_footfall <= 3.0):
-            raise ConfigError(
-                f"step_ahead_footfall ({step_ahead_footfall!r}) is the gain on the capture "
-                f"point's error moving step_ahead's steps off the clip's next footfall, in "
-                f"(0, 3]: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -583,7 +570,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_footfall=step_ahead_footfall,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._soft = float(step_soft)
