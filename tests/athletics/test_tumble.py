@@ -348,24 +348,6 @@ def test_the_forward_tucks_hanging_foot_put_down_near_the_support_lands_seed_2s_
     assert before.report["fell"] and not before.report["landed"]
 
 
-def test_the_forward_tucks_planted_foots_com_target_held_back_lands_seed_2s_start_25() -> None:
-    """Start 25 of the capture region at full size, seed 2: the last balance puts its hung
-    foot down 0.79 s after touchdown; with the COM target at once both soles' middle the COM
-    tips toward the foot while it still hovers, carries on over it and the body falls 3.7 s
-    after touchdown; with ``hang_hold`` 0.5 (the target held half way back toward the
-    standing sole until the foot is down) it lands (docs/athletics.md, "Forward tuck: the
-    planted foot's COM target held back")."""
-    rng = np.random.default_rng(2)
-    start = [Perturbation.sample(rng, **FULL) for _ in range(26)][25]
-    m = replace(load_maneuver(FORWARD_FILE), seconds=6.8)
-    last = {k: v for k, v in m.phases[-1].params.items() if k != "hang_hold"}
-    held = run_maneuver(_with_last_balance_params(m, {**last, "hang_hold": 0.5}),
-                        perturbation=start, fps=10.0).report  # fmt: skip
-    assert held["landed"] and not held["fell"] and abs(held["rotation_deg"] - 360.0) <= 30.0
-    before = run_maneuver(_with_last_balance_params(m, last), perturbation=start, fps=10.0)
-    assert before.report["fell"] and not before.report["landed"]
-
-
 def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> None:
     """Start 2 of the capture region at full size (seed 0). Its "com" push let the start's
     small roll grow to -5.8 kg m^2/s of cartwheel momentum: the feet touched down 12 cm to
