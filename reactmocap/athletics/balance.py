@@ -225,10 +225,10 @@ class Step:
             pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
             foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
             "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
-        hang_hold: with the posture's plant on, until the hung foot first comes down, the
-            COM target is held back this fraction of the way from both soles' middle toward
-            the standing sole's (0: off, both soles' middle: the forward tuck's hung foot
-            hovered while the COM tipped toward it and carried on over it; opt-in,
+        hang_hold: with the posture's plant on and one foot still off the floor, the COM
+            target is held back this fraction of the way from both soles' middle toward the
+            standing sole's (0: off, both soles' middle: put down late, the forward tuck's
+            hung foot hovered while the COM tipped toward it and carried on over it; opt-in,
             docs/athletics.md "Forward tuck: the planted foot's COM target held back").
     """
 
@@ -501,7 +501,6 @@ class BalanceLaw:
         self.stepper: Stepper | None = None
         #: the pelvis's roll target (rad, heading frame; 0 upright): the landing's roll_ease
         self.roll = 0.0
-        self._hold_done = False  # Step.hang_hold: the hung foot came down since the plant
         self._knee_standing = float(np.mean(knee_for_length(
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
 
@@ -594,12 +593,8 @@ class BalanceLaw:
         self.heading = h
         centre = s.support_center(h, both=self.posture.plant)
         hold = self.stepper.step.hang_hold if self.stepper is not None else 0.0
-        if hold and self.posture.plant and not self._hold_done:  # Step.hang_hold
-            # until the hung foot first comes down (held on its later lifts, the target
-            # switching on each lift pushed the COM over the planted foot)
-            self._hold_done = bool(s.foot_contact.all())
-            if s.foot_contact.any() and not self._hold_done:
-                centre += hold * (s.support_center(h) - centre)
+        if hold and self.posture.plant and s.foot_contact.any() and not s.foot_contact.all():
+            centre += hold * (s.support_center(h) - centre)  # Step.hang_hold
         c, sn = math.cos(h), math.sin(h)
         if self.posture.side_both and not self.posture.plant:
             # across the feet the middle of both soles, along them the soles in contact
