@@ -225,11 +225,6 @@ class Step:
             pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
             foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
             "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
-        hang_hold: with the posture's plant on and one foot still off the floor, the COM
-            target is held back this fraction of the way from both soles' middle toward the
-            standing sole's (0: off, both soles' middle: put down late, the forward tuck's
-            hung foot hovered while the COM tipped toward it and carried on over it; opt-in,
-            docs/athletics.md "Forward tuck: the planted foot's COM target held back").
     """
 
     margin: float = 0.05
@@ -246,7 +241,6 @@ class Step:
     hang_near: float = 0.0
     pair: float = 0.0
     bow_hold: float = 0.0
-    hang_hold: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -268,7 +262,7 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"), ("hang_hold", 1.0, "of the way"))  # fmt: skip
+                  ("pair", 0.3, "m"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -592,9 +586,6 @@ class BalanceLaw:
         h = s.heading()
         self.heading = h
         centre = s.support_center(h, both=self.posture.plant)
-        hold = self.stepper.step.hang_hold if self.stepper is not None else 0.0
-        if hold and self.posture.plant and s.foot_contact.any() and not s.foot_contact.all():
-            centre += hold * (s.support_center(h) - centre)  # Step.hang_hold
         c, sn = math.cos(h), math.sin(h)
         if self.posture.side_both and not self.posture.plant:
             # across the feet the middle of both soles, along them the soles in contact

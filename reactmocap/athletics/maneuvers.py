@@ -157,13 +157,11 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
     g = BALANCE_GAIN_SETS[gains]
     standing = bool(p.pop("standing_step", False))
     near = float(p.pop("hang_near", 0.0))  # check_phase: only with standing_step, (0, 0.3]
-    hold = float(p.pop("hang_hold", 0.0))  # check_phase: only with standing_step, (0, 1]
     if standing:
         # the balance behaviour's step="on": a hung foot planted, steps across the feet too,
         # the bow (standing gains) eased; `step` numbers override its own, not the plant
         step = replace(step, hang_still=STANDING_STEP.hang_still) if step else STANDING_STEP
         step = replace(step, hang_near=near) if near else step
-        step = replace(step, hang_hold=hold) if hold else step
         g = replace(g, bow_ease=STANDING_BOW_EASE) if g.bow is not None else g
     seconds = phase.seconds if phase.exit == "after" else None
     within = None
@@ -246,12 +244,9 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
         "behaviour's step \"on\": a foot left hanging put down once the COM is slower than "
         "0.25 m/s, steps across the feet too; `step` overrides its step's numbers, not the "
         "plant); `hang_near` (m, (0, 0.3], with `standing_step`; default off): that foot "
-        "is put down only once the COM also lies within this of the standing sole's middle; "
-        "`hang_hold` (a fraction, (0, 1], with `standing_step`; default off): while that foot "
-        "is still off the floor, the COM target is held back this fraction of the way from "
-        "both soles' middle toward the standing sole's",
+        "is put down only once the COM also lies within this of the standing sole's middle",
         {**_kinds(Posture), "settle_share": "number", "gains": "string", "step": "numbers",
-         "standing_step": "bool", "hang_near": "number", "hang_hold": "number"},
+         "standing_step": "bool", "hang_near": "number"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
          "settled": "once standing still on both feet with the COM over them (a perturbed "
                     "start); not settled within `seconds` (default 2): the run fails there"},
@@ -362,10 +357,6 @@ def check_phase(phase: Phase, where: str) -> Phase:
     if near is not None and not (params.get("standing_step") is True and 0.0 < near <= 0.3):
         raise ConfigError(f"{where}.params.hang_near: needs standing_step = true and must "
                           f"be in (0, 0.3] m, got {near:g}")  # fmt: skip
-    hold = params.get("hang_hold") if phase.controller == "balance" else None
-    if hold is not None and not (params.get("standing_step") is True and 0.0 < hold <= 1.0):
-        raise ConfigError(f"{where}.params.hang_hold: needs standing_step = true and must "
-                          f"be in (0, 1], got {hold:g}")  # fmt: skip
     if phase.controller == "tumble" and params.get("position", "tuck") not in POSITIONS:
         raise ConfigError(
             f"{where}.params.position: unknown position {params['position']!r}; valid "

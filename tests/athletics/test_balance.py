@@ -240,35 +240,6 @@ def test_a_maneuver_balances_hang_near_waits_for_the_com_near_the_sole_to_put_th
         Step(hang_near=-0.1)
 
 
-def test_a_maneuver_balances_hang_hold_keeps_the_com_back_while_the_foot_hangs(
-    tmp_path: Path,
-) -> None:
-    # the file key hang_hold (issue 19, 2026-12-05): with the standing step's plant on and
-    # the foot still up, the COM target held back toward the standing sole; the forward
-    # tuck's COM tipped toward its hovering foot and on over it (docs/athletics.md, "Forward
-    # tuck: the planted foot's COM target held back")
-    p: dict[str, object] = {"standing_step": True, "step": [10.0]}
-    runs = [_drifting(p), _drifting({**p, "hang_hold": 0.5})]
-    down, toward = [], []
-    for r in runs:
-        assert not r.report["fell"]
-        t, feet = np.asarray(r.log["t"]), np.asarray(r.log["feet"])
-        assert np.all(feet[t > 2.0] == 2)  # put down all the same
-        down.append(float(t[feet == 1].max()))
-        toward.append(float(np.asarray(r.log["com_vel"])[t > 0.5, 1].min()))  # (-y: right)
-    # held back: the COM goes over to the hung foot slower, the foot comes down later
-    assert toward[1] > toward[0] + 0.01 and down[1] > down[0] + 0.2
-    for params in ("standing_step = true, hang_hold = 1.5", "hang_hold = 0.5"):
-        bad = tmp_path / "m.toml"
-        bad.write_text(f'[[phase]]\ncontroller = "balance"\nparams = {{ {params} }}\n'
-                       'exit = { event = "never" }\n')  # fmt: skip
-        with pytest.raises(ConfigError, match=r"phase\[1\]\.params\.hang_hold: needs") as err:
-            load_maneuver(bad)
-        assert str(bad) in str(err.value)
-    with pytest.raises(ConfigError, match="hang_hold"):
-        Step(hang_hold=1.5)
-
-
 def _pushed_back(step: list[float] | None) -> AthleticsResult:
     """A standing male balance started with the body moving back at 0.5 m/s (its capture
     point past the heels), with the balance's step if given."""
