@@ -535,3 +535,24 @@ def test_the_landings_step_fires_on_the_capture_point_across_the_feet_foreseen()
             LandingParams(step=(0.05,), **bad).balance_step()
     with pytest.raises(ConfigError, match="need a step"):
         LandingParams(step_foresee=0.25)
+
+
+def test_the_landings_steps_leave_the_knees_at_the_postures() -> None:
+    """Full-size start 29 (seed 0) steps after the landing with its knees left at the swing's
+    last targets, the legs unequal: the pelvis rolls and it falls over a third step. With
+    ``step_knees`` 1.0 (both knees' targets to the posture's at each touchdown) it stands.
+    A share outside [0, 1] or without a step is named."""
+    m = replace(load_maneuver(EXAMPLE), seconds=6.0)
+    land = next(p for p in m.phases if p.controller == "land").params
+    plain = {k: v for k, v in land.items() if k != "step_knees"}
+    start = _starts(1.0, 30)[29]
+    r = run_maneuver(_with(m, "land", {**plain, "step_knees": 1.0}), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["landed"] and not r["fell"]
+    old = run_maneuver(_with(m, "land", plain), perturbation=start, fps=10.0).report
+    assert old["fell"] and not old["landed"]
+    for bad in (-0.1, 1.5, math.nan):
+        with pytest.raises(ConfigError, match="step_knees"):
+            LandingParams(step=(0.05,), step_knees=bad)
+    with pytest.raises(ConfigError, match="need a step"):
+        LandingParams(step_knees=1.0)
