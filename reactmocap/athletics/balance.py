@@ -226,10 +226,11 @@ class Step:
             foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
             "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
         knees: at a step's touchdown both knees' targets go this share of the way (in [0, 1])
-            from their last ones to the posture's (0: off, the last ones: each stepped leg's
-            is its swing's, and after the male back handspring's two landing steps the legs
-            stood 0.17-0.19 rad apart in the knee, the pelvis rolled 15-20 deg and the COM
-            drifted out over the more bent one on both feet; docs/athletics.md "kind (c)").
+            from their last ones to their mean, the legs alike (0: off, the last ones: each
+            stepped leg's is its swing's, and after the male back handspring's two landing
+            steps the legs stood 0.17-0.19 rad apart in the knee, the pelvis rolled 15-20 deg
+            and the COM drifted out over the more bent one on both feet; to the posture's
+            knees lost more starts; docs/athletics.md "kind (c)").
     """
 
     margin: float = 0.05
@@ -887,8 +888,8 @@ class Stepper:
             # leveling on top
             left = max(float(rig.time_left(t)[_KNEE].max()), STEP_SETTLE)
             goal = rig.goal()[_KNEE, 0]
-            if st.knees:  # Step.knees: toward the posture's, not the swings' last targets
-                goal += st.knees * (self._posture_knees(bl) - goal)
+            if st.knees:  # Step.knees: the legs alike, not each at its swing's last target
+                goal += st.knees * (float(goal.mean()) - goal)
             rig.move(rig.current_angles(), 0.0, t, _KNEE)
             self._goal[_KNEE, 0] = goal
             rig.move(self._goal, left, t, _KNEE)
@@ -970,11 +971,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-
-    def _posture_knees(self, bl: BalanceLaw) -> F64:
-        """``(2,)`` the knees' flexion for the posture's leg length (as :meth:`BalanceLaw.set_posture`)."""
-        a = self.ctx.athlete
-        return knee_for_length(a.thigh, a.shin, bl.posture.leg * (a.thigh + a.shin))[0]
 
     def along(self) -> bool:
         """A swing under way along the feet (not a sideways one, nor a closing one)."""

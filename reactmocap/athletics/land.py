@@ -262,7 +262,7 @@ class LandingParams:
             the starts that stood on both feet after the two landing steps kept each stepped
             knee at its swing's last target, 0.17-0.19 rad apart; the pelvis rolled 15-20 deg
             and the COM drifted out over the more bent leg until it fell (docs/athletics.md,
-            "kind (c)").
+            "kind (c)"; the share of the way to the two knees' mean).
         recover_leg: the recovery stands up to at least this fraction of the straight leg
             (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
