@@ -159,10 +159,11 @@ def _unspun(m: Maneuver) -> Maneuver:
 
 
 def _unforeseen(m: Maneuver) -> Maneuver:
-    """``m`` with the landing's step as the file had it before 2026-12-05 (latest): no
-    ``step_across`` / ``step_foresee``."""
+    """``m`` with the landing's step as the file had it before 2026-12-05 (later): no
+    ``step_across`` / ``step_foresee`` (nor the latest ``step_knees``)."""
     land = next(p for p in m.phases if p.controller == "land").params
-    old = {k: v for k, v in land.items() if k not in ("step_across", "step_foresee")}
+    drop = ("step_across", "step_foresee", "step_knees")
+    old = {k: v for k, v in land.items() if k not in drop}
     return _with(m, "land", old)
 
 
@@ -537,11 +538,11 @@ def test_the_landings_step_fires_on_the_capture_point_across_the_feet_foreseen()
         LandingParams(step_foresee=0.25)
 
 
-def test_the_landings_steps_leave_the_knees_at_the_postures() -> None:
-    """Full-size start 29 (seed 0) steps after the landing with its knees left at the swing's
-    last targets, the legs unequal: the pelvis rolls and it falls over a third step. With
-    ``step_knees`` 1.0 (both knees' targets to the posture's at each touchdown) it stands.
-    A share outside [0, 1] or without a step is named."""
+def test_the_landings_steps_leave_both_knees_alike() -> None:
+    """Full-size start 29 (seed 0) steps after the landing with each stepped knee left at its
+    swing's last target: it falls over a third and fourth step. With ``step_knees`` 1.0 (both
+    knees' targets to their mean at each touchdown: the file since 2026-12-05, latest) it
+    stands on its first step. A share outside [0, 1] or without a step is named."""
     m = replace(load_maneuver(EXAMPLE), seconds=6.0)
     land = next(p for p in m.phases if p.controller == "land").params
     plain = {k: v for k, v in land.items() if k != "step_knees"}
