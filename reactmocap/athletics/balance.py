@@ -225,6 +225,12 @@ class Step:
             pitching back at up to 6 rad/s took the lagging swing thigh up with it and the
             foot 0.2-0.3 m over the floor; on a step along the feet only; docs/athletics.md
             "The standing step's bow held through the swing"; :data:`STANDING_STEP` 1.0).
+        knees: at a step's touchdown both knees' targets go this share of the way (in [0, 1])
+            from their last ones to their mean, the legs alike (0: off, the last ones: each
+            stepped leg's is its swing's, and after the male back handspring's two landing
+            steps the legs stood 0.17-0.19 rad apart in the knee, the pelvis rolled 15-20 deg
+            and the COM drifted out over the more bent one on both feet; to the posture's
+            knees lost more starts; docs/athletics.md "kind (c)").
     """
 
     margin: float = 0.05
@@ -241,6 +247,7 @@ class Step:
     hang_near: float = 0.0
     pair: float = 0.0
     bow_hold: float = 0.0
+    knees: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -262,7 +269,7 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"))  # fmt: skip
+                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -881,6 +888,8 @@ class Stepper:
             # leveling on top
             left = max(float(rig.time_left(t)[_KNEE].max()), STEP_SETTLE)
             goal = rig.goal()[_KNEE, 0]
+            if st.knees:  # Step.knees: the legs alike, not each at its swing's last target
+                goal += st.knees * (float(goal.mean()) - goal)
             rig.move(rig.current_angles(), 0.0, t, _KNEE)
             self._goal[_KNEE, 0] = goal
             rig.move(self._goal, left, t, _KNEE)

@@ -257,6 +257,12 @@ class LandingParams:
             class-S fallers tipped out sideways over one foot after the closing step; with
             ``step_across`` 0.05 and ``step_foresee`` 0.25 the three seeds land 106 of 150
             from 94, none lost (docs/athletics.md, "class S ... across/foresee").
+        step_knees: the ``step``'s :class:`~reactmocap.athletics.balance.Step` ``knees``
+            (a share in [0, 1], 0: off; only with ``step``). Why: on the male back handspring
+            the starts that stood on both feet after the two landing steps kept each stepped
+            knee at its swing's last target, 0.17-0.19 rad apart; the pelvis rolled 15-20 deg
+            and the COM drifted out over the more bent leg until it fell (docs/athletics.md,
+            "kind (c)"; the share of the way to the two knees' mean).
         recover_leg: the recovery stands up to at least this fraction of the straight leg
             (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
@@ -306,6 +312,7 @@ class LandingParams:
     step_down_after: float = 0.0
     step_foresee: float = 0.0
     recover_leg: float = 0.0
+    step_knees: float = 0.0
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -439,11 +446,12 @@ class LandingParams:
         ``step_*`` fields), or None (off)."""
         step = Step.of(self.step)
         more = {"across": self.step_across, "ground": self.step_ground,
-                "down_after": self.step_down_after, "foresee": self.step_foresee}  # fmt: skip
+                "down_after": self.step_down_after, "foresee": self.step_foresee,
+                "knees": self.step_knees}  # fmt: skip
         if step is None:
             if any(v != getattr(Step, k) for k, v in more.items()):
-                raise ConfigError("landing step_across, step_ground, step_down_after and "
-                                  "step_foresee need a step")  # fmt: skip
+                raise ConfigError("landing step_across, step_ground, step_down_after, "
+                                  "step_foresee and step_knees need a step")  # fmt: skip
             return None
         try:
             return replace(step, **more)

@@ -450,7 +450,9 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # soles while one is unloaded (Posture.side_both: 35/50 and 29/50 from 32 and 26, held-out
     # seed 2 30 from 30); and (later) his landing's step also fires on the capture point
     # across the feet carried 0.25 s on (LandingParams.step_foresee with step_across: 40/50
-    # and 31/50 from 35 and 29, held-out seed 2 35 from 30). A list: a maneuver file's
+    # and 31/50 from 35 and 29, held-out seed 2 35 from 30); and (latest) at each step's
+    # touchdown both knees' targets go to their mean (LandingParams.step_knees: 40/50 and
+    # 36/50 from 40 and 31, held-out seed 2 38 from 35). A list: a maneuver file's
     # numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3, "hold": 0.22, "com_offset": -0.13,
@@ -459,7 +461,8 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
         "handspring": MappingProxyType({"aim": -3.25, "knees": 0.9, "aim_knees": 1.3}),
         "land": MappingProxyType({"delta": -0.6, "spin_ref": -96.8,
                                   "step": [0.05, 0.0, 0.3, 0.25], "recover_leg": 0.8,
-                                  "step_across": 0.05, "step_foresee": 0.25}),
+                                  "step_across": 0.05, "step_foresee": 0.25,
+                                  "step_knees": 1.0}),
         "balance": MappingProxyType({"side_both": True}),
     }),
     "female": MappingProxyType({

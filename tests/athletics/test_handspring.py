@@ -159,10 +159,11 @@ def _unspun(m: Maneuver) -> Maneuver:
 
 
 def _unforeseen(m: Maneuver) -> Maneuver:
-    """``m`` with the landing's step as the file had it before 2026-12-05 (latest): no
-    ``step_across`` / ``step_foresee``."""
+    """``m`` with the landing's step as the file had it before 2026-12-05 (later): no
+    ``step_across`` / ``step_foresee`` (nor the latest ``step_knees``)."""
     land = next(p for p in m.phases if p.controller == "land").params
-    old = {k: v for k, v in land.items() if k not in ("step_across", "step_foresee")}
+    drop = ("step_across", "step_foresee", "step_knees")
+    old = {k: v for k, v in land.items() if k not in drop}
     return _with(m, "land", old)
 
 
@@ -535,3 +536,24 @@ def test_the_landings_step_fires_on_the_capture_point_across_the_feet_foreseen()
             LandingParams(step=(0.05,), **bad).balance_step()
     with pytest.raises(ConfigError, match="need a step"):
         LandingParams(step_foresee=0.25)
+
+
+def test_the_landings_steps_leave_both_knees_alike() -> None:
+    """Full-size start 29 (seed 0) steps after the landing with each stepped knee left at its
+    swing's last target: it falls over a third and fourth step. With ``step_knees`` 1.0 (both
+    knees' targets to their mean at each touchdown: the file since 2026-12-05, latest) it
+    stands on its first step. A share outside [0, 1] or without a step is named."""
+    m = replace(load_maneuver(EXAMPLE), seconds=6.0)
+    land = next(p for p in m.phases if p.controller == "land").params
+    plain = {k: v for k, v in land.items() if k != "step_knees"}
+    start = _starts(1.0, 30)[29]
+    r = run_maneuver(_with(m, "land", {**plain, "step_knees": 1.0}), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["landed"] and not r["fell"]
+    old = run_maneuver(_with(m, "land", plain), perturbation=start, fps=10.0).report
+    assert old["fell"] and not old["landed"]
+    for bad in (-0.1, 1.5, math.nan):
+        with pytest.raises(ConfigError, match="step_knees"):
+            LandingParams(step=(0.05,), step_knees=bad)
+    with pytest.raises(ConfigError, match="need a step"):
+        LandingParams(step_knees=1.0)
