@@ -213,6 +213,11 @@ class Step:
             (m, horizontal) of the supporting sole's middle (0: off; opt-in: the forward tuck's
             hung foot put down 9-11 cm off the support kept it on one foot, docs/athletics.md
             "Forward tuck: the hung foot put down near the support").
+        plant_settle: when the standing balance plants a hung foot, the posture's stand-up (knees, spine, arms,
+            the pelvis's pitch) starts again from where its targets are, at rest, and
+            reaches the posture over this many seconds (0: off, it runs on over the
+            posture's settle; opt-in: the forward tuck's stand-up bounced the hung foot off
+            the floor, docs/athletics.md "Forward tuck: the stand-up restarted at the plant").
         pair: after the run's first step, the next starts only once the capture point lies
             more than this (m) past the box of both soles, a lifted one counted, in either
             axis (the COM's sideways speed in it); while it lies within, a foot that hangs is
@@ -239,6 +244,7 @@ class Step:
     down_after: float = 0.0
     hang_still: float = 0.0
     hang_near: float = 0.0
+    plant_settle: float = 0.0
     pair: float = 0.0
     bow_hold: float = 0.0
 
@@ -262,7 +268,7 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"))  # fmt: skip
+                  ("pair", 0.3, "m"), ("plant_settle", 5.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -994,6 +1000,9 @@ class Stepper:
                 if float(np.hypot(*(s.com[:2] - s.support_center()[:2]))) >= self.step.hang_near:
                     return  # Step.hang_near: the COM still far off the standing sole
             bl.posture = replace(bl.posture, plant=True)
+            if self.step.plant_settle:  # the stand-up again from rest, from here
+                bl.set_posture(replace(bl.posture, settle=self.step.plant_settle), t,
+                               gains=False, pitch_from=bl.pitch_target(t))  # fmt: skip
 
 
 def hips_for_thighs(  # type: ignore[no-untyped-def]
