@@ -207,6 +207,7 @@ class Runner:
         self._att_err = np.empty(3)
         self._att_axes = np.eye(3)
         self._att_axes_flat = self._att_axes.reshape(-1)
+        self._iz = np.empty(len(self._bodies))  # the bodies' yaw inertias (yaw_momentum)
         self._angles = np.zeros((NJ, 3))
         self._hip_rows = np.array(HIP)
         self._knee_rows = np.array(KNEE)
@@ -463,9 +464,17 @@ class Runner:
         axes, flat = self._att_axes, self._att_axes_flat
         flat[0], flat[1], flat[3], flat[4] = c, s, -s, c
         local = axes @ err
-        gain = self.inertia_unit * (
-            self._attitude_kp * local - self._attitude_kv * (axes @ d.cvel[self._chest, :3])
-        )
+        rate = axes @ d.cvel[self._chest, :3]
+        if (k["yaw_momentum"] > 0 and abs(self.curvature) > ARM_CURVE
+                and d.time >= PATH_AFTER):  # fmt: skip
+            # the yaw damped on the whole body's mean rate (``yaw_momentum``): the swing leg
+            # and arms carry yaw momentum the chest's rate misses, and at a reversal it
+            # carried the chest past the facing in flight (mj_subtreeVel has run: Senses;
+            # cinert's and subtree_angmom's origin is the same, the body's COM)
+            iz = np.take(d.cinert[:, 2], self._bodies, out=self._iz).sum()
+            body = float(d.subtree_angmom[self._root, 2]) / max(float(iz), 1e-9)
+            rate[2] += k["yaw_momentum"] * (body - rate[2])
+        gain = self.inertia_unit * (self._attitude_kp * local - self._attitude_kv * rate)
         if k["pitch_integral"] > 0:
             dt = self.control_every * self._timestep
             self.pitch_sum = clamp(self.pitch_sum + local[1] * dt, -PITCH_SUM, PITCH_SUM)

@@ -153,6 +153,11 @@ class RunParams:
         arm_yaw_rate: the same for the trunk's yaw rate past the desired facing's rate (s;
             0: off): each shoulder's pitch also moved by this times it, the same signs as
             ``arm_yaw``'s, where ``arm_yaw`` acts. Within [0, 1].
+        yaw_momentum: how much of the attitude servo's yaw damping acts on the whole body's
+            mean yaw rate (its yaw momentum about the COM over its yaw inertia, swing leg and
+            arms included) instead of the chest's rate alone (0: off, the chest's; 1: the
+            body's). Only where the course curves (``ARM_CURVE``) and from ``PATH_AFTER`` on.
+            Within [0, 1].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -202,6 +207,7 @@ class RunParams:
     lean: float | Speeds = 1.0
     arm_yaw: float | Speeds = 1.0
     arm_yaw_rate: float | Speeds = 0.05
+    yaw_momentum: float | Speeds = 0.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
@@ -226,6 +232,7 @@ class RunParams:
             ("push_ramp", 1.0),
             ("arm_yaw", 5.0),
             ("arm_yaw_rate", 1.0),
+            ("yaw_momentum", 1.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):

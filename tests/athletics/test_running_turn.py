@@ -131,3 +131,52 @@ def test_arm_yaw_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"arm_yaw_rate must be in \[0, 1\]"):
         RunParams(arm_yaw_rate=(0.0, -0.05, 0.0))
     assert RunParams().at(2.5)["arm_yaw_rate"] == 0.05
+
+
+def test_yaw_momentum_damps_the_bodys_mean_yaw_rate_on_a_curve_and_not_a_line() -> None:
+    """``yaw_momentum``: on the circle the run is the one without it to the bit before
+    ``PATH_AFTER`` and differs after; on its last state the attitude torque differs from
+    the chest-damped one only about the vertical, by the yaw damping times the share of the
+    whole body's mean yaw rate (its yaw momentum over its yaw inertia about the COM) past
+    the chest's; on a straight line the run is the one without it to the bit."""
+    w, secs = 0.5, PATH_AFTER + 0.5
+    runs = [run_course(2.5, seconds=secs, path="circle:10", fps=10.0,
+                       params=RunParams(yaw_momentum=v)) for v in (w, 0.0)]  # fmt: skip
+    on, off = runs[0].log, runs[1].log
+    before = off["t"] < PATH_AFTER
+    assert max(on["t"]) > PATH_AFTER + 0.4
+    assert np.array_equal(on["com"][before], off["com"][before])
+    assert not np.array_equal(on["com"][~before], off["com"][~before])
+    r = runs[0].runner
+    d, m = r.world.data, r.world.model
+    # the yaw inertia about the vertical through the COM, from the bodies' own inertias
+    iz = 0.0
+    for b in r._bodies:
+        rot = d.ximat[b].reshape(3, 3)
+        arm = d.xipos[b, :2] - d.subtree_com[r._root, :2]
+        iz += (rot @ np.diag(m.body_inertia[b]) @ rot.T)[2, 2] + m.body_mass[b] * arm @ arm
+    body = float(d.subtree_angmom[r._root, 2]) / iz
+    chest = float(d.cvel[r._chest, 2])
+    assert abs(body - chest) > 1e-3
+    # the torque unclamped (limits, ramp, grip off) with the option and without
+    r.k.update(attitude_limit=0.0, touchdown_limit=0.0, attitude_ramp=0.0, pitch_integral=0.0,
+               yaw_grip=1e12)  # fmt: skip
+    with_it = r._attitude_torque(r.heading_d)
+    r.k["yaw_momentum"] = 0.0
+    without = r._attitude_torque(r.heading_d)
+    kv = r.params.attitude_kv[2]
+    want = -r.inertia_unit * kv * w * (body - chest)
+    assert with_it - without == pytest.approx([0.0, 0.0, want], rel=1e-6, abs=1e-6 * abs(want))
+    line = [run_course(2.5, seconds=secs, fps=10.0, params=RunParams(yaw_momentum=v))
+            for v in (1.0, 0.0)]  # fmt: skip
+    for key in ("t", "com", "cross_track", "heading"):
+        assert np.array_equal(line[0].log[key], line[1].log[key]), key
+    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
+
+
+def test_yaw_momentum_is_checked() -> None:
+    with pytest.raises(ConfigError, match=r"yaw_momentum must be in \[0, 1\]"):
+        RunParams(yaw_momentum=1.5)
+    with pytest.raises(ConfigError, match=r"yaw_momentum must be in \[0, 1\]"):
+        RunParams(yaw_momentum=(0.0, -0.1, 0.0))
+    assert RunParams().at(2.5)["yaw_momentum"] == 0.0
