@@ -1,0 +1,35 @@
+"""The athletics benchmark's limit searches (``benchmarks/bench_athletics.py``)."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+from types import ModuleType
+
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_athletics.py"
+
+
+def _bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("bench_athletics", BENCH)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_contiguous_limit_stops_at_the_first_failure_where_the_bisection_finds_an_island() -> (
+    None
+):
+    bench = _bench()
+    calls: list[float] = []
+
+    def held(f: float) -> bool:  # held to 160 N, an island at 220-230 N (his front-left's shape)
+        calls.append(f)
+        return f <= 160.0 or 220.0 <= f <= 230.0
+
+    assert bench._contiguous(held, 0.0, 600.0, 5.0) == 160.0
+    assert max(calls) == 165.0  # stepped up to the first failure, no further
+    assert bench._largest(held, 0.0, 300.0, 5.0) == 230.0  # the bisection lands on the island
+    assert math.isnan(bench._contiguous(lambda f: f > 0.0, 0.0, 600.0, 5.0))
+    assert bench._contiguous(lambda f: True, 0.0, 20.0, 5.0) == 20.0
