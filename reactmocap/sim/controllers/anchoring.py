@@ -88,7 +88,8 @@ def _left_of(heading: float) -> F64:
     return np.array([-np.sin(heading), np.cos(heading)])
 
 
-def _rot2(yaw: float) -> F64:
+def rot2(yaw: float) -> F64:
+    """The ``(2, 2)`` rotation of the floor plane by ``yaw`` (rad): the mocap's re-anchoring."""
     c, s = np.cos(yaw), np.sin(yaw)
     return np.array([[c, -s], [s, c]])
 
@@ -250,7 +251,7 @@ class AnchoredReference:
         #: ``x -> Rz(yaw) x + shift``
         self.anchor_yaw = 0.0
         self.anchor_shift = np.zeros(2)
-        self._turn = (0.0, _rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
+        self._turn = (0.0, rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
         self.warp_gain = float(warp_gain)
         self.warp_lead = float(warp_lead)
         self.warp_phase = float(warp_phase)
@@ -328,7 +329,7 @@ class AnchoredReference:
             if self._turn[0] != self.anchor_yaw:  # it moves every few ticks only
                 self._turn = (
                     self.anchor_yaw,
-                    _rot2(self.anchor_yaw),
+                    rot2(self.anchor_yaw),
                     quat_from_yaw(self.anchor_yaw),
                 )
             _, rot, turn = self._turn
@@ -416,7 +417,7 @@ class AnchoredReference:
         if coast > 0:
             c = c + coast * v
             a = np.zeros(3)
-        rot = _rot2(self.anchor_yaw)
+        rot = rot2(self.anchor_yaw)
         c[:2] = rot @ c[:2] + self.anchor_shift + self.balance_shift
         v[:2] = rot @ v[:2]
         a[:2] = rot @ a[:2]
@@ -498,7 +499,7 @@ class AnchoredReference:
         if p[2] - self.floor_z < self.place_height and not self._placed[f]:
             return None
         v = (1 - w) * self._sole_v[i0, f] + w * self._sole_v[i1, f]
-        rot = _rot2(self.anchor_yaw)
+        rot = rot2(self.anchor_yaw)
         p[:2] = rot @ p[:2] + self.anchor_shift
         v[:2] = rot @ v[:2]
         return p, v
@@ -546,7 +547,7 @@ class AnchoredReference:
             if low[f] < self.anchor_touch or self._mocap_swing(t, f) is None:
                 continue
             k = int(np.argmax(ahead[:, f] < self.place_height))  # the mocap's landing
-            land = _rot2(self.anchor_yaw) @ self.path.sole[i + k, f, :2] + self.anchor_shift
+            land = rot2(self.anchor_yaw) @ self.path.sole[i + k, f, :2] + self.anchor_shift
             out = left if f == 0 else -left
             side = float(miss @ out)
             along = abs(float(miss @ np.array([left[1], -left[0]])))
@@ -790,7 +791,7 @@ class AnchoredReference:
         centre = self._sole_centres()
         stance = centre[1 - f, :2]
         pred = stance + (xi - stance) * np.exp(omega * left_s)
-        land = _rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
+        land = rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
         if float((pred - land) @ u) <= self._swing_limit[i]:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
@@ -847,7 +848,7 @@ class AnchoredReference:
         rot = d.geom_xmat[self.sole].reshape(2, 3, 3)
         sim = (d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half)[on, :2]
         ref, ref_yaw = self.path.sole_at(self.clock.frame(t))
-        ref = ref[on, :2] @ _rot2(self.anchor_yaw).T + self.anchor_shift
+        ref = ref[on, :2] @ rot2(self.anchor_yaw).T + self.anchor_shift
         centre = sim.mean(axis=0)
         err = centre - ref.mean(axis=0)
         if t <= self.lag_until:
@@ -869,7 +870,7 @@ class AnchoredReference:
             most = self._turn_step + float(self._sole_turn[i, turn].mean())
             dyaw = min(max(dyaw, -most), most)
         self.anchor_yaw += dyaw
-        self.anchor_shift = _rot2(dyaw) @ (self.anchor_shift + k * err - centre) + centre
+        self.anchor_shift = rot2(dyaw) @ (self.anchor_shift + k * err - centre) + centre
         # and slowly back toward the captured path, which the gait then follows step by step
         self.anchor_yaw -= self._return_rate * self.anchor_yaw
         self.anchor_shift -= self._return_rate * self.anchor_shift

@@ -21,7 +21,7 @@ from scipy.optimize import nnls
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.controllers.anchoring import AnchoredReference, _rot2
+from reactmocap.sim.controllers.anchoring import AnchoredReference, rot2
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import outside_distance
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
@@ -880,7 +880,7 @@ class WholeBodyTracker(AnchoredReference):
             if (corners[f, :, 2] - self.floor_z < self.touch).sum() > 2:
                 continue
             up = self.path.sole_up[i, f].copy()
-            up[:2] = _rot2(self.anchor_yaw) @ up[:2]
+            up[:2] = rot2(self.anchor_yaw) @ up[:2]
             if float(d.geom_xmat[self.sole[f], 2::3] @ up) > self._flat_cos:  # its z axis
                 continue
             out[f] = up
