@@ -186,11 +186,6 @@ class TumbleParams:
             rotation is unstable: a little cartwheel or twist momentum from the take-off grows
             into a tilt and a twist (the tuck's is its largest axis). At -2.0 it is the largest
             (6.28 against 6.00).
-        apex_gain: rad of ``lead`` added per m that the COM's ballistic apex (``z + vz^2 /
-            2g``, constant in the air) lies above ``apex_ref``; 0: off. Why: the back layout's
-            higher leaps open later, falling faster, and their reach turns less: touchdown
-            short of -300 deg (docs/athletics.md, "the lead by the apex").
-        apex_ref: the apex height (m, world) at which ``apex_gain`` adds nothing.
     """
 
     position: str = "tuck"
@@ -210,8 +205,6 @@ class TumbleParams:
     extend_lead: float = 0.5
     hip: float | None = None
     open_delay: float = 0.0
-    apex_gain: float = 0.0
-    apex_ref: float = 0.0
 
     def __post_init__(self) -> None:
         position_angles(self.position)  # an unknown position lists the valid ones
@@ -240,10 +233,6 @@ class TumbleParams:
             raise ConfigError(f"tumble open_delay must be in [0, 5) s, got {self.open_delay!r}")
         if self.hip is not None and not (math.isfinite(self.hip) and -2.6 <= self.hip <= 0.0):
             raise ConfigError(f"tumble hip must be in [-2.6, 0] rad, got {self.hip!r}")
-        if not (isinstance(self.apex_gain, (int, float)) and -20.0 <= self.apex_gain <= 20.0):
-            raise ConfigError(f"tumble apex_gain must be in [-20, 20] rad/m, got {self.apex_gain!r}")
-        if not (isinstance(self.apex_ref, (int, float)) and 0.0 <= self.apex_ref <= 10.0):
-            raise ConfigError(f"tumble apex_ref must be in [0, 10] m, got {self.apex_ref!r}")
 
 
 class Tumble(Basis):
@@ -293,7 +282,6 @@ class Tumble(Basis):
             memo.pop("thrown", None)
             memo.pop("extended", None)
             memo.pop("undone", None)
-            memo.pop("lead", None)
             memo["twist0"] = ctx.twist
             memo["tick"] = t
 
@@ -330,10 +318,6 @@ class Tumble(Basis):
             if aim is None:
                 aim = p.touchdown_height * (ctx.standing_com or float(s.com[2]))
             memo["t_td"] = time_to_height(ctx, aim)
-            if p.apex_gain:  # the lead moved by the leap's height (apex_gain)
-                g = float(np.linalg.norm(world.model.opt.gravity))
-                apex = float(s.com[2]) + float(s.com_vel[2]) ** 2 / (2.0 * g)
-                memo["lead"] = p.lead + p.apex_gain * (apex - p.apex_ref)
             turning = max(memo["t_td"] - p.open_delay, 0.0)
             memo["predicted"] = ctx.rotation + momentum / i_open * turning
             want = 2.0 * math.pi * p.turns - p.lead - p.extend_lead
@@ -360,10 +344,9 @@ class Tumble(Basis):
             if p.twist and ("undone" not in memo or t < memo["undone"] + p.arm_throw):
                 return False  # a twist is opened out of only once it is stopped
             want = 2.0 * math.pi * p.turns
-            lead = memo.get("lead", p.lead)
             if slower:
-                return abs(memo["predicted"]) <= want + lead or memo["t_td"] <= p.latest
-            return abs(memo["predicted"]) >= want - lead or memo["t_td"] <= p.latest
+                return abs(memo["predicted"]) <= want + p.lead or memo["t_td"] <= p.latest
+            return abs(memo["predicted"]) >= want - p.lead or memo["t_td"] <= p.latest
 
         exits: list[tuple[Event, str]] = [(opened, NEXT), (after(p.max_seconds), NEXT)]
         return [State("tumble", law(control, every), enter, tuple(exits))]
