@@ -143,7 +143,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_ahead_land: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -312,15 +311,6 @@ class AnchoredReference:
                 )
             else:
                 self._swing_limit[:] = largest * self.step_ahead
-        # ``step_ahead_land``: the step from double support only once the clip's own next
-        # landing of the stepping foot is this close (s), landing with it; per frame and foot
-        # that landing, the first planted frame after its next swing (len: never)
-        self.step_ahead_land = float(step_ahead_land)
-        if self.step_ahead_land:
-            idx = np.where(self._firm, n, np.arange(n)[:, None])
-            lift = np.minimum.accumulate(idx[::-1], axis=0)[::-1]
-            landed = np.vstack([self._next_planted, np.full((1, 2), n)])
-            self._next_landing = np.take_along_axis(landed, lift, axis=0)
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -767,18 +757,8 @@ class AnchoredReference:
         grown = lead + self.step_ahead_horizon * float(self._xi_rate @ u)
         if lead <= limit and grown <= self._grown_margin * self.step_ahead:
             return
-        duration = 0.0
-        if self.step_ahead_land:
-            # timed by the clip's stride: a step far ahead of the clip's own landing of that
-            # foot came as the clip had just landed the other one (``docs/tracking.md``)
-            k = int(self._next_landing[i, 1 - front])
-            if k < len(self._firm):
-                left_s = (k - self.clock.frame(t)) / (self.path.fps * self.rate)
-                if left_s > self.step_ahead_land:
-                    return
-                duration = max(_SWING_AHEAD_MIN, left_s)
         self._start_step(t, 1 - front, centre, xi, omega, _left_of(self.sole_heading()),
-                         shorten=False, duration=duration)  # fmt: skip
+                         shorten=False)  # fmt: skip
 
     def _swing_ahead(self, t: float, i: int) -> None:
         """``step_ahead_swing``: in the clip's single support at frame ``i`` (its one-frame

@@ -287,10 +287,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_servo: with ``step_ahead``, the pelvis position servo's gain while one of
             its steps is under way (1/s^2, at most 100; 0: off): the clip's pelvis, at the
             clip's speed, pulled the body on past its feet (``docs/tracking.md``, issue 16).
-        step_ahead_land: with ``step_ahead``, its step from double support starts only once
-            the clip's own next landing of the stepping foot is at most this far ahead (s, at
-            most 1; 0: off) and takes the time left to it, so it lands with the clip's foot
-            (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -391,7 +387,6 @@ class WholeBodyTracker(AnchoredReference):
         centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
         step_ahead_servo: float = 0.0,
-        step_ahead_land: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         flat_weight: float = 0.0,
@@ -431,7 +426,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_phase": step_ahead_phase, "centre_speed_lock": centre_speed_lock,
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
-                "step_ahead_servo": step_ahead_servo, "step_ahead_land": step_ahead_land,
+                "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band,
             },
@@ -475,11 +470,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
-            )
-        if step_ahead_land and not (step_ahead and step_ahead_land <= 1.0):
-            raise ConfigError(
-                f"step_ahead_land ({step_ahead_land!r}) is the most time (s) in (0, 1] to the "
-                f"clip's own landing of step_ahead's stepping foot: it needs step_ahead > 0"
             )
         if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
             # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
@@ -597,7 +587,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_land=step_ahead_land,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._flat_w = float(flat_weight)
