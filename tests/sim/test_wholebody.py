@@ -292,6 +292,7 @@ def test_unknown_controller_lists_the_keys(guard: Motion) -> None:
         ("flat_weight", -1.0),
         ("flat_band", 0.0),
         ("flat_band", 2.0),
+        ("flat_toe", -0.1),
     ],
 )
 def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
@@ -300,13 +301,16 @@ def test_bad_parameters_rejected(guard: Motion, key: str, value: float) -> None:
         _tracker(world, guard, 0.0, **{key: value})
 
 
-def _edge_tilt(clip: Motion, start: float, seconds: float, flat_weight: float) -> float:
+def _edge_tilt(
+    clip: Motion, start: float, seconds: float, flat_weight: float, flat_toe: float = 0.0
+) -> float:
     """Mean over the control ticks and the feet planted in the clip of how far (deg) the
-    simulated sole tilts past the clip's, tracking with ``WHOLE_CLIP`` and ``flat_weight``."""
+    simulated sole tilts past the clip's, tracking with ``WHOLE_CLIP``, ``flat_weight`` and
+    ``flat_toe``."""
     frame = round(start * clip.fps)
     world = World(build_character(clip, frame=frame))
     world.set_from_motion(0, clip, frame)
-    params = {**WHOLE_CLIP, "flat_weight": flat_weight}
+    params = {**WHOLE_CLIP, "flat_weight": flat_weight, "flat_toe": flat_toe}
     wb = build("wholebody", world, clip, params, start=start)
     assert isinstance(wb, WholeBodyTracker) and wb.path.sole_up is not None
     excess: list[float] = []
@@ -337,6 +341,32 @@ def test_flat_weight_turns_feet_standing_on_an_edge_back_toward_the_clips_soles(
     off, on = (_edge_tilt(punch, 2.0, 1.5, w) for w in (0.0, 1.0))
     assert off > 5.0, off  # the defaults' feet do stand tilted past the clip's
     assert on < 0.8 * off, (on, off)
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason=f"shared mocap not found at {SHARED}")
+def test_flat_toe_spares_a_clip_standing_on_the_balls_of_its_feet() -> None:
+    """``punch_normal_001`` stands on the balls of its feet (its planted soles' median
+    toe-down pitch 9 deg): ``flat_toe`` 0.1 rad leaves it the defaults' run exactly (no flat
+    rows), 0.2 rad (past its 9 deg) ``flat_weight``'s own run."""
+    from reactmocap.library.bvh import read_bvh
+
+    clips = sorted(SHARED.glob("*/*punch_normal_001.bvh"))
+    if not clips:
+        pytest.skip(f"no punch_normal_001 clip under {SHARED}")
+    punch = read_bvh(clips[0])
+    off, on = (_edge_tilt(punch, 2.0, 0.5, w) for w in (0.0, 1.0))
+    spared, kept = (_edge_tilt(punch, 2.0, 0.5, 1.0, toe) for toe in (0.1, 0.2))
+    assert on != off, (on, off)  # the rows act on this clip
+    assert spared == off, (spared, off)
+    assert kept == on, (kept, on)
+
+
+def test_flat_toe_needs_flat_weight(guard: Motion) -> None:
+    """``flat_toe`` without the flat rows, or past a right angle, is refused."""
+    world = World(build_character(guard, frame=0))
+    for kw in ({"flat_toe": 0.1}, {"flat_weight": 1.0, "flat_toe": 2.0}):
+        with pytest.raises(ConfigError, match="flat_toe"):
+            _tracker(world, guard, 0.0, **kw)
 
 
 def test_centre_speed_lock_walking_needs_the_lock(guard: Motion) -> None:

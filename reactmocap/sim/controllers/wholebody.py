@@ -297,6 +297,10 @@ class WholeBodyTracker(AnchoredReference):
             mocap's (``kp_swing``, critically damped): a foot loaded on its edge while the
             mocap's was flat stayed on it and the capture point left the line of the edges
             (``docs/tracking.md``, issue 16).
+        flat_toe: with ``flat_weight``, no flat rows in a clip whose planted soles' median
+            toe-down pitch is past this (rad; 0: off): it stands on the balls of its feet on
+            purpose, which the box foot's toe edge cannot do; every rule per foot and tick
+            tried still felled such a clip (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -391,6 +395,7 @@ class WholeBodyTracker(AnchoredReference):
         torque_limit: float = 0.0,
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
+        flat_toe: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -428,7 +433,7 @@ class WholeBodyTracker(AnchoredReference):
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
-                "flat_weight": flat_weight, "flat_band": flat_band,
+                "flat_weight": flat_weight, "flat_band": flat_band, "flat_toe": flat_toe,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -477,6 +482,11 @@ class WholeBodyTracker(AnchoredReference):
                 f"flat_band must be in (0, pi/2) rad and flat_weight needs swing_weight > 0, "
                 f"got flat_band {flat_band!r}, flat_weight {flat_weight!r}, "
                 f"swing_weight {swing_weight!r}"
+            )
+        if flat_toe and not (flat_weight and flat_toe < np.pi / 2):
+            raise ConfigError(
+                f"flat_toe ({flat_toe!r}) is a toe-down pitch in (0, pi/2) rad past which "
+                f"a clip gets no flat_weight rows: it needs flat_weight > 0"
             )
         servo = world.servo
         m = world.model
@@ -590,6 +600,8 @@ class WholeBodyTracker(AnchoredReference):
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._flat_w = float(flat_weight)
+        if flat_toe and self._toe_pitch() > np.sin(flat_toe):
+            self._flat_w = 0.0  # a clip on the balls of its feet: no flat rows
         self._flat_cos = float(np.cos(flat_band))
         self._soft = float(step_soft)
         self._soft_reg = float(np.sqrt(step_soft_reg))
@@ -885,6 +897,17 @@ class WholeBodyTracker(AnchoredReference):
                 continue
             out[f] = up
         return out
+
+    def _toe_pitch(self) -> float:
+        """The sine of the median toe-down pitch of the clip's planted (not pivoting) soles
+        about their headings (0 with none)."""
+        p = self.path
+        assert p.sole_up is not None and p.sole_yaw is not None
+        on = p.planted & ~p.pivoting
+        if not on.any():
+            return 0.0
+        up, yaw = p.sole_up[on], p.sole_yaw[on]
+        return float(np.median(up[:, 0] * np.cos(yaw) + up[:, 1] * np.sin(yaw)))
 
     def _landing_weights(self, t: float, sup: _Support) -> F64 | None:
         """The no-slip rows' square-root weights in the ``step_soft`` s after a balance
