@@ -128,6 +128,24 @@ def test_the_female_handspring_lands_on_feet_placed_past_the_default_hip_swing()
     assert capped["landed"] is False and capped["fell"] is True
 
 
+def test_the_female_crouch_eased_in_narrows_her_take_off_and_her_hands_meet_the_floor() -> None:
+    """A tenth's start 3 (seed 0): with the crouch's COM target stepped back at once and the
+    hips' feedback allowed 2.0 rad (her preset before 2026-12-05) the step rocks her, she
+    leaves with over 52 kg m^2/s of backward spin against the nominal's 48.8 and turns past
+    her hands before they reach the floor. Her preset eases the target in over 0.2 s
+    (``com_ramp``, 1.8 rad): she leaves within 0.3 of the nominal's spin and her hands touch
+    (docs/athletics.md). Cut at 1.8 s, past the hands' contact (1.60 s)."""
+    m = replace(handspring_maneuver("female"), seconds=1.8)
+    leap = next(p for p in m.phases if p.controller == "leap").params
+    start = _starts(0.1, 4)[3]
+    nominal = run_maneuver(m, fps=10.0).report
+    eased = run_maneuver(m, perturbation=start, fps=10.0).report
+    stepped = run_maneuver(_with(m, "leap", {**leap, "com_ramp": 0.0, "spin_limit": 2.0}),
+                           perturbation=start, fps=10.0).report  # fmt: skip
+    assert stepped["liftoff_pitch_momentum"] < -52.0 and stepped["rotation_at_hands_deg"] is None
+    assert abs(eased["liftoff_pitch_momentum"] - nominal["liftoff_pitch_momentum"]) < 0.3
+    assert -200.0 < eased["rotation_at_hands_deg"] < -180.0
+
 def _starts(scale: float, n: int) -> list[Perturbation]:
     """The first ``n`` of the capture region's starts (seed 0) at ``scale`` of the benchmark's
     distribution, written as it writes it (the same floats)."""
