@@ -231,6 +231,19 @@ class Step:
             steps the legs stood 0.17-0.19 rad apart in the knee, the pelvis rolled 15-20 deg
             and the COM drifted out over the more bent one on both feet; to the posture's
             knees lost more starts; docs/athletics.md "kind (c)").
+        stance_roll: during a swing this share (in [0, 1]) of the law's hip roll offset is
+            taken off the standing hip (0: off, all of it kept: on the male back handspring's
+            landing steps it rolled the pelvis 10 deg down on the swing side, whose foot then
+            landed inside its hip, short of its place; docs/athletics.md "the last falling
+            starts").
+        hang_plant: on a step that is not the standing balance's (the landing's), the
+            posture's plant on once a foot has hung this many seconds with no swing under way
+            (0: off; in [0, 2]; the male back handspring's landers that stood on one foot for
+            1-1.5 s, a later step's swing never down; docs/athletics.md "the last falling
+            starts").
+        swing_roll: the swing thigh's roll (heading frame) allowed up to asin of this (0:
+            off, :data:`STEP_ROLL` 0.5; else in [0.5, 0.95]; docs/athletics.md "the last
+            falling starts").
     """
 
     margin: float = 0.05
@@ -248,6 +261,9 @@ class Step:
     pair: float = 0.0
     bow_hold: float = 0.0
     knees: float = 0.0
+    stance_roll: float = 0.0
+    swing_roll: float = 0.0
+    hang_plant: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -269,11 +285,14 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"))  # fmt: skip
+                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"),
+                  ("stance_roll", 1.0, "of the offset"), ("swing_roll", 0.95, ""), ("hang_plant", 2.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
                 raise ConfigError(f"step {name} must be in [0, {hi:g}] {unit}, got {v!r}")
+        if 0.0 < self.swing_roll < STEP_ROLL:
+            raise ConfigError(f"step swing_roll must be 0 or in [0.5, 0.95], got {self.swing_roll}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -419,6 +438,8 @@ SIDE_SLOPE = 0.2
 #: ``swing_cap``), the seconds after a step before the next may start
 STEP_LONGEST = 0.7
 STEP_SWING_CAP = 0.8
+#: the swing thigh's roll allowed up to asin of this (Step.swing_roll replaces it)
+STEP_ROLL = 0.5
 STEP_PAUSE = 0.1
 #: seconds after a step within which a foot left hanging is brought down beside the other
 STEP_CLOSE = 1.0
@@ -839,6 +860,8 @@ class Stepper:
                                     "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
         if self.foot < 0 and self.standing and not bl.posture.plant:
             self._plant_if_hanging(bl, float(np.hypot(*vel)), t)
+        elif self.foot < 0 and st.hang_plant and not bl.posture.plant:
+            self._plant_hung(bl, t)
         if self.foot < 0 and t - self._t_give < (1.0 + STEP_GIVE_BACK) * st.give_time:
             self._give(t)
         if self.foot < 0:
@@ -956,7 +979,8 @@ class Stepper:
         # the leg aimed in the world at the place, whatever the pelvis's orientation (as the
         # landing's reach); the COM servo's offsets off it, its weight on the other foot
         self._thigh[0] = -swing + geom
-        self._thigh[1] = math.asin(float(np.clip(aside / length, -0.5, 0.5)))
+        roll = st.swing_roll or STEP_ROLL
+        self._thigh[1] = math.asin(float(np.clip(aside / length, -roll, roll)))
         aim = hips_for_thighs(self.ctx, d, self._thigh[None], h)[0]
         # the hip eased toward its aim (first order): a jump in its target kicked the pelvis
         # back and the standing foot off the floor
@@ -969,6 +993,8 @@ class Stepper:
         rig.offset[_HIP[k]] = 0.0
         rig.offset[_ANKLE[k]] = 0.0
         rig.offset[_KNEE[k]] = 0.0
+        if st.stance_roll:  # Step.stance_roll: the standing hip's roll offset eased off
+            rig.offset[_HIP[1 - k], 1] *= 1.0 - st.stance_roll
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
 
@@ -987,6 +1013,15 @@ class Stepper:
         law = rig.desired(t)[joints, 0] + rig.offset[joints, 0]
         w = min((1.0 + STEP_GIVE_BACK - x) / STEP_GIVE_BACK, 1.0)  # then the law's, linearly
         rig.offset[joints, 0] += w * (held - law)
+
+    def _plant_hung(self, bl: BalanceLaw, t: float) -> None:
+        """:attr:`Step.hang_plant`: the posture's plant on once a foot has hung that long."""
+        if int(self.ctx.senses.foot_contact.sum()) != 1:
+            self._t_hang = math.inf
+            return
+        self._t_hang = min(self._t_hang, t)
+        if t >= max(self._t_hang + self.step.hang_plant, self._t_end + STEP_PAUSE):
+            bl.posture = replace(bl.posture, plant=True)
 
     def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
         """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough
