@@ -231,19 +231,12 @@ class Step:
             steps the legs stood 0.17-0.19 rad apart in the knee, the pelvis rolled 15-20 deg
             and the COM drifted out over the more bent one on both feet; to the posture's
             knees lost more starts; docs/athletics.md "kind (c)").
-        stance_roll: during a swing this share (in [0, 1]) of the law's hip roll offset is
-            taken off the standing hip (0: off, all of it kept: on the male back handspring's
-            landing steps it rolled the pelvis 10 deg down on the swing side, whose foot then
-            landed inside its hip, short of its place; docs/athletics.md "the last falling
+        hang_plant: on a stepper that is not the standing balance's (the landing's, carried
+            on by the balance after it), the posture's plant (:attr:`Posture.plant`) on once
+            a foot has hung this many seconds with no swing under way (0: off; in [0, 2] s;
+            opt-in: male back handspring starts stood 1-2 s on one foot after the landing,
+            then a step's swing never came down; docs/athletics.md "the last falling
             starts").
-        hang_plant: on a step that is not the standing balance's (the landing's), the
-            posture's plant on once a foot has hung this many seconds with no swing under way
-            (0: off; in [0, 2]; the male back handspring's landers that stood on one foot for
-            1-1.5 s, a later step's swing never down; docs/athletics.md "the last falling
-            starts").
-        swing_roll: the swing thigh's roll (heading frame) allowed up to asin of this (0:
-            off, :data:`STEP_ROLL` 0.5; else in [0.5, 0.95]; docs/athletics.md "the last
-            falling starts").
     """
 
     margin: float = 0.05
@@ -261,8 +254,6 @@ class Step:
     pair: float = 0.0
     bow_hold: float = 0.0
     knees: float = 0.0
-    stance_roll: float = 0.0
-    swing_roll: float = 0.0
     hang_plant: float = 0.0
 
     def __post_init__(self) -> None:
@@ -285,14 +276,11 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"),
-                  ("stance_roll", 1.0, "of the offset"), ("swing_roll", 0.95, ""), ("hang_plant", 2.0, "s"))  # fmt: skip
+                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
                 raise ConfigError(f"step {name} must be in [0, {hi:g}] {unit}, got {v!r}")
-        if 0.0 < self.swing_roll < STEP_ROLL:
-            raise ConfigError(f"step swing_roll must be 0 or in [0.5, 0.95], got {self.swing_roll}")
 
     @classmethod
     def of(cls, values: Step | Sequence[float] | None) -> Step | None:
@@ -438,8 +426,6 @@ SIDE_SLOPE = 0.2
 #: ``swing_cap``), the seconds after a step before the next may start
 STEP_LONGEST = 0.7
 STEP_SWING_CAP = 0.8
-#: the swing thigh's roll allowed up to asin of this (Step.swing_roll replaces it)
-STEP_ROLL = 0.5
 STEP_PAUSE = 0.1
 #: seconds after a step within which a foot left hanging is brought down beside the other
 STEP_CLOSE = 1.0
@@ -979,8 +965,7 @@ class Stepper:
         # the leg aimed in the world at the place, whatever the pelvis's orientation (as the
         # landing's reach); the COM servo's offsets off it, its weight on the other foot
         self._thigh[0] = -swing + geom
-        roll = st.swing_roll or STEP_ROLL
-        self._thigh[1] = math.asin(float(np.clip(aside / length, -roll, roll)))
+        self._thigh[1] = math.asin(float(np.clip(aside / length, -0.5, 0.5)))
         aim = hips_for_thighs(self.ctx, d, self._thigh[None], h)[0]
         # the hip eased toward its aim (first order): a jump in its target kicked the pelvis
         # back and the standing foot off the floor
@@ -993,8 +978,6 @@ class Stepper:
         rig.offset[_HIP[k]] = 0.0
         rig.offset[_ANKLE[k]] = 0.0
         rig.offset[_KNEE[k]] = 0.0
-        if st.stance_roll:  # Step.stance_roll: the standing hip's roll offset eased off
-            rig.offset[_HIP[1 - k], 1] *= 1.0 - st.stance_roll
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
 
