@@ -160,9 +160,9 @@ def _unspun(m: Maneuver) -> Maneuver:
 
 def _unforeseen(m: Maneuver) -> Maneuver:
     """``m`` with the landing's step as the file had it before 2026-12-05 (later): no
-    ``step_across`` / ``step_foresee`` (nor the latest ``step_knees``)."""
+    ``step_across`` / ``step_foresee`` (nor the later ``step_knees`` / ``step_hang_plant``)."""
     land = next(p for p in m.phases if p.controller == "land").params
-    drop = ("step_across", "step_foresee", "step_knees")
+    drop = ("step_across", "step_foresee", "step_knees", "step_hang_plant")
     old = {k: v for k, v in land.items() if k not in drop}
     return _with(m, "land", old)
 
