@@ -231,6 +231,12 @@ class Step:
             steps the legs stood 0.17-0.19 rad apart in the knee, the pelvis rolled 15-20 deg
             and the COM drifted out over the more bent one on both feet; to the posture's
             knees lost more starts; docs/athletics.md "kind (c)").
+        hang_plant: on a stepper that is not the standing balance's (the landing's, carried
+            on by the balance after it), the posture's plant (:attr:`Posture.plant`) on once
+            a foot has hung this many seconds with no swing under way (0: off; in [0, 2] s;
+            opt-in: male back handspring starts stood 1-2 s on one foot after the landing,
+            then a step's swing never came down; docs/athletics.md "the last falling
+            starts").
     """
 
     margin: float = 0.05
@@ -248,6 +254,7 @@ class Step:
     pair: float = 0.0
     bow_hold: float = 0.0
     knees: float = 0.0
+    hang_plant: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -269,7 +276,7 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"))  # fmt: skip
+                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -839,6 +846,8 @@ class Stepper:
                                     "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
         if self.foot < 0 and self.standing and not bl.posture.plant:
             self._plant_if_hanging(bl, float(np.hypot(*vel)), t)
+        elif self.foot < 0 and st.hang_plant and not bl.posture.plant:
+            self._plant_hung(bl, t)
         if self.foot < 0 and t - self._t_give < (1.0 + STEP_GIVE_BACK) * st.give_time:
             self._give(t)
         if self.foot < 0:
@@ -987,6 +996,15 @@ class Stepper:
         law = rig.desired(t)[joints, 0] + rig.offset[joints, 0]
         w = min((1.0 + STEP_GIVE_BACK - x) / STEP_GIVE_BACK, 1.0)  # then the law's, linearly
         rig.offset[joints, 0] += w * (held - law)
+
+    def _plant_hung(self, bl: BalanceLaw, t: float) -> None:
+        """:attr:`Step.hang_plant`: the posture's plant on once a foot has hung that long."""
+        if int(self.ctx.senses.foot_contact.sum()) != 1:
+            self._t_hang = math.inf
+            return
+        self._t_hang = min(self._t_hang, t)
+        if t >= max(self._t_hang + self.step.hang_plant, self._t_end + STEP_PAUSE):
+            bl.posture = replace(bl.posture, plant=True)
 
     def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
         """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough

@@ -454,7 +454,9 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # across the feet carried 0.25 s on (LandingParams.step_foresee with step_across: 40/50
     # and 31/50 from 35 and 29, held-out seed 2 35 from 30); and (latest) at each step's
     # touchdown both knees' targets go to their mean (LandingParams.step_knees: 40/50 and
-    # 36/50 from 40 and 31, held-out seed 2 38 from 35). A list: a maneuver file's
+    # 36/50 from 40 and 31, held-out seed 2 38 from 35); and (last) a foot left hanging 0.4 s
+    # with no swing is put down (LandingParams.step_hang_plant: 41/50 and 37/50 from 40 and
+    # 36, held-out seed 2 39/50 from 38). A list: a maneuver file's
     # numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3, "hold": 0.22, "com_offset": -0.13,
@@ -464,7 +466,7 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
         "land": MappingProxyType({"delta": -0.6, "spin_ref": -96.8,
                                   "step": [0.05, 0.0, 0.3, 0.25], "recover_leg": 0.8,
                                   "step_across": 0.05, "step_foresee": 0.25,
-                                  "step_knees": 1.0}),
+                                  "step_knees": 1.0, "step_hang_plant": 0.4}),
         "balance": MappingProxyType({"side_both": True}),
     }),
     "female": MappingProxyType({

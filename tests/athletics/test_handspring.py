@@ -146,10 +146,11 @@ def test_the_female_crouch_eased_in_narrows_her_take_off_and_her_hands_meet_the_
     assert abs(eased["liftoff_pitch_momentum"] - nominal["liftoff_pitch_momentum"]) < 0.3
     assert -200.0 < eased["rotation_at_hands_deg"] < -180.0
 
-def _starts(scale: float, n: int) -> list[Perturbation]:
-    """The first ``n`` of the capture region's starts (seed 0) at ``scale`` of the benchmark's
+
+def _starts(scale: float, n: int, seed: int = 0) -> list[Perturbation]:
+    """The first ``n`` of the capture region's starts (``seed``) at ``scale`` of the benchmark's
     distribution, written as it writes it (the same floats)."""
-    rng = np.random.default_rng(0)
+    rng = np.random.default_rng(seed)
     sd = {"joint_sd": math.radians(3.0) * scale, "pitch_sd": math.radians(2.0) * scale,
           "velocity_sd": 0.05 * scale, "spin_sd": 0.1 * scale}  # fmt: skip
     return [Perturbation.sample(rng, **sd) for _ in range(n)]
@@ -178,9 +179,9 @@ def _unspun(m: Maneuver) -> Maneuver:
 
 def _unforeseen(m: Maneuver) -> Maneuver:
     """``m`` with the landing's step as the file had it before 2026-12-05 (later): no
-    ``step_across`` / ``step_foresee`` (nor the latest ``step_knees``)."""
+    ``step_across`` / ``step_foresee`` (nor the later ``step_knees`` / ``step_hang_plant``)."""
     land = next(p for p in m.phases if p.controller == "land").params
-    drop = ("step_across", "step_foresee", "step_knees")
+    drop = ("step_across", "step_foresee", "step_knees", "step_hang_plant")
     old = {k: v for k, v in land.items() if k not in drop}
     return _with(m, "land", old)
 
@@ -575,3 +576,24 @@ def test_the_landings_steps_leave_both_knees_alike() -> None:
             LandingParams(step=(0.05,), step_knees=bad)
     with pytest.raises(ConfigError, match="need a step"):
         LandingParams(step_knees=1.0)
+
+
+def test_the_landings_hung_foot_is_planted_after_step_hang_plant() -> None:
+    """Full-size start 4 (seed 1) stands on one foot after the landing, the other hung, and
+    falls over a late step. With ``step_hang_plant`` 0.4 (the landing's carried stepper puts
+    the posture's plant on once a foot has hung 0.4 s with no swing) the hung foot is put
+    down and it lands with no step. A bad value, or one without a step, is named."""
+    m = replace(load_maneuver(EXAMPLE), seconds=6.0)
+    land = next(p for p in m.phases if p.controller == "land").params
+    plain = {k: v for k, v in land.items() if k != "step_hang_plant"}
+    start = _starts(1.0, 5, seed=1)[4]
+    r = run_maneuver(_with(m, "land", {**plain, "step_hang_plant": 0.4}), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["landed"] and not r["fell"] and not r.get("steps")
+    old = run_maneuver(_with(m, "land", plain), perturbation=start, fps=10.0).report
+    assert old["fell"] and not old["landed"]
+    for bad in (-0.1, 2.5, math.nan):
+        with pytest.raises(ConfigError, match="step_hang_plant"):
+            LandingParams(step=(0.05,), step_hang_plant=bad)
+    with pytest.raises(ConfigError, match="need a step"):
+        LandingParams(step_hang_plant=0.4)
