@@ -297,10 +297,6 @@ class WholeBodyTracker(AnchoredReference):
             mocap's (``kp_swing``, critically damped): a foot loaded on its edge while the
             mocap's was flat stayed on it and the capture point left the line of the edges
             (``docs/tracking.md``, issue 16).
-        anchor_shift_speed: with ``step_ahead`` and ``anchor_tau``, after a back push this
-            fraction (0, 1] of the ground path's shift rate is added to the pelvis's velocity
-            target (0: off): the re-anchoring dragged the path back while the target kept the
-            clip's speed (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -395,7 +391,6 @@ class WholeBodyTracker(AnchoredReference):
         torque_limit: float = 0.0,
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
-        anchor_shift_speed: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -434,7 +429,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band,
-                "anchor_shift_speed": anchor_shift_speed,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -477,12 +471,6 @@ class WholeBodyTracker(AnchoredReference):
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
             )
-        if anchor_shift_speed and not (step_ahead and anchor_tau and anchor_shift_speed <= 1.0):
-            raise ConfigError(
-                f"anchor_shift_speed ({anchor_shift_speed!r}) is the fraction in (0, 1] of the "
-                f"ground path's shift rate added to the pelvis's velocity target after a back "
-                f"push: it needs step_ahead > 0 and anchor_tau > 0"
-            )
         if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
             # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
             raise ConfigError(
@@ -521,10 +509,6 @@ class WholeBodyTracker(AnchoredReference):
         # and the one the push set (back to it on landing)
         self._ahead_servo = float(step_ahead_servo)
         self._kp_pushed = float(self.kp[0])
-        # ``anchor_shift_speed``: the ground path's shift at the last slow tick and its rate
-        self._shift_speed = float(anchor_shift_speed)
-        self._shift_prev = np.zeros(2)
-        self._shift_rate = np.zeros(2)
         self._step_pushed = bool(step_pushed)
         self._pushed = False  # an external force has acted on the body
         self._pushing = False  # one acts now
@@ -733,10 +717,6 @@ class WholeBodyTracker(AnchoredReference):
         quantities of the last step). Does not touch the simulation."""
         m, d = self.world.model, self.world.data
         qr, vr, ar, planted = self.reference(t)
-        if self._shift_speed and self._ahead_armed:
-            # the path's own velocity: the clip's at full speed while the re-anchoring
-            # dragged the path back after the feet asked 20-28 m/s^2 forward of a pushed body
-            vr[:2] += self._shift_speed * self._shift_rate
         held = self._held(t)
         flat = self._flat_feet(planted, t) if self._flat_w else {}
         sl = self._dofs
@@ -1101,18 +1081,8 @@ class WholeBodyTracker(AnchoredReference):
         self.kp[:3], self.kv[:3] = memory[-4], memory[-3]
         self._holding, self._scale = bool(memory[-2]), float(memory[-1])  # type: ignore[arg-type]
 
-    def reanchor(self, t: float) -> None:
-        if not (self._shift_speed and self._ahead_armed):
-            super().reanchor(t)
-            return
-        np.copyto(self._shift_prev, self.anchor_shift)
-        super().reanchor(t)
-        np.subtract(self.anchor_shift, self._shift_prev, out=self._shift_rate)
-        self._shift_rate /= self._dt_slow
-
     def reset(self, world: World) -> None:
         self.reset_ground(world)
-        self._shift_rate[:] = 0.0
         self._pushed, self._back_from, self._hip_from = False, -np.inf, -np.inf
         self._holding = False
         if self._stiffness != 1.0:
