@@ -143,7 +143,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        warp_along: bool = False,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -254,7 +253,6 @@ class AnchoredReference:
         self.anchor_shift = np.zeros(2)
         self._turn = (0.0, rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
         self.warp_gain = float(warp_gain)
-        self.warp_along = bool(warp_along)
         self.warp_lead = float(warp_lead)
         self.warp_phase = float(warp_phase)
         self.warp_for = float(warp_for)
@@ -937,13 +935,7 @@ class AnchoredReference:
         # the whole speed, not its part along the walk: a sideways push is caught sooner by
         # quicker steps too (the part along the walk drops then, and a clip slowed with it
         # lost the right pushes it survived: the rate never goes below 1)
-        body = self.world.data.subtree_linvel[self._root][:2]
-        if self.warp_along and self._ahead_armed:
-            # after a back push: its speed along the walk (a diagonal push's sideways speed
-            # played the clip 1.1-1.25 times faster while the body lagged along it)
-            speed = max(0.0, float(body @ v_ref)) / n2
-        else:
-            speed = float(np.linalg.norm(body)) / ref
+        speed = float(np.linalg.norm(self.world.data.subtree_linvel[self._root][:2])) / ref
         target = 1.0 + self.warp_gain * (speed - 1.0)
         if self.leading:
             # the speed ratio forgets a position lead: after a caught sideways fall the body

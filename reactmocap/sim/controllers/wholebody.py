@@ -302,9 +302,6 @@ class WholeBodyTracker(AnchoredReference):
             most 1; 0: off), the pelvis's acceleration target loses its forward part: the
             servo's speed deficit asked 10-30 m/s^2 forward of a body already past its feet
             (``docs/tracking.md``, issue 16).
-        warp_along: with ``step_ahead`` and ``warp_gain``, after a back push the clip's rate
-            follows the body's speed along the clip's walk, not its whole horizontal speed
-            (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -400,7 +397,6 @@ class WholeBodyTracker(AnchoredReference):
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
         step_ahead_brake: float = 0.0,
-        warp_along: bool = False,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -439,7 +435,7 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band,
-                "step_ahead_brake": step_ahead_brake, "warp_along": warp_along,
+                "step_ahead_brake": step_ahead_brake,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -487,11 +483,6 @@ class WholeBodyTracker(AnchoredReference):
                 f"step_ahead_brake ({step_ahead_brake!r}) is the capture point's lead past the "
                 f"front sole, in (0, 1] m, that ends the pelvis's forward acceleration target "
                 f"after a back push: it needs step_ahead > 0"
-            )
-        if warp_along and not (step_ahead and warp_gain):
-            raise ConfigError(
-                f"warp_along ({warp_along!r}) sets the clip's rate after a back push from the "
-                f"body's speed along the walk: it needs step_ahead > 0 and warp_gain > 0"
             )
         if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
             # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
@@ -612,7 +603,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            warp_along=warp_along,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._flat_w = float(flat_weight)
