@@ -297,11 +297,6 @@ class WholeBodyTracker(AnchoredReference):
             mocap's (``kp_swing``, critically damped): a foot loaded on its edge while the
             mocap's was flat stayed on it and the capture point left the line of the edges
             (``docs/tracking.md``, issue 16).
-        step_ahead_brake: with ``step_ahead``, after a back push, while the simulated
-            capture point leads the front sole along the clip's walk by more than this (m, at
-            most 1; 0: off), the pelvis's acceleration target loses its forward part: the
-            servo's speed deficit asked 10-30 m/s^2 forward of a body already past its feet
-            (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -396,7 +391,6 @@ class WholeBodyTracker(AnchoredReference):
         torque_limit: float = 0.0,
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
-        step_ahead_brake: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -435,7 +429,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band,
-                "step_ahead_brake": step_ahead_brake,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -478,12 +471,6 @@ class WholeBodyTracker(AnchoredReference):
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
             )
-        if step_ahead_brake and not (step_ahead and step_ahead_brake <= 1.0):
-            raise ConfigError(
-                f"step_ahead_brake ({step_ahead_brake!r}) is the capture point's lead past the "
-                f"front sole, in (0, 1] m, that ends the pelvis's forward acceleration target "
-                f"after a back push: it needs step_ahead > 0"
-            )
         if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
             # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
             raise ConfigError(
@@ -522,9 +509,6 @@ class WholeBodyTracker(AnchoredReference):
         # and the one the push set (back to it on landing)
         self._ahead_servo = float(step_ahead_servo)
         self._kp_pushed = float(self.kp[0])
-        # ``step_ahead_brake``: the clip's walking direction while it acts, else None
-        self._brake = float(step_ahead_brake)
-        self._brake_u: F64 | None = None
         self._step_pushed = bool(step_pushed)
         self._pushed = False  # an external force has acted on the body
         self._pushing = False  # one acts now
@@ -745,12 +729,6 @@ class WholeBodyTracker(AnchoredReference):
         mujoco.mj_differentiatePos(m, self._dq, 1.0, d.qpos, self._qref)
         acc_des = ar + self.kp * self._dq[sl] + self.kv * (vr - v)
         acc_des[:6] += self.root_bias
-        if self._brake_u is not None:
-            u0, u1 = self._brake_u
-            along = acc_des[0] * u0 + acc_des[1] * u1
-            if along > 0.0:
-                acc_des[0] -= along * u0
-                acc_des[1] -= along * u1
 
         mujoco.mj_fullM(m, d, self._full)
         big_m = self._full[sl, sl]
@@ -1103,20 +1081,8 @@ class WholeBodyTracker(AnchoredReference):
         self.kp[:3], self.kv[:3] = memory[-4], memory[-3]
         self._holding, self._scale = bool(memory[-2]), float(memory[-1])  # type: ignore[arg-type]
 
-    def update_ground(self, t: float) -> None:
-        slow = t >= self._slow_next - 1e-9
-        super().update_ground(t)
-        if slow and self._brake:
-            self._brake_u = None
-            if self._ahead_armed and (u := self._walk_direction(t)) is not None:
-                xi, _ = self.capture_point()
-                front = float((self._sole_centres()[:, :2] @ u).max())
-                if float(xi @ u) - front > self._brake:
-                    self._brake_u = u
-
     def reset(self, world: World) -> None:
         self.reset_ground(world)
-        self._brake_u = None
         self._pushed, self._back_from, self._hip_from = False, -np.inf, -np.inf
         self._holding = False
         if self._stiffness != 1.0:
