@@ -143,7 +143,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_ahead_follow: bool = False,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -254,7 +253,6 @@ class AnchoredReference:
         self.anchor_shift = np.zeros(2)
         self._turn = (0.0, rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
         self.warp_gain = float(warp_gain)
-        self.step_ahead_follow = bool(step_ahead_follow)
         self.warp_lead = float(warp_lead)
         self.warp_phase = float(warp_phase)
         self.warp_for = float(warp_for)
@@ -471,17 +469,11 @@ class AnchoredReference:
         if self.step is not None:
             p, v, a = self.step.at(t)
             out[self.step.foot] = (p, v, a, np.array([0.0, 0.0, 1.0]))
-        # ``step_ahead_follow``: after a back push the clip's swing foot follows its own sole
-        # (a slowed body's leg pose landed it 0.5 m short of the clip's landing)
-        follow = self.step_ahead_follow and self._ahead_armed
-        if not (self.place_shift.any() or self._place_move.any() or follow):
+        if not (self.place_shift.any() or self._place_move.any()):
             return out
-        low = self.sole_corners()[:, :, 2].min(axis=1) - self.floor_z if follow else None
         for f in range(2):  # two feet
-            if f in out or not (self.place_shift.any() or self._place_move[f].any() or follow):
+            if f in out or not (self.place_shift.any() or self._place_move[f].any()):
                 continue
-            if low is not None and low[f] < self.anchor_touch and not self._place_move[f].any():
-                continue  # a foot still (or already) down: its leg carries the body
             sole = self._mocap_swing(t, f)
             if sole is None:
                 continue

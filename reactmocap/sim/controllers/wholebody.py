@@ -297,9 +297,6 @@ class WholeBodyTracker(AnchoredReference):
             mocap's (``kp_swing``, critically damped): a foot loaded on its edge while the
             mocap's was flat stayed on it and the capture point left the line of the edges
             (``docs/tracking.md``, issue 16).
-        step_ahead_follow: with ``step_ahead``, after a back push the clip's swinging foot
-            follows its own sole (re-anchored) in world space, with the placement's rows
-            (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -394,7 +391,6 @@ class WholeBodyTracker(AnchoredReference):
         torque_limit: float = 0.0,
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
-        step_ahead_follow: bool = False,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -433,7 +429,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band,
-                "step_ahead_follow": step_ahead_follow,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -475,11 +470,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
-            )
-        if step_ahead_follow and not step_ahead:
-            raise ConfigError(
-                f"step_ahead_follow ({step_ahead_follow!r}) acts after step_ahead's back "
-                f"pushes: it needs step_ahead > 0"
             )
         if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
             # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
@@ -597,7 +587,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_follow=step_ahead_follow,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._flat_w = float(flat_weight)
