@@ -143,7 +143,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_ahead_reach: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -254,8 +253,6 @@ class AnchoredReference:
         self.anchor_shift = np.zeros(2)
         self._turn = (0.0, rot2(0.0), quat_from_yaw(0.0))  # the anchor's yaw as matrix, quat
         self.warp_gain = float(warp_gain)
-        self.step_ahead_reach = float(step_ahead_reach)
-        self._reached = False
         self.warp_lead = float(warp_lead)
         self.warp_phase = float(warp_phase)
         self.warp_for = float(warp_for)
@@ -795,19 +792,6 @@ class AnchoredReference:
         stance = centre[1 - f, :2]
         pred = stance + (xi - stance) * np.exp(omega * left_s)
         land = rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
-        if self.step_ahead_reach and not self._reached and not self.world.data.xfrc_applied.any():
-            # the first swing after the push: a slowed body's leg pose landed that foot 0.5 m
-            # short of the clip's landing; a step toward it, at most ``step_ahead_reach`` past
-            # where the clip's leg would put it now
-            self._reached = True
-            now = centre[f, :2]
-            gap = land - now
-            n = float(np.linalg.norm(gap))
-            target = now + gap * min(1.0, self.step_ahead_reach / n) if n > 0 else now
-            self.step = Step(f, t, min(max(_SWING_AHEAD_MIN, left_s), self.step_time),
-                             centre[f].copy(), np.r_[target, self.floor_z], self.step_height)  # fmt: skip
-            self.steps_taken.append(t)
-            return
         if float((pred - land) @ u) <= self._swing_limit[i]:
             return
         duration = max(_SWING_AHEAD_MIN, self.step_ahead_swing * left_s)
@@ -1005,7 +989,6 @@ class AnchoredReference:
         self._placed[:] = False
         self.step = None
         self.steps_taken = []
-        self._reached = False
         self._step_ready = 0.0
         self._landed = (-1, -np.inf)
         self._gone_down = False

@@ -391,7 +391,6 @@ class WholeBodyTracker(AnchoredReference):
         torque_limit: float = 0.0,
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
-        step_ahead_reach: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -430,7 +429,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band,
-                "step_ahead_reach": step_ahead_reach,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -472,11 +470,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
-            )
-        if step_ahead_reach and not (step_ahead_swing and step_ahead_reach <= 1.0):
-            raise ConfigError(
-                f"step_ahead_reach ({step_ahead_reach!r}) is a distance in (0, 1] m toward the "
-                f"clip's landing in the first swing after a back push: it needs step_ahead_swing"
             )
         if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
             # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
@@ -594,7 +587,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_reach=step_ahead_reach,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._flat_w = float(flat_weight)
