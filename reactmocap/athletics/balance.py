@@ -237,6 +237,12 @@ class Step:
             opt-in: male back handspring starts stood 1-2 s on one foot after the landing,
             then a step's swing never came down; docs/athletics.md "the last falling
             starts").
+        plant_settle: when the standing balance plants a hung foot, the posture's stand-up
+            (knees, spine, arms, the pelvis's pitch) starts again from where its targets
+            are, at rest, and reaches the posture over this many seconds (0: off, it runs
+            on over the posture's settle; opt-in: the forward tuck's stand-up bounced the
+            hung foot off the floor, docs/athletics.md "Forward tuck: the stand-up
+            restarted at the plant").
     """
 
     margin: float = 0.05
@@ -255,6 +261,7 @@ class Step:
     bow_hold: float = 0.0
     knees: float = 0.0
     hang_plant: float = 0.0
+    plant_settle: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -276,7 +283,8 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"))  # fmt: skip
+                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"),
+                  ("plant_settle", 5.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -1021,6 +1029,9 @@ class Stepper:
                 if float(np.hypot(*(s.com[:2] - s.support_center()[:2]))) >= self.step.hang_near:
                     return  # Step.hang_near: the COM still far off the standing sole
             bl.posture = replace(bl.posture, plant=True)
+            if self.step.plant_settle:  # the stand-up again from rest, from here
+                bl.set_posture(replace(bl.posture, settle=self.step.plant_settle), t,
+                               gains=False, pitch_from=bl.pitch_target(t))  # fmt: skip
 
 
 def hips_for_thighs(  # type: ignore[no-untyped-def]

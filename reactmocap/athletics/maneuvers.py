@@ -157,11 +157,13 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
     g = BALANCE_GAIN_SETS[gains]
     standing = bool(p.pop("standing_step", False))
     near = float(p.pop("hang_near", 0.0))  # check_phase: only with standing_step, (0, 0.3]
+    again = float(p.pop("plant_settle", 0.0))  # check_phase: only with standing_step, (0, 5]
     if standing:
         # the balance behaviour's step="on": a hung foot planted, steps across the feet too,
         # the bow (standing gains) eased; `step` numbers override its own, not the plant
         step = replace(step, hang_still=STANDING_STEP.hang_still) if step else STANDING_STEP
         step = replace(step, hang_near=near) if near else step
+        step = replace(step, plant_settle=again) if again else step
         g = replace(g, bow_ease=STANDING_BOW_EASE) if g.bow is not None else g
     seconds = phase.seconds if phase.exit == "after" else None
     within = None
@@ -244,9 +246,11 @@ CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
         "behaviour's step \"on\": a foot left hanging put down once the COM is slower than "
         "0.25 m/s, steps across the feet too; `step` overrides its step's numbers, not the "
         "plant); `hang_near` (m, (0, 0.3], with `standing_step`; default off): that foot "
-        "is put down only once the COM also lies within this of the standing sole's middle",
+        "is put down only once the COM also lies within this of the standing sole's middle; "
+        "`plant_settle` (s, (0, 5], with `standing_step`; default off): as that foot is put "
+        "down the stand-up starts again from rest and takes this long",
         {**_kinds(Posture), "settle_share": "number", "gains": "string", "step": "numbers",
-         "standing_step": "bool", "hang_near": "number"},
+         "standing_step": "bool", "hang_near": "number", "plant_settle": "number"},
         {"after": "after `seconds`", "never": "holds to the end of the run",
          "settled": "once standing still on both feet with the COM over them (a perturbed "
                     "start); not settled within `seconds` (default 2): the run fails there"},
@@ -357,6 +361,10 @@ def check_phase(phase: Phase, where: str) -> Phase:
     if near is not None and not (params.get("standing_step") is True and 0.0 < near <= 0.3):
         raise ConfigError(f"{where}.params.hang_near: needs standing_step = true and must "
                           f"be in (0, 0.3] m, got {near:g}")  # fmt: skip
+    again = params.get("plant_settle") if phase.controller == "balance" else None
+    if again is not None and not (params.get("standing_step") is True and 0.0 < again <= 5.0):
+        raise ConfigError(f"{where}.params.plant_settle: needs standing_step = true and must "
+                          f"be in (0, 5] s, got {again:g}")  # fmt: skip
     if phase.controller == "tumble" and params.get("position", "tuck") not in POSITIONS:
         raise ConfigError(
             f"{where}.params.position: unknown position {params['position']!r}; valid "

@@ -240,6 +240,21 @@ def test_a_maneuver_balances_hang_near_waits_for_the_com_near_the_sole_to_put_th
         Step(hang_near=-0.1)
 
 
+def test_a_maneuver_balances_plant_settle_is_refused_out_of_range(tmp_path: Path) -> None:
+    # the file key plant_settle (issue 19, 2026-12-05): only with standing_step, (0, 5] s
+    for params in ("standing_step = true, plant_settle = 6.0", "plant_settle = 1.0",
+                   "standing_step = true, plant_settle = 0.0"):  # fmt: skip
+        bad = tmp_path / "m.toml"
+        bad.write_text(f'[[phase]]\ncontroller = "balance"\nparams = {{ {params} }}\n'
+                       'exit = { event = "never" }\n')  # fmt: skip
+        with pytest.raises(ConfigError, match=r"phase\[1\]\.params\.plant_settle: needs") as err:
+            load_maneuver(bad)
+        assert str(bad) in str(err.value)
+    for value in (-0.5, 5.5, math.nan):
+        with pytest.raises(ConfigError, match="plant_settle"):
+            Step(plant_settle=value)
+
+
 def _pushed_back(step: list[float] | None) -> AthleticsResult:
     """A standing male balance started with the body moving back at 0.5 m/s (its capture
     point past the heels), with the balance's step if given."""

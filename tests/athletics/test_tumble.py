@@ -342,10 +342,29 @@ def test_the_forward_tucks_hanging_foot_put_down_near_the_support_lands_seed_2s_
     m = replace(load_maneuver(FORWARD_FILE), seconds=5.5)
     last = dict(m.phases[-1].params)
     assert last.pop("hang_near") == 0.085
+    last.pop("plant_settle")  # the file before hang_near (2026-12-05)
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
     before = run_maneuver(_with_last_balance_params(m, last), perturbation=start, fps=10.0)
     assert before.report["fell"] and not before.report["landed"]
+
+
+def test_the_forward_tucks_stand_up_restarted_at_the_plant_lands_seed_2s_start_18() -> None:
+    """Start 18 of the capture region at full size, seed 2: without ``plant_settle`` the last
+    balance puts its hung foot down 0.34 s after touchdown in the stand-up's bounce, the foot
+    hovers, the COM crosses past it and the body falls toward it; the file since 2026-12-05
+    (``plant_settle`` 1.0: the stand-up starts again from rest at the plant and takes 1 s)
+    lands (full size 45 / 47 on seeds 0 / 1 as before, held-out seeds 3 / 4 43 / 45 from
+    42 / 45; docs/athletics.md, "Forward tuck: the stand-up restarted at the plant")."""
+    rng = np.random.default_rng(2)
+    start = [Perturbation.sample(rng, **FULL) for _ in range(19)][18]
+    m = replace(load_maneuver(FORWARD_FILE), seconds=6.0)
+    last = dict(m.phases[-1].params)
+    assert last.pop("plant_settle") == 1.0
+    r = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+    before = run_maneuver(_with_last_balance_params(m, last), perturbation=start, fps=10.0).report
+    assert before["fell"] and not before["landed"]
 
 
 def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> None:
