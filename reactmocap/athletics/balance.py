@@ -231,6 +231,12 @@ class Step:
             steps the legs stood 0.17-0.19 rad apart in the knee, the pelvis rolled 15-20 deg
             and the COM drifted out over the more bent one on both feet; to the posture's
             knees lost more starts; docs/athletics.md "kind (c)").
+        bow_band: the hip strategy's bow (:attr:`BalanceGains.bow`) scaled by the COM's speed
+            along the feet over this band (m/s): in full from it, 0 at a COM at rest, instead
+            of all or nothing at the COM's turn (0: off; opt-in: at the turn it switched
+            0 <-> 0.9 rad every 8-12 ms and hopped the feet, docs/athletics.md "The standing
+            step's bow made continuous at the COM's turn"; judged on the contiguous limits in
+            "His forward pushes traced").
     """
 
     margin: float = 0.05
@@ -248,6 +254,7 @@ class Step:
     pair: float = 0.0
     bow_hold: float = 0.0
     knees: float = 0.0
+    bow_band: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -269,7 +276,7 @@ class Step:
         if not (isinstance(self.down_after, (int, float)) and 0.0 <= self.down_after <= 2.0):
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
-                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"))  # fmt: skip
+                  ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("bow_band", 0.5, "m/s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -724,7 +731,11 @@ class BalanceLaw:
         if cp * vel <= 0.0:  # the COM on its way back (or to a moved target)
             return 0.0
         beyond = math.copysign(max(abs(cp) - margin, 0.0), cp)
-        return float(np.clip(gain * beyond, -back, forward))
+        bow = float(np.clip(gain * beyond, -back, forward))
+        st = self.stepper
+        if st is not None and st.step.bow_band:  # Step.bow_band: no switch at the COM's turn
+            bow *= min(abs(vel) / st.step.bow_band, 1.0)
+        return bow
 
     def _plant(self, s, d, h: float) -> F64:  # type: ignore[no-untyped-def]
         """:attr:`Posture.plant`'s ankle give (on the rig's offsets); returns each foot's
