@@ -235,9 +235,9 @@ class Step:
             along the feet over this band (m/s): in full from it, 0 at a COM at rest, instead
             of all or nothing at the COM's turn (0: off; opt-in: at the turn it switched
             0 <-> 0.9 rad every 8-12 ms and hopped the feet, docs/athletics.md "The standing
-            step's bow made continuous at the COM's turn"; 0.05: the contiguous 16 limits
-            2195 -> 2200 N, none more than 5 N lower, docs/athletics.md "His forward pushes
-            traced").
+            step's bow made continuous at the COM's turn"; 0.06: the contiguous 16 limits
+            2195 -> 2220 N, none lower, but 2165 N at 0.04 and 0.1, docs/athletics.md "His
+            forward pushes traced").
     """
 
     margin: float = 0.05
