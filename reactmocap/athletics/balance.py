@@ -126,15 +126,6 @@ class Posture:
             0 off): a back handspring crouch on both feet rolled the pelvis 8 deg with the
             knees alike, and the thrust's extension about a rolled pelvis twists the body
             (docs/athletics.md).
-        kv_along: extra COM velocity gain (rad per m/s) along the feet (heading frame) on top
-            of the gains' ``kv``, for ``kv_for`` s after the posture is set (0: off; opt-in:
-            the male back layout's short touchdowns went on forward on one foot after the
-            hand-over, docs/athletics.md "the balance's first 0.3 s").
-        kv_across: the same across the feet.
-        kv_for: the seconds ``kv_along`` / ``kv_across`` act (0: the whole posture).
-        lower_hang: a foot hanging over the floor while the other stands is brought down by
-            this times its height (its leg lengthened and the other shortened by half of it
-            each, as ``plant``'s, but the COM target and the ankles as without; 0: off).
     """
 
     pitch: float = 0.0
@@ -146,10 +137,6 @@ class Posture:
     plant: bool = False
     side_both: bool = False
     level_hips: float = 0.0
-    kv_along: float = 0.0
-    kv_across: float = 0.0
-    kv_for: float = 0.0
-    lower_hang: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("plant", "side_both"):
@@ -166,10 +153,6 @@ class Posture:
             raise ConfigError(f"posture com_offset must be 2 finite numbers, got {self.com_offset}")
         if not 0.0 <= self.level_hips <= 20.0:
             raise ConfigError(f"posture level_hips must be in [0, 20], got {self.level_hips}")
-        for name, hi in (("kv_along", 5.0), ("kv_across", 5.0), ("kv_for", 5.0), ("lower_hang", 2.0)):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not (isinstance(v, (int, float)) and 0.0 <= v <= hi):
-                raise ConfigError(f"posture {name} must be in [0, {hi}], got {v!r}")
 
 
 @dataclass(frozen=True)
@@ -644,12 +627,6 @@ class BalanceLaw:
         err = s.local(target - s.com, h)
         vel = s.local(s.com_vel, h)
         delta = g.kp * err - g.kv * vel
-        po = self.posture
-        if (po.kv_along or po.kv_across) and (
-            not po.kv_for or t - getattr(self, "_t_pitch", t) < po.kv_for
-        ):  # Posture.kv_along / kv_across: more damping in the posture's first seconds
-            delta[0] -= po.kv_along * vel[0]
-            delta[1] -= po.kv_across * vel[1]
         delta[1] *= g.side
         np.clip(delta, -g.max_offset, g.max_offset, out=delta)
         pitch = self.pitch_target(t)
@@ -696,8 +673,6 @@ class BalanceLaw:
             total = desired[_ANKLE[k], 0] + rig.offset[_ANKLE[k], 0]
             rig.offset[_ANKLE[k], 0] += float(np.clip(total, lo, hi)) - total
         hang = self._plant(s, d, h) if self.posture.plant else None
-        if hang is None and self.posture.lower_hang:
-            hang = self.posture.lower_hang * self._hang(s, d)
         self._level_legs(d, desired, hang)
         self.support(s)
         if self.stepper is not None:
@@ -760,11 +735,6 @@ class BalanceLaw:
         tilt = (back * corners[..., 2]).sum(axis=1)  # heel over toes (m), each foot
         excess = np.sign(tilt) * np.maximum(np.abs(tilt) - PLANT_DEADBAND, 0.0)
         self.ctx.rig.offset[_ANKLE, 0] -= PLANT_GAIN * excess * s.foot_contact
-        return self._hang(s, d)
-
-    def _hang(self, s, d) -> F64:  # type: ignore[no-untyped-def]
-        """Each foot's height over the floor (m) while it hangs and the other stands, else 0."""
-        corners = s.corners
         n = s.floor_normal
         height = ((corners - d.geom_xpos[s.floor]) @ n).min(axis=1)
         return np.where(~s.foot_contact & s.foot_contact[::-1], np.maximum(height, 0.0), 0.0)
