@@ -263,6 +263,10 @@ class LandingParams:
             knee at its swing's last target, 0.17-0.19 rad apart; the pelvis rolled 15-20 deg
             and the COM drifted out over the more bent leg until it fell (docs/athletics.md,
             "kind (c)"; the share of the way to the two knees' mean).
+        turn_short: ``turn_gain`` for a touchdown predicted less turned than ``turn_ref`` (None:
+            ``turn_gain`` both ways; in [0, 2] m/rad; opt-in: the male back layout's short
+            touchdowns reached the balance with the capture point at the toes,
+            docs/athletics.md "the short class's first 0.3 s").
         recover_leg: the recovery stands up to at least this fraction of the straight leg
             (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
@@ -313,6 +317,7 @@ class LandingParams:
     step_foresee: float = 0.0
     recover_leg: float = 0.0
     step_knees: float = 0.0
+    turn_short: float | None = None
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -403,6 +408,11 @@ class LandingParams:
             raise ConfigError("landing late_kv_rotation needs late_kv (it gates it)")
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
+        ts = self.turn_short
+        if ts is not None and (isinstance(ts, bool) or not (
+            isinstance(ts, (int, float)) and 0.0 <= ts <= 2.0
+        )):
+            raise ConfigError(f"landing turn_short must be in [0, 2] m/rad, got {ts!r}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
             raise ConfigError(f"landing roll_min must be in [0, pi/2] rad, got {self.roll_min}")
         if not (isinstance(self.swing_cap, (int, float)) and 0.0 < self.swing_cap < 1.0):
@@ -548,7 +558,9 @@ class Landing(Basis):
                 t_td = time_to_height(ctx, float(s.com[2]) - clearance)
                 if t_td <= p.turn_window:
                     turn = ctx.rotation + rate * t_td - p.turn_ref
-                    want[0] += p.turn_gain * turn
+                    # a touchdown predicted less turned: its own gain (turn_short)
+                    gain = p.turn_gain if turn <= 0.0 or p.turn_short is None else p.turn_short
+                    want[0] += gain * turn
             # eq. 6.1 as a correction on top of the geometric placement below
             xd = s.local(fvel - s.com_vel, h)
             servo = np.clip(p.kp * (want - x) - memo["kv"] * xd, -0.3, 0.3)
