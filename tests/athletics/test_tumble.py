@@ -1067,6 +1067,28 @@ def test_a_late_back_layout_undamps_its_servo_only_once_turned_past_late_kv_rota
         assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0, k
 
 
+def test_a_short_back_layout_puts_its_feet_farther_ahead_with_turn_short() -> None:
+    """Full size's start 19 (seed 0) touches down short (-298 deg) and reaches the last
+    balance with its capture point at the toes: it falls forward with the file's landing.
+    ``turn_short`` 1.0 moves the feet of a touchdown predicted short of ``turn_ref`` 1.0 m/rad
+    (the file's ``turn_gain`` 0.3 past it), and it lands."""
+    m = load_maneuver(Path(__file__).parents[2] / "examples/athletics/maneuvers/back_layout.toml")
+    land = next(ph for ph in m.phases if ph.controller == "land")
+    params = {k: v for k, v in land.params.items() if k != "turn_short"}
+    start = full_starts(20)[19]
+    r = run_maneuver(_with_land_params(m, params), perturbation=start, fps=10.0).report
+    assert not (r["landed"] and not r["fell"])
+    r = run_maneuver(_with_land_params(m, {**params, "turn_short": 1.0}), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] + 360.0) <= 30.0
+
+
+def test_the_landing_refuses_a_bad_turn_short() -> None:
+    for bad in (-0.1, 2.5, float("nan"), True):
+        with pytest.raises(ConfigError, match="turn_short"):
+            LandingParams(turn_short=bad)
+
+
 def test_a_back_layout_carrying_its_pitch_target_leans_on_past_the_hand_over() -> None:
     """``back_layout.toml``'s landing leans the trunk 0.8 rad per radian of knee flexion, the
     balance after it 0.5: at the hand-over its pelvis pitch target dropped to the pelvis's
