@@ -429,7 +429,10 @@ HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
 #: allowed past asin 0.9) with stiffer, more damped knees, which stop the legs bouncing her
 #: back into the air; since 2026-12-05 her crouch's COM target is eased back over 0.2 s
 #: (``com_ramp``, as the male's; the step spread her take-off momentum and 10/50 starts at a
-#: tenth missed the hands) with the hips' feedback allowed 1.8 rad and her feet 56 cm back
+#: tenth missed the hands) with the hips' feedback allowed 1.8 rad and her feet 56 cm back;
+#: since 2026-12-05 (later) that delta is scaled by the spin the push left (``spin_ref``, her
+#: nominal's -41.0 kg m^2/s: a start whose hands met the floor less turned keeps less spin
+#: and lands only with its feet nearer)
 HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingProxyType({
     # the male's landing scales its delta by the spin the push left (LandingParams.spin_ref:
     # the spin at the nominal's release, 2026-12-03). Since 2026-12-03 his knees aim the
@@ -472,8 +475,8 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     "female": MappingProxyType({
         "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 1.8,
                                   "com_ramp": 0.2}),
-        "land": MappingProxyType({"delta": -0.56, "swing_cap": 0.97, "knee_stiffness": 1.0,
-                                  "damping": 2.0}),
+        "land": MappingProxyType({"delta": -0.56, "spin_ref": -41.0, "swing_cap": 0.97,
+                                  "knee_stiffness": 1.0, "damping": 2.0}),
     }),
 })  # fmt: skip
 

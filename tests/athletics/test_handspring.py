@@ -147,6 +147,24 @@ def test_the_female_crouch_eased_in_narrows_her_take_off_and_her_hands_meet_the_
     assert -200.0 < eased["rotation_at_hands_deg"] < -180.0
 
 
+def test_the_female_landing_places_her_feet_by_the_spin_the_push_left() -> None:
+    """A tenth's start 3 (seed 0): her hands meet the floor at -187.8 deg, 2 deg before the
+    nominal's, and the push leaves her -39.0 kg m^2/s against the nominal's -41.0. With her
+    feet put 56 cm back whatever the spin (the preset before 2026-12-05, later) she falls;
+    scaled by the spin (``spin_ref`` -41.0, her preset's) they go nearer and she lands
+    (docs/athletics.md)."""
+    m = handspring_maneuver("female")
+    land = next(p for p in m.phases if p.controller == "land").params
+    assert land["spin_ref"] == -41.0
+    start = _starts(0.1, 4)[3]
+    scaled = run_maneuver(m, perturbation=start, fps=10.0).report
+    assert scaled["landed"] and not scaled["fell"] and abs(scaled["rotation_deg"] + 360.0) <= 45.0
+    fixed = run_maneuver(_with(m, "land", {**land, "spin_ref": 0.0}), perturbation=start,
+                         fps=10.0).report  # fmt: skip
+    assert fixed["fell"] and not fixed["landed"]
+    assert abs(fixed["rotation_at_hands_deg"] - scaled["rotation_at_hands_deg"]) < 1e-9
+
+
 def _starts(scale: float, n: int, seed: int = 0) -> list[Perturbation]:
     """The first ``n`` of the capture region's starts (``seed``) at ``scale`` of the benchmark's
     distribution, written as it writes it (the same floats)."""
