@@ -1017,25 +1017,26 @@ class Stepper:
         w = min((1.0 + STEP_GIVE_BACK - x) / STEP_GIVE_BACK, 1.0)  # then the law's, linearly
         rig.offset[joints, 0] += w * (held - law)
 
-    def _plant_hung(self, bl: BalanceLaw, t: float) -> None:
-        """:attr:`Step.hang_plant`: the posture's plant on once a foot has hung that long."""
+    def _hung_since(self, t: float) -> float:
+        """Since when one foot alone has been down (inf while both or neither are)."""
         if int(self.ctx.senses.foot_contact.sum()) != 1:
             self._t_hang = math.inf
-            return
-        self._t_hang = min(self._t_hang, t)
-        if t >= max(self._t_hang + self.step.hang_plant, self._t_end + STEP_PAUSE):
+        else:
+            self._t_hang = min(self._t_hang, t)
+        return self._t_hang
+
+    def _plant_hung(self, bl: BalanceLaw, t: float) -> None:
+        """:attr:`Step.hang_plant`: the posture's plant on once a foot has hung that long."""
+        if t >= max(self._hung_since(t) + self.step.hang_plant, self._t_end + STEP_PAUSE):
             bl.posture = replace(bl.posture, plant=True)
 
     def _plant_if_hanging(self, bl: BalanceLaw, speed: float, t: float) -> None:
         """:data:`STANDING_HANG`: the posture's plant on once a foot has hung long enough
         over a COM slower than :data:`STANDING_STILL` (standing still on one foot is no rest)."""
-        if int(self.ctx.senses.foot_contact.sum()) != 1:
-            self._t_hang = math.inf
-            return
-        self._t_hang = min(self._t_hang, t)
+        hang = self._hung_since(t)
         first = bool(self.step.hang_still and not self.record)
         still = self.step.hang_still if first else STANDING_STILL
-        if t >= max(self._t_hang + STANDING_HANG, self._t_end + STEP_PAUSE) and speed < still:
+        if t >= max(hang + STANDING_HANG, self._t_end + STEP_PAUSE) and speed < still:
             if first and self.step.hang_near:
                 s = self.ctx.senses
                 if float(np.hypot(*(s.com[:2] - s.support_center()[:2]))) >= self.step.hang_near:

@@ -156,14 +156,12 @@ def _build_balance(phase: Phase, ath: Athlete) -> Basis:
         )
     g = BALANCE_GAIN_SETS[gains]
     standing = bool(p.pop("standing_step", False))
-    near = float(p.pop("hang_near", 0.0))  # check_phase: only with standing_step, (0, 0.3]
-    again = float(p.pop("plant_settle", 0.0))  # check_phase: only with standing_step, (0, 5]
+    standing_only = {k: float(p.pop(k)) for k in _STANDING_ONLY if k in p}  # see check_phase
     if standing:
         # the balance behaviour's step="on": a hung foot planted, steps across the feet too,
         # the bow (standing gains) eased; `step` numbers override its own, not the plant
         step = replace(step, hang_still=STANDING_STEP.hang_still) if step else STANDING_STEP
-        step = replace(step, hang_near=near) if near else step
-        step = replace(step, plant_settle=again) if again else step
+        step = replace(step, **standing_only)
         g = replace(g, bow_ease=STANDING_BOW_EASE) if g.bow is not None else g
     seconds = phase.seconds if phase.exit == "after" else None
     within = None
@@ -234,6 +232,8 @@ SETTLE_WITHIN = 2.0
 #: a balance phase's ``gains`` by name: the thesis's COM servo, or the standing behaviour's
 #: (its hip and arm strategies and windmilling against a fall; on a level floor the rest is the
 #: same)
+#: balance keys taken only with ``standing_step``: (upper bound, unit), each in (0, bound]
+_STANDING_ONLY = {"hang_near": (0.3, "m"), "plant_settle": (5.0, "s")}
 BALANCE_GAIN_SETS = MappingProxyType({"balance": BALANCE_GAINS, "standing": STANDING_GAINS})
 _LEAP_KINDS = {"effort": "number", **_kinds(LeapParams, skip=("handover",))}
 CONTROLLERS: Mapping[str, BasisSpec] = MappingProxyType({
@@ -357,14 +357,11 @@ def check_phase(phase: Phase, where: str) -> Phase:
     effort = params.get("effort") if phase.controller == "leap" else None
     if effort is not None and not 0.0 <= effort <= 1.0:  # the measured tables' range
         raise ConfigError(f"{where}.params.effort: must be 0-1, got {effort:g}")
-    near = params.get("hang_near") if phase.controller == "balance" else None
-    if near is not None and not (params.get("standing_step") is True and 0.0 < near <= 0.3):
-        raise ConfigError(f"{where}.params.hang_near: needs standing_step = true and must "
-                          f"be in (0, 0.3] m, got {near:g}")  # fmt: skip
-    again = params.get("plant_settle") if phase.controller == "balance" else None
-    if again is not None and not (params.get("standing_step") is True and 0.0 < again <= 5.0):
-        raise ConfigError(f"{where}.params.plant_settle: needs standing_step = true and must "
-                          f"be in (0, 5] s, got {again:g}")  # fmt: skip
+    for key, (hi, unit) in _STANDING_ONLY.items() if phase.controller == "balance" else ():
+        v = params.get(key)
+        if v is not None and not (params.get("standing_step") is True and 0.0 < v <= hi):
+            raise ConfigError(f"{where}.params.{key}: needs standing_step = true and must "
+                              f"be in (0, {hi:g}] {unit}, got {v:g}")  # fmt: skip
     if phase.controller == "tumble" and params.get("position", "tuck") not in POSITIONS:
         raise ConfigError(
             f"{where}.params.position: unknown position {params['position']!r}; valid "
