@@ -81,6 +81,11 @@ _LAG_MOVING = 0.2
 _AHEAD_RATE_TAU = 0.1
 # ``step_ahead_swing``: a swing foot's landing brought forward takes at least this long (s)
 _SWING_AHEAD_MIN = 0.1
+# ``step_ahead_landing``: the moved landing's states (armed by a push with a backward part,
+# the push over, the clip's double support seen, its swing under way, landed) and the
+# largest move (m, ``step_target``'s cap)
+_LAND_OFF, _LAND_PUSHED, _LAND_WAIT, _LAND_READY, _LAND_SWING, _LAND_DOWN = range(6)
+_LAND_MAX = 0.6
 
 
 def _left_of(heading: float) -> F64:
@@ -143,6 +148,7 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
+        step_ahead_landing: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -311,6 +317,12 @@ class AnchoredReference:
                 )
             else:
                 self._swing_limit[:] = largest * self.step_ahead
+        # ``step_ahead_landing``: the first clip swing after a push with a backward part has
+        # its reference landing moved (world, m, per foot) to this far ahead of the capture
+        # point; the state (``_LAND_*``) and the swing's foot
+        self.step_ahead_landing = float(step_ahead_landing)
+        self._land_move = np.zeros((2, 2))
+        self._land_state, self._land_foot = _LAND_OFF, 0
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -469,19 +481,23 @@ class AnchoredReference:
         if self.step is not None:
             p, v, a = self.step.at(t)
             out[self.step.foot] = (p, v, a, np.array([0.0, 0.0, 1.0]))
-        if not (self.place_shift.any() or self._place_move.any()):
+        # ``step_ahead_landing``'s moved landing: the placement's rows while its swing lasts
+        land = self._land_state == _LAND_SWING
+        if not (self.place_shift.any() or self._place_move.any() or land):
             return out
         for f in range(2):  # two feet
-            if f in out or not (self.place_shift.any() or self._place_move[f].any()):
+            mine = land and f == self._land_foot
+            if f in out or not (self.place_shift.any() or self._place_move[f].any() or mine):
                 continue
             sole = self._mocap_swing(t, f)
             if sole is None:
                 continue
             p, v = sole
-            p[:2] += self.place_shift + self._place_move[f]
+            p[:2] += self.place_shift + self._place_move[f] + self._land_move[f]
             # a pushed walk's foot also comes down level where it lands (lateral rows alone
             # left it hanging 0.2-0.4 m up, short of the landing)
-            out[f] = (p, v, np.zeros(3), np.array([0.0, 0.0, 1.0]) if self.placing else None)
+            level = self.placing or mine
+            out[f] = (p, v, np.zeros(3), np.array([0.0, 0.0, 1.0]) if level else None)
         return out
 
     def _mocap_swing(self, t: float, f: int) -> tuple[F64, F64] | None:
@@ -590,6 +606,8 @@ class AnchoredReference:
             self._track_capture_rate(t)
         if self._ahead_armed and self.step is None and t >= self._step_ready:
             self._step_ahead(t)
+        if self._land_state > _LAND_PUSHED:
+            self._land_ahead(t)
         if self.step is not None or not self.stepping or t < self._step_ready:
             return
         i = self.clock.nearest(t)
@@ -798,6 +816,57 @@ class AnchoredReference:
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),
                          shorten=False, duration=min(duration, self.step_time))  # fmt: skip
 
+    def _land_ahead(self, t: float) -> None:
+        """``step_ahead_landing``: after a push with a backward part, in the clip's first
+        swing that starts after the push (past a double support of the clip's), that swing's
+        reference landing moves along the clip's walk to ``step_ahead_landing`` m ahead of the
+        capture point predicted (pivoting over the stance foot) to the clip's landing, at
+        most ``_LAND_MAX``; the placement's rows follow it while the foot swings, and the
+        anchoring reads the foot at it from its landing until the clip lifts it again. A
+        foot tracking the clip's leg on a body the push slowed landed 0.5 m short of the
+        clip's landing, at the centre of mass, and the anchoring followed it there; pulling
+        it to the clip's landing diverged (``docs/tracking.md``)."""
+        assert self.path.sole is not None
+        i = self.clock.nearest(t)
+        firm = self._firm[i]
+        f = self._land_foot
+        low = self.sole_corners()[:, :, 2].min(axis=1) - self.floor_z
+        if self._land_state == _LAND_WAIT:
+            if firm.all():
+                self._land_state = _LAND_READY
+            return
+        if self._land_state == _LAND_READY:
+            if firm.all():
+                return
+            if not firm.any() or self._going_down():
+                self._land_state = _LAND_OFF
+                return
+            f = self._land_foot = int(np.argmin(firm))
+            self._land_state = _LAND_SWING
+        if self._land_state == _LAND_DOWN:
+            if not firm[f]:  # the clip lifts it again
+                self._land_move[:] = 0.0
+                self._land_state = _LAND_OFF
+            return
+        # the swing: down once the foot, having left the floor, is back on it
+        if low[f] >= self.anchor_touch:
+            self._placed[f] = True  # in the air: the rows hold it to its moved landing
+        elif self._placed[f] or firm[f]:
+            self._placed[f] = False
+            self._land_state = _LAND_DOWN
+            return
+        k = int(self._next_planted[i, f])
+        u = self._walk_direction(t)
+        if k >= len(self._next_planted) or u is None:
+            return
+        left_s = max(0.0, (k - self.clock.frame(t)) / (self.path.fps * self.rate))
+        xi, omega = self.capture_point()
+        stance = self._sole_centres()[1 - f, :2]
+        pred = stance + (xi - stance) * np.exp(omega * left_s)
+        land = rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
+        move = float((pred - land) @ u) + self.step_ahead_landing
+        self._land_move[f] = min(max(move, -_LAND_MAX), _LAND_MAX) * u
+
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
         change since the last slow tick, smoothed (``_AHEAD_RATE_TAU``); restarted after a
@@ -849,6 +918,8 @@ class AnchoredReference:
         sim = (d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half)[on, :2]
         ref, ref_yaw = self.path.sole_at(self.clock.frame(t))
         ref = ref[on, :2] @ rot2(self.anchor_yaw).T + self.anchor_shift
+        if self._land_state == _LAND_DOWN:
+            ref = ref + self._land_move[on]  # ``step_ahead_landing``: its moved landing
         centre = sim.mean(axis=0)
         err = centre - ref.mean(axis=0)
         if t <= self.lag_until:
@@ -1004,6 +1075,8 @@ class AnchoredReference:
         self._ahead_armed = False
         self._xi_rate = np.zeros(2)
         self._xi_last = (-np.inf, np.zeros(2))
+        self._land_move[:] = 0.0
+        self._land_state = _LAND_OFF
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[2].copy()
 
@@ -1021,14 +1094,15 @@ class AnchoredReference:
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
                 self.lag_until, self._lag_acted, self._ahead_armed, self._xi_rate.copy(),
-                self._xi_last)  # fmt: skip
+                self._xi_last, self._land_move.copy(), self._land_state,
+                self._land_foot)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
          catching, drop_step, warp_until, lag_until, lag_acted, ahead_armed, xi_rate,
-         xi_last) = memory  # fmt: skip
+         xi_last, land_move, land_state, land_foot) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -1055,3 +1129,6 @@ class AnchoredReference:
         self._ahead_armed = bool(ahead_armed)
         self._xi_rate = np.array(xi_rate)
         self._xi_last = xi_last  # type: ignore[assignment]
+        self._land_move[:] = land_move  # type: ignore[call-overload]
+        self._land_state = int(land_state)  # type: ignore[call-overload]
+        self._land_foot = int(land_foot)  # type: ignore[call-overload]
