@@ -820,7 +820,7 @@ class AnchoredReference:
         """``step_ahead_landing``: after a push with a backward part, in the clip's first
         swing that starts after the push (past a double support of the clip's), that swing's
         reference landing moves along the clip's walk to ``step_ahead_landing`` m ahead of the
-        capture point predicted (pivoting over the stance foot) to the clip's landing, at
+        centre of mass predicted (pivoting over the stance foot) to the clip's landing, by at
         most ``_LAND_MAX``; the placement's rows follow it while the foot swings, and the
         anchoring reads the foot at it from its landing until the clip lifts it again. A
         foot tracking the clip's leg on a body the push slowed landed 0.5 m short of the
@@ -860,9 +860,13 @@ class AnchoredReference:
         if k >= len(self._next_planted) or u is None:
             return
         left_s = max(0.0, (k - self.clock.frame(t)) / (self.path.fps * self.rate))
-        xi, omega = self.capture_point()
+        _, omega = self.capture_point()  # and the subtree velocities
+        d = self.world.data
+        c, v = d.subtree_com[self._root][:2], d.subtree_linvel[self._root][:2]
         stance = self._sole_centres()[1 - f, :2]
-        pred = stance + (xi - stance) * np.exp(omega * left_s)
+        # the centre of mass at the landing, pivoting over the stance foot
+        w = omega * left_s
+        pred = stance + (c - stance) * np.cosh(w) + v * (np.sinh(w) / omega)
         land = rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
         move = float((pred - land) @ u) + self.step_ahead_landing
         self._land_move[f] = min(max(move, -_LAND_MAX), _LAND_MAX) * u

@@ -308,7 +308,7 @@ class WholeBodyTracker(AnchoredReference):
             tried still felled such a clip (``docs/tracking.md``, issue 16).
         step_ahead_landing: with ``step_ahead``, after a push with a backward part, the
             clip's first swing after it lands (its reference, which the placement's rows and
-            the anchoring follow) this far (m, at most 0.5; 0: off) ahead of the capture point
+            the anchoring follow) this far (m, at most 0.5; 0: off) ahead of the centre of mass
             predicted to that landing along the walk: the foot tracking the clip's leg landed
             0.5 m short of the clip's landing, at the centre of mass (``docs/tracking.md``,
             issue 16).
@@ -504,7 +504,7 @@ class WholeBodyTracker(AnchoredReference):
         if step_ahead_landing and not (step_ahead and step_ahead_landing <= 0.5):
             raise ConfigError(
                 f"step_ahead_landing ({step_ahead_landing!r}) is a lead in (0, 0.5] m past the "
-                f"capture point for the first swing after a back push: it needs step_ahead > 0"
+                f"centre of mass for the first swing after a back push: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
