@@ -323,6 +323,7 @@ class AnchoredReference:
         self.step_ahead_landing = float(step_ahead_landing)
         self._land_move = np.zeros((2, 2))
         self._land_state, self._land_foot = _LAND_OFF, 0
+        self._land_span = (0.0, 1.0)  # the swing's clip frames: lift-off, landing
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -493,7 +494,10 @@ class AnchoredReference:
             if sole is None:
                 continue
             p, v = sole
-            p[:2] += self.place_shift + self._place_move[f] + self._land_move[f]
+            p[:2] += self.place_shift + self._place_move[f]
+            if mine:  # brought in over the swing: held from its start, it pulled the foot back
+                a, b = self._land_span
+                p[:2] += self._land_move[f] * min(1.0, (self.clock.frame(t) - a) / (b - a))
             # a pushed walk's foot also comes down level where it lands (lateral rows alone
             # left it hanging 0.2-0.4 m up, short of the landing)
             level = self.placing or mine
@@ -843,6 +847,8 @@ class AnchoredReference:
                 return
             f = self._land_foot = int(np.argmin(firm))
             self._land_state = _LAND_SWING
+            k = float(self._next_planted[i, f])
+            self._land_span = (self.clock.frame(t), max(k, self.clock.frame(t) + 1.0))
         if self._land_state == _LAND_DOWN:
             if not firm[f]:  # the clip lifts it again
                 self._land_move[:] = 0.0
@@ -1099,14 +1105,14 @@ class AnchoredReference:
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
                 self.lag_until, self._lag_acted, self._ahead_armed, self._xi_rate.copy(),
                 self._xi_last, self._land_move.copy(), self._land_state,
-                self._land_foot)  # fmt: skip
+                self._land_foot, self._land_span)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
          catching, drop_step, warp_until, lag_until, lag_acted, ahead_armed, xi_rate,
-         xi_last, land_move, land_state, land_foot) = memory  # fmt: skip
+         xi_last, land_move, land_state, land_foot, land_span) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -1136,3 +1142,4 @@ class AnchoredReference:
         self._land_move[:] = land_move  # type: ignore[call-overload]
         self._land_state = int(land_state)  # type: ignore[call-overload]
         self._land_foot = int(land_foot)  # type: ignore[call-overload]
+        self._land_span = land_span  # type: ignore[assignment]
