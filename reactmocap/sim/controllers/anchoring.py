@@ -496,8 +496,8 @@ class AnchoredReference:
             p, v = sole
             p[:2] += self.place_shift + self._place_move[f]
             if mine:  # brought in over the swing: held from its start, it pulled the foot back
-                a, b = self._land_span
-                p[:2] += self._land_move[f] * min(1.0, (self.clock.frame(t) - a) / (b - a))
+                lift, down = self._land_span
+                p[:2] += self._land_move[f] * min(1.0, (self.clock.frame(t) - lift) / (down - lift))
             # a pushed walk's foot also comes down level where it lands (lateral rows alone
             # left it hanging 0.2-0.4 m up, short of the landing)
             level = self.placing or mine
