@@ -82,10 +82,10 @@ _AHEAD_RATE_TAU = 0.1
 # ``step_ahead_swing``: a swing foot's landing brought forward takes at least this long (s)
 _SWING_AHEAD_MIN = 0.1
 # ``step_ahead_landing``: the moved landing's states (armed by a push with a backward part,
-# the push over, the clip's double support seen, its swing under way, landed) and the
-# largest move (m, ``step_target``'s cap)
+# the push over, the clip's double support seen, its swing under way, landed) and how
+# long (s) after the push a swing may still be moved
 _LAND_OFF, _LAND_PUSHED, _LAND_WAIT, _LAND_READY, _LAND_SWING, _LAND_DOWN = range(6)
-_LAND_MAX = 0.6
+_LAND_WINDOW = 1.5
 
 
 def _left_of(heading: float) -> F64:
@@ -324,6 +324,7 @@ class AnchoredReference:
         self._land_move = np.zeros((2, 2))
         self._land_state, self._land_foot = _LAND_OFF, 0
         self._land_span = (0.0, 1.0)  # the swing's clip frames: lift-off, landing
+        self._land_until = -np.inf
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -487,7 +488,7 @@ class AnchoredReference:
         if not (self.place_shift.any() or self._place_move.any() or land):
             return out
         for f in range(2):  # two feet
-            mine = land and f == self._land_foot
+            mine = land and f == self._land_foot and bool(self._land_move[f].any())
             if f in out or not (self.place_shift.any() or self._place_move[f].any() or mine):
                 continue
             sole = self._mocap_swing(t, f)
@@ -820,6 +821,11 @@ class AnchoredReference:
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),
                          shorten=False, duration=min(duration, self.step_time))  # fmt: skip
 
+    def _land_push_over(self, t: float) -> None:
+        """``step_ahead_landing``: the push that armed it ended at ``t``."""
+        self._land_state = _LAND_WAIT
+        self._land_until = t + _LAND_WINDOW
+
     def _land_ahead(self, t: float) -> None:
         """``step_ahead_landing``: after a push with a backward part, in the clip's first
         swing that starts after the push (past a double support of the clip's), that swing's
@@ -859,7 +865,11 @@ class AnchoredReference:
             self._placed[f] = True  # in the air: the rows hold it to its moved landing
         elif self._placed[f] or firm[f]:
             self._placed[f] = False
-            self._land_state = _LAND_DOWN
+            # a swing left where the clip put it: the next one, within the window
+            moved = bool(self._land_move[f].any())
+            self._land_state = _LAND_DOWN if moved else _LAND_WAIT
+            if not (moved or t < self._land_until):
+                self._land_state = _LAND_OFF
             return
         k = int(self._next_planted[i, f])
         u = self._walk_direction(t)
@@ -874,8 +884,10 @@ class AnchoredReference:
         w = omega * left_s
         pred = stance + (c - stance) * np.cosh(w) + v * (np.sinh(w) / omega)
         land = rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
-        move = float((pred - land) @ u) + self.step_ahead_landing
-        self._land_move[f] = min(max(move, -_LAND_MAX), _LAND_MAX) * u
+        # forward only, by at most the lead: a landing pulled back to the body, or forward
+        # by more, made the rows pull the foot 0.3-0.6 m off the clip's and felled every walk
+        lead = self.step_ahead_landing
+        self._land_move[f] = min(lead, max(0.0, float((pred - land) @ u) + lead)) * u
 
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
@@ -1105,14 +1117,14 @@ class AnchoredReference:
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
                 self.lag_until, self._lag_acted, self._ahead_armed, self._xi_rate.copy(),
                 self._xi_last, self._land_move.copy(), self._land_state,
-                self._land_foot, self._land_span)  # fmt: skip
+                self._land_foot, self._land_span, self._land_until)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
          catching, drop_step, warp_until, lag_until, lag_acted, ahead_armed, xi_rate,
-         xi_last, land_move, land_state, land_foot, land_span) = memory  # fmt: skip
+         xi_last, land_move, land_state, land_foot, land_span, land_until) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -1143,3 +1155,4 @@ class AnchoredReference:
         self._land_state = int(land_state)  # type: ignore[call-overload]
         self._land_foot = int(land_foot)  # type: ignore[call-overload]
         self._land_span = land_span  # type: ignore[assignment]
+        self._land_until = float(land_until)  # type: ignore[arg-type]

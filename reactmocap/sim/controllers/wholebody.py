@@ -23,7 +23,6 @@ from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.anchoring import (
     _LAND_PUSHED,
-    _LAND_WAIT,
     AnchoredReference,
     rot2,
 )
@@ -990,7 +989,7 @@ class WholeBodyTracker(AnchoredReference):
                 self.kv[:3] = critical_kv(kp)
             self._kp_pushed = float(self.kp[0])
         if self._land_state == _LAND_PUSHED and not pushing:
-            self._land_state = _LAND_WAIT  # the push is over
+            self._land_push_over(t)
         if self._ahead_servo and self._ahead_armed:
             # the clip's pelvis, at the clip's speed, pulled the body on past its feet while
             # the step after the push swung
