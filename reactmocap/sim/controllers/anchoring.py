@@ -886,8 +886,11 @@ class AnchoredReference:
         land = rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
         # forward only, by at most the lead: a landing pulled back to the body, or forward
         # by more, made the rows pull the foot 0.3-0.6 m off the clip's and felled every walk
+        # and never taken back within the swing: the clip's landing closes on the body as it
+        # swings
         lead = self.step_ahead_landing
-        self._land_move[f] = min(lead, max(0.0, float((pred - land) @ u) + lead)) * u
+        move = min(lead, max(0.0, float((pred - land) @ u) + lead))
+        self._land_move[f] = max(move, float(self._land_move[f] @ u)) * u
 
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
