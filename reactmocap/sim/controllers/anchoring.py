@@ -317,9 +317,9 @@ class AnchoredReference:
                 )
             else:
                 self._swing_limit[:] = largest * self.step_ahead
-        # ``step_ahead_landing``: the first clip swing after a push with a backward part has
-        # its reference landing moved (world, m, per foot) to this far ahead of the capture
-        # point; the state (``_LAND_*``) and the swing's foot
+        # ``step_ahead_landing``: a clip swing after a push with a backward part has its
+        # reference landing moved forward (world, m, per foot) to this far ahead of the
+        # centre of mass; the state (``_LAND_*``) and the swing's foot
         self.step_ahead_landing = float(step_ahead_landing)
         self._land_move = np.zeros((2, 2))
         self._land_state, self._land_foot = _LAND_OFF, 0
@@ -828,14 +828,14 @@ class AnchoredReference:
 
     def _land_ahead(self, t: float) -> None:
         """``step_ahead_landing``: after a push with a backward part, in the clip's first
-        swing that starts after the push (past a double support of the clip's), that swing's
-        reference landing moves along the clip's walk to ``step_ahead_landing`` m ahead of the
-        centre of mass predicted (pivoting over the stance foot) to the clip's landing, by at
-        most ``_LAND_MAX``; the placement's rows follow it while the foot swings, and the
-        anchoring reads the foot at it from its landing until the clip lifts it again. A
-        foot tracking the clip's leg on a body the push slowed landed 0.5 m short of the
-        clip's landing, at the centre of mass, and the anchoring followed it there; pulling
-        it to the clip's landing diverged (``docs/tracking.md``)."""
+        swing after it (past a double support of the clip's) whose landing falls short of
+        ``step_ahead_landing`` m ahead of the centre of mass predicted (pivoting over the
+        stance foot) to that landing along the clip's walk, the landing moves forward to it,
+        by at most that lead (swings that start within ``_LAND_WINDOW`` s of the push's end);
+        the placement's rows follow the moved swing, brought in over it, and the anchoring
+        reads the foot at its moved landing until the clip lifts it again. A foot tracking
+        the clip's leg on a body the push slowed landed 0.5 m short of the clip's landing, at
+        the centre of mass, and the anchoring followed it there (``docs/tracking.md``)."""
         assert self.path.sole is not None
         i = self.clock.nearest(t)
         firm = self._firm[i]

@@ -306,11 +306,11 @@ class WholeBodyTracker(AnchoredReference):
             purpose, which the box foot's toe edge cannot do; every rule per foot and tick
             tried still felled such a clip (``docs/tracking.md``, issue 16).
         step_ahead_landing: with ``step_ahead``, after a push with a backward part, the
-            clip's first swing after it lands (its reference, which the placement's rows and
-            the anchoring follow) this far (m, at most 0.5; 0: off) ahead of the centre of mass
-            predicted to that landing along the walk: the foot tracking the clip's leg landed
-            0.5 m short of the clip's landing, at the centre of mass (``docs/tracking.md``,
-            issue 16).
+            clip's first swing after it whose landing falls short of this lead (m, at most
+            0.5; 0: off) ahead of the centre of mass predicted to it along the walk lands
+            forward there, by at most the lead (its reference, which the placement's rows and
+            the anchoring follow): the foot tracking the clip's leg landed 0.5 m short of the
+            clip's landing, at the centre of mass (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
