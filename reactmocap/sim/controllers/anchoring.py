@@ -81,11 +81,6 @@ _LAG_MOVING = 0.2
 _AHEAD_RATE_TAU = 0.1
 # ``step_ahead_swing``: a swing foot's landing brought forward takes at least this long (s)
 _SWING_AHEAD_MIN = 0.1
-# ``step_ahead_landing``: the moved landing's states (armed by a push with a backward part,
-# the push over, the clip's double support seen, its swing under way, landed) and how
-# long (s) after the push a swing may still be moved
-_LAND_OFF, _LAND_PUSHED, _LAND_WAIT, _LAND_READY, _LAND_SWING, _LAND_DOWN = range(6)
-_LAND_WINDOW = 1.5
 
 
 def _left_of(heading: float) -> F64:
@@ -148,7 +143,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_ahead_landing: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -317,14 +311,6 @@ class AnchoredReference:
                 )
             else:
                 self._swing_limit[:] = largest * self.step_ahead
-        # ``step_ahead_landing``: a clip swing after a push with a backward part has its
-        # reference landing moved forward (world, m, per foot) to this far ahead of the
-        # centre of mass; the state (``_LAND_*``) and the swing's foot
-        self.step_ahead_landing = float(step_ahead_landing)
-        self._land_move = np.zeros((2, 2))
-        self._land_state, self._land_foot = _LAND_OFF, 0
-        self._land_span = (0.0, 1.0)  # the swing's clip frames: lift-off, landing
-        self._land_until = -np.inf
         self._dt_slow = float(dt_slow)
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
@@ -483,26 +469,19 @@ class AnchoredReference:
         if self.step is not None:
             p, v, a = self.step.at(t)
             out[self.step.foot] = (p, v, a, np.array([0.0, 0.0, 1.0]))
-        # ``step_ahead_landing``'s moved landing: the placement's rows while its swing lasts
-        land = self._land_state == _LAND_SWING
-        if not (self.place_shift.any() or self._place_move.any() or land):
+        if not (self.place_shift.any() or self._place_move.any()):
             return out
         for f in range(2):  # two feet
-            mine = land and f == self._land_foot and bool(self._land_move[f].any())
-            if f in out or not (self.place_shift.any() or self._place_move[f].any() or mine):
+            if f in out or not (self.place_shift.any() or self._place_move[f].any()):
                 continue
             sole = self._mocap_swing(t, f)
             if sole is None:
                 continue
             p, v = sole
             p[:2] += self.place_shift + self._place_move[f]
-            if mine:  # brought in over the swing: held from its start, it pulled the foot back
-                lift, down = self._land_span
-                p[:2] += self._land_move[f] * min(1.0, (self.clock.frame(t) - lift) / (down - lift))
             # a pushed walk's foot also comes down level where it lands (lateral rows alone
             # left it hanging 0.2-0.4 m up, short of the landing)
-            level = self.placing or mine
-            out[f] = (p, v, np.zeros(3), np.array([0.0, 0.0, 1.0]) if level else None)
+            out[f] = (p, v, np.zeros(3), np.array([0.0, 0.0, 1.0]) if self.placing else None)
         return out
 
     def _mocap_swing(self, t: float, f: int) -> tuple[F64, F64] | None:
@@ -611,8 +590,6 @@ class AnchoredReference:
             self._track_capture_rate(t)
         if self._ahead_armed and self.step is None and t >= self._step_ready:
             self._step_ahead(t)
-        if self._land_state > _LAND_PUSHED:
-            self._land_ahead(t)
         if self.step is not None or not self.stepping or t < self._step_ready:
             return
         i = self.clock.nearest(t)
@@ -821,77 +798,6 @@ class AnchoredReference:
         self._start_step(t, f, centre, xi, omega, _left_of(self.sole_heading()),
                          shorten=False, duration=min(duration, self.step_time))  # fmt: skip
 
-    def _land_push_over(self, t: float) -> None:
-        """``step_ahead_landing``: the push that armed it ended at ``t``."""
-        self._land_state = _LAND_WAIT
-        self._land_until = t + _LAND_WINDOW
-
-    def _land_ahead(self, t: float) -> None:
-        """``step_ahead_landing``: after a push with a backward part, in the clip's first
-        swing after it (past a double support of the clip's) whose landing falls short of
-        ``step_ahead_landing`` m ahead of the centre of mass predicted (pivoting over the
-        stance foot) to that landing along the clip's walk, the landing moves forward to it,
-        by at most that lead (swings that start within ``_LAND_WINDOW`` s of the push's end);
-        the placement's rows follow the moved swing, brought in over it, and the anchoring
-        reads the foot at its moved landing until the clip lifts it again. A foot tracking
-        the clip's leg on a body the push slowed landed 0.5 m short of the clip's landing, at
-        the centre of mass, and the anchoring followed it there (``docs/tracking.md``)."""
-        assert self.path.sole is not None
-        i = self.clock.nearest(t)
-        firm = self._firm[i]
-        f = self._land_foot
-        low = self.sole_corners()[:, :, 2].min(axis=1) - self.floor_z
-        if self._land_state == _LAND_WAIT:
-            if firm.all():
-                self._land_state = _LAND_READY
-            return
-        if self._land_state == _LAND_READY:
-            if firm.all():
-                return
-            if not firm.any() or self._going_down():
-                self._land_state = _LAND_OFF
-                return
-            f = self._land_foot = int(np.argmin(firm))
-            self._land_state = _LAND_SWING
-            k = float(self._next_planted[i, f])
-            self._land_span = (self.clock.frame(t), max(k, self.clock.frame(t) + 1.0))
-        if self._land_state == _LAND_DOWN:
-            if not firm[f]:  # the clip lifts it again
-                self._land_move[:] = 0.0
-                self._land_state = _LAND_OFF
-            return
-        # the swing: down once the foot, having left the floor, is back on it
-        if low[f] >= self.anchor_touch:
-            self._placed[f] = True  # in the air: the rows hold it to its moved landing
-        elif self._placed[f] or firm[f]:
-            self._placed[f] = False
-            # a swing left where the clip put it: the next one, within the window
-            moved = bool(self._land_move[f].any())
-            self._land_state = _LAND_DOWN if moved else _LAND_WAIT
-            if not (moved or t < self._land_until):
-                self._land_state = _LAND_OFF
-            return
-        k = int(self._next_planted[i, f])
-        u = self._walk_direction(t)
-        if k >= len(self._next_planted) or u is None:
-            return
-        left_s = max(0.0, (k - self.clock.frame(t)) / (self.path.fps * self.rate))
-        _, omega = self.capture_point()  # and the subtree velocities
-        d = self.world.data
-        c, v = d.subtree_com[self._root][:2], d.subtree_linvel[self._root][:2]
-        stance = self._sole_centres()[1 - f, :2]
-        # the centre of mass at the landing, pivoting over the stance foot
-        w = omega * left_s
-        pred = stance + (c - stance) * np.cosh(w) + v * (np.sinh(w) / omega)
-        land = rot2(self.anchor_yaw) @ self.path.sole[k, f, :2] + self.anchor_shift
-        # forward only, by at most the lead: a landing pulled back to the body, or forward
-        # by more, made the rows pull the foot 0.3-0.6 m off the clip's and felled every walk
-        # and never taken back within the swing: the clip's landing closes on the body as it
-        # swings
-        lead = self.step_ahead_landing
-        move = min(lead, max(0.0, float((pred - land) @ u) + lead))
-        self._land_move[f] = max(move, float(self._land_move[f] @ u)) * u
-
     def _track_capture_rate(self, t: float) -> None:
         """``step_ahead_horizon``: the simulated capture point's velocity (2,), from its
         change since the last slow tick, smoothed (``_AHEAD_RATE_TAU``); restarted after a
@@ -943,8 +849,6 @@ class AnchoredReference:
         sim = (d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half)[on, :2]
         ref, ref_yaw = self.path.sole_at(self.clock.frame(t))
         ref = ref[on, :2] @ rot2(self.anchor_yaw).T + self.anchor_shift
-        if self._land_state == _LAND_DOWN:
-            ref = ref + self._land_move[on]  # ``step_ahead_landing``: its moved landing
         centre = sim.mean(axis=0)
         err = centre - ref.mean(axis=0)
         if t <= self.lag_until:
@@ -1100,8 +1004,6 @@ class AnchoredReference:
         self._ahead_armed = False
         self._xi_rate = np.zeros(2)
         self._xi_last = (-np.inf, np.zeros(2))
-        self._land_move[:] = 0.0
-        self._land_state = _LAND_OFF
         self._z0 = float(world.data.qpos[self._z_adr])
         self._root_up0 = world.data.xmat[self._root].reshape(3, 3)[2].copy()
 
@@ -1119,15 +1021,14 @@ class AnchoredReference:
                 self._placed.copy(), self._gone_down, self.leading, self._drop,
                 self._drop_t, self._catching, self._drop_step, self.warp_until,
                 self.lag_until, self._lag_acted, self._ahead_armed, self._xi_rate.copy(),
-                self._xi_last, self._land_move.copy(), self._land_state,
-                self._land_foot, self._land_span, self._land_until)  # fmt: skip
+                self._xi_last)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
         """Back to a :meth:`memory`."""
         (yaw, shift, bal, place, step, taken, ready, slow, clock, rate, warping, landed, placing,
          until, place_move, placed, gone_down, leading, drop, drop_t,
          catching, drop_step, warp_until, lag_until, lag_acted, ahead_armed, xi_rate,
-         xi_last, land_move, land_state, land_foot, land_span, land_until) = memory  # fmt: skip
+         xi_last) = memory  # fmt: skip
         self.anchor_yaw = float(yaw)  # type: ignore[arg-type]
         self.anchor_shift = np.array(shift)
         self.balance_shift = np.array(bal)
@@ -1154,8 +1055,3 @@ class AnchoredReference:
         self._ahead_armed = bool(ahead_armed)
         self._xi_rate = np.array(xi_rate)
         self._xi_last = xi_last  # type: ignore[assignment]
-        self._land_move[:] = land_move  # type: ignore[call-overload]
-        self._land_state = int(land_state)  # type: ignore[call-overload]
-        self._land_foot = int(land_foot)  # type: ignore[call-overload]
-        self._land_span = land_span  # type: ignore[assignment]
-        self._land_until = float(land_until)  # type: ignore[arg-type]

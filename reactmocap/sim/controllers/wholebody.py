@@ -21,11 +21,7 @@ from scipy.optimize import nnls
 from reactmocap.errors import ConfigError, SimulationError
 from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
-from reactmocap.sim.controllers.anchoring import (
-    _LAND_PUSHED,
-    AnchoredReference,
-    rot2,
-)
+from reactmocap.sim.controllers.anchoring import AnchoredReference, rot2
 from reactmocap.sim.controllers.base import check_character, check_params
 from reactmocap.sim.controllers.stepping import outside_distance
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
@@ -305,12 +301,6 @@ class WholeBodyTracker(AnchoredReference):
             toe-down pitch is past this (rad; 0: off): it stands on the balls of its feet on
             purpose, which the box foot's toe edge cannot do; every rule per foot and tick
             tried still felled such a clip (``docs/tracking.md``, issue 16).
-        step_ahead_landing: with ``step_ahead``, after a push with a backward part, the
-            clip's first swing after it whose landing falls short of this lead (m, at most
-            0.5; 0: off) ahead of the centre of mass predicted to it along the walk lands
-            forward there, by at most the lead (its reference, which the placement's rows and
-            the anchoring follow): the foot tracking the clip's leg landed 0.5 m short of the
-            clip's landing, at the centre of mass (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -406,7 +396,6 @@ class WholeBodyTracker(AnchoredReference):
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
         flat_toe: float = 0.0,
-        step_ahead_landing: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -445,7 +434,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band, "flat_toe": flat_toe,
-                "step_ahead_landing": step_ahead_landing,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -499,11 +487,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"flat_toe ({flat_toe!r}) is a toe-down pitch in (0, pi/2) rad past which "
                 f"a clip gets no flat_weight rows: it needs flat_weight > 0"
-            )
-        if step_ahead_landing and not (step_ahead and step_ahead_landing <= 0.5):
-            raise ConfigError(
-                f"step_ahead_landing ({step_ahead_landing!r}) is a lead in (0, 0.5] m past the "
-                f"centre of mass for the first swing after a back push: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -614,7 +597,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_landing=step_ahead_landing,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._flat_w = float(flat_weight)
@@ -978,8 +960,6 @@ class WholeBodyTracker(AnchoredReference):
             # push the clip played faster (``warp_gain``) and after a sideways one the placed
             # foot (``place_pushed``) caught what a step from double support lost
             self._ahead_armed = self.step_ahead > 0 and ahead <= -0.5 * np.hypot(f[0], f[1])
-            if self.step_ahead_landing and ahead < 0:
-                self._land_state = _LAND_PUSHED  # its first swing after the push lands ahead
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
                 kp = self._kp_root_pushed
@@ -988,8 +968,6 @@ class WholeBodyTracker(AnchoredReference):
                 self.kp[:3] = kp
                 self.kv[:3] = critical_kv(kp)
             self._kp_pushed = float(self.kp[0])
-        if self._land_state == _LAND_PUSHED and not pushing:
-            self._land_push_over(t)
         if self._ahead_servo and self._ahead_armed:
             # the clip's pelvis, at the clip's speed, pulled the body on past its feet while
             # the step after the push swung
