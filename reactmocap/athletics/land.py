@@ -271,12 +271,6 @@ class LandingParams:
             (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
             0.71-0.78 m, sinking (docs/athletics.md, "the one-leg stand-up").
-        low_spin_delta: ``(spin kg m^2/s, offset m)``: with ``spin_ref``, a reach whose spin
-            (read as ``spin_ref``'s) is weaker than ``spin`` (the same sign, less in size)
-            adds ``offset`` to the scaled delta; empty: off. Why: the female back
-            handspring's low-spin starts land about 1-2 cm farther back than the proportion
-            puts them (the pelvis's heading flips earlier in their reach, mirroring the
-            delta longer), while the nominal's band sits on it (docs/athletics.md).
     """
 
     knee: float = 0.6
@@ -324,7 +318,6 @@ class LandingParams:
     recover_leg: float = 0.0
     step_knees: float = 0.0
     step_hang_plant: float = 0.0
-    low_spin_delta: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -413,19 +406,6 @@ class LandingParams:
             )
         if self.late_kv_rotation is not None and self.late_kv is None:
             raise ConfigError("landing late_kv_rotation needs late_kv (it gates it)")
-        lo = self.low_spin_delta
-        if lo and not (
-            len(lo) == 2
-            and all(isinstance(x, (int, float)) and math.isfinite(x) for x in lo)
-            and lo[0] != 0.0
-            and abs(lo[1]) <= 0.2
-        ):
-            raise ConfigError(
-                "landing low_spin_delta must be (spin kg m^2/s nonzero, offset m in [-0.2, 0.2]), "
-                f"got {lo!r}"
-            )
-        if lo and not self.spin_ref:
-            raise ConfigError("landing low_spin_delta needs spin_ref (it reads its spin)")
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
@@ -528,11 +508,6 @@ class Landing(Basis):
                 memo["spin"] = float(world.data.subtree_angmom[sn.root] @ sn.side_axis())
             if p.spin_ref:  # the spin to stop against the delta's (see spin_ref)
                 memo["scale"] = memo["spin"] / p.spin_ref
-            memo["low"] = 0.0  # low_spin_delta: a weak spin's offset, decided once
-            if p.low_spin_delta:
-                lo, off = p.low_spin_delta
-                weak = memo["spin"] * lo > 0.0 and abs(memo["spin"]) < abs(lo)
-                memo["low"] = off if weak else 0.0
             memo["fall"] = p.fall_ref
             if p.fall_gain:  # the fall predicted now, in the landing pose (see fall_gain)
                 sn = ctx.sense(t)
@@ -566,8 +541,6 @@ class Landing(Basis):
                     memo["kv"] = p.late_kv_at(past, ctx.rotation)
             delta = p.late_delta[2] if memo["late"] > 0 else p.delta_at(float(v[0]))
             want = np.array([lead * v[0] + delta * memo["scale"], side * v[1]])
-            if p.low_spin_delta:
-                want[0] += memo["low"]
             want[0] -= p.fall_gain * v[0] * (memo["fall"] - p.fall_ref)
             if p.momentum_gain:  # the feet also stop the rotation (see momentum_gain)
                 spin = memo["spin"] if p.momentum_side else pitch_momentum(world, s)
