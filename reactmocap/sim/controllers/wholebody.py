@@ -42,6 +42,8 @@ _ZERO3 = np.zeros(3)
 #: ``tiptoe_weight``: a mocap sole pitched toe-down past this (rad) stands on its toes
 _TIPTOE_PITCH = 0.17
 _TIPTOE_SIN = float(np.sin(_TIPTOE_PITCH))
+_TIPTOE_FLAT_PROBE = False
+_TIPTOE_LEG_PROBE = 0.1
 # a walk's push within this angle of sideways (tan 30 deg) places its swing feet
 _PLACE_SIDE_TAN = float(np.tan(np.radians(30.0)))
 # a walk's push within this angle of straight against the walk is one ``kp_root_against``
@@ -842,6 +844,13 @@ class WholeBodyTracker(AnchoredReference):
                 tasks.append((k * rows[3:], k * target[3:]))
         for f, p_d in tiptoe.items():
             if f not in swing:  # the height row only, at ``tiptoe_weight``
+                if _TIPTOE_FLAT_PROBE:
+                    rows, target = self._swing_task(f, v, p_d, _ZERO3, _ZERO3, _UP[:, 0])
+                    k = np.sqrt(self._tiptoe_w) / self.sqrt_ws
+                    tasks.append((k * rows[2:], k * target[2:]))
+                    wj = wj.copy()
+                    wj[self._leg_rows[f]] = _TIPTOE_LEG_PROBE
+                    continue
                 # (a tilt target given only so the rows come whole; their tilt rows unused)
                 rows, target = self._swing_task(f, v, p_d, _ZERO3, _ZERO3, _ZERO3)
                 k = np.sqrt(self._tiptoe_w) / self.sqrt_ws
