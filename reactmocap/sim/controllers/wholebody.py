@@ -39,11 +39,6 @@ _UP = np.array([[0.0], [0.0], [1.0]])
 # largest acceleration a swinging foot's rows ask for (m/s^2, and rad/s^2 for its tilt)
 _SWING_ACC = 100.0
 _ZERO3 = np.zeros(3)
-#: ``tiptoe_weight``: a mocap sole pitched toe-down past this (rad) stands on its toes
-_TIPTOE_PITCH = 0.17
-_TIPTOE_SIN = float(np.sin(_TIPTOE_PITCH))
-_TIPTOE_FLAT_PROBE = False
-_TIPTOE_LEG_PROBE = 0.1
 # a walk's push within this angle of sideways (tan 30 deg) places its swing feet
 _PLACE_SIDE_TAN = float(np.tan(np.radians(30.0)))
 # a walk's push within this angle of straight against the walk is one ``kp_root_against``
@@ -306,13 +301,6 @@ class WholeBodyTracker(AnchoredReference):
             toe-down pitch is past this (rad; 0: off): it stands on the balls of its feet on
             purpose, which the box foot's toe edge cannot do; every rule per foot and tick
             tried still felled such a clip (``docs/tracking.md``, issue 16).
-        tiptoe_weight: a foot planted in the mocap on its toes (its sole pitched toe-down past
-            ``_TIPTOE_PITCH`` with no corner within ``touch`` of the floor: the mocap's toes,
-            beyond the sole box, carry it) whose simulated sole is off the floor too gets one
-            row of this weight (as ``swing_weight``; 0: off) pulling it down (``kp_swing``)
-            until its lowest corner, or its ball patch, touches: tracked as captured it hung
-            1-5 cm up for 0.6 s and the body stood on its other foot alone
-            (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -408,7 +396,6 @@ class WholeBodyTracker(AnchoredReference):
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
         flat_toe: float = 0.0,
-        tiptoe_weight: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -447,7 +434,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band, "flat_toe": flat_toe,
-                "tiptoe_weight": tiptoe_weight,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -501,11 +487,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"flat_toe ({flat_toe!r}) is a toe-down pitch in (0, pi/2) rad past which "
                 f"a clip gets no flat_weight rows: it needs flat_weight > 0"
-            )
-        if tiptoe_weight and not swing_weight:
-            raise ConfigError(
-                f"tiptoe_weight ({tiptoe_weight!r}) rescales the swing task's rows: it needs "
-                f"swing_weight > 0"
             )
         servo = world.servo
         m = world.model
@@ -622,7 +603,6 @@ class WholeBodyTracker(AnchoredReference):
         if flat_toe and self._toe_pitch() > np.sin(flat_toe):
             self._flat_w = 0.0  # a clip on the balls of its feet: no flat rows
         self._flat_cos = float(np.cos(flat_band))
-        self._tiptoe_w = float(tiptoe_weight)
         self._soft = float(step_soft)
         self._soft_reg = float(np.sqrt(step_soft_reg))
         self._dt_tick = self.control_every * world.timestep
@@ -751,7 +731,6 @@ class WholeBodyTracker(AnchoredReference):
         qr, vr, ar, planted = self.reference(t)
         held = self._held(t)
         flat = self._flat_feet(planted, t) if self._flat_w else {}
-        tiptoe = self._tiptoe_feet(planted, t) if self._tiptoe_w else {}
         sl = self._dofs
         v = d.qvel[sl]
         if not (np.isfinite(d.qpos[self.wc.qpos_slice]).all() and np.isfinite(v).all()):
@@ -842,19 +821,6 @@ class WholeBodyTracker(AnchoredReference):
                 rows, target = self._swing_task(f, v, _ZERO3, _ZERO3, _ZERO3, up_d)
                 k = np.sqrt(self._flat_w) / self.sqrt_ws
                 tasks.append((k * rows[3:], k * target[3:]))
-        for f, p_d in tiptoe.items():
-            if f not in swing:  # the height row only, at ``tiptoe_weight``
-                if _TIPTOE_FLAT_PROBE:
-                    rows, target = self._swing_task(f, v, p_d, _ZERO3, _ZERO3, _UP[:, 0])
-                    k = np.sqrt(self._tiptoe_w) / self.sqrt_ws
-                    tasks.append((k * rows[2:], k * target[2:]))
-                    wj = wj.copy()
-                    wj[self._leg_rows[f]] = _TIPTOE_LEG_PROBE
-                    continue
-                # (a tilt target given only so the rows come whole; their tilt rows unused)
-                rows, target = self._swing_task(f, v, p_d, _ZERO3, _ZERO3, _ZERO3)
-                k = np.sqrt(self._tiptoe_w) / self.sqrt_ws
-                tasks.append((k * rows[2:3], k * target[2:3]))
         a = acc_des[6:]
         beta = np.zeros(0)
         if not tasks:
@@ -930,37 +896,6 @@ class WholeBodyTracker(AnchoredReference):
             if float(d.geom_xmat[self.sole[f], 2::3] @ up) > self._flat_cos:  # its z axis
                 continue
             out[f] = up
-        return out
-
-    def _tiptoe_feet(self, planted: NDArray[np.bool_], t: float) -> dict[int, F64]:
-        """``tiptoe_weight``: the feet the mocap holds planted on its toes (toe-down past
-        ``_TIPTOE_PITCH``, no sole corner within ``touch``) whose simulated sole is off the
-        floor, with the sole centre's target: its place now, lowered by the gap."""
-        assert self.path.sole_up is not None and self.path.sole_yaw is not None
-        assert self.path.corners is not None
-        d = self.world.data
-        i = self.clock.nearest(t)
-        patch_on = self.world.foot_patch_on(self.character)
-        corners = self.sole_corners()
-        out: dict[int, F64] = {}
-        for f in range(2):  # two feet
-            if not planted[f] or self.path.corners[i, f, :, 2].min() < self.touch:
-                continue
-            up, yaw = self.path.sole_up[i, f], self.path.sole_yaw[i, f]
-            if up[0] * np.cos(yaw) + up[1] * np.sin(yaw) < _TIPTOE_SIN:
-                continue
-            rot = d.geom_xmat[self.sole[f]].reshape(3, 3)
-            if patch_on[f]:  # the ball patch carries it
-                prot = d.geom_xmat[self.patch[f]].reshape(3, 3)
-                low = float(d.geom_xpos[self.patch[f], 2] - prot[2, 2] * self.patch_half[f])
-            else:
-                low = float(corners[f, :, 2].min())
-            gap = low - self.floor_z
-            if gap < self.touch:
-                continue
-            p_d = d.geom_xpos[self.sole[f]] - rot[:, 2] * self._sole_half[f]
-            p_d[2] -= gap
-            out[f] = p_d
         return out
 
     def _toe_pitch(self) -> float:
