@@ -271,12 +271,6 @@ class LandingParams:
             (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
             0.71-0.78 m, sinking (docs/athletics.md, "the one-leg stand-up").
-        absorb_tilt: while absorbing, the push line's forward lean (its horizontal part
-            along the heading per unit of its vertical part) is at most this ([-0.5, 0.5]);
-            ``None``: off, the line from the feet to the COM as it is. Why: on the male back
-            layout a short touchdown (the COM near the toes, the feet's middle behind it) has
-            the push lean forward and throw the COM on over the toes (docs/athletics.md,
-            "the absorption's push leaned back").
     """
 
     knee: float = 0.6
@@ -324,7 +318,6 @@ class LandingParams:
     recover_leg: float = 0.0
     step_knees: float = 0.0
     step_hang_plant: float = 0.0
-    absorb_tilt: float | None = None
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -413,9 +406,6 @@ class LandingParams:
             )
         if self.late_kv_rotation is not None and self.late_kv is None:
             raise ConfigError("landing late_kv_rotation needs late_kv (it gates it)")
-        t = self.absorb_tilt
-        if t is not None and not (isinstance(t, (int, float)) and -0.5 <= t <= 0.5):
-            raise ConfigError(f"landing absorb_tilt must be in [-0.5, 0.5], got {t!r}")
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
@@ -678,9 +668,6 @@ class Landing(Basis):
             else:
                 line = s.com - s.sole_corners().mean(axis=(0, 1))
             line /= max(float(line @ s.floor_normal), 0.2)
-            if p.absorb_tilt is not None:  # the push's forward lean capped (absorb_tilt)
-                fwd = np.array([math.cos(h), math.sin(h), 0.0])
-                line -= max(float(line @ fwd) - p.absorb_tilt, 0.0) * fwd
             rig.support_scale = vertical * float(np.linalg.norm(line))
             rig.support_dir = line / np.linalg.norm(line)
             z_d = float(s.com @ s.floor_normal) + v * ctx.control_every * world.timestep
