@@ -250,12 +250,6 @@ class Step:
             step's bow made continuous at the COM's turn"; 0.06: the contiguous 16 limits
             2195 -> 2220 N, none lower, but 2165 N at 0.04 and 0.1, docs/athletics.md "His
             forward pushes traced").
-        squat: on both feet, while the COM moves back and the arms' windmill
-            (:attr:`BalanceGains.windmill`) turns for a fall back, both knees bend so the hips
-            sink ``squat`` (1 - cos(the circle's angle)) / 2 (m: all of it with the arms
-            overhead), the arms' lift of the COM taken off (0: off, in [0, 0.15] m; opt-in:
-            the lift, 4 cm on her back pushes, took the load off her heels before the step,
-            docs/athletics.md "Her back pushes: the windmill's lift taken off").
     """
 
     margin: float = 0.05
@@ -276,7 +270,6 @@ class Step:
     hang_plant: float = 0.0
     plant_settle: float = 0.0
     bow_band: float = 0.0
-    squat: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -299,7 +292,7 @@ class Step:
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
                   ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"),
-                  ("plant_settle", 5.0, "s"), ("bow_band", 0.5, "m/s"), ("squat", 0.15, "m"))  # fmt: skip
+                  ("plant_settle", 5.0, "s"), ("bow_band", 0.5, "m/s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -707,20 +700,6 @@ class BalanceLaw:
         self.support(s)
         if self.stepper is not None:
             self.stepper.control(self, d, h, t)
-            if self.stepper.step.squat and float(vel[0]) < 0.0:
-                self._squat(self.stepper, s, t)
-
-    def _squat(self, st: Stepper, s: Senses, t: float) -> None:
-        """:attr:`Step.squat`: both knees' offsets bent on for the hips to sink as the
-        arms rise in their circle for a fall back, on both feet with no swing under way."""
-        if self._wind_dir[0] >= 0.0 or st.foot >= 0 or not s.foot_contact.all():
-            return
-        drop = 0.5 * st.step.squat * (1.0 - math.cos(float(self._wind[0])))
-        rig = self.ctx.rig
-        a = self.athlete
-        knee = rig.desired(t)[_KNEE, 0] + rig.offset[_KNEE, 0]
-        length = np.sqrt(a.thigh**2 + a.shin**2 + 2.0 * a.thigh * a.shin * np.cos(knee))
-        rig.offset[_KNEE, 0] += knee_for_length(a.thigh, a.shin, length - drop)[0] - knee
 
     def _windmill(
         self, k: int, cp: float, ahead: float, dt: float, level: bool, rate: float, margin: float
