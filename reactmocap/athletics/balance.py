@@ -243,13 +243,6 @@ class Step:
             on over the posture's settle; opt-in: the forward tuck's stand-up bounced the
             hung foot off the floor, docs/athletics.md "Forward tuck: the stand-up
             restarted at the plant").
-        bow_band: the hip strategy's bow (:attr:`BalanceGains.bow`) scaled by the COM's speed
-            along the feet over this band (m/s): in full from it, 0 at a COM at rest, instead
-            of all or nothing at the COM's turn (0: off; opt-in: at the turn it switched
-            0 <-> 0.9 rad every 8-12 ms and hopped the feet, docs/athletics.md "The standing
-            step's bow made continuous at the COM's turn"; 0.06: the contiguous 16 limits
-            2195 -> 2220 N, none lower, but 2165 N at 0.04 and 0.1, docs/athletics.md "His
-            forward pushes traced").
     """
 
     margin: float = 0.05
@@ -269,7 +262,6 @@ class Step:
     knees: float = 0.0
     hang_plant: float = 0.0
     plant_settle: float = 0.0
-    bow_band: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -292,7 +284,7 @@ class Step:
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
                   ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"),
-                  ("plant_settle", 5.0, "s"), ("bow_band", 0.5, "m/s"))  # fmt: skip
+                  ("plant_settle", 5.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -747,11 +739,7 @@ class BalanceLaw:
         if cp * vel <= 0.0:  # the COM on its way back (or to a moved target)
             return 0.0
         beyond = math.copysign(max(abs(cp) - margin, 0.0), cp)
-        bow = float(np.clip(gain * beyond, -back, forward))
-        st = self.stepper
-        if st is not None and st.step.bow_band:  # Step.bow_band: no switch at the COM's turn
-            bow *= min(abs(vel) / st.step.bow_band, 1.0)
-        return bow
+        return float(np.clip(gain * beyond, -back, forward))
 
     def _plant(self, s, d, h: float) -> F64:  # type: ignore[no-untyped-def]
         """:attr:`Posture.plant`'s ankle give (on the rig's offsets); returns each foot's

@@ -522,22 +522,3 @@ def test_the_standing_step_holds_his_175_n_forward_push_with_the_bow_held(
     r_before = run("balance", "male", **push).report
     assert r_before["steps"][0]["t"] == r["steps"][0]["t"]
     assert r_before["steps"][0]["s"] > 0.5 and not r_before["balanced"]
-
-
-def test_a_standing_bow_scaled_by_the_com_speed_holds_his_165_n_forward_push(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # issue 18 (2026-12-05, docs/athletics.md "His forward pushes traced"): step="on" loses
-    # the male's 165 N forward push (the bow's switch at the COM's turn hops the feet and he
-    # is still moving at 3 s, no step); with the bow scaled by the COM's speed over 0.06 m/s
-    # (Step.bow_band) he ends still on both feet
-    push = {"check_range": False, "seconds": 3.0, "push": 165.0, "step": "on"}
-    r = run("balance", "male", **push).report
-    assert not r["steps"] and not r["balanced"] and not r["fell"]
-    band = dataclasses.replace(balance.STANDING_STEP, bow_band=0.06)
-    monkeypatch.setattr(behaviours, "STANDING_STEP", band)
-    r_band = run("balance", "male", **push).report
-    assert r_band["balanced"] and r_band["on_both_feet"]
-    for bad in (-0.01, 0.51, float("nan")):
-        with pytest.raises(ConfigError, match="bow_band"):
-            Step(bow_band=bad)
