@@ -272,9 +272,11 @@ class LandingParams:
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
             0.71-0.78 m, sinking (docs/athletics.md, "the one-leg stand-up").
         recover_min: the recovery's shortest time (s, [0.05, 1]) before it may hand over to
-            the balance; 0.05: the code's minimum. Why: the forward tuck's file with a 4 kg
-            backpack bounced off both feet 12 ms into the recovery and was handed over at
-            0.052 s on one foot, then fell (docs/athletics.md, "the file with a 4 kg backpack").
+            the balance while a foot is off the floor; on both feet, and at the default 0.05,
+            the code's 0.05. Why: the forward tuck's file with a 4 kg backpack bounced off both
+            feet 12 ms into the recovery, was handed over at 0.052 s on one foot and fell; a
+            minimum on both feet too moved most perturbed starts' landings and lost some
+            (docs/athletics.md, "Forward tuck: the file's 4 kg backpack landed").
     """
 
     knee: float = 0.6
@@ -717,7 +719,9 @@ class Landing(Basis):
             eased = t - memo["t_touch"] >= memo["roll_ease"]  # the pelvis's roll upright first
             # pitching forward on feet it stands over: the balance takes that down (recover_spin)
             spin = p.recover_spin > 0 and pitch_momentum(world, s) > p.recover_spin
-            return t_in > p.recover_min and (passed or still or spin) and eased
+            # on one foot (a bounced landing) wait recover_min; on both the code's 0.05
+            lo = p.recover_min if p.recover_min > 0.05 and not s.foot_contact.all() else 0.05
+            return t_in > lo and (passed or still or spin) and eased
 
         def done(world: World, t: float) -> None:
             del world
