@@ -342,10 +342,11 @@ def test_the_forward_tucks_hanging_foot_put_down_near_the_support_lands_seed_2s_
     m = replace(load_maneuver(FORWARD_FILE), seconds=5.5)
     last = dict(m.phases[-1].params)
     assert last.pop("hang_near") == 0.085
-    last.pop("plant_settle")  # the file before hang_near (2026-12-05)
+    last.pop("plant_settle")  # the file before hang_near (2026-12-05): nor recover_min
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
-    before = run_maneuver(_with_last_balance_params(m, last), perturbation=start, fps=10.0)
+    old = _without_land_param(_with_last_balance_params(m, last), "recover_min")
+    before = run_maneuver(old, perturbation=start, fps=10.0)
     assert before.report["fell"] and not before.report["landed"]
 
 
@@ -363,8 +364,32 @@ def test_the_forward_tucks_stand_up_restarted_at_the_plant_lands_seed_2s_start_1
     assert last.pop("plant_settle") == 1.0
     r = run_maneuver(m, perturbation=start, fps=10.0).report
     assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
-    before = run_maneuver(_with_last_balance_params(m, last), perturbation=start, fps=10.0).report
+    old = _without_land_param(_with_last_balance_params(m, last), "recover_min")  # the file then
+    before = run_maneuver(old, perturbation=start, fps=10.0).report
     assert before["fell"] and not before["landed"]
+
+
+def test_the_forward_tuck_files_4_kg_backpack_lands_with_the_landings_recover_min() -> None:
+    """Thesis 8.5.2 on the file: with a 4 kg backpack its landing bounced off both feet 12 ms
+    into the recovery, which handed over at its 0.05 s minimum on one foot, and the run fell
+    (-305.5 deg); the file since 2026-12-06 (``recover_min`` 0.15 s) lands it
+    (docs/athletics.md, "Forward tuck: the file's 4 kg backpack landed"). Cut at 5.5 s."""
+    m = replace(load_maneuver(FORWARD_FILE), backpack=4.0, seconds=5.5)
+    land = next(p for p in m.phases if p.controller == "land").params
+    assert land["recover_min"] == 0.15
+    r = run_maneuver(m, fps=10.0).report
+    assert r["landed"] and not r["fell"] and abs(r["rotation_deg"] - 360.0) <= 30.0
+    before = run_maneuver(_without_land_param(m, "recover_min"), fps=10.0).report
+    assert before["fell"] and not before["landed"]
+
+
+def test_the_landing_refuses_a_recover_min_out_of_range() -> None:
+    for bad in (0.0, 0.04, 1.5, math.nan, -1.0):
+        with pytest.raises(ConfigError, match="recover_min"):
+            LandingParams(recover_min=bad)
+    m = _with_land_params(load_maneuver(FORWARD_FILE), {"recover_min": 2.0})
+    with pytest.raises(ConfigError, match="recover_min"):
+        run_maneuver(m, fps=10.0)
 
 
 def test_a_perturbed_forward_tuck_pushes_off_without_cartwheel_and_lands() -> None:
