@@ -276,7 +276,6 @@ class Step:
     plant_settle: float = 0.0
     bow_band: float = 0.0
     twist: float = 0.0
-    foot_aim: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -300,7 +299,7 @@ class Step:
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
                   ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"),
                   ("plant_settle", 5.0, "s"), ("bow_band", 0.5, "m/s"),
-                  ("twist", 1.0, "of the yaw"), ("foot_aim", 2.0, "of the miss"))  # fmt: skip
+                  ("twist", 1.0, "of the yaw"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -965,8 +964,6 @@ class Stepper:
         down = float(hip[2]) - float(d.xanchor[self._ankles[1 - k], 2])
         down += STEP_PRESS * min(max(2.0 * u - 1.0, 0.0), 1.0)  # pressed down as it ends
         ahead, aside = (float(x) for x in want - at)
-        if st.foot_aim and u >= 0.5:  # Step.foot_aim: the bent knee's shin carried the foot in
-            aside += st.foot_aim * float(want[1] - feet[k, 1])
         a = self.ctx.athlete
         ul, ll = float(a.thigh[k]), float(a.shin[k])
         reach = STEP_REACH * (ul + ll)
