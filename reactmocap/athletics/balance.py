@@ -250,6 +250,12 @@ class Step:
             step's bow made continuous at the COM's turn"; 0.06: the contiguous 16 limits
             2195 -> 2220 N, none lower, but 2165 N at 0.04 and 0.1, docs/athletics.md "His
             forward pushes traced").
+        twist: on a step out (not a closing one) the swing hip's yaw target this share (in
+            [0, 1]) of the one that keeps the swing thigh untwisted in the heading frame (0:
+            off, yaw 0 on the pelvis: with the hip flexed ~1.2 rad the pelvis's roll went into
+            the thigh's twist, and the bent knee put the male back handspring's out step 4-6
+            cm inside its hip; opt-in, no gain beyond the noise, docs/athletics.md "group T's
+            out step traced").
     """
 
     margin: float = 0.05
@@ -270,6 +276,7 @@ class Step:
     hang_plant: float = 0.0
     plant_settle: float = 0.0
     bow_band: float = 0.0
+    twist: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -292,7 +299,8 @@ class Step:
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
                   ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"),
-                  ("plant_settle", 5.0, "s"), ("bow_band", 0.5, "m/s"))  # fmt: skip
+                  ("plant_settle", 5.0, "s"), ("bow_band", 0.5, "m/s"),
+                  ("twist", 1.0, "of the yaw"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -986,7 +994,8 @@ class Stepper:
         # landing's reach); the COM servo's offsets off it, its weight on the other foot
         self._thigh[0] = -swing + geom
         self._thigh[1] = math.asin(float(np.clip(aside / length, -0.5, 0.5)))
-        aim = hips_for_thighs(self.ctx, d, self._thigh[None], h)[0]
+        twist = st.twist if self._out is not None else 0.0  # Step.twist: out steps only
+        aim = hips_for_thighs(self.ctx, d, self._thigh[None], h, twist=twist)[0]
         # the hip eased toward its aim (first order): a jump in its target kicked the pelvis
         # back and the standing foot off the floor
         ease = min(max(t - self._t_last, 0.0) / STEP_EASE, 1.0) if STEP_EASE > 0 else 1.0
@@ -1048,17 +1057,26 @@ class Stepper:
 
 
 def hips_for_thighs(  # type: ignore[no-untyped-def]
-    ctx: Context, d, thighs: np.ndarray, heading: float, ahead: np.ndarray | None = None
+    ctx: Context,
+    d,
+    thighs: np.ndarray,
+    heading: float,
+    ahead: np.ndarray | None = None,
+    twist: float = 0.0,
 ) -> np.ndarray:
     """``(2, 3)`` hip angles that give the thighs the world ``thighs`` ``(2, 3)`` (anatomical
     pitch, roll, yaw in the heading frame) from where the pelvis is now, in all three axes,
-    or turned on by the world rotation vector ``ahead`` (the landing's ``twist_aim``)."""
+    or turned on by the world rotation vector ``ahead`` (the landing's ``twist_aim``); the
+    yaw targets ``twist`` times the ones that give the thighs' yaw (0: zero, :attr:`Step.twist`)."""
     pelvis = quat_mul(d.xquat[ctx.senses.root], quat_conj(ctx.athlete.neutral[0]))
     if ahead is not None:
         pelvis = quat_mul(quat_exp(ahead), pelvis)
     want = quat_mul(quat_from_yaw(heading)[None], quat_from_euler(thighs, EULER_ORDER))
     eul = quat_to_euler(quat_mul(quat_conj(pelvis)[None], want), EULER_ORDER)
-    eul[:, 2] = 0.0  # the hips' yaw targets stay 0, as elsewhere
+    if twist:  # Step.twist: a pelvis rolled over a flexed hip twists the thigh without it
+        eul[:, 2] *= twist
+    else:
+        eul[:, 2] = 0.0  # the hips' yaw targets stay 0, as elsewhere
     return eul
 
 

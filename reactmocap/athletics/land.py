@@ -267,6 +267,12 @@ class LandingParams:
             ``hang_plant`` (s, 0: off; only with ``step``). Why: on the male back handspring
             starts stood 1-2 s on one foot after the landing, the other hung, and fell when a
             later step's swing never came down (docs/athletics.md, "the last falling starts").
+        step_twist: the ``step``'s :class:`~reactmocap.athletics.balance.Step` ``twist``
+            (a share in [0, 1], 0: off; only with ``step``; out steps only). Why: on the male
+            back handspring the pelvis rolled 10-16 deg over the flexed swing hip went into the
+            thigh's twist and the bent knee put the out step's foot 4-6 cm inside its hip; a
+            candidate, 1.0 lands 42 / 37 / 39 of 50 on seeds 0 / 1 / 2 against the file's 41 /
+            37 / 39 (docs/athletics.md, "group T's out step traced").
         recover_leg: the recovery stands up to at least this fraction of the straight leg
             (0: off, to where the legs are, at least half; else in [0.5, 1]). Why: on the male
             back handspring the fallers stood on one knee bent 1.6-1.7 rad with the COM at
@@ -318,6 +324,7 @@ class LandingParams:
     recover_leg: float = 0.0
     step_knees: float = 0.0
     step_hang_plant: float = 0.0
+    step_twist: float = 0.0
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -452,11 +459,13 @@ class LandingParams:
         step = Step.of(self.step)
         more = {"across": self.step_across, "ground": self.step_ground,
                 "down_after": self.step_down_after, "foresee": self.step_foresee,
-                "knees": self.step_knees, "hang_plant": self.step_hang_plant}  # fmt: skip
+                "knees": self.step_knees, "hang_plant": self.step_hang_plant,
+                "twist": self.step_twist}  # fmt: skip
         if step is None:
             if any(v != getattr(Step, k) for k, v in more.items()):
                 raise ConfigError("landing step_across, step_ground, step_down_after, "
-                                  "step_foresee, step_knees and step_hang_plant need a step")  # fmt: skip
+                                  "step_foresee, step_knees, step_hang_plant and step_twist "
+                                  "need a step")  # fmt: skip
             return None
         try:
             return replace(step, **more)

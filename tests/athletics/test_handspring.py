@@ -615,3 +615,25 @@ def test_the_landings_hung_foot_is_planted_after_step_hang_plant() -> None:
             LandingParams(step=(0.05,), step_hang_plant=bad)
     with pytest.raises(ConfigError, match="need a step"):
         LandingParams(step_hang_plant=0.4)
+
+
+def test_the_landings_swing_thigh_is_kept_untwisted_with_step_twist() -> None:
+    """Full-size start 16 (seed 0) steps out with the pelvis rolled over the flexed swing
+    hip; the hip's yaw target 0 lets that roll twist the thigh, and it falls over more steps.
+    With ``step_twist`` 1.0 (on the out step the swing hip's yaw keeps the thigh untwisted in
+    the heading frame) it lands on that one step. A bad value, or one without a step, is
+    named."""
+    m = replace(load_maneuver(EXAMPLE), seconds=6.0)
+    land = next(p for p in m.phases if p.controller == "land").params
+    plain = {k: v for k, v in land.items() if k != "step_twist"}
+    start = _starts(1.0, 17)[16]
+    r = run_maneuver(_with(m, "land", {**plain, "step_twist": 1.0}), perturbation=start,
+                     fps=10.0).report  # fmt: skip
+    assert r["landed"] and not r["fell"] and len(r["steps"]) == 1
+    old = run_maneuver(_with(m, "land", plain), perturbation=start, fps=10.0).report
+    assert old["fell"] and not old["landed"] and len(old["steps"]) > 1
+    for bad in (-0.1, 1.5, math.nan):
+        with pytest.raises(ConfigError, match="step_twist"):
+            LandingParams(step=(0.05,), step_twist=bad)
+    with pytest.raises(ConfigError, match="need a step"):
+        LandingParams(step_twist=1.0)
