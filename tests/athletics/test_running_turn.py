@@ -180,3 +180,50 @@ def test_yaw_momentum_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"yaw_momentum must be in \[0, 1\]"):
         RunParams(yaw_momentum=(0.0, -0.1, 0.0))
     assert RunParams().at(2.5)["yaw_momentum"] == 0.0
+
+
+def _stance_turns(log: dict[str, np.ndarray], after: float) -> list[np.ndarray]:
+    """The desired facing's turn per tick over each stance that starts after ``after``: the
+    touchdown tick's (the facing moves before the state machine) to the lift-off tick's."""
+    turn = np.diff(log["desired_heading"])  # turn[i - 1]: tick i's
+    stance = log["state"] != 0
+    out = []
+    for i in np.flatnonzero(stance[1:] & ~stance[:-1]) + 1:  # touchdown ticks
+        j = i
+        while j + 1 < len(stance) and stance[j + 1]:
+            j += 1
+        if log["t"][i] >= after and j + 1 < len(stance):
+            out.append(turn[i - 1 : j + 1])
+    return out
+
+
+def test_turn_hold_keeps_the_touchdowns_facing_rate_through_the_stance() -> None:
+    """``turn_hold``: on the circle the run is the one without it to the bit before
+    ``PATH_AFTER``; after it the desired facing turns by the touchdown tick's step on every
+    tick of each stance (without it the pursuit's step varies within a stance); on a straight
+    line the run is the one without it to the bit."""
+    secs = PATH_AFTER + 1.5
+    runs = [run_course(2.5, seconds=secs, path="circle:10", fps=10.0,
+                       params=RunParams(turn_hold=v)) for v in (1.0, 0.0)]  # fmt: skip
+    on, off = runs[0].log, runs[1].log
+    before = off["t"] < PATH_AFTER
+    assert np.array_equal(on["com"][before], off["com"][before])
+    assert not np.array_equal(on["com"][~before], off["com"][~before])
+    held, free = _stance_turns(on, PATH_AFTER + 0.01), _stance_turns(off, PATH_AFTER + 0.01)
+    assert len(held) >= 3 and len(free) >= 3
+    for steps in held:
+        assert steps == pytest.approx(np.full(len(steps), steps[0]), abs=1e-12)
+    assert max(float(np.ptp(s)) for s in free) > 1e-4
+    line = [run_course(2.5, seconds=secs, fps=10.0, params=RunParams(turn_hold=v))
+            for v in (1.0, 0.0)]  # fmt: skip
+    for key in ("t", "com", "cross_track", "heading"):
+        assert np.array_equal(line[0].log[key], line[1].log[key]), key
+    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
+
+
+def test_turn_hold_is_checked() -> None:
+    with pytest.raises(ConfigError, match=r"turn_hold must be in \[0, 1\]"):
+        RunParams(turn_hold=1.5)
+    with pytest.raises(ConfigError, match=r"turn_hold must be in \[0, 1\]"):
+        RunParams(turn_hold=(0.0, -0.1, 0.0))
+    assert RunParams().at(2.5)["turn_hold"] == 0.0
