@@ -202,7 +202,7 @@ def test_turn_hold_keeps_the_touchdowns_facing_rate_through_the_stance() -> None
     ``PATH_AFTER``; after it the desired facing turns by the touchdown tick's step on every
     tick of each stance (without it the pursuit's step varies within a stance); on a straight
     line the run is the one without it to the bit."""
-    secs = PATH_AFTER + 1.5
+    secs = PATH_AFTER + 1.2
     runs = [run_course(2.5, seconds=secs, path="circle:10", fps=10.0,
                        params=RunParams(turn_hold=v)) for v in (1.0, 0.0)]  # fmt: skip
     on, off = runs[0].log, runs[1].log
@@ -214,7 +214,7 @@ def test_turn_hold_keeps_the_touchdowns_facing_rate_through_the_stance() -> None
     for steps in held:
         assert steps == pytest.approx(np.full(len(steps), steps[0]), abs=1e-12)
     assert max(float(np.ptp(s)) for s in free) > 1e-4
-    line = [run_course(2.5, seconds=secs, fps=10.0, params=RunParams(turn_hold=v))
+    line = [run_course(2.5, seconds=PATH_AFTER + 0.5, fps=10.0, params=RunParams(turn_hold=v))
             for v in (1.0, 0.0)]  # fmt: skip
     for key in ("t", "com", "cross_track", "heading"):
         assert np.array_equal(line[0].log[key], line[1].log[key]), key
