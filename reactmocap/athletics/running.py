@@ -244,8 +244,6 @@ class Runner:
         self.toe = np.zeros(2, dtype=bool)
         self.heading_d = 0.0
         self.facing_rate = 0.0  # the desired facing's turn per second, this tick
-        self._turn = 0.0  # the desired facing's turn this tick (rad)
-        self._held_turn = 0.0  # its value at the last touchdown (turn_hold)
         self._steered = False
         self.curvature = 0.0
         self.cross_track = math.nan
@@ -657,7 +655,6 @@ class Runner:
     def _enter_loading(self, world: World, t: float) -> None:
         del world
         self.t_touchdown = t
-        self._held_turn = self._turn  # this tick's: the facing moved before the machine
         self.released = False
         self.vz_peak = -math.inf
         self.vz_touchdown = float(self.senses.com_vel[2])
@@ -751,12 +748,6 @@ class Runner:
             step = wrap_angle(want - self.heading_d)
             limit = self.k["turn_rate"] * self.control_every * self._timestep
             turn = clamp(step, -limit, limit)
-            if (self.k["turn_hold"] > 0 and self.machine.current.name != "flight"
-                    and abs(self.curvature) > ARM_CURVE and t >= PATH_AFTER):  # fmt: skip
-                # in stance the facing keeps (a share of) the touchdown's rate: the pursuit's
-                # rate falling within a stance built the yaw momentum the eights fell by
-                turn += self.k["turn_hold"] * (self._held_turn - turn)
-            self._turn = turn
             self.heading_d += turn
             self.facing_rate = turn / (self.control_every * self._timestep)
         else:

@@ -158,12 +158,6 @@ class RunParams:
             arms included) instead of the chest's rate alone (0: off, the chest's; 1: the
             body's). Only where the course curves (``ARM_CURVE``) and from ``PATH_AFTER`` on.
             Within [0, 1].
-        turn_hold: how much of the desired facing's rate in a stance is held at its value at
-            the touchdown (0: off, the course's rate on every tick; 1: held), so the facing
-            does not slow or speed up while the stance hip's servo turns the body (the
-            eight's falls: the pursuit's rate falling 0.33 -> 0.01 rad/s within a stance
-            built the body's yaw momentum). Only where the course curves (``ARM_CURVE``) and
-            from ``PATH_AFTER`` on. Within [0, 1].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -214,7 +208,6 @@ class RunParams:
     arm_yaw: float | Speeds = 1.0
     arm_yaw_rate: float | Speeds = 0.05
     yaw_momentum: float | Speeds = 0.0
-    turn_hold: float | Speeds = 0.0
     smoothing: float | Speeds = (0.02435, 0.0202, 0.0157)
     stiffness: dict[str, float] = field(
         default_factory=lambda: {
@@ -240,7 +233,6 @@ class RunParams:
             ("arm_yaw", 5.0),
             ("arm_yaw_rate", 1.0),
             ("yaw_momentum", 1.0),
-            ("turn_hold", 1.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
