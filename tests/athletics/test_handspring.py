@@ -165,6 +165,31 @@ def test_the_female_landing_places_her_feet_by_the_spin_the_push_left() -> None:
     assert abs(fixed["rotation_at_hands_deg"] - scaled["rotation_at_hands_deg"]) < 1e-9
 
 
+def test_the_female_landings_low_spin_restore_holds_a_weak_spins_kick_a_tick() -> None:
+    """A tenth's start 0 (seed 0) leaves her hands with -35.7 kg m^2/s, weaker than -37.5: the
+    knees' slowing to ``restore`` 0.2 hands the absorption over a tick early, the recovery's
+    kick sends her off the floor with too much spin and she falls on past. With
+    ``low_spin_restore`` (-37.5, 0.15) the kick comes later and she lands (docs/athletics.md,
+    "low_spin_restore")."""
+    m = handspring_maneuver("female")
+    land = {k: v for k, v in next(p for p in m.phases if p.controller == "land").params.items()
+            if k != "low_spin_restore"}  # fmt: skip
+    start = _starts(0.1, 1)[0]
+    off = run_maneuver(_with(m, "land", land), perturbation=start, fps=10.0).report
+    assert off["fell"] and not off["landed"] and off["rotation_deg"] < -380.0
+    on = run_maneuver(_with(m, "land", {**land, "low_spin_restore": (-37.5, 0.15)}),
+                      perturbation=start, fps=10.0).report  # fmt: skip
+    assert on["landed"] and not on["fell"] and abs(on["rotation_deg"] + 360.0) <= 45.0
+    assert abs(on["rotation_at_hands_deg"] - off["rotation_at_hands_deg"]) < 1e-9
+    for bad in ({"low_spin_restore": (-37.5,)}, {"low_spin_restore": (0.0, 0.15)},
+                {"low_spin_restore": (-37.5, 0.0)}, {"low_spin_restore": (-37.5, 1.5)},
+                {"low_spin_restore": (float("nan"), 0.15)}):  # fmt: skip
+        with pytest.raises(ConfigError, match="low_spin_restore"):
+            LandingParams(spin_ref=-41.0, **bad)
+    with pytest.raises(ConfigError, match="low_spin_restore needs spin_ref"):
+        LandingParams(low_spin_restore=(-37.5, 0.15))
+
+
 def _starts(scale: float, n: int, seed: int = 0) -> list[Perturbation]:
     """The first ``n`` of the capture region's starts (``seed``) at ``scale`` of the benchmark's
     distribution, written as it writes it (the same floats)."""
