@@ -177,7 +177,7 @@ def test_the_female_landings_low_spin_restore_holds_a_weak_spins_kick_a_tick() -
     start = _starts(0.1, 1)[0]
     off = run_maneuver(_with(m, "land", land), perturbation=start, fps=10.0).report
     assert off["fell"] and not off["landed"] and off["rotation_deg"] < -380.0
-    on = run_maneuver(_with(m, "land", {**land, "low_spin_restore": (-37.5, 0.15)}),
+    on = run_maneuver(_with(m, "land", {**land, "low_spin_restore": [-37.5, 0.15]}),
                       perturbation=start, fps=10.0).report  # fmt: skip
     assert on["landed"] and not on["fell"] and abs(on["rotation_deg"] + 360.0) <= 45.0
     assert abs(on["rotation_at_hands_deg"] - off["rotation_at_hands_deg"]) < 1e-9
