@@ -281,8 +281,8 @@ class LandingParams:
             (read as ``spin_ref``'s) is weaker than ``spin`` (the same sign, less in size)
             hands the absorption over at ``restore`` (in (0, 1]) instead; empty: off. Why: the
             female back handspring's low-spin starts kick a tick early and hop off with too
-            much spin; 0.15 below -37.5 lands 32 of 50 at a tenth on seed 0 against 26
-            (docs/athletics.md, "the low-spin starts after touchdown").
+            much spin; (-37.5, 0.17), her file's, lands 31 / 23 / 29 of 50 at a tenth on
+            seeds 0 / 1 / 2 against 26 / 23 / 27 (docs/athletics.md, "low_spin_restore").
     """
 
     knee: float = 0.6

@@ -432,7 +432,10 @@ HANDSPRING_PRESET: Mapping[str, Mapping[str, float]] = MappingProxyType({
 #: tenth missed the hands) with the hips' feedback allowed 1.8 rad and her feet 56 cm back;
 #: since 2026-12-05 (later) that delta is scaled by the spin the push left (``spin_ref``, her
 #: nominal's -41.0 kg m^2/s: a start whose hands met the floor less turned keeps less spin
-#: and lands only with its feet nearer)
+#: and lands only with its feet nearer); since 2026-12-06 a start whose spin is weaker than
+#: -37.5 hands her absorption over at 0.17 of the knees' peak speed, not 0.2
+#: (``low_spin_restore``: its recovery's kick came a tick early and hopped it off with too
+#: much spin; 31 / 23 / 29 of 50 at a tenth on seeds 0 / 1 / 2, from 26 / 23 / 27)
 HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingProxyType({
     # the male's landing scales its delta by the spin the push left (LandingParams.spin_ref:
     # the spin at the nominal's release, 2026-12-03). Since 2026-12-03 his knees aim the
@@ -476,7 +479,8 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
         "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 1.8,
                                   "com_ramp": 0.2}),
         "land": MappingProxyType({"delta": -0.56, "spin_ref": -41.0, "swing_cap": 0.97,
-                                  "knee_stiffness": 1.0, "damping": 2.0}),
+                                  "knee_stiffness": 1.0, "damping": 2.0,
+                                  "low_spin_restore": [-37.5, 0.17]}),
     }),
 })  # fmt: skip
 

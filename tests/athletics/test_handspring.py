@@ -159,7 +159,8 @@ def test_the_female_landing_places_her_feet_by_the_spin_the_push_left() -> None:
     start = _starts(0.1, 4)[3]
     scaled = run_maneuver(m, perturbation=start, fps=10.0).report
     assert scaled["landed"] and not scaled["fell"] and abs(scaled["rotation_deg"] + 360.0) <= 45.0
-    fixed = run_maneuver(_with(m, "land", {**land, "spin_ref": 0.0}), perturbation=start,
+    unscaled = {k: v for k, v in land.items() if k != "low_spin_restore"}  # it needs spin_ref
+    fixed = run_maneuver(_with(m, "land", {**unscaled, "spin_ref": 0.0}), perturbation=start,
                          fps=10.0).report  # fmt: skip
     assert fixed["fell"] and not fixed["landed"]
     assert abs(fixed["rotation_at_hands_deg"] - scaled["rotation_at_hands_deg"]) < 1e-9
@@ -169,15 +170,15 @@ def test_the_female_landings_low_spin_restore_holds_a_weak_spins_kick_a_tick() -
     """A tenth's start 0 (seed 0) leaves her hands with -35.7 kg m^2/s, weaker than -37.5: the
     knees' slowing to ``restore`` 0.2 hands the absorption over a tick early, the recovery's
     kick sends her off the floor with too much spin and she falls on past. With
-    ``low_spin_restore`` (-37.5, 0.15) the kick comes later and she lands (docs/athletics.md,
-    "low_spin_restore")."""
+    ``low_spin_restore`` (-37.5, 0.17), her preset's, the kick comes later and she lands
+    (docs/athletics.md, "low_spin_restore")."""
     m = handspring_maneuver("female")
-    land = {k: v for k, v in next(p for p in m.phases if p.controller == "land").params.items()
-            if k != "low_spin_restore"}  # fmt: skip
+    land = dict(next(p for p in m.phases if p.controller == "land").params)
+    assert land.pop("low_spin_restore") == [-37.5, 0.17]
     start = _starts(0.1, 1)[0]
     off = run_maneuver(_with(m, "land", land), perturbation=start, fps=10.0).report
     assert off["fell"] and not off["landed"] and off["rotation_deg"] < -380.0
-    on = run_maneuver(_with(m, "land", {**land, "low_spin_restore": [-37.5, 0.15]}),
+    on = run_maneuver(_with(m, "land", {**land, "low_spin_restore": [-37.5, 0.17]}),
                       perturbation=start, fps=10.0).report  # fmt: skip
     assert on["landed"] and not on["fell"] and abs(on["rotation_deg"] + 360.0) <= 45.0
     assert abs(on["rotation_at_hands_deg"] - off["rotation_at_hands_deg"]) < 1e-9
