@@ -720,7 +720,7 @@ class Landing(Basis):
             # pitching forward on feet it stands over: the balance takes that down (recover_spin)
             spin = p.recover_spin > 0 and pitch_momentum(world, s) > p.recover_spin
             # on one foot (a bounced landing) wait recover_min; on both the code's 0.05
-            lo = p.recover_min if p.recover_min > 0.05 and not s.foot_contact.all() else 0.05
+            lo = 0.05 if s.foot_contact.all() else p.recover_min
             return t_in > lo and (passed or still or spin) and eased
 
         def done(world: World, t: float) -> None:

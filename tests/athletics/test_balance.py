@@ -212,6 +212,17 @@ def test_a_maneuver_balance_with_the_standing_step_puts_a_hanging_foot_down(
     assert str(bad) in str(err.value)
 
 
+def _refused_balance_key(tmp_path: Path, params: str, key: str) -> None:
+    """A one-phase balance maneuver file with ``params`` is refused, naming the file and
+    ``phase[1].params.<key>``."""
+    bad = tmp_path / "m.toml"
+    bad.write_text(f'[[phase]]\ncontroller = "balance"\nparams = {{ {params} }}\n'
+                   'exit = { event = "never" }\n')  # fmt: skip
+    with pytest.raises(ConfigError, match=rf"phase\[1\]\.params\.{key}: needs") as err:
+        load_maneuver(bad)
+    assert str(bad) in str(err.value)
+
+
 def test_a_maneuver_balances_hang_near_waits_for_the_com_near_the_sole_to_put_the_foot_down(
     tmp_path: Path,
 ) -> None:
@@ -230,12 +241,7 @@ def test_a_maneuver_balances_hang_near_waits_for_the_com_near_the_sole_to_put_th
     assert default.max() < 1.5 and np.array_equal(wide, default)  # near enough: as before
     assert close.max() > 2.9  # never that near: on one foot to the end
     for params in ("standing_step = true, hang_near = 0.5", "hang_near = 0.05"):
-        bad = tmp_path / "m.toml"
-        bad.write_text(f'[[phase]]\ncontroller = "balance"\nparams = {{ {params} }}\n'
-                       'exit = { event = "never" }\n')  # fmt: skip
-        with pytest.raises(ConfigError, match=r"phase\[1\]\.params\.hang_near: needs") as err:
-            load_maneuver(bad)
-        assert str(bad) in str(err.value)
+        _refused_balance_key(tmp_path, params, "hang_near")
     with pytest.raises(ConfigError, match="hang_near"):
         Step(hang_near=-0.1)
 
@@ -244,12 +250,7 @@ def test_a_maneuver_balances_plant_settle_is_refused_out_of_range(tmp_path: Path
     # the file key plant_settle (issue 19, 2026-12-05): only with standing_step, (0, 5] s
     for params in ("standing_step = true, plant_settle = 6.0", "plant_settle = 1.0",
                    "standing_step = true, plant_settle = 0.0"):  # fmt: skip
-        bad = tmp_path / "m.toml"
-        bad.write_text(f'[[phase]]\ncontroller = "balance"\nparams = {{ {params} }}\n'
-                       'exit = { event = "never" }\n')  # fmt: skip
-        with pytest.raises(ConfigError, match=r"phase\[1\]\.params\.plant_settle: needs") as err:
-            load_maneuver(bad)
-        assert str(bad) in str(err.value)
+        _refused_balance_key(tmp_path, params, "plant_settle")
     for value in (-0.5, 5.5, math.nan):
         with pytest.raises(ConfigError, match="plant_settle"):
             Step(plant_settle=value)

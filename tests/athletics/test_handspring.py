@@ -9,6 +9,7 @@ import json
 import math
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -575,19 +576,26 @@ def test_the_landings_step_fires_on_the_capture_point_across_the_feet_foreseen()
         LandingParams(step_foresee=0.25)
 
 
+def _landing_with_and_without(
+    key: str, value: float, start: Perturbation
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The male file's reports (run cut to 6 s) from ``start`` with the landing's ``key`` at
+    ``value`` and without it."""
+    m = replace(load_maneuver(EXAMPLE), seconds=6.0)
+    land = next(p for p in m.phases if p.controller == "land").params
+    plain = {k: v for k, v in land.items() if k != key}
+    runs = (_with(m, "land", {**plain, key: value}), _with(m, "land", plain))
+    with_key, without = (run_maneuver(r, perturbation=start, fps=10.0).report for r in runs)
+    return with_key, without
+
+
 def test_the_landings_steps_leave_both_knees_alike() -> None:
     """Full-size start 29 (seed 0) steps after the landing with each stepped knee left at its
     swing's last target: it falls over a third and fourth step. With ``step_knees`` 1.0 (both
     knees' targets to their mean at each touchdown: the file since 2026-12-05, latest) it
     stands on its first step. A share outside [0, 1] or without a step is named."""
-    m = replace(load_maneuver(EXAMPLE), seconds=6.0)
-    land = next(p for p in m.phases if p.controller == "land").params
-    plain = {k: v for k, v in land.items() if k != "step_knees"}
-    start = _starts(1.0, 30)[29]
-    r = run_maneuver(_with(m, "land", {**plain, "step_knees": 1.0}), perturbation=start,
-                     fps=10.0).report  # fmt: skip
+    r, old = _landing_with_and_without("step_knees", 1.0, _starts(1.0, 30)[29])
     assert r["landed"] and not r["fell"]
-    old = run_maneuver(_with(m, "land", plain), perturbation=start, fps=10.0).report
     assert old["fell"] and not old["landed"]
     for bad in (-0.1, 1.5, math.nan):
         with pytest.raises(ConfigError, match="step_knees"):
@@ -601,14 +609,8 @@ def test_the_landings_hung_foot_is_planted_after_step_hang_plant() -> None:
     falls over a late step. With ``step_hang_plant`` 0.4 (the landing's carried stepper puts
     the posture's plant on once a foot has hung 0.4 s with no swing) the hung foot is put
     down and it lands with no step. A bad value, or one without a step, is named."""
-    m = replace(load_maneuver(EXAMPLE), seconds=6.0)
-    land = next(p for p in m.phases if p.controller == "land").params
-    plain = {k: v for k, v in land.items() if k != "step_hang_plant"}
-    start = _starts(1.0, 5, seed=1)[4]
-    r = run_maneuver(_with(m, "land", {**plain, "step_hang_plant": 0.4}), perturbation=start,
-                     fps=10.0).report  # fmt: skip
+    r, old = _landing_with_and_without("step_hang_plant", 0.4, _starts(1.0, 5, seed=1)[4])
     assert r["landed"] and not r["fell"] and not r.get("steps")
-    old = run_maneuver(_with(m, "land", plain), perturbation=start, fps=10.0).report
     assert old["fell"] and not old["landed"]
     for bad in (-0.1, 2.5, math.nan):
         with pytest.raises(ConfigError, match="step_hang_plant"):
