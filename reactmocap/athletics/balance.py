@@ -243,12 +243,6 @@ class Step:
             on over the posture's settle; opt-in: the forward tuck's stand-up bounced the
             hung foot off the floor, docs/athletics.md "Forward tuck: the stand-up
             restarted at the plant").
-        fall: on a forward step along the feet, the standing leg's fore-aft COM-servo
-            offsets (ankle, hip) scaled by ``1 - fall`` over the swing (in [0, 1]; 0: off):
-            the servo held the hip 0.10-0.17 m behind the standing sole in the deep bow, so
-            ``ground``'s reach from it put the foot 0.004-0.04 m ahead of the other (the
-            male's 175-180 N forward push); opt-in, docs/athletics.md "His forward steps
-            let the hip go ahead".
     """
 
     margin: float = 0.05
@@ -268,7 +262,6 @@ class Step:
     knees: float = 0.0
     hang_plant: float = 0.0
     plant_settle: float = 0.0
-    fall: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -291,7 +284,7 @@ class Step:
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
                   ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"),
-                  ("plant_settle", 5.0, "s"), ("fall", 1.0, "of the offsets"))  # fmt: skip
+                  ("plant_settle", 5.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -995,9 +988,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-        if st.fall and under and self._out is not None and self._out[0] > 0.0:  # Step.fall
-            rig.offset[_ANKLE[1 - k], 0] *= 1.0 - st.fall
-            rig.offset[_HIP[1 - k], 0] *= 1.0 - st.fall
 
     def along(self) -> bool:
         """A swing under way along the feet (not a sideways one, nor a closing one)."""

@@ -523,26 +523,3 @@ def test_the_standing_step_holds_his_175_n_forward_push_with_the_bow_held(
     r_before = run("balance", "male", **push).report
     assert r_before["steps"][0]["t"] == r["steps"][0]["t"]
     assert r_before["steps"][0]["s"] > 0.5 and not r_before["balanced"]
-
-
-def test_a_forward_standing_step_that_lets_the_hip_go_ahead_lands_farther_and_stays_up(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # issue 18 (2026-12-06, docs/athletics.md "His forward steps let the hip go ahead"): at
-    # the male's 185 N forward push step="on" fires its first step in the deep bow's bounce;
-    # the standing leg's COM servo holds the hip behind the standing sole, Step.ground cuts
-    # the foot's place to 0.14 m ahead of the other and he falls; with the servo's fore-aft
-    # offsets off the standing leg over the swing (Step.fall 1) it lands farther ahead and
-    # he does not fall
-    push = {"check_range": False, "seconds": 3.0, "push": 185.0, "push_dir": 0.0}
-    assert balance.STANDING_STEP.fall == 0.0
-    r = run("balance", "male", step="on", **push).report
-    assert r["fell"] and r["steps"]
-    monkeypatch.setattr(behaviours, "STANDING_STEP",
-                        dataclasses.replace(balance.STANDING_STEP, fall=1.0))  # fmt: skip
-    r_fall = run("balance", "male", step="on", **push).report
-    assert not r_fall["fell"]
-    assert r_fall["steps"][0]["to_m"] > r["steps"][0]["to_m"] + 0.2
-    for bad in (-0.1, 1.5, float("nan")):
-        with pytest.raises(ConfigError, match="step fall"):
-            Step(fall=bad)
