@@ -617,26 +617,3 @@ def test_the_landings_hung_foot_is_planted_after_step_hang_plant() -> None:
             LandingParams(step=(0.05,), step_hang_plant=bad)
     with pytest.raises(ConfigError, match="need a step"):
         LandingParams(step_hang_plant=0.4)
-
-
-def test_the_female_landings_spin_restore_times_the_kick_by_the_spin_brought() -> None:
-    """A tenth's start 0 (seed 0) reaches for the floor with -35.4 kg m^2/s against the
-    nominal's -40.9: with ``restore`` 0.2 the knees' slowing hands the absorption over a tick
-    early, the recovery's kick sends her off the floor with too much spin and she falls on
-    past. With ``spin_restore`` (-0.01, -0.21) (restore 0.144 at her spin, 0.199 at the
-    nominal's) the kick comes later and she lands; the hands' rotation is the same
-    (docs/athletics.md, "spin_restore"). A bad line, or one without a spin read, is named."""
-    m = handspring_maneuver("female")  # "landed" is read at the end: 4 s does not show it
-    land = next(p for p in m.phases if p.controller == "land").params
-    start = _starts(0.1, 1)[0]
-    off = run_maneuver(m, perturbation=start, fps=10.0).report
-    assert off["fell"] and not off["landed"] and off["rotation_deg"] < -380.0
-    on = run_maneuver(_with(m, "land", {**land, "spin_restore": [-0.01, -0.21]}),
-                      perturbation=start, fps=10.0).report  # fmt: skip
-    assert on["landed"] and not on["fell"] and abs(on["rotation_deg"] + 360.0) <= 45.0
-    assert abs(on["rotation_at_hands_deg"] - off["rotation_at_hands_deg"]) < 1e-9
-    for bad in ((-0.01,), (-0.01, math.nan), (-0.01, -0.21, 0.3)):
-        with pytest.raises(ConfigError, match="spin_restore"):
-            LandingParams(spin_ref=-41.0, spin_restore=bad)
-    with pytest.raises(ConfigError, match="spin_restore needs spin_ref"):
-        LandingParams(spin_restore=(-0.01, -0.21))
