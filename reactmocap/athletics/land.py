@@ -277,12 +277,6 @@ class LandingParams:
             feet 12 ms into the recovery, was handed over at 0.052 s on one foot and fell; a
             minimum on both feet too moved most perturbed starts' landings and lost some
             (docs/athletics.md, "Forward tuck: the file's 4 kg backpack landed").
-        spin_restore: ``(slope per kg m^2/s, intercept)``: with ``spin_ref`` or
-            ``momentum_side``, the absorption hands over at ``intercept + slope * spin`` (the
-            reach's spin, read once), clipped to [0.05, 1], instead of ``restore``; empty: off.
-            Why: the female back handspring's recovery kick comes a tick early or late for the
-            spin she brings and the hop leaves with too much or too little (docs/athletics.md,
-            "the recovery's kick read from the hop's spin").
     """
 
     knee: float = 0.6
@@ -331,7 +325,6 @@ class LandingParams:
     step_knees: float = 0.0
     step_hang_plant: float = 0.0
     recover_min: float = 0.05
-    spin_restore: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -423,15 +416,6 @@ class LandingParams:
             )
         if self.late_kv_rotation is not None and self.late_kv is None:
             raise ConfigError("landing late_kv_rotation needs late_kv (it gates it)")
-        sr = self.spin_restore
-        if sr and not (
-            len(sr) == 2 and all(isinstance(x, (int, float)) and math.isfinite(x) for x in sr)
-        ):
-            raise ConfigError(
-                f"landing spin_restore must be (slope, intercept), two finite numbers, got {sr!r}"
-            )
-        if sr and not (self.spin_ref or self.momentum_side):
-            raise ConfigError("landing spin_restore needs spin_ref or momentum_side (its spin)")
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
@@ -534,10 +518,6 @@ class Landing(Basis):
                 memo["spin"] = float(world.data.subtree_angmom[sn.root] @ sn.side_axis())
             if p.spin_ref:  # the spin to stop against the delta's (see spin_ref)
                 memo["scale"] = memo["spin"] / p.spin_ref
-            memo["restore"] = p.restore
-            if p.spin_restore:  # the kick's tick set by the spin brought (see spin_restore)
-                slope, b = p.spin_restore
-                memo["restore"] = min(max(b + slope * memo["spin"], 0.05), 1.0)
             memo["fall"] = p.fall_ref
             if p.fall_gain:  # the fall predicted now, in the landing pose (see fall_gain)
                 sn = ctx.sense(t)
@@ -717,7 +697,7 @@ class Landing(Basis):
 
         def slowed(world: World, t: float, t_in: float) -> bool:
             """The knees have slowed to ``restore`` of their peak speed."""
-            return t_in > 0.03 and _knee_speed(world, ctx) < memo["restore"] * memo["knee_peak"]
+            return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
 
         def recover_enter(world: World, t: float) -> None:
             del world
