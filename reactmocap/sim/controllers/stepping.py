@@ -200,13 +200,14 @@ def _axis_angle(axis: F64, angle: float) -> F64:
     return out
 
 
-def reach_leg(q: F64, leg: LegFrames, move: F64) -> float:
+def reach_leg(q: F64, leg: LegFrames, move: F64, cut: bool = True) -> F64:
     """Turn the hip and knee of ``leg`` in the pose ``q`` (a character's qpos, changed in
     place) so that its ankle moves by ``move`` (world, (3,)), the foot's orientation kept (the
-    ankle turned back); a move past the leg's reach is cut along its line to what the
-    straight leg reaches. Returns the fraction of ``move`` made (0-1). A closed-form two-link
-    solve (law of cosines at the knee, then the hip turned onto the target): MuJoCo and scipy
-    have no analytic leg IK, and an iterative solve each control tick costs more."""
+    ankle turned back). A target past the leg's reach is, with ``cut``, moved back along
+    ``move`` to what the straight leg reaches, else the straight leg points at it. Returns the
+    ankle's move made (world, (3,)). A closed-form two-link solve (law of cosines at the
+    knee, then the hip turned onto the target): MuJoCo and scipy have no analytic leg IK,
+    and an iterative solve each control tick costs more."""
     bt, bs, bf = leg.body_quat
     qh, qk, qa = q[leg.hip : leg.hip + 4], q[leg.knee : leg.knee + 4], q[leg.ankle : leg.ankle + 4]
     m = _rot(_conj(q[leg.root : leg.root + 4]), move)  # the move in the pelvis's frame
@@ -217,12 +218,14 @@ def reach_leg(q: F64, leg: LegFrames, move: F64) -> float:
     a = kp + wp
     reach = 0.995 * (float(np.linalg.norm(leg.knee_pos)) + float(np.linalg.norm(leg.ankle_pos)))
     mm, am, aa = float(m @ m), float(a @ m), float(a @ a)
-    if mm < 1e-12 or aa >= reach * reach:
-        return 0.0
-    frac = 1.0
-    if aa + 2.0 * am + mm > reach * reach:  # |a + x m| = reach, the root in (0, 1)
-        frac = (-am + float(np.sqrt(am * am - mm * (aa - reach * reach)))) / mm
-    target = a + frac * m
+    if mm < 1e-12 or (cut and aa >= reach * reach):
+        return np.zeros(3)
+    target = a + m
+    out = float(target @ target) - reach * reach
+    if out > 0 and cut:  # |a + x m| = reach, the root in (0, 1)
+        target = a + m * (-am + float(np.sqrt(am * am - mm * (aa - reach * reach)))) / mm
+    elif out > 0:
+        target *= reach / float(np.linalg.norm(target))
     # the knee: turned about the hip's flexion axis (the pelvis's left, off the thigh) so
     # the hip-ankle distance is the target's
     n = leg.left - (leg.left @ kp) / (kp @ kp) * kp
@@ -247,4 +250,4 @@ def reach_leg(q: F64, leg: LegFrames, move: F64) -> float:
     # the ankle: the foot as it was, (shin' bf qa') = (shin bf qa)
     foot = _mul(_mul(shin, bf), qa)
     q[leg.ankle : leg.ankle + 4] = _mul(_conj(_mul(shin_new, bf)), foot)
-    return frac
+    return _rot(q[leg.root : leg.root + 4], target - a)

@@ -58,6 +58,7 @@ _PATCH_OWNER = np.array([0, 0, 0, 0, 1, 2, 3, 4])
 # clip's double support seen; the first swing after it (the move brought in); that foot
 # down in the clip (held); lifted again (taken back over that swing)
 _LEG_OFF, _LEG_PUSHED, _LEG_WAIT, _LEG_READY, _LEG_SWING, _LEG_DOWN, _LEG_BACK = range(7)
+_LEG_CUT = True  # a landing past the leg's reach cut back to it (else the leg points at it)
 
 
 @dataclass(frozen=True)
@@ -948,7 +949,10 @@ class WholeBodyTracker(AnchoredReference):
             self._leg_span = (x, float(k))
             self._leg_move[:2] = self._leg_reach * u
         elif st == _LEG_SWING and firm[f]:
+            # down: the move the reference made at the landing is held and read there
             self._leg_state = st = _LEG_DOWN
+            self._leg_move[:2] = self._landing_moved[f]
+            self._leg_move[2] = 0.0
         elif st == _LEG_DOWN and not firm[f]:
             k = int(self._next_planted[i, f])
             self._leg_state = st = _LEG_BACK
@@ -961,11 +965,12 @@ class WholeBodyTracker(AnchoredReference):
                 self._landing_on = False
                 return
             share = 1.0 - share
-        made = reach_leg(qr, self._legs[f], share * self._leg_move)
+        # a planted foot's move is always cut to the leg's reach: pointed at, it left the floor
+        made = reach_leg(qr, self._legs[f], share * self._leg_move, _LEG_CUT or st == _LEG_DOWN)
         # the anchoring reads the foot at its moved landing while the clip keeps it down
         self._landing_on = st == _LEG_DOWN
         self._landing_moved[:] = 0.0
-        self._landing_moved[f] = made * share * self._leg_move[:2]
+        self._landing_moved[f] = made[:2]
 
     def _flat_feet(self, planted: NDArray[np.bool_], t: float) -> dict[int, F64]:
         """``flat_weight``: the planted feet on at most two sole corners whose sole is more than
