@@ -59,6 +59,7 @@ _PATCH_OWNER = np.array([0, 0, 0, 0, 1, 2, 3, 4])
 # down in the clip (held); lifted again (taken back over that swing)
 _LEG_OFF, _LEG_PUSHED, _LEG_WAIT, _LEG_READY, _LEG_SWING, _LEG_DOWN, _LEG_BACK = range(7)
 _LEG_CUT = True  # a landing past the leg's reach cut back to it (else the leg points at it)
+_LEG_DOWN_MODE = "cut"  # probe switch
 
 
 @dataclass(frozen=True)
@@ -949,6 +950,9 @@ class WholeBodyTracker(AnchoredReference):
             self._leg_span = (x, float(k))
             self._leg_move[:2] = self._leg_reach * u
         elif st == _LEG_SWING and firm[f]:
+            if _LEG_DOWN_MODE == "off":  # probe: the swing only
+                self._leg_state = _LEG_OFF
+                return
             # down: the move the reference made at the landing is held and read there
             self._leg_state = st = _LEG_DOWN
             self._leg_move[:2] = self._landing_moved[f]
@@ -966,7 +970,8 @@ class WholeBodyTracker(AnchoredReference):
                 return
             share = 1.0 - share
         # a planted foot's move is always cut to the leg's reach: pointed at, it left the floor
-        made = reach_leg(qr, self._legs[f], share * self._leg_move, _LEG_CUT or st == _LEG_DOWN)
+        cut = _LEG_CUT or (st == _LEG_DOWN and _LEG_DOWN_MODE == "cut")
+        made = reach_leg(qr, self._legs[f], share * self._leg_move, cut)
         # the anchoring reads the foot at its moved landing while the clip keeps it down
         self._landing_on = st == _LEG_DOWN
         self._landing_moved[:] = 0.0
