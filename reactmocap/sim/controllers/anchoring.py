@@ -312,10 +312,6 @@ class AnchoredReference:
             else:
                 self._swing_limit[:] = largest * self.step_ahead
         self._dt_slow = float(dt_slow)
-        # per foot, a clip landing the tracker moved (world, m; ``step_ahead_leg``), read by
-        # the anchoring while ``_landing_on``
-        self._landing_moved = np.zeros((2, 2))
-        self._landing_on = False
         #: set once a walk is pushed: the clip's rate then follows the body's speed
         self.warping = False
         #: set after a sideways walk's push: the rate then also follows the capture point's
@@ -853,8 +849,6 @@ class AnchoredReference:
         sim = (d.geom_xpos[self.sole] - rot[:, :, 2] * self._sole_half)[on, :2]
         ref, ref_yaw = self.path.sole_at(self.clock.frame(t))
         ref = ref[on, :2] @ rot2(self.anchor_yaw).T + self.anchor_shift
-        if self._landing_on:
-            ref = ref + self._landing_moved[on]
         centre = sim.mean(axis=0)
         err = centre - ref.mean(axis=0)
         if t <= self.lag_until:

@@ -6,14 +6,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = [
-    "LegFrames", "Step", "clamp_to_support", "convex_hull", "outside_distance", "reach_leg",
-    "step_target",
-]  # fmt: skip
+__all__ = ["Step", "clamp_to_support", "convex_hull", "outside_distance", "step_target"]
 
 F64 = NDArray[np.float64]
 
@@ -156,98 +152,3 @@ def step_target(
         target = stance + rel * (max_length / n)
     del swing
     return target
-
-
-@dataclass(frozen=True)
-class LegFrames:
-    """One leg of a character's model for :func:`reach_leg`: the qpos addresses (within the
-    character's qpos) of the pelvis's free-joint quaternion and the hip, knee and ankle ball
-    joints; the thigh's, shin's and foot's body quaternions ``(3, 4)``; the knee in the
-    thigh's frame and the ankle in the shin's ``(3,)`` (m); the pelvis's left axis in its own
-    frame ``(3,)``."""
-
-    root: int
-    hip: int
-    knee: int
-    ankle: int
-    body_quat: F64
-    knee_pos: F64
-    ankle_pos: F64
-    left: F64
-
-
-def _mul(a: F64, b: F64) -> F64:
-    out = np.empty(4)
-    mujoco.mju_mulQuat(out, a, b)
-    return out
-
-
-def _conj(a: F64) -> F64:
-    out = np.empty(4)
-    mujoco.mju_negQuat(out, a)
-    return out
-
-
-def _rot(q: F64, v: F64) -> F64:
-    out = np.empty(3)
-    mujoco.mju_rotVecQuat(out, v, q)
-    return out
-
-
-def _axis_angle(axis: F64, angle: float) -> F64:
-    out = np.empty(4)
-    mujoco.mju_axisAngle2Quat(out, axis, angle)
-    return out
-
-
-def reach_leg(q: F64, leg: LegFrames, move: F64, cut: bool = True) -> F64:
-    """Turn the hip and knee of ``leg`` in the pose ``q`` (a character's qpos, changed in
-    place) so that its ankle moves by ``move`` (world, (3,)), the foot's orientation kept (the
-    ankle turned back). A target past the leg's reach is, with ``cut``, moved back along
-    ``move`` to what the straight leg reaches, else the straight leg points at it. Returns the
-    ankle's move made (world, (3,)). A closed-form two-link solve (law of cosines at the
-    knee, then the hip turned onto the target): MuJoCo and scipy have no analytic leg IK,
-    and an iterative solve each control tick costs more."""
-    bt, bs, bf = leg.body_quat
-    qh, qk, qa = q[leg.hip : leg.hip + 4], q[leg.knee : leg.knee + 4], q[leg.ankle : leg.ankle + 4]
-    m = _rot(_conj(q[leg.root : leg.root + 4]), move)  # the move in the pelvis's frame
-    thigh = _mul(bt, qh)
-    shin_base = _mul(thigh, bs)  # the shin's frame before the knee's turn
-    shin = _mul(shin_base, qk)
-    kp, wp = _rot(thigh, leg.knee_pos), _rot(shin, leg.ankle_pos)
-    a = kp + wp
-    reach = 0.995 * (float(np.linalg.norm(leg.knee_pos)) + float(np.linalg.norm(leg.ankle_pos)))
-    mm, am, aa = float(m @ m), float(a @ m), float(a @ a)
-    if mm < 1e-12 or (cut and aa >= reach * reach):
-        return np.zeros(3)
-    target = a + m
-    out = float(target @ target) - reach * reach
-    if out > 0 and cut:  # |a + x m| = reach, the root in (0, 1)
-        target = a + m * (-am + float(np.sqrt(am * am - mm * (aa - reach * reach)))) / mm
-    elif out > 0:
-        target *= reach / float(np.linalg.norm(target))
-    # the knee: turned about the hip's flexion axis (the pelvis's left, off the thigh) so
-    # the hip-ankle distance is the target's
-    n = leg.left - (leg.left @ kp) / (kp @ kp) * kp
-    n /= np.linalg.norm(n)
-    kn, wn = float(kp @ n), float(wp @ n)
-    k_perp, w_perp = kp - kn * n, wp - wn * n
-    lk, lw = float(np.linalg.norm(k_perp)), float(np.linalg.norm(w_perp))
-    phi = float(np.arctan2(n @ np.cross(k_perp, w_perp), k_perp @ w_perp))
-    c = (float(target @ target) - float(kp @ kp) - float(wp @ wp) - 2.0 * kn * wn) / (2.0 * lk * lw)
-    turn = np.copysign(float(np.arccos(min(1.0, max(-1.0, c)))), phi) - phi
-    knee_turn = _axis_angle(n, turn)  # in the pelvis's frame
-    shin_new = _mul(knee_turn, shin)
-    q[leg.knee : leg.knee + 4] = _mul(_conj(shin_base), shin_new)
-    # the hip: the shortest turn of the new ankle onto the target
-    a2 = kp + _rot(shin_new, leg.ankle_pos)
-    axis = np.cross(a2, target)
-    s = float(np.linalg.norm(axis))
-    hip_turn = _axis_angle(axis / s, float(np.arctan2(s, a2 @ target))) if s > 1e-12 else None
-    if hip_turn is not None:
-        q[leg.hip : leg.hip + 4] = _mul(_conj(bt), _mul(hip_turn, thigh))
-        shin_new = _mul(hip_turn, shin_new)
-    # the ankle: the foot as it was, (shin' bf qa') = (shin bf qa)
-    foot = _mul(_mul(shin, bf), qa)
-    q[leg.ankle : leg.ankle + 4] = _mul(_conj(_mul(shin_new, bf)), foot)
-    return _rot(q[leg.root : leg.root + 4], target - a)

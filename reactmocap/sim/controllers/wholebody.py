@@ -23,7 +23,7 @@ from reactmocap.library.motion import Motion
 from reactmocap.sim.character import BALL_JOINTS, SIM_BODIES
 from reactmocap.sim.controllers.anchoring import AnchoredReference, rot2
 from reactmocap.sim.controllers.base import check_character, check_params
-from reactmocap.sim.controllers.stepping import LegFrames, outside_distance, reach_leg
+from reactmocap.sim.controllers.stepping import outside_distance
 from reactmocap.sim.reference import ReferencePath, reference_path, with_soles
 from reactmocap.sim.servo import critical_kv
 from reactmocap.sim.world import World
@@ -54,12 +54,6 @@ _LEVI_CIVITA = np.array(
 _PATCH_SIGNS = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
 # a patch's five points: its centre (a pyramid's 4 edges), then its 4 corners (straight up)
 _PATCH_OWNER = np.array([0, 0, 0, 0, 1, 2, 3, 4])
-# ``step_ahead_leg``'s states: off; armed by a push with a backward part; the push over; the
-# clip's double support seen; the first swing after it (the move brought in); that foot
-# down in the clip (held); lifted again (taken back over that swing)
-_LEG_OFF, _LEG_PUSHED, _LEG_WAIT, _LEG_READY, _LEG_SWING, _LEG_DOWN, _LEG_BACK = range(7)
-_LEG_CUT = True  # a landing past the leg's reach cut back to it (else the leg points at it)
-_LEG_DOWN_MODE = "cut"  # probe switch
 
 
 @dataclass(frozen=True)
@@ -307,13 +301,6 @@ class WholeBodyTracker(AnchoredReference):
             toe-down pitch is past this (rad; 0: off): it stands on the balls of its feet on
             purpose, which the box foot's toe edge cannot do; every rule per foot and tick
             tried still felled such a clip (``docs/tracking.md``, issue 16).
-        step_ahead_leg: with ``step_ahead``, after a push with a backward part, the clip's
-            first swing after it lands this far (m, at most 0.5; 0: off) further along the
-            walk through the swing leg's joint reference (hip and knee turned by a two-link
-            solve, brought in over the swing, held while the clip keeps the foot down, taken
-            back over its next swing), the anchoring reading the foot at the moved landing:
-            sole rows pulling the foot there lifted it and delayed its landing
-            (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -409,7 +396,6 @@ class WholeBodyTracker(AnchoredReference):
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
         flat_toe: float = 0.0,
-        step_ahead_leg: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -448,7 +434,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band, "flat_toe": flat_toe,
-                "step_ahead_leg": step_ahead_leg,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -502,11 +487,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"flat_toe ({flat_toe!r}) is a toe-down pitch in (0, pi/2) rad past which "
                 f"a clip gets no flat_weight rows: it needs flat_weight > 0"
-            )
-        if step_ahead_leg and not (step_ahead and step_ahead_leg <= 0.5):
-            raise ConfigError(
-                f"step_ahead_leg ({step_ahead_leg!r}) is a landing moved in (0, 0.5] m along "
-                f"the walk for the first swing after a back push: it needs step_ahead > 0"
             )
         servo = world.servo
         m = world.model
@@ -633,13 +613,6 @@ class WholeBodyTracker(AnchoredReference):
             [BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")] for side in "lr"
         ]
         self._leg_rows = [np.concatenate([3 * k + np.arange(3) for k in leg]) for leg in legs]
-        # ``step_ahead_leg``: the legs' frames for the two-link solve, the state (``_LEG_*``),
-        # the foot, its clip frames (lift-off, landing) and the full move (world, (3,))
-        self._leg_reach = float(step_ahead_leg)
-        self._legs = [self._leg_frames(side) for side in "lr"]
-        self._leg_state, self._leg_foot = _LEG_OFF, 0
-        self._leg_span = (0.0, 1.0)
-        self._leg_move = np.zeros(3)
         self._hold_balance = bool(hold_balance)
         self._stance_rows = np.r_[np.arange(6), 6 + np.concatenate(self._leg_rows)]
         self._holding = False  # hold_balance has taken hold
@@ -756,8 +729,6 @@ class WholeBodyTracker(AnchoredReference):
         quantities of the last step). Does not touch the simulation."""
         m, d = self.world.model, self.world.data
         qr, vr, ar, planted = self.reference(t)
-        if self._leg_state > _LEG_PUSHED:
-            self._reach_swing(t, qr)
         held = self._held(t)
         flat = self._flat_feet(planted, t) if self._flat_w else {}
         sl = self._dofs
@@ -906,77 +877,6 @@ class WholeBodyTracker(AnchoredReference):
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
 
-    def _leg_frames(self, side: str) -> LegFrames:
-        """``step_ahead_leg``'s frames of the ``side`` ("l" or "r") leg (qpos addresses
-        within the character's qpos)."""
-        m = self.world.model
-        ids = self.wc.body_ids
-        body = [ids[SIM_BODIES.index(f"{side}_{b}")] for b in ("thigh", "shin", "foot")]
-        hips = [m.body_pos[ids[SIM_BODIES.index(f"{s}_thigh")]] for s in "lr"]
-        hip, knee, ankle = (
-            7 + 4 * BALL_JOINTS.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")
-        )
-        return LegFrames(
-            3, hip, knee, ankle, m.body_quat[body].copy(), m.body_pos[body[1]].copy(),
-            m.body_pos[body[2]].copy(), (hips[0] - hips[1]) / np.linalg.norm(hips[0] - hips[1]),
-        )  # fmt: skip
-
-    def _reach_swing(self, t: float, qr: F64) -> None:
-        """``step_ahead_leg`` at ``t``: after a push with a backward part (the push over, a
-        double support of the clip's seen), the clip's next swing foot's joint reference in
-        ``qr`` (changed in place) reaches ``step_ahead_leg`` m further along the clip's walk,
-        brought in linearly from the clip's lift-off to its landing, held while the clip
-        keeps that foot down (the anchoring reading it there) and taken back over its next
-        swing."""
-        i = self.clock.nearest(t)
-        x = self.clock.frame(t)
-        firm = self._firm[i]
-        st, f = self._leg_state, self._leg_foot
-        if st == _LEG_WAIT:
-            if firm.all():
-                self._leg_state = _LEG_READY
-            return
-        if st == _LEG_READY:
-            if firm.all():
-                return
-            u = self._walk_direction(t)
-            f = int(np.argmin(firm))
-            k = int(self._next_planted[i, f])
-            if not firm.any() or u is None or k >= len(self._next_planted):
-                self._leg_state = _LEG_OFF
-                return
-            self._leg_state = st = _LEG_SWING
-            self._leg_foot = f
-            self._leg_span = (x, float(k))
-            self._leg_move[:2] = self._leg_reach * u
-        elif st == _LEG_SWING and firm[f]:
-            if _LEG_DOWN_MODE == "off":  # probe: the swing only
-                self._leg_state = _LEG_OFF
-                return
-            # down: the move the reference made at the landing is held and read there
-            self._leg_state = st = _LEG_DOWN
-            self._leg_move[:2] = self._landing_moved[f]
-            self._leg_move[2] = 0.0
-        elif st == _LEG_DOWN and not firm[f]:
-            k = int(self._next_planted[i, f])
-            self._leg_state = st = _LEG_BACK
-            self._leg_span = (x, float(min(k, len(self._next_planted) - 1)))
-        lift, down = self._leg_span
-        share = 1.0 if st == _LEG_DOWN else min(1.0, max(0.0, (x - lift) / max(down - lift, 1.0)))
-        if st == _LEG_BACK:
-            if share >= 1.0:
-                self._leg_state = _LEG_OFF
-                self._landing_on = False
-                return
-            share = 1.0 - share
-        # a planted foot's move is always cut to the leg's reach: pointed at, it left the floor
-        cut = _LEG_CUT or (st == _LEG_DOWN and _LEG_DOWN_MODE == "cut")
-        made = reach_leg(qr, self._legs[f], share * self._leg_move, cut)
-        # the anchoring reads the foot at its moved landing while the clip keeps it down
-        self._landing_on = st == _LEG_DOWN
-        self._landing_moved[:] = 0.0
-        self._landing_moved[f] = made[:2]
-
     def _flat_feet(self, planted: NDArray[np.bool_], t: float) -> dict[int, F64]:
         """``flat_weight``: the planted feet on at most two sole corners whose sole is more than
         ``flat_band`` off the mocap's, with the mocap's sole normal (world, as re-anchored)."""
@@ -1060,8 +960,6 @@ class WholeBodyTracker(AnchoredReference):
             # push the clip played faster (``warp_gain``) and after a sideways one the placed
             # foot (``place_pushed``) caught what a step from double support lost
             self._ahead_armed = self.step_ahead > 0 and ahead <= -0.5 * np.hypot(f[0], f[1])
-            if self._leg_reach and ahead < 0:
-                self._leg_state = _LEG_PUSHED  # its first swing after the push lands further
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
                 kp = self._kp_root_pushed
@@ -1070,8 +968,6 @@ class WholeBodyTracker(AnchoredReference):
                 self.kp[:3] = kp
                 self.kv[:3] = critical_kv(kp)
             self._kp_pushed = float(self.kp[0])
-        if self._leg_state == _LEG_PUSHED and not pushing:
-            self._leg_state = _LEG_WAIT
         if self._ahead_servo and self._ahead_armed:
             # the clip's pelvis, at the clip's speed, pulled the body on past its feet while
             # the step after the push swung
@@ -1197,19 +1093,11 @@ class WholeBodyTracker(AnchoredReference):
             self.scale_gains(self._scale)
 
     def memory(self) -> tuple[object, ...]:
-        return (*super().memory(), self._leg_state, self._leg_foot, self._leg_span,
-                self._leg_move.copy(), self._landing_on, self._landing_moved.copy(),
-                self._hip_from, self._pushed, self._back_from,
+        return (*super().memory(), self._hip_from, self._pushed, self._back_from,
                 self.kp[:3].copy(), self.kv[:3].copy(), self._holding, self._scale)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
-        super().restore(memory[:-13])
-        (state, foot, span, move, on, moved) = memory[-13:-7]
-        self._leg_state, self._leg_foot = int(state), int(foot)  # type: ignore[call-overload]
-        self._leg_span = span  # type: ignore[assignment]
-        self._leg_move[:] = move  # type: ignore[call-overload]
-        self._landing_on = bool(on)
-        self._landing_moved[:] = moved  # type: ignore[call-overload]
+        super().restore(memory[:-7])
         self._hip_from = float(memory[-7])  # type: ignore[arg-type]
         self._pushed = bool(memory[-6])
         self._back_from = float(memory[-5])  # type: ignore[arg-type]
@@ -1219,7 +1107,6 @@ class WholeBodyTracker(AnchoredReference):
     def reset(self, world: World) -> None:
         self.reset_ground(world)
         self._pushed, self._back_from, self._hip_from = False, -np.inf, -np.inf
-        self._leg_state, self._landing_on = _LEG_OFF, False
         self._holding = False
         if self._stiffness != 1.0:
             self.stiffen_joints(1.0)
