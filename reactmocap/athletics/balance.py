@@ -262,8 +262,6 @@ class Step:
     knees: float = 0.0
     hang_plant: float = 0.0
     plant_settle: float = 0.0
-    close_hold: float = 0.0
-    close_cross: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -286,8 +284,7 @@ class Step:
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
                   ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"),
-                  ("plant_settle", 5.0, "s"), ("close_hold", 0.5, "m"),
-                  ("close_cross", 0.5, "m"))  # fmt: skip
+                  ("plant_settle", 5.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -851,8 +848,7 @@ class Stepper:
             # free leg up and over)
             k = self._stood
             self._close = t < self._t_end + STEP_CLOSE
-            held = st.close_hold and self._past_landed(cp, k, h, feet) > st.close_hold
-            if self._close and s.foot_contact[1 - k] and not s.foot_contact[k] and not held:
+            if self._close and s.foot_contact[1 - k] and not s.foot_contact[k]:
                 self.foot, self._out, self._t0, self._close = k, None, t, False
                 self.record.append({"t": t, "foot": float(k), "beyond_m": 0.0,
                                     "from_m": float(feet[k, 0] - feet[1 - k, 0])})  # fmt: skip
@@ -940,10 +936,6 @@ class Stepper:
                 lat *= math.exp(omega * max(st.foresee - (t - self._t0), 0.0))
             past = max(side * (at[1] - stand[1]), side * lat + st.across)
             want[1] = stand[1] + side * past
-        if self._out is None and st.close_cross:  # Step.close_cross: across past the CP
-            if self._past_landed(cp, k, h, feet) > st.close_cross:
-                far = 1.0 if stand[1] >= at[1] else -1.0
-                want[1] = cp[1] + far * st.across
         if st.down_after and t - self._t0 >= st.down_after:  # put down under where it is
             if self._down is None:
                 self._down = s.corners[k].mean(axis=0)
@@ -996,15 +988,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-
-    def _past_landed(self, cp: F64, k: int, h: float, feet: F64) -> float:
-        """How far (m) the capture point ``cp`` lies past the landed sole (the one foot
-        ``k`` did not stand on) across the feet, on its side away from foot ``k``."""
-        j = 1 - k
-        lat = self.ctx.senses.local(self.ctx.senses.corners[j], h)[:, 1]
-        if feet[j, 1] >= feet[k, 1]:
-            return float(cp[1] - lat.max())
-        return float(lat.min() - cp[1])
 
     def along(self) -> bool:
         """A swing under way along the feet (not a sideways one, nor a closing one)."""
