@@ -6,7 +6,7 @@ down). Why a Character rather than the listing's own MuJoCo model: ``docs/athlet
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
@@ -32,13 +32,11 @@ from reactmocap.rotations import (
 )
 from reactmocap.sim.bodies import BALL_JOINTS, SIM_BODIES, SIM_PARENTS
 from reactmocap.sim.character import Character, SegmentInertia, build_character
-from reactmocap.sim.geometry import GeomSpec
 from reactmocap.sim.reference_bodies import inertia_matrix, reference_listing
 
 __all__ = [
     "BODIES",
     "EULER_ORDER",
-    "MAX_HEEL",
     "Athlete",
     "athlete",
     "athlete_of",
@@ -55,9 +53,6 @@ BODIES: tuple[str, ...] = SEXES
 #: anatomical joint angles are intrinsic Euler angles in this order: pitch (about +Y, the
 #: flexion axis of hips, knees, ankles and spine), then roll (+X), then yaw (+Z)
 EULER_ORDER = "YXZ"
-#: the largest heel extension (m) :func:`athlete` takes: the soles' heel edges lie 5.3 / 6.0 cm
-#: behind the ankle (female / male), a person's 5-7 cm (``docs/athletics.md``)
-MAX_HEEL = 0.04
 
 # (joint, parent joint, listing body whose inboard joint it is, or a point rule)
 _JOINTS: tuple[tuple[str, str | None, str], ...] = (
@@ -153,39 +148,16 @@ def segment_inertials(sex: str) -> dict[str, SegmentInertia]:
     return out
 
 
-def thesis_character(sex: str, heel: float = 0.0) -> Character:
+def thesis_character(sex: str) -> Character:
     """The thesis's ``"male"`` (97.84 kg) or ``"female"`` (53.30 kg) body as a 16-body
     Character: joints where the listing has them, every segment's mass and inertia from the
     listing (merged segments by the parallel-axis theorem), collision geometry from
-    :func:`~reactmocap.sim.character.build_character` on the body's proportions; ``heel``: see
-    :func:`athlete`."""
+    :func:`~reactmocap.sim.character.build_character` on the body's proportions."""
     skel, parts = thesis_skeleton(sex)
     pts = joint_points(sex)
     root = 0.5 * (pts["ULEGL"] + pts["ULEGR"])
     ref = Motion(skel, 30.0, root[None], np.tile([1.0, 0.0, 0.0, 0.0], (1, skel.num_joints, 1)))
-    char = build_character(skel, parts, reference=ref, inertials=segment_inertials(sex))
-    return _heel_extended(char, heel)
-
-
-def _heel_extended(character: Character, heel: float) -> Character:
-    """``character`` with both sole boxes ``heel`` m longer behind (the toe edge kept); the
-    character itself at 0. Contact only: a listing body's mass does not come from its geoms."""
-    if not 0.0 <= heel <= MAX_HEEL:  # (also NaN)
-        raise ConfigError(f"heel must be in [0, {MAX_HEEL}] m, got {heel!r}")
-    if heel == 0.0:
-        return character
-
-    def longer(g: GeomSpec) -> GeomSpec:
-        if g.kind != "box" or g.patch:
-            return g
-        back = quat_rotate(np.asarray(g.quat), np.array([-0.5 * heel, 0.0, 0.0]))
-        return replace(
-            g, size=(g.size[0] + 0.5 * heel, *g.size[1:]), pos=tuple(np.add(g.pos, back))
-        )
-
-    character.geoms = tuple(longer(g) for g in character.geoms)
-    character._model = None
-    return character
+    return build_character(skel, parts, reference=ref, inertials=segment_inertials(sex))
 
 
 # ---------------------------------------------------------------------------------- athlete
@@ -386,22 +358,20 @@ def athlete_of(character: Character, name: str = "character") -> Athlete:
     return _athlete(name, character)
 
 
-_CACHE: dict[tuple[str, float], Athlete] = {}
+_CACHE: dict[str, Athlete] = {}
 
 
-def athlete(body: str | Path | Motion, heel: float = 0.0) -> Athlete:
+def athlete(body: str | Path | Motion) -> Athlete:
     """The athlete for ``body``: ``"male"`` or ``"female"`` (the thesis bodies), a BVH file or
     a Motion of any mapped skeleton (built on the skeleton's rest pose; 75 kg, the project's
-    mass fractions). ``heel`` (m, in [0, :data:`MAX_HEEL`], 0 the body as built) lengthens
-    both soles behind the ankle by that much (an opt-in probe of the support behind the
-    ankle; ``docs/athletics.md``)."""
+    mass fractions)."""
     if isinstance(body, Motion):
-        return _mocap_athlete(body.name or "clip", body.skeleton, heel)
+        return _mocap_athlete(body.name or "clip", body.skeleton)
     key = str(body)
     if key in BODIES:
-        if (key, heel) not in _CACHE:
-            _CACHE[key, heel] = _athlete(key, thesis_character(key, heel))
-        return _CACHE[key, heel]
+        if key not in _CACHE:
+            _CACHE[key] = _athlete(key, thesis_character(key))
+        return _CACHE[key]
     path = Path(key)
     if path.suffix.lower() != ".bvh":
         raise UnknownKeyError(
@@ -412,11 +382,10 @@ def athlete(body: str | Path | Motion, heel: float = 0.0) -> Athlete:
     from reactmocap.library.bvh import read_bvh
 
     clip = read_bvh(path)
-    return _mocap_athlete(path.stem, clip.skeleton, heel)
+    return _mocap_athlete(path.stem, clip.skeleton)
 
 
-def _mocap_athlete(name: str, skeleton: Skeleton, heel: float = 0.0) -> Athlete:
+def _mocap_athlete(name: str, skeleton: Skeleton) -> Athlete:
     """A mocap skeleton's athlete, built on its rest pose (a BVH rest pose stands with the legs
     straight down and the feet forward; a clip's frames are in a stance of their own)."""
-    char = build_character(skeleton, map_body_parts(skeleton))
-    return _athlete(name, _heel_extended(char, heel))
+    return _athlete(name, build_character(skeleton, map_body_parts(skeleton)))
