@@ -377,7 +377,8 @@ class Runner:
         ul, ll = self._thigh_len[leg], self._shin_len[leg]  # floats: numpy's values
         length = k["touchdown_leg"] * (ul + ll)
         fwd = clamp(fwd, -0.5 * length, 0.75 * length)
-        lat = clamp(lat, -0.3 * length, 0.3 * length)
+        reach = k["lateral_reach"] * length
+        lat = clamp(lat, -reach, reach)
         down = math.sqrt(max(length * length - fwd * fwd - lat * lat, 0.04))
         swing = math.atan2(fwd, down)  # forward angle of the hip-ankle line
         roll = math.atan2(lat, math.hypot(fwd, down))
@@ -673,6 +674,10 @@ class Runner:
         if self.step_start is not None and t > self.step_start[0] + 0.05:
             h = self.heading_d
             dist = float((com - self.step_start[1]) @ np.array([math.cos(h), math.sin(h)]))
+            if self.k["step_chord"] > 0 and abs(self.curvature) > ARM_CURVE:
+                # on a curve the velocity lags the facing: along the step's own chord
+                chord = math.hypot(*(com - self.step_start[1]).tolist())
+                dist += self.k["step_chord"] * (chord - dist)
             err = dist / (t - self.step_start[0]) - self.speed
             # not over the start (its first steps lose up to 1 m/s, which the proportional
             # gain recovers and the slow part would wind up on) nor while the speed ramps up

@@ -160,6 +160,15 @@ class RunParams:
             Within [0, 1].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
+        lateral_reach: the most eqs. 1-2 place the heel to the side of the body's line, in
+            touchdown leg lengths (0.3: as tuned). On 20 m loops at 4-5 m/s the placement
+            asked for up to 0.6-0.8 and the velocity stopped turning with the facing. Within
+            [0.3, 1].
+        step_chord: the placement's slow speed correction measures each step's progress
+            along the facing (0: as tuned) or, by this share, along the step's own chord,
+            where the course curves (``ARM_CURVE``): at 4-5 m/s the velocity lagged the
+            facing by 0.5-1 rad and the correction read a shortfall that was not there, and
+            sped the runner up. Within [0, 1].
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
@@ -215,6 +224,8 @@ class RunParams:
             "wrist": 0.05, "hip": 3.935, "knee": 0.70, "ankle": 0.4,
         }
     )  # fmt: skip
+    lateral_reach: float | Speeds = 0.3
+    step_chord: float | Speeds = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -233,6 +244,7 @@ class RunParams:
             ("arm_yaw", 5.0),
             ("arm_yaw_rate", 1.0),
             ("yaw_momentum", 1.0),
+            ("step_chord", 1.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
@@ -248,6 +260,8 @@ class RunParams:
                 raise ConfigError(f"stance_blend must be in (0, 1], got {self.stance_blend}")
             if r["thrust_drop"] <= 0:
                 raise ConfigError(f"thrust_drop must be > 0, got {self.thrust_drop}")
+            if not 0.3 <= r["lateral_reach"] <= 1.0:
+                raise ConfigError(f"lateral_reach must be in [0.3, 1], got {self.lateral_reach}")
             if r["path_integral"] < 0:
                 raise ConfigError(f"path_integral must be >= 0, got {self.path_integral}")
             if not (r["step_stance"] == 0 or 0.1 <= r["step_stance"] <= 0.5):
