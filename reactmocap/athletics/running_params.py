@@ -158,6 +158,11 @@ class RunParams:
             arms included) instead of the chest's rate alone (0: off, the chest's; 1: the
             body's). Only where the course curves (``ARM_CURVE``) and from ``PATH_AFTER`` on.
             Within [0, 1].
+        turn_place: on a curve, each foot is placed toward the curve's outside by this
+            times the leg length times ``v^2 kappa / g`` (the tangent of the turn's lean; 0:
+            off): the leg's force then leans into the curve and gives the centripetal
+            force. Eqs. 1-2 give it only from a velocity lagging the facing (0.35-0.5 rad at
+            3.5 m/s on a 10 m circle, where the runner fell). Within [0, 3].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
@@ -215,6 +220,7 @@ class RunParams:
             "wrist": 0.05, "hip": 3.935, "knee": 0.70, "ankle": 0.4,
         }
     )  # fmt: skip
+    turn_place: float | Speeds = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -233,6 +239,7 @@ class RunParams:
             ("arm_yaw", 5.0),
             ("arm_yaw_rate", 1.0),
             ("yaw_momentum", 1.0),
+            ("turn_place", 3.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
