@@ -162,7 +162,8 @@ class RunParams:
             times the leg length times ``v^2 kappa / g`` (the tangent of the turn's lean; 0:
             off): the leg's force then leans into the curve and gives the centripetal
             force. Eqs. 1-2 give it only from a velocity lagging the facing (0.35-0.5 rad at
-            3.5 m/s on a 10 m circle, where the runner fell). Within [0, 3].
+            3.5 m/s on a 10 m circle, where the runner fell). From ``PATH_AFTER`` on (from
+            the start it upset the first steps). Within [0, 3].
         smoothing: time constant (s) of the trajectories toward the desired angles (eq. 6).
         stiffness: the servos' stiffness by joint kind outside the stance leg.
     """
