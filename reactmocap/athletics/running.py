@@ -366,6 +366,11 @@ class Runner:
         off = (x_hh + com[0] - hip[0], y_hh + com[1] - hip[1])
         fwd = c * off[0] + sn * off[1]
         lat = -sn * off[0] + c * off[1] + (0.5 if leg == 0 else -0.5) * k["step_width"]
+        if k["turn_place"] > 0 and self.world.data.time >= PATH_AFTER:
+            # toward the curve's outside by the turn's lean: the leg's force then gives the
+            # centripetal force (eqs. 1-2 make it only from a velocity lagging the facing);
+            # not over the start, whose first steps it upset (falls within 1-2.4 s)
+            lat -= k["turn_place"] * self._leg_length * self.speed**2 * self.curvature / self.g
         # ground-speed matching: the foot reaches further forward while it is high and comes
         # back over the last moments before touchdown (predicted from the lowest sole corner
         # and the body's vertical speed), so it meets the ground moving back under the body

@@ -169,6 +169,12 @@ class RunParams:
             where the course curves (``ARM_CURVE``): at 4-5 m/s the velocity lagged the
             facing by 0.5-1 rad and the correction read a shortfall that was not there, and
             sped the runner up. Within [0, 1].
+        turn_place: on a curve, each foot is placed toward the curve's outside by this
+            times the leg length times ``v^2 kappa / g`` (the tangent of the turn's lean; 0:
+            off): the leg's force then leans into the curve and gives the centripetal
+            force. Eqs. 1-2 give it only from a velocity lagging the facing (0.35-0.5 rad at
+            3.5 m/s on a 10 m circle, where the runner fell). From ``PATH_AFTER`` on (from
+            the start it upset the first steps). Within [0, 3].
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
@@ -226,6 +232,7 @@ class RunParams:
     )  # fmt: skip
     lateral_reach: float | Speeds = 0.3
     step_chord: float | Speeds = 0.0
+    turn_place: float | Speeds = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -245,6 +252,7 @@ class RunParams:
             ("arm_yaw_rate", 1.0),
             ("yaw_momentum", 1.0),
             ("step_chord", 1.0),
+            ("turn_place", 3.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):

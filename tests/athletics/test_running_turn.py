@@ -14,6 +14,7 @@ from reactmocap.athletics.running import PATH_AFTER, SHOULDER, Runner
 from reactmocap.athletics.running_body import euler_yxz, qmul1, qyaw
 from reactmocap.athletics.running_params import RunParams
 from reactmocap.errors import ConfigError
+from reactmocap.rotations import wrap_angle
 from reactmocap.sim.bodies import SIM_BODY_INDEX
 
 
@@ -180,3 +181,45 @@ def test_yaw_momentum_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"yaw_momentum must be in \[0, 1\]"):
         RunParams(yaw_momentum=(0.0, -0.1, 0.0))
     assert RunParams().at(2.5)["yaw_momentum"] == 0.0
+
+
+def test_turn_place_turns_the_velocity_with_the_facing_and_holds_the_20_m_circle() -> None:
+    """``turn_place``: on the 20 m circle at 3.5 m/s the run is the one without it to the bit
+    before ``PATH_AFTER``; after it the COM's velocity lags the desired facing by less than
+    half as much as without it (eqs. 1-2 alone make the centripetal force only from that
+    lag, and the runner drifts outside the path) and the runner comes back onto the path;
+    on a straight line the run is the one without it to the bit."""
+    secs = 8.0
+    runs = {g: run_course(3.5, seconds=secs, path="circle:20", fps=10.0,
+                          params=RunParams(turn_place=g)) for g in (0.0, 0.5)}  # fmt: skip
+    on, off = runs[0.5].log, runs[0.0].log
+    before = off["t"] < PATH_AFTER
+    assert np.array_equal(on["com"][before], off["com"][before])
+    assert not np.array_equal(on["com"][~before], off["com"][~before])
+    lag, out = {}, {}
+    for g, res in runs.items():
+        assert not res.report["fell"], g
+        log = res.log
+        after = log["t"] >= PATH_AFTER
+        vel = np.arctan2(log["com_vel"][after, 1], log["com_vel"][after, 0])
+        lag[g] = float(np.mean([wrap_angle(a) for a in vel - log["desired_heading"][after]]))
+        # over the last 3 s; < 0: outside the circle
+        out[g] = float(np.mean(log["cross_track"][log["t"] >= secs - 3.0]))
+    # anticlockwise: a velocity turned right of the facing lags it
+    assert lag[0.0] < -0.15
+    assert lag[0.0] < 2.0 * lag[0.5] < 0.0
+    assert out[0.0] < -0.3
+    assert abs(out[0.5]) < 0.3 * abs(out[0.0])
+    line = [run_course(3.5, seconds=PATH_AFTER + 1.0, fps=10.0, params=RunParams(turn_place=g))
+            for g in (1.0, 0.0)]  # fmt: skip
+    for key in ("t", "com", "cross_track", "heading"):
+        assert np.array_equal(line[0].log[key], line[1].log[key]), key
+    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
+
+
+def test_turn_place_is_checked() -> None:
+    with pytest.raises(ConfigError, match=r"turn_place must be in \[0, 3\]"):
+        RunParams(turn_place=-0.1)
+    with pytest.raises(ConfigError, match=r"turn_place must be in \[0, 3\]"):
+        RunParams(turn_place=(0.0, 0.5, 3.5))
+    assert RunParams().at(3.5)["turn_place"] == 0.0
