@@ -243,12 +243,6 @@ class Step:
             on over the posture's settle; opt-in: the forward tuck's stand-up bounced the
             hung foot off the floor, docs/athletics.md "Forward tuck: the stand-up
             restarted at the plant").
-        hold_heading: during a step out (not a closing one) the standing hip's yaw target
-            is its angle plus this share of the pelvis's heading turn since the swing began
-            (the pelvis held at its heading against the standing leg, not turned with it; 0:
-            off, the target 0, and the male back handspring's pelvis turned with the standing
-            leg and foot at 76-95 deg/s through the out step; in [0, 3]; docs/athletics.md
-            "the pelvis turning with the standing leg").
     """
 
     margin: float = 0.05
@@ -268,7 +262,6 @@ class Step:
     knees: float = 0.0
     hang_plant: float = 0.0
     plant_settle: float = 0.0
-    hold_heading: float = 0.0
 
     def __post_init__(self) -> None:
         names = ("margin", "reach", "lift", "seconds", "across", "ground", "give", "foresee")
@@ -291,7 +284,7 @@ class Step:
             raise ConfigError(f"step down_after must be in [0, 2] s, got {self.down_after!r}")
         ranges = (("hang_still", 1.0, "m/s"), ("hang_near", 0.3, "m"), ("bow_hold", 5.0, "s"),
                   ("pair", 0.3, "m"), ("knees", 1.0, "of the way"), ("hang_plant", 2.0, "s"),
-                  ("plant_settle", 5.0, "s"), ("hold_heading", 3.0, "of the turn"))  # fmt: skip
+                  ("plant_settle", 5.0, "s"))  # fmt: skip
         for name, hi, unit in ranges:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= hi):
@@ -836,7 +829,6 @@ class Stepper:
         self._t_give = -math.inf  # Step.give: the touchdown it is for
         self._thigh = np.zeros(3)  # the swing thigh's pitch, roll, yaw (heading frame)
         self._down: F64 | None = None  # Step.down_after: where the foot goes down (world)
-        self._h0 = 0.0  # Step.hold_heading: the heading when the swing began
         steps = ctx.handover.setdefault("steps", [])  # shared by the run's steppers
         self.record: list[dict[str, float]] = steps if isinstance(steps, list) else []
 
@@ -898,7 +890,6 @@ class Stepper:
             self._bend = 0.0
             self._hip[:] = rig.current_angles()[_HIP[k]]
             self._down = None
-            self._h0 = h
         u = (t - self._t0) / st.seconds
         if (u >= 0.5 and bool(s.foot_contact[k])) or u >= 3.0:  # down: balance on both feet
             self.record[-1]["to_m"] = float(feet[k, 0] - feet[1 - k, 0])
@@ -997,11 +988,6 @@ class Stepper:
         rig.offset[_KNEE[k]] = 0.0
         rig.support[k] = 0.0
         rig.support[1 - k] = 1.0
-        if st.hold_heading and self._out is not None:  # Step.hold_heading: the standing hip
-            j = _HIP[1 - k]
-            turn = math.remainder(h - self._h0, math.tau)
-            yaw = float(rig.current_angles()[j, 2]) + st.hold_heading * turn
-            rig.offset[j, 2] = yaw - float(rig.desired(t)[j, 2])
 
     def along(self) -> bool:
         """A swing under way along the feet (not a sideways one, nor a closing one)."""
