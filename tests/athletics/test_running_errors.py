@@ -167,7 +167,8 @@ def test_an_entry_ramps_the_curvature_onto_the_loop_tangent_to_it(kind: str, ent
     assert heading[join - 1] == pytest.approx(entry / (2 * r), abs=0.02)  # s^2 / (2 L R)
     # the first lap after the join is a circle of R
     lap = path.points[join : join + 100]
-    centre = path.points[join] + r * np.array([-math.sin(entry / (2 * r)), math.cos(entry / (2 * r))])
+    turn = entry / (2 * r)
+    centre = path.points[join] + r * np.array([-math.sin(turn), math.cos(turn)])
     assert np.allclose(np.hypot(*(lap - centre).T), r, atol=1e-9)
     # the steering's curvature (over its look-ahead) ramps too
     assert path.steer(path.points[0], 0.0)[1] < 0.5 / r
