@@ -24,10 +24,13 @@ __all__ = [
     "TURN_RATE",
     "Circle",
     "Course",
+    "EntryPath",
     "Facing",
     "Polyline",
     "Straight",
+    "clothoid",
     "figure_eight",
+    "loop_with_entry",
     "parse_course",
 ]
 
@@ -38,6 +41,12 @@ LOOKAHEAD = 3.0
 MAX_COORD = 1e6
 #: how fast a commanded facing is turned toward (rad/s)
 TURN_RATE = 0.2
+#: the longest entry onto a loop (m)
+MAX_ENTRY = 100.0
+#: spacing of an entry's points (m)
+ENTRY_STEP = 0.25
+#: how long a loop with an entry is laid out (m): its laps repeated, as Straight's 10 km
+ENTRY_PATH_LENGTH = 1e4
 
 
 class Course(Protocol):
@@ -222,6 +231,66 @@ class Polyline:
         return math.atan2(ty - py, tx - px), turn / half, cross
 
 
+class EntryPath(Polyline):
+    """A loop entered along a clothoid (see :func:`loop_with_entry`): an open path whose
+    first ``entry`` m ramp the curvature; ``entered_at`` is the time (s) the runner's progress
+    first reached the loop (None before), from which the run's cross-track error is scored."""
+
+    def __init__(self, points: F64, entry: float) -> None:
+        self.entry = float(entry)
+        self.entered_at: float | None = None
+        super().__init__(points)
+
+    def reset(self) -> None:
+        super().reset()
+        self.entered_at = None
+
+    def steer(self, pos: F64, t: float) -> tuple[float, float, float]:
+        out = super().steer(pos, t)
+        if self.entered_at is None and self.progress >= self.entry:
+            self.entered_at = t
+        return out
+
+
+def clothoid(length: float, radius: float, step: float = ENTRY_STEP) -> F64:
+    """Points ``(N, 2)`` of a clothoid from the origin along +X, its curvature ramped
+    linearly from 0 to ``1 / radius`` (left) over ``length`` m: heading ``s^2 / (2 L R)``,
+    the position from the Fresnel integrals."""
+    from scipy.special import fresnel
+
+    a = math.sqrt(math.pi * length * radius)
+    s = np.linspace(0.0, length, max(int(math.ceil(length / step)), 2) + 1)
+    fs, fc = fresnel(s / a)
+    return np.column_stack([a * fc, a * fs])
+
+
+def loop_with_entry(kind: str, radius: float, entry: float, start: ArrayLike = (0.0, 0.0),
+                    heading: float = 0.0, per_circle: int = 120) -> EntryPath:  # fmt: skip
+    """A ``kind`` (``"circle"`` or ``"eight"``) loop of ``radius`` m entered from ``start``
+    along ``heading`` over a clothoid of ``entry`` m (> 0) whose curvature ramps from 0 to the
+    loop's first circle's (left); the loop leaves the clothoid's end tangent to it, and its
+    laps are laid out to :data:`ENTRY_PATH_LENGTH`."""
+    if not (math.isfinite(radius) and radius > 0):
+        raise ConfigError(f"{kind} radius must be > 0 m, got {radius!r}")
+    if not (math.isfinite(entry) and 0 < entry <= MAX_ENTRY):
+        raise ConfigError(f"entry must be within (0, {MAX_ENTRY:g}] m, got {entry!r}")
+    ramp = clothoid(entry, radius)
+    turn = entry / (2 * radius)  # the clothoid's end heading
+    th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
+    lap = np.column_stack([radius * np.sin(th), radius * (1 - np.cos(th))])
+    if kind == "eight":
+        lap = np.vstack([lap, lap * [1.0, -1.0]])
+    elif kind != "circle":
+        raise ConfigError(f"an entry is for 'circle' or 'eight' loops, got {kind!r}")
+    laps = int(math.ceil(ENTRY_PATH_LENGTH / (2 * np.pi * radius * (2 if kind == "eight" else 1))))
+    c, s = math.cos(turn), math.sin(turn)
+    loop = np.tile(lap, (laps, 1)) @ np.array([[c, -s], [s, c]]).T + ramp[-1]
+    pts = np.vstack([ramp, loop, loop[:1]])
+    c, s = math.cos(heading), math.sin(heading)
+    pts = pts @ np.array([[c, -s], [s, c]]).T + np.asarray(start, dtype=np.float64)[:2]
+    return EntryPath(pts, entry)
+
+
 def Straight(heading: float = 0.0, start: ArrayLike = (0.0, 0.0)) -> Polyline:
     """A straight line from ``start`` along ``heading`` (rad), 10 km long."""
     p0 = np.asarray(start, dtype=np.float64)[:2]
@@ -243,12 +312,27 @@ def figure_eight(radius: float, start: ArrayLike = (0.0, 0.0), heading: float = 
     return Polyline(pts @ rot.T + np.asarray(start, dtype=np.float64)[:2], closed=True)
 
 
-def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0) -> Course:
+def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0,
+                 entry: float = 0.0) -> Course:  # fmt: skip
     """A course from the CLI's ``--path``: ``line``, ``circle:R`` (anticlockwise, starting
     tangent to the runner's heading, centre on its left), ``eight:R`` (figure eight) or a CSV
-    file of ``x,y`` rows in metres (a header line is allowed)."""
+    file of ``x,y`` rows in metres (a header line is allowed). A loop's ``entry`` (m, or the
+    spec's suffix ``circle:R+entry:L``) starts the runner on a clothoid of that length onto
+    it (:func:`loop_with_entry`); 0 (the default) starts on the loop."""
     spec = spec.strip()
+    if "+entry:" in spec:
+        spec, _, tail = spec.partition("+entry:")
+        try:
+            entry = float(tail)
+        except ValueError:
+            raise ConfigError(
+                f"--path ...+entry:L needs a length in metres, got {tail!r}"
+            ) from None
+    if not (math.isfinite(entry) and 0 <= entry <= MAX_ENTRY):
+        raise ConfigError(f"entry must be within [0, {MAX_ENTRY:g}] m, got {entry!r}")
     p0 = np.asarray(start, dtype=np.float64)[:2]
+    if entry > 0 and not spec.startswith(("circle:", "eight:")):
+        raise ConfigError(f"entry is for 'circle:R' or 'eight:R' paths, got {spec!r}")
     if spec == "line":
         return Straight(heading, p0)
     for kind in ("circle", "eight"):
@@ -259,6 +343,8 @@ def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0)
                 raise ConfigError(
                     f"--path {kind}:R needs a radius in metres, got {spec!r}"
                 ) from None
+            if entry > 0:
+                return loop_with_entry(kind, r, entry, p0, heading)
             if kind == "eight":
                 return figure_eight(r, p0, heading)
             left = np.array([-math.sin(heading), math.cos(heading)])

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from reactmocap.athletics.bodies import athlete as make_athlete
-from reactmocap.athletics.paths import Course, Facing, Polyline, parse_course
+from reactmocap.athletics.paths import Course, EntryPath, Facing, Polyline, parse_course
 from reactmocap.athletics.report import FALL_HEIGHT, report_json
 from reactmocap.athletics.running import (
     START_SPEED,
@@ -84,8 +84,8 @@ def run_course(
     on_tick: Callable[[float], None] | None = None,
 ) -> RunResult:
     """Run at ``speed`` m/s (2.5-5) for ``seconds`` along ``path`` (``"line"``,
-    ``"circle:R"``, ``"eight:R"``, a CSV file, or a Course), starting in flight along +X from
-    the origin. ``cloth="pants"`` dresses the runner in cloth driven by the body (with
+    ``"circle:R"``, ``"eight:R"``, either with ``"+entry:L"`` for a clothoid entry of L m onto
+    the loop, a CSV file, or a Course), starting in flight along +X from the origin. ``cloth="pants"`` dresses the runner in cloth driven by the body (with
     ``cloth_feedback`` its forces act back on the body). ``push`` is ``(time s, impulse N s,
     direction rad relative to the runner's heading)`` on the chest over 0.1 s. ``on_tick`` is
     called now and then with the fraction simulated."""
@@ -136,7 +136,13 @@ def run_course(
         "speed_m_s": speed, "seconds": float(seconds),
         "path": path if isinstance(path, str) else type(path).__name__,
     }  # fmt: skip
-    report.update(run_metrics(log, runner.log.touchdowns, speed, standing))
+    # a loop's entry is not scored: its cross-track error counts from the loop's start
+    entered = course.entered_at if isinstance(course, EntryPath) else 0.0
+    path_from = math.inf if entered is None else entered
+    report.update(run_metrics(log, runner.log.touchdowns, speed, standing, path_from=path_from))
+    if isinstance(course, EntryPath):
+        report["path_entry_m"] = course.entry
+        report["loop_from_s"] = entered
     # how far along a path the runner got (whether a figure eight was run through)
     report["path_progress_m"] = course.progress if isinstance(course, Polyline) else None
     report["path_length_m"] = course.total if isinstance(course, Polyline) else None
@@ -162,6 +168,7 @@ def run_metrics(
     speed: float,
     standing_pelvis: float,
     settle: float = SETTLE,
+    path_from: float = 0.0,
 ) -> dict[str, Any]:
     """The run's figures from the runner's log, after ``settle`` seconds (or over the
     second half of a shorter run):
@@ -172,7 +179,8 @@ def run_metrics(
     * ``speed_error_m_s``: RMS over strides (same-foot touchdown to touchdown) of the stride's
       mean speed (its ground-track length over its duration) minus the desired speed; the
       speed within a stride swings by design, so the stride is the unit a speed is held over;
-    * ``path_error_m``: RMS cross-track distance from the path (None without a path);
+    * ``path_error_m``: RMS cross-track distance from the path, from ``path_from`` s too (a
+      loop's start after its entry; None without a path or before it);
     * ``cadence_steps_s``: touchdowns per second; ``stride_m``: same-foot touchdown spacing;
     * ``heading_deg``: the pelvis's mean heading over the last second.
     """
@@ -204,7 +212,7 @@ def run_metrics(
     errs = np.asarray(strides) - speed
     times = [r[0] for r in td]
     cadence = (len(times) - 1) / (times[-1] - times[0]) if len(times) > 2 else None
-    cross = log["cross_track"][sel]
+    cross = log["cross_track"][sel & (t >= path_from)]
     path_error = (float(np.sqrt(np.mean(cross**2))) if cross.size and np.isfinite(cross).all()
                   else None)  # fmt: skip
     last = t >= end - 1.0

@@ -10,10 +10,12 @@ import pytest
 
 from reactmocap.athletics.paths import (
     Circle,
+    EntryPath,
     Facing,
     Polyline,
     Straight,
     figure_eight,
+    loop_with_entry,
     parse_course,
 )
 from reactmocap.athletics.run_course import run_course
@@ -133,6 +135,79 @@ def test_figure_eight_curvature_is_its_loops() -> None:
             got.append(-curvature)
     assert len(got) > 500
     assert np.allclose(got, 0.1, rtol=0.02), (min(got), max(got))
+
+
+def _curvature(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Headings of a polyline's segments and its curvature at the inner points (the turn
+    between neighbouring segments over their mean length)."""
+    seg = np.diff(points, axis=0)
+    heading = np.unwrap(np.arctan2(seg[:, 1], seg[:, 0]))
+    length = np.hypot(seg[:, 0], seg[:, 1])
+    return heading, np.diff(heading) / (0.5 * (length[1:] + length[:-1]))
+
+
+@pytest.mark.parametrize(("kind", "entry"), [("circle", 5.0), ("circle", 20.0), ("eight", 10.0)])
+def test_an_entry_ramps_the_curvature_onto_the_loop_tangent_to_it(kind: str, entry: float) -> None:
+    """The clothoid's curvature grows linearly from 0 to 1/R over the entry and goes on at
+    1/R on the loop: no jump at the join, the heading there continuous, the loop a circle of
+    R through the join."""
+    r = 10.0
+    path = parse_course(f"{kind}:{r:g}+entry:{entry:g}")
+    assert isinstance(path, EntryPath) and path.entry == entry
+    heading, curv = _curvature(path.points)
+    s = path.cum[1:-1]  # the inner points' arc lengths
+    ramp, loop = s < entry - 0.1, (s > entry + 0.1) & (s < entry + 0.9 * 2 * math.pi * r)
+    assert np.allclose(curv[ramp], s[ramp] / (entry * r), atol=2e-3)
+    assert np.allclose(curv[loop], 1.0 / r, atol=2e-3)
+    join = int(np.abs(path.cum - entry).argmin())  # the chords fall short of the arc by < 1e-3 m
+    assert path.cum[join] == pytest.approx(entry, abs=1e-3)
+    near = slice(join - 3, join + 3)
+    assert np.abs(np.diff(curv[near])).max() < 0.02  # the curvature continuous
+    assert heading[join] - heading[join - 1] < 0.05  # one corner's turn: tangent
+    assert heading[join - 1] == pytest.approx(entry / (2 * r), abs=0.02)  # s^2 / (2 L R)
+    # the first lap after the join is a circle of R
+    lap = path.points[join : join + 100]
+    turn = entry / (2 * r)
+    centre = path.points[join] + r * np.array([-math.sin(turn), math.cos(turn)])
+    assert np.allclose(np.hypot(*(lap - centre).T), r, atol=1e-9)
+    # the steering's curvature (over its look-ahead) ramps too
+    assert path.steer(path.points[0], 0.0)[1] < 0.5 / r
+    path.reset()
+    assert path.entered_at is None
+
+
+def test_no_entry_is_the_loop_as_before() -> None:
+    for spec in ("circle:10", "circle:10+entry:0"):
+        c = parse_course(spec, (1.0, 2.0))
+        assert isinstance(c, Circle) and np.array_equal(c.centre, [1.0, 12.0])
+    e = parse_course("eight:10", entry=0.0)
+    assert isinstance(e, Polyline) and np.array_equal(e.points, figure_eight(10.0).points)
+
+
+@pytest.mark.parametrize(
+    ("spec", "entry", "message"),
+    [
+        ("circle:10", -1.0, r"entry must be within \[0, 100\] m"),
+        ("circle:10", math.nan, "entry must be within"),
+        ("eight:10", 101.0, "entry must be within"),
+        ("circle:10+entry:far", 0.0, "entry:L needs a length"),
+        ("circle:10+entry:inf", 0.0, "entry must be within"),
+        ("line+entry:5", 0.0, "entry is for 'circle:R' or 'eight:R'"),
+        ("p.csv", 5.0, "entry is for 'circle:R' or 'eight:R'"),
+    ],
+)
+def test_a_bad_entry_is_refused(spec: str, entry: float, message: str) -> None:
+    with pytest.raises(ConfigError, match=message):
+        parse_course(spec, entry=entry)
+
+
+def test_loop_with_entry_checks_its_inputs() -> None:
+    with pytest.raises(ConfigError, match=r"entry must be within \(0, 100\] m"):
+        loop_with_entry("circle", 10.0, 0.0)
+    with pytest.raises(ConfigError, match="radius"):
+        loop_with_entry("eight", -1.0, 5.0)
+    with pytest.raises(ConfigError, match="'circle' or 'eight'"):
+        loop_with_entry("spiral", 10.0, 5.0)
 
 
 def test_facing_turns_at_a_limited_rate() -> None:

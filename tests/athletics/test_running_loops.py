@@ -1,6 +1,7 @@
 """The opt-ins for 20 m loops at 4-5 m/s (``docs/athletics.md``, "The 20 m loops at 4-5 m/s
 traced"): the foot placement's sideways reach (``lateral_reach``) and the speed correction's
-step measured along its own chord on curves (``step_chord``)."""
+step measured along its own chord on curves (``step_chord``); and a 10 m loop entered along a
+clothoid ("The 10 m loops at 3.5-5 m/s entered along a clothoid")."""
 
 from __future__ import annotations
 
@@ -66,3 +67,19 @@ def test_lateral_reach_and_step_chord_are_checked() -> None:
         RunParams(step_chord=(0.0, 0.0, 2.0))
     assert RunParams().at(4.0)["lateral_reach"] == 0.3
     assert RunParams().at(4.0)["step_chord"] == 0.0
+
+
+def test_a_clothoid_entry_carries_the_runner_past_the_10_m_circles_start_at_3_5_m_s() -> None:
+    # started on circle:10 at 3.5 m/s the defaults fall at 1.70 s; entered over 5 m of
+    # clothoid they reach the loop at 1.68 s and run on (they fall there at 8.0 s)
+    on, entered = (run_course(3.5, seconds=3.0, path=p, fps=10.0)
+                   for p in ("circle:10", "circle:10+entry:5"))  # fmt: skip
+    assert on.report["fell"] and on.report["fell_at_s"] < 2.0
+    r = entered.report
+    assert not r["fell"] and r["path_entry_m"] == 5.0
+    assert 1.5 < r["loop_from_s"] < 2.0 and r["path_progress_m"] > 8.0
+    # the cross-track error is scored from the loop's start, not the figures' (1.5 s)
+    t, cross = entered.log["t"], entered.log["cross_track"]
+    assert r["figures_from_s"] < r["loop_from_s"]
+    loop = np.sqrt(np.mean(cross[t >= r["loop_from_s"]] ** 2))
+    assert r["path_error_m"] == pytest.approx(loop)
