@@ -617,24 +617,3 @@ def test_the_landings_hung_foot_is_planted_after_step_hang_plant() -> None:
             LandingParams(step=(0.05,), step_hang_plant=bad)
     with pytest.raises(ConfigError, match="need a step"):
         LandingParams(step_hang_plant=0.4)
-
-
-def test_the_female_landings_kick_spin_grades_the_kick_by_the_spin_left() -> None:
-    """A tenth's start 0 (seed 0) hands over to the recovery with -19.9 kg m^2/s still to take
-    out: the recovery's full kick sends her off the floor with too much spin and she falls on
-    past. With ``kick_spin`` (-24.0, -0.2) the same kick, at the same tick, has a quarter of
-    the legs' stiffness (1 - 0.2 (-19.9 + 24.0), clipped to 0.25) and she lands; the hands'
-    rotation is the same (docs/athletics.md, "the kick graded by the spin"). A bad pair is
-    named."""
-    m = handspring_maneuver("female")  # "landed" is read at the end: 4 s does not show it
-    land = next(p for p in m.phases if p.controller == "land").params
-    start = _starts(0.1, 1)[0]
-    off = run_maneuver(m, perturbation=start, fps=10.0).report
-    assert off["fell"] and not off["landed"] and off["rotation_deg"] < -380.0
-    on = run_maneuver(_with(m, "land", {**land, "kick_spin": [-24.0, -0.2]}),
-                      perturbation=start, fps=10.0).report  # fmt: skip
-    assert on["landed"] and not on["fell"] and abs(on["rotation_deg"] + 360.0) <= 45.0
-    assert abs(on["rotation_at_hands_deg"] - off["rotation_at_hands_deg"]) < 1e-9
-    for bad in ((-24.0,), (-24.0, math.nan), (-24.0, -0.2, 0.3), ("x", -0.2)):
-        with pytest.raises(ConfigError, match="kick_spin"):
-            LandingParams(kick_spin=bad)  # type: ignore[arg-type]
