@@ -281,8 +281,7 @@ class LandingParams:
             minimum on both feet too moved most perturbed starts' landings and lost some
             (docs/athletics.md, "Forward tuck: the file's 4 kg backpack landed").
         kick_spin: ``(spin kg m^2/s, gain per kg m^2/s)``: the recovery's kick (its ankles'
-            and knees' stiffness, from its first tick until no foot is down or
-            :data:`KICK_HOLD` s)
+            stiffness, from its first tick until no foot is down or :data:`KICK_HOLD` s)
             scaled by ``1 + gain * (spin now - spin)``, clipped to :data:`KICK_SCALE`; its
             timing unchanged; empty: off. Why: the female back handspring's hop leaves with
             too much or too little spin for a kick a 4 ms tick early or late, and no timing
@@ -732,7 +731,7 @@ class Landing(Basis):
                 ref, gain = p.kick_spin
                 k = min(max(1.0 + gain * (spin - ref), KICK_SCALE[0]), KICK_SCALE[1])
                 stiff = rig.stiffness.copy()
-                stiff[_KNEE + _ANKLE] *= k
+                stiff[_ANKLE] *= k
                 rig.set_stiffness(stiff)
                 memo["t_kick"] = t
 
