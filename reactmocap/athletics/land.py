@@ -68,9 +68,6 @@ KNEE_GUARD = 0.2
 KNEE_GUARD_STIFFNESS = 1.0
 #: a foot within this height (m) of the floor after touchdown carries weight
 STANCE_REACH = 0.02
-#: kick_spin: the graded kick's longest hold (s) and its scale's range
-KICK_HOLD = 0.1
-KICK_SCALE = (0.25, 2.0)
 
 
 @dataclass(frozen=True)
@@ -280,12 +277,6 @@ class LandingParams:
             feet 12 ms into the recovery, was handed over at 0.052 s on one foot and fell; a
             minimum on both feet too moved most perturbed starts' landings and lost some
             (docs/athletics.md, "Forward tuck: the file's 4 kg backpack landed").
-        kick_spin: ``(spin kg m^2/s, gain per kg m^2/s)``: the recovery's kick (its ankles'
-            stiffness, from its first tick until no foot is down or :data:`KICK_HOLD` s)
-            scaled by ``1 + gain * (spin now - spin)``, clipped to :data:`KICK_SCALE`; its
-            timing unchanged; empty: off. Why: the female back handspring's hop leaves with
-            too much or too little spin for a kick a 4 ms tick early or late, and no timing
-            rule picks the tick (docs/athletics.md, "the kick graded by the spin").
     """
 
     knee: float = 0.6
@@ -334,7 +325,6 @@ class LandingParams:
     step_knees: float = 0.0
     step_hang_plant: float = 0.0
     recover_min: float = 0.05
-    kick_spin: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -426,13 +416,6 @@ class LandingParams:
             )
         if self.late_kv_rotation is not None and self.late_kv is None:
             raise ConfigError("landing late_kv_rotation needs late_kv (it gates it)")
-        ks = self.kick_spin
-        if ks and not (
-            len(ks) == 2 and all(isinstance(x, (int, float)) and math.isfinite(x) for x in ks)
-        ):
-            raise ConfigError(
-                f"landing kick_spin must be (spin, gain), two finite numbers, got {ks!r}"
-            )
         if self.recover_spin < 0:
             raise ConfigError(f"landing recover_spin must be >= 0, got {self.recover_spin}")
         if not 0.0 <= self.roll_min <= 0.5 * math.pi:
@@ -717,6 +700,7 @@ class Landing(Basis):
             return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
 
         def recover_enter(world: World, t: float) -> None:
+            del world
             rig.support_scale = 1.0
             rig.support_dir = None
             rig.move(rig.current_angles(), 0.0, t, _KNEE)  # the knees stiffen where they are
@@ -724,28 +708,6 @@ class Landing(Basis):
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
             stand_up = max(leg, 0.5, p.recover_leg)  # recover_leg: at least so tall
             bl.set_posture(Posture(leg=stand_up, lean=p.lean, settle=0.3), t)
-            memo["t_kick"] = math.inf
-            if p.kick_spin:  # the kick graded by the spin still to take out (see kick_spin)
-                sn = ctx.sense(t)
-                spin = float(world.data.subtree_angmom[sn.root] @ sn.side_axis())
-                ref, gain = p.kick_spin
-                k = min(max(1.0 + gain * (spin - ref), KICK_SCALE[0]), KICK_SCALE[1])
-                stiff = rig.stiffness.copy()
-                stiff[_ANKLE] *= k
-                rig.set_stiffness(stiff)
-                memo["t_kick"] = t
-
-        def kick_end(world: World, t: float) -> None:
-            """The balance's ankles again once the feet have left or KICK_HOLD has passed."""
-            del world
-            if t - memo["t_kick"] >= KICK_HOLD or not ctx.sense(t).foot_contact.any():
-                rig.set_stiffness(bl.gains.stiffness_array())
-                memo["t_kick"] = math.inf
-
-        def recover(world: World, t: float) -> None:
-            if memo["t_kick"] < math.inf:
-                kick_end(world, t)
-            stand(world, t)
 
         def settled(world: World, t: float, t_in: float) -> bool:
             s = ctx.sense(t)
@@ -773,7 +735,7 @@ class Landing(Basis):
             State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),
             State("absorb", law(absorb, every), absorb_enter,
                   ((slowed, "recover"), (after(1.0), "recover"))),
-            State("recover", law(recover if p.kick_spin else stand, every), recover_enter,
+            State("recover", law(stand, every), recover_enter,
                   ((settled, "done"), (after(1.0), "done"))),
             State("done", law(stand, every), done, ((after(0.0), NEXT),)),
         ]  # fmt: skip

@@ -221,7 +221,7 @@ def _build_land(phase: Phase, ath: Athlete) -> Basis:
     if "delta" in phase.params:  # an explicit delta holds at every speed
         base = replace(base, deltas=())
     p = dict(phase.params)
-    for key in ("step", "late_delta", "kick_spin"):
+    for key in ("step", "late_delta"):
         if key in p:
             p[key] = tuple(p[key])
     return Landing(replace(base, **p))
