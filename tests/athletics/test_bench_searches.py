@@ -7,6 +7,9 @@ import math
 from pathlib import Path
 from types import ModuleType
 
+from reactmocap.athletics import run
+from reactmocap.athletics.scene import DEFAULT_CONTACT
+
 BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_athletics.py"
 
 
@@ -33,3 +36,14 @@ def test_the_contiguous_limit_stops_at_the_first_failure_where_the_bisection_fin
     assert bench._largest(held, 0.0, 300.0, 5.0) == 230.0  # the bisection lands on the island
     assert math.isnan(bench._contiguous(lambda f: f > 0.0, 0.0, 600.0, 5.0))
     assert bench._contiguous(lambda f: True, 0.0, 20.0, 5.0) == 20.0
+
+
+def test_the_push_judge_runs_long_enough_to_see_a_one_foot_stand_fall() -> None:
+    # her 95 N back-left push: still on one foot at 3 s (the 3 s judge held it), down by 5 s
+    bench = _bench()
+    short = run("balance", "female", check_range=False, seconds=3.0, push=95.0,
+                push_dir=math.radians(135.0)).report  # fmt: skip
+    assert short["balanced"] and not short["on_both_feet"]
+    assert bench.PUSH_SECONDS >= 5.0
+    assert not bench._push_held("female", 135.0, DEFAULT_CONTACT)(95.0)
+    assert bench._push_held("female", 135.0, DEFAULT_CONTACT)(90.0)  # held at 8 s too
