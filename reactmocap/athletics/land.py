@@ -277,6 +277,12 @@ class LandingParams:
             feet 12 ms into the recovery, was handed over at 0.052 s on one foot and fell; a
             minimum on both feet too moved most perturbed starts' landings and lost some
             (docs/athletics.md, "Forward tuck: the file's 4 kg backpack landed").
+        absorb_spin: ``(gate, wait)``: the absorb does not hand over to the recovery while
+            the whole body's angular momentum about the pelvis's side axis is below ``gate``
+            (kg m^2/s, < 0: the back somersault's sense) until ``wait`` s (0, 1] after
+            touchdown; () off. Why: on the male back handspring every start that stepped
+            forward out of the recovery entered it at -27..-36 kg m^2/s, the others at
+            +2.7..+8.3 (docs/athletics.md, "the absorb's hand-over held").
     """
 
     knee: float = 0.6
@@ -325,6 +331,7 @@ class LandingParams:
     step_knees: float = 0.0
     step_hang_plant: float = 0.0
     recover_min: float = 0.05
+    absorb_spin: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -372,6 +379,17 @@ class LandingParams:
         m = self.recover_min
         if not (isinstance(m, (int, float)) and 0.05 <= m <= 1.0):  # after(1.0) ends it anyway
             raise ConfigError(f"landing recover_min must be in [0.05, 1] s, got {m!r}")
+        a = self.absorb_spin
+        if a and not (
+            len(a) == 2
+            and all(isinstance(x, (int, float)) and math.isfinite(x) for x in a)
+            and -200.0 <= a[0] < 0.0
+            and 0.0 < a[1] <= 1.0  # the absorb's after(1.0) ends it anyway
+        ):
+            raise ConfigError(
+                "landing absorb_spin must be (gate in [-200, 0) kg m^2/s, wait in (0, 1] s), "
+                f"got {a!r}"
+            )
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
         if self.late_delta and not (
@@ -696,7 +714,12 @@ class Landing(Basis):
             memo["knee_peak"] = max(memo["knee_peak"], _knee_speed(world, ctx))
 
         def slowed(world: World, t: float, t_in: float) -> bool:
-            """The knees have slowed to ``restore`` of their peak speed."""
+            """The knees have slowed to ``restore`` of their peak speed (and, with absorb_spin,
+            the body no longer turns on past its gate)."""
+            if p.absorb_spin and t_in < p.absorb_spin[1]:
+                s = ctx.sense(t)  # mj_subtreeVel has run
+                if float(world.data.subtree_angmom[s.root] @ s.side_axis()) < p.absorb_spin[0]:
+                    return False
             return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
 
         def recover_enter(world: World, t: float) -> None:

@@ -469,7 +469,8 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
         "land": MappingProxyType({"delta": -0.6, "spin_ref": -96.8,
                                   "step": [0.05, 0.0, 0.3, 0.25], "recover_leg": 0.8,
                                   "step_across": 0.05, "step_foresee": 0.25,
-                                  "step_knees": 1.0, "step_hang_plant": 0.4}),
+                                  "step_knees": 1.0, "step_hang_plant": 0.4,
+                                  "absorb_spin": [-15.0, 0.5]}),
         "balance": MappingProxyType({"side_both": True}),
     }),
     "female": MappingProxyType({

@@ -577,7 +577,7 @@ def test_the_landings_step_fires_on_the_capture_point_across_the_feet_foreseen()
 
 
 def _landing_with_and_without(
-    key: str, value: float, start: Perturbation
+    key: str, value: float | list[float], start: Perturbation
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     """The male file's reports (run cut to 6 s) from ``start`` with the landing's ``key`` at
     ``value`` and without it."""
@@ -617,3 +617,17 @@ def test_the_landings_hung_foot_is_planted_after_step_hang_plant() -> None:
             LandingParams(step=(0.05,), step_hang_plant=bad)
     with pytest.raises(ConfigError, match="need a step"):
         LandingParams(step_hang_plant=0.4)
+
+
+def test_the_landings_absorb_holds_its_hand_over_while_the_body_still_turns() -> None:
+    """Full-size start 20 (seed 0) enters the landing's recovery still turning back (-33
+    kg m^2/s about the pelvis's side axis), steps forward out of it and falls. With
+    ``absorb_spin`` (-15, 0.5) (the file since 2026-12-06) the absorb hands over only once
+    the momentum is above -15 kg m^2/s (or 0.5 s after touchdown) and it lands
+    (docs/athletics.md, "the absorb's hand-over held"). A bad gate or wait is named."""
+    r, old = _landing_with_and_without("absorb_spin", [-15.0, 0.5], _starts(1.0, 21)[20])
+    assert r["landed"] and not r["fell"]
+    assert old["fell"] and not old["landed"]
+    for bad in ((1.0, 0.5), (-15.0, 0.0), (-15.0, 1.5), (-15.0,), (math.nan, 0.5)):
+        with pytest.raises(ConfigError, match="absorb_spin"):
+            LandingParams(absorb_spin=bad)
