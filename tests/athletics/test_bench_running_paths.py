@@ -3,30 +3,19 @@ path at several speeds, and a verdict that names the speeds the goal is met at."
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
+from collections.abc import Callable
 from types import ModuleType
 
 import pytest
 
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_athletics_running.py"
-
-
-def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_athletics_running", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
 
 def test_the_path_row_says_met_only_at_the_speeds_that_hold(
-    capsys: pytest.CaptureFixture[str],
+    capsys: pytest.CaptureFixture[str], load_bench: Callable[[str], ModuleType]
 ) -> None:
     # a 10 m circle holds at 3 m/s and falls within 2 s at 3.5 (docs/athletics.md): cut to
     # 5 s (3 s at 2.5 m/s are still the entry's 0.4 m), the verdict must name 3 alone and
     # not call the path goal met
-    met = _bench().paths(speeds=(3.0, 3.5), runs=(("circle:10", 5.0),))
+    met = load_bench("bench_athletics_running").paths(speeds=(3.0, 3.5), runs=(("circle:10", 5.0),))
     out = capsys.readouterr().out
     assert met == {"circle:10": [3.0]}
     assert "| circle:10 | 3 | 5 | no |" in out

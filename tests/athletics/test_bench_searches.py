@@ -2,29 +2,18 @@
 
 from __future__ import annotations
 
-import importlib.util
 import math
-from pathlib import Path
+from collections.abc import Callable
 from types import ModuleType
 
 from reactmocap.athletics import run
 from reactmocap.athletics.scene import DEFAULT_CONTACT
 
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_athletics.py"
 
-
-def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_athletics", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_the_contiguous_limit_stops_at_the_first_failure_where_the_bisection_finds_an_island() -> (
-    None
-):
-    bench = _bench()
+def test_the_contiguous_limit_stops_at_the_first_failure_where_the_bisection_finds_an_island(
+    load_bench: Callable[[str], ModuleType],
+) -> None:
+    bench = load_bench("bench_athletics")
     calls: list[float] = []
 
     def held(f: float) -> bool:  # held to 160 N, an island at 220-230 N (his front-left's shape)
@@ -38,9 +27,11 @@ def test_the_contiguous_limit_stops_at_the_first_failure_where_the_bisection_fin
     assert bench._contiguous(lambda f: True, 0.0, 20.0, 5.0) == 20.0
 
 
-def test_the_push_judge_runs_long_enough_to_see_a_one_foot_stand_fall() -> None:
+def test_the_push_judge_runs_long_enough_to_see_a_one_foot_stand_fall(
+    load_bench: Callable[[str], ModuleType],
+) -> None:
     # her 95 N back-left push: still on one foot at 3 s (the 3 s judge held it), down by 5 s
-    bench = _bench()
+    bench = load_bench("bench_athletics")
     short = run("balance", "female", check_range=False, seconds=3.0, push=95.0,
                 push_dir=math.radians(135.0)).report  # fmt: skip
     assert short["balanced"] and not short["on_both_feet"]
