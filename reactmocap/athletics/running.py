@@ -678,10 +678,11 @@ class Runner:
         com = self.senses.com[:2].copy()
         if self.step_start is not None and t > self.step_start[0] + 0.05:
             h = self.heading_d
-            dist = float((com - self.step_start[1]) @ np.array([math.cos(h), math.sin(h)]))
+            dx, dy = (com - self.step_start[1]).tolist()
+            dist = dx * math.cos(h) + dy * math.sin(h)
             if self.k["step_chord"] > 0 and abs(self.curvature) > ARM_CURVE:
                 # on a curve the velocity lags the facing: along the step's own chord
-                chord = math.hypot(*(com - self.step_start[1]).tolist())
+                chord = math.hypot(dx, dy)
                 dist += self.k["step_chord"] * (chord - dist)
             err = dist / (t - self.step_start[0]) - self.speed
             # not over the start (its first steps lose up to 1 m/s, which the proportional

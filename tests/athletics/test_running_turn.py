@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from reactmocap.athletics.paths import Facing
-from reactmocap.athletics.run_course import run_course
+from reactmocap.athletics.run_course import RunResult, run_course
 from reactmocap.athletics.running import PATH_AFTER, SHOULDER, Runner
 from reactmocap.athletics.running_body import euler_yxz, qmul1, qyaw
 from reactmocap.athletics.running_params import RunParams
@@ -43,6 +43,13 @@ def test_stance_estimate_is_smoothed_at_the_path_speed() -> None:
     assert runner.stance_estimate == pytest.approx(est, rel=1e-12)
     # and it is not the last stance's duration alone (eqs. 1-2 unsmoothed)
     assert abs(runner.stance_estimate - last) > 1e-4
+
+
+def _assert_runs_alike(a: RunResult, b: RunResult) -> None:
+    """Two runs the same to the bit (an option that must not act on them)."""
+    for key in ("t", "com", "cross_track", "heading"):
+        assert np.array_equal(a.log[key], b.log[key]), key
+    assert np.array_equal(a.motion.rotations, b.motion.rotations)
 
 
 def _arms_past_eq5(params: RunParams) -> tuple[Runner, list[float]]:
@@ -111,9 +118,7 @@ def test_arm_yaw_terms_are_off_on_a_straight_line() -> None:
     line = [run_course(2.5, seconds=secs, fps=10.0, params=p) for p in (on, off)]
     assert line[0].report["simulated_s"] == pytest.approx(secs)
     assert max(line[0].log["t"]) > PATH_AFTER + 0.4
-    for key in ("t", "com", "cross_track", "heading"):
-        assert np.array_equal(line[0].log[key], line[1].log[key]), key
-    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
+    _assert_runs_alike(*line)
     curve = [run_course(2.5, seconds=secs, path="circle:10", fps=10.0, params=p).log
              for p in (on, off)]  # fmt: skip
     before = curve[0]["t"] < PATH_AFTER
@@ -170,9 +175,7 @@ def test_yaw_momentum_damps_the_bodys_mean_yaw_rate_on_a_curve_and_not_a_line() 
     assert with_it - without == pytest.approx([0.0, 0.0, want], rel=1e-6, abs=1e-6 * abs(want))
     line = [run_course(2.5, seconds=secs, fps=10.0, params=RunParams(yaw_momentum=v))
             for v in (1.0, 0.0)]  # fmt: skip
-    for key in ("t", "com", "cross_track", "heading"):
-        assert np.array_equal(line[0].log[key], line[1].log[key]), key
-    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
+    _assert_runs_alike(*line)
 
 
 def test_yaw_momentum_is_checked() -> None:
@@ -212,9 +215,7 @@ def test_turn_place_turns_the_velocity_with_the_facing_and_holds_the_20_m_circle
     assert abs(out[0.5]) < 0.3 * abs(out[0.0])
     line = [run_course(3.5, seconds=PATH_AFTER + 1.0, fps=10.0, params=RunParams(turn_place=g))
             for g in (1.0, 0.0)]  # fmt: skip
-    for key in ("t", "com", "cross_track", "heading"):
-        assert np.array_equal(line[0].log[key], line[1].log[key]), key
-    assert np.array_equal(line[0].motion.rotations, line[1].motion.rotations)
+    _assert_runs_alike(*line)
 
 
 def test_turn_place_is_checked() -> None:
