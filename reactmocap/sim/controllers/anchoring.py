@@ -827,7 +827,8 @@ class AnchoredReference:
             omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
             xi = c[:2] - self.balance_shift + v[:2] / omega
             target = clamp_to_support(xi, np.concatenate(feet), self.balance_margin) - xi
-            if self._ahead_armed and self._shift_lead < np.inf:
+        if self._ahead_armed and self._shift_lead < np.inf:
+            if self.path.planted[self.clock.nearest(t)].all():
                 target = self._shift_capped(t, target)
         self.balance_shift += self._balance_rate * (target - self.balance_shift)
 
@@ -841,10 +842,12 @@ class AnchoredReference:
             return target
         xi, _ = self.capture_point()
         lead = float(xi @ u) - float((self._sole_centres()[:, :2] @ u).max())
-        back = float(target @ u)
-        if lead <= self._shift_lead or back >= 0.0:
+        if lead <= self._shift_lead:
             return target
-        return target - back * u
+        # probe B: aimed so the capture point comes back to the margin past the front sole
+        want = self._shift_lead - lead
+        along = float(target @ u)
+        return target + min(0.0, want - along) * u
 
     def _held(self, t: float) -> NDArray[np.bool_]:
         """``(2, 4)`` the sole corners the mocap keeps on the ground at ``t`` (within
