@@ -143,7 +143,6 @@ class AnchoredReference:
         centre_speed_lock: float = 0.0,
         anchor_turn_rate: float = 0.0,
         centre_speed_lock_walking: float = 0.0,
-        step_ahead_shift: float = 0.0,
     ) -> None:
         m = world.model
         wc = world.characters[character]
@@ -284,9 +283,6 @@ class AnchoredReference:
         )
         self._xi_rate = np.zeros(2)
         self._xi_last: tuple[float, F64] = (-np.inf, np.zeros(2))
-        # ``step_ahead_shift``: after a back push, no backward balance shift along the walk
-        # while the simulated capture point leads the front sole by more than this (m; inf: off)
-        self._shift_lead = float(step_ahead_shift) if step_ahead_shift else np.inf
         # ``step_ahead_swing``: the clip's swing foot's landing brought forward in its single
         # supports, the swing taking this fraction of the clip's time left to its landing;
         # the clip's stance without its one-frame double supports (a swing foot touching
@@ -827,27 +823,7 @@ class AnchoredReference:
             omega = np.sqrt(-self._gravity[2] / max(c[2] - self.floor_z, 0.3))
             xi = c[:2] - self.balance_shift + v[:2] / omega
             target = clamp_to_support(xi, np.concatenate(feet), self.balance_margin) - xi
-        if self._ahead_armed and self._shift_lead < np.inf:
-            if self.path.planted[self.clock.nearest(t)].all():
-                target = self._shift_capped(t, target)
         self.balance_shift += self._balance_rate * (target - self.balance_shift)
-
-    def _shift_capped(self, t: float, target: F64) -> F64:
-        """``step_ahead_shift``: the balance shift's target (2,) without its backward part
-        along the clip's walk while the simulated capture point leads the front sole along it
-        by more than ``step_ahead_shift``: the shift pulled a body already past its feet back
-        0.3-0.5 m in the clip's double supports (``docs/tracking.md``, issue 16)."""
-        u = self._walk_direction(t)
-        if u is None:
-            return target
-        xi, _ = self.capture_point()
-        lead = float(xi @ u) - float((self._sole_centres()[:, :2] @ u).max())
-        if lead <= self._shift_lead:
-            return target
-        # probe B: aimed so the capture point comes back to the margin past the front sole
-        want = self._shift_lead - lead
-        along = float(target @ u)
-        return target + min(0.0, want - along) * u
 
     def _held(self, t: float) -> NDArray[np.bool_]:
         """``(2, 4)`` the sole corners the mocap keeps on the ground at ``t`` (within

@@ -287,10 +287,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_servo: with ``step_ahead``, the pelvis position servo's gain while one of
             its steps is under way (1/s^2, at most 100; 0: off): the clip's pelvis, at the
             clip's speed, pulled the body on past its feet (``docs/tracking.md``, issue 16).
-        step_ahead_shift: with ``step_ahead`` and ``balance_tau``, after a back push the
-            balance shift loses its backward part along the clip's walk while the simulated
-            capture point leads the front sole along it by more than this (m, at most 0.5; 0:
-            off) (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -400,7 +396,6 @@ class WholeBodyTracker(AnchoredReference):
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
         flat_toe: float = 0.0,
-        step_ahead_shift: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -439,7 +434,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band, "flat_toe": flat_toe,
-                "step_ahead_shift": step_ahead_shift,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -481,12 +475,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
-            )
-        if step_ahead_shift and not (step_ahead and balance_tau and step_ahead_shift <= 0.5):
-            raise ConfigError(
-                f"step_ahead_shift ({step_ahead_shift!r}) is a capture point's lead in (0, 0.5] m "
-                f"gating the balance shift after step_ahead's pushes: it needs step_ahead > 0 "
-                f"and balance_tau > 0"
             )
         if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
             # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
@@ -609,7 +597,6 @@ class WholeBodyTracker(AnchoredReference):
             step_ahead_horizon=step_ahead_horizon, step_ahead_swing=step_ahead_swing,
             step_ahead_phase=step_ahead_phase, centre_speed_lock=centre_speed_lock,
             anchor_turn_rate=anchor_turn_rate, centre_speed_lock_walking=centre_speed_lock_walking,
-            step_ahead_shift=step_ahead_shift,
         )  # fmt: skip
         self._stand_frames = max(1, round(self.step_time * self.path.fps))
         self._flat_w = float(flat_weight)
