@@ -283,12 +283,6 @@ class LandingParams:
             touchdown; () off. Why: on the male back handspring every start that stepped
             forward out of the recovery entered it at -27..-36 kg m^2/s, the others at
             +2.7..+8.3 (docs/athletics.md, "the absorb's hand-over held").
-        held_step_margin: once ``absorb_spin``'s gate has held a hand-over (the knees had
-            slowed with the momentum still below the gate), the landing's step fires at this
-            margin (m, [0, 0.5]) from the recovery on, not the step's own; None off. Why: on
-            the male back handspring the held starts came into the recovery with the capture
-            point back near the soles' edge, stood on one foot while the pelvis pitched
-            forward and stepped late (docs/athletics.md, "the recovery's first step").
     """
 
     knee: float = 0.6
@@ -338,7 +332,6 @@ class LandingParams:
     step_hang_plant: float = 0.0
     recover_min: float = 0.05
     absorb_spin: tuple[float, ...] = ()
-    held_step_margin: float | None = None
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -397,11 +390,6 @@ class LandingParams:
                 "landing absorb_spin must be (gate in [-200, 0) kg m^2/s, wait in (0, 1] s), "
                 f"got {a!r}"
             )
-        h = self.held_step_margin
-        if h is not None and not (isinstance(h, (int, float)) and 0.0 <= h <= 0.5):
-            raise ConfigError(f"landing held_step_margin must be in [0, 0.5] m, got {h!r}")
-        if h is not None and not (self.absorb_spin and self.step):
-            raise ConfigError("landing held_step_margin needs absorb_spin and a step")
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
         if self.late_delta and not (
@@ -647,7 +635,6 @@ class Landing(Basis):
             guard[:] = False
             bl.posture = Posture(leg=_leg_fraction(ctx), lean=p.lean, settle=0.0)
             memo["t_touch"] = t
-            memo["held"] = 0.0  # held_step_margin: absorb_spin's gate has held the hand-over
             memo["pitch_touch"] = bl.pelvis_pitch() - bl.lean()
             memo["roll_touch"] = bl.pelvis_roll(ctx.sense(t).heading()) if p.roll_ease else 0.0
             # eased only past roll_min (else as without: upright at once, no wait)
@@ -732,10 +719,6 @@ class Landing(Basis):
             if p.absorb_spin and t_in < p.absorb_spin[1]:
                 s = ctx.sense(t)  # mj_subtreeVel has run
                 if float(world.data.subtree_angmom[s.root] @ s.side_axis()) < p.absorb_spin[0]:
-                    if p.held_step_margin is not None and not memo["held"]:
-                        memo["held"] = float(  # the knees had slowed: the gate holds it
-                            t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
-                        )
                     return False
             return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
 
@@ -748,8 +731,6 @@ class Landing(Basis):
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
             stand_up = max(leg, 0.5, p.recover_leg)  # recover_leg: at least so tall
             bl.set_posture(Posture(leg=stand_up, lean=p.lean, settle=0.3), t)
-            if memo["held"] and bl.stepper is not None and p.held_step_margin is not None:
-                bl.stepper.step = replace(bl.stepper.step, margin=p.held_step_margin)
 
         def settled(world: World, t: float, t_in: float) -> bool:
             s = ctx.sense(t)

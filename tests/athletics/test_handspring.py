@@ -631,20 +631,3 @@ def test_the_landings_absorb_holds_its_hand_over_while_the_body_still_turns() ->
     for bad in ((1.0, 0.5), (-15.0, 0.0), (-15.0, 1.5), (-15.0,), (math.nan, 0.5)):
         with pytest.raises(ConfigError, match="absorb_spin"):
             LandingParams(absorb_spin=bad)
-
-
-def test_the_landings_held_start_steps_at_the_soles_edge() -> None:
-    """Full-size start 24 (seed 2): ``absorb_spin`` holds its hand-over until the capture point
-    has come back to the soles' edge, the recovery takes no step, stands on one foot while
-    the pelvis pitches forward and falls. With ``held_step_margin`` 0 (a start whose
-    hand-over the gate held steps as soon as the capture point leaves the soles) it steps at
-    once and lands (docs/athletics.md, "the recovery's first step"). A bad margin, or one
-    without ``absorb_spin``, is named."""
-    r, old = _landing_with_and_without("held_step_margin", 0.0, _starts(1.0, 25, seed=2)[24])
-    assert r["landed"] and not r["fell"]
-    assert old["fell"] and not old["landed"]
-    for bad in (-0.01, 0.6, math.nan):
-        with pytest.raises(ConfigError, match="held_step_margin"):
-            LandingParams(step=(0.05,), absorb_spin=(-15.0, 0.5), held_step_margin=bad)
-    with pytest.raises(ConfigError, match="held_step_margin needs"):
-        LandingParams(step=(0.05,), held_step_margin=0.0)
