@@ -180,7 +180,9 @@ class RunParams:
             off, the whole vertical force): the friction that carries the sideways and
             braking force is not there for the twist (a pyramidal cone, ``mu`` 1: 1). On the
             10 m loop at 3.5 m/s the outer foot's sole pushed 600-700 N sideways on 1.8 kN
-            and spun 14-16 rad/s under the full grip. From ``PATH_AFTER`` on. Within [0, 2].
+            and spun 14-16 rad/s under the full grip. At 2.5 m/s the 10 m loops fell with it
+            (the twist holds the foot there): off there by speed. From ``PATH_AFTER`` on.
+            Within [0, 2].
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
