@@ -507,7 +507,13 @@ class Runner:
         axis = d.xanchor[self._knees[leg]] - d.xanchor[self._hips[leg]]
         axis /= max(norm(axis), 1e-9)
         along = float(torque @ axis)
-        limit = k["yaw_grip"] * self.foot_length * max(float(self.senses.grf[2]), 0.0)
+        grf = self.senses.grf
+        load = float(grf[2])
+        if k["grip_reserve"] > 0 and d.time >= PATH_AFTER:
+            # less the friction the horizontal force takes: at the full grip the outer foot
+            # on a tight loop spun in its push (``grip_reserve``)
+            load -= k["grip_reserve"] * math.hypot(float(grf[0]), float(grf[1]))
+        limit = k["yaw_grip"] * self.foot_length * max(load, 0.0)
         return torque - (along - clamp(along, -limit, limit)) * axis
 
     def _support_point(self, t: float) -> F64:

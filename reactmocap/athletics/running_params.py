@@ -175,6 +175,14 @@ class RunParams:
             force. Eqs. 1-2 give it only from a velocity lagging the facing (0.35-0.5 rad at
             3.5 m/s on a 10 m circle, where the runner fell). From ``PATH_AFTER`` on (from
             the start it upset the first steps). Within [0, 3].
+        grip_reserve: the twist ``yaw_grip`` lets the stance hip put along the thigh is
+            figured on the vertical ground force less this times its horizontal part (0:
+            off, the whole vertical force): the friction that carries the sideways and
+            braking force is not there for the twist (a pyramidal cone, ``mu`` 1: 1). On the
+            10 m loop at 3.5 m/s the outer foot's sole pushed 600-700 N sideways on 1.8 kN
+            and spun 14-16 rad/s under the full grip. At 2.5 m/s the 10 m loops fell with it
+            (the twist holds the foot there): off there by speed. From ``PATH_AFTER`` on.
+            Within [0, 2].
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
@@ -233,6 +241,7 @@ class RunParams:
     lateral_reach: float | Speeds = 0.3
     step_chord: float | Speeds = 0.0
     turn_place: float | Speeds = 0.0
+    grip_reserve: float | Speeds = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -253,6 +262,7 @@ class RunParams:
             ("yaw_momentum", 1.0),
             ("step_chord", 1.0),
             ("turn_place", 3.0),
+            ("grip_reserve", 2.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):

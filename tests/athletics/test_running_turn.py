@@ -8,14 +8,24 @@ import math
 import numpy as np
 import pytest
 
-from reactmocap.athletics.paths import Facing
-from reactmocap.athletics.run_course import RunResult, run_course
-from reactmocap.athletics.running import PATH_AFTER, SHOULDER, Runner
+from reactmocap.athletics.paths import Facing, Polyline
+from reactmocap.athletics.run_course import (
+    CONTROL_EVERY,
+    RunResult,
+    athletics_world,
+    make_athlete,
+    parse_course,
+    run_course,
+)
+from reactmocap.athletics.running import PATH_AFTER, SHOULDER, Runner, running_start
 from reactmocap.athletics.running_body import euler_yxz, qmul1, qyaw
 from reactmocap.athletics.running_params import RunParams
 from reactmocap.errors import ConfigError
 from reactmocap.rotations import wrap_angle
 from reactmocap.sim.bodies import SIM_BODY_INDEX
+from reactmocap.sim.controllers.base import FunctionController
+from reactmocap.sim.rollout import rollout
+from reactmocap.sim.world import World
 
 
 @pytest.mark.parametrize("angle", [45.0])
@@ -224,3 +234,71 @@ def test_turn_place_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"turn_place must be in \[0, 3\]"):
         RunParams(turn_place=(0.0, 0.5, 3.5))
     assert RunParams().at(3.5)["turn_place"] == 0.0
+
+
+def _foot_slips(grip: float, secs: float) -> tuple[Runner, dict[tuple[float, int], float]]:
+    """The 10 m loop at 3.5 m/s after a 10 m entry (``run_course``'s set-up, a recorder
+    ticked after the runner): each stance's foot yaw past the facing's turn from
+    ``PATH_AFTER`` on (rad, by touchdown time and leg)."""
+    ath = make_athlete("male")
+    world = athletics_world(ath)
+    qpos, qvel = running_start(ath, 3.5)
+    world.set_pose(0, qpos, qvel)
+    course = parse_course("circle:10+entry:10", world.com(0)[:2], 0.0)
+    assert isinstance(course, Polyline)
+    course.reset()
+    r = Runner(world, ath, 3.5, course, RunParams(grip_reserve=grip), control_every=CONTROL_EVERY)
+    dt = CONTROL_EVERY * world.timestep
+    slips: dict[tuple[float, int], float] = {}
+
+    def record(w: World, t: float) -> None:
+        if t >= PATH_AFTER and r.machine.current.name != "flight":
+            key = (r.t_touchdown, r.active)
+            turn = float(w.data.cvel[r._feet[r.active], 2]) - r.facing_rate
+            slips[key] = slips.get(key, 0.0) + turn * dt
+
+    rollout(world, secs, controllers=[r, FunctionController(record, CONTROL_EVERY)],
+            record_fps=10.0, on_unstable="stop")  # fmt: skip
+    return r, slips
+
+
+def test_grip_reserve_keeps_the_stance_feet_from_spinning_on_the_10_m_loop() -> None:
+    """``grip_reserve``: on the 10 m loop at 3.5 m/s the run is the one without it to the bit
+    before ``PATH_AFTER``; after it the stance hip's twist along the thigh stays within the
+    grip on the vertical ground force less its horizontal part, and the stance feet turn
+    past the facing's turn less than half as much (the outer, right foot's median per
+    stance)."""
+    secs = 6.5
+    runs = {g: _foot_slips(g, secs) for g in (0.0, 1.0)}
+    on, off = runs[1.0][0].log, runs[0.0][0].log
+    n = min(len(on.rows), len(off.rows))
+    before = [i for i in range(n) if off.rows[i][0] < PATH_AFTER]
+    assert all(np.array_equal(on.rows[i][1], off.rows[i][1]) for i in before)
+    assert not all(np.array_equal(on.rows[i][1], off.rows[i][1]) for i in range(n))
+    med = {}
+    for g, (r, slips) in runs.items():
+        assert r.world.data.time > secs - 0.01, g  # neither fell over these seconds
+        right = [abs(v) for (_, leg), v in slips.items() if leg == 1]
+        assert len(right) >= 6
+        med[g] = float(np.median(right))
+    assert med[0.0] > 0.15
+    assert med[1.0] < 0.5 * med[0.0]
+    # on the last state the twist along the stance thigh is within the reduced grip
+    r = runs[1.0][0]
+    assert r.machine.current.name != "flight"
+    torque = r._attitude_torque(r.heading_d)
+    leg = r.active
+    d = r.world.data
+    axis = d.xanchor[r._knees[leg]] - d.xanchor[r._hips[leg]]
+    axis /= np.linalg.norm(axis)
+    grf = r.senses.grf
+    load = max(float(grf[2]) - float(np.hypot(grf[0], grf[1])), 0.0)
+    assert abs(float(torque @ axis)) <= r.k["yaw_grip"] * r.foot_length * load + 1e-9
+
+
+def test_grip_reserve_is_checked() -> None:
+    with pytest.raises(ConfigError, match=r"grip_reserve must be in \[0, 2\]"):
+        RunParams(grip_reserve=-0.5)
+    with pytest.raises(ConfigError, match=r"grip_reserve must be in \[0, 2\]"):
+        RunParams(grip_reserve=(0.0, 1.0, 2.5))
+    assert RunParams().at(3.5)["grip_reserve"] == 0.0
