@@ -374,12 +374,6 @@ class Runner:
             if k["turn_place_ease"] > 0:
                 # ramped in: stepped on at once, 4-4.5 m/s loops fell within 1.5 s of it
                 shift *= min((self.world.data.time - PATH_AFTER) / k["turn_place_ease"], 1.0)
-            if k["turn_place_room"] > 0:
-                # cut by the room left under the lateral clamp on the shift's side
-                reach = k["lateral_reach"] * k["touchdown_leg"] * (
-                    self._thigh_len[leg] + self._shin_len[leg])
-                room = reach + math.copysign(1.0, shift) * lat
-                shift *= clamp(room / (k["turn_place_room"] * reach), 0.0, 1.0)
             lat -= shift
         # ground-speed matching: the foot reaches further forward while it is high and comes
         # back over the last moments before touchdown (predicted from the lowest sole corner

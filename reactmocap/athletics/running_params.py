@@ -236,7 +236,6 @@ class RunParams:
     step_chord: float | Speeds = 0.0
     turn_place: float | Speeds = 0.0
     turn_place_ease: float | Speeds = 0.0
-    turn_place_room: float | Speeds = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -258,7 +257,6 @@ class RunParams:
             ("step_chord", 1.0),
             ("turn_place", 3.0),
             ("turn_place_ease", 10.0),
-            ("turn_place_room", 1.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
