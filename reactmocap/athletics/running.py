@@ -370,11 +370,7 @@ class Runner:
             # toward the curve's outside by the turn's lean: the leg's force then gives the
             # centripetal force (eqs. 1-2 make it only from a velocity lagging the facing);
             # not over the start, whose first steps it upset (falls within 1-2.4 s)
-            shift = k["turn_place"] * self._leg_length * self.speed**2 * self.curvature / self.g
-            if k["turn_place_ease"] > 0:
-                # ramped in: stepped on at once, 4-4.5 m/s loops fell within 1.5 s of it
-                shift *= min((self.world.data.time - PATH_AFTER) / k["turn_place_ease"], 1.0)
-            lat -= shift
+            lat -= k["turn_place"] * self._leg_length * self.speed**2 * self.curvature / self.g
         # ground-speed matching: the foot reaches further forward while it is high and comes
         # back over the last moments before touchdown (predicted from the lowest sole corner
         # and the body's vertical speed), so it meets the ground moving back under the body

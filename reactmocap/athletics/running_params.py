@@ -175,8 +175,6 @@ class RunParams:
             force. Eqs. 1-2 give it only from a velocity lagging the facing (0.35-0.5 rad at
             3.5 m/s on a 10 m circle, where the runner fell). From ``PATH_AFTER`` on (from
             the start it upset the first steps). Within [0, 3].
-        turn_place_ease: ``turn_place`` ramps in linearly over this long (s) from
-            ``PATH_AFTER`` (0: at once, as tuned). Within [0, 10].
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
@@ -235,7 +233,6 @@ class RunParams:
     lateral_reach: float | Speeds = 0.3
     step_chord: float | Speeds = 0.0
     turn_place: float | Speeds = 0.0
-    turn_place_ease: float | Speeds = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -256,7 +253,6 @@ class RunParams:
             ("yaw_momentum", 1.0),
             ("step_chord", 1.0),
             ("turn_place", 3.0),
-            ("turn_place_ease", 10.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):
