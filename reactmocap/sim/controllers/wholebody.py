@@ -803,7 +803,7 @@ class WholeBodyTracker(AnchoredReference):
                 firm = self._firm[self.clock.nearest(t)]
                 if firm.sum() == 1:  # the clip's single support: its swing leg holds its pose
                     np.copyto(self._wj_swing, wj)
-                    self._wj_swing[self._leg_rows[int(np.argmin(firm))]] = self._ahead_swing_w
+                    self._wj_swing[self._leg_rows[int(np.argmin(firm))][:3]] = self._ahead_swing_w
                     wj = self._wj_swing
             if w_trunk:
                 # the chest's world turn as the plan's own targets turn it (pelvis, waist and
