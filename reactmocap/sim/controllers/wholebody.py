@@ -287,11 +287,6 @@ class WholeBodyTracker(AnchoredReference):
         step_ahead_servo: with ``step_ahead``, the pelvis position servo's gain while one of
             its steps is under way (1/s^2, at most 100; 0: off): the clip's pelvis, at the
             clip's speed, pulled the body on past its feet (``docs/tracking.md``, issue 16).
-        step_ahead_swing_weight: with ``step_ahead``, after a walk's push armed it, the joint
-            rows of the clip's swing leg (hip, knee, ankle; the clip's single supports) weigh
-            this against 1 for the other joints (in (1, 30]; 0: off): at 1 the plan spent the
-            swing hip on the pelvis's forward demand and the foot came down behind the hip,
-            0.3-0.6 m short of the clip's landing (``docs/tracking.md``, issue 16).
         torque_limit: the largest joint torque the plan may apply (N m, the norm of each ball
             joint's torque; 0: none). The plan's torques come as feed-forward, which the
             servo's own ``torque_limit`` does not clip; a hit body whose plan asked for 41 kN m
@@ -396,7 +391,6 @@ class WholeBodyTracker(AnchoredReference):
         centre_speed_lock_walking: float = 0.0,
         anchor_turn_rate: float = 0.0,
         step_ahead_servo: float = 0.0,
-        step_ahead_swing_weight: float = 0.0,
         hold_balance: bool = False,
         torque_limit: float = 0.0,
         flat_weight: float = 0.0,
@@ -438,7 +432,6 @@ class WholeBodyTracker(AnchoredReference):
                 "centre_speed_lock_walking": centre_speed_lock_walking,
                 "anchor_turn_rate": anchor_turn_rate, "torque_limit": torque_limit,
                 "step_ahead_servo": step_ahead_servo,
-                "step_ahead_swing_weight": step_ahead_swing_weight,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band, "flat_toe": flat_toe,
             },
@@ -483,11 +476,6 @@ class WholeBodyTracker(AnchoredReference):
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
                 f"step_ahead's steps, in (0, 100] 1/s^2: it needs step_ahead > 0"
             )
-        if step_ahead_swing_weight and not (step_ahead and 1.0 < step_ahead_swing_weight <= 30.0):
-            raise ConfigError(
-                f"step_ahead_swing_weight ({step_ahead_swing_weight!r}) is the clip's swing "
-                f"leg's joint-row weight after a back push, in (1, 30]: it needs step_ahead > 0"
-            )
         if not 0.0 < flat_band < np.pi / 2 or (flat_weight and not swing_weight):
             # the rows are the swing task's tilt rows, rescaled from ``swing_weight``
             raise ConfigError(
@@ -531,8 +519,6 @@ class WholeBodyTracker(AnchoredReference):
         # and the one the push set (back to it on landing)
         self._ahead_servo = float(step_ahead_servo)
         self._kp_pushed = float(self.kp[0])
-        # ``step_ahead_swing_weight``: the clip's swing leg's joint rows after a back push
-        self._ahead_swing_w = float(step_ahead_swing_weight)
         self._step_pushed = bool(step_pushed)
         self._pushed = False  # an external force has acted on the body
         self._pushing = False  # one acts now
@@ -630,7 +616,6 @@ class WholeBodyTracker(AnchoredReference):
         self._hold_balance = bool(hold_balance)
         self._stance_rows = np.r_[np.arange(6), 6 + np.concatenate(self._leg_rows)]
         self._holding = False  # hold_balance has taken hold
-        self._wj_swing = np.ones(3 * NJ)  # ``step_ahead_swing_weight``'s rows, no per-tick copy
         self._scale = 1.0  # the last scale_gains
         self._stiffness = 1.0  # the last stiffen_joints
         self.release()
@@ -799,12 +784,6 @@ class WholeBodyTracker(AnchoredReference):
                 wj = wj.copy()
                 wj[self._hip_joints] = free
             tasks.append((root_rows, root_target))
-            if self._ahead_swing_w and self._ahead_armed:
-                firm = self._firm[self.clock.nearest(t)]
-                if firm.sum() == 1:  # the clip's single support: its swing leg holds its pose
-                    np.copyto(self._wj_swing, wj)
-                    self._wj_swing[self._leg_rows[int(np.argmin(firm))][:3]] = self._ahead_swing_w
-                    wj = self._wj_swing
             if w_trunk:
                 # the chest's world turn as the plan's own targets turn it (pelvis, waist and
                 # back together): without it the least squares spent the waist to hold the
