@@ -110,7 +110,7 @@ def build_tables(
             rng = calibrate.contiguous_range(vxs, [_landed(r) for r in vr], 0.0)
             if rng:
                 supported.setdefault(("land", "vx"), {})[body] = rng
-            slopes = _slope_limits(body, workers)
+            slopes = _slope_limits(body, workers, seconds=TABLE_SLOPE_SECONDS)
             supported.setdefault(("balance", "slope"), {})[body] = (
                 0.0,
                 math.radians(min(slopes.values())),
@@ -232,29 +232,46 @@ def _contiguous(ok: Any, lo: float, hi: float, step: float) -> float:
 
 
 def _pool(
-    fn: Any, body: str, dirs: list[float], workers: int, contact: str = DEFAULT_CONTACT
-) -> list[float]:
-    """``fn(body, direction, contact)`` for each direction, in ``workers`` processes."""
+    fn: Any, body: str, dirs: list[float], workers: int, contact: str = DEFAULT_CONTACT,
+    *extra: Any,
+) -> list[float]:  # fmt: skip
+    """``fn(body, direction, contact, *extra)`` for each direction, in ``workers`` processes."""
     if workers <= 1:
-        return [fn(body, d, contact) for d in dirs]
+        return [fn(body, d, contact, *extra) for d in dirs]
     from concurrent.futures import ProcessPoolExecutor
 
+    n = len(dirs)
     with ProcessPoolExecutor(workers) as ex:
-        return list(ex.map(fn, [body] * len(dirs), dirs, [contact] * len(dirs)))
+        return list(ex.map(fn, [body] * n, dirs, [contact] * n, *([e] * n for e in extra)))
 
 
-def _slope_limit(body: str, direction: float, contact: str = DEFAULT_CONTACT) -> float:
-    def ok(deg: float) -> bool:
-        r = run("balance", body, check_range=False, seconds=3.0, slope=math.radians(deg),
-                slope_dir=math.radians(direction), contact=contact)  # fmt: skip
-        return bool(r.report["balanced"])
+#: seconds a COM offset or a slope (after its 2 s ramp) is run before it is judged: run 3 s,
+#: his back-diagonal offsets drifted and fell by 8 s, and on every slope the feet crept
+#: downhill (docs/athletics.md, "The Fig. 7.5 offsets and the slopes judged at 8 s")
+STAND_SECONDS = 8.0
+#: the supported slope range (``--tables``) is what the library's default run balances
+#: (``run("balance")``'s ``seconds``, 3 s), not the benchmark's longer judge
+TABLE_SLOPE_SECONDS = 3.0
 
-    return _largest(ok, 0.0, 45.0, 0.5)
+
+def _slope_held(body: str, direction: float, contact: str, seconds: float) -> Any:
+    return lambda deg: bool(run("balance", body, check_range=False, seconds=seconds,
+                                slope=math.radians(deg), slope_dir=math.radians(direction),
+                                contact=contact).report["balanced"])  # fmt: skip
 
 
-def _slope_limits(body: str, workers: int, contact: str = DEFAULT_CONTACT) -> dict[str, float]:
+def _slope_limit(
+    body: str, direction: float, contact: str = DEFAULT_CONTACT, seconds: float = STAND_SECONDS
+) -> float:
+    return _largest(_slope_held(body, direction, contact, seconds), 0.0, 45.0, 0.5)
+
+
+def _slope_limits(
+    body: str, workers: int, contact: str = DEFAULT_CONTACT, seconds: float = STAND_SECONDS
+) -> dict[str, float]:
     dirs = {"+X": 0.0, "-X": 180.0, "Y": 90.0}
-    return dict(zip(dirs, _pool(_slope_limit, body, list(dirs.values()), workers, contact)))
+    lims = _pool(_slope_limit, body, list(dirs.values()), workers, contact, seconds)
+    return dict(zip(dirs, lims))
 
 
 #: seconds a pushed body is run before it is judged (the push at 1.0-1.25 s): run 3 s, five of
@@ -277,12 +294,15 @@ def _push_contiguous(body: str, direction: float, contact: str = DEFAULT_CONTACT
     return _contiguous(_push_held(body, direction, contact), 0.0, 600.0, 5.0)
 
 
-def _offset_limit(body: str, direction: float, contact: str = DEFAULT_CONTACT) -> float:
+def _offset_held(body: str, direction: float, contact: str) -> Any:
     a = math.radians(direction)
-    return _largest(lambda m: bool(run("balance", body, check_range=False, seconds=3.0,
-                                       com_offset_x=m * math.cos(a), com_offset_y=m * math.sin(a),
-                                       contact=contact).report["balanced"]),
-                    0.0, 0.3, 0.005)  # fmt: skip
+    return lambda m: bool(run("balance", body, check_range=False, seconds=STAND_SECONDS,
+                              com_offset_x=m * math.cos(a), com_offset_y=m * math.sin(a),
+                              contact=contact).report["balanced"])  # fmt: skip
+
+
+def _offset_limit(body: str, direction: float, contact: str = DEFAULT_CONTACT) -> float:
+    return _largest(_offset_held(body, direction, contact), 0.0, 0.3, 0.005)
 
 
 # ---------------------------------------------------------------------------------- experiments

@@ -362,6 +362,8 @@ def _run_balance(
         # says rather than hides (docs/athletics.md, Fig. 7.7)
         "on_both_feet": bool(ctx.senses.foot_contact.all()),
     }  # fmt: skip
+    if p["feet"] == "both":
+        rep["balanced"] = bool(rep["balanced"] and rep["on_both_feet"])
     if step is not None:
         # a run that stepped counts only if it ends on both feet (a step held on one foot is
         # no recovery; without a step the judge is the default's)
@@ -411,6 +413,10 @@ BEHAVIOURS: Mapping[str, Behaviour] = MappingProxyType({
          Param("step", "off", "", "a balance step when the capture point leaves the soles "
                "(balance.STANDING_STEP; opt-in, our own: the thesis's balance has none)",
                choices=("off", "on")),
+         Param("feet", "any", "", "what `balanced` asks of the feet at the last tick: 'any' "
+               "(one foot allowed if still over it) or 'both' (opt-in: a still one-foot stand "
+               "at 3 s was a fall in progress on 5 of 5 default pushes, docs/athletics.md)",
+               choices=("any", "both")),
          _BACKPACK, _CONTACT, _FPS),
         lambda a, p, cb: _run_balance(a, p, cb), ("push", "slope")),
     "leap": Behaviour(

@@ -523,3 +523,18 @@ def test_the_standing_step_holds_his_175_n_forward_push_with_the_bow_held(
     r_before = run("balance", "male", **push).report
     assert r_before["steps"][0]["t"] == r["steps"][0]["t"]
     assert r_before["steps"][0]["s"] > 0.5 and not r_before["balanced"]
+
+
+def test_the_both_feet_judge_calls_a_one_foot_stand_at_the_end_lost() -> None:
+    # her 95 N back-left push: still on one foot at 3 s, down by 5 s (docs/athletics.md, Fig.
+    # 7.7 judged at 8 s); feet="both" calls the 3 s run lost, as the 8 s run is; the motion is
+    # the same, only the judge differs; 90 N ends on both feet and is held either way
+    push = {"check_range": False, "seconds": 3.0, "push_dir": math.radians(135.0)}
+    loose = run("balance", "female", push=95.0, **push)
+    strict = run("balance", "female", push=95.0, feet="both", **push)
+    assert loose.report["balanced"] and not loose.report["on_both_feet"]
+    assert not strict.report["balanced"] and not strict.report["on_both_feet"]
+    assert np.array_equal(loose.log["com"], strict.log["com"])
+    assert run("balance", "female", push=90.0, feet="both", **push).report["balanced"]
+    with pytest.raises(ConfigError, match="feet"):
+        run("balance", "female", feet="one", **push)

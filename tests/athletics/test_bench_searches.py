@@ -38,3 +38,30 @@ def test_the_push_judge_runs_long_enough_to_see_a_one_foot_stand_fall(
     assert bench.PUSH_SECONDS >= 5.0
     assert not bench._push_held("female", 135.0, DEFAULT_CONTACT)(95.0)
     assert bench._push_held("female", 135.0, DEFAULT_CONTACT)(90.0)  # held at 8 s too
+
+
+def test_the_offset_judge_runs_long_enough_to_see_a_drift_fall(
+    load_bench: Callable[[str], ModuleType],
+) -> None:
+    # his back-left COM offset 0.08 m: still on both feet at 3 s (the 3 s judge held it, the
+    # limit was 0.085), the COM drifting back over the heel and falling by 8 s; 0.065 m holds
+    bench = load_bench("bench_athletics")
+    a = math.radians(135.0)
+    short = run("balance", "male", check_range=False, seconds=3.0,
+                com_offset_x=0.08 * math.cos(a), com_offset_y=0.08 * math.sin(a)).report  # fmt: skip
+    assert short["balanced"] and short["on_both_feet"]
+    assert bench.STAND_SECONDS >= 8.0
+    assert not bench._offset_held("male", 135.0, DEFAULT_CONTACT)(0.08)
+    assert bench._offset_held("male", 135.0, DEFAULT_CONTACT)(0.065)
+
+
+def test_the_slope_judge_runs_long_enough_to_see_the_feet_creep(
+    load_bench: Callable[[str], ModuleType],
+) -> None:
+    # his sideways slope at 22.5 deg: still on both feet at 3 s, the feet creeping downhill
+    # and the stance narrowing until he falls (about 6 s); the supported range (--tables)
+    # keeps the library's default 3 s run
+    bench = load_bench("bench_athletics")
+    assert bench.TABLE_SLOPE_SECONDS == 3.0
+    assert bench._slope_held("male", 90.0, DEFAULT_CONTACT, bench.TABLE_SLOPE_SECONDS)(22.5)
+    assert not bench._slope_held("male", 90.0, DEFAULT_CONTACT, bench.STAND_SECONDS)(22.5)
