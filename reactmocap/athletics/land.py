@@ -283,6 +283,13 @@ class LandingParams:
             touchdown; () off. Why: on the male back handspring every start that stepped
             forward out of the recovery entered it at -27..-36 kg m^2/s, the others at
             +2.7..+8.3 (docs/athletics.md, "the absorb's hand-over held").
+        hop_spin: ``(ref, gain)``: if the recovery's kick lifts the feet off (a hop), the
+            feet of its second touchdown go ``gain * (spin - ref)`` m farther ahead (the hips'
+            pitch, on top of the balance law's), the spin (kg m^2/s, about the pelvis's side
+            axis) read once as the feet leave, as ``momentum_gain`` places the reach's; the
+            recovery hands over only with a foot down; () off. Why: the female back
+            handspring's hop lands only if it leaves with -8.5..-2.8 kg m^2/s; with more the
+            feet came down ahead of the COM, with less behind it (docs/athletics.md).
     """
 
     knee: float = 0.6
@@ -332,6 +339,7 @@ class LandingParams:
     step_hang_plant: float = 0.0
     recover_min: float = 0.05
     absorb_spin: tuple[float, ...] = ()
+    hop_spin: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -389,6 +397,17 @@ class LandingParams:
             raise ConfigError(
                 "landing absorb_spin must be (gate in [-200, 0) kg m^2/s, wait in (0, 1] s), "
                 f"got {a!r}"
+            )
+        h = self.hop_spin
+        if h and not (
+            len(h) == 2
+            and all(isinstance(x, (int, float)) and math.isfinite(x) for x in h)
+            and -100.0 <= h[0] <= 100.0
+            and -0.1 <= h[1] <= 0.1
+        ):
+            raise ConfigError(
+                "landing hop_spin must be (ref in [-100, 100] kg m^2/s, gain in [-0.1, 0.1] "
+                f"m per kg m^2/s), got {h!r}"
             )
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
@@ -731,6 +750,24 @@ class Landing(Basis):
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
             stand_up = max(leg, 0.5, p.recover_leg)  # recover_leg: at least so tall
             bl.set_posture(Posture(leg=stand_up, lean=p.lean, settle=0.3), t)
+            memo["hop"] = 0.0  # hop_spin: 0 not off the floor yet, 1 in the hop, 2 down again
+
+        def recover(world: World, t: float) -> None:
+            """The balance law; with hop_spin the hop's legs placed for its spin."""
+            stand(world, t)
+            if not p.hop_spin or memo["hop"] == 2.0:
+                return
+            s = ctx.senses  # sensed this tick by the law
+            down = bool(s.foot_contact.any())
+            if memo["hop"] == 0.0 and not down:  # the feet leave: the spin the hop keeps
+                spin = float(world.data.subtree_angmom[s.root] @ s.side_axis())
+                ahead = p.hop_spin[1] * (spin - p.hop_spin[0]) / ctx.athlete.leg_length
+                memo["hop_hip"] = -math.asin(float(np.clip(ahead, -0.9, 0.9)))
+                memo["hop"] = 1.0
+            elif memo["hop"] == 1.0 and down:
+                memo["hop"] = 2.0
+            if memo["hop"] == 1.0:  # hip pitch < 0 swings the foot forward
+                rig.offset[_HIP, 0] += memo["hop_hip"]
 
         def settled(world: World, t: float, t_in: float) -> bool:
             s = ctx.sense(t)
@@ -744,6 +781,8 @@ class Landing(Basis):
             spin = p.recover_spin > 0 and pitch_momentum(world, s) > p.recover_spin
             # on one foot (a bounced landing) wait recover_min; on both the code's 0.05
             lo = 0.05 if s.foot_contact.all() else p.recover_min
+            if p.hop_spin and memo["hop"] == 1.0:  # the hop's own placement until it is down
+                return False
             return t_in > lo and (passed or still or spin) and eased
 
         def done(world: World, t: float) -> None:
@@ -758,7 +797,7 @@ class Landing(Basis):
             State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),
             State("absorb", law(absorb, every), absorb_enter,
                   ((slowed, "recover"), (after(1.0), "recover"))),
-            State("recover", law(stand, every), recover_enter,
+            State("recover", law(recover, every), recover_enter,
                   ((settled, "done"), (after(1.0), "done"))),
             State("done", law(stand, every), done, ((after(0.0), NEXT),)),
         ]  # fmt: skip

@@ -476,8 +476,10 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     "female": MappingProxyType({
         "leap": MappingProxyType({"effort": 0.75, "spin": -70.0, "spin_limit": 1.8,
                                   "com_ramp": 0.2}),
+        # hop_spin since 2026-12-06: the recovery's hop placed for the spin it left with
         "land": MappingProxyType({"delta": -0.56, "spin_ref": -41.0, "swing_cap": 0.97,
-                                  "knee_stiffness": 1.0, "damping": 2.0}),
+                                  "knee_stiffness": 1.0, "damping": 2.0,
+                                  "hop_spin": [-5.5, 0.02]}),
     }),
 })  # fmt: skip
 

@@ -631,3 +631,24 @@ def test_the_landings_absorb_holds_its_hand_over_while_the_body_still_turns() ->
     for bad in ((1.0, 0.5), (-15.0, 0.0), (-15.0, 1.5), (-15.0,), (math.nan, 0.5)):
         with pytest.raises(ConfigError, match="absorb_spin"):
             LandingParams(absorb_spin=bad)
+
+
+def test_the_female_hops_second_touchdown_is_placed_for_the_spin_it_left_with() -> None:
+    """A tenth's start 14 (seed 0): the recovery's kick lifts her off with -8.2 kg m^2/s
+    (her landers' hops leave with -8.5..-2.8); with her preset the hop's feet come down
+    ahead of the COM and she falls on past (+39.5 deg). With ``hop_spin`` (-5.5, 0.02) the
+    hop's feet go 5.4 cm farther back for that spin and she lands; up to the lift-off the run
+    is the preset's (docs/athletics.md, "the hop's second touchdown placed"). Bad values are
+    named."""
+    m = handspring_maneuver("female")
+    land = next(p for p in m.phases if p.controller == "land").params
+    plain_land = {k: v for k, v in land.items() if k != "hop_spin"}
+    start = _starts(0.1, 15)[14]
+    plain, hop = (run_maneuver(_with(m, "land", params), perturbation=start, fps=10.0).report
+                  for params in (plain_land, {**plain_land, "hop_spin": [-5.5, 0.02]}))  # fmt: skip
+    assert hop["landed"] and not hop["fell"] and abs(hop["rotation_deg"] + 360.0) <= 45.0
+    assert plain["fell"] and not plain["landed"]
+    assert hop["rotation_at_touchdown_deg"] == plain["rotation_at_touchdown_deg"]
+    for bad in ((-5.5,), (-5.5, 0.5), (math.nan, 0.02), (-500.0, 0.02)):
+        with pytest.raises(ConfigError, match="hop_spin"):
+            LandingParams(hop_spin=bad)
