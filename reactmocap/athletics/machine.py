@@ -46,7 +46,7 @@ class Log:
     rows: list[tuple[float, F64, F64, F64, int, str]] = field(default_factory=list)
     torques: list[F64] = field(default_factory=list)
     powers: list[F64] = field(default_factory=list)
-    #: per tick: whether anything but the feet touched the floor, and the pelvis height
+    #: per tick: whether anything but the feet touched the floor, and the pelvis height above the floor plane
     others: list[bool] = field(default_factory=list)
     pelvis: list[float] = field(default_factory=list)
     #: per tick: horizontal distance (m) of the COM from the support centre

@@ -122,7 +122,7 @@ def plausibility(
 
 def fell(ctx: Context, standing_pelvis: float) -> bool:
     """Anything but the feet touched the floor at some tick, or the pelvis dropped below
-    :data:`FALL_HEIGHT` of its standing height."""
+    :data:`FALL_HEIGHT` of its standing height (both above the floor plane, along its normal)."""
     log = ctx.log
     low = min(log.pelvis, default=standing_pelvis) < FALL_HEIGHT * standing_pelvis
     return bool(any(log.others) or low)

@@ -89,7 +89,9 @@ class Sequencer:
         ctx.log.momentum.append(d.subtree_angmom[s.root].copy())
         centre = s.support_center()
         ctx.log.offsets.append(float(np.hypot(*(s.com[:2] - centre[:2]))))
-        ctx.log.pelvis.append(float(d.xpos[s.root][2]))
+        # above the floor plane, along its normal: on a slope a body that slides down it
+        # upright has not fallen (on a level floor through z = 0 this is the world z)
+        ctx.log.pelvis.append(float((d.xpos[s.root] - d.geom_xpos[s.floor]) @ s.floor_normal))
         ctx.log.rotation.append(ctx.rotation)
         ctx.log.twist.append(ctx.twist)
         ctx.log.trunk.append(self._trunk_dir)

@@ -19,6 +19,7 @@ from reactmocap.athletics.maneuvers import (
     load_maneuver,
     run_maneuver,
 )
+from reactmocap.athletics.report import FALL_HEIGHT
 from reactmocap.cli import main
 from reactmocap.errors import ConfigError
 
@@ -68,6 +69,18 @@ def test_the_com_target_moves_uphill_on_a_sideways_slope() -> None:
     assert r.report["balanced"] and not r.report["fell"]
     with pytest.raises(ConfigError):
         BalanceGains(uphill=(0.0, math.nan))
+
+
+def test_a_body_that_slides_upright_down_a_steep_slope_has_not_fallen() -> None:
+    # the fall's pelvis height is measured above the floor plane, along its normal: at 37 deg
+    # the male slides down the slope on both feet, his pelvis lower in the world than
+    # FALL_HEIGHT of its standing height, which a world-z height called a fall (2026-12-06)
+    r = run("balance", "male", check_range=False, seconds=8.0, slope=math.radians(37.0))
+    assert not r.report["fell"] and r.report["on_both_feet"]
+    world = r.rollout.world
+    standing = float(r.log["pelvis"][0])
+    root = world.model.body("a/pelvis").id
+    assert world.data.xpos[root][2] < FALL_HEIGHT * standing < float(r.log["pelvis"][-1])
 
 
 def test_on_a_sideways_slope_the_hips_shift_the_weight_and_the_feet_stay_flat() -> None:
