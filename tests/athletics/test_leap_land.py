@@ -194,12 +194,6 @@ def test_landing_carry_pitch_must_be_a_bool() -> None:
         LandingParams(carry_pitch=1)  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize("bad", [1, 0.0, "true", None])
-def test_landing_side_frame_must_be_a_bool(bad: object) -> None:
-    with pytest.raises(ConfigError, match="side_frame"):
-        LandingParams(side_frame=bad)  # type: ignore[arg-type]
-
-
 @pytest.mark.parametrize("bad", [-0.1, 1.5, math.nan, "0.1"])
 def test_landing_late_kv_must_be_in_range(bad: object) -> None:
     with pytest.raises(ConfigError, match="late_kv"):
