@@ -283,15 +283,6 @@ class LandingParams:
             touchdown; () off. Why: on the male back handspring every start that stepped
             forward out of the recovery entered it at -27..-36 kg m^2/s, the others at
             +2.7..+8.3 (docs/athletics.md, "the absorb's hand-over held").
-        side_frame: the reach's sideways (hip roll) servo reads the feet, the COM and their
-            speeds in the heading of the pelvis's left-right axis (``Senses.side_heading``),
-            the fore-aft servo and the placement as without it (a no-op with ``spin_aim``,
-            whose heading that already is). Why: on the male back layout the pelvis's
-            forward axis passes the vertical in the reach, its heading flips and the roll
-            servo's sideways error flips sign with it; the short fallers touched down on one
-            foot with the COM moving away sideways at 0.4-0.7 m/s (docs/athletics.md, "the
-            reach's sideways servo in a frame that does not flip"). Off (the default): as
-            before.
     """
 
     knee: float = 0.6
@@ -341,7 +332,6 @@ class LandingParams:
     step_hang_plant: float = 0.0
     recover_min: float = 0.05
     absorb_spin: tuple[float, ...] = ()
-    side_frame: bool = False
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -412,8 +402,6 @@ class LandingParams:
                 "landing late_delta must be (seconds in [0, 1], offset > 0 m, delta m), "
                 f"got {self.late_delta!r}"
             )
-        if not isinstance(self.side_frame, bool):
-            raise ConfigError(f"landing side_frame must be true or false, got {self.side_frame!r}")
         if not isinstance(self.carry_pitch, bool):
             raise ConfigError(
                 f"landing carry_pitch must be true or false, got {self.carry_pitch!r}"
@@ -597,11 +585,6 @@ class Landing(Basis):
             # eq. 6.1 as a correction on top of the geometric placement below
             xd = s.local(fvel - s.com_vel, h)
             servo = np.clip(p.kp * (want - x) - memo["kv"] * xd, -0.3, 0.3)
-            if p.side_frame:  # the roll's error in a frame that does not flip (side_frame)
-                hs = s.side_heading()
-                err = side * float(s.local(s.com_vel, hs)[1]) - float(s.local(feet - s.com, hs)[1])
-                yd = float(s.local(fvel - s.com_vel, hs)[1])
-                servo[1] = min(max(p.kp * err - memo["kv"] * yd, -0.3), 0.3)
             # each leg aimed in the world at its foot's place, whatever the pelvis's pitch
             # (it turns freely in the air with the body's angular momentum)
             pelvis = bl.pelvis_pitch()
