@@ -509,11 +509,22 @@ class Runner:
         along = float(torque @ axis)
         grf = self.senses.grf
         load = float(grf[2])
+        grip = k["yaw_grip"] * self.foot_length
         if k["grip_reserve"] > 0 and d.time >= PATH_AFTER:
             # less the friction the horizontal force takes: at the full grip the outer foot
             # on a tight loop spun in its push (``grip_reserve``)
-            load -= k["grip_reserve"] * math.hypot(float(grf[0]), float(grf[1]))
-        limit = k["yaw_grip"] * self.foot_length * max(load, 0.0)
+            reserve = k["grip_reserve"] * math.hypot(float(grf[0]), float(grf[1]))
+            if k["grip_one_sided"] > 0:
+                # only the twist that turns the foot the way it already turns: the other
+                # holds it against the stride's counter-swing (2.5 m/s fell without it);
+                # the thigh takes -along, the foot's rate about the same axis
+                spin = float(d.cvel[self._feet[leg], :3] @ axis)
+                other = grip * max(load - (1.0 - k["grip_one_sided"]) * reserve, 0.0)
+                cut = grip * max(load - reserve, 0.0)
+                lo, hi = (-cut, other) if spin > 0 else (-other, cut)
+                return torque - (along - clamp(along, lo, hi)) * axis
+            load -= reserve
+        limit = grip * max(load, 0.0)
         return torque - (along - clamp(along, -limit, limit)) * axis
 
     def _support_point(self, t: float) -> F64:

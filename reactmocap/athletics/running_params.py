@@ -183,6 +183,11 @@ class RunParams:
             and spun 14-16 rad/s under the full grip. At 2.5 m/s the 10 m loops fell with it
             (the twist holds the foot there): off there by speed. From ``PATH_AFTER`` on.
             Within [0, 2].
+        grip_one_sided: with ``grip_reserve`` on, the share of its cut taken off only the
+            twist that turns the stance foot the way it already turns (its rate about the
+            thigh from ``cvel``); the other way keeps the grip less ``1 - this`` times the
+            cut (0: off, both ways cut; 1: the other way at the full grip). At 2.5 m/s the
+            twist both ways cut let the feet spin against the turn. Within [0, 1].
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
@@ -242,6 +247,7 @@ class RunParams:
     step_chord: float | Speeds = 0.0
     turn_place: float | Speeds = 0.0
     grip_reserve: float | Speeds = 0.0
+    grip_one_sided: float | Speeds = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -263,6 +269,7 @@ class RunParams:
             ("step_chord", 1.0),
             ("turn_place", 3.0),
             ("grip_reserve", 2.0),
+            ("grip_one_sided", 1.0),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):

@@ -302,3 +302,39 @@ def test_grip_reserve_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"grip_reserve must be in \[0, 2\]"):
         RunParams(grip_reserve=(0.0, 1.0, 2.5))
     assert RunParams().at(3.5)["grip_reserve"] == 0.0
+
+
+def test_grip_one_sided_keeps_the_2_5_m_s_loop_that_grip_reserve_fell_on() -> None:
+    """``grip_one_sided``: on the 10 m loop at 2.5 m/s ``grip_reserve`` 1 cut both ways lets
+    the feet spin against the turn and the runner falls before 7.5 s; cut only on the twist
+    that turns the foot the way it turns, it runs on. On the last stance state the twist
+    along the thigh is within the full grip one way and the reduced one the other."""
+    runs = {s: run_course(2.5, seconds=7.5, path="circle:10", fps=10.0,
+                          params=RunParams(grip_reserve=1.0, grip_one_sided=s))
+            for s in (0.0, 1.0)}  # fmt: skip
+    assert runs[0.0].report["fell"], runs[0.0].report["notes"]
+    assert not runs[1.0].report["fell"], runs[1.0].report["notes"]
+    r = runs[1.0].runner
+    assert r.machine.current.name != "flight"
+    d = r.world.data
+    torque = r._attitude_torque(r.heading_d)
+    leg = r.active
+    axis = d.xanchor[r._knees[leg]] - d.xanchor[r._hips[leg]]
+    axis /= np.linalg.norm(axis)
+    along = float(torque @ axis)
+    spin = float(d.cvel[r._feet[leg], :3] @ axis)
+    grf = r.senses.grf
+    grip = r.k["yaw_grip"] * r.foot_length
+    cut = grip * max(float(grf[2]) - float(np.hypot(grf[0], grf[1])), 0.0)
+    full = grip * max(float(grf[2]), 0.0)
+    # the thigh takes -along: the way that turns the foot along ``spin`` is cut
+    lo, hi = (-cut, full) if spin > 0 else (-full, cut)
+    assert lo - 1e-9 <= along <= hi + 1e-9
+
+
+def test_grip_one_sided_is_checked() -> None:
+    with pytest.raises(ConfigError, match=r"grip_one_sided must be in \[0, 1\]"):
+        RunParams(grip_one_sided=1.5)
+    with pytest.raises(ConfigError, match=r"grip_one_sided must be in \[0, 1\]"):
+        RunParams(grip_one_sided=(0.0, -0.1, 1.0))
+    assert RunParams().at(3.5)["grip_one_sided"] == 0.0
