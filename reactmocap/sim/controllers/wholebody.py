@@ -297,11 +297,6 @@ class WholeBodyTracker(AnchoredReference):
             mocap's (``kp_swing``, critically damped): a foot loaded on its edge while the
             mocap's was flat stayed on it and the capture point left the line of the edges
             (``docs/tracking.md``, issue 16).
-        pivot_box: a foot the clip pivots keeps its sole box (MuJoCo's contact and the plan's
-            corners) while its ball patch is more than this over the floor (m, at most 0.05;
-            0: off) and a box corner within ``touch``: after a back push
-            the rear foot pivoted with its patch up and its toe through the floor, and the plan
-            had it in no support (``docs/tracking.md``, issue 16).
         flat_toe: with ``flat_weight``, no flat rows in a clip whose planted soles' median
             toe-down pitch is past this (rad; 0: off): it stands on the balls of its feet on
             purpose, which the box foot's toe edge cannot do; every rule per foot and tick
@@ -401,7 +396,6 @@ class WholeBodyTracker(AnchoredReference):
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
         flat_toe: float = 0.0,
-        pivot_box: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -440,7 +434,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band, "flat_toe": flat_toe,
-                "pivot_box": pivot_box,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -478,8 +471,6 @@ class WholeBodyTracker(AnchoredReference):
                 f"step_ahead_phase ({step_ahead_phase!r}) is a margin in (0, 0.5] m over the "
                 f"clip's own lead, and sets step_ahead_swing's limit: it needs step_ahead_swing"
             )
-        if pivot_box > 0.05:
-            raise ConfigError(f"pivot_box must be 0 (off) or in (0, 0.05] m, got {pivot_box!r}")
         if step_ahead_servo and not (step_ahead and step_ahead_servo <= 100.0):
             raise ConfigError(
                 f"step_ahead_servo ({step_ahead_servo!r}) is the pelvis servo's gain during "
@@ -527,8 +518,6 @@ class WholeBodyTracker(AnchoredReference):
         # ``step_ahead_servo``: the pelvis gain while a step after a back push is under way,
         # and the one the push set (back to it on landing)
         self._ahead_servo = float(step_ahead_servo)
-        # ``pivot_box``: a pivoting foot keeps its box while its patch is this far up
-        self._pivot_box = float(pivot_box)
         self._kp_pushed = float(self.kp[0])
         self._step_pushed = bool(step_pushed)
         self._pushed = False  # an external force has acted on the body
@@ -1128,16 +1117,6 @@ class WholeBodyTracker(AnchoredReference):
         servo.set_gains(0.0, self.servo_kv, self.character)
         servo.refresh_every = self.control_every
 
-    def _box_down(self, d: mujoco.MjData) -> NDArray[np.bool_]:
-        """``(2,)`` feet whose ball patch is over ``pivot_box`` up while a box corner is within
-        ``touch`` of the floor: pivoting there, the toe sank through the floor unfelt and the
-        plan lost the rear foot (``docs/tracking.md``, issue 16)."""
-        rot = d.geom_xmat[self.patch].reshape(2, 3, 3)
-        low = d.geom_xpos[self.patch, 2] - rot[:, 2, 2] * self.patch_half
-        low -= self.patch_half * np.abs(rot[:, 2, :2]).sum(axis=1)
-        corner = self.sole_corners()[:, :, 2].min(axis=1)
-        return (low - self.floor_z > self._pivot_box) & (corner - self.floor_z < self.touch)
-
     def control(self, world: World, t: float) -> None:
         d = world.data
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
@@ -1147,8 +1126,6 @@ class WholeBodyTracker(AnchoredReference):
             return
         i = self.clock.nearest(t)
         patch = self._lock_pivoting[i]
-        if self._pivot_box and patch.any():
-            patch = patch & ~self._box_down(d)
         for f in range(2):
             world.set_foot_patch(self.character, f, bool(patch[f]))
         self.update_ground(t)
