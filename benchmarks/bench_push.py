@@ -192,7 +192,8 @@ def sweep(
     return "".join(verdict((name, at, angle, f, duration, after, params, judge)) for f in forces)
 
 
-def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> list[Any]:
+def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> list[Any] | None:
+    """The row's eight directions, or None where the clip falls unpushed."""
     motion = _clip(name)
     yaw = heading(motion, at)
     params = json.loads(args.params)
@@ -200,7 +201,7 @@ def measure(name: str, at: float, duration: float, args: argparse.Namespace) -> 
     if not survives((name, at, yaw, 0.0, duration, args.after, params, judge)):
         # a clip that falls unpushed in the window measures the tracker, not the push
         print(f"{name} falls unpushed within {args.after} s after {at} s: choose another clip")
-        return [float("nan")] * 8
+        return None
     dirs = [k for k in range(8) if LABELS[k] in args.dirs]
     if args.forces:
         sweeps = [(name, at, yaw + k * np.pi / 4, duration, args.after, params, args.forces,
@@ -238,7 +239,7 @@ def plot(out: Path, runs: list[dict[str, Any]]) -> None:
         ax.set_title(title, pad=14)
     for run in runs:
         for ax, key in zip(axes, ("standing", "walking")):
-            if key not in run:
+            if "max_force_n" not in run.get(key, {}):  # absent, or fell unpushed
                 continue
             forces = np.array(run[key]["max_force_n"])
             # a walk's push never turns balance steps on
@@ -303,6 +304,14 @@ def main(argv: list[str] | None = None) -> int:
         t0 = time.perf_counter()
         forces = measure(name, float(at), dur, args)
         took = time.perf_counter() - t0
+        if forces is None:  # nothing to measure: recorded, not a crash
+            out[key] = {
+                "clip": name,
+                "time_s": float(at),
+                "duration_s": dur,
+                "falls_unpushed": True,
+            }
+            continue
         if args.forces:
             total = sum(len(m) for m in forces)
             upright = ["".join("." if c in ".:" else "x" for c in m) for m in forces]

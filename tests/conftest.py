@@ -3,9 +3,12 @@ CI); tests that need it skip with a clear reason on a user's fresh clone."""
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 
@@ -34,6 +37,24 @@ def linked_library(root: Path, *folders: Path, without: tuple[str, ...] = ()) ->
 # the library some response tests' cases were found on, before the right-lying fall (the
 # search now finds it for some of those bodies, so the case no longer arises with it)
 BEFORE_RIGHT_FALL = ("fall_sideways_fast_right",)
+
+
+@pytest.fixture(scope="session")
+def load_bench() -> Callable[[str], ModuleType]:
+    """``load_bench("bench_athletics")``: ``benchmarks/bench_athletics.py`` as a module (the
+    scripts are not a package)."""
+
+    def load(name: str) -> ModuleType:
+        path = REPO / "benchmarks" / f"{name}.py"
+        spec = importlib.util.spec_from_file_location(name, path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        # a script's dataclasses look their module up by name
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+        return module
+
+    return load
 
 
 @pytest.fixture(scope="session")
