@@ -316,9 +316,9 @@ def test_turn_place_lag_leaves_the_offset_out_while_the_velocity_lags_the_facing
     without ``turn_place`` to the bit (without the gate it parts at ``PATH_AFTER``); at 3.5
     m/s, where the lag falls under the gate, the offset acts, later than ungated."""
     p = {"turn_place": 0.5}
+    sets = {"off": {}, "on": p, "gated": {**p, "turn_place_lag": 0.25}}
     fast = {k: run_course(4.1, seconds=PATH_AFTER + 1.0, path="circle:20", fps=10.0,
-                          params=RunParams(**q)) for k, q in  # fmt: skip
-            (("off", {}), ("on", p), ("gated", {**p, "turn_place_lag": 0.25}))}
+                          params=RunParams(**q)) for k, q in sets.items()}  # fmt: skip
     log = fast["gated"].log
     after = log["t"] >= PATH_AFTER
     vel = np.arctan2(log["com_vel"][after, 1], log["com_vel"][after, 0])
@@ -327,8 +327,7 @@ def test_turn_place_lag_leaves_the_offset_out_while_the_velocity_lags_the_facing
     _assert_runs_alike(fast["gated"], fast["off"])
     assert _first_change(fast["on"], fast["off"]) < PATH_AFTER + 0.01
     slow = {k: run_course(3.5, seconds=PATH_AFTER + 2.0, path="circle:20", fps=10.0,
-                          params=RunParams(**q)) for k, q in  # fmt: skip
-            (("off", {}), ("gated", {**p, "turn_place_lag": 0.25}))}
+                          params=RunParams(**sets[k])) for k in ("off", "gated")}  # fmt: skip
     assert PATH_AFTER + 0.01 < _first_change(slow["gated"], slow["off"]) < PATH_AFTER + 2.0
 
 
