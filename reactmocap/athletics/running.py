@@ -370,11 +370,7 @@ class Runner:
             # toward the curve's outside by the turn's lean: the leg's force then gives the
             # centripetal force (eqs. 1-2 make it only from a velocity lagging the facing);
             # not over the start, whose first steps it upset (falls within 1-2.4 s)
-            gate, kap = k["turn_place_lag"], self.curvature
-            # off while the velocity lags the facing by more than the gate: the offset is
-            # sized by the asked speed, 1.2-1.5 times what the runner ran at 4+ m/s
-            if gate == 0 or wrap_angle(hd - math.atan2(v[1], v[0])) * kap < gate * abs(kap):
-                lat -= k["turn_place"] * self._leg_length * self.speed**2 * kap / self.g
+            lat -= k["turn_place"] * self._leg_length * self.speed**2 * self.curvature / self.g
         # ground-speed matching: the foot reaches further forward while it is high and comes
         # back over the last moments before touchdown (predicted from the lowest sole corner
         # and the body's vertical speed), so it meets the ground moving back under the body

@@ -183,11 +183,6 @@ class RunParams:
             and spun 14-16 rad/s under the full grip. At 2.5 m/s the 10 m loops fell with it
             (the twist holds the foot there): off there by speed. From ``PATH_AFTER`` on.
             Within [0, 2].
-        turn_place_lag: ``turn_place``'s offset is left out while the COM's velocity lags
-            the desired facing (toward the curve's outside) by more than this angle (rad; 0:
-            off, always applied). The offset is sized by the asked speed: at 4.1 m/s on
-            20 m loops the runner ran 3.4-3.8 m/s, its velocity 0.31-0.41 rad behind the
-            facing. Within [0, 1.5].
     """
 
     stance_time: float | Speeds = (0.2299, 0.177, 0.1639)
@@ -247,7 +242,6 @@ class RunParams:
     step_chord: float | Speeds = 0.0
     turn_place: float | Speeds = 0.0
     grip_reserve: float | Speeds = 0.0
-    turn_place_lag: float | Speeds = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -269,7 +263,6 @@ class RunParams:
             ("step_chord", 1.0),
             ("turn_place", 3.0),
             ("grip_reserve", 2.0),
-            ("turn_place_lag", 1.5),
         ):
             v = getattr(self, name)
             if not all(0.0 <= b <= top for b in (v if isinstance(v, tuple) else (v,))):

@@ -302,38 +302,3 @@ def test_grip_reserve_is_checked() -> None:
     with pytest.raises(ConfigError, match=r"grip_reserve must be in \[0, 2\]"):
         RunParams(grip_reserve=(0.0, 1.0, 2.5))
     assert RunParams().at(3.5)["grip_reserve"] == 0.0
-
-
-def _first_change(a: RunResult, b: RunResult) -> float:
-    """The log time from which two runs of one set-up part (inf: the same to the bit)."""
-    apart = np.abs(a.log["com"] - b.log["com"]).max(axis=1) > 0
-    return float(a.log["t"][np.argmax(apart)]) if apart.any() else math.inf
-
-
-def test_turn_place_lag_leaves_the_offset_out_while_the_velocity_lags_the_facing() -> None:
-    """``turn_place_lag``: on the 20 m circle at 4.1 m/s the velocity lags the desired facing
-    by more than 0.25 rad from ``PATH_AFTER`` on, and with that gate the run is the one
-    without ``turn_place`` to the bit (without the gate it parts at ``PATH_AFTER``); at 3.5
-    m/s, where the lag falls under the gate, the offset acts, later than ungated."""
-    p = {"turn_place": 0.5}
-    sets = {"off": {}, "on": p, "gated": {**p, "turn_place_lag": 0.25}}
-    fast = {k: run_course(4.1, seconds=PATH_AFTER + 1.0, path="circle:20", fps=10.0,
-                          params=RunParams(**q)) for k, q in sets.items()}  # fmt: skip
-    log = fast["gated"].log
-    after = log["t"] >= PATH_AFTER
-    vel = np.arctan2(log["com_vel"][after, 1], log["com_vel"][after, 0])
-    lag = [wrap_angle(a) for a in vel - log["desired_heading"][after]]
-    assert max(lag) < -0.25  # anticlockwise: behind the facing
-    _assert_runs_alike(fast["gated"], fast["off"])
-    assert _first_change(fast["on"], fast["off"]) < PATH_AFTER + 0.01
-    slow = {k: run_course(3.5, seconds=PATH_AFTER + 2.0, path="circle:20", fps=10.0,
-                          params=RunParams(**sets[k])) for k in ("off", "gated")}  # fmt: skip
-    assert PATH_AFTER + 0.01 < _first_change(slow["gated"], slow["off"]) < PATH_AFTER + 2.0
-
-
-def test_turn_place_lag_is_checked() -> None:
-    with pytest.raises(ConfigError, match=r"turn_place_lag must be in \[0, 1.5\]"):
-        RunParams(turn_place_lag=-0.1)
-    with pytest.raises(ConfigError, match=r"turn_place_lag must be in \[0, 1.5\]"):
-        RunParams(turn_place_lag=(0.0, 0.25, 2.0))
-    assert RunParams().at(4.5)["turn_place_lag"] == 0.0
