@@ -283,6 +283,13 @@ class LandingParams:
             touchdown; () off. Why: on the male back handspring every start that stepped
             forward out of the recovery entered it at -27..-36 kg m^2/s, the others at
             +2.7..+8.3 (docs/athletics.md, "the absorb's hand-over held").
+        held_hip_share: once ``absorb_spin``'s gate has held a hand-over (the knees had slowed
+            to ``restore`` with the body's momentum still below the gate), the share in [0, 1]
+            of the balance's COM-servo hip pitch offset (its ``0.5 delta``) kept in the
+            recovery and the balance after the landing; 1: off. Why: on the male back
+            handspring the held starts that fell stood on one foot while that offset flexed
+            the hip up to its limit and pitched the pelvis forward past its target
+            (docs/athletics.md, "the balance's hip offset zeroed after a held absorb").
     """
 
     knee: float = 0.6
@@ -332,6 +339,7 @@ class LandingParams:
     step_hang_plant: float = 0.0
     recover_min: float = 0.05
     absorb_spin: tuple[float, ...] = ()
+    held_hip_share: float = 1.0
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -390,6 +398,11 @@ class LandingParams:
                 "landing absorb_spin must be (gate in [-200, 0) kg m^2/s, wait in (0, 1] s), "
                 f"got {a!r}"
             )
+        h = self.held_hip_share
+        if not (isinstance(h, (int, float)) and 0.0 <= h <= 1.0):
+            raise ConfigError(f"landing held_hip_share must be in [0, 1], got {h!r}")
+        if h < 1.0 and not a:
+            raise ConfigError("landing held_hip_share needs absorb_spin (it acts on its held starts)")
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
         if self.late_delta and not (
@@ -719,6 +732,9 @@ class Landing(Basis):
             if p.absorb_spin and t_in < p.absorb_spin[1]:
                 s = ctx.sense(t)  # mj_subtreeVel has run
                 if float(world.data.subtree_angmom[s.root] @ s.side_axis()) < p.absorb_spin[0]:
+                    if p.held_hip_share < 1.0 and t_in > 0.03:  # held: the knees had slowed
+                        knees = _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
+                        memo["held"] = max(memo.get("held", 0.0), float(knees))
                     return False
             return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
 
@@ -731,6 +747,8 @@ class Landing(Basis):
             bl.posture = Posture(leg=leg, lean=p.lean, settle=0.0)
             stand_up = max(leg, 0.5, p.recover_leg)  # recover_leg: at least so tall
             bl.set_posture(Posture(leg=stand_up, lean=p.lean, settle=0.3), t)
+            if memo.get("held"):  # held_hip_share, from here and in the balance after
+                bl.hip_share = float(p.held_hip_share)
 
         def settled(world: World, t: float, t_in: float) -> bool:
             s = ctx.sense(t)
@@ -753,6 +771,8 @@ class Landing(Basis):
                 ctx.handover["stepper"] = bl.stepper
             if p.carry_pitch:  # the balance's pitch target starts from ours (carry_pitch)
                 ctx.handover["pitch"] = bl.pitch_target(t)
+            if memo.get("held"):  # the held absorb's hip share goes on (held_hip_share)
+                ctx.handover["hip_share"] = float(p.held_hip_share)
 
         return [
             State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),
