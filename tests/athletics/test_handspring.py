@@ -631,3 +631,20 @@ def test_the_landings_absorb_holds_its_hand_over_while_the_body_still_turns() ->
     for bad in ((1.0, 0.5), (-15.0, 0.0), (-15.0, 1.5), (-15.0,), (math.nan, 0.5)):
         with pytest.raises(ConfigError, match="absorb_spin"):
             LandingParams(absorb_spin=bad)
+
+
+def test_the_held_absorbs_balance_drops_its_hip_offset() -> None:
+    """Full-size start 14 (seed 0): the file's absorb holds its hand-over (``absorb_spin``),
+    then the body stands on one foot while the COM servo's hip offset flexes the standing hip
+    and the pelvis pitches forward; it steps forward and falls. With ``held_hip_share`` 0
+    (that offset dropped after a held absorb) it lands (docs/athletics.md, "the balance's
+    hip offset zeroed after a held absorb"). A share outside [0, 1] or without
+    ``absorb_spin`` is named."""
+    r, old = _landing_with_and_without("held_hip_share", 0.0, _starts(1.0, 15)[14])
+    assert r["landed"] and not r["fell"]
+    assert old["fell"] and not old["landed"]
+    for bad in (-0.1, 1.5, math.nan):
+        with pytest.raises(ConfigError, match="held_hip_share"):
+            LandingParams(absorb_spin=(-15.0, 0.5), held_hip_share=bad)
+    with pytest.raises(ConfigError, match="needs absorb_spin"):
+        LandingParams(held_hip_share=0.0)
