@@ -583,7 +583,9 @@ def _landing_with_and_without(
     ``value`` and without it."""
     m = replace(load_maneuver(EXAMPLE), seconds=6.0)
     land = next(p for p in m.phases if p.controller == "land").params
-    plain = {k: v for k, v in land.items() if k != key}
+    # held_hip_share acts on absorb_spin's held starts only: it goes with it
+    gone = {key, "held_hip_share"} if key == "absorb_spin" else {key}
+    plain = {k: v for k, v in land.items() if k not in gone}
     runs = (_with(m, "land", {**plain, key: value}), _with(m, "land", plain))
     with_key, without = (run_maneuver(r, perturbation=start, fps=10.0).report for r in runs)
     return with_key, without
