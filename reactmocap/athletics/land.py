@@ -402,7 +402,9 @@ class LandingParams:
         if not (isinstance(h, (int, float)) and 0.0 <= h <= 1.0):
             raise ConfigError(f"landing held_hip_share must be in [0, 1], got {h!r}")
         if h < 1.0 and not a:
-            raise ConfigError("landing held_hip_share needs absorb_spin (it acts on its held starts)")
+            raise ConfigError(
+                "landing held_hip_share needs absorb_spin (it acts on its held starts)"
+            )
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
         if self.late_delta and not (
