@@ -517,6 +517,9 @@ class BalanceLaw:
         self.stepper: Stepper | None = None
         #: the pelvis's roll target (rad, heading frame; 0 upright): the landing's roll_ease
         self.roll = 0.0
+        #: the share of the COM servo's stance-hip pitch offset kept (1: all; the landing's
+        #: held_hip_share after a held absorb, carried to the balance after it)
+        self.hip_share = 1.0
         self._knee_standing = float(np.mean(knee_for_length(
             a.thigh, a.shin, STANDING_LEG * (a.thigh + a.shin))[0]))  # fmt: skip
 
@@ -659,7 +662,7 @@ class BalanceLaw:
         for k in range(2):
             rig.offset[_ANKLE[k], 0] = -delta[0]
             rig.offset[_ANKLE[k], 1] = roll[0] * delta[1]
-            rig.offset[_HIP[k], 0] = 0.5 * delta[0]
+            rig.offset[_HIP[k], 0] = 0.5 * delta[0] * self.hip_share
             rig.offset[_HIP[k], 1] = roll[1] * delta[1]
         if g.arms is not None:
             gain, margin, limit = g.arms
@@ -1186,6 +1189,10 @@ class Balance(Basis):
             # a landing's last pitch target, carried on (LandingParams.carry_pitch)
             pitch = ctx.handover.pop("pitch", None)
             bl.set_posture(self.posture, t, pitch_from=pitch if isinstance(pitch, float) else None)
+            # a landing's share of the hip offset after a held absorb (held_hip_share)
+            share = ctx.handover.pop("hip_share", None)
+            if isinstance(share, float):
+                bl.hip_share = share
 
         exits: list[tuple[Event, str]] = []
         if self.until is not None:

@@ -290,6 +290,13 @@ class LandingParams:
             recovery hands over only with a foot down; () off. Why: the female back
             handspring's hop lands only if it leaves with -8.5..-2.8 kg m^2/s; with more the
             feet came down ahead of the COM, with less behind it (docs/athletics.md).
+        held_hip_share: once ``absorb_spin``'s gate has held a hand-over (the knees had slowed
+            to ``restore`` with the body's momentum still below the gate), the share in [0, 1]
+            of the balance's COM-servo hip pitch offset (its ``0.5 delta``) kept in the
+            recovery and the balance after the landing; 1: off. Why: on the male back
+            handspring the held starts that fell stood on one foot while that offset flexed
+            the hip up to its limit and pitched the pelvis forward past its target
+            (docs/athletics.md, "the balance's hip offset zeroed after a held absorb").
     """
 
     knee: float = 0.6
@@ -340,6 +347,7 @@ class LandingParams:
     recover_min: float = 0.05
     absorb_spin: tuple[float, ...] = ()
     hop_spin: tuple[float, ...] = ()
+    held_hip_share: float = 1.0
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -408,6 +416,13 @@ class LandingParams:
             raise ConfigError(
                 "landing hop_spin must be (ref in [-100, 100] kg m^2/s, gain in [-0.1, 0.1] "
                 f"m per kg m^2/s), got {h!r}"
+            )
+        hs = self.held_hip_share
+        if not (isinstance(hs, (int, float)) and 0.0 <= hs <= 1.0):
+            raise ConfigError(f"landing held_hip_share must be in [0, 1], got {hs!r}")
+        if hs < 1.0 and not a:
+            raise ConfigError(
+                "landing held_hip_share needs absorb_spin (it acts on its held starts)"
             )
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
@@ -738,6 +753,9 @@ class Landing(Basis):
             if p.absorb_spin and t_in < p.absorb_spin[1]:
                 s = ctx.sense(t)  # mj_subtreeVel has run
                 if float(world.data.subtree_angmom[s.root] @ s.side_axis()) < p.absorb_spin[0]:
+                    if p.held_hip_share < 1.0 and t_in > 0.03:  # held: the knees had slowed
+                        knees = _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
+                        memo["held"] = max(memo.get("held", 0.0), float(knees))
                     return False
             return t_in > 0.03 and _knee_speed(world, ctx) < p.restore * memo["knee_peak"]
 
@@ -751,6 +769,8 @@ class Landing(Basis):
             stand_up = max(leg, 0.5, p.recover_leg)  # recover_leg: at least so tall
             bl.set_posture(Posture(leg=stand_up, lean=p.lean, settle=0.3), t)
             memo["hop"] = 0.0  # hop_spin: 0 not off the floor yet, 1 in the hop, 2 down again
+            if memo.get("held"):  # held_hip_share, from here and in the balance after
+                bl.hip_share = float(p.held_hip_share)
 
         def recover(world: World, t: float) -> None:
             """The balance law; with hop_spin the hop's legs placed for its spin."""
@@ -792,6 +812,8 @@ class Landing(Basis):
                 ctx.handover["stepper"] = bl.stepper
             if p.carry_pitch:  # the balance's pitch target starts from ours (carry_pitch)
                 ctx.handover["pitch"] = bl.pitch_target(t)
+            if memo.get("held"):  # the held absorb's hip share goes on (held_hip_share)
+                ctx.handover["hip_share"] = float(p.held_hip_share)
 
         return [
             State("reach", law(reach, every), reach_enter, ((touchdown(ctx), "absorb"),)),

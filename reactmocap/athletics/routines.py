@@ -459,8 +459,10 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
     # touchdown both knees' targets go to their mean (LandingParams.step_knees: 40/50 and
     # 36/50 from 40 and 31, held-out seed 2 38 from 35); and (last) a foot left hanging 0.4 s
     # with no swing is put down (LandingParams.step_hang_plant: 41/50 and 37/50 from 40 and
-    # 36, held-out seed 2 39/50 from 38). A list: a maneuver file's
-    # numbers load as one
+    # 36, held-out seed 2 39/50 from 38); since 2026-12-06 the absorb's hand-over held while
+    # he still turns back (LandingParams.absorb_spin) and after such a hold no COM-servo hip
+    # offset (held_hip_share 0: 44 / 40 / 42 of 50 on seeds 0-2 from 42 / 39 / 40). A list:
+    # a maneuver file's numbers load as one
     "male": MappingProxyType({
         "leap": MappingProxyType({"spin_limit": 1.3, "hold": 0.22, "com_offset": -0.13,
                                   "com_ramp": 0.2, "rise_cap": 1.0, "rise_lead": 0.012,
@@ -470,7 +472,7 @@ HANDSPRING_BODY_PRESET: Mapping[str, Mapping[str, Mapping[str, Any]]] = MappingP
                                   "step": [0.05, 0.0, 0.3, 0.25], "recover_leg": 0.8,
                                   "step_across": 0.05, "step_foresee": 0.25,
                                   "step_knees": 1.0, "step_hang_plant": 0.4,
-                                  "absorb_spin": [-15.0, 0.5]}),
+                                  "absorb_spin": [-15.0, 0.5], "held_hip_share": 0.0}),
         "balance": MappingProxyType({"side_both": True}),
     }),
     "female": MappingProxyType({

@@ -583,7 +583,9 @@ def _landing_with_and_without(
     ``value`` and without it."""
     m = replace(load_maneuver(EXAMPLE), seconds=6.0)
     land = next(p for p in m.phases if p.controller == "land").params
-    plain = {k: v for k, v in land.items() if k != key}
+    # held_hip_share acts on absorb_spin's held starts only: it goes with it
+    gone = {key, "held_hip_share"} if key == "absorb_spin" else {key}
+    plain = {k: v for k, v in land.items() if k not in gone}
     runs = (_with(m, "land", {**plain, key: value}), _with(m, "land", plain))
     with_key, without = (run_maneuver(r, perturbation=start, fps=10.0).report for r in runs)
     return with_key, without
@@ -652,3 +654,20 @@ def test_the_female_hops_second_touchdown_is_placed_for_the_spin_it_left_with() 
     for bad in ((-5.5,), (-5.5, 0.5), (math.nan, 0.02), (-500.0, 0.02)):
         with pytest.raises(ConfigError, match="hop_spin"):
             LandingParams(hop_spin=bad)
+
+
+def test_the_held_absorbs_balance_drops_its_hip_offset() -> None:
+    """Full-size start 14 (seed 0): the file's absorb holds its hand-over (``absorb_spin``),
+    then the body stands on one foot while the COM servo's hip offset flexes the standing hip
+    and the pelvis pitches forward; it steps forward and falls. With ``held_hip_share`` 0
+    (that offset dropped after a held absorb) it lands (docs/athletics.md, "the balance's
+    hip offset zeroed after a held absorb"). A share outside [0, 1] or without
+    ``absorb_spin`` is named."""
+    r, old = _landing_with_and_without("held_hip_share", 0.0, _starts(1.0, 15)[14])
+    assert r["landed"] and not r["fell"]
+    assert old["fell"] and not old["landed"]
+    for bad in (-0.1, 1.5, math.nan):
+        with pytest.raises(ConfigError, match="held_hip_share"):
+            LandingParams(absorb_spin=(-15.0, 0.5), held_hip_share=bad)
+    with pytest.raises(ConfigError, match="needs absorb_spin"):
+        LandingParams(held_hip_share=0.0)
