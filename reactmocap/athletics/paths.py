@@ -313,14 +313,13 @@ def figure_eight(radius: float, start: ArrayLike = (0.0, 0.0), heading: float = 
     """Two circles of ``radius`` m meeting at ``start``: the first anticlockwise, the second
     clockwise, leaving ``start`` along ``heading``; closed (it laps). With a ``reversal`` of L m
     (within (0, 2R]) each change of loop is a clothoid pair, the curvature ramped linearly
-    +-1/R -> 0 -> -+1/R over L (:func:`_eight_lobe`): the lobes cross at ``start`` at an
-    angle, and the runner starts there on the pair's inflection (curvature 0)."""
+    +-1/R -> 0 -> -+1/R over L (:func:`_eight_lobe`; the lobes then cross at an angle); the
+    runner still starts on the first circle (curvature 1/R), where its arc begins
+    (:func:`_reversal_lap`), so only the reversals differ."""
     if not (math.isfinite(radius) and radius > 0):
         raise ConfigError(f"figure-eight radius must be > 0 m, got {radius!r}")
     if reversal != 0:
-        lobe, alpha = _eight_lobe(radius, reversal, per_circle)
-        pts = np.vstack([lobe, lobe * [1.0, -1.0]])
-        heading -= alpha  # the crossing's heading onto the runner's
+        pts = _reversal_lap(radius, reversal, per_circle)
     else:
         th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
         left = np.column_stack([radius * np.sin(th), radius * (1 - np.cos(th))])
