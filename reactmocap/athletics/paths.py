@@ -359,15 +359,21 @@ def _eight_lobe(radius: float, reversal: float, per_circle: int) -> tuple[F64, f
 
 
 def _reversal_lap(radius: float, reversal: float, per_circle: int) -> F64:
-    """One lap of :func:`figure_eight`'s eight with a ``reversal``, starting where its first
-    lobe's arc does (curvature 1/R), moved to the origin and turned to head along +X: the lap
-    :func:`loop_with_entry` lays after an entry."""
+    """One lap of an eight with a ``reversal`` (:func:`_eight_lobe`), starting where its first
+    lobe's arc does (curvature 1/R), at the origin heading +X. The arc's points are
+    :func:`figure_eight`'s first circle's own, so a run on it is the eight's without a reversal
+    to the bit until the path ahead reaches the first reversal."""
     lobe, alpha = _eight_lobe(radius, reversal, per_circle)
-    k = len(clothoid(0.5 * reversal, radius)) - 1  # the arc's first point
-    lap = np.roll(np.vstack([lobe, lobe * [1.0, -1.0]]), -k, axis=0)
+    n = len(clothoid(0.5 * reversal, radius))  # the ramp's points, the crossing's and Q's
     beta = alpha + 0.25 * reversal / radius
+    sweep = 2 * math.pi - 2 * beta
+    th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
+    th = th[th < sweep - np.pi / per_circle]  # no step shorter than half the arc's
+    arc = np.column_stack([radius * np.sin(th), radius * (1 - np.cos(th))])
+    n_arc = len(lobe) - 2 * n + 1  # the lobe's arc points between its two Q's
+    rest = np.vstack([lobe[n + n_arc :], lobe * [1.0, -1.0], lobe[1 : n - 1]])
     c, s = math.cos(-beta), math.sin(-beta)
-    return (lap - lap[0]) @ np.array([[c, -s], [s, c]]).T
+    return np.vstack([arc, (rest - lobe[n - 1]) @ np.array([[c, -s], [s, c]]).T])
 
 
 def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0,
