@@ -265,11 +265,13 @@ def clothoid(length: float, radius: float, step: float = ENTRY_STEP) -> F64:
 
 
 def loop_with_entry(kind: str, radius: float, entry: float, start: ArrayLike = (0.0, 0.0),
-                    heading: float = 0.0, per_circle: int = 120) -> EntryPath:  # fmt: skip
+                    heading: float = 0.0, per_circle: int = 120,
+                    reversal: float = 0.0) -> EntryPath:  # fmt: skip
     """A ``kind`` (``"circle"`` or ``"eight"``) loop of ``radius`` m entered from ``start``
     along ``heading`` over a clothoid of ``entry`` m (> 0) whose curvature ramps from 0 to the
     loop's first circle's (left); the loop leaves the clothoid's end tangent to it, and its
-    laps are laid out to :data:`ENTRY_PATH_LENGTH`."""
+    laps are laid out to :data:`ENTRY_PATH_LENGTH`. An eight's ``reversal`` (m) is as
+    :func:`figure_eight`'s; its lap then starts where its first lobe's arc does."""
     if not (math.isfinite(radius) and radius > 0):
         raise ConfigError(f"{kind} radius must be > 0 m, got {radius!r}")
     if not (math.isfinite(entry) and 0 < entry <= MAX_ENTRY):
@@ -278,11 +280,20 @@ def loop_with_entry(kind: str, radius: float, entry: float, start: ArrayLike = (
     turn = entry / (2 * radius)  # the clothoid's end heading
     th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
     lap = np.column_stack([radius * np.sin(th), radius * (1 - np.cos(th))])
-    if kind == "eight":
+    if kind == "eight" and reversal != 0:
+        lap = _reversal_lap(radius, reversal, per_circle)
+    elif kind == "eight":
         lap = np.vstack([lap, lap * [1.0, -1.0]])
     elif kind != "circle":
         raise ConfigError(f"an entry is for 'circle' or 'eight' loops, got {kind!r}")
-    laps = int(math.ceil(ENTRY_PATH_LENGTH / (2 * np.pi * radius * (2 if kind == "eight" else 1))))
+    elif reversal != 0:
+        raise ConfigError(f"reversal is for 'eight' loops, got {kind!r}")
+    if reversal != 0:
+        seg = np.diff(np.vstack([lap, lap[:1]]), axis=0)
+        lap_length = float(np.hypot(seg[:, 0], seg[:, 1]).sum())
+    else:
+        lap_length = 2 * np.pi * radius * (2 if kind == "eight" else 1)
+    laps = int(math.ceil(ENTRY_PATH_LENGTH / lap_length))
     c, s = math.cos(turn), math.sin(turn)
     loop = np.tile(lap, (laps, 1)) @ np.array([[c, -s], [s, c]]).T + ramp[-1]
     pts = np.vstack([ramp, loop, loop[:1]])
@@ -298,38 +309,105 @@ def Straight(heading: float = 0.0, start: ArrayLike = (0.0, 0.0)) -> Polyline:
 
 
 def figure_eight(radius: float, start: ArrayLike = (0.0, 0.0), heading: float = 0.0,
-                 per_circle: int = 120) -> Polyline:  # fmt: skip
+                 per_circle: int = 120, reversal: float = 0.0) -> Polyline:  # fmt: skip
     """Two circles of ``radius`` m meeting at ``start``: the first anticlockwise, the second
-    clockwise, leaving ``start`` along ``heading``; closed (it laps)."""
+    clockwise, leaving ``start`` along ``heading``; closed (it laps). With a ``reversal`` of L m
+    (within (0, 2R]) each change of loop is a clothoid pair, the curvature ramped linearly
+    +-1/R -> 0 -> -+1/R over L (:func:`_eight_lobe`; the lobes then cross at an angle); the
+    runner still starts on the first circle (curvature 1/R), where its arc begins
+    (:func:`_reversal_lap`), so only the reversals differ."""
     if not (math.isfinite(radius) and radius > 0):
         raise ConfigError(f"figure-eight radius must be > 0 m, got {radius!r}")
-    th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
-    left = np.column_stack([radius * np.sin(th), radius * (1 - np.cos(th))])
-    right = np.column_stack([radius * np.sin(th), -radius * (1 - np.cos(th))])
-    pts = np.vstack([left, right])
+    if reversal != 0:
+        pts = _reversal_lap(radius, reversal, per_circle)
+    else:
+        th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
+        left = np.column_stack([radius * np.sin(th), radius * (1 - np.cos(th))])
+        right = np.column_stack([radius * np.sin(th), -radius * (1 - np.cos(th))])
+        pts = np.vstack([left, right])
     c, s = math.cos(heading), math.sin(heading)
     rot = np.array([[c, -s], [s, c]])
     return Polyline(pts @ rot.T + np.asarray(start, dtype=np.float64)[:2], closed=True)
 
 
+def _eight_lobe(radius: float, reversal: float, per_circle: int) -> tuple[F64, float]:
+    """An eight's anticlockwise lobe whose ends are halves of a ``reversal`` m clothoid pair:
+    points from the crossing at the origin (curvature 0, heading ``alpha``) over a clothoid of
+    ``reversal / 2`` (curvature 0 -> 1/R), an arc of ``radius`` and the mirror clothoid back to
+    the origin (heading ``-alpha``; the origin itself left off). ``alpha`` puts the arc's centre
+    on the Y axis, so the lobe is symmetric about it and closes; the clockwise lobe is its
+    mirror in X. Returns the points ``(N, 2)`` and ``alpha`` (rad)."""
+    if not (math.isfinite(reversal) and 0 < reversal <= 2 * radius):
+        raise ConfigError(
+            f"reversal must be within (0, {2 * radius:g}] m (twice the radius), got {reversal!r}"
+        )
+    ramp = clothoid(0.5 * reversal, radius)
+    tau = 0.25 * reversal / radius  # the half's turn, s^2 / (2 l R) at s = l
+    qx, qy = ramp[-1]
+    # the centre's x, (qx, qy) rotated by alpha less R sin(alpha + tau), is 0
+    alpha = math.atan2(qx - radius * math.sin(tau), qy + radius * math.cos(tau))
+    c, s = math.cos(alpha), math.sin(alpha)
+    ramp = ramp @ np.array([[c, -s], [s, c]]).T
+    beta = alpha + tau  # the heading where the arc starts
+    centre = ramp[-1] + radius * np.array([-math.sin(beta), math.cos(beta)])
+    sweep = 2 * math.pi - 2 * beta
+    n = max(int(math.ceil(sweep / (2 * math.pi) * per_circle)), 2)
+    phi = beta - 0.5 * math.pi + np.linspace(0.0, sweep, n + 1)[1:-1]
+    arc = centre + radius * np.column_stack([np.cos(phi), np.sin(phi)])
+    back = ramp[::-1] * [-1.0, 1.0]
+    return np.vstack([ramp, arc, back[:-1]]), alpha
+
+
+def _reversal_lap(radius: float, reversal: float, per_circle: int) -> F64:
+    """One lap of an eight with a ``reversal`` (:func:`_eight_lobe`), starting where its first
+    lobe's arc does (curvature 1/R), at the origin heading +X. The arc's points are
+    :func:`figure_eight`'s first circle's own, so a run on it is the eight's without a reversal
+    to the bit until the path ahead reaches the first reversal."""
+    lobe, alpha = _eight_lobe(radius, reversal, per_circle)
+    n = len(clothoid(0.5 * reversal, radius))  # the ramp's points, the crossing's and Q's
+    beta = alpha + 0.25 * reversal / radius
+    sweep = 2 * math.pi - 2 * beta
+    th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
+    th = th[th < sweep - np.pi / per_circle]  # no step shorter than half the arc's
+    arc = np.column_stack([radius * np.sin(th), radius * (1 - np.cos(th))])
+    n_arc = len(lobe) - 2 * n + 1  # the lobe's arc points between its two Q's
+    rest = np.vstack([lobe[n + n_arc :], lobe * [1.0, -1.0], lobe[1 : n - 1]])
+    c, s = math.cos(-beta), math.sin(-beta)
+    return np.vstack([arc, (rest - lobe[n - 1]) @ np.array([[c, -s], [s, c]]).T])
+
+
 def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0,
-                 entry: float = 0.0) -> Course:  # fmt: skip
+                 entry: float = 0.0, reversal: float = 0.0) -> Course:  # fmt: skip
     """A course from the CLI's ``--path``: ``line``, ``circle:R`` (anticlockwise, starting
     tangent to the runner's heading, centre on its left), ``eight:R`` (figure eight) or a CSV
     file of ``x,y`` rows in metres (a header line is allowed). A loop's ``entry`` (m, or the
     spec's suffix ``circle:R+entry:L``) starts the runner on a clothoid of that length onto
-    it (:func:`loop_with_entry`); 0 (the default) starts on the loop."""
+    it (:func:`loop_with_entry`); 0 (the default) starts on the loop. An eight's ``reversal``
+    (m, or the suffix ``eight:R+turn:L``; within [0, 2R]) joins its loops by a clothoid pair
+    of that length (:func:`figure_eight`); 0 (the default) joins them at the curvature's
+    jump."""
     spec = spec.strip()
-    if "+entry:" in spec:
-        spec, _, tail = spec.partition("+entry:")
-        try:
-            entry = float(tail)
-        except ValueError:
-            raise ConfigError(
-                f"--path ...+entry:L needs a length in metres, got {tail!r}"
-            ) from None
+    for key in ("entry", "turn"):
+        if f"+{key}:" in spec:
+            spec, _, tail = spec.partition(f"+{key}:")
+            tail, plus, rest = tail.partition("+")
+            spec += plus + rest  # another suffix after this one
+            try:
+                value = float(tail)
+            except ValueError:
+                raise ConfigError(
+                    f"--path ...+{key}:L needs a length in metres, got {tail!r}"
+                ) from None
+            if key == "entry":
+                entry = value
+            else:
+                reversal = value
     if not (math.isfinite(entry) and 0 <= entry <= MAX_ENTRY):
         raise ConfigError(f"entry must be within [0, {MAX_ENTRY:g}] m, got {entry!r}")
+    if not (math.isfinite(reversal) and reversal >= 0):
+        raise ConfigError(f"reversal must be within [0, 2R] m (twice the radius), got {reversal!r}")
+    if reversal > 0 and not spec.startswith("eight:"):
+        raise ConfigError(f"reversal is for 'eight:R' paths, got {spec!r}")
     p0 = np.asarray(start, dtype=np.float64)[:2]
     if entry > 0 and not spec.startswith(("circle:", "eight:")):
         raise ConfigError(f"entry is for 'circle:R' or 'eight:R' paths, got {spec!r}")
@@ -344,9 +422,9 @@ def parse_course(spec: str, start: ArrayLike = (0.0, 0.0), heading: float = 0.0,
                     f"--path {kind}:R needs a radius in metres, got {spec!r}"
                 ) from None
             if entry > 0:
-                return loop_with_entry(kind, r, entry, p0, heading)
+                return loop_with_entry(kind, r, entry, p0, heading, reversal=reversal)
             if kind == "eight":
-                return figure_eight(r, p0, heading)
+                return figure_eight(r, p0, heading, reversal=reversal)
             left = np.array([-math.sin(heading), math.cos(heading)])
             return Circle(p0 + r * left, r, ccw=True)
     path = Path(spec)

@@ -85,7 +85,8 @@ def run_course(
 ) -> RunResult:
     """Run at ``speed`` m/s (2.5-5) for ``seconds`` along ``path`` (``"line"``,
     ``"circle:R"``, ``"eight:R"``, either with ``"+entry:L"`` for a clothoid entry of L m onto
-    the loop, a CSV file, or a Course), starting in flight along +X from the origin.
+    the loop, the eight with ``"+turn:L"`` for a clothoid pair of L m between its loops, a CSV
+    file, or a Course), starting in flight along +X from the origin.
     ``cloth="pants"`` dresses the runner in cloth driven by the body (with
     ``cloth_feedback`` its forces act back on the body). ``push`` is ``(time s, impulse N s,
     direction rad relative to the runner's heading)`` on the chest over 0.1 s. ``on_tick`` is

@@ -33,7 +33,9 @@ def register_run(inner: argparse._SubParsersAction) -> None:  # type: ignore[typ
     p.add_argument("--path", default="line",
                    help="line, circle:R (radius m), eight:R (figure eight) or FILE.csv of x,y "
                         "points (m); a loop with +entry:L (e.g. circle:10+entry:10) is entered "
-                        "along a clothoid of L m (0-100), scored from the loop's start")  # fmt: skip
+                        "along a clothoid of L m (0-100), scored from the loop's start; an "
+                        "eight with +turn:L (e.g. eight:10+turn:10) joins its loops by a "
+                        "clothoid pair of L m (0-2R)")  # fmt: skip
     p.add_argument("--cloth", choices=sorted(CLOTHES), help="dress the runner (cloth driven by "
                    "the body; it does not act on the runner unless --cloth-feedback)")  # fmt: skip
     p.add_argument("--cloth-feedback", action="store_true",

@@ -210,6 +210,83 @@ def test_loop_with_entry_checks_its_inputs() -> None:
         loop_with_entry("spiral", 10.0, 5.0)
 
 
+@pytest.mark.parametrize(("r", "length"), [(10.0, 5.0), (10.0, 20.0), (12.5, 10.0), (20.0, 40.0)])
+def test_a_reversal_joins_the_eights_loops_by_a_clothoid_pair(r: float, length: float) -> None:
+    """``eight:R+turn:L``: the lap closes on itself tangent to its start, its curvature is
+    continuous everywhere (no corner), +-1/R on the arcs and
+    ramped linearly +1/R -> -1/R over L at each reversal; the runner starts on the first
+    circle, heading +X, as on the eight without."""
+    eight = parse_course(f"eight:{r:g}+turn:{length:g}")
+    assert isinstance(eight, Polyline) and eight.closed
+    pts = eight.points  # closed: the last point is the first
+    assert np.array_equal(pts[0], [0.0, 0.0]) and np.array_equal(pts[-1], pts[0])
+    # the headings and curvature round the lap and across its closing point
+    heading, curv = _curvature(np.vstack([pts, pts[1:3]]))
+    assert heading[0] == pytest.approx(0.0, abs=2 * math.pi / 120)  # along +X
+    # tangent: no corner beyond the arc's own steps (the arc is the eight's first circle's
+    # points, its last step up to 1.5 of them)
+    assert np.abs(np.diff(heading)).max() < 1.3 * 2 * math.pi / 120
+    assert np.abs(curv).max() < 1.0 / r + 1e-3
+    # continuous: no step beyond the ramp's over its 0.25 m points (the chord estimate's
+    # 4/3 of it where they meet the arc's), where the eight without jumps by 2/R
+    assert np.abs(np.diff(curv)).max() < 1.5 * 0.25 * 2 / (r * length)
+    # the arcs are +-1/R, the two reversals ramps of slope -+2 / (R L) over L
+    s, k = eight.cum[1:-1], curv[: len(pts) - 2]  # the inner points' arc lengths
+    arc = np.abs(k) > (1 - 1e-3) / r
+    assert np.allclose(np.abs(k[arc]), 1.0 / r, rtol=1e-3)
+    for sign, part in ((-1.0, s < eight.total / 2), (1.0, s > eight.total / 2)):
+        assert np.ptp(s[~arc & part]) == pytest.approx(length, abs=0.6)
+        sel = (np.abs(k) < 0.9 / r) & part
+        assert np.polyfit(s[sel], k[sel], 1)[0] == pytest.approx(sign * 2 / (r * length), rel=0.02)
+    # with an entry the same lap follows the entry's ramp
+    entered = parse_course(f"eight:{r:g}+entry:10+turn:{length:g}")
+    assert isinstance(entered, EntryPath)
+    join = int(np.abs(entered.cum - 10.0).argmin())
+    lap = entered.points[join : join + len(pts) - 1] - entered.points[join]
+    turn = 10.0 / (2 * r)
+    c, s_ = math.cos(-turn), math.sin(-turn)
+    assert np.allclose(lap @ np.array([[c, -s_], [s_, c]]).T, pts[:-1], atol=1e-9)
+    _, ecurv = _curvature(entered.points[: join + 2 * len(pts)])
+    assert np.abs(np.diff(ecurv)).max() < 0.02
+
+
+def test_no_reversal_is_the_eight_as_before() -> None:
+    for spec, kw in (("eight:10+turn:0", {}), ("eight:10", {"reversal": 0.0})):
+        e = parse_course(spec, **kw)
+        assert isinstance(e, Polyline) and np.array_equal(e.points, figure_eight(10.0).points)
+    a, b = parse_course("eight:10+entry:20"), parse_course("eight:10+entry:20+turn:0")
+    assert isinstance(a, EntryPath) and isinstance(b, EntryPath)
+    assert np.array_equal(a.points, b.points)
+
+
+@pytest.mark.parametrize(
+    ("spec", "reversal", "message"),
+    [
+        ("eight:10", -1.0, r"reversal must be within \[0, 2R\] m"),
+        ("eight:10", math.nan, "reversal must be within"),
+        ("eight:10+turn:inf", 0.0, "reversal must be within"),
+        ("eight:10+turn:20.5", 0.0, r"reversal must be within \(0, 20\] m"),
+        ("eight:10+turn:far", 0.0, "turn:L needs a length"),
+        ("circle:10+turn:5", 0.0, "reversal is for 'eight:R'"),
+        ("circle:10+entry:5", 5.0, "reversal is for 'eight:R'"),
+        ("line", 5.0, "reversal is for 'eight:R'"),
+        ("p.csv", 5.0, "reversal is for 'eight:R'"),
+    ],
+)
+def test_a_bad_reversal_is_refused(spec: str, reversal: float, message: str) -> None:
+    with pytest.raises(ConfigError, match=message):
+        parse_course(spec, reversal=reversal)
+
+
+def test_the_eights_builders_check_the_reversal() -> None:
+    with pytest.raises(ConfigError, match=r"reversal must be within \(0, 50\] m"):
+        figure_eight(25.0, reversal=-2.0)
+    with pytest.raises(ConfigError, match="reversal is for 'eight' loops"):
+        loop_with_entry("circle", 10.0, 5.0, reversal=5.0)
+    with pytest.raises(ConfigError, match=r"reversal must be within \(0, 20\] m"):
+        loop_with_entry("eight", 10.0, 5.0, reversal=30.0)
+
+
 def test_facing_turns_at_a_limited_rate() -> None:
     f = Facing([(0.0, 0.0), (1.0, math.pi / 2)], rate=0.5)
     assert f.steer(np.zeros(2), 0.5)[0] == 0.0

@@ -1,7 +1,8 @@
 """The opt-ins for 20 m loops at 4-5 m/s (``docs/athletics.md``, "The 20 m loops at 4-5 m/s
 traced"): the foot placement's sideways reach (``lateral_reach``) and the speed correction's
 step measured along its own chord on curves (``step_chord``); and a 10 m loop entered along a
-clothoid ("The 10 m loops at 3.5-5 m/s entered along a clothoid")."""
+clothoid ("The 10 m loops at 3.5-5 m/s entered along a clothoid"); an eight whose loops are
+joined by a clothoid pair ("The figure eight's reversal along a clothoid pair")."""
 
 from __future__ import annotations
 
@@ -83,3 +84,29 @@ def test_a_clothoid_entry_carries_the_runner_past_the_10_m_circles_start_at_3_5_
     assert r["figures_from_s"] < r["loop_from_s"]
     loop = np.sqrt(np.mean(cross[t >= r["loop_from_s"]] ** 2))
     assert r["path_error_m"] == pytest.approx(loop)
+
+
+def _facing_flip(run: Any) -> tuple[float, float]:
+    """When the desired facing's rate (over 0.5 s) was last above +0.15 rad/s before it first
+    fell below -0.15 after 5 s, and that first time: the first reversal's flip."""
+    t, h = run.log["t"], np.unwrap(run.log["desired_heading"])
+    w = int(round(0.25 / float(np.median(np.diff(t)))))
+    rate, tr = (h[2 * w :] - h[: -2 * w]) / (t[2 * w :] - t[: -2 * w]), t[w:-w]
+    neg = int(np.nonzero((rate < -0.15) & (tr > 5.0))[0][0])
+    pos = int(np.nonzero((rate > 0.15) & (tr > 5.0) & (tr < tr[neg]))[0][-1])
+    return float(tr[pos]), float(tr[neg])
+
+
+def test_a_reversal_clothoid_spreads_the_eights_facing_flip_and_leaves_the_loop_alone() -> None:
+    # eight:10 at 2.5 m/s: the facing's rate flips from +0.15 to -0.15 rad/s in 0.53 s at the
+    # first reversal (26.6 s); with a 10 m clothoid pair there in 1.84 s (24.0-25.8 s), and
+    # the run is the same to the bit until the path ahead reaches the pair (21.1 s)
+    plain, turned = (run_course(2.5, seconds=27.5, path=p, fps=10.0)
+                     for p in ("eight:10", "eight:10+turn:10"))  # fmt: skip
+    assert not plain.report["fell"] and not turned.report["fell"]
+    early = plain.log["t"] < 20.0
+    assert np.array_equal(plain.log["com"][early], turned.log["com"][early])
+    assert not np.array_equal(plain.log["com"], turned.log["com"][: len(plain.log["com"])])
+    (a0, a1), (b0, b1) = _facing_flip(plain), _facing_flip(turned)
+    assert a1 - a0 < 0.8 and b1 - b0 > 1.4
+    assert b1 < a1  # the pair starts the turn back earlier, where the arc ends
