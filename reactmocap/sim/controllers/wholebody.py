@@ -618,6 +618,7 @@ class WholeBodyTracker(AnchoredReference):
         # ``rear_share``'s force (N) and whether a back push has armed it
         self._rear_n = float(rear_share) * self._mass * float(-m.opt.gravity[2])
         self._rear_armed = False
+        self._rear_seen = False
         self._soft = float(step_soft)
         self._soft_reg = float(np.sqrt(step_soft_reg))
         self._dt_tick = self.control_every * world.timestep
@@ -880,6 +881,9 @@ class WholeBodyTracker(AnchoredReference):
                 beta = self._nnls(lhs, rhs)
                 if self._rear_armed and planted.all() and len(sup.feet) == 2:
                     beta = self._rear_floor(sup, beta, lhs, rhs)
+                    self._rear_seen = True
+                elif self._rear_seen and not planted.all():
+                    self._rear_armed = False  # the first double support only
                 e0 = e0 + vb @ beta
             z, _ = dpotrs(chol, e0, lower=1)
             y = a - ud.T @ z
@@ -1146,6 +1150,7 @@ class WholeBodyTracker(AnchoredReference):
         self.reset_ground(world)
         self._pushed, self._back_from, self._hip_from = False, -np.inf, -np.inf
         self._rear_armed = False
+        self._rear_seen = False
         self._holding = False
         if self._stiffness != 1.0:
             self.stiffen_joints(1.0)
