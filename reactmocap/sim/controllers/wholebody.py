@@ -301,11 +301,6 @@ class WholeBodyTracker(AnchoredReference):
             toe-down pitch is past this (rad; 0: off): it stands on the balls of its feet on
             purpose, which the box foot's toe edge cannot do; every rule per foot and tick
             tried still felled such a clip (``docs/tracking.md``, issue 16).
-        rear_share: after a walk's push within 60 deg of straight back, the rear foot (along
-            the sole heading) of the clip's double support is asked at least this fraction of
-            the body's weight (a row on the ground forces at the no-slip weight; 0: off): the
-            plan put the weight on the front foot as it landed and the unloaded rear foot rose
-            (``docs/tracking.md``, issue 16).
         servo_kv: the servo's damping (1/s).
         hold_balance: once the simulated capture point leaves the feet on the floor (a hit
             the ankles cannot take), the pelvis and leg rows keep their gains for the rest of
@@ -401,7 +396,6 @@ class WholeBodyTracker(AnchoredReference):
         flat_weight: float = 0.0,
         flat_band: float = 0.07,
         flat_toe: float = 0.0,
-        rear_share: float = 0.0,
         servo_kv: float,
         control_every: int,
     ) -> None:
@@ -440,7 +434,6 @@ class WholeBodyTracker(AnchoredReference):
                 "step_ahead_servo": step_ahead_servo,
                 "kv_root": kv_root, "kv_rot": kv_rot, "kv_joint": kv_joint, "hold_balance": hold_balance,
                 "flat_weight": flat_weight, "flat_band": flat_band, "flat_toe": flat_toe,
-                "rear_share": rear_share,
             },
         )  # fmt: skip
         if not 0.0 < hip_free <= 1.0 or (hip_weight and not (hip_back and hip_tilt)):
@@ -494,11 +487,6 @@ class WholeBodyTracker(AnchoredReference):
             raise ConfigError(
                 f"flat_toe ({flat_toe!r}) is a toe-down pitch in (0, pi/2) rad past which "
                 f"a clip gets no flat_weight rows: it needs flat_weight > 0"
-            )
-        if not 0.0 <= rear_share <= 0.5:
-            raise ConfigError(
-                f"rear_share must be 0 (off) or a fraction of the body's weight in (0, 0.5], "
-                f"got {rear_share!r}"
             )
         servo = world.servo
         m = world.model
@@ -615,10 +603,6 @@ class WholeBodyTracker(AnchoredReference):
         if flat_toe and self._toe_pitch() > np.sin(flat_toe):
             self._flat_w = 0.0  # a clip on the balls of its feet: no flat rows
         self._flat_cos = float(np.cos(flat_band))
-        # ``rear_share``'s force (N) and whether a back push has armed it
-        self._rear_n = float(rear_share) * self._mass * float(-m.opt.gravity[2])
-        self._rear_armed = False
-        self._rear_seen = False
         self._soft = float(step_soft)
         self._soft_reg = float(np.sqrt(step_soft_reg))
         self._dt_tick = self.control_every * world.timestep
@@ -879,11 +863,6 @@ class WholeBodyTracker(AnchoredReference):
                 rhs = np.zeros(len(lhs))
                 rhs[: len(mt)] = -x[:, nb]
                 beta = self._nnls(lhs, rhs)
-                if self._rear_armed and planted.all() and len(sup.feet) == 2:
-                    beta = self._rear_floor(sup, beta, lhs, rhs)
-                    self._rear_seen = True
-                elif self._rear_seen and not planted.all():
-                    self._rear_armed = False  # the first double support only
                 e0 = e0 + vb @ beta
             z, _ = dpotrs(chol, e0, lower=1)
             y = a - ud.T @ z
@@ -897,24 +876,6 @@ class WholeBodyTracker(AnchoredReference):
             qacc=qdd, torques=tau.reshape(NJ, 3), support=sup.feet, points=sup.points,
             forces=forces, desired_qacc=acc_des, generalized_contact=qb @ beta,
         )  # fmt: skip
-
-    def _rear_floor(self, sup: _Support, beta: F64, lhs: F64, rhs: F64) -> F64:
-        """``rear_share``: the ground forces re-solved with the rear foot's vertical force
-        pulled to ``rear_share`` of the weight when the plan asked it for less."""
-        c = self._sole_centres()
-        h = self.sole_heading()
-        rear = int((c[1, :2] - c[0, :2]) @ (np.cos(h), np.sin(h)) < 0.0)
-        # the rear foot's points: a patch has 5, corners 3 no-slip rows each
-        npts = [5 if n % 3 else n // 3 for n in sup.nrows]
-        k0 = npts[0] if sup.feet.index(rear) else 0
-        mine = (sup.owner >= k0) & (sup.owner < k0 + npts[sup.feet.index(rear)])
-        up = np.where(mine, sup.basis[:, 2], 0.0)
-        if float(up @ beta) >= self._rear_n:
-            return beta
-        w = self.sqrt_wc / self._mass
-        a = np.vstack([lhs, w * up])
-        b = np.append(rhs, w * self._rear_n)
-        return nnls(a, b, maxiter=50 * len(beta))[0]
 
     def _flat_feet(self, planted: NDArray[np.bool_], t: float) -> dict[int, F64]:
         """``flat_weight``: the planted feet on at most two sole corners whose sole is more than
@@ -968,7 +929,7 @@ class WholeBodyTracker(AnchoredReference):
         pushed gets the softer pelvis servo (``kp_root_pushed``)."""
         if not ((self._w_trunk and self._give) or self._w_hip or self.warp_gain
                 or self._step_pushed or self.place_pushed or self.anchor_lag
-                or self.step_ahead or self._rear_n):  # fmt: skip
+                or self.step_ahead):  # fmt: skip
             return self._w_trunk
         # into a buffer: this runs every control tick
         np.take(self.world.data.xfrc_applied, self.wc.body_ids, axis=0, out=self._xfrc)
@@ -999,7 +960,6 @@ class WholeBodyTracker(AnchoredReference):
             # push the clip played faster (``warp_gain``) and after a sideways one the placed
             # foot (``place_pushed``) caught what a step from double support lost
             self._ahead_armed = self.step_ahead > 0 and ahead <= -0.5 * np.hypot(f[0], f[1])
-            self._rear_armed = self._rear_n > 0 and ahead <= -0.5 * np.hypot(f[0], f[1])
             if self._kp_root_pushed:
                 # a softer pelvis servo lets its steps catch it
                 kp = self._kp_root_pushed
@@ -1134,23 +1094,19 @@ class WholeBodyTracker(AnchoredReference):
 
     def memory(self) -> tuple[object, ...]:
         return (*super().memory(), self._hip_from, self._pushed, self._back_from,
-                self.kp[:3].copy(), self.kv[:3].copy(), self._holding, self._scale,
-                self._rear_armed)  # fmt: skip
+                self.kp[:3].copy(), self.kv[:3].copy(), self._holding, self._scale)  # fmt: skip
 
     def restore(self, memory: tuple[object, ...]) -> None:
-        super().restore(memory[:-8])
-        self._hip_from = float(memory[-8])  # type: ignore[arg-type]
-        self._pushed = bool(memory[-7])
-        self._back_from = float(memory[-6])  # type: ignore[arg-type]
-        self.kp[:3], self.kv[:3] = memory[-5], memory[-4]
-        self._holding, self._scale = bool(memory[-3]), float(memory[-2])  # type: ignore[arg-type]
-        self._rear_armed = bool(memory[-1])
+        super().restore(memory[:-7])
+        self._hip_from = float(memory[-7])  # type: ignore[arg-type]
+        self._pushed = bool(memory[-6])
+        self._back_from = float(memory[-5])  # type: ignore[arg-type]
+        self.kp[:3], self.kv[:3] = memory[-4], memory[-3]
+        self._holding, self._scale = bool(memory[-2]), float(memory[-1])  # type: ignore[arg-type]
 
     def reset(self, world: World) -> None:
         self.reset_ground(world)
         self._pushed, self._back_from, self._hip_from = False, -np.inf, -np.inf
-        self._rear_armed = False
-        self._rear_seen = False
         self._holding = False
         if self._stiffness != 1.0:
             self.stiffen_joints(1.0)
