@@ -297,11 +297,6 @@ class LandingParams:
             handspring the held starts that fell stood on one foot while that offset flexed
             the hip up to its limit and pitched the pelvis forward past its target
             (docs/athletics.md, "the balance's hip offset zeroed after a held absorb").
-        held_hip_below: ``(gate,)``: ``held_hip_share`` applied only if the COM's speed
-            forward along the feet (m/s, the pelvis's heading) at the absorb's hand-over is
-            below ``gate`` in [-1, 1]; else the full offset kept; () off. Why: one held start
-            that landed with the offset moved off forward without it and fell
-            (docs/athletics.md, "held_hip_share chosen by the COM's forward speed").
     """
 
     knee: float = 0.6
@@ -353,7 +348,6 @@ class LandingParams:
     absorb_spin: tuple[float, ...] = ()
     hop_spin: tuple[float, ...] = ()
     held_hip_share: float = 1.0
-    held_hip_below: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         self.balance_step()  # checked here (ConfigError) though built per run
@@ -429,14 +423,6 @@ class LandingParams:
         if hs < 1.0 and not a:
             raise ConfigError(
                 "landing held_hip_share needs absorb_spin (it acts on its held starts)"
-            )
-        b = self.held_hip_below
-        if b and not (
-            len(b) == 1 and isinstance(b[0], (int, float)) and -1.0 <= b[0] <= 1.0 and hs < 1.0
-        ):
-            raise ConfigError(
-                "landing held_hip_below must be (gate in [-1, 1] m/s,) with held_hip_share "
-                f"below 1, got {b!r}"
             )
         if not 0.0 < self.turn_window <= 1.0:
             raise ConfigError(f"landing turn_window must be in (0, 1] s, got {self.turn_window!r}")
@@ -775,10 +761,6 @@ class Landing(Basis):
 
         def recover_enter(world: World, t: float) -> None:
             del world
-            if memo.get("held") and p.held_hip_below:  # too fast forward: the offset kept
-                s = ctx.sense(t)
-                if float(s.local(s.com_vel, s.heading())[0]) >= p.held_hip_below[0]:
-                    memo["held"] = 0.0
             rig.support_scale = 1.0
             rig.support_dir = None
             rig.move(rig.current_angles(), 0.0, t, _KNEE)  # the knees stiffen where they are
