@@ -42,8 +42,10 @@ from typing import Any
 
 import numpy as np
 
+from reactmocap.errors import ConfigError
 from reactmocap.io import atomic_write, atomic_write_text
 from reactmocap.library.motion import Motion
+from reactmocap.sim.controllers.registry import controller_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT / ".." / "shared" / "mocap" / "bandai-namco-1"
@@ -288,6 +290,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="earlier --json outputs drawn in the same plot")  # fmt: skip
     ap.add_argument("--plot-only", action="store_true", help="plot --overlay files only")
     args = ap.parse_args(argv)
+    try:  # here, not in a worker's traceback
+        controller_spec("wholebody").params(json.loads(args.params))
+    except (json.JSONDecodeError, ConfigError) as e:
+        ap.error(f"--params: {e}")
     if not SHARED.is_dir():
         print(f"(no shared clips under {SHARED.resolve()}: nothing to measure)")
         return 0

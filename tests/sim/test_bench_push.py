@@ -1,4 +1,5 @@
-"""``benchmarks/bench_push.py`` on a clip that falls unpushed: recorded, not a crash."""
+"""``benchmarks/bench_push.py``: a clip that falls unpushed is recorded, not a crash; bad ``--params``
+are refused before any run."""
 
 from __future__ import annotations
 
@@ -6,6 +7,8 @@ import json
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
+
+import pytest
 
 
 def test_the_push_benchmark_records_a_clip_that_falls_unpushed(
@@ -22,3 +25,14 @@ def test_the_push_benchmark_records_a_clip_that_falls_unpushed(
     row = json.loads(out.read_text())["standing"]
     assert row["falls_unpushed"] is True and row["clip"] == "bye_normal_001"
     assert "survived" not in row and "max_force_n" not in row
+
+
+def test_the_push_benchmark_refuses_bad_params_before_running(
+    load_bench: Callable[[str], ModuleType], capsys: pytest.CaptureFixture[str]
+) -> None:
+    bench = load_bench("bench_push")
+    for bad, says in (('{"nope": 1}', "no parameter 'nope'"), ("{nope", "--params")):
+        with pytest.raises(SystemExit) as exit_:
+            bench.main(["--params", bad])
+        assert exit_.value.code == 2
+        assert says in capsys.readouterr().err
