@@ -330,13 +330,14 @@ def figure_eight(radius: float, start: ArrayLike = (0.0, 0.0), heading: float = 
     return Polyline(pts @ rot.T + np.asarray(start, dtype=np.float64)[:2], closed=True)
 
 
-def _eight_lobe(radius: float, reversal: float, per_circle: int) -> tuple[F64, float]:
+def _eight_lobe(radius: float, reversal: float, per_circle: int) -> tuple[F64, float, int]:
     """An eight's anticlockwise lobe whose ends are halves of a ``reversal`` m clothoid pair:
     points from the crossing at the origin (curvature 0, heading ``alpha``) over a clothoid of
     ``reversal / 2`` (curvature 0 -> 1/R), an arc of ``radius`` and the mirror clothoid back to
     the origin (heading ``-alpha``; the origin itself left off). ``alpha`` puts the arc's centre
     on the Y axis, so the lobe is symmetric about it and closes; the clockwise lobe is its
-    mirror in X. Returns the points ``(N, 2)`` and ``alpha`` (rad)."""
+    mirror in X. Returns the points ``(N, 2)``, the heading where the arc starts (``alpha``
+    plus the half's turn, rad) and the ramp's point count (the crossing's and the arc's start)."""
     if not (math.isfinite(reversal) and 0 < reversal <= 2 * radius):
         raise ConfigError(
             f"reversal must be within (0, {2 * radius:g}] m (twice the radius), got {reversal!r}"
@@ -355,7 +356,7 @@ def _eight_lobe(radius: float, reversal: float, per_circle: int) -> tuple[F64, f
     phi = beta - 0.5 * math.pi + np.linspace(0.0, sweep, n + 1)[1:-1]
     arc = centre + radius * np.column_stack([np.cos(phi), np.sin(phi)])
     back = ramp[::-1] * [-1.0, 1.0]
-    return np.vstack([ramp, arc, back[:-1]]), alpha
+    return np.vstack([ramp, arc, back[:-1]]), beta, len(ramp)
 
 
 def _reversal_lap(radius: float, reversal: float, per_circle: int) -> F64:
@@ -363,9 +364,7 @@ def _reversal_lap(radius: float, reversal: float, per_circle: int) -> F64:
     lobe's arc does (curvature 1/R), at the origin heading +X. The arc's points are
     :func:`figure_eight`'s first circle's own, so a run on it is the eight's without a reversal
     to the bit until the path ahead reaches the first reversal."""
-    lobe, alpha = _eight_lobe(radius, reversal, per_circle)
-    n = len(clothoid(0.5 * reversal, radius))  # the ramp's points, the crossing's and Q's
-    beta = alpha + 0.25 * reversal / radius
+    lobe, beta, n = _eight_lobe(radius, reversal, per_circle)
     sweep = 2 * math.pi - 2 * beta
     th = np.linspace(0.0, 2 * np.pi, per_circle, endpoint=False)
     th = th[th < sweep - np.pi / per_circle]  # no step shorter than half the arc's
